@@ -1,0 +1,338 @@
+// dyad/component.hpp — the component API: everything a plugin author compiles against.
+//
+// A component is one node of an experiment graph: it declares typed inputs and outputs and
+// parameters, and the runtime steps it either periodically (`rate_hz:` in the graph) or when a
+// chosen input receives a sample (`trigger: <input>`). Components never talk to each other
+// directly: every input and output is bound by the graph file to a DDS topic.
+//
+// Lifecycle (each call happens once, on the thread that will step the component):
+//   construct -> Configure(ctx) -> Activate() -> Step(info)* -> Deactivate() -> Shutdown()
+//   - Configure: read params, look up ports; the component is then "inactive". An error stops
+//     the whole process before any component is activated.
+//   - Activate: start talking to hardware, open files; then "active": Step() is called.
+//   - Step: inputs have been polled just before; publish outputs. A non-OK Status stops the run
+//     (all components are deactivated and shut down) and the process exits non-zero.
+//   - Deactivate: stop motion, flush; back to "inactive". Called even after a failed Step().
+//   - Shutdown: release everything. Called for every configured component.
+// The runtime calls these from one thread per component in wall-clock mode, and from a single
+// thread in stepped mode; a component needs no locks for its own state.
+//
+// Writing one (see components/examples/ for complete, tested ones):
+//
+//   class Doubler : public dyad::Component {
+//    public:
+//     static void Describe(dyad::ComponentSpec& spec) {
+//       spec.Summary("Publishes twice the input value.");
+//       spec.Param("factor", 2.0).Doc("multiplier");
+//       spec.Input<dyad::msg::Counter>("in");
+//       spec.Output<dyad::msg::Counter>("out");
+//     }
+//     dyad::Status Configure(dyad::Context& ctx) override {
+//       factor_ = ctx.params().Double("factor");
+//       in_ = &ctx.input<dyad::msg::Counter>("in");
+//       out_ = &ctx.output<dyad::msg::Counter>("out");
+//       return dyad::Status::OK();
+//     }
+//     dyad::Status Step(const dyad::StepInfo&) override {
+//       for (const auto& s : in_->received()) {
+//         dyad::msg::Counter c; c.value(static_cast<int64_t>(factor_ * s.value()));
+//         if (auto st = out_->Publish(c); !st.ok()) return st;
+//       }
+//       return dyad::Status::OK();
+//     }
+//    private:
+//     double factor_ = 2;
+//     dyad::Input<dyad::msg::Counter>* in_ = nullptr;    // owned by the runtime
+//     dyad::Output<dyad::msg::Counter>* out_ = nullptr;  // owned by the runtime
+//   };
+//   DYAD_PLUGIN(registry) { registry.Add<Doubler>("doubler"); }
+//
+// Build it as a shared library linking `dyad::runtime` (find_package(dyad)), put it where the
+// graph's `plugins:` list or DYAD_PLUGIN_PATH points, and name `type: doubler` in a graph.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <dyad/message_traits.hpp>
+#include <dyad/params.hpp>
+#include <dyad/status.hpp>
+
+namespace dyad {
+
+// Bump when anything in this header changes layout or meaning; plugins built against another
+// version are refused at load time with a message naming both versions.
+inline constexpr uint32_t kPluginAbiVersion = 1;
+
+// The runtime clock: wall time (ns since the Unix epoch) in `clock: wall` graphs, simulated time
+// (ns since start) in `clock: stepped` graphs. Thread-safe.
+class Clock {
+ public:
+  virtual ~Clock() = default;
+  virtual int64_t now_ns() const = 0;
+};
+
+// Thread-safe; each line is prefixed with the component's name.
+class Logger {
+ public:
+  enum class Level { kDebug, kInfo, kWarn, kError };
+  virtual ~Logger() = default;
+  virtual void Write(Level level, std::string_view message) = 0;
+  void Debug(std::string_view m) { Write(Level::kDebug, m); }
+  void Info(std::string_view m) { Write(Level::kInfo, m); }
+  void Warn(std::string_view m) { Write(Level::kWarn, m); }
+  void Error(std::string_view m) { Write(Level::kError, m); }
+};
+
+namespace detail {
+// Implemented by the runtime's transport; ports forward to it. Not for component code.
+class ReaderEndpoint {
+ public:
+  virtual ~ReaderEndpoint() = default;
+  // Deserialises the next unread sample into *sample (a T); false when none is left.
+  virtual bool TakeNext(void* sample) = 0;
+};
+class WriterEndpoint {
+ public:
+  virtual ~WriterEndpoint() = default;
+  virtual Status Write(const void* sample) = 0;
+};
+}  // namespace detail
+
+// An input port. The runtime polls it just before each Step(); between steps it does not change.
+class InputBase {
+ public:
+  virtual ~InputBase() = default;
+  const std::string& name() const { return name_; }
+  const std::string& topic() const { return topic_; }  // empty when the graph leaves it unbound
+  bool bound() const { return endpoint_ != nullptr; }
+  // Clock time of the newest sample's arrival; -1 before the first.
+  int64_t last_receive_ns() const { return last_receive_ns_; }
+  // Samples received in the last poll.
+  size_t new_count() const { return new_count_; }
+
+  // Runtime use only.
+  void Bind(std::string name, std::string topic, detail::ReaderEndpoint* endpoint) {
+    name_ = std::move(name); topic_ = std::move(topic); endpoint_ = endpoint;
+  }
+  virtual size_t Poll(int64_t now_ns) = 0;
+
+ protected:
+  std::string name_, topic_;
+  detail::ReaderEndpoint* endpoint_ = nullptr;  // owned by the runtime; null when unbound
+  int64_t last_receive_ns_ = -1;
+  size_t new_count_ = 0;
+};
+
+template <class T>
+class Input final : public InputBase {
+ public:
+  // Samples received since the previous step, oldest first (at most the topic's history depth).
+  const std::vector<T>& received() const { return received_; }
+  // The newest sample ever received; nullptr before the first.
+  const T* latest() const { return has_latest_ ? &latest_ : nullptr; }
+
+  size_t Poll(int64_t now_ns) override {
+    received_.clear();
+    if (endpoint_ == nullptr) return 0;
+    while (endpoint_->TakeNext(&scratch_)) received_.push_back(scratch_);
+    new_count_ = received_.size();
+    if (!received_.empty()) {
+      latest_ = received_.back();
+      has_latest_ = true;
+      last_receive_ns_ = now_ns;
+    }
+    return new_count_;
+  }
+
+ private:
+  std::vector<T> received_;
+  T latest_{}, scratch_{};
+  bool has_latest_ = false;
+};
+
+class OutputBase {
+ public:
+  virtual ~OutputBase() = default;
+  const std::string& name() const { return name_; }
+  const std::string& topic() const { return topic_; }
+  bool bound() const { return endpoint_ != nullptr; }
+  uint64_t published() const { return sequence_; }
+
+  // Runtime use only.
+  void Bind(std::string name, std::string topic, std::string source, detail::WriterEndpoint* endpoint,
+            const Clock* clock) {
+    name_ = std::move(name); topic_ = std::move(topic); source_ = std::move(source);
+    endpoint_ = endpoint; clock_ = clock;
+  }
+
+ protected:
+  std::string name_, topic_, source_;
+  detail::WriterEndpoint* endpoint_ = nullptr;  // owned by the runtime; null when unbound
+  const Clock* clock_ = nullptr;                // owned by the runtime
+  uint64_t sequence_ = 0;
+};
+
+template <class T>
+class Output final : public OutputBase {
+ public:
+  // Fills sample.header() (source, next sequence number, clock stamp) and publishes it.
+  // Unbound outputs accept and drop samples.
+  Status Publish(T& sample) {
+    auto& h = sample.header();
+    h.source(source_);
+    h.sequence_number(++sequence_);
+    h.stamp_ns(clock_ ? clock_->now_ns() : 0);
+    if (endpoint_ == nullptr) return Status::OK();
+    return endpoint_->Write(&sample);
+  }
+};
+
+// A port as declared by Describe().
+struct PortSpec {
+  std::string name;
+  const TypeInfo* type = nullptr;  // static storage
+  std::string doc;
+  bool optional = false;  // inputs: may be left unbound in the graph
+  std::function<std::unique_ptr<InputBase>()> make_input;
+  std::function<std::unique_ptr<OutputBase>()> make_output;
+
+  PortSpec& Doc(std::string d) { doc = std::move(d); return *this; }
+  PortSpec& Optional() { optional = true; return *this; }
+};
+
+// What a component type declares about itself: filled by its static Describe(spec).
+class ComponentSpec {
+ public:
+  ComponentSpec& Summary(std::string s) { summary_ = std::move(s); return *this; }
+
+  // A parameter with a default; its type follows the default's C++ type.
+  ParamSpec& Param(std::string name, double default_value) { return AddParam(std::move(name), ParamType::kDouble, default_value); }
+  ParamSpec& Param(std::string name, int default_value) { return AddParam(std::move(name), ParamType::kInt, int64_t{default_value}); }
+  ParamSpec& Param(std::string name, int64_t default_value) { return AddParam(std::move(name), ParamType::kInt, default_value); }
+  ParamSpec& Param(std::string name, bool default_value) { return AddParam(std::move(name), ParamType::kBool, default_value); }
+  ParamSpec& Param(std::string name, const char* default_value) { return AddParam(std::move(name), ParamType::kString, std::string(default_value)); }
+  ParamSpec& Param(std::string name, std::string default_value) { return AddParam(std::move(name), ParamType::kString, std::move(default_value)); }
+  ParamSpec& Param(std::string name, std::vector<double> default_value) { return AddParam(std::move(name), ParamType::kDoubleList, std::move(default_value)); }
+  ParamSpec& Param(std::string name, std::vector<std::string> default_value) { return AddParam(std::move(name), ParamType::kStringList, std::move(default_value)); }
+  // A parameter the graph must set.
+  ParamSpec& RequiredParam(std::string name, ParamType type);
+  // A kYaml parameter (structured values the component parses itself); default is YAML text.
+  ParamSpec& YamlParam(std::string name, std::string default_yaml);
+
+  template <class T>
+  PortSpec& Input(std::string name) {
+    PortSpec& p = AddPort(inputs_, std::move(name), &TypeInfoOf<T>());
+    p.make_input = [] { return std::unique_ptr<InputBase>(new dyad::Input<T>()); };
+    return p;
+  }
+  template <class T>
+  PortSpec& Output(std::string name) {
+    PortSpec& p = AddPort(outputs_, std::move(name), &TypeInfoOf<T>());
+    p.make_output = [] { return std::unique_ptr<OutputBase>(new dyad::Output<T>()); };
+    return p;
+  }
+
+  const std::string& summary() const { return summary_; }
+  const std::vector<ParamSpec>& params() const { return params_; }
+  const std::vector<PortSpec>& inputs() const { return inputs_; }
+  const std::vector<PortSpec>& outputs() const { return outputs_; }
+  const ParamSpec* FindParam(std::string_view name) const;
+  const PortSpec* FindInput(std::string_view name) const;
+  const PortSpec* FindOutput(std::string_view name) const;
+
+ private:
+  ParamSpec& AddParam(std::string name, ParamType type, std::optional<ParamValue> default_value);
+  PortSpec& AddPort(std::vector<PortSpec>& ports, std::string name, const TypeInfo* type);
+  std::string summary_;
+  std::vector<ParamSpec> params_;
+  std::vector<PortSpec> inputs_, outputs_;
+};
+
+// What the runtime hands a component in Configure(). Valid until Shutdown() returns.
+class Context {
+ public:
+  virtual ~Context() = default;
+  virtual const std::string& name() const = 0;      // instance name in the graph
+  virtual const Params& params() const = 0;         // validated, defaults filled
+  virtual const Clock& clock() const = 0;
+  virtual Logger& log() = 0;
+  // The graph's seed mixed with the instance name: same graph + seed = same value.
+  virtual uint64_t seed() const = 0;
+  // Nominal period; 0 for triggered components.
+  virtual int64_t period_ns() const = 0;
+  // Ends the run cleanly after the current step (e.g. a replay reached its end).
+  virtual void RequestStop(std::string reason) = 0;
+
+  // The port declared under `name` with type T. Asking for an undeclared port or another type is
+  // a programming error: it aborts naming the component and port.
+  template <class T>
+  dyad::Input<T>& input(std::string_view name) { return *static_cast<dyad::Input<T>*>(FindInput(name, TypeInfoOf<T>())); }
+  template <class T>
+  dyad::Output<T>& output(std::string_view name) { return *static_cast<dyad::Output<T>*>(FindOutput(name, TypeInfoOf<T>())); }
+
+ protected:
+  virtual InputBase* FindInput(std::string_view name, const TypeInfo& type) = 0;
+  virtual OutputBase* FindOutput(std::string_view name, const TypeInfo& type) = 0;
+};
+
+struct StepInfo {
+  int64_t now_ns = 0;        // clock time at the start of this step
+  uint64_t index = 0;        // 0, 1, 2, ...
+  int64_t period_ns = 0;     // nominal; 0 when triggered
+};
+
+// Base class of every component. Non-copyable; the runtime owns instances.
+class Component {
+ public:
+  Component() = default;
+  Component(const Component&) = delete;
+  Component& operator=(const Component&) = delete;
+  virtual ~Component() = default;
+
+  virtual Status Configure(Context& ctx) = 0;
+  virtual Status Activate() { return Status::OK(); }
+  virtual Status Step(const StepInfo& info) = 0;
+  virtual Status Deactivate() { return Status::OK(); }
+  virtual void Shutdown() {}
+};
+
+// One component type: its registered name, its self-description and its factory.
+struct ComponentType {
+  std::string name;
+  void (*describe)(ComponentSpec&) = nullptr;
+  std::unique_ptr<Component> (*create)() = nullptr;
+  std::string plugin_path;  // filled by the loader
+};
+
+// Handed to a plugin's DYAD_PLUGIN body.
+class PluginRegistry {
+ public:
+  virtual ~PluginRegistry() = default;
+  virtual void AddType(ComponentType type) = 0;
+
+  // C must be default-constructible and have `static void Describe(ComponentSpec&)`.
+  template <class C>
+  void Add(std::string type_name) {
+    ComponentType t;
+    t.name = std::move(type_name);
+    t.describe = &C::Describe;
+    t.create = [] { return std::unique_ptr<Component>(new C()); };
+    AddType(std::move(t));
+  }
+};
+
+}  // namespace dyad
+
+// A plugin's one entry point: `DYAD_PLUGIN(registry) { registry.Add<MyComponent>("my_type"); }`.
+#define DYAD_PLUGIN(REGISTRY)                                                             \
+  extern "C" __attribute__((visibility("default"))) uint32_t dyad_plugin_abi_version() { \
+    return ::dyad::kPluginAbiVersion;                                                     \
+  }                                                                                       \
+  extern "C" __attribute__((visibility("default"))) void dyad_plugin_register(            \
+      ::dyad::PluginRegistry& REGISTRY)

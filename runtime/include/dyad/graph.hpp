@@ -1,0 +1,120 @@
+// dyad/graph.hpp — an experiment graph as read from YAML, before and after validation.
+//
+// File format (every key is checked; unknown keys are errors):
+//
+//   graph: demo                 # name, used in DDS participant names
+//   domain_id: 0                # DDS domain, 0..232
+//   clock: wall                 # wall | stepped
+//   seed: 1                     # stepped-mode determinism and component seeds
+//   plugins: [build/plugins]    # extra plugin files or folders, relative to this file
+//   processes:                  # optional; default: one process "main"
+//     main: {}
+//     robot: {host: robot-pc}   # host: where `dyad run` without --process starts it (default: here)
+//   topics:                     # optional per topic: type and QoS
+//     human/input: {type: HumanInput, reliability: reliable, depth: 1, deadline_ms: 200}
+//   components:
+//     human:
+//       type: synthetic_human   # a registered component type (`dyad types`)
+//       rate_hz: 10             # periodic; or `trigger: <input name>` to step on arrival
+//       process: main
+//       params: {noise: 0.5}
+//       inputs: {robot: robot/state}     # port name: topic
+//       outputs: {input: human/input}
+//
+// LoadGraph reads the file and applies `--set component.param=value` overrides;
+// ValidateGraph (validate.hpp) checks it against the component types. Both return every
+// problem found, each "file:line:col: key: message".
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+namespace dyad {
+
+// A position in a source file (1-based); line 0 means "not from a file" (command line).
+struct SourceMark {
+  std::string file;
+  int line = 0;
+  int column = 0;
+  std::string ToString() const;  // "file:line:col" or "file"
+};
+
+struct Diagnostic {
+  SourceMark mark;
+  std::string key;      // dotted path, e.g. "components.mixer.params.gain"
+  std::string message;
+  std::string ToString() const;  // "file:line:col: key: message"
+};
+
+enum class Reliability { kReliable, kBestEffort };
+enum class ClockMode { kWall, kStepped };
+
+struct TopicConfig {
+  std::string name;
+  std::string type;  // as written: "HumanInput" or "dyad::msg::HumanInput"; empty: from ports
+  Reliability reliability = Reliability::kReliable;
+  int depth = 1;             // KEEP_LAST history depth
+  double deadline_ms = 0;    // 0: none
+  SourceMark mark;
+  SourceMark type_mark;
+};
+
+struct ProcessConfig {
+  std::string name;
+  std::string host;  // empty: this machine
+  SourceMark mark;
+};
+
+struct PortBinding {
+  std::string port;
+  std::string topic;
+  SourceMark mark;
+};
+
+struct ComponentConfig {
+  std::string name;
+  std::string type;
+  std::string process;     // empty: the graph's only/default process
+  double rate_hz = 0;      // > 0: periodic
+  std::string trigger;     // input name: step when it receives
+  YAML::Node params;       // map as written (with overrides applied)
+  std::vector<PortBinding> inputs, outputs;
+  SourceMark mark, type_mark, rate_mark, trigger_mark, process_mark, params_mark;
+};
+
+struct Graph {
+  std::string file;  // path as given
+  std::string name = "dyad";
+  int domain_id = 0;
+  ClockMode clock = ClockMode::kWall;
+  uint64_t seed = 1;
+  std::vector<std::string> plugins;  // resolved against the file's folder
+  std::vector<ProcessConfig> processes;
+  std::vector<TopicConfig> topics;
+  std::vector<ComponentConfig> components;
+  std::string yaml_text;  // the file as read (recorded as metadata)
+
+  const ComponentConfig* FindComponent(const std::string& name) const;
+  const TopicConfig* FindTopic(const std::string& name) const;
+  // The process a component runs in ("main" when the graph lists none).
+  std::string ProcessOf(const ComponentConfig& c) const;
+};
+
+// `--set NAME.PARAM=VALUE`: VALUE is parsed as YAML.
+struct Override {
+  std::string text;  // as given, for messages
+};
+
+// Parses `path`. Structural problems (bad YAML, unknown keys, wrong scalar types, duplicates)
+// are appended to *diagnostics; the returned graph holds what could be read.
+Graph LoadGraph(const std::string& path, const std::vector<Override>& overrides,
+                std::vector<Diagnostic>* diagnostics);
+// Same, from text (tests); `path` is used in messages and to resolve plugin paths.
+Graph ParseGraph(const std::string& yaml_text, const std::string& path, const std::vector<Override>& overrides,
+                 std::vector<Diagnostic>* diagnostics);
+
+}  // namespace dyad

@@ -1,0 +1,44 @@
+// dyad/run.hpp — running a graph: what `dyad run` and `dyad validate` do.
+//
+// RunGraph loads the graph, loads plugins, validates (printing every problem and returning 2 if
+// there is any), then either
+//   - runs the components placed in `process` (one DDS participant for them), or
+//   - with no `process` given and components in several processes: starts one child
+//     `dyad run --process P` per process whose host is this machine (or unset), forwards
+//     SIGINT/SIGTERM to them and waits; the exit code is the worst child's.
+// It returns when the run ends: SIGINT/SIGTERM, `duration_s`, `steps`, a component's
+// RequestStop(), or a failed step. At exit it prints a timing table (per component: steps, step
+// duration mean/p99/max, start jitter, deadline misses) and publishes the same as
+// dyad::msg::ComponentStats on topic "dyad/stats" every `stats_period_s` while running.
+//
+// Exit codes: 0 clean end, 1 runtime failure (a component failed, DDS error, type mismatch with
+// a peer), 2 invalid graph or options.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include <dyad/graph.hpp>
+
+namespace dyad {
+
+struct RunOptions {
+  std::string graph_path;
+  std::vector<Override> overrides;
+  std::string process;             // empty: every process of the graph (see above)
+  double duration_s = 0;           // > 0: stop after this much wall time
+  uint64_t steps = 0;              // > 0: stop after the fastest periodic component ran this many steps
+  double stats_period_s = 1.0;     // ComponentStats publication period (wall time)
+  std::vector<std::string> plugin_paths;  // in addition to the graph's plugins:
+  bool quiet = false;              // no timing table
+};
+
+int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err);
+
+// Loads and validates only. Prints "<file>: OK (...)" or every problem; returns 0 or 2.
+int ValidateGraphFile(const std::string& path, const std::vector<Override>& overrides,
+                      const std::vector<std::string>& plugin_paths, std::ostream& out, std::ostream& err);
+
+}  // namespace dyad

@@ -1,0 +1,45 @@
+// dyad/validate.hpp — checks a graph against the available component types before anything runs.
+//
+// Reports every problem at once (file:line:col: key: message): unknown component types, unknown
+// or missing or mistyped or out-of-range params, unknown ports, inputs bound to a topic that no
+// component publishes, required inputs left unbound, topic type mismatches (between writer and
+// reader ports, and against the type declared under `topics:`), rates that are not positive, a
+// component with neither rate_hz nor trigger, processes that are not declared, stepped clock
+// across several processes.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <dyad/catalog.hpp>
+#include <dyad/graph.hpp>
+#include <dyad/params.hpp>
+
+namespace dyad {
+
+struct ResolvedComponent {
+  const ComponentConfig* config = nullptr;  // into the Graph
+  const CatalogEntry* entry = nullptr;      // into the Catalog
+  Params params;
+  int64_t period_ns = 0;  // 0: triggered
+};
+
+struct ResolvedTopic {
+  const TopicConfig* config = nullptr;  // null: not declared under topics:, defaults apply
+  const TypeInfo* type = nullptr;
+  std::string name;
+};
+
+struct ResolvedGraph {
+  std::vector<ResolvedComponent> components;   // graph order
+  std::map<std::string, ResolvedTopic> topics; // every topic some port binds
+};
+
+// Appends problems to *diagnostics; the result is complete only when none were added.
+ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vector<Diagnostic>* diagnostics);
+
+// Converts a YAML value to a param of `spec`'s type; on failure returns a message (no location).
+bool ParamFromYaml(const ParamSpec& spec, const YAML::Node& node, ParamValue* out, std::string* error);
+
+}  // namespace dyad

@@ -1,0 +1,62 @@
+// Out-of-line parts of the component API (compiled into the runtime library).
+#include "dyad/component.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+
+namespace dyad {
+
+std::string TypeInfo::short_name() const {
+  const auto pos = name.rfind("::");
+  return pos == std::string::npos ? name : name.substr(pos + 2);
+}
+
+ParamSpec& ComponentSpec::AddParam(std::string name, ParamType type, std::optional<ParamValue> default_value) {
+  if (FindParam(name) != nullptr) {
+    std::fprintf(stderr, "dyad: parameter '%s' declared twice\n", name.c_str());
+    std::abort();
+  }
+  ParamSpec p;
+  p.name = std::move(name);
+  p.type = type;
+  p.default_value = std::move(default_value);
+  params_.push_back(std::move(p));
+  return params_.back();
+}
+
+ParamSpec& ComponentSpec::RequiredParam(std::string name, ParamType type) { return AddParam(std::move(name), type, std::nullopt); }
+
+ParamSpec& ComponentSpec::YamlParam(std::string name, std::string default_yaml) {
+  return AddParam(std::move(name), ParamType::kYaml, std::move(default_yaml));
+}
+
+PortSpec& ComponentSpec::AddPort(std::vector<PortSpec>& ports, std::string name, const TypeInfo* type) {
+  for (const auto& p : ports)
+    if (p.name == name) {
+      std::fprintf(stderr, "dyad: port '%s' declared twice\n", name.c_str());
+      std::abort();
+    }
+  PortSpec p;
+  p.name = std::move(name);
+  p.type = type;
+  ports.push_back(std::move(p));
+  return ports.back();
+}
+
+const ParamSpec* ComponentSpec::FindParam(std::string_view name) const {
+  for (const auto& p : params_)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+const PortSpec* ComponentSpec::FindInput(std::string_view name) const {
+  for (const auto& p : inputs_)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+const PortSpec* ComponentSpec::FindOutput(std::string_view name) const {
+  for (const auto& p : outputs_)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+}  // namespace dyad

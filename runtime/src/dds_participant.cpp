@@ -1,0 +1,271 @@
+#include "dds_participant.hpp"
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/builtin/data/ParticipantProxyData.h>
+#include <fastdds/rtps/builtin/data/ReaderProxyData.h>
+#include <fastdds/rtps/builtin/data/WriterProxyData.h>
+
+#include <sstream>
+
+namespace fdds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+
+namespace dyad {
+namespace {
+
+std::string GuidPrefixString(const rtps::GuidPrefix_t& p) {
+  std::ostringstream os;
+  os << p;
+  return os.str();
+}
+
+std::string QosPolicyName(fdds::QosPolicyId_t id) {
+  switch (id) {
+    case fdds::RELIABILITY_QOS_POLICY_ID: return "reliability";
+    case fdds::DURABILITY_QOS_POLICY_ID: return "durability";
+    case fdds::DEADLINE_QOS_POLICY_ID: return "deadline";
+    case fdds::HISTORY_QOS_POLICY_ID: return "history";
+    default: return "policy " + std::to_string(static_cast<int>(id));
+  }
+}
+
+}  // namespace
+
+class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantListener {
+ public:
+  DiscoveryListener(DdsParticipant* owner, ProblemHandler on_problem) : owner_(owner), on_problem_(std::move(on_problem)) {}
+
+  void on_participant_discovery(fdds::DomainParticipant*, rtps::ParticipantDiscoveryInfo&& info) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    names_[GuidPrefixString(info.info.m_guid.guidPrefix)] = info.info.m_participantName.to_string();
+  }
+  void on_publisher_discovery(fdds::DomainParticipant*, rtps::WriterDiscoveryInfo&& info) override {
+    const bool gone = info.status == rtps::WriterDiscoveryInfo::REMOVED_WRITER;
+    Track(true, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid());
+    if (info.status != rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) return;
+    Check("writer", info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid().guidPrefix);
+  }
+  void on_subscriber_discovery(fdds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override {
+    const bool gone = info.status == rtps::ReaderDiscoveryInfo::REMOVED_READER;
+    Track(false, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid());
+    if (info.status != rtps::ReaderDiscoveryInfo::DISCOVERED_READER) return;
+    Check("reader", info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid().guidPrefix);
+  }
+
+  std::vector<DiscoveredEndpoint> Snapshot() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<DiscoveredEndpoint> out;
+    for (auto [guid, e] : endpoints_) {
+      auto it = names_.find(e.participant);
+      if (it != names_.end()) e.participant = it->second;
+      out.push_back(e);
+    }
+    return out;
+  }
+  void on_requested_incompatible_qos(fdds::DataReader* reader, const fdds::RequestedIncompatibleQosStatus& status) override {
+    if (on_problem_)
+      on_problem_("topic '" + reader->get_topicdescription()->get_name() + "': a writer offers an incompatible " +
+                  QosPolicyName(status.last_policy_id) + " QoS; no data will flow to this reader");
+  }
+  void on_offered_incompatible_qos(fdds::DataWriter* writer, const fdds::OfferedIncompatibleQosStatus& status) override {
+    if (on_problem_)
+      on_problem_("topic '" + writer->get_topic()->get_name() + "': a reader requests an incompatible " +
+                  QosPolicyName(status.last_policy_id) + " QoS; this writer's data will not reach it");
+  }
+
+ private:
+  void Check(const char* kind, const std::string& topic, const std::string& type, const rtps::GuidPrefix_t& prefix) {
+    std::string ours;
+    {
+      std::lock_guard<std::mutex> lock(owner_->mutex_);
+      auto it = owner_->topic_types_.find(topic);
+      if (it == owner_->topic_types_.end()) return;
+      ours = it->second;
+    }
+    if (ours == type || !on_problem_) return;
+    std::string remote;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      auto it = names_.find(GuidPrefixString(prefix));
+      remote = it != names_.end() ? it->second : "participant " + GuidPrefixString(prefix);
+    }
+    const bool same_idl_name = ours.substr(0, ours.find('#')) == type.substr(0, type.find('#'));
+    on_problem_("type mismatch on topic '" + topic + "': '" + owner_->name_ + "' uses " + ours + ", a " + kind + " of '" +
+                remote + "' uses " + type +
+                (same_idl_name ? " (same IDL name, different definition: rebuild both from the same idl/)"
+                               : " (different types)") +
+                "; no samples will flow between them");
+  }
+
+  void Track(bool writer, bool gone, const std::string& topic, const std::string& type, const rtps::GUID_t& guid) {
+    std::ostringstream os;
+    os << guid;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (gone) {
+      endpoints_.erase(os.str());
+      return;
+    }
+    endpoints_[os.str()] = DiscoveredEndpoint{writer, topic, type, GuidPrefixString(guid.guidPrefix), os.str()};
+  }
+
+  DdsParticipant* owner_;
+  ProblemHandler on_problem_;
+  std::mutex mutex_;
+  std::map<std::string, std::string> names_;  // guid prefix -> participant name
+  std::map<std::string, DiscoveredEndpoint> endpoints_;  // by guid; participant holds the prefix
+};
+
+std::vector<DiscoveredEndpoint> DdsParticipant::Discovered() const { return listener_->Snapshot(); }
+
+class DdsReader::Listener final : public fdds::DataReaderListener {
+ public:
+  explicit Listener(std::function<void()> on_data) : on_data_(std::move(on_data)) {}
+  void on_data_available(fdds::DataReader*) override {
+    if (on_data_) on_data_();
+  }
+
+ private:
+  std::function<void()> on_data_;
+};
+
+DdsReader::~DdsReader() {
+  if (on_delete_) on_delete_();
+}
+
+bool DdsReader::TakeNext(void* sample) {
+  fdds::SampleInfo info;
+  while (reader_->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
+    if (info.valid_data) return true;
+  }
+  return false;
+}
+
+uint64_t DdsReader::Unread() const { return reader_->get_unread_count(); }
+
+DdsWriter::~DdsWriter() {
+  if (on_delete_) on_delete_();
+}
+
+Status DdsWriter::Write(const void* sample) {
+  if (!writer_->write(const_cast<void*>(sample)))
+    return Status::IOError("topic '" + topic_ + "': DDS write failed");
+  return Status::OK();
+}
+
+int DdsWriter::matched() const {
+  fdds::PublicationMatchedStatus st;
+  writer_->get_publication_matched_status(st);
+  return st.current_count;
+}
+
+StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, const std::string& name,
+                                                                  ProblemHandler on_problem) {
+  std::unique_ptr<DdsParticipant> p(new DdsParticipant());
+  p->name_ = name;
+  p->listener_ = std::make_unique<DiscoveryListener>(p.get(), std::move(on_problem));
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  factory->load_profiles();  // profiles load lazily; load them before reading defaults
+  fdds::DomainParticipantQos qos = factory->get_default_participant_qos();
+  qos.name(name);
+  fdds::StatusMask mask = fdds::StatusMask::none();
+  mask << fdds::StatusMask::requested_incompatible_qos() << fdds::StatusMask::offered_incompatible_qos();
+  p->participant_ = factory->create_participant(domain_id, qos, p->listener_.get(), mask);
+  if (p->participant_ == nullptr)
+    return Status::Internal("cannot create DDS participant '" + name + "' on domain " + std::to_string(domain_id));
+  p->publisher_ = p->participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+  p->subscriber_ = p->participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  if (p->publisher_ == nullptr || p->subscriber_ == nullptr)
+    return Status::Internal("cannot create DDS publisher/subscriber for '" + name + "'");
+  return p;
+}
+
+DdsParticipant::~DdsParticipant() {
+  if (participant_ == nullptr) return;
+  participant_->set_listener(nullptr);
+  participant_->delete_contained_entities();
+  fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+StatusOr<fdds::Topic*> DdsParticipant::GetTopic(const std::string& topic, const TypeInfo& type) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::string dds_type = type.dds_name();
+  auto it = topics_.find(topic);
+  if (it != topics_.end()) {
+    if (topic_types_[topic] != dds_type)
+      return Status::InvalidArgument("topic '" + topic + "' already carries " + topic_types_[topic] + ", not " + dds_type);
+    return it->second;
+  }
+  if (participant_->find_type(dds_type).empty()) {
+    fdds::TypeSupport support(type.make_type_support());
+    if (support.register_type(participant_, dds_type) != ReturnCode_t::RETCODE_OK)
+      return Status::Internal("cannot register type " + dds_type);
+  }
+  fdds::Topic* t = participant_->create_topic(topic, dds_type, fdds::TOPIC_QOS_DEFAULT);
+  if (t == nullptr) return Status::Internal("cannot create topic '" + topic + "' of type " + dds_type);
+  topics_[topic] = t;
+  topic_types_[topic] = dds_type;
+  return t;
+}
+
+namespace {
+template <class Q>
+void ApplyQos(Q& q, const TopicQos& qos) {
+  q.reliability().kind = qos.reliability == Reliability::kReliable ? fdds::RELIABLE_RELIABILITY_QOS : fdds::BEST_EFFORT_RELIABILITY_QOS;
+  q.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+  if (qos.keep_all) {
+    q.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
+  } else {
+    q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    q.history().depth = qos.depth;
+  }
+  if (qos.deadline_ms > 0) q.deadline().period = eprosima::fastrtps::Duration_t(qos.deadline_ms * 1e-3);
+}
+}  // namespace
+
+StatusOr<std::unique_ptr<DdsReader>> DdsParticipant::CreateReader(const std::string& topic, const TypeInfo& type,
+                                                                  const TopicQos& qos, std::function<void()> on_data) {
+  auto t = GetTopic(topic, type);
+  if (!t.ok()) return t.status();
+  fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
+  ApplyQos(rq, qos);
+  std::unique_ptr<DdsReader> r(new DdsReader());
+  r->topic_ = topic;
+  r->listener_ = std::make_unique<DdsReader::Listener>(std::move(on_data));
+  r->reader_ = subscriber_->create_datareader(*t, rq, r->listener_.get(), fdds::StatusMask::data_available());
+  if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
+  auto* sub = subscriber_;
+  auto* raw = r->reader_;
+  r->on_delete_ = [sub, raw] {
+    const_cast<fdds::DataReader*>(raw)->set_listener(nullptr);
+    sub->delete_datareader(raw);
+  };
+  return r;
+}
+
+StatusOr<std::unique_ptr<DdsWriter>> DdsParticipant::CreateWriter(const std::string& topic, const TypeInfo& type,
+                                                                  const TopicQos& qos) {
+  auto t = GetTopic(topic, type);
+  if (!t.ok()) return t.status();
+  fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
+  ApplyQos(wq, qos);
+  std::unique_ptr<DdsWriter> w(new DdsWriter());
+  w->topic_ = topic;
+  w->writer_ = publisher_->create_datawriter(*t, wq);
+  if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'");
+  auto* pub = publisher_;
+  auto* raw = w->writer_;
+  w->on_delete_ = [pub, raw] { pub->delete_datawriter(raw); };
+  return w;
+}
+
+}  // namespace dyad

@@ -1,0 +1,114 @@
+// DdsParticipant — RAII owner of one Fast DDS DomainParticipant and the topics, writers and
+// readers the runtime creates on it. Internal to the runtime.
+//
+// Every type is registered under TypeInfo::dds_name() ("name#hash"). Discovery callbacks compare
+// remote endpoints' type names with ours per topic; a remote endpoint on one of our topics with
+// another type (same IDL name, other hash: a layout change) is reported through `on_mismatch`
+// naming both participants, because Fast DDS would otherwise match them silently (same name)
+// or never match them and say nothing (other name).
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <dyad/component.hpp>
+#include <dyad/graph.hpp>
+#include <dyad/status.hpp>
+
+namespace eprosima::fastdds::dds {
+class DomainParticipant;
+class Publisher;
+class Subscriber;
+class Topic;
+class DataReader;
+class DataWriter;
+}  // namespace eprosima::fastdds::dds
+
+namespace dyad {
+
+struct TopicQos {
+  Reliability reliability = Reliability::kReliable;
+  int depth = 1;
+  double deadline_ms = 0;
+  bool keep_all = false;  // KEEP_ALL history (recorders); depth then sizes resource limits only
+};
+
+// A reader the runtime polls; `on_data` (may be empty) is called from Fast DDS's delivery thread
+// whenever samples arrive.
+class DdsReader final : public detail::ReaderEndpoint {
+ public:
+  ~DdsReader() override;
+  bool TakeNext(void* sample) override;
+  uint64_t Unread() const;
+  const std::string& topic() const { return topic_; }
+
+ private:
+  friend class DdsParticipant;
+  class Listener;
+  std::string topic_;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;  // owned by the participant's subscriber
+  std::unique_ptr<Listener> listener_;
+  std::function<void()> on_delete_;
+};
+
+class DdsWriter final : public detail::WriterEndpoint {
+ public:
+  ~DdsWriter() override;
+  Status Write(const void* sample) override;
+  int matched() const;
+
+ private:
+  friend class DdsParticipant;
+  std::string topic_;
+  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;  // owned by the participant's publisher
+  std::function<void()> on_delete_;
+};
+
+// An endpoint seen through discovery.
+struct DiscoveredEndpoint {
+  bool writer = false;
+  std::string topic;
+  std::string type;         // DDS type name ("name#hash" for dyad types)
+  std::string participant;  // its participant's name
+  std::string guid;
+};
+
+class DdsParticipant {
+ public:
+  // Reports type mismatches and incompatible QoS; called from Fast DDS threads.
+  using ProblemHandler = std::function<void(const std::string& message)>;
+
+  static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, ProblemHandler on_problem);
+  ~DdsParticipant();  // REQUIRES: every reader and writer created here was destroyed first
+  DdsParticipant(const DdsParticipant&) = delete;
+  DdsParticipant& operator=(const DdsParticipant&) = delete;
+
+  StatusOr<std::unique_ptr<DdsReader>> CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
+                                                    std::function<void()> on_data);
+  StatusOr<std::unique_ptr<DdsWriter>> CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos);
+  const std::string& name() const { return name_; }
+  // Every remote (or local) endpoint discovered so far that is still alive.
+  std::vector<DiscoveredEndpoint> Discovered() const;
+  eprosima::fastdds::dds::DomainParticipant* raw() { return participant_; }
+
+ private:
+  class DiscoveryListener;
+  DdsParticipant() = default;
+  StatusOr<eprosima::fastdds::dds::Topic*> GetTopic(const std::string& topic, const TypeInfo& type);
+
+  std::string name_;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::unique_ptr<DiscoveryListener> listener_;
+  std::mutex mutex_;  // guards the maps below (discovery reads them from Fast DDS threads)
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+  std::map<std::string, std::string> topic_types_;  // topic -> dds type name
+};
+
+}  // namespace dyad

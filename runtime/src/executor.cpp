@@ -1,0 +1,434 @@
+#include "executor.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+
+#include <dyad/msg/types.hpp>
+
+#include "logger.hpp"
+
+namespace dyad {
+namespace {
+
+int64_t SteadyNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// splitmix64 of the graph seed and the component name: stable across runs and platforms.
+uint64_t MixSeed(uint64_t seed, const std::string& name) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : name) h = (h ^ c) * 1099511628211ull;
+  uint64_t z = seed + h + 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+class Executor::ClockImpl final : public Clock {
+ public:
+  explicit ClockImpl(bool stepped) : stepped_(stepped) {}
+  int64_t now_ns() const override {
+    if (stepped_) return sim_ns_.load(std::memory_order_acquire);
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  }
+  void Set(int64_t t) { sim_ns_.store(t, std::memory_order_release); }
+  bool stepped() const { return stepped_; }
+
+ private:
+  bool stepped_;
+  std::atomic<int64_t> sim_ns_{0};
+};
+
+struct Executor::Instance {
+  const ResolvedComponent* rc = nullptr;
+  std::unique_ptr<Component> component;
+  std::unique_ptr<ContextImpl> ctx;
+  std::vector<std::unique_ptr<InputBase>> inputs;
+  std::vector<std::unique_ptr<OutputBase>> outputs;
+  std::vector<std::unique_ptr<DdsReader>> readers;
+  std::vector<std::unique_ptr<DdsWriter>> writers;
+  DdsReader* trigger = nullptr;
+  StepStats stats;
+  std::atomic<bool> active{false};
+  std::atomic<bool> busy{false};
+  std::atomic<bool> pending{false};
+  uint64_t index = 0;
+  bool configured = false;
+  bool activated = false;
+  std::thread thread;
+  const std::string& name() const { return rc->config->name; }
+};
+
+class Executor::ContextImpl final : public Context {
+ public:
+  ContextImpl(Executor* ex, Instance* inst)
+      : ex_(ex), inst_(inst), logger_(inst->name()), seed_(MixSeed(ex->graph_.seed, inst->name())) {}
+  const std::string& name() const override { return inst_->name(); }
+  const Params& params() const override { return inst_->rc->params; }
+  const Clock& clock() const override { return *ex_->clock_; }
+  Logger& log() override { return logger_; }
+  uint64_t seed() const override { return seed_; }
+  int64_t period_ns() const override { return inst_->rc->period_ns; }
+  void RequestStop(std::string reason) override { ex_->RequestStop(inst_->name() + ": " + reason); }
+
+ protected:
+  InputBase* FindInput(std::string_view port, const TypeInfo& type) override {
+    const auto& ins = inst_->rc->entry->spec.inputs();
+    for (size_t i = 0; i < ins.size(); ++i)
+      if (ins[i].name == port) {
+        if (ins[i].type->name != type.name) Abort("input", port, type);
+        return inst_->inputs[i].get();
+      }
+    Abort("input", port, type);
+  }
+  OutputBase* FindOutput(std::string_view port, const TypeInfo& type) override {
+    const auto& outs = inst_->rc->entry->spec.outputs();
+    for (size_t i = 0; i < outs.size(); ++i)
+      if (outs[i].name == port) {
+        if (outs[i].type->name != type.name) Abort("output", port, type);
+        return inst_->outputs[i].get();
+      }
+    Abort("output", port, type);
+  }
+
+ private:
+  [[noreturn]] void Abort(const char* kind, std::string_view port, const TypeInfo& type) {
+    std::fprintf(stderr, "dyad: component '%s' (%s) asked for %s '%.*s' of type %s, which it did not declare so\n",
+                 inst_->name().c_str(), inst_->rc->config->type.c_str(), kind, static_cast<int>(port.size()), port.data(),
+                 type.name.c_str());
+    std::abort();
+  }
+  Executor* ex_;
+  Instance* inst_;
+  StderrLogger logger_;
+  uint64_t seed_;
+};
+
+Executor::Executor(const Graph& graph, const ResolvedGraph& resolved, Options options)
+    : graph_(graph), resolved_(resolved), options_(std::move(options)),
+      clock_(std::make_unique<ClockImpl>(graph.clock == ClockMode::kStepped)) {}
+
+Executor::~Executor() {
+  for (auto& inst : instances_)
+    if (inst->thread.joinable()) inst->thread.join();
+  // Ports and endpoints before the participant; components before their ports.
+  for (auto& inst : instances_) {
+    inst->component.reset();
+    inst->inputs.clear();
+    inst->outputs.clear();
+    inst->readers.clear();
+    inst->writers.clear();
+  }
+  stats_writer_.reset();
+  instances_.clear();
+  participant_.reset();
+}
+
+void Executor::RequestStop(const std::string& reason) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stop_reason_.empty()) stop_reason_ = reason;
+    stop_.store(true, std::memory_order_release);
+  }
+  cv_.notify_all();
+}
+
+void Executor::Fail(const Status& status) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (failure_.ok()) failure_ = status;
+  }
+  RequestStop("failure: " + status.message());
+}
+
+Status Executor::Setup() {
+  auto p = DdsParticipant::Create(graph_.domain_id, "dyad/" + graph_.name + "/" + options_.process,
+                                  [this](const std::string& msg) {
+                                    ++problems_;
+                                    StderrLogger("dds").Error(msg);
+                                  });
+  if (!p.ok()) return p.status();
+  participant_ = std::move(p.value());
+  const bool stepped = clock_->stepped();
+
+  for (const auto& rc : resolved_.components) {
+    if (graph_.ProcessOf(*rc.config) != options_.process) continue;
+    auto inst = std::make_unique<Instance>();
+    inst->rc = &rc;
+    const ComponentSpec& spec = rc.entry->spec;
+    Instance* raw = inst.get();
+    for (const auto& ps : spec.inputs()) {
+      auto port = ps.make_input();
+      std::string topic;
+      for (const auto& b : rc.config->inputs)
+        if (b.port == ps.name) topic = b.topic;
+      DdsReader* reader = nullptr;
+      if (!topic.empty()) {
+        const ResolvedTopic& rt = resolved_.topics.at(topic);
+        TopicQos qos;
+        if (rt.config) qos = TopicQos{rt.config->reliability, rt.config->depth, rt.config->deadline_ms, false};
+        std::function<void()> on_data;
+        if (!stepped && rc.config->trigger == ps.name) on_data = [this, raw] { TriggerStep(*raw); };
+        auto r = participant_->CreateReader(topic, *ps.type, qos, on_data);
+        if (!r.ok()) return Status::Internal(rc.config->name + "." + ps.name + ": " + r.status().message());
+        reader = r.value().get();
+        inst->readers.push_back(std::move(r.value()));
+        if (rc.config->trigger == ps.name) inst->trigger = reader;
+      }
+      port->Bind(ps.name, topic, reader);
+      inst->inputs.push_back(std::move(port));
+    }
+    for (const auto& ps : spec.outputs()) {
+      auto port = ps.make_output();
+      std::string topic;
+      for (const auto& b : rc.config->outputs)
+        if (b.port == ps.name) topic = b.topic;
+      DdsWriter* writer = nullptr;
+      if (!topic.empty()) {
+        const ResolvedTopic& rt = resolved_.topics.at(topic);
+        TopicQos qos;
+        if (rt.config) qos = TopicQos{rt.config->reliability, rt.config->depth, rt.config->deadline_ms, false};
+        auto w = participant_->CreateWriter(topic, *ps.type, qos);
+        if (!w.ok()) return Status::Internal(rc.config->name + "." + ps.name + ": " + w.status().message());
+        writer = w.value().get();
+        inst->writers.push_back(std::move(w.value()));
+      }
+      port->Bind(ps.name, topic, rc.config->name, writer, clock_.get());
+      inst->outputs.push_back(std::move(port));
+    }
+    inst->ctx = std::make_unique<ContextImpl>(this, raw);
+    inst->component = rc.entry->type.create();
+    instances_.push_back(std::move(inst));
+  }
+  if (instances_.empty()) return Status::InvalidArgument("no component is placed in process '" + options_.process + "'");
+
+  // The runtime's own output: timing of this process's components.
+  auto w = participant_->CreateWriter("dyad/stats", TypeInfoOf<msg::ComponentStats>(), TopicQos{Reliability::kReliable, 16, 0, false});
+  if (!w.ok()) return w.status();
+  stats_writer_ = std::move(w.value());
+  stats_output_ = std::make_unique<Output<msg::ComponentStats>>();
+  stats_output_->Bind("stats", "dyad/stats", "dyad/" + options_.process, stats_writer_.get(), clock_.get());
+
+  for (auto& inst : instances_) {
+    Status s = inst->component->Configure(*inst->ctx);
+    if (!s.ok()) return Status::FailedPrecondition(inst->name() + ": configure failed: " + s.message());
+    inst->configured = true;
+  }
+  return Status::OK();
+}
+
+Status Executor::StepOnce(Instance& inst, int64_t scheduled_steady_ns, bool periodic) {
+  const int64_t t0 = SteadyNs();
+  const int64_t now = clock_->now_ns();
+  for (auto& in : inst.inputs) in->Poll(now);
+  Status s = inst.component->Step(StepInfo{now, inst.index++, inst.rc->period_ns});
+  const int64_t t1 = SteadyNs();
+  int64_t jitter = 0;
+  bool missed = false;
+  if (periodic && !clock_->stepped()) {
+    jitter = std::abs(t0 - scheduled_steady_ns);
+    missed = t1 > scheduled_steady_ns + inst.rc->period_ns;
+  }
+  inst.stats.Record(t1 - t0, jitter, missed);
+  if (!s.ok()) return Status::Internal(inst.name() + ": step " + std::to_string(inst.index - 1) + " failed: " + s.message());
+  return s;
+}
+
+void Executor::TriggerStep(Instance& inst) {
+  inst.pending.store(true, std::memory_order_release);
+  for (;;) {
+    bool expected = false;
+    if (!inst.busy.compare_exchange_strong(expected, true, std::memory_order_acquire)) return;  // the owner steps again
+    while (inst.pending.exchange(false, std::memory_order_acq_rel)) {
+      if (!inst.active.load(std::memory_order_acquire) || stopping()) break;
+      Status s = StepOnce(inst, 0, false);
+      if (!s.ok()) {
+        Fail(s);
+        break;
+      }
+    }
+    inst.busy.store(false, std::memory_order_release);
+    if (!inst.pending.load(std::memory_order_acquire) || !inst.active.load(std::memory_order_acquire) || stopping()) return;
+  }
+}
+
+void Executor::PeriodicLoop(Instance& inst) {
+  const int64_t period = inst.rc->period_ns;
+  int64_t next = SteadyNs();
+  std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
+  while (!stopping()) {
+    lock.lock();
+    cv_.wait_until(lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(next)), [&] { return stopping(); });
+    lock.unlock();
+    if (stopping()) break;
+    Status s = StepOnce(inst, next, true);
+    if (!s.ok()) {
+      Fail(s);
+      break;
+    }
+    if (options_.steps > 0 && inst.index >= options_.steps) RequestStop("reached " + std::to_string(options_.steps) + " steps");
+    next += period;
+    const int64_t now = SteadyNs();
+    if (now > next) next += ((now - next) / period + 1) * period;  // skip missed periods, don't burst
+  }
+}
+
+Status Executor::RunStepped() {
+  struct Due {
+    Instance* inst;
+    int64_t next;
+  };
+  std::vector<Due> periodic;
+  std::vector<Instance*> triggered;
+  for (auto& inst : instances_) {
+    if (inst->rc->period_ns > 0) periodic.push_back({inst.get(), 0});
+    else triggered.push_back(inst.get());
+  }
+  if (periodic.empty()) return Status::InvalidArgument("stepped clock needs at least one periodic component (rate_hz)");
+  int64_t fastest = periodic.front().inst->rc->period_ns;
+  for (const auto& d : periodic) fastest = std::min(fastest, d.inst->rc->period_ns);
+  const int64_t end_ns = options_.steps > 0 ? static_cast<int64_t>(options_.steps) * fastest : INT64_MAX;
+  const int64_t wall_end = options_.duration_s > 0 ? SteadyNs() + static_cast<int64_t>(options_.duration_s * 1e9) : INT64_MAX;
+  int64_t last_stats = SteadyNs();
+
+  auto run_triggered = [&]() -> Status {
+    for (int round = 0; round < 1000; ++round) {
+      bool any = false;
+      for (Instance* t : triggered) {
+        if (t->trigger == nullptr || t->trigger->Unread() == 0) continue;
+        any = true;
+        if (Status s = StepOnce(*t, 0, false); !s.ok()) return s;
+      }
+      if (!any) return Status::OK();
+    }
+    return Status::Internal("triggered components kept triggering each other for 1000 rounds in one instant");
+  };
+
+  while (!stopping()) {
+    int64_t t = INT64_MAX;
+    for (const auto& d : periodic) t = std::min(t, d.next);
+    if (t >= end_ns) {
+      RequestStop("reached " + std::to_string(options_.steps) + " steps");
+      break;
+    }
+    if (SteadyNs() > wall_end) {
+      RequestStop("duration reached");
+      break;
+    }
+    clock_->Set(t);
+    for (auto& d : periodic) {
+      if (d.next != t) continue;
+      if (Status s = StepOnce(*d.inst, 0, true); !s.ok()) return s;
+      if (Status s = run_triggered(); !s.ok()) return s;
+      d.next += d.inst->rc->period_ns;
+      if (stopping()) break;
+    }
+    if (options_.stats_period_s > 0 && SteadyNs() - last_stats > static_cast<int64_t>(options_.stats_period_s * 1e9)) {
+      PublishStats();
+      last_stats = SteadyNs();
+    }
+  }
+  return Status::OK();
+}
+
+Status Executor::RunWall() {
+  for (auto& inst : instances_)
+    if (inst->rc->period_ns > 0) inst->thread = std::thread([this, i = inst.get()] { PeriodicLoop(*i); });
+  // A triggered component may have missed samples delivered before it was active.
+  for (auto& inst : instances_)
+    if (inst->trigger != nullptr && inst->trigger->Unread() > 0) TriggerStep(*inst);
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stopping()) {
+    auto wake = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<int64_t>(options_.stats_period_s * 1000));
+    if (options_.duration_s > 0) {
+      const auto end = start + std::chrono::nanoseconds(static_cast<int64_t>(options_.duration_s * 1e9));
+      if (end < wake) wake = end;
+    }
+    cv_.wait_until(lock, wake, [&] { return stopping(); });
+    if (stopping()) break;
+    if (options_.duration_s > 0 && std::chrono::steady_clock::now() - start >= std::chrono::nanoseconds(static_cast<int64_t>(options_.duration_s * 1e9))) {
+      lock.unlock();
+      RequestStop("duration reached");
+      lock.lock();
+      break;
+    }
+    lock.unlock();
+    PublishStats();
+    lock.lock();
+  }
+  lock.unlock();
+  for (auto& inst : instances_)
+    if (inst->thread.joinable()) inst->thread.join();
+  return Status::OK();
+}
+
+Status Executor::Run() {
+  Status s = Setup();
+  if (s.ok()) {
+    for (auto& inst : instances_) {
+      s = inst->component->Activate();
+      if (!s.ok()) {
+        s = Status::FailedPrecondition(inst->name() + ": activate failed: " + s.message());
+        break;
+      }
+      inst->activated = true;
+      inst->active.store(true, std::memory_order_release);
+    }
+  }
+  if (s.ok()) {
+    Status r = clock_->stepped() ? RunStepped() : RunWall();
+    if (!r.ok()) Fail(r);
+  }
+  // Stop: no more triggered steps, wait for any in flight, then deactivate in reverse order.
+  stop_.store(true, std::memory_order_release);
+  cv_.notify_all();
+  for (auto& inst : instances_) {
+    inst->active.store(false, std::memory_order_release);
+    if (inst->thread.joinable()) inst->thread.join();
+    while (inst->busy.load(std::memory_order_acquire)) std::this_thread::yield();
+  }
+  for (auto it = instances_.rbegin(); it != instances_.rend(); ++it) {
+    Instance& inst = **it;
+    if (!inst.activated) continue;
+    Status d = inst.component->Deactivate();
+    if (!d.ok() && s.ok()) s = Status::Internal(inst.name() + ": deactivate failed: " + d.message());
+  }
+  for (auto it = instances_.rbegin(); it != instances_.rend(); ++it)
+    if ((*it)->configured) (*it)->component->Shutdown();
+  if (participant_) PublishStats();
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!s.ok()) return s;
+  return failure_;
+}
+
+void Executor::PublishStats() {
+  if (!stats_output_) return;
+  auto* out = static_cast<Output<msg::ComponentStats>*>(stats_output_.get());
+  for (const auto& inst : instances_) {
+    const auto snap = inst->stats.Get();
+    msg::ComponentStats m;
+    m.component_name(inst->name());
+    m.process_name(options_.process);
+    m.steps(snap.steps);
+    m.step_mean_s(snap.mean_s);
+    m.step_p99_s(snap.p99_s);
+    m.step_max_s(snap.max_s);
+    m.jitter_mean_s(snap.jitter_mean_s);
+    m.jitter_max_s(snap.jitter_max_s);
+    m.deadline_misses(snap.deadline_misses);
+    out->Publish(m);
+  }
+}
+
+std::vector<Executor::Row> Executor::Report() const {
+  std::vector<Row> rows;
+  for (const auto& inst : instances_) rows.push_back({inst->name(), inst->stats.Get()});
+  return rows;
+}
+
+}  // namespace dyad

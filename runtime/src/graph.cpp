@@ -1,0 +1,300 @@
+// Reads an experiment graph from YAML, keeping every node's position for error messages.
+#include "dyad/graph.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace dyad {
+namespace {
+
+SourceMark MarkOf(const std::string& file, const YAML::Node& node) {
+  const YAML::Mark m = node.Mark();
+  if (m.is_null()) return SourceMark{file, 0, 0};
+  return SourceMark{file, m.line + 1, m.column + 1};
+}
+
+// Collects diagnostics for one file.
+class Reader {
+ public:
+  Reader(std::string file, std::vector<Diagnostic>* out) : file_(std::move(file)), out_(out) {}
+
+  void Error(const YAML::Node& node, const std::string& key, const std::string& message) {
+    out_->push_back(Diagnostic{MarkOf(file_, node), key, message});
+  }
+  void Error(const SourceMark& mark, const std::string& key, const std::string& message) {
+    out_->push_back(Diagnostic{mark, key, message});
+  }
+  SourceMark Mark(const YAML::Node& node) const { return MarkOf(file_, node); }
+
+  // Checks `node` is a map, reports keys outside `allowed` and duplicate keys.
+  bool Map(const YAML::Node& node, const std::string& key, const std::set<std::string>& allowed) {
+    if (!node.IsMap()) {
+      Error(node, key, "must be a mapping");
+      return false;
+    }
+    std::set<std::string> seen;
+    for (const auto& kv : node) {
+      const std::string k = kv.first.Scalar();
+      const std::string path = key.empty() ? k : key + "." + k;
+      if (!seen.insert(k).second) Error(kv.first, path, "duplicate key");
+      if (!allowed.empty() && !allowed.count(k)) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        Error(kv.first, path, "unknown key (expected one of: " + list + ")");
+      }
+    }
+    return true;
+  }
+
+  bool String(const YAML::Node& node, const std::string& key, std::string* out) {
+    if (!node.IsScalar() || node.Scalar().empty()) {
+      Error(node, key, "must be a non-empty string");
+      return false;
+    }
+    *out = node.Scalar();
+    return true;
+  }
+
+  template <class T>
+  bool Number(const YAML::Node& node, const std::string& key, T* out, const char* what) {
+    if (node.IsScalar()) {
+      try {
+        *out = node.as<T>();
+        return true;
+      } catch (const YAML::Exception&) {
+      }
+    }
+    Error(node, key, std::string("must be ") + what + (node.IsScalar() ? ", got '" + node.Scalar() + "'" : ""));
+    return false;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+  std::vector<Diagnostic>* out_;
+};
+
+void ReadTopics(Reader& r, const YAML::Node& node, Graph* g) {
+  if (!r.Map(node, "topics", {})) return;
+  for (const auto& kv : node) {
+    TopicConfig t;
+    t.name = kv.first.Scalar();
+    t.mark = r.Mark(kv.first);
+    const std::string key = "topics." + t.name;
+    const YAML::Node spec = kv.second;
+    if (spec.IsNull()) {
+      g->topics.push_back(t);
+      continue;
+    }
+    if (!r.Map(spec, key, {"type", "reliability", "depth", "deadline_ms"})) continue;
+    if (spec["type"]) {
+      r.String(spec["type"], key + ".type", &t.type);
+      t.type_mark = r.Mark(spec["type"]);
+    }
+    if (spec["reliability"]) {
+      std::string rel;
+      if (r.String(spec["reliability"], key + ".reliability", &rel)) {
+        if (rel == "reliable") t.reliability = Reliability::kReliable;
+        else if (rel == "best_effort") t.reliability = Reliability::kBestEffort;
+        else r.Error(spec["reliability"], key + ".reliability", "must be reliable or best_effort, got '" + rel + "'");
+      }
+    }
+    if (spec["depth"] && r.Number(spec["depth"], key + ".depth", &t.depth, "an integer") && t.depth < 1)
+      r.Error(spec["depth"], key + ".depth", "must be >= 1, got " + std::to_string(t.depth));
+    if (spec["deadline_ms"] && r.Number(spec["deadline_ms"], key + ".deadline_ms", &t.deadline_ms, "a number") &&
+        t.deadline_ms < 0)
+      r.Error(spec["deadline_ms"], key + ".deadline_ms", "must be >= 0");
+    g->topics.push_back(t);
+  }
+}
+
+void ReadBindings(Reader& r, const YAML::Node& node, const std::string& key, std::vector<PortBinding>* out) {
+  if (!r.Map(node, key, {})) return;
+  for (const auto& kv : node) {
+    PortBinding b;
+    b.port = kv.first.Scalar();
+    b.mark = r.Mark(kv.second);
+    if (r.String(kv.second, key + "." + b.port, &b.topic)) out->push_back(b);
+  }
+}
+
+void ReadComponents(Reader& r, const YAML::Node& node, Graph* g) {
+  if (!r.Map(node, "components", {})) return;
+  for (const auto& kv : node) {
+    ComponentConfig c;
+    c.name = kv.first.Scalar();
+    c.mark = r.Mark(kv.first);
+    const std::string key = "components." + c.name;
+    const YAML::Node spec = kv.second;
+    if (!r.Map(spec, key, {"type", "rate_hz", "trigger", "process", "params", "inputs", "outputs"})) continue;
+    if (spec["type"]) {
+      r.String(spec["type"], key + ".type", &c.type);
+      c.type_mark = r.Mark(spec["type"]);
+    } else {
+      r.Error(kv.first, key + ".type", "missing (every component names its type)");
+    }
+    if (spec["rate_hz"]) {
+      c.rate_mark = r.Mark(spec["rate_hz"]);
+      if (r.Number(spec["rate_hz"], key + ".rate_hz", &c.rate_hz, "a number") && !(c.rate_hz > 0))
+        r.Error(spec["rate_hz"], key + ".rate_hz", "must be > 0, got " + spec["rate_hz"].Scalar());
+    }
+    if (spec["trigger"]) {
+      c.trigger_mark = r.Mark(spec["trigger"]);
+      r.String(spec["trigger"], key + ".trigger", &c.trigger);
+    }
+    if (spec["process"]) {
+      c.process_mark = r.Mark(spec["process"]);
+      r.String(spec["process"], key + ".process", &c.process);
+    }
+    if (spec["params"]) {
+      c.params_mark = r.Mark(spec["params"]);
+      if (spec["params"].IsNull()) c.params = YAML::Node(YAML::NodeType::Map);
+      else if (r.Map(spec["params"], key + ".params", {})) c.params = spec["params"];
+    } else {
+      c.params = YAML::Node(YAML::NodeType::Map);
+      c.params_mark = c.mark;
+    }
+    if (spec["inputs"] && !spec["inputs"].IsNull()) ReadBindings(r, spec["inputs"], key + ".inputs", &c.inputs);
+    if (spec["outputs"] && !spec["outputs"].IsNull()) ReadBindings(r, spec["outputs"], key + ".outputs", &c.outputs);
+    g->components.push_back(std::move(c));
+  }
+}
+
+void ApplyOverrides(const std::vector<Override>& overrides, Graph* g, std::vector<Diagnostic>* out) {
+  for (const auto& o : overrides) {
+    const SourceMark cli{"--set " + o.text, 0, 0};
+    const auto eq = o.text.find('=');
+    const auto dot = o.text.find('.');
+    if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || dot + 1 == eq) {
+      out->push_back({cli, o.text, "expected COMPONENT.PARAM=VALUE"});
+      continue;
+    }
+    const std::string comp = o.text.substr(0, dot);
+    std::string param = o.text.substr(dot + 1, eq - dot - 1);
+    if (param.rfind("params.", 0) == 0) param = param.substr(7);
+    const std::string value = o.text.substr(eq + 1);
+    ComponentConfig* c = nullptr;
+    for (auto& cc : g->components)
+      if (cc.name == comp) c = &cc;
+    if (c == nullptr) {
+      out->push_back({cli, "components." + comp, "no such component in the graph"});
+      continue;
+    }
+    try {
+      c->params[param] = YAML::Load(value);
+    } catch (const YAML::Exception& e) {
+      out->push_back({cli, "components." + comp + ".params." + param, "value is not valid YAML: " + e.msg});
+    }
+  }
+}
+
+}  // namespace
+
+std::string SourceMark::ToString() const {
+  if (line <= 0) return file;
+  return file + ":" + std::to_string(line) + ":" + std::to_string(column);
+}
+
+std::string Diagnostic::ToString() const {
+  return mark.ToString() + ": " + (key.empty() ? "" : key + ": ") + message;
+}
+
+const ComponentConfig* Graph::FindComponent(const std::string& n) const {
+  for (const auto& c : components)
+    if (c.name == n) return &c;
+  return nullptr;
+}
+
+const TopicConfig* Graph::FindTopic(const std::string& n) const {
+  for (const auto& t : topics)
+    if (t.name == n) return &t;
+  return nullptr;
+}
+
+std::string Graph::ProcessOf(const ComponentConfig& c) const {
+  if (!c.process.empty()) return c.process;
+  if (processes.size() == 1) return processes.front().name;
+  return "main";
+}
+
+Graph ParseGraph(const std::string& yaml_text, const std::string& path, const std::vector<Override>& overrides,
+                 std::vector<Diagnostic>* diagnostics) {
+  Graph g;
+  g.file = path;
+  g.yaml_text = yaml_text;
+  Reader r(path, diagnostics);
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::ParserException& e) {
+    diagnostics->push_back({SourceMark{path, e.mark.line + 1, e.mark.column + 1}, "", "YAML syntax error: " + e.msg});
+    return g;
+  }
+  if (!root.IsMap()) {
+    diagnostics->push_back({SourceMark{path, 1, 1}, "", "a graph file must be a YAML mapping"});
+    return g;
+  }
+  r.Map(root, "", {"graph", "domain_id", "clock", "seed", "plugins", "processes", "topics", "components"});
+  if (root["graph"]) r.String(root["graph"], "graph", &g.name);
+  if (root["domain_id"] && r.Number(root["domain_id"], "domain_id", &g.domain_id, "an integer") &&
+      (g.domain_id < 0 || g.domain_id > 232))
+    r.Error(root["domain_id"], "domain_id", "must be in 0..232 (DDS), got " + std::to_string(g.domain_id));
+  if (root["clock"]) {
+    std::string mode;
+    if (r.String(root["clock"], "clock", &mode)) {
+      if (mode == "wall") g.clock = ClockMode::kWall;
+      else if (mode == "stepped") g.clock = ClockMode::kStepped;
+      else r.Error(root["clock"], "clock", "must be wall or stepped, got '" + mode + "'");
+    }
+  }
+  if (root["seed"]) r.Number(root["seed"], "seed", &g.seed, "a non-negative integer");
+  const std::filesystem::path base = std::filesystem::path(path).parent_path();
+  if (const YAML::Node plugins = root["plugins"]) {
+    if (!plugins.IsSequence()) {
+      r.Error(plugins, "plugins", "must be a list of paths");
+    } else {
+      for (const auto& p : plugins) {
+        std::string s;
+        if (!r.String(p, "plugins", &s)) continue;
+        std::filesystem::path fp(s);
+        g.plugins.push_back(fp.is_absolute() ? s : (base / fp).lexically_normal().string());
+      }
+    }
+  }
+  if (const YAML::Node procs = root["processes"]) {
+    if (r.Map(procs, "processes", {})) {
+      for (const auto& kv : procs) {
+        ProcessConfig p;
+        p.name = kv.first.Scalar();
+        p.mark = r.Mark(kv.first);
+        const std::string key = "processes." + p.name;
+        if (!kv.second.IsNull() && r.Map(kv.second, key, {"host"}) && kv.second["host"])
+          r.String(kv.second["host"], key + ".host", &p.host);
+        g.processes.push_back(p);
+      }
+    }
+  }
+  if (const YAML::Node topics = root["topics"]) ReadTopics(r, topics, &g);
+  if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, &g);
+  else r.Error(SourceMark{path, 1, 1}, "components", "missing: a graph needs at least one component");
+  ApplyOverrides(overrides, &g, diagnostics);
+  return g;
+}
+
+Graph LoadGraph(const std::string& path, const std::vector<Override>& overrides, std::vector<Diagnostic>* diagnostics) {
+  std::ifstream in(path);
+  if (!in) {
+    diagnostics->push_back({SourceMark{path, 0, 0}, "", "cannot open graph file"});
+    Graph g;
+    g.file = path;
+    return g;
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ParseGraph(ss.str(), path, overrides, diagnostics);
+}
+
+}  // namespace dyad

@@ -1,0 +1,222 @@
+// `dyad run` and `dyad validate`: load, validate, then run in this process or launch one child
+// per process of the graph.
+#include "dyad/run.hpp"
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <set>
+#include <thread>
+
+#include "dyad/catalog.hpp"
+#include "dyad/validate.hpp"
+#include "executor.hpp"
+
+namespace dyad {
+namespace {
+
+struct Loaded {
+  Graph graph;
+  Catalog catalog;
+  ResolvedGraph resolved;
+};
+
+// Returns false (after printing every problem) when the graph is invalid.
+bool LoadAndValidate(const std::string& path, const std::vector<Override>& overrides,
+                     const std::vector<std::string>& plugin_paths, Loaded* l, std::ostream& err) {
+  std::vector<Diagnostic> diags;
+  l->graph = LoadGraph(path, overrides, &diags);
+  std::vector<std::string> plugins = l->graph.plugins;
+  plugins.insert(plugins.end(), plugin_paths.begin(), plugin_paths.end());
+  Status loaded = l->catalog.LoadDefault(plugins);
+  if (!loaded.ok()) err << "warning: " << loaded.message() << "\n";
+  if (!l->graph.components.empty()) l->resolved = ValidateGraph(l->graph, l->catalog, &diags);
+  for (const auto& d : diags) err << d.ToString() << "\n";
+  if (!diags.empty()) err << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", nothing was started\n";
+  return diags.empty();
+}
+
+std::set<std::string> ProcessesOf(const Graph& g) {
+  std::set<std::string> out;
+  for (const auto& c : g.components) out.insert(g.ProcessOf(c));
+  return out;
+}
+
+void PrintReport(const std::vector<Executor::Row>& rows, const std::string& process, std::ostream& out) {
+  out << "timing (process " << process << "):\n";
+  out << std::left << std::setw(20) << "component" << std::right << std::setw(9) << "steps" << std::setw(12) << "mean_ms"
+      << std::setw(12) << "p99_ms" << std::setw(12) << "max_ms" << std::setw(13) << "jitter_ms" << std::setw(15)
+      << "jitter_max_ms" << std::setw(8) << "misses" << "\n";
+  out << std::fixed << std::setprecision(3);
+  for (const auto& r : rows)
+    out << std::left << std::setw(20) << r.component << std::right << std::setw(9) << r.stats.steps << std::setw(12)
+        << r.stats.mean_s * 1e3 << std::setw(12) << r.stats.p99_s * 1e3 << std::setw(12) << r.stats.max_s * 1e3
+        << std::setw(13) << r.stats.jitter_mean_s * 1e3 << std::setw(15) << r.stats.jitter_max_s * 1e3 << std::setw(8)
+        << r.stats.deadline_misses << "\n";
+  out.unsetf(std::ios::fixed);
+}
+
+// SIGINT/SIGTERM are blocked in every thread and taken here, so no Fast DDS or component thread
+// is interrupted by them. A second signal while stopping ends the process at once.
+class SignalWatcher {
+ public:
+  explicit SignalWatcher(std::function<void(int)> on_signal) : on_signal_(std::move(on_signal)) {
+    sigemptyset(&set_);
+    sigaddset(&set_, SIGINT);
+    sigaddset(&set_, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &set_, &old_);
+    thread_ = std::thread([this] {
+      int count = 0;
+      while (!done_.load()) {
+        timespec ts{0, 50'000'000};
+        const int sig = sigtimedwait(&set_, nullptr, &ts);
+        if (sig <= 0) continue;
+        if (++count > 1) {
+          std::fprintf(stderr, "dyad: second signal, exiting now\n");
+          _exit(128 + sig);
+        }
+        on_signal_(sig);
+      }
+    });
+  }
+  ~SignalWatcher() {
+    done_.store(true);
+    thread_.join();
+    pthread_sigmask(SIG_SETMASK, &old_, nullptr);
+  }
+
+ private:
+  sigset_t set_, old_;
+  std::function<void(int)> on_signal_;
+  std::atomic<bool> done_{false};
+  std::thread thread_;
+};
+
+int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err) {
+  char host[256] = {0};
+  gethostname(host, sizeof(host) - 1);
+  std::map<pid_t, std::string> children;
+  std::vector<std::string> names;
+  for (const auto& p : ProcessesOf(l.graph)) {
+    std::string where;
+    for (const auto& pc : l.graph.processes)
+      if (pc.name == p) where = pc.host;
+    if (!where.empty() && where != host && where != "localhost") {
+      err << "process '" << p << "' runs on host '" << where << "': start it there with `dyad run " << options.graph_path
+          << " --process " << p << "`\n";
+      continue;
+    }
+    names.push_back(p);
+  }
+  std::atomic<bool> stopping{false};
+  SignalWatcher watcher([&](int sig) {
+    stopping.store(true);
+    for (const auto& [pid, _] : children) kill(pid, sig);
+  });
+  for (const auto& p : names) {
+    std::vector<std::string> args = {"dyad", "run", options.graph_path, "--process", p};
+    for (const auto& o : options.overrides) args.insert(args.end(), {"--set", o.text});
+    for (const auto& pp : options.plugin_paths) args.insert(args.end(), {"--plugins", pp});
+    if (options.duration_s > 0) args.insert(args.end(), {"--duration", std::to_string(options.duration_s)});
+    if (options.steps > 0) args.insert(args.end(), {"--steps", std::to_string(options.steps)});
+    if (options.quiet) args.push_back("--quiet");
+    const pid_t pid = fork();
+    if (pid == 0) {
+      sigset_t none;
+      sigemptyset(&none);
+      pthread_sigmask(SIG_SETMASK, &none, nullptr);
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv("/proc/self/exe", argv.data());
+      std::perror("dyad: exec");
+      _exit(127);
+    }
+    if (pid < 0) {
+      err << "cannot start process '" << p << "'\n";
+      continue;
+    }
+    children[pid] = p;
+  }
+  int worst = 0;
+  while (!children.empty()) {
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, 0);
+    if (pid < 0) break;
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    if (code != 0) {
+      err << "process '" << children[pid] << "' exited with " << code << "\n";
+      // One process failing ends the experiment.
+      if (!stopping.exchange(true))
+        for (const auto& [other, _] : children)
+          if (other != pid) kill(other, SIGTERM);
+    }
+    worst = std::max(worst, code);
+    children.erase(pid);
+  }
+  return worst;
+}
+
+}  // namespace
+
+int ValidateGraphFile(const std::string& path, const std::vector<Override>& overrides,
+                      const std::vector<std::string>& plugin_paths, std::ostream& out, std::ostream& err) {
+  Loaded l;
+  if (!LoadAndValidate(path, overrides, plugin_paths, &l, err)) return 2;
+  out << path << ": OK (" << l.graph.components.size() << " components, " << l.resolved.topics.size() << " topics, "
+      << ProcessesOf(l.graph).size() << " process" << (ProcessesOf(l.graph).size() == 1 ? "" : "es") << ")\n";
+  return 0;
+}
+
+int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
+  Loaded l;
+  if (!LoadAndValidate(options.graph_path, options.overrides, options.plugin_paths, &l, err)) return 2;
+  const std::set<std::string> procs = ProcessesOf(l.graph);
+  std::string process = options.process;
+  if (process.empty()) {
+    if (procs.size() > 1) return LaunchChildren(options, l, err);
+    process = *procs.begin();
+  } else if (!procs.count(process)) {
+    std::string list;
+    for (const auto& p : procs) list += (list.empty() ? "" : ", ") + p;
+    err << options.graph_path << ": --process " << process << ": no component is placed there (processes: " << list << ")\n";
+    return 2;
+  }
+  Executor::Options eo{process, options.duration_s, options.steps, options.stats_period_s};
+  std::atomic<Executor*> current{nullptr};
+  std::atomic<int> pending_signal{0};
+  Status result;
+  std::vector<Executor::Row> rows;
+  int mismatches = 0;
+  {
+    SignalWatcher watcher([&](int sig) {
+      pending_signal.store(sig);
+      if (Executor* ex = current.load()) ex->RequestStop(sig == SIGINT ? "SIGINT" : "SIGTERM");
+    });
+    Executor ex(l.graph, l.resolved, eo);
+    current.store(&ex);
+    if (const int sig = pending_signal.load()) ex.RequestStop(sig == SIGINT ? "SIGINT" : "SIGTERM");
+    result = ex.Run();
+    rows = ex.Report();
+    mismatches = ex.type_mismatches();
+    current.store(nullptr);
+  }
+  if (!options.quiet) PrintReport(rows, process, out);
+  if (!result.ok()) {
+    err << "dyad run: " << result.message() << "\n";
+    return 1;
+  }
+  if (mismatches > 0) {
+    err << "dyad run: " << mismatches << " type/QoS mismatch(es) with peers (see above)\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace dyad

@@ -1,0 +1,39 @@
+// StepStats — timing of one component's steps: count, duration (mean, p99, max), start jitter,
+// deadline misses. O(1) per step, no allocation: durations go into a log-linear histogram
+// (16 sub-buckets per power of two, so a percentile is within ~6% of the true value).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <mutex>
+
+namespace dyad {
+
+class StepStats {
+ public:
+  struct Snapshot {
+    uint64_t steps = 0;
+    double mean_s = 0, p99_s = 0, max_s = 0;
+    double jitter_mean_s = 0, jitter_max_s = 0;
+    uint64_t deadline_misses = 0;
+  };
+
+  // duration: step wall time; jitter: |actual start - scheduled start| (0 for triggered steps).
+  void Record(int64_t duration_ns, int64_t jitter_ns, bool missed_deadline);
+  Snapshot Get() const;  // thread-safe against Record
+
+  // Histogram bucket of a duration, and the bucket's upper bound (exposed for tests).
+  static int Bucket(int64_t ns);
+  static int64_t BucketUpper(int bucket);
+
+ private:
+  static constexpr int kSub = 16;
+  static constexpr int kBuckets = 64 * kSub;
+  mutable std::mutex mutex_;
+  std::array<uint64_t, kBuckets> histogram_{};
+  uint64_t steps_ = 0, misses_ = 0;
+  double sum_ns_ = 0, jitter_sum_ns_ = 0;
+  int64_t max_ns_ = 0, jitter_max_ns_ = 0;
+};
+
+}  // namespace dyad

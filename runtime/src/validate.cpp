@@ -1,0 +1,263 @@
+// Graph validation: every check in one pass, every problem reported.
+#include "dyad/validate.hpp"
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace dyad {
+namespace {
+
+std::string Join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+SourceMark MarkOf(const std::string& file, const YAML::Node& node) {
+  const YAML::Mark m = node.Mark();
+  if (m.is_null()) return SourceMark{file, 0, 0};
+  return SourceMark{file, m.line + 1, m.column + 1};
+}
+
+bool ScalarAs(const YAML::Node& node, double* out) {
+  if (!node.IsScalar()) return false;
+  try {
+    *out = node.as<double>();
+    return true;
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+}
+
+std::string RangeError(const ParamSpec& spec, double v) {
+  std::ostringstream os;
+  if (spec.min && v < *spec.min) os << "must be >= " << *spec.min << ", got " << v;
+  else if (spec.max && v > *spec.max) os << "must be <= " << *spec.max << ", got " << v;
+  return os.str();
+}
+
+}  // namespace
+
+bool ParamFromYaml(const ParamSpec& spec, const YAML::Node& node, ParamValue* out, std::string* error) {
+  const std::string got = node.IsScalar() ? "'" + node.Scalar() + "'" : node.IsSequence() ? "a list" : node.IsMap() ? "a mapping" : "null";
+  auto fail = [&](const std::string& what) {
+    *error = "must be " + what + ", got " + got;
+    return false;
+  };
+  switch (spec.type) {
+    case ParamType::kBool: {
+      if (!node.IsScalar()) return fail("true or false");
+      try {
+        *out = node.as<bool>();
+        return true;
+      } catch (const YAML::Exception&) {
+        return fail("true or false");
+      }
+    }
+    case ParamType::kInt: {
+      if (!node.IsScalar()) return fail("an integer");
+      try {
+        const int64_t v = node.as<int64_t>();
+        if (auto e = RangeError(spec, static_cast<double>(v)); !e.empty()) { *error = e; return false; }
+        *out = v;
+        return true;
+      } catch (const YAML::Exception&) {
+        return fail("an integer");
+      }
+    }
+    case ParamType::kDouble: {
+      double v;
+      if (!ScalarAs(node, &v) || !std::isfinite(v)) return fail("a finite number");
+      if (auto e = RangeError(spec, v); !e.empty()) { *error = e; return false; }
+      *out = v;
+      return true;
+    }
+    case ParamType::kString: {
+      if (!node.IsScalar()) return fail("a string");
+      if (!spec.choices.empty() && std::find(spec.choices.begin(), spec.choices.end(), node.Scalar()) == spec.choices.end())
+        return fail("one of: " + Join(spec.choices));
+      *out = node.Scalar();
+      return true;
+    }
+    case ParamType::kDoubleList: {
+      if (!node.IsSequence()) return fail("a list of numbers");
+      std::vector<double> v;
+      for (const auto& e : node) {
+        double x;
+        if (!ScalarAs(e, &x) || !std::isfinite(x)) return fail("a list of numbers");
+        if (auto err = RangeError(spec, x); !err.empty()) { *error = "element " + err; return false; }
+        v.push_back(x);
+      }
+      *out = v;
+      return true;
+    }
+    case ParamType::kStringList: {
+      if (!node.IsSequence()) return fail("a list of strings");
+      std::vector<std::string> v;
+      for (const auto& e : node) {
+        if (!e.IsScalar()) return fail("a list of strings");
+        v.push_back(e.Scalar());
+      }
+      *out = v;
+      return true;
+    }
+    case ParamType::kYaml: {
+      YAML::Emitter em;
+      em << YAML::Flow << node;
+      *out = std::string(em.c_str());
+      return true;
+    }
+  }
+  return fail("a valid value");
+}
+
+ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vector<Diagnostic>* diags) {
+  ResolvedGraph out;
+  auto error = [&](const SourceMark& m, const std::string& key, const std::string& msg) {
+    diags->push_back(Diagnostic{m, key, msg});
+  };
+  const SourceMark file_mark{graph.file, 1, 1};
+
+  std::set<std::string> process_names;
+  for (const auto& p : graph.processes) process_names.insert(p.name);
+
+  // Topic -> (type, who) per writer and reader, for type checks and "nobody publishes".
+  struct PortUse {
+    const TypeInfo* type;
+    std::string who;  // "components.x.outputs.y"
+    SourceMark mark;
+  };
+  std::map<std::string, std::vector<PortUse>> writers, readers;
+  std::set<std::string> processes_used;
+
+  for (const auto& c : graph.components) {
+    const std::string key = "components." + c.name;
+    ResolvedComponent rc;
+    rc.config = &c;
+    const std::string proc = graph.ProcessOf(c);
+    processes_used.insert(proc);
+    if (!c.process.empty() && !graph.processes.empty() && !process_names.count(c.process))
+      error(c.process_mark, key + ".process", "no process '" + c.process + "' under processes:");
+
+    if (c.rate_hz > 0 && !c.trigger.empty())
+      error(c.trigger_mark, key + ".trigger", "give either rate_hz or trigger, not both");
+    if (c.rate_hz > 0) rc.period_ns = static_cast<int64_t>(std::llround(1e9 / c.rate_hz));
+
+    const CatalogEntry* entry = c.type.empty() ? nullptr : catalog.Find(c.type);
+    if (entry == nullptr) {
+      if (!c.type.empty()) {
+        std::vector<std::string> known;
+        for (const auto& [name, e] : catalog.entries()) known.push_back(name);
+        error(c.type_mark, key + ".type", "unknown component type '" + c.type + "' (known: " + Join(known) + ")");
+      }
+      continue;
+    }
+    rc.entry = entry;
+    const ComponentSpec& spec = entry->spec;
+
+    if (!(c.rate_hz > 0) && c.trigger.empty() && !c.rate_mark.line)
+      error(c.mark, key, "needs rate_hz (periodic) or trigger: <input> (steps when that input receives)");
+    if (!c.trigger.empty() && spec.FindInput(c.trigger) == nullptr)
+      error(c.trigger_mark, key + ".trigger", "'" + c.trigger + "' is not an input of type " + c.type);
+
+    // Params: unknown, mistyped, out of range, missing.
+    std::map<std::string, ParamValue> values;
+    if (c.params && c.params.IsMap()) {
+      for (const auto& kv : c.params) {
+        const std::string pname = kv.first.Scalar();
+        const std::string pkey = key + ".params." + pname;
+        const SourceMark pmark = kv.second.Mark().is_null() ? SourceMark{graph.file, 0, 0} : MarkOf(graph.file, kv.second);
+        const SourceMark at = pmark.line ? pmark : SourceMark{"--set " + c.name + "." + pname, 0, 0};
+        const ParamSpec* ps = spec.FindParam(pname);
+        if (ps == nullptr) {
+          std::vector<std::string> known;
+          for (const auto& p : spec.params()) known.push_back(p.name);
+          error(MarkOf(graph.file, kv.first).line ? MarkOf(graph.file, kv.first) : at, pkey,
+                "unknown parameter of " + c.type + " (known: " + (known.empty() ? "none" : Join(known)) + ")");
+          continue;
+        }
+        ParamValue v;
+        std::string msg;
+        if (!ParamFromYaml(*ps, kv.second, &v, &msg)) error(at, pkey, msg);
+        else values[pname] = v;
+      }
+    }
+    for (const auto& ps : spec.params()) {
+      if (values.count(ps.name)) continue;
+      if (ps.default_value) values[ps.name] = *ps.default_value;
+      else error(c.params_mark.line ? c.params_mark : c.mark, key + ".params." + ps.name,
+                 std::string("missing required parameter (") + ToString(ps.type) + (ps.doc.empty() ? "" : ": " + ps.doc) + ")");
+    }
+    rc.params = Params(std::move(values));
+
+    // Ports.
+    std::set<std::string> bound_inputs;
+    for (const auto& b : c.inputs) {
+      const PortSpec* ps = spec.FindInput(b.port);
+      if (ps == nullptr) {
+        std::vector<std::string> known;
+        for (const auto& p : spec.inputs()) known.push_back(p.name);
+        error(b.mark, key + ".inputs." + b.port, "no input '" + b.port + "' on type " + c.type + " (inputs: " + (known.empty() ? "none" : Join(known)) + ")");
+        continue;
+      }
+      bound_inputs.insert(b.port);
+      readers[b.topic].push_back({ps->type, key + ".inputs." + b.port, b.mark});
+    }
+    for (const auto& ps : spec.inputs())
+      if (!ps.optional && !bound_inputs.count(ps.name))
+        error(c.mark, key + ".inputs." + ps.name, "required input is not bound to a topic (" + ps.type->short_name() + ")");
+    for (const auto& b : c.outputs) {
+      const PortSpec* ps = spec.FindOutput(b.port);
+      if (ps == nullptr) {
+        std::vector<std::string> known;
+        for (const auto& p : spec.outputs()) known.push_back(p.name);
+        error(b.mark, key + ".outputs." + b.port, "no output '" + b.port + "' on type " + c.type + " (outputs: " + (known.empty() ? "none" : Join(known)) + ")");
+        continue;
+      }
+      writers[b.topic].push_back({ps->type, key + ".outputs." + b.port, b.mark});
+    }
+    out.components.push_back(std::move(rc));
+  }
+
+  // Declared topic types must exist.
+  for (const auto& t : graph.topics) {
+    if (!t.type.empty() && catalog.FindMessageType(t.type) == nullptr) {
+      std::vector<std::string> known;
+      for (const auto* ti : catalog.MessageTypes()) known.push_back(ti->short_name());
+      error(t.type_mark, "topics." + t.name + ".type", "unknown message type '" + t.type + "' (known: " + Join(known) + ")");
+    }
+  }
+
+  // Topic types agree; every read topic has a writer.
+  std::set<std::string> all_topics;
+  for (const auto& [t, _] : writers) all_topics.insert(t);
+  for (const auto& [t, _] : readers) all_topics.insert(t);
+  for (const auto& name : all_topics) {
+    ResolvedTopic rt;
+    rt.name = name;
+    rt.config = graph.FindTopic(name);
+    const TypeInfo* declared = rt.config && !rt.config->type.empty() ? catalog.FindMessageType(rt.config->type) : nullptr;
+    std::vector<PortUse> uses = writers[name];
+    uses.insert(uses.end(), readers[name].begin(), readers[name].end());
+    const TypeInfo* first = declared ? declared : uses.front().type;
+    const std::string first_who = declared ? "topics." + name + ".type" : uses.front().who;
+    for (const auto& u : uses) {
+      if (u.type->name != first->name)
+        error(u.mark, u.who, "topic '" + name + "' carries " + first->short_name() + " (" + first_who + ") but this port is " +
+                                 u.type->short_name());
+    }
+    rt.type = first;
+    if (writers[name].empty())
+      for (const auto& u : readers[name])
+        error(u.mark, u.who, "nothing publishes topic '" + name + "' (no component output is bound to it)");
+    out.topics[name] = rt;
+  }
+
+  if (graph.clock == ClockMode::kStepped && processes_used.size() > 1)
+    error(file_mark, "clock", "stepped clock runs the graph in one process, but components are placed in " +
+                                  std::to_string(processes_used.size()) + " processes");
+  return out;
+}
+
+}  // namespace dyad

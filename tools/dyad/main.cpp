@@ -1,0 +1,24 @@
+// The dyad command line: one executable, one subcommand per job. Each command group lives in
+// its own library and adds its subcommands here.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+#include "runtime_commands.hpp"
+#include "introspection_commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"dyad: human-robot interaction experiments as graphs of components over DDS"};
+  app.require_subcommand(1);
+  app.set_help_all_flag("--help-all", "Show every subcommand's help");
+  int exit_code = 0;
+  dyad::cli::AddRuntimeCommands(app, exit_code);
+  dyad::cli::AddIntrospectionCommands(app, exit_code);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;  // usage errors are bad input
+  }
+  return exit_code;
+}

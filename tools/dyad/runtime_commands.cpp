@@ -1,0 +1,86 @@
+#include "runtime_commands.hpp"
+
+#include <iomanip>
+#include <iostream>
+
+#include <dyad/catalog.hpp>
+#include <dyad/run.hpp>
+
+namespace dyad::cli {
+namespace {
+
+std::vector<Override> ToOverrides(const std::vector<std::string>& sets) {
+  std::vector<Override> out;
+  for (const auto& s : sets) out.push_back(Override{s});
+  return out;
+}
+
+void PrintTypes(const Catalog& catalog, std::ostream& out) {
+  for (const auto& [name, e] : catalog.entries()) {
+    out << name << "  (" << e.type.plugin_path << ")\n";
+    if (!e.spec.summary().empty()) out << "  " << e.spec.summary() << "\n";
+    for (const auto& p : e.spec.inputs())
+      out << "  input  " << p.name << ": " << p.type->short_name() << (p.optional ? " (optional)" : "")
+          << (p.doc.empty() ? "" : "  # " + p.doc) << "\n";
+    for (const auto& p : e.spec.outputs())
+      out << "  output " << p.name << ": " << p.type->short_name() << (p.doc.empty() ? "" : "  # " + p.doc) << "\n";
+    for (const auto& p : e.spec.params()) {
+      out << "  param  " << p.name << ": " << ToString(p.type);
+      out << (p.default_value ? " = " + ToYamlText(*p.default_value) : " (required)");
+      if (!p.unit.empty()) out << " [" << p.unit << "]";
+      if (p.min || p.max)
+        out << " range " << (p.min ? std::to_string(*p.min) : "-inf") << ".." << (p.max ? std::to_string(*p.max) : "inf");
+      if (!p.choices.empty()) {
+        out << " one of";
+        for (const auto& c : p.choices) out << " " << c;
+      }
+      if (!p.doc.empty()) out << "  # " << p.doc;
+      out << "\n";
+    }
+  }
+}
+
+}  // namespace
+
+void AddRuntimeCommands(CLI::App& app, int& exit_code) {
+  // Shared between subcommands; CLI11 keeps the pointers.
+  static RunOptions run;
+  static std::vector<std::string> sets;
+  static std::vector<std::string> plugins;
+
+  auto* validate = app.add_subcommand("validate", "Check a graph file; print every problem (exit 2) or OK");
+  validate->add_option("graph", run.graph_path, "Graph YAML file")->required();
+  validate->add_option("--set", sets, "Override a parameter: COMPONENT.PARAM=VALUE (repeatable)");
+  validate->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
+  validate->callback([&exit_code] {
+    exit_code = ValidateGraphFile(run.graph_path, ToOverrides(sets), plugins, std::cout, std::cerr);
+  });
+
+  auto* r = app.add_subcommand("run", "Run a graph (the components of one process, or launch every process)");
+  r->add_option("graph", run.graph_path, "Graph YAML file")->required();
+  r->add_option("--process", run.process, "Run only the components placed in this process");
+  r->add_option("--set", sets, "Override a parameter: COMPONENT.PARAM=VALUE (repeatable)");
+  r->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
+  r->add_option("--duration", run.duration_s, "Stop after this many seconds of wall time")->check(CLI::NonNegativeNumber);
+  r->add_option("--steps", run.steps, "Stop after the fastest periodic component ran this many steps");
+  r->add_option("--stats-period", run.stats_period_s, "Seconds between ComponentStats samples on dyad/stats")
+      ->check(CLI::PositiveNumber);
+  r->add_flag("--quiet", run.quiet, "Do not print the timing table at exit");
+  r->callback([&exit_code] {
+    run.overrides = ToOverrides(sets);
+    run.plugin_paths = plugins;
+    exit_code = RunGraph(run, std::cout, std::cerr);
+  });
+
+  auto* types = app.add_subcommand("types", "List every component type found, with its ports and parameters");
+  types->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
+  types->callback([&exit_code] {
+    Catalog catalog;
+    Status s = catalog.LoadDefault(plugins);
+    if (!s.ok()) std::cerr << "warning: " << s.message() << "\n";
+    PrintTypes(catalog, std::cout);
+    exit_code = catalog.entries().empty() ? 1 : 0;
+  });
+}
+
+}  // namespace dyad::cli
