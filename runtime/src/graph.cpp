@@ -185,6 +185,7 @@ void ApplyOverrides(const std::vector<Override>& overrides, Graph* g, std::vecto
     }
     try {
       c->params[param] = YAML::Load(value);
+      c->overridden[param] = o.text;
     } catch (const YAML::Exception& e) {
       out->push_back({cli, "components." + comp + ".params." + param, "value is not valid YAML: " + e.msg});
     }

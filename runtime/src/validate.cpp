@@ -167,13 +167,13 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
       for (const auto& kv : c.params) {
         const std::string pname = kv.first.Scalar();
         const std::string pkey = key + ".params." + pname;
-        const SourceMark pmark = kv.second.Mark().is_null() ? SourceMark{graph.file, 0, 0} : MarkOf(graph.file, kv.second);
-        const SourceMark at = pmark.line ? pmark : SourceMark{"--set " + c.name + "." + pname, 0, 0};
+        auto set = c.overridden.find(pname);
+        const SourceMark at = set != c.overridden.end() ? SourceMark{"--set " + set->second, 0, 0} : MarkOf(graph.file, kv.second);
         const ParamSpec* ps = spec.FindParam(pname);
         if (ps == nullptr) {
           std::vector<std::string> known;
           for (const auto& p : spec.params()) known.push_back(p.name);
-          error(MarkOf(graph.file, kv.first).line ? MarkOf(graph.file, kv.first) : at, pkey,
+          error(set != c.overridden.end() ? at : MarkOf(graph.file, kv.first), pkey,
                 "unknown parameter of " + c.type + " (known: " + (known.empty() ? "none" : Join(known)) + ")");
           continue;
         }

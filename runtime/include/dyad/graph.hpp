@@ -82,6 +82,7 @@ struct ComponentConfig {
   double rate_hz = 0;      // > 0: periodic
   std::string trigger;     // input name: step when it receives
   YAML::Node params;       // map as written (with overrides applied)
+  std::map<std::string, std::string> overridden;  // param -> the --set text that set it
   std::vector<PortBinding> inputs, outputs;
   SourceMark mark, type_mark, rate_mark, trigger_mark, process_mark, params_mark;
 };

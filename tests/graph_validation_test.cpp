@@ -1,0 +1,176 @@
+// Invalid graphs are rejected before anything runs, each problem with file:line:col and key.
+#include <gtest/gtest.h>
+
+#include <dyad/catalog.hpp>
+#include <dyad/graph.hpp>
+#include <dyad/validate.hpp>
+
+namespace dyad {
+namespace {
+
+const Catalog& ExampleCatalog() {
+  static Catalog* catalog = [] {
+    auto* c = new Catalog();
+    Status s = c->Load(DYAD_TEST_PLUGIN_DIR);
+    EXPECT_TRUE(s.ok()) << s.ToString();
+    return c;
+  }();
+  return *catalog;
+}
+
+std::vector<Diagnostic> Check(const std::string& yaml, const std::vector<std::string>& sets = {}) {
+  std::vector<Diagnostic> diags;
+  std::vector<Override> overrides;
+  for (const auto& s : sets) overrides.push_back({s});
+  Graph g = ParseGraph(yaml, "g.yaml", overrides, &diags);
+  if (!g.components.empty()) ValidateGraph(g, ExampleCatalog(), &diags);
+  return diags;
+}
+
+// A valid base graph; cases below change one thing.
+const char* kValid = R"(graph: ok
+clock: stepped
+components:
+  src:
+    type: counter_source
+    rate_hz: 10
+    params: {noise: 1}
+    outputs: {out: count}
+  sink:
+    type: counter_sink
+    trigger: in
+    inputs: {in: count}
+)";
+
+TEST(GraphValidation, ValidGraphHasNoProblems) {
+  auto d = Check(kValid);
+  for (const auto& x : d) ADD_FAILURE() << x.ToString();
+}
+
+struct BadCase {
+  const char* name;
+  std::string yaml;
+  std::string where;  // "g.yaml:L:C"
+  std::string key;
+  std::string message_part;
+};
+
+std::string Replace(std::string s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  if (pos != std::string::npos) s.replace(pos, from.size(), to);
+  return s;
+}
+
+std::vector<BadCase> BadCases() {
+  const std::string v = kValid;
+  return {
+      {"YamlSyntax", "components: {a: [1, 2}\n", "g.yaml:1:", "", "YAML syntax error"},
+      {"UnknownTopLevelKey", Replace(v, "clock: stepped", "clock: stepped\nspeed: 3"), "g.yaml:3:1", "speed", "unknown key"},
+      {"UnknownComponentKey", Replace(v, "    rate_hz: 10", "    rate_hz: 10\n    colour: red"), "g.yaml:7:5",
+       "components.src.colour", "unknown key"},
+      {"UnknownType", Replace(v, "type: counter_source", "type: counter_sauce"), "g.yaml:5:11", "components.src.type",
+       "unknown component type 'counter_sauce'"},
+      {"MissingType", Replace(v, "    type: counter_source\n", ""), "g.yaml:4:3", "components.src.type", "missing"},
+      {"UnknownParam", Replace(v, "{noise: 1}", "{noize: 1}"), "g.yaml:7:14", "components.src.params.noize",
+       "unknown parameter"},
+      {"MistypedParam", Replace(v, "{noise: 1}", "{noise: loud}"), "g.yaml:7:21", "components.src.params.noise",
+       "must be a finite number"},
+      {"ParamOutOfRange", Replace(v, "{noise: 1}", "{noise: -1}"), "g.yaml:7:21", "components.src.params.noise",
+       "must be >= 0"},
+      {"IntParamGivenFloat", Replace(v, "{noise: 1}", "{limit: 2.5}"), "g.yaml:7:21", "components.src.params.limit",
+       "must be an integer"},
+      {"ZeroRate", Replace(v, "rate_hz: 10", "rate_hz: 0"), "g.yaml:6:14", "components.src.rate_hz", "must be > 0"},
+      {"NegativeRate", Replace(v, "rate_hz: 10", "rate_hz: -5"), "g.yaml:6:14", "components.src.rate_hz", "must be > 0"},
+      {"RateNotANumber", Replace(v, "rate_hz: 10", "rate_hz: fast"), "g.yaml:6:14", "components.src.rate_hz",
+       "must be a number"},
+      {"NoRateNorTrigger", Replace(v, "    trigger: in\n", ""), "g.yaml:9:3", "components.sink", "needs rate_hz"},
+      {"TriggerNotAnInput", Replace(v, "trigger: in", "trigger: nope"), "g.yaml:11:14", "components.sink.trigger",
+       "not an input"},
+      {"DuplicateComponent", Replace(v, "  sink:", "  src:\n    type: counter_source\n    rate_hz: 1\n  sink:"),
+       "g.yaml:9:3", "components.src", "duplicate key"},
+      {"InputNobodyPublishes", Replace(v, "inputs: {in: count}", "inputs: {in: cuont}"), "g.yaml:12:18",
+       "components.sink.inputs.in", "nothing publishes topic 'cuont'"},
+      {"UnknownInputPort", Replace(v, "inputs: {in: count}", "inputs: {in: count, extra: count}"), "g.yaml:12:32",
+       "components.sink.inputs.extra", "no input 'extra'"},
+      {"UnknownOutputPort", Replace(v, "outputs: {out: count}", "outputs: {output: count}"), "g.yaml:8:23",
+       "components.src.outputs.output", "no output 'output'"},
+      {"TopicTypeMismatch", v + "topics:\n  count: {type: HumanInput}\n", "g.yaml:8:20", "components.src.outputs.out",
+       "carries HumanInput"},
+      {"UnknownTopicType", v + "topics:\n  count: {type: Humanoid}\n", "g.yaml:14:17", "topics.count.type",
+       "unknown message type 'Humanoid'"},
+      {"BadReliability", v + "topics:\n  count: {reliability: sometimes}\n", "g.yaml:14:24", "topics.count.reliability",
+       "reliable or best_effort"},
+      {"BadDepth", v + "topics:\n  count: {depth: 0}\n", "g.yaml:14:18", "topics.count.depth", "must be >= 1"},
+      {"BadClock", Replace(v, "clock: stepped", "clock: sundial"), "g.yaml:2:8", "clock", "wall or stepped"},
+      {"BadDomain", Replace(v, "clock: stepped", "clock: stepped\ndomain_id: 300"), "g.yaml:3:12", "domain_id",
+       "0..232"},
+      {"UndeclaredProcess", Replace(v, "    rate_hz: 10", "    rate_hz: 10\n    process: robot") + "processes:\n  main: {}\n",
+       "g.yaml:7:14", "components.src.process", "no process 'robot'"},
+      {"SteppedAcrossProcesses",
+       Replace(Replace(v, "    rate_hz: 10", "    rate_hz: 10\n    process: a"), "    trigger: in", "    trigger: in\n    process: b") +
+           "processes:\n  a: {}\n  b: {}\n",
+       "g.yaml:1:1", "clock", "one process"},
+      {"RequiredInputUnbound", Replace(v, "    inputs: {in: count}\n", ""), "g.yaml:9:3", "components.sink.inputs.in",
+       "required input is not bound"},
+      {"BothRateAndTrigger", Replace(v, "    trigger: in", "    trigger: in\n    rate_hz: 5"), "g.yaml:11:14",
+       "components.sink.trigger", "either rate_hz or trigger"},
+      {"ComponentsNotAMap", "graph: x\ncomponents: [a, b]\n", "g.yaml:2:13", "components", "must be a mapping"},
+  };
+}
+
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.name; }
+
+class BadGraph : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadGraph, IsRejectedWithFileLineAndKey) {
+  const BadCase& c = GetParam();
+  const auto diags = Check(c.yaml);
+  ASSERT_FALSE(diags.empty()) << "accepted:\n" << c.yaml;
+  bool found = false;
+  std::string all;
+  for (const auto& d : diags) {
+    all += d.ToString() + "\n";
+    if (d.ToString().rfind(c.where, 0) == 0 && d.key == c.key && d.message.find(c.message_part) != std::string::npos)
+      found = true;
+  }
+  EXPECT_TRUE(found) << "expected " << c.where << ": " << c.key << ": ..." << c.message_part << "...\ngot:\n" << all;
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, BadGraph, ::testing::ValuesIn(BadCases()),
+                         [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });
+
+TEST(GraphValidation, ReportsEveryProblemAtOnce) {
+  std::string y = Replace(Replace(Replace(kValid, "{noise: 1}", "{noise: -1}"), "rate_hz: 10", "rate_hz: 0"),
+                          "inputs: {in: count}", "inputs: {in: other}");
+  const auto diags = Check(y);
+  EXPECT_GE(diags.size(), 3u);
+}
+
+TEST(GraphValidation, OverrideSetsParamAndIsValidated) {
+  EXPECT_TRUE(Check(kValid, {"src.noise=2"}).empty());
+  const auto bad = Check(kValid, {"src.noise=-3"});
+  ASSERT_EQ(bad.size(), 1u);
+  EXPECT_EQ(bad[0].key, "components.src.params.noise");
+  EXPECT_NE(bad[0].mark.file.find("--set src.noise"), std::string::npos) << bad[0].ToString();
+  const auto unknown = Check(kValid, {"nobody.noise=1"});
+  ASSERT_EQ(unknown.size(), 1u);
+  EXPECT_NE(unknown[0].message.find("no such component"), std::string::npos);
+  EXPECT_EQ(Check(kValid, {"garbage"}).size(), 1u);
+}
+
+TEST(GraphValidation, FillsDefaultsAndResolvesPeriods) {
+  std::vector<Diagnostic> diags;
+  Graph g = ParseGraph(kValid, "g.yaml", {}, &diags);
+  ResolvedGraph r = ValidateGraph(g, ExampleCatalog(), &diags);
+  ASSERT_TRUE(diags.empty());
+  ASSERT_EQ(r.components.size(), 2u);
+  EXPECT_EQ(r.components[0].period_ns, 100'000'000);
+  EXPECT_EQ(r.components[1].period_ns, 0);
+  EXPECT_DOUBLE_EQ(r.components[0].params.Double("noise"), 1.0);
+  EXPECT_EQ(r.components[0].params.Int("limit"), 0);
+  EXPECT_EQ(r.topics.at("count").type->short_name(), "Counter");
+}
+
+}  // namespace
+}  // namespace dyad

@@ -1,0 +1,37 @@
+// Test peer: publishes dyad::msg::Counter under a different definition hash, as a process built
+// from another version of the IDL would. Usage: dyad_type_peer DOMAIN TOPIC SECONDS
+#include <chrono>
+#include <cstdlib>
+#include <iostream>
+#include <thread>
+
+#include <dyad/msg/types.hpp>
+
+#include "dds_participant.hpp"
+
+int main(int argc, char** argv) {
+  if (argc != 4) {
+    std::cerr << "usage: dyad_type_peer DOMAIN TOPIC SECONDS\n";
+    return 2;
+  }
+  dyad::TypeInfo other = dyad::TypeInfoOf<dyad::msg::Counter>();
+  other.hash = "0000000000000000";
+  const std::string dds_name = other.dds_name();
+  other.make_type_support = [dds_name] {
+    auto* t = new dyad::msg::CounterPubSubType();
+    t->setName(dds_name.c_str());
+    return static_cast<eprosima::fastdds::dds::TopicDataType*>(t);
+  };
+  auto p = dyad::DdsParticipant::Create(std::atoi(argv[1]), "type-peer", nullptr);
+  if (!p.ok()) return 1;
+  auto w = p.value()->CreateWriter(argv[2], other, dyad::TopicQos{});
+  if (!w.ok()) return 1;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(std::atof(argv[3]));
+  dyad::msg::Counter c;
+  while (std::chrono::steady_clock::now() < end) {
+    c.value(c.value() + 1);
+    w.value()->Write(&c);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return 0;
+}
