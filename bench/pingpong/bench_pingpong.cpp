@@ -1,0 +1,196 @@
+// Round-trip latency of a sample through two dyad components (bench_ping -> bench_pong -> back)
+// versus two bare Fast DDS endpoints doing the same (same type, QoS, transport and process),
+// alternating in one run. Prints median and p99 of each and their ratio.
+//
+//   build/bin/bench_pingpong [--rounds N] [--repeats R] [--payload BYTES]
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+
+#include <dyad/msg/types.hpp>
+#include <dyad/run.hpp>
+
+namespace fdds = eprosima::fastdds::dds;
+
+namespace {
+
+int64_t SteadyNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The bare Fast DDS version: pong's listener replies; ping's listener records the round trip and
+// the next sample is sent as soon as the previous one is back (on the delivering thread, like a
+// triggered dyad component).
+class BarePingPong {
+ public:
+  BarePingPong(int domain, size_t payload) {
+    auto* f = fdds::DomainParticipantFactory::get_instance();
+    participant_ = f->create_participant(domain, fdds::PARTICIPANT_QOS_DEFAULT);
+    const auto& info = dyad::TypeInfoOf<dyad::msg::PingPong>();
+    fdds::TypeSupport ts(info.make_type_support());
+    ts.register_type(participant_, info.dds_name());
+    auto* ping_topic = participant_->create_topic("bare/ping", info.dds_name(), fdds::TOPIC_QOS_DEFAULT);
+    auto* pong_topic = participant_->create_topic("bare/pong", info.dds_name(), fdds::TOPIC_QOS_DEFAULT);
+    auto* pub = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+    auto* sub = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+    fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
+    wq.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+    wq.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+    wq.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    wq.history().depth = 1;
+    fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
+    rq.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+    rq.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+    rq.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    rq.history().depth = 1;
+    ping_writer_ = pub->create_datawriter(ping_topic, wq);
+    pong_writer_ = pub->create_datawriter(pong_topic, wq);
+    pong_listener_.owner = this;
+    ping_listener_.owner = this;
+    sub->create_datareader(ping_topic, rq, &pong_listener_, fdds::StatusMask::data_available());
+    sub->create_datareader(pong_topic, rq, &ping_listener_, fdds::StatusMask::data_available());
+    sample_.payload().resize(payload);
+  }
+  ~BarePingPong() {
+    participant_->delete_contained_entities();
+    fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+
+  std::vector<int64_t> Run(int rounds) {
+    rtt_.clear();
+    rtt_.reserve(rounds);
+    while (static_cast<int>(rtt_.size()) < rounds) {
+      pending_.store(false);
+      sending_.store(true);
+      sample_.id(sample_.id() + 1);
+      sample_.t0_ns(SteadyNs());
+      ping_writer_->write(&sample_);
+      sending_.store(false);
+      if (!pending_.load()) {  // delivered on another thread: wait for it
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait_for(lock, std::chrono::seconds(1), [&] { return pending_.load(); });
+      }
+    }
+    return rtt_;
+  }
+
+ private:
+  struct PongListener : fdds::DataReaderListener {
+    BarePingPong* owner;
+    dyad::msg::PingPong s;
+    void on_data_available(fdds::DataReader* r) override {
+      fdds::SampleInfo info;
+      while (r->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK)
+        if (info.valid_data) owner->pong_writer_->write(&s);
+    }
+  };
+  struct PingListener : fdds::DataReaderListener {
+    BarePingPong* owner;
+    dyad::msg::PingPong s;
+    void on_data_available(fdds::DataReader* r) override {
+      fdds::SampleInfo info;
+      const int64_t now = SteadyNs();
+      while (r->take_next_sample(&s, &info) == ReturnCode_t::RETCODE_OK)
+        if (info.valid_data && s.id() == owner->sample_.id()) owner->rtt_.push_back(now - s.t0_ns());
+      std::lock_guard<std::mutex> lock(owner->mutex_);
+      owner->pending_.store(true);
+      owner->cv_.notify_one();
+    }
+  };
+  fdds::DomainParticipant* participant_ = nullptr;
+  fdds::DataWriter* ping_writer_ = nullptr;
+  fdds::DataWriter* pong_writer_ = nullptr;
+  PongListener pong_listener_;
+  PingListener ping_listener_;
+  dyad::msg::PingPong sample_;
+  std::vector<int64_t> rtt_;
+  std::atomic<bool> pending_{false}, sending_{false};
+  std::mutex mutex_;
+  std::condition_variable cv_;
+};
+
+std::vector<int64_t> RunDyad(int domain, int rounds, size_t payload, const std::string& dir) {
+  const std::string graph = dir + "/pingpong.yaml";
+  const std::string out = dir + "/rtt.txt";
+  std::ofstream(graph) << "graph: pingpong\nclock: wall\ndomain_id: " << domain
+                       << "\ncomponents:\n"
+                          "  pong: {type: bench_pong, trigger: in, inputs: {in: ping}, outputs: {out: pong}}\n"
+                          "  ping: {type: bench_ping, trigger: back, params: {rounds: "
+                       << rounds << ", payload: " << payload << ", file: " << out
+                       << "}, inputs: {back: pong}, outputs: {out: ping}}\n"
+                          "topics:\n  ping: {reliability: reliable, depth: 1}\n  pong: {reliability: reliable, depth: 1}\n";
+  dyad::RunOptions o;
+  o.graph_path = graph;
+  o.quiet = true;
+  o.plugin_paths = {DYAD_BENCH_PLUGIN};
+  std::ostringstream sink;
+  if (dyad::RunGraph(o, sink, std::cerr) != 0) {
+    std::cerr << "dyad run failed\n";
+    std::exit(1);
+  }
+  std::vector<int64_t> v;
+  std::ifstream in(out);
+  for (int64_t x; in >> x;) v.push_back(x);
+  return v;
+}
+
+double Percentile(std::vector<int64_t> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return static_cast<double>(v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))]) * 1e-3;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int rounds = 20000, repeats = 5;
+  size_t payload = 0;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--rounds")) rounds = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--repeats")) repeats = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--payload")) payload = static_cast<size_t>(std::atoi(argv[i + 1]));
+  }
+  const int domain = 1 + static_cast<int>(getpid() % 200);
+  const std::string dir = std::filesystem::temp_directory_path() / ("dyad_pingpong_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  std::vector<int64_t> bare_all, dyad_all;
+  BarePingPong bare(domain, payload);
+  bare.Run(1000);  // warm-up
+  for (int r = 0; r < repeats; ++r) {  // alternate, so drift on a shared machine hits both alike
+    auto b = bare.Run(rounds);
+    bare_all.insert(bare_all.end(), b.begin() + b.size() / 10, b.end());
+    auto d = RunDyad(domain + 1, rounds, payload, dir);
+    dyad_all.insert(dyad_all.end(), d.begin() + d.size() / 10, d.end());
+  }
+  std::filesystem::remove_all(dir);
+  const double bm = Percentile(bare_all, 0.5), bp = Percentile(bare_all, 0.99);
+  const double dm = Percentile(dyad_all, 0.5), dp = Percentile(dyad_all, 0.99);
+  std::printf("round trip, one process, RELIABLE KEEP_LAST 1, PingPong with %zu-byte payload, %d x %d rounds (first 10%% of each dropped)\n",
+              payload, repeats, rounds);
+  std::printf("%-22s %12s %12s\n", "", "median_us", "p99_us");
+  std::printf("%-22s %12.2f %12.2f\n", "bare Fast DDS", bm, bp);
+  std::printf("%-22s %12.2f %12.2f\n", "dyad components", dm, dp);
+  std::printf("%-22s %12.3f %12.3f\n", "ratio dyad/bare", dm / bm, dp / bp);
+  return 0;
+}
