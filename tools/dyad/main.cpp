@@ -4,8 +4,9 @@
 
 #include <iostream>
 
-#include "runtime_commands.hpp"
+#include "bag_commands.hpp"
 #include "introspection_commands.hpp"
+#include "runtime_commands.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"dyad: human-robot interaction experiments as graphs of components over DDS"};
@@ -14,6 +15,7 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   dyad::cli::AddRuntimeCommands(app, exit_code);
   dyad::cli::AddIntrospectionCommands(app, exit_code);
+  dyad::cli::AddBagCommands(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,105 @@
+#include "bag_commands.hpp"
+
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bag_info.hpp"
+#include "csv_export.hpp"
+#include "dyad/mcap/reader.hpp"
+
+namespace dyad::cli {
+namespace {
+
+constexpr int kOk = 0;
+constexpr int kFailure = 1;
+constexpr int kBadInput = 2;
+
+// Opens a recording; prints why not and returns null when it cannot be read at all.
+std::unique_ptr<mcap::Reader> OpenRecording(const std::string& path, bool scan) {
+  mcap::ReaderOptions options;
+  options.use_summary = !scan;
+  mcap::StatusOr<mcap::Reader> reader = mcap::Reader::Open(path, options);
+  if (!reader.ok()) {
+    std::cerr << "dyad bag: " << reader.status().message() << "\n";
+    return nullptr;
+  }
+  return std::make_unique<mcap::Reader>(std::move(reader).value());
+}
+
+int RunInfo(const std::string& path, bool scan) {
+  auto reader = OpenRecording(path, scan);
+  if (!reader) return kBadInput;
+  std::cout << bag::FormatInfo(*reader);
+  return reader->recovery().damaged_chunks.empty() ? kOk : kFailure;
+}
+
+int RunExport(const std::string& path, const std::string& dir, const std::vector<std::string>& topics) {
+  auto reader = OpenRecording(path, false);
+  if (!reader) return kBadInput;
+  if (reader->recovery().truncated) std::cerr << "dyad bag: " << path << ": " << reader->recovery().Describe() << "\n";
+  bag::CsvExportOptions options;
+  options.topics.insert(topics.begin(), topics.end());
+  for (const std::string& topic : topics) {
+    bool known = false;
+    for (const auto& [id, channel] : reader->channels()) known = known || channel.topic == topic;
+    if (!known) {
+      std::cerr << "dyad bag: " << path << ": no channel with topic \"" << topic << "\"\n";
+      return kBadInput;
+    }
+  }
+  bag::CsvExportSummary summary;
+  mcap::Status status = bag::ExportCsv(*reader, dir, options, &summary);
+  for (const auto& [topic, file] : summary.files) {
+    std::cout << file << ": " << summary.rows[topic] << " rows (" << topic << ")\n";
+  }
+  if (!status.ok()) {
+    std::cerr << "dyad bag: " << status.message() << "\n";
+    return kFailure;
+  }
+  int code = kOk;
+  if (summary.skipped_chunks > 0) {
+    std::cerr << "dyad bag: " << path << ": skipped " << summary.skipped_chunks << " damaged chunk(s)\n";
+    code = kFailure;
+  }
+  if (summary.undecodable > 0) {
+    std::cerr << "dyad bag: " << summary.undecodable << " payload(s) could not be decoded; first: "
+              << summary.first_decode_error << "\n";
+    code = kFailure;
+  }
+  return code;
+}
+
+}  // namespace
+
+void AddBagCommands(CLI::App& app, int& exit_code) {
+  CLI::App* bag = app.add_subcommand("bag", "Inspect and export MCAP recordings");
+  bag->require_subcommand(1);
+
+  struct InfoArgs {
+    std::string file;
+    bool scan = false;
+  };
+  auto info_args = std::make_shared<InfoArgs>();
+  CLI::App* info = bag->add_subcommand("info", "Channels, counts, time range, chunks and metadata of a recording");
+  info->add_option("FILE", info_args->file, "MCAP file")->required();
+  info->add_flag("--scan", info_args->scan, "Ignore the summary and scan the file record by record");
+  info->callback([info_args, &exit_code] { exit_code = RunInfo(info_args->file, info_args->scan); });
+
+  struct ExportArgs {
+    std::string file;
+    std::string csv_dir;
+    std::vector<std::string> topics;
+  };
+  auto export_args = std::make_shared<ExportArgs>();
+  CLI::App* exp = bag->add_subcommand("export", "Write one CSV per channel");
+  exp->add_option("FILE", export_args->file, "MCAP file")->required();
+  exp->add_option("--csv", export_args->csv_dir, "Output directory (created if missing)")->required();
+  exp->add_option("--topic", export_args->topics, "Only this topic (repeatable)");
+  exp->callback([export_args, &exit_code] {
+    exit_code = RunExport(export_args->file, export_args->csv_dir, export_args->topics);
+  });
+}
+
+}  // namespace dyad::cli
