@@ -229,7 +229,7 @@ class Machine {
     const char* type = internal::PrimName(op.prim);
     switch (op.prim) {
       case Prim::kBool: {
-        uint8_t v;
+        uint8_t v = 0;
         if (!Read(&v, op.name, type)) return false;
         if (v > 1) {
           return Fail(op.name, pos_ - 1,
@@ -240,7 +240,7 @@ class Machine {
         break;
       }
       case Prim::kChar: {
-        uint8_t v;
+        uint8_t v = 0;
         if (!Read(&v, op.name, type)) return false;
         text = v ? std::string_view(reinterpret_cast<const char*>(data_ + pos_ - 1), 1)
                  : std::string_view();
@@ -249,46 +249,46 @@ class Machine {
       }
       case Prim::kOctet:
       case Prim::kUInt8: {
-        uint8_t v;
+        uint8_t v = 0;
         if (!Read(&v, op.name, type)) return false;
         text = FormatInt(buf, unsigned{v});
         break;
       }
       case Prim::kInt8: {
-        uint8_t v;
+        uint8_t v = 0;
         if (!Read(&v, op.name, type)) return false;
         text = FormatInt(buf, int{static_cast<int8_t>(v)});
         break;
       }
       case Prim::kInt16:
       case Prim::kUInt16: {
-        uint16_t v;
+        uint16_t v = 0;
         if (!Read(&v, op.name, type)) return false;
         text = op.prim == Prim::kInt16 ? FormatInt(buf, static_cast<int16_t>(v)) : FormatInt(buf, v);
         break;
       }
       case Prim::kInt32:
       case Prim::kUInt32: {
-        uint32_t v;
+        uint32_t v = 0;
         if (!Read(&v, op.name, type)) return false;
         text = op.prim == Prim::kInt32 ? FormatInt(buf, static_cast<int32_t>(v)) : FormatInt(buf, v);
         break;
       }
       case Prim::kInt64:
       case Prim::kUInt64: {
-        uint64_t v;
+        uint64_t v = 0;
         if (!Read(&v, op.name, type)) return false;
         text = op.prim == Prim::kInt64 ? FormatInt(buf, static_cast<int64_t>(v)) : FormatInt(buf, v);
         break;
       }
       case Prim::kFloat: {
-        uint32_t v;
+        uint32_t v = 0;
         if (!Read(&v, op.name, type)) return false;
         text = FormatReal(buf, std::bit_cast<float>(v));
         break;
       }
       case Prim::kDouble: {
-        uint64_t v;
+        uint64_t v = 0;
         if (!Read(&v, op.name, type)) return false;
         text = FormatReal(buf, std::bit_cast<double>(v));
         break;
@@ -299,7 +299,7 @@ class Machine {
   }
 
   bool String(const Op& op) {
-    uint32_t length;
+    uint32_t length = 0;
     if (!Read(&length, op.name, "string length")) return false;
     if (length > Left(pos_)) {
       return Fail(op.name, pos_, "truncated: string of " + std::to_string(length) + " bytes, " +
@@ -314,7 +314,7 @@ class Machine {
   }
 
   bool Enum(const Op& op) {
-    uint32_t v;
+    uint32_t v = 0;
     if (!Read(&v, op.name, "enum")) return false;
     const std::vector<std::string>& names = schema_.enums[op.arg].enumerators;
     if (v < names.size()) {
@@ -333,7 +333,7 @@ class Machine {
     static_assert(std::is_unsigned_v<U>);
     const size_t at = (pos_ + (sizeof(U) - 1)) & ~(sizeof(U) - 1);
     if (at > size_ || size_ - at < sizeof(U)) {
-      return Fail(name, pos_, std::string("truncated: ") + type + " needs " +
+      return Fail(name, at, std::string("truncated: ") + type + " needs " +
                                   std::to_string(sizeof(U)) + " bytes, " +
                                   std::to_string(Left(at)) + " left");
     }
@@ -464,7 +464,9 @@ void AddColumns(const std::vector<Op>& ops, uint32_t begin, uint32_t end, std::s
         const size_t base = path->size();
         for (uint32_t i = 0; i < op.arg; ++i) {
           path->resize(base);
-          *path += "[" + std::to_string(i) + "]";
+          path->push_back('[');
+          path->append(std::to_string(i));
+          path->push_back(']');
           AddColumns(ops, pc + 1, op.end, path, columns);
         }
         break;

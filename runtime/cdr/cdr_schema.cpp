@@ -40,7 +40,7 @@ const StructDef* SchemaImpl::FindStruct(const std::string& name) const {
   std::string_view n = name;
   if (n.starts_with("::")) n.remove_prefix(2);
   if (size_t hash = n.find('#'); hash != std::string_view::npos) n = n.substr(0, hash);
-  auto it = struct_index.find(std::string(n));
+  auto it = struct_index.find(n);
   return it == struct_index.end() ? nullptr : &structs[it->second];
 }
 
@@ -222,7 +222,6 @@ class Parser {
   std::string Identifier(const char* what) {
     const Token& t = Peek();
     if (t.type != Token::Type::kIdent) Fail(std::string("expected ") + what + ", found " + Describe(t));
-    if (IsUnsupportedKeyword(t.text)) Fail("'" + t.text + "' is not supported");
     return Next().text;
   }
 
@@ -285,7 +284,14 @@ class Parser {
     }
   }
 
+  // Guards the recursion of Module and TypeSpec against absurdly deep input.
+  void Deeper() {
+    if (++depth_ > kMaxDepth) Fail("nesting deeper than " + std::to_string(kMaxDepth) + " levels");
+  }
+  static constexpr int kMaxDepth = 64;
+
   void Module() {
+    Deeper();
     const std::string name = Identifier("a module name");
     Expect("{", "after the module name");
     scope_.push_back(name);
@@ -293,6 +299,7 @@ class Parser {
     scope_.pop_back();
     Expect("}", "closing the module");
     Expect(";", "after the module's '}'");
+    --depth_;
   }
 
   // Registers `qualified` unless it exists. Returns false if an identical definition already
@@ -351,6 +358,10 @@ class Parser {
     Expect("}", "closing the struct");
     Expect(";", "after the struct's '}'");
     if (def.members.empty()) FailAt(line, "struct '" + name + "' has no members (not supported)");
+    for (const Member& m : def.members) def.depth = std::max(def.depth, out_->nodes[m.node].depth + 1);
+    if (def.depth > kMaxDepth) {
+      FailAt(line, "types nested deeper than " + std::to_string(kMaxDepth) + " levels");
+    }
 
     const Symbol* old = Existing(def.name, Symbol::Kind::kStruct);
     const bool same = old && SameMembers(out_->structs[old->index].members, def.members);
@@ -477,6 +488,9 @@ class Parser {
   }
 
   int AddNode(TypeNode n) {
+    if (n.elem >= 0) n.depth = out_->nodes[n.elem].depth + 1;
+    if (n.kind == TypeNode::Kind::kStruct) n.depth = out_->structs[n.def].depth;
+    if (n.depth > kMaxDepth) Fail("types nested deeper than " + std::to_string(kMaxDepth) + " levels");
     out_->nodes.push_back(n);
     return static_cast<int>(out_->nodes.size() - 1);
   }
@@ -530,11 +544,13 @@ class Parser {
     if (w == "sequence") {
       Next();
       Expect("<", "after 'sequence'");
+      Deeper();
       TypeNode n;
       n.kind = TypeNode::Kind::kSequence;
       n.elem = TypeSpec();
       if (Accept(",")) n.size = Bound("a sequence bound");
       Expect(">", "closing the sequence");
+      --depth_;
       return AddNode(n);
     }
     if (IsUnsupportedKeyword(w)) Fail("'" + w + "' is not supported");
@@ -601,6 +617,7 @@ class Parser {
   SchemaImpl* out_;
   std::vector<std::string> scope_;
   std::unordered_map<std::string, Symbol> symbols_;
+  int depth_ = 0;
 };
 
 // Smallest number of bytes one value of `node` takes on the wire (>= 1; structs are never empty).
@@ -615,16 +632,19 @@ uint32_t MinWireSize(const SchemaImpl& s, int node) {
       const uint64_t v = uint64_t{n.size} * MinWireSize(s, n.elem);
       return static_cast<uint32_t>(std::min<uint64_t>(v, std::numeric_limits<uint32_t>::max()));
     }
-    case TypeNode::Kind::kStruct: {
-      uint64_t v = 0;
-      for (const Member& m : s.structs[n.def].members) v += MinWireSize(s, m.node);
-      return static_cast<uint32_t>(std::min<uint64_t>(v, std::numeric_limits<uint32_t>::max()));
-    }
+    case TypeNode::Kind::kStruct:
+      return s.structs[n.def].min_size;
   }
   return 1;
 }
 
+// Bounds the ops of one struct: nesting structs inside structs multiplies them. (Nesting depth,
+// hence the recursion here and in the decoder, is bounded by the parser.)
+constexpr size_t kMaxOps = 1 << 20;
+
+// Appends the ops decoding one value of `node`. Throws past kMaxOps.
 void Emit(const SchemaImpl& s, int node, const std::string& name, std::vector<Op>* ops) {
+  if (ops->size() >= kMaxOps) throw ParseError{0, ""};
   const TypeNode& n = s.nodes[node];
   Op op;
   op.name = name;
@@ -685,7 +705,20 @@ Schema Schema::Parse(const std::string& idl_text, std::string* error) {
     return Schema();
   }
   for (internal::StructDef& def : impl->structs) {
-    for (const internal::Member& m : def.members) internal::Emit(*impl, m.node, m.name, &def.ops);
+    uint64_t min_size = 0;
+    for (const internal::Member& m : def.members) min_size += internal::MinWireSize(*impl, m.node);
+    def.min_size = static_cast<uint32_t>(
+        std::min<uint64_t>(min_size, std::numeric_limits<uint32_t>::max()));
+    try {
+      for (const internal::Member& m : def.members) internal::Emit(*impl, m.node, m.name, &def.ops);
+    } catch (const internal::ParseError&) {
+      if (error) {
+        *error = "line " + std::to_string(def.line) + ": struct '" + def.name +
+                 "' is too large to decode (more than " + std::to_string(internal::kMaxOps) +
+                 " steps once nested structs are expanded)";
+      }
+      return Schema();
+    }
   }
   if (error) error->clear();
   return Schema(std::move(impl));

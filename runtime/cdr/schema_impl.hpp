@@ -2,7 +2,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -41,6 +43,7 @@ struct TypeNode {
   uint32_t size = 0;        // kArray: element count; kString/kSequence: bound (0: unbounded)
   int elem = -1;            // kSequence/kArray: element node
   int def = -1;             // kStruct: index in structs; kEnum: index in enums
+  int depth = 1;            // levels of nesting, this one included
 };
 
 struct Member {
@@ -65,7 +68,10 @@ struct StructDef {
   std::string name;  // qualified
   int line = 0;
   std::vector<Member> members;
-  std::vector<Op> ops;  // compiled once parsing is done
+  // Compiled once parsing is done, in definition order (members only use earlier structs).
+  int depth = 1;          // levels of nesting, this one included
+  uint32_t min_size = 0;  // fewest bytes one value takes on the wire (saturating)
+  std::vector<Op> ops;
 };
 
 struct EnumDef {
@@ -77,7 +83,12 @@ struct SchemaImpl {
   std::vector<TypeNode> nodes;
   std::vector<StructDef> structs;
   std::vector<EnumDef> enums;
-  std::unordered_map<std::string, int> struct_index;  // qualified name -> structs index
+  // Qualified name -> index in structs; looked up by string_view without allocating.
+  struct NameHash {
+    using is_transparent = void;
+    size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
+  };
+  std::unordered_map<std::string, int, NameHash, std::equal_to<>> struct_index;
 
   // The struct named `name` ("a::B", "::a::B" or "a::B#hash"), or null.
   const StructDef* FindStruct(const std::string& name) const;

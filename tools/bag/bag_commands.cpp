@@ -1,5 +1,7 @@
 #include "bag_commands.hpp"
 
+#include <dyad/cdr_decoder.hpp>
+
 #include <iostream>
 #include <memory>
 #include <string>
@@ -41,6 +43,20 @@ int RunExport(const std::string& path, const std::string& dir, const std::vector
   if (reader->recovery().truncated) std::cerr << "dyad bag: " << path << ": " << reader->recovery().Describe() << "\n";
   bag::CsvExportOptions options;
   options.topics.insert(topics.begin(), topics.end());
+  // omgidl schemas (what dyad records) are decoded into one column per field.
+  options.decoder_factory = [](const mcap::Schema* schema, const mcap::Channel&) -> std::optional<bag::PayloadDecoder> {
+    if (schema == nullptr || schema->encoding != "omgidl") return std::nullopt;
+    std::string error;
+    auto parsed = std::make_shared<cdr::Schema>(cdr::Schema::Parse(schema->data, &error));
+    if (!error.empty() || !parsed->HasType(schema->name)) return std::nullopt;
+    bag::PayloadDecoder d;
+    d.columns = cdr::Columns(*parsed, schema->name);
+    d.decode = [parsed, type = schema->name](std::span<const std::uint8_t> data, std::vector<std::string>* cells,
+                                             std::string* err) {
+      return cdr::DecodeRow(*parsed, type, data.data(), data.size(), cells, err);
+    };
+    return d;
+  };
   for (const std::string& topic : topics) {
     bool known = false;
     for (const auto& [id, channel] : reader->channels()) known = known || channel.topic == topic;

@@ -4,15 +4,20 @@
 #include <iostream>
 #include <sstream>
 
+#include <dyad/cdr_decoder.hpp>
 #include <dyad/introspect.hpp>
 
 namespace dyad::cli {
 namespace {
 
-// Until a schema decoder is plugged in: the sample as hex.
-std::string HexPrinter(const TypeInfo& type, const uint8_t* data, size_t size) {
+// One sample as JSON, decoded with the type's own IDL text; hex if that fails.
+std::string JsonPrinter(const TypeInfo& type, const uint8_t* data, size_t size) {
+  std::string error;
+  cdr::Schema schema = cdr::Schema::Parse(type.idl, &error);
+  std::vector<cdr::Field> fields;
+  if (error.empty() && cdr::Decode(schema, type.name, data, size, &fields, &error)) return cdr::ToJson(fields);
   std::ostringstream os;
-  os << type.short_name() << " " << size << " bytes:";
+  os << type.short_name() << " (" << error << ") " << size << " bytes:";
   for (size_t i = 0; i < size; ++i) os << (i % 4 == 0 ? " " : "") << std::hex << std::setw(2) << std::setfill('0') << int(data[i]);
   return os.str();
 }
@@ -44,7 +49,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   echo->callback([&exit_code] {
     Catalog catalog;
     catalog.LoadDefault(plugins);
-    exit_code = EchoTopic(opts, catalog, topic, count, duration, HexPrinter, std::cout, std::cerr);
+    exit_code = EchoTopic(opts, catalog, topic, count, duration, JsonPrinter, std::cout, std::cerr);
   });
 
   auto* hz = app.add_subcommand("hz", "Measure the publication rate of a topic");

@@ -6,6 +6,7 @@
 
 #include "bag_commands.hpp"
 #include "introspection_commands.hpp"
+#include "pvrnn_commands.hpp"
 #include "runtime_commands.hpp"
 
 int main(int argc, char** argv) {
@@ -16,6 +17,7 @@ int main(int argc, char** argv) {
   dyad::cli::AddRuntimeCommands(app, exit_code);
   dyad::cli::AddIntrospectionCommands(app, exit_code);
   dyad::cli::AddBagCommands(app, exit_code);
+  dyad::cli::AddPvrnnCommands(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

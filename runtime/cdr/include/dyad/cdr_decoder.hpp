@@ -35,7 +35,9 @@
 //   Unsupported, reported as a parse error naming the line: union, map, bitset, bitmask, wchar,
 //   wstring, long double, fixed, any, interface, valuetype, exception, forward declarations (so no
 //   recursive types), @optional, @mutable, @value and any other annotation, other preprocessor
-//   directives, const expressions.
+//   directives, const expressions. Limits (also parse errors): types nested more than 64 levels
+//   deep; a struct that expands to more than 2^20 decoding steps (structs inside structs are
+//   expanded; arrays and sequences are loops, whatever their length).
 //
 // OUTPUT
 //   Decode() gives one Field per leaf value, in declaration order (depth first). Paths join member
@@ -62,13 +64,15 @@
 //   Decode / DecodeRow: "offset N (path): message" where N is the byte offset in the payload after
 //   the encapsulation header, e.g. "offset 24 (header.stamp_ns): truncated: long long needs 8
 //   bytes, 3 left". Truncated or garbled payloads never read out of bounds; a garbled sequence
-//   count larger than the remaining bytes could hold is an error, not a huge allocation.
+//   count (or an array) larger than the remaining bytes could hold is an error, caught before
+//   any element is decoded.
 //   On failure the output holds what was decoded before the error.
 //
 // PERFORMANCE / THREADS
 //   Parse compiles every struct once into a flat list of ops; decoding walks the ops with no
-//   allocation besides the output strings (DecodeRow reuses the row's strings). A Schema is
-//   immutable and cheap to copy (shared); all functions are safe to call concurrently.
+//   per-field allocation besides the output strings (DecodeRow reuses the row's strings), about
+//   1 us for a 14-value sample, most of it formatting doubles. A Schema is immutable and cheap to
+//   copy (shared); all functions are safe to call concurrently.
 //
 // EXAMPLE
 //   std::string error;

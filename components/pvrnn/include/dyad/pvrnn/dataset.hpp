@@ -1,0 +1,33 @@
+// dyad/pvrnn/dataset.hpp: training sequences and the NRL/VCBot data set layout.
+//
+// Layout of a data set folder (read and written):
+//   dataset.d                 key=value lines: samplingperiod (ms), numbertimes, numberprims
+//   primitive_<id>_<sample>.csv   one row per step, comma-separated DOF values, no header
+// Only sample 0 of each primitive is used (the study has one sample per primitive).
+//
+// Contract: every sequence has the same number of steps and DOFs; loading checks that and
+// reports the file (and line) at fault.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "dyad/pvrnn/status.hpp"
+
+namespace dyad::pvrnn {
+
+struct Dataset {
+  std::string name;                       // folder name or "analytic"
+  double sampling_period_ms = 100;
+  std::vector<Eigen::MatrixXd> sequences;  // each num_dofs x steps (positions, workspace units)
+
+  int size() const { return static_cast<int>(sequences.size()); }
+  int steps() const { return sequences.empty() ? 0 : static_cast<int>(sequences[0].cols()); }
+  int dofs() const { return sequences.empty() ? 0 : static_cast<int>(sequences[0].rows()); }
+};
+
+StatusOr<Dataset> LoadNrlDataset(const std::string& dir);
+Status WriteNrlDataset(const Dataset& data, const std::string& dir);
+
+}  // namespace dyad::pvrnn

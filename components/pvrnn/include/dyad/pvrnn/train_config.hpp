@@ -1,0 +1,51 @@
+// dyad/pvrnn/train_config.hpp: the YAML file of `dyad train`.
+//
+//   dataset: ../../../shared/data/vcbot/dataset/Macaw   # relative to this file's folder
+//   layers:                                    # bottom (fast) first
+//     - {d: 40, z: 4, tau: 2, w: 0.01}
+//     - {d: 10, z: 1, tau: 10, w: 0.01}
+//   encoding: {dofs: [[-50, 50], [-50, 50]], dsoft: 10, sigma: 0.2}   # softmax output code
+//   epochs: 50000
+//   adam: {lr: 0.001, beta1: 0.9, beta2: 0.999, epsilon: 1.0e-8}
+//   seed: 1
+//   scalar: float                              # float | double
+//   noise: true                                # sample eps during training
+//   log_every: 100                             # progress line + CSV row
+//   checkpoint_every: 5000                     # 0 = only at the end / on Ctrl-C
+//   output: macaw.dpvrnn                       # relative to the working directory
+//   checkpoint: macaw.ckpt.dpvrnn              # default: <output>.ckpt
+//   log_csv: macaw.csv                         # default: <output>.csv
+//
+// Contract: unknown keys, wrong types and invalid values are errors, each reported as
+// "file:line:col: key: message" (1-based), all of them at once. `overrides` ("adam.lr=0.002")
+// replace values before validation and are reported as "--set key: message".
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "dyad/pvrnn/adam.hpp"
+#include "dyad/pvrnn/model_spec.hpp"
+#include "dyad/pvrnn/status.hpp"
+
+namespace dyad::pvrnn {
+
+struct TrainConfig {
+  std::string dataset;             // resolved path
+  ModelSpec spec;
+  int64_t epochs = 50000;          // REQUIRES > 0
+  AdamOptions adam;
+  uint64_t seed = 1;
+  std::string scalar = "float";    // "float" | "double"
+  bool noise = true;
+  int64_t log_every = 100;         // REQUIRES > 0
+  int64_t checkpoint_every = 5000; // REQUIRES >= 0
+  std::string output;              // REQUIRED
+  std::string checkpoint;          // default output + ".ckpt"
+  std::string log_csv;             // default output + ".csv"
+};
+
+StatusOr<TrainConfig> LoadTrainConfig(const std::string& path,
+                                      const std::vector<std::string>& overrides = {});
+
+}  // namespace dyad::pvrnn

@@ -1,0 +1,248 @@
+#include "dyad/pvrnn/model_file.hpp"
+
+#include <zlib.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace dyad::pvrnn {
+namespace {
+
+using nlohmann::json;
+constexpr char kMagic[8] = {'D', 'Y', 'A', 'D', 'P', 'V', 'R', 'N'};
+constexpr size_t kFixedHeader = 8 + 4 + 4 + 8;
+constexpr size_t kTrailer = 4;
+
+template <typename T>
+void Put(std::string& out, T v) {
+  unsigned char b[sizeof(T)];
+  for (size_t i = 0; i < sizeof(T); ++i) b[i] = static_cast<unsigned char>((static_cast<uint64_t>(v) >> (8 * i)) & 0xff);
+  out.append(reinterpret_cast<const char*>(b), sizeof(T));
+}
+
+template <typename T>
+T Get(const std::string& in, size_t at) {
+  uint64_t v = 0;
+  for (size_t i = 0; i < sizeof(T); ++i) v |= static_cast<uint64_t>(static_cast<unsigned char>(in[at + i])) << (8 * i);
+  return static_cast<T>(v);
+}
+
+void PutDouble(std::string& out, double d) {
+  uint64_t bits;
+  std::memcpy(&bits, &d, 8);
+  Put<uint64_t>(out, bits);
+}
+
+double GetDouble(const std::string& in, size_t at) {
+  const uint64_t bits = Get<uint64_t>(in, at);
+  double d;
+  std::memcpy(&d, &bits, 8);
+  return d;
+}
+
+uint32_t Crc(const char* data, size_t n) {
+  uLong crc = crc32(0L, Z_NULL, 0);
+  while (n > 0) {  // zlib takes uInt lengths
+    const uInt chunk = static_cast<uInt>(std::min<size_t>(n, 1u << 30));
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(data), chunk);
+    data += chunk;
+    n -= chunk;
+  }
+  return static_cast<uint32_t>(crc);
+}
+
+json SpecToJson(const ModelSpec& s) {
+  json layers = json::array();
+  for (const auto& l : s.layers) layers.push_back({{"d", l.d}, {"z", l.z}, {"tau", l.tau}, {"w", l.w}});
+  json dofs = json::array();
+  for (const auto& r : s.output.dofs) dofs.push_back({r.min, r.max});
+  return {{"layers", layers}, {"output", {{"dofs", dofs}, {"dsoft", s.output.dsoft}, {"sigma", s.output.sigma}}}};
+}
+
+ModelSpec SpecFromJson(const json& j) {
+  ModelSpec s;
+  for (const auto& l : j.at("layers"))
+    s.layers.push_back({l.at("d").get<int>(), l.at("z").get<int>(), l.at("tau").get<double>(), l.at("w").get<double>()});
+  for (const auto& r : j.at("output").at("dofs")) s.output.dofs.push_back({r.at(0).get<double>(), r.at(1).get<double>()});
+  s.output.dsoft = j.at("output").at("dsoft").get<double>();
+  s.output.sigma = j.at("output").at("sigma").get<double>();
+  return s;
+}
+
+// NaN is not JSON: store it as null.
+json Num(double v) { return std::isnan(v) ? json(nullptr) : json(v); }
+double NumFrom(const json& j) { return j.is_null() ? std::numeric_limits<double>::quiet_NaN() : j.get<double>(); }
+
+struct Tensor {
+  std::string name;
+  int rows, cols;
+  const double* data;
+};
+
+}  // namespace
+
+Status SaveModel(const Model& model, const std::string& path) {
+  NetworkLayout layout(model.spec);
+  std::vector<Tensor> tensors;
+  std::vector<Eigen::MatrixXd> keep;  // contiguous copies of strided groups
+  keep.reserve(layout.groups().size());
+  for (const auto& g : layout.groups()) {
+    keep.emplace_back(model.weights.Group(g));
+    tensors.push_back({g.name, g.rows, g.cols, keep.back().data()});
+  }
+  const auto& a = model.adaptive;
+  tensors.push_back({"A.mu", a.total_z(), a.cols(), a.mu().data()});
+  tensors.push_back({"A.log_sigma", a.total_z(), a.cols(), a.log_sigma().data()});
+  json training = nullptr;
+  if (model.training) {
+    const auto& t = *model.training;
+    tensors.push_back({"adam.weights.m", static_cast<int>(t.weights_m.size()), 1, t.weights_m.data()});
+    tensors.push_back({"adam.weights.v", static_cast<int>(t.weights_v.size()), 1, t.weights_v.data()});
+    tensors.push_back({"adam.adaptive.m", static_cast<int>(t.adaptive_m.size()), 1, t.adaptive_m.data()});
+    tensors.push_back({"adam.adaptive.v", static_cast<int>(t.adaptive_v.size()), 1, t.adaptive_v.data()});
+    training = {{"adam_step", t.adam_step}, {"rng_state", t.rng_state}};
+  }
+  json table = json::array();
+  uint64_t offset = 0;
+  for (const auto& t : tensors) {
+    table.push_back({{"name", t.name}, {"rows", t.rows}, {"cols", t.cols}, {"offset", offset}});
+    offset += static_cast<uint64_t>(t.rows) * t.cols;
+  }
+  const auto& p = model.provenance;
+  json header = {
+      {"format", "dyad PV-RNN model"},
+      {"spec", SpecToJson(model.spec)},
+      {"steps", a.steps()},
+      {"sequences", a.sequences()},
+      {"provenance",
+       {{"source", p.source}, {"dataset", p.dataset}, {"epochs", p.epochs}, {"seed", p.seed},
+        {"scalar", p.scalar}, {"final_loss", Num(p.final_loss)},
+        {"final_reconstruction", Num(p.final_reconstruction)}, {"final_regulation", Num(p.final_regulation)}}},
+      {"tensors", table},
+      {"training", training},
+  };
+  const std::string js = header.dump(1);
+  std::string out;
+  out.reserve(kFixedHeader + js.size() + offset * 8 + kTrailer);
+  out.append(kMagic, 8);
+  Put<uint32_t>(out, kModelFileVersion);
+  Put<uint32_t>(out, 0);
+  Put<uint64_t>(out, js.size());
+  out += js;
+  for (const auto& t : tensors)
+    for (int64_t i = 0; i < static_cast<int64_t>(t.rows) * t.cols; ++i) PutDouble(out, t.data[i]);
+  Put<uint32_t>(out, Crc(out.data(), out.size()));
+
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) return Status::IoError(path + ": cannot open " + tmp + " for writing");
+    f.write(out.data(), static_cast<std::streamsize>(out.size()));
+    f.flush();
+    if (!f) return Status::IoError(path + ": write failed (disk full?)");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) return Status::IoError(path + ": cannot rename " + tmp + ": " + ec.message());
+  return Status::Ok();
+}
+
+StatusOr<Model> LoadModel(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return Status::NotFound(path + ": cannot open");
+  std::string in((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  if (in.size() < 8 || std::memcmp(in.data(), kMagic, 8) != 0)
+    return Status::Corrupted(path + ": not a dyad PV-RNN model file (bad magic)");
+  if (in.size() < kFixedHeader + kTrailer)
+    return Status::Corrupted(path + ": truncated: " + std::to_string(in.size()) + " bytes, less than the fixed header");
+  const uint32_t version = Get<uint32_t>(in, 8);
+  if (version != kModelFileVersion)
+    return Status::Unsupported(path + ": format version " + std::to_string(version) + ", this build reads version " +
+                               std::to_string(kModelFileVersion));
+  const uint64_t jlen = Get<uint64_t>(in, 16);
+  if (jlen > in.size() - kFixedHeader - kTrailer)
+    return Status::Corrupted(path + ": truncated: header of " + std::to_string(jlen) + " bytes does not fit in " +
+                             std::to_string(in.size()) + " bytes");
+  const uint32_t stored_crc = Get<uint32_t>(in, in.size() - kTrailer);
+  const uint32_t crc = Crc(in.data(), in.size() - kTrailer);
+  json header;
+  try {
+    header = json::parse(in.begin() + kFixedHeader, in.begin() + kFixedHeader + static_cast<std::ptrdiff_t>(jlen));
+  } catch (const std::exception& e) {
+    if (crc != stored_crc) return Status::Corrupted(path + ": corrupted or truncated (checksum mismatch)");
+    return Status::Corrupted(path + ": unreadable header: " + e.what());
+  }
+  const size_t payload_at = kFixedHeader + jlen;
+  const size_t payload_bytes = in.size() - kTrailer - payload_at;
+  Model m;
+  try {
+    uint64_t needed = 0;
+    for (const auto& t : header.at("tensors"))
+      needed = std::max<uint64_t>(needed, t.at("offset").get<uint64_t>() + t.at("rows").get<uint64_t>() * t.at("cols").get<uint64_t>());
+    if (needed * 8 > payload_bytes)
+      return Status::Corrupted(path + ": truncated: tensors need " + std::to_string(needed * 8) + " bytes, file has " +
+                               std::to_string(payload_bytes));
+    if (crc != stored_crc) return Status::Corrupted(path + ": corrupted (checksum mismatch)");
+    if (needed * 8 != payload_bytes)
+      return Status::Corrupted(path + ": " + std::to_string(payload_bytes - needed * 8) + " unexpected bytes after the tensors");
+    m.spec = SpecFromJson(header.at("spec"));
+    if (Status s = m.spec.Validate(); !s.ok()) return Status::Corrupted(path + ": spec: " + s.message());
+    const int steps = header.at("steps").get<int>(), sequences = header.at("sequences").get<int>();
+    if (steps < 0 || sequences < 0) return Status::Corrupted(path + ": negative steps or sequences");
+    NetworkLayout layout(m.spec);
+    m.weights = Weights<double>(layout);
+    m.adaptive = AdaptiveVariables<double>(layout.total_z(), steps, sequences);
+    auto read = [&](const std::string& name, int rows, int cols, auto&& sink) -> Status {
+      for (const auto& t : header.at("tensors")) {
+        if (t.at("name").get<std::string>() != name) continue;
+        if (t.at("rows").get<int>() != rows || t.at("cols").get<int>() != cols)
+          return Status::Corrupted(path + ": tensor " + name + " is " + std::to_string(t.at("rows").get<int>()) + " x " +
+                                   std::to_string(t.at("cols").get<int>()) + ", the spec needs " + std::to_string(rows) +
+                                   " x " + std::to_string(cols));
+        const size_t at = payload_at + t.at("offset").get<size_t>() * 8;
+        for (int c = 0; c < cols; ++c)
+          for (int r = 0; r < rows; ++r) sink(r, c, GetDouble(in, at + (static_cast<size_t>(c) * rows + r) * 8));
+        return Status::Ok();
+      }
+      return Status::Corrupted(path + ": tensor " + name + " missing");
+    };
+    for (const auto& g : layout.groups()) {
+      auto view = m.weights.Group(g);
+      if (Status s = read(g.name, g.rows, g.cols, [&](int r, int c, double v) { view(r, c) = v; }); !s.ok()) return s;
+    }
+    auto mu = m.adaptive.mu();
+    auto ls = m.adaptive.log_sigma();
+    if (Status s = read("A.mu", layout.total_z(), m.adaptive.cols(), [&](int r, int c, double v) { mu(r, c) = v; }); !s.ok()) return s;
+    if (Status s = read("A.log_sigma", layout.total_z(), m.adaptive.cols(), [&](int r, int c, double v) { ls(r, c) = v; }); !s.ok()) return s;
+    const json& p = header.at("provenance");
+    m.provenance.source = p.at("source").get<std::string>();
+    m.provenance.dataset = p.at("dataset").get<std::string>();
+    m.provenance.epochs = p.at("epochs").get<int64_t>();
+    m.provenance.seed = p.at("seed").get<uint64_t>();
+    m.provenance.scalar = p.at("scalar").get<std::string>();
+    m.provenance.final_loss = NumFrom(p.at("final_loss"));
+    m.provenance.final_reconstruction = NumFrom(p.at("final_reconstruction"));
+    m.provenance.final_regulation = NumFrom(p.at("final_regulation"));
+    if (!header.at("training").is_null()) {
+      TrainingState t;
+      t.adam_step = header.at("training").at("adam_step").get<int64_t>();
+      t.rng_state = header.at("training").at("rng_state").get<std::string>();
+      const int nw = layout.num_weights(), na = static_cast<int>(m.adaptive.flat().size());
+      t.weights_m.resize(nw); t.weights_v.resize(nw); t.adaptive_m.resize(na); t.adaptive_v.resize(na);
+      for (auto [name, vec, n] : {std::tuple{"adam.weights.m", &t.weights_m, nw}, std::tuple{"adam.weights.v", &t.weights_v, nw},
+                                  std::tuple{"adam.adaptive.m", &t.adaptive_m, na}, std::tuple{"adam.adaptive.v", &t.adaptive_v, na}}) {
+        auto* v = vec;
+        if (Status s = read(name, n, 1, [&](int r, int, double x) { (*v)[r] = x; }); !s.ok()) return s;
+      }
+      m.training = std::move(t);
+    }
+  } catch (const std::exception& e) {
+    return Status::Corrupted(path + ": malformed header: " + e.what());
+  }
+  return m;
+}
+
+}  // namespace dyad::pvrnn

@@ -1,0 +1,206 @@
+#include "dyad/pvrnn/nrl_import.hpp"
+
+#include <charconv>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace dyad::pvrnn {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string Trim(const std::string& s) {
+  const size_t b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
+  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+}
+
+// A text file of NRL matrices: one comma-separated line per matrix.
+class NrlMatrixFile {
+ public:
+  static StatusOr<NrlMatrixFile> Open(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) return Status::NotFound(path + ": cannot open");
+    NrlMatrixFile f;
+    f.path_ = path;
+    f.name_ = fs::path(path).filename().string();
+    std::string line;
+    while (std::getline(in, line)) f.lines_.push_back(line);
+    return f;
+  }
+  // Reads the next line as a rows x cols column-major matrix.
+  Status Next(int rows, int cols, const std::string& what, Eigen::MatrixXd* out) {
+    const std::string where = name_ + ":" + std::to_string(next_ + 1);
+    if (next_ >= lines_.size())
+      return Status::Corrupted(where + ": missing line for " + what + " (file has " + std::to_string(lines_.size()) + " lines)");
+    const std::string& line = lines_[next_++];
+    out->resize(rows, cols);
+    size_t count = 0, pos = 0;
+    while (pos <= line.size()) {
+      size_t end = line.find(',', pos);
+      if (end == std::string::npos) end = line.size();
+      const std::string tok = Trim(line.substr(pos, end - pos));
+      if (!tok.empty()) {
+        double v = 0;
+        auto r = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+        if (r.ec != std::errc() || r.ptr != tok.data() + tok.size())
+          return Status::Corrupted(where + ": '" + tok + "' is not a number (" + what + ")");
+        if (count < static_cast<size_t>(rows) * cols) out->data()[count] = v;
+        ++count;
+      }
+      pos = end + 1;
+    }
+    if (count != static_cast<size_t>(rows) * cols)
+      return Status::Corrupted(where + ": expected " + std::to_string(rows * cols) + " values (" + std::to_string(rows) +
+                               " x " + std::to_string(cols) + ": " + what + "), found " + std::to_string(count));
+    return Status::Ok();
+  }
+
+ private:
+  std::string path_, name_;
+  std::vector<std::string> lines_;
+  size_t next_ = 0;
+};
+
+StatusOr<std::vector<double>> Numbers(const std::string& file, const std::string& key, const std::string& value) {
+  std::vector<double> out;
+  std::stringstream ss(value);
+  std::string tok;
+  while (std::getline(ss, tok, ',')) {
+    try {
+      size_t used = 0;
+      out.push_back(std::stod(Trim(tok), &used));
+    } catch (const std::exception&) {
+      return Status::Corrupted(file + ": " + key + " = '" + value + "': not a comma-separated list of numbers");
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+StatusOr<std::vector<std::pair<std::string, std::string>>> ReadKeyValueFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::NotFound(path + ": cannot open");
+  std::vector<std::pair<std::string, std::string>> out;
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    const std::string t = Trim(line.substr(0, line.find('#')));
+    if (t.empty()) continue;
+    const size_t eq = t.find('=');
+    if (eq == std::string::npos) return Status::Corrupted(path + ":" + std::to_string(n) + ": expected key=value");
+    out.emplace_back(Trim(t.substr(0, eq)), Trim(t.substr(eq + 1)));
+  }
+  return out;
+}
+
+StatusOr<Model> ImportNrlModel(const NrlImportOptions& options) {
+  const std::string& pf = options.properties_file;
+  auto kv = ReadKeyValueFile(pf);
+  if (!kv.ok()) return kv.status();
+  std::map<std::string, std::vector<double>> num;
+  std::map<std::string, std::string> text;
+  for (const auto& [k, v] : kv.value()) {
+    text[k] = v;
+    if (k == "d" || k == "z" || k == "t" || k == "w" || k == "dsoft" || k == "sigma" || k == "activejoints" ||
+        k == "epochs") {
+      auto n = Numbers(pf, k, v);
+      if (!n.ok()) return n.status();
+      num[k] = n.value();
+    }
+  }
+  for (const char* key : {"d", "z", "t", "w", "activejoints"})
+    if (!num.count(key)) return Status::Corrupted(pf + ": property '" + key + "' missing");
+  if (text.count("network") && text["network"] != "pvrnn")
+    return Status::Unsupported(pf + ": network=" + text["network"] + ", only pvrnn can be imported");
+  if (text.count("robot") && text["robot"] != "cartesian")
+    return Status::Unsupported(pf + ": robot=" + text["robot"] + ", only the cartesian robot (joints -50..50) is supported");
+  const size_t K = num["d"].size();
+  if (num["z"].size() != K || num["t"].size() != K || num["w"].size() != K)
+    return Status::Corrupted(pf + ": d, z, t and w must list the same number of layers");
+  ModelSpec spec;
+  for (size_t k = 0; k < K; ++k)
+    spec.layers.push_back({static_cast<int>(num["d"][k]), static_cast<int>(num["z"][k]), num["t"][k], num["w"][k]});
+  for (double a : num["activejoints"])
+    if (a == 1) spec.output.dofs.push_back({-50, 50});
+  spec.output.dsoft = num.count("dsoft") ? num["dsoft"][0] : 10;
+  spec.output.sigma = num.count("sigma") ? num["sigma"][0] : 0.2;
+  if (Status s = spec.Validate(); !s.ok()) return Status::Corrupted(pf + ": " + s.message());
+
+  auto data = LoadNrlDataset(options.dataset_dir);
+  if (!data.ok()) return data.status();
+  if (data->dofs() != spec.num_dofs())
+    return Status::InvalidArgument(options.dataset_dir + ": " + std::to_string(data->dofs()) + " DOFs, properties activate " +
+                                   std::to_string(spec.num_dofs()));
+  const int prims = data->size(), steps = data->steps();
+
+  NetworkLayout layout(spec);
+  Model m;
+  m.spec = spec;
+  m.weights = Weights<double>(layout);
+  m.adaptive = AdaptiveVariables<double>(layout.total_z(), steps, prims);
+  const fs::path dir(options.model_dir);
+  Eigen::MatrixXd buf;
+  auto group = [&](int k, const char* name) { return m.weights.Group(*layout.FindGroup("L" + std::to_string(k) + "." + name)); };
+  for (size_t k = 0; k < K; ++k) {
+    const std::string L = "L" + std::to_string(k);
+    auto wf = NrlMatrixFile::Open((dir / (L + "_w_p.d")).string());
+    if (!wf.ok()) return wf.status();
+    const int d = spec.layers[k].d, z = spec.layers[k].z;
+    struct Item { const char* name; int rows, cols; };
+    std::vector<Item> items = {{"W_dh", d, d}, {"W_zh", d, z}, {"W_mu_p", z, d}, {"W_ls_p", z, d}, {"W_mu_q", z, d}, {"W_ls_q", z, d}};
+    if (k > 0) items.push_back({"W_below", d, spec.layers[k - 1].d});
+    if (k + 1 < K) items.push_back({"W_above", d, spec.layers[k + 1].d});
+    for (const auto& it : items) {
+      if (Status s = wf->Next(it.rows, it.cols, it.name, &buf); !s.ok()) return s;
+      group(static_cast<int>(k), it.name) = buf;
+    }
+    auto bf = NrlMatrixFile::Open((dir / (L + "_b_p.d")).string());
+    if (!bf.ok()) return bf.status();
+    for (const auto& it : std::vector<Item>{{"b_h", d, 1}, {"b_mu_p", z, 1}, {"b_ls_p", z, 1}, {"b_mu_q", z, 1}, {"b_ls_q", z, 1}}) {
+      if (Status s = bf->Next(it.rows, it.cols, it.name, &buf); !s.ok()) return s;
+      group(static_cast<int>(k), it.name) = buf;
+    }
+    for (auto [suffix, view] : {std::pair{"_au_p.d", m.adaptive.mu()}, std::pair{"_al_p.d", m.adaptive.log_sigma()}}) {
+      auto af = NrlMatrixFile::Open((dir / (L + suffix)).string());
+      if (!af.ok()) return af.status();
+      for (int p = 0; p < prims; ++p)
+        for (int t = 0; t < steps; ++t) {
+          if (Status s = af->Next(z, 1, "A of primitive " + std::to_string(p) + " step " + std::to_string(t), &buf); !s.ok()) return s;
+          view.col(m.adaptive.Column(t, p)).segment(layout.z_offset(static_cast<int>(k)), z) = buf.col(0);
+        }
+    }
+  }
+  for (int o = 0; o < spec.num_dofs(); ++o) {
+    const std::string O = "o" + std::to_string(o);
+    auto wf = NrlMatrixFile::Open((dir / (O + "_w_p.d")).string());
+    if (!wf.ok()) return wf.status();
+    const int n = layout.output_units(o);
+    if (Status s = wf->Next(n, spec.layers[0].d, "W_x", &buf); !s.ok()) return s;
+    m.weights.Group(*layout.FindGroup("out.W_x" + std::to_string(o))) = buf;
+    auto bf = NrlMatrixFile::Open((dir / (O + "_b_p.d")).string());
+    if (!bf.ok()) return bf.status();
+    if (Status s = bf->Next(n, 1, "b_x", &buf); !s.ok()) return s;
+    m.weights.Group(*layout.FindGroup("out.b_x" + std::to_string(o))) = buf;
+  }
+  m.provenance.source = "import-nrl " + options.model_dir;
+  m.provenance.dataset = options.dataset_dir;
+  m.provenance.scalar = "float";
+  m.provenance.epochs = num.count("epochs") ? static_cast<int64_t>(num["epochs"][0]) : 0;
+  // epoch.d: "<last saved epoch>,<loss>" (NRL saves greedily: the best loss seen).
+  if (std::ifstream ef(dir / "epoch.d"); ef) {
+    std::string line;
+    std::getline(ef, line);
+    auto v = Numbers("epoch.d", "epoch", line);
+    if (v.ok() && v->size() >= 2) {
+      m.provenance.epochs = static_cast<int64_t>(v.value()[0]);
+      m.provenance.final_loss = v.value()[1];
+    }
+  }
+  return m;
+}
+
+}  // namespace dyad::pvrnn

@@ -1,0 +1,201 @@
+#include "dyad/pvrnn/posterior_pass.hpp"
+
+#include <cmath>
+
+#include "step_kernel.hpp"
+
+namespace dyad::pvrnn {
+
+using internal::Source;
+
+template <typename Scalar>
+PosteriorPass<Scalar>::PosteriorPass(const NetworkLayout& layout, int steps, int sequences)
+    : layout_(layout), steps_(steps), sequences_(sequences), cols_(steps * sequences) {
+  const int td = layout.total_d(), tz = layout.total_z(), rr = layout.recurrent_rows();
+  const int nx = layout.output_units(), d0 = layout.d0();
+  rate_.resize(td);
+  keep_.resize(td);
+  for (int i = 0; i < td; ++i) {
+    rate_[i] = static_cast<Scalar>(layout.rate()[i]);
+    keep_[i] = Scalar(1) - rate_[i];
+  }
+  kl_coef_.resize(tz);
+  r_t_.resize(td, rr);
+  wz_t_.resize(tz, td);
+  wx_t_.resize(d0, nx);
+  r_maskf_.resize(rr, td);
+  for (int i = 0; i < rr * td; ++i) r_maskf_.data()[i] = layout.r_mask()[i];
+  wz_maskf_.resize(td, tz);
+  for (int i = 0; i < td * tz; ++i) wz_maskf_.data()[i] = layout.wz_mask()[i];
+  h_.resize(td, (steps + 1) * sequences);
+  d_.resize(td, (steps + 1) * sequences);
+  for (auto* m : {&mu_p_, &ls_p_, &mu_q_, &ls_q_, &sig_p_, &sig_q_, &z_}) m->resize(tz, cols_);
+  pre_.resize(rr, sequences);
+  logits_.resize(nx, cols_);
+  x_.resize(nx, cols_);
+  log_x_.resize(nx, cols_);
+  g_pre_.resize(rr, cols_);
+  g_out_.resize(nx, cols_);
+  g_d0_.resize(d0, cols_);
+  for (auto* m : {&g_d_, &g_h_, &g_h_next_, &g_start_h_, &g_start_d_}) m->resize(td, sequences);
+  g_z_.resize(tz, sequences);
+}
+
+template <typename Scalar>
+LossTerms PosteriorPass<Scalar>::Forward(const Weights<Scalar>& weights,
+                                         const AdaptiveVariables<Scalar>& a,
+                                         const MatrixT<Scalar>& eps,
+                                         const MatrixT<Scalar>& targets,
+                                         const NetworkState<Scalar>& start,
+                                         const std::vector<double>& meta_prior) {
+  const int S = sequences_, td = layout_.total_d(), tz = layout_.total_z();
+  w_ = &weights;
+  eps_ = &eps;
+  targets_ = &targets;
+  for (int k = 0; k < layout_.num_layers(); ++k) {
+    const Scalar c = static_cast<Scalar>(meta_prior[k] / tz);
+    kl_coef_.segment(layout_.z_offset(k), layout_.spec().layers[k].z).setConstant(c);
+  }
+  const auto r = weights.R();
+  const auto rbias = weights.RBias().col(0);
+  const auto wz = weights.Wz();
+  const auto a_mu = a.mu();
+  const auto a_ls = a.log_sigma();
+  h_.leftCols(S) = start.h;
+  d_.leftCols(S) = start.d;
+  for (int t = 0; t < steps_; ++t) {
+    const int c0 = t * S;
+    internal::StepForward<Scalar>(
+        r, rbias, wz, rate_, keep_, td, tz, Source::kPosterior, d_.middleCols(c0, S),
+        h_.middleCols(c0, S), a_mu.middleCols(c0, S), a_ls.middleCols(c0, S),
+        eps.middleCols(c0, S), pre_, mu_p_.middleCols(c0, S), ls_p_.middleCols(c0, S),
+        sig_p_.middleCols(c0, S), mu_q_.middleCols(c0, S), ls_q_.middleCols(c0, S),
+        sig_q_.middleCols(c0, S), z_.middleCols(c0, S), h_.middleCols(c0 + S, S),
+        d_.middleCols(c0 + S, S));
+  }
+  // Output layer for all steps at once (one large product).
+  const int d0 = layout_.d0();
+  logits_.noalias() = weights.Wx() * d_.block(0, S, d0, cols_);
+  logits_.colwise() += weights.Bx().col(0);
+  for (int dof = 0; dof < layout_.spec().num_dofs(); ++dof) {
+    const int off = layout_.output_offset(dof), n = layout_.output_units(dof);
+    for (int j = 0; j < cols_; ++j) {
+      auto l = logits_.col(j).segment(off, n);
+      const Scalar m = l.maxCoeff();
+      auto lx = log_x_.col(j).segment(off, n);
+      lx.array() = l.array() - m;
+    }
+    auto lx = log_x_.middleRows(off, n);
+    x_.middleRows(off, n) = lx.array().exp().matrix();
+    for (int j = 0; j < cols_; ++j) {
+      auto xc = x_.col(j).segment(off, n);
+      const Scalar sum = xc.sum();
+      xc /= sum;
+      log_x_.col(j).segment(off, n).array() -= std::log(sum);
+    }
+  }
+  LossTerms terms;
+  // KL(target || x); targets are strictly positive codes.
+  terms.reconstruction = static_cast<double>(
+      (targets.array() * (targets.array().log() - log_x_.array())).sum());
+  terms.kl_per_layer.assign(layout_.num_layers(), 0.0);
+  for (int k = 0; k < layout_.num_layers(); ++k) {
+    const int off = layout_.z_offset(k), n = layout_.spec().layers[k].z;
+    const auto lp = ls_p_.middleRows(off, n).array();
+    const auto lq = ls_q_.middleRows(off, n).array();
+    const auto sp = sig_p_.middleRows(off, n).array();
+    const auto sq = sig_q_.middleRows(off, n).array();
+    const auto diff = mu_q_.middleRows(off, n).array() - mu_p_.middleRows(off, n).array();
+    terms.kl_per_layer[k] = static_cast<double>(
+        ((lp - lq) + (diff.square() + sq.square()) / (Scalar(2) * sp.square()) - Scalar(0.5))
+            .sum());
+    terms.regulation += meta_prior[k] * terms.kl_per_layer[k];
+  }
+  terms.loss = terms.reconstruction / layout_.spec().num_dofs() + terms.regulation / tz;
+  return terms;
+}
+
+template <typename Scalar>
+void PosteriorPass<Scalar>::Backward(Weights<Scalar>* grad_w, AdaptiveVariables<Scalar>* grad_a) {
+  const int S = sequences_, td = layout_.total_d(), tz = layout_.total_z(), d0 = layout_.d0();
+  const Weights<Scalar>& w = *w_;
+  r_t_ = w.R().transpose();
+  wz_t_ = w.Wz().transpose();
+  wx_t_ = w.Wx().transpose();
+  const Scalar inv_dofs = Scalar(1) / static_cast<Scalar>(layout_.spec().num_dofs());
+  g_out_ = (x_ - *targets_) * inv_dofs;
+  g_d0_.noalias() = wx_t_ * g_out_;
+  g_h_next_.setZero();
+  g_start_d_.setZero();  // holds dL/dd(t) coming from step t+1 through R
+  auto a_mu_g = grad_a->mu();
+  auto a_ls_g = grad_a->log_sigma();
+  const int zp = td, zlp = td + tz, zq = td + 2 * tz, zlq = td + 3 * tz;
+  for (int t = steps_ - 1; t >= 0; --t) {
+    const int c0 = t * S;
+    g_d_ = g_start_d_;
+    g_d_.topRows(d0) += g_d0_.middleCols(c0, S);
+    const auto d_t = d_.middleCols(c0 + S, S).array();
+    g_h_ = (g_d_.array() * (Scalar(1) - d_t.square()) +
+            g_h_next_.array().colwise() * keep_.array())
+               .matrix();
+    auto gp = g_pre_.middleCols(c0, S);
+    gp.topRows(td) = (g_h_.array().colwise() * rate_.array()).matrix();
+    g_z_.noalias() = wz_t_.lazyProduct(gp.topRows(td));
+    const auto mup = mu_p_.middleCols(c0, S).array();
+    const auto muq = mu_q_.middleCols(c0, S).array();
+    const auto sp = sig_p_.middleCols(c0, S).array();
+    const auto sq = sig_q_.middleCols(c0, S).array();
+    const auto ep = eps_->middleCols(c0, S).array();
+    const auto diff = muq - mup;
+    const auto inv_vp = sp.square().inverse();
+    const auto c = kl_coef_.array();
+    gp.middleRows(zq, tz) =
+        ((g_z_.array() + (diff * inv_vp).colwise() * c) * (Scalar(1) - muq.square())).matrix();
+    gp.middleRows(zlq, tz) =
+        (g_z_.array() * sq * ep + (sq.square() * inv_vp - Scalar(1)).colwise() * c).matrix();
+    gp.middleRows(zp, tz) = ((-(diff * inv_vp)).colwise() * c * (Scalar(1) - mup.square())).matrix();
+    gp.middleRows(zlp, tz) =
+        ((Scalar(1) - (diff.square() + sq.square()) * inv_vp).colwise() * c).matrix();
+    a_mu_g.middleCols(c0, S) = gp.middleRows(zq, tz);
+    a_ls_g.middleCols(c0, S) = gp.middleRows(zlq, tz);
+    g_start_d_.noalias() = r_t_.lazyProduct(gp);
+    g_h_next_ = g_h_;
+  }
+  g_start_h_ = (g_h_next_.array().colwise() * keep_.array()).matrix();
+  if (grad_w == nullptr) return;
+  // Weight gradients: one large product per piece over all steps and sequences.
+  auto gr = grad_w->R();
+  gr.noalias() = g_pre_ * d_.leftCols(cols_).transpose();
+  gr.array() *= r_maskf_.array();
+  grad_w->RBias().col(0) = g_pre_.rowwise().sum();
+  auto gwz = grad_w->Wz();
+  gwz.noalias() = g_pre_.topRows(td) * z_.transpose();
+  gwz.array() *= wz_maskf_.array();
+  grad_w->Wx().noalias() = g_out_ * d_.block(0, S, d0, cols_).transpose();
+  grad_w->Bx().col(0) = g_out_.rowwise().sum();
+}
+
+template <typename Scalar>
+std::vector<double> PosteriorPass<Scalar>::ReconstructionPerSequence() const {
+  std::vector<double> out(sequences_, 0.0);
+  for (int j = 0; j < cols_; ++j) {
+    const auto y = targets_->col(j).array();
+    out[j % sequences_] += static_cast<double>((y * (y.log() - log_x_.col(j).array())).sum());
+  }
+  return out;
+}
+
+template <typename Scalar>
+double PosteriorPass<Scalar>::MultiplyAddsPerIteration() const {
+  const double td = layout_.total_d(), tz = layout_.total_z(), rr = layout_.recurrent_rows();
+  const double nx = layout_.output_units(), d0 = layout_.d0(), n = cols_;
+  const double forward = n * (rr * td + td * tz + nx * d0);
+  const double backward_inputs = n * (td * rr + tz * td + d0 * nx);
+  const double backward_weights = n * (rr * td + td * tz + nx * d0);
+  return forward + backward_inputs + backward_weights;
+}
+
+template class PosteriorPass<float>;
+template class PosteriorPass<double>;
+
+}  // namespace dyad::pvrnn

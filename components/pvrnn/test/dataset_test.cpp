@@ -1,0 +1,62 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "dyad/pvrnn/analytic_dataset.hpp"
+#include "dyad/pvrnn/dataset.hpp"
+#include "test_paths.hpp"
+
+namespace dyad::pvrnn {
+namespace {
+
+TEST(Dataset, ReadsTheMacawSet) {
+  DYAD_REQUIRE_VCBOT();
+  auto d = LoadNrlDataset(testing::VcbotDir() + "/dataset/Macaw");
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  EXPECT_EQ(d->size(), 7);
+  EXPECT_EQ(d->steps(), 72);
+  EXPECT_EQ(d->dofs(), 2);
+  EXPECT_NEAR(d->sequences[0](0, 0), -2.5558292687809034, 1e-12);
+}
+
+TEST(AnalyticDataset, SevenClosedPrimitivesInsideTheWorkspace) {
+  const Dataset d = MakeAnalyticDataset();
+  ASSERT_EQ(d.size(), 7);
+  for (const auto& s : d.sequences) {
+    ASSERT_EQ(s.rows(), 2);
+    ASSERT_EQ(s.cols(), 72);
+    EXPECT_LE(s.cwiseAbs().maxCoeff(), 50.0);
+    // Closed: the step from the last point back to the first is no longer than the longest step.
+    double longest = 0;
+    for (int t = 1; t < 72; ++t) longest = std::max(longest, (s.col(t) - s.col(t - 1)).norm());
+    EXPECT_LE((s.col(0) - s.col(71)).norm(), longest + 1e-9);
+  }
+}
+
+TEST(Dataset, WrittenAnalyticSetReadsBackIdentically) {
+  const Dataset d = MakeAnalyticDataset();
+  const std::string dir = testing::TempPath("analytic_set");
+  std::filesystem::remove_all(dir);
+  ASSERT_TRUE(WriteNrlDataset(d, dir).ok());
+  auto back = LoadNrlDataset(dir);
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  ASSERT_EQ(back->size(), 7);
+  for (int p = 0; p < 7; ++p) EXPECT_EQ(back->sequences[p], d.sequences[p]);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Dataset, ShortPrimitiveFileIsReportedWithItsName) {
+  const std::string dir = testing::TempPath("short_set");
+  std::filesystem::remove_all(dir);
+  ASSERT_TRUE(WriteNrlDataset(MakeAnalyticDataset(), dir).ok());
+  { std::ofstream(dir + "/primitive_3_0.csv") << "1,2\n3,4\n"; }
+  auto back = LoadNrlDataset(dir);
+  ASSERT_FALSE(back.ok());
+  EXPECT_NE(back.status().message().find("primitive_3_0.csv: 2 rows, dataset.d says numbertimes=72"), std::string::npos)
+      << back.status().message();
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace dyad::pvrnn

@@ -1,0 +1,116 @@
+#include "dyad/pvrnn/model_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "test_paths.hpp"
+
+namespace dyad::pvrnn {
+namespace {
+
+std::string ReadAll(const std::string& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+void WriteAll(const std::string& p, const std::string& s) { std::ofstream(p, std::ios::binary) << s; }
+
+Model SmallModel() {
+  ModelSpec spec = ModelSpec::MacawBot();
+  spec.layers[0].d = 6;
+  spec.layers[1].d = 3;
+  Model m = Model::Initialize(spec, 5, 2, 42);
+  m.provenance = {"test", "somewhere/Macaw", 123, 42, "float", 0.5, 0.25, 0.125};
+  return m;
+}
+
+TEST(ModelFile, RoundTripsEverything) {
+  const std::string path = testing::TempPath("roundtrip.dpvrnn");
+  Model m = SmallModel();
+  TrainingState st;
+  st.adam_step = 7;
+  st.weights_m = Eigen::VectorXd::Random(m.weights.flat().size());
+  st.weights_v = Eigen::VectorXd::Random(m.weights.flat().size());
+  st.adaptive_m = Eigen::VectorXd::Random(m.adaptive.flat().size());
+  st.adaptive_v = Eigen::VectorXd::Random(m.adaptive.flat().size());
+  st.rng_state = "1 2 3";
+  m.training = st;
+  ASSERT_TRUE(SaveModel(m, path).ok());
+  auto back = LoadModel(path);
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->spec, m.spec);
+  EXPECT_EQ(back->weights.flat(), m.weights.flat());
+  EXPECT_EQ(back->adaptive.flat(), m.adaptive.flat());
+  EXPECT_EQ(back->provenance.dataset, "somewhere/Macaw");
+  EXPECT_EQ(back->provenance.epochs, 123);
+  EXPECT_EQ(back->provenance.final_loss, 0.5);
+  ASSERT_TRUE(back->training.has_value());
+  EXPECT_EQ(back->training->adam_step, 7);
+  EXPECT_EQ(back->training->weights_v, st.weights_v);
+  EXPECT_EQ(back->training->rng_state, "1 2 3");
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, MissingFileNamesThePath) {
+  auto r = LoadModel("/nonexistent/x.dpvrnn");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().message(), "/nonexistent/x.dpvrnn: cannot open");
+}
+
+TEST(ModelFile, EveryTruncationIsAnErrorNeverACrash) {
+  const std::string path = testing::TempPath("trunc.dpvrnn");
+  ASSERT_TRUE(SaveModel(SmallModel(), path).ok());
+  const std::string full = ReadAll(path);
+  for (size_t n : {size_t(0), size_t(5), size_t(8), size_t(20), size_t(30), full.size() / 2, full.size() - 9,
+                   full.size() - 1}) {
+    WriteAll(path, full.substr(0, n));
+    auto r = LoadModel(path);
+    ASSERT_FALSE(r.ok()) << "cut at " << n;
+    EXPECT_EQ(r.status().message().rfind(path + ": ", 0), 0u) << r.status().message();
+  }
+  WriteAll(path, full.substr(0, full.size() / 2));
+  EXPECT_NE(LoadModel(path).status().message().find("truncated"), std::string::npos) << LoadModel(path).status().message();
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, FlippedByteIsReportedAsCorrupted) {
+  const std::string path = testing::TempPath("flip.dpvrnn");
+  ASSERT_TRUE(SaveModel(SmallModel(), path).ok());
+  std::string bytes = ReadAll(path);
+  for (size_t at : {size_t(40), bytes.size() / 2, bytes.size() - 20}) {
+    std::string bad = bytes;
+    bad[at] ^= 0x10;
+    WriteAll(path, bad);
+    auto r = LoadModel(path);
+    ASSERT_FALSE(r.ok()) << "flip at " << at;
+    EXPECT_NE(r.status().message().find(path + ": "), std::string::npos);
+  }
+  std::string bad = bytes;
+  bad[bytes.size() / 2] ^= 0x01;  // inside the payload: only the checksum can tell
+  WriteAll(path, bad);
+  EXPECT_EQ(LoadModel(path).status().message(), path + ": corrupted (checksum mismatch)");
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, WrongVersionIsReportedWithBothVersions) {
+  const std::string path = testing::TempPath("version.dpvrnn");
+  ASSERT_TRUE(SaveModel(SmallModel(), path).ok());
+  std::string bytes = ReadAll(path);
+  bytes[8] = 9;
+  WriteAll(path, bytes);
+  auto r = LoadModel(path);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().message(), path + ": format version 9, this build reads version 1");
+  std::filesystem::remove(path);
+}
+
+TEST(ModelFile, OtherFileIsNotAModel) {
+  const std::string path = testing::TempPath("other.dpvrnn");
+  WriteAll(path, "d=40,10\nz=4,1\n");
+  EXPECT_EQ(LoadModel(path).status().message(), path + ": not a dyad PV-RNN model file (bad magic)");
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace dyad::pvrnn

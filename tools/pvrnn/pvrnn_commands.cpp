@@ -1,0 +1,255 @@
+#include "pvrnn_commands.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dyad/pvrnn/analytic_dataset.hpp"
+#include "dyad/pvrnn/model_file.hpp"
+#include "dyad/pvrnn/nrl_import.hpp"
+#include "dyad/pvrnn/prior_generator.hpp"
+#include "dyad/pvrnn/train_config.hpp"
+#include "dyad/pvrnn/trainer.hpp"
+
+namespace dyad::cli {
+namespace {
+
+using namespace dyad::pvrnn;
+using Clock = std::chrono::steady_clock;
+
+constexpr int kOk = 0, kFailure = 1, kBadInput = 2;
+
+int Fail(int code, const std::string& msg) {
+  std::fprintf(stderr, "error: %s\n", msg.c_str());
+  return code;
+}
+
+// Set by SIGINT while training; the loop saves a checkpoint and stops.
+std::atomic<bool> g_interrupted{false};
+extern "C" void OnSigint(int) { g_interrupted.store(true); }
+
+// Restores the previous SIGINT handler when training ends.
+class SigintGuard {
+ public:
+  SigintGuard() {
+    g_interrupted.store(false);
+    struct sigaction sa {};
+    sa.sa_handler = OnSigint;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &previous_);
+  }
+  ~SigintGuard() { sigaction(SIGINT, &previous_, nullptr); }
+  SigintGuard(const SigintGuard&) = delete;
+  SigintGuard& operator=(const SigintGuard&) = delete;
+
+ private:
+  struct sigaction previous_ {};
+};
+
+std::string Duration(double s) {
+  char buf[32];
+  if (s < 120) std::snprintf(buf, sizeof buf, "%.0fs", s);
+  else if (s < 7200) std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  else std::snprintf(buf, sizeof buf, "%dh%02dm", static_cast<int>(s) / 3600, (static_cast<int>(s) / 60) % 60);
+  return buf;
+}
+
+template <typename Scalar>
+int RunTraining(const TrainConfig& c, const std::string& config_path, const Dataset& data, bool resume) {
+  Model init;
+  if (resume) {
+    auto ck = LoadModel(c.checkpoint);
+    if (!ck.ok()) return Fail(kBadInput, "--resume: " + ck.status().message());
+    if (!ck->training) return Fail(kBadInput, c.checkpoint + ": has no training state (not a checkpoint)");
+    if (!(ck->spec == c.spec)) return Fail(kBadInput, c.checkpoint + ": model shape differs from " + config_path);
+    init = std::move(ck.value());
+  } else {
+    init = Model::Initialize(c.spec, data.steps(), data.size(), c.seed);
+  }
+  init.provenance.source = "dyad train " + config_path;
+  init.provenance.dataset = c.dataset;
+  init.provenance.seed = c.seed;
+  init.provenance.scalar = c.scalar;
+  TrainerOptions opts;
+  opts.adam = c.adam;
+  opts.seed = c.seed;
+  opts.sample_noise = c.noise;
+  auto made = Trainer<Scalar>::Create(init, data, opts);
+  if (!made.ok()) return Fail(kBadInput, made.status().message());
+  Trainer<Scalar>& trainer = *made.value();
+  const int64_t start_epoch = trainer.epoch();
+  if (start_epoch >= c.epochs)
+    return Fail(kBadInput, c.checkpoint + ": already at epoch " + std::to_string(start_epoch) + " of " + std::to_string(c.epochs));
+
+  for (const std::string& f : {c.output, c.checkpoint, c.log_csv}) {
+    const auto dir = std::filesystem::path(f).parent_path();
+    std::error_code ec;
+    if (!dir.empty()) std::filesystem::create_directories(dir, ec);
+    if (ec) return Fail(kFailure, dir.string() + ": cannot create folder: " + ec.message());
+  }
+  std::ofstream csv(c.log_csv, resume && std::filesystem::exists(c.log_csv) ? std::ios::app : std::ios::trunc);
+  if (!csv) return Fail(kFailure, c.log_csv + ": cannot open for writing");
+  if (!resume || csv.tellp() == 0) {
+    csv << "epoch,reconstruction_q,reconstruction_p,regulation,loss";
+    for (int k = 0; k < c.spec.num_layers(); ++k) csv << ",kl_layer" << k;
+    csv << ",elapsed_s\n";
+  }
+  const bool tty = isatty(fileno(stdout));
+  std::printf("training %s (%d sequences x %d steps) from epoch %lld to %lld, %s, seed %llu\n", c.dataset.c_str(),
+              data.size(), data.steps(), static_cast<long long>(start_epoch), static_cast<long long>(c.epochs),
+              c.scalar.c_str(), static_cast<unsigned long long>(c.seed));
+  auto snapshot = [&](bool with_state, const LossTerms& l) {
+    Model m = trainer.Snapshot(with_state);
+    m.provenance.epochs = trainer.epoch();
+    m.provenance.final_loss = l.loss;
+    m.provenance.final_reconstruction = l.reconstruction;
+    m.provenance.final_regulation = l.regulation;
+    return m;
+  };
+  SigintGuard guard;
+  const auto t0 = Clock::now();
+  LossTerms l;
+  while (trainer.epoch() < c.epochs) {
+    l = trainer.Epoch();
+    const int64_t e = trainer.epoch();
+    if (!std::isfinite(l.loss)) {
+      std::printf("\n");
+      return Fail(kFailure, "training diverged at epoch " + std::to_string(e) + " (loss " + std::to_string(l.loss) + ")");
+    }
+    const bool interrupted = g_interrupted.load();
+    if (e % c.log_every == 0 || e == c.epochs || interrupted) {
+      const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
+      const double re_p = trainer.PriorReconstruction(true, c.seed + static_cast<uint64_t>(e));
+      const double eta = elapsed / static_cast<double>(e - start_epoch) * static_cast<double>(c.epochs - e);
+      std::printf("%sepoch %lld/%lld  RE_Q %.4g  RE_P %.4g  Regulation %.4g  loss %.4g  %.3f ms/epoch  ETA %s%s",
+                  tty ? "\r\033[K" : "", static_cast<long long>(e), static_cast<long long>(c.epochs), l.reconstruction,
+                  re_p, l.regulation, l.loss, 1e3 * elapsed / static_cast<double>(e - start_epoch),
+                  Duration(eta).c_str(), tty ? "" : "\n");
+      std::fflush(stdout);
+      csv << e << ',' << l.reconstruction << ',' << re_p << ',' << l.regulation << ',' << l.loss;
+      for (double kl : l.kl_per_layer) csv << ',' << kl;
+      csv << ',' << elapsed << '\n';
+      csv.flush();
+    }
+    const bool checkpoint_due = c.checkpoint_every > 0 && e % c.checkpoint_every == 0;
+    if (checkpoint_due || interrupted) {
+      if (Status s = SaveModel(snapshot(true, l), c.checkpoint); !s.ok()) return Fail(kFailure, s.message());
+    }
+    if (interrupted) {
+      std::printf("\ninterrupted at epoch %lld: checkpoint saved to %s (continue with --resume)\n",
+                  static_cast<long long>(e), c.checkpoint.c_str());
+      return kFailure;
+    }
+  }
+  if (tty) std::printf("\n");
+  if (Status s = SaveModel(snapshot(true, l), c.checkpoint); !s.ok()) return Fail(kFailure, s.message());
+  if (Status s = SaveModel(snapshot(false, l), c.output); !s.ok()) return Fail(kFailure, s.message());
+  std::printf("done: %lld epochs in %s, loss %.4f; model written to %s\n",
+              static_cast<long long>(c.epochs - start_epoch),
+              Duration(std::chrono::duration<double>(Clock::now() - t0).count()).c_str(), l.loss, c.output.c_str());
+  return kOk;
+}
+
+int Train(const std::string& config_path, bool resume, const std::vector<std::string>& sets) {
+  auto c = LoadTrainConfig(config_path, sets);
+  if (!c.ok()) return Fail(kBadInput, c.status().message());
+  auto data = LoadNrlDataset(c->dataset);
+  if (!data.ok()) return Fail(kBadInput, data.status().message());
+  return c->scalar == "double" ? RunTraining<double>(c.value(), config_path, data.value(), resume)
+                               : RunTraining<float>(c.value(), config_path, data.value(), resume);
+}
+
+int ImportNrl(const NrlImportOptions& o, const std::string& out) {
+  auto m = ImportNrlModel(o);
+  if (!m.ok()) return Fail(kBadInput, m.status().message());
+  if (Status s = SaveModel(m.value(), out); !s.ok()) return Fail(kFailure, s.message());
+  std::printf("imported %s: %d layers, %d primitives x %d steps, epoch %lld -> %s\n", o.model_dir.c_str(),
+              m->spec.num_layers(), m->sequences(), m->steps(), static_cast<long long>(m->provenance.epochs), out.c_str());
+  return kOk;
+}
+
+int GenerateModel(const std::string& path, int primitive, int steps, const std::string& out, uint64_t seed, bool no_noise) {
+  auto m = LoadModel(path);
+  if (!m.ok()) return Fail(kBadInput, m.status().message());
+  if (primitive < 0 || primitive >= m->sequences())
+    return Fail(kBadInput, "--primitive " + std::to_string(primitive) + ": the model has primitives 0.." +
+                               std::to_string(m->sequences() - 1));
+  if (steps <= 0) return Fail(kBadInput, "--steps must be > 0");
+  GenerateOptions g;
+  g.noise = !no_noise;
+  g.seed = seed;
+  const Eigen::MatrixXd xy = GeneratePrimitive(m.value(), primitive, steps, g);
+  std::FILE* f = out.empty() ? stdout : std::fopen(out.c_str(), "w");
+  if (f == nullptr) return Fail(kFailure, out + ": cannot open for writing");
+  for (int t = 0; t < xy.cols(); ++t) {
+    for (int i = 0; i < xy.rows(); ++i) std::fprintf(f, i ? ",%.17g" : "%.17g", xy(i, t));
+    std::fprintf(f, "\n");
+  }
+  if (f != stdout && std::fclose(f) != 0) return Fail(kFailure, out + ": write failed");
+  return kOk;
+}
+
+}  // namespace
+
+void AddPvrnnCommands(CLI::App& app, int& exit_code) {
+  {
+    auto* cmd = app.add_subcommand("train", "Train a PV-RNN model from a YAML config (Ctrl-C saves a checkpoint)");
+    auto config = std::make_shared<std::string>();
+    auto resume = std::make_shared<bool>(false);
+    auto sets = std::make_shared<std::vector<std::string>>();
+    cmd->add_option("config", *config, "Training config (YAML)")->required();
+    cmd->add_flag("--resume", *resume, "Continue from the config's checkpoint file");
+    cmd->add_option("--set", *sets, "Override a config value, e.g. --set adam.lr=0.002 (repeatable)");
+    cmd->callback([&exit_code, config, resume, sets] { exit_code = Train(*config, *resume, *sets); });
+  }
+  {
+    auto* cmd = app.add_subcommand("import-nrl", "Convert an NRL/VCBot model folder into a dyad model file");
+    auto o = std::make_shared<NrlImportOptions>();
+    auto out = std::make_shared<std::string>();
+    cmd->add_option("model_dir", o->model_dir, "NRL model folder (L0_w_p.d, ...)")->required();
+    cmd->add_option("--properties", o->properties_file, "properties_*.d of the model")->required();
+    cmd->add_option("--dataset", o->dataset_dir, "Data set folder the model was trained on")->required();
+    cmd->add_option("-o,--output", *out, "Output model file (.dpvrnn)")->required();
+    cmd->callback([&exit_code, o, out] { exit_code = ImportNrl(*o, *out); });
+  }
+  {
+    auto* gen = app.add_subcommand("generate", "Generate trajectories or data sets");
+    gen->require_subcommand(1);
+    auto* model = gen->add_subcommand("model", "Write a primitive generated from the prior (CSV x,y per step)");
+    struct Args {
+      std::string path, out;
+      int primitive = 0, steps = 72;
+      uint64_t seed = 1;
+      bool no_noise = false;
+    };
+    auto a = std::make_shared<Args>();
+    model->add_option("model", a->path, "Model file (.dpvrnn)")->required();
+    model->add_option("--primitive", a->primitive, "Primitive (sequence) index")->required();
+    model->add_option("--steps", a->steps, "Steps to generate")->required();
+    model->add_option("-o,--output", a->out, "CSV file (default: stdout)");
+    auto* seed = model->add_option("--seed", a->seed, "Noise seed (default 1)");
+    auto* nn = model->add_flag("--no-noise", a->no_noise, "Means only (reproducible)");
+    seed->excludes(nn);
+    model->callback([&exit_code, a] {
+      exit_code = GenerateModel(a->path, a->primitive, a->steps, a->out, a->seed, a->no_noise);
+    });
+    auto* ds = gen->add_subcommand("dataset", "Write the built-in analytic data set (7 closed shapes, 72 steps, 2 DOF)");
+    auto dir = std::make_shared<std::string>();
+    ds->add_option("--out", *dir, "Output folder (NRL layout)")->required();
+    ds->callback([&exit_code, dir] {
+      Status s = WriteNrlDataset(MakeAnalyticDataset(), *dir);
+      exit_code = s.ok() ? kOk : Fail(kFailure, s.message());
+      if (s.ok()) std::printf("wrote 7 primitives x 72 steps to %s\n", dir->c_str());
+    });
+  }
+}
+
+}  // namespace dyad::cli
