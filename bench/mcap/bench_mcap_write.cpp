@@ -78,13 +78,13 @@ Result RunMcap(const std::string& path, std::uint64_t samples, const dyad::mcap:
     MakeSample(i, sample);
     const int c = static_cast<int>(i % 3);
     const std::uint64_t t = 1'700'000'000'000'000'000ull + i * 3'333;
-    dyad::mcap::Status s = writer->Write(channels[c], sequence[c]++, t, t - 1000, sample);
+    dyad::Status s = writer->Write(channels[c], sequence[c]++, t, t - 1000, sample);
     if (!s.ok()) {
       std::fprintf(stderr, "%s\n", s.ToString().c_str());
       std::exit(1);
     }
   }
-  if (dyad::mcap::Status s = writer->Close(); !s.ok()) {
+  if (dyad::Status s = writer->Close(); !s.ok()) {
     std::fprintf(stderr, "%s\n", s.ToString().c_str());
     std::exit(1);
   }

@@ -22,7 +22,7 @@ constexpr int kBadInput = 2;
 std::unique_ptr<mcap::Reader> OpenRecording(const std::string& path, bool scan) {
   mcap::ReaderOptions options;
   options.use_summary = !scan;
-  mcap::StatusOr<mcap::Reader> reader = mcap::Reader::Open(path, options);
+  StatusOr<mcap::Reader> reader = mcap::Reader::Open(path, options);
   if (!reader.ok()) {
     std::cerr << "dyad bag: " << reader.status().message() << "\n";
     return nullptr;
@@ -66,7 +66,7 @@ int RunExport(const std::string& path, const std::string& dir, const std::vector
     }
   }
   bag::CsvExportSummary summary;
-  mcap::Status status = bag::ExportCsv(*reader, dir, options, &summary);
+  Status status = bag::ExportCsv(*reader, dir, options, &summary);
   for (const auto& [topic, file] : summary.files) {
     std::cout << file << ": " << summary.rows[topic] << " rows (" << topic << ")\n";
   }

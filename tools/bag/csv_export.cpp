@@ -55,11 +55,11 @@ std::string FileNameForTopic(const std::string& topic) {
   return name.empty() ? "topic" : name;
 }
 
-mcap::Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const CsvExportOptions& options,
+Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const CsvExportOptions& options,
                        CsvExportSummary* summary) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) return mcap::Status::IOError(dir, "cannot create directory: " + ec.message());
+  if (ec) return Status::IOError(dir, "cannot create directory: " + ec.message());
 
   std::map<mcap::ChannelId, std::unique_ptr<ChannelOutput>> outputs;
   std::set<std::string> used_names;
@@ -77,7 +77,7 @@ mcap::Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const
     used_names.insert(name);
     out->path = (std::filesystem::path(dir) / (name + ".csv")).string();
     out->file.open(out->path, std::ios::out | std::ios::trunc);
-    if (!out->file) return mcap::Status::IOError(out->path, "cannot open for writing");
+    if (!out->file) return Status::IOError(out->path, "cannot open for writing");
     out->file << "log_time,publish_time,sequence";
     for (const std::string& column : out->decoder.columns) {
       out->file << ',';
@@ -93,7 +93,7 @@ mcap::Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const
   read.skip_damaged = true;
   read.skipped_chunks = &summary->skipped_chunks;
   std::vector<std::string> cells;
-  mcap::Status status = reader.ReadMessages(read, [&](const mcap::MessageView& m) {
+  Status status = reader.ReadMessages(read, [&](const mcap::MessageView& m) {
     ChannelOutput& out = *outputs.at(m.channel->id);
     out.file << m.log_time << ',' << m.publish_time << ',' << m.sequence;
     cells.clear();
@@ -115,7 +115,7 @@ mcap::Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const
   });
   for (auto& [id, out] : outputs) {
     out->file.close();
-    if (!out->file) return mcap::Status::IOError(out->path, "write failed");
+    if (!out->file) return Status::IOError(out->path, "write failed");
     summary->rows[reader.channels().at(id).topic] = out->rows;
   }
   return status;

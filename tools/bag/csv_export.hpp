@@ -13,7 +13,7 @@
 //     return MakeCdrDecoder(*schema);  // columns: stamp_ns, x, y, ...
 //   };
 //   dyad::bag::CsvExportSummary summary;
-//   dyad::mcap::Status s = dyad::bag::ExportCsv(reader, "out/", options, &summary);
+//   dyad::Status s = dyad::bag::ExportCsv(reader, "out/", options, &summary);
 #pragma once
 
 #include <cstdint>
@@ -64,7 +64,7 @@ struct CsvExportSummary {
 // channel id is appended when two topics would share a name). Creates `dir` if missing.
 // Damaged chunks are skipped and counted rather than failing the export.
 // Fails: IOError naming the CSV that cannot be written; errors of Reader::ReadMessages.
-mcap::Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const CsvExportOptions& options,
+Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const CsvExportOptions& options,
                        CsvExportSummary* summary);
 
 // "robot_pose" for "/robot/pose": letters, digits, '-', '.', '_' kept, the rest '_'.

@@ -15,7 +15,7 @@ Status AdamOptions::Validate() const {
   if (!(beta1 >= 0 && beta1 < 1)) return bad("beta1", beta1, "must be in [0, 1)");
   if (!(beta2 >= 0 && beta2 < 1)) return bad("beta2", beta2, "must be in [0, 1)");
   if (!(epsilon > 0)) return bad("epsilon", epsilon, "must be > 0");
-  return Status::Ok();
+  return Status::OK();
 }
 
 template <typename Scalar>

@@ -46,11 +46,11 @@ StatusOr<Dataset> LoadNrlDataset(const std::string& dir) {
       if (k == "numbertimes") steps = std::stoi(v);
       if (k == "numberprims") prims = std::stoi(v);
     } catch (const std::exception&) {
-      return Status::Corrupted(meta + ": " + k + " = '" + v + "': not a number");
+      return Status::DataLoss(meta + ": " + k + " = '" + v + "': not a number");
     }
   }
-  if (steps <= 0) return Status::Corrupted(meta + ": numbertimes missing or not > 0");
-  if (prims <= 0) return Status::Corrupted(meta + ": numberprims missing or not > 0");
+  if (steps <= 0) return Status::DataLoss(meta + ": numbertimes missing or not > 0");
+  if (prims <= 0) return Status::DataLoss(meta + ": numberprims missing or not > 0");
   std::vector<double> row;
   for (int p = 0; p < prims; ++p) {
     const std::string file = (fs::path(dir) / ("primitive_" + std::to_string(p) + "_0.csv")).string();
@@ -63,20 +63,20 @@ StatusOr<Dataset> LoadNrlDataset(const std::string& dir) {
       ++line_no;
       if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
       if (!ParseRow(line, &row))
-        return Status::Corrupted(file + ":" + std::to_string(line_no) + ": not a comma-separated row of numbers");
+        return Status::DataLoss(file + ":" + std::to_string(line_no) + ": not a comma-separated row of numbers");
       if (!rows.empty() && row.size() != rows[0].size())
-        return Status::Corrupted(file + ":" + std::to_string(line_no) + ": " + std::to_string(row.size()) +
+        return Status::DataLoss(file + ":" + std::to_string(line_no) + ": " + std::to_string(row.size()) +
                                  " values, earlier rows have " + std::to_string(rows[0].size()));
       rows.push_back(row);
     }
     if (static_cast<int>(rows.size()) != steps)
-      return Status::Corrupted(file + ": " + std::to_string(rows.size()) + " rows, dataset.d says numbertimes=" +
+      return Status::DataLoss(file + ": " + std::to_string(rows.size()) + " rows, dataset.d says numbertimes=" +
                                std::to_string(steps));
     Eigen::MatrixXd seq(rows[0].size(), steps);
     for (int t = 0; t < steps; ++t)
       for (size_t i = 0; i < rows[t].size(); ++i) seq(i, t) = rows[t][i];
     if (!data.sequences.empty() && seq.rows() != data.sequences[0].rows())
-      return Status::Corrupted(file + ": " + std::to_string(seq.rows()) + " DOFs, primitive_0_0.csv has " +
+      return Status::DataLoss(file + ": " + std::to_string(seq.rows()) + " DOFs, primitive_0_0.csv has " +
                                std::to_string(data.sequences[0].rows()));
     data.sequences.push_back(std::move(seq));
   }
@@ -86,13 +86,13 @@ StatusOr<Dataset> LoadNrlDataset(const std::string& dir) {
 Status WriteNrlDataset(const Dataset& data, const std::string& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec) return Status::IoError(dir + ": cannot create folder: " + ec.message());
+  if (ec) return Status::IOError(dir + ": cannot create folder: " + ec.message());
   {
     const std::string meta = (fs::path(dir) / "dataset.d").string();
     std::ofstream out(meta);
     out << "samplingperiod=" << data.sampling_period_ms << "\nnumbertimes=" << data.steps()
         << "\nnumberprims=" << data.size() << "\n";
-    if (!out) return Status::IoError(meta + ": write failed");
+    if (!out) return Status::IOError(meta + ": write failed");
   }
   for (int p = 0; p < data.size(); ++p) {
     const std::string file = (fs::path(dir) / ("primitive_" + std::to_string(p) + "_0.csv")).string();
@@ -103,9 +103,9 @@ Status WriteNrlDataset(const Dataset& data, const std::string& dir) {
       for (int i = 0; i < s.rows(); ++i) out << (i ? "," : "") << s(i, t);
       out << "\n";
     }
-    if (!out) return Status::IoError(file + ": write failed");
+    if (!out) return Status::IOError(file + ": write failed");
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 }  // namespace dyad::pvrnn

@@ -139,15 +139,15 @@ Status SaveModel(const Model& model, const std::string& path) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) return Status::IoError(path + ": cannot open " + tmp + " for writing");
+    if (!f) return Status::IOError(path + ": cannot open " + tmp + " for writing");
     f.write(out.data(), static_cast<std::streamsize>(out.size()));
     f.flush();
-    if (!f) return Status::IoError(path + ": write failed (disk full?)");
+    if (!f) return Status::IOError(path + ": write failed (disk full?)");
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
-  if (ec) return Status::IoError(path + ": cannot rename " + tmp + ": " + ec.message());
-  return Status::Ok();
+  if (ec) return Status::IOError(path + ": cannot rename " + tmp + ": " + ec.message());
+  return Status::OK();
 }
 
 StatusOr<Model> LoadModel(const std::string& path) {
@@ -155,16 +155,16 @@ StatusOr<Model> LoadModel(const std::string& path) {
   if (!f) return Status::NotFound(path + ": cannot open");
   std::string in((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   if (in.size() < 8 || std::memcmp(in.data(), kMagic, 8) != 0)
-    return Status::Corrupted(path + ": not a dyad PV-RNN model file (bad magic)");
+    return Status::DataLoss(path + ": not a dyad PV-RNN model file (bad magic)");
   if (in.size() < kFixedHeader + kTrailer)
-    return Status::Corrupted(path + ": truncated: " + std::to_string(in.size()) + " bytes, less than the fixed header");
+    return Status::DataLoss(path + ": truncated: " + std::to_string(in.size()) + " bytes, less than the fixed header");
   const uint32_t version = Get<uint32_t>(in, 8);
   if (version != kModelFileVersion)
-    return Status::Unsupported(path + ": format version " + std::to_string(version) + ", this build reads version " +
+    return Status::Unimplemented(path + ": format version " + std::to_string(version) + ", this build reads version " +
                                std::to_string(kModelFileVersion));
   const uint64_t jlen = Get<uint64_t>(in, 16);
   if (jlen > in.size() - kFixedHeader - kTrailer)
-    return Status::Corrupted(path + ": truncated: header of " + std::to_string(jlen) + " bytes does not fit in " +
+    return Status::DataLoss(path + ": truncated: header of " + std::to_string(jlen) + " bytes does not fit in " +
                              std::to_string(in.size()) + " bytes");
   const uint32_t stored_crc = Get<uint32_t>(in, in.size() - kTrailer);
   const uint32_t crc = Crc(in.data(), in.size() - kTrailer);
@@ -172,8 +172,8 @@ StatusOr<Model> LoadModel(const std::string& path) {
   try {
     header = json::parse(in.begin() + kFixedHeader, in.begin() + kFixedHeader + static_cast<std::ptrdiff_t>(jlen));
   } catch (const std::exception& e) {
-    if (crc != stored_crc) return Status::Corrupted(path + ": corrupted or truncated (checksum mismatch)");
-    return Status::Corrupted(path + ": unreadable header: " + e.what());
+    if (crc != stored_crc) return Status::DataLoss(path + ": corrupted or truncated (checksum mismatch)");
+    return Status::DataLoss(path + ": unreadable header: " + e.what());
   }
   const size_t payload_at = kFixedHeader + jlen;
   const size_t payload_bytes = in.size() - kTrailer - payload_at;
@@ -183,15 +183,15 @@ StatusOr<Model> LoadModel(const std::string& path) {
     for (const auto& t : header.at("tensors"))
       needed = std::max<uint64_t>(needed, t.at("offset").get<uint64_t>() + t.at("rows").get<uint64_t>() * t.at("cols").get<uint64_t>());
     if (needed * 8 > payload_bytes)
-      return Status::Corrupted(path + ": truncated: tensors need " + std::to_string(needed * 8) + " bytes, file has " +
+      return Status::DataLoss(path + ": truncated: tensors need " + std::to_string(needed * 8) + " bytes, file has " +
                                std::to_string(payload_bytes));
-    if (crc != stored_crc) return Status::Corrupted(path + ": corrupted (checksum mismatch)");
+    if (crc != stored_crc) return Status::DataLoss(path + ": corrupted (checksum mismatch)");
     if (needed * 8 != payload_bytes)
-      return Status::Corrupted(path + ": " + std::to_string(payload_bytes - needed * 8) + " unexpected bytes after the tensors");
+      return Status::DataLoss(path + ": " + std::to_string(payload_bytes - needed * 8) + " unexpected bytes after the tensors");
     m.spec = SpecFromJson(header.at("spec"));
-    if (Status s = m.spec.Validate(); !s.ok()) return Status::Corrupted(path + ": spec: " + s.message());
+    if (Status s = m.spec.Validate(); !s.ok()) return Status::DataLoss(path + ": spec: " + s.message());
     const int steps = header.at("steps").get<int>(), sequences = header.at("sequences").get<int>();
-    if (steps < 0 || sequences < 0) return Status::Corrupted(path + ": negative steps or sequences");
+    if (steps < 0 || sequences < 0) return Status::DataLoss(path + ": negative steps or sequences");
     NetworkLayout layout(m.spec);
     m.weights = Weights<double>(layout);
     m.adaptive = AdaptiveVariables<double>(layout.total_z(), steps, sequences);
@@ -199,15 +199,15 @@ StatusOr<Model> LoadModel(const std::string& path) {
       for (const auto& t : header.at("tensors")) {
         if (t.at("name").get<std::string>() != name) continue;
         if (t.at("rows").get<int>() != rows || t.at("cols").get<int>() != cols)
-          return Status::Corrupted(path + ": tensor " + name + " is " + std::to_string(t.at("rows").get<int>()) + " x " +
+          return Status::DataLoss(path + ": tensor " + name + " is " + std::to_string(t.at("rows").get<int>()) + " x " +
                                    std::to_string(t.at("cols").get<int>()) + ", the spec needs " + std::to_string(rows) +
                                    " x " + std::to_string(cols));
         const size_t at = payload_at + t.at("offset").get<size_t>() * 8;
         for (int c = 0; c < cols; ++c)
           for (int r = 0; r < rows; ++r) sink(r, c, GetDouble(in, at + (static_cast<size_t>(c) * rows + r) * 8));
-        return Status::Ok();
+        return Status::OK();
       }
-      return Status::Corrupted(path + ": tensor " + name + " missing");
+      return Status::DataLoss(path + ": tensor " + name + " missing");
     };
     for (const auto& g : layout.groups()) {
       auto view = m.weights.Group(g);
@@ -240,7 +240,7 @@ StatusOr<Model> LoadModel(const std::string& path) {
       m.training = std::move(t);
     }
   } catch (const std::exception& e) {
-    return Status::Corrupted(path + ": malformed header: " + e.what());
+    return Status::DataLoss(path + ": malformed header: " + e.what());
   }
   return m;
 }

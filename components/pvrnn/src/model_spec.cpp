@@ -54,7 +54,7 @@ Status ModelSpec::Validate() const {
     if ((output.dofs[i].max - output.dofs[i].min) / output.dsoft > 10000)
       return bad("output.dsoft", output.dsoft, "gives more than 10000 softmax units per DOF");
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 ModelSpec ModelSpec::MacawBot() {

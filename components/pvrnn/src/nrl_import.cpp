@@ -33,7 +33,7 @@ class NrlMatrixFile {
   Status Next(int rows, int cols, const std::string& what, Eigen::MatrixXd* out) {
     const std::string where = name_ + ":" + std::to_string(next_ + 1);
     if (next_ >= lines_.size())
-      return Status::Corrupted(where + ": missing line for " + what + " (file has " + std::to_string(lines_.size()) + " lines)");
+      return Status::DataLoss(where + ": missing line for " + what + " (file has " + std::to_string(lines_.size()) + " lines)");
     const std::string& line = lines_[next_++];
     out->resize(rows, cols);
     size_t count = 0, pos = 0;
@@ -45,16 +45,16 @@ class NrlMatrixFile {
         double v = 0;
         auto r = std::from_chars(tok.data(), tok.data() + tok.size(), v);
         if (r.ec != std::errc() || r.ptr != tok.data() + tok.size())
-          return Status::Corrupted(where + ": '" + tok + "' is not a number (" + what + ")");
+          return Status::DataLoss(where + ": '" + tok + "' is not a number (" + what + ")");
         if (count < static_cast<size_t>(rows) * cols) out->data()[count] = v;
         ++count;
       }
       pos = end + 1;
     }
     if (count != static_cast<size_t>(rows) * cols)
-      return Status::Corrupted(where + ": expected " + std::to_string(rows * cols) + " values (" + std::to_string(rows) +
+      return Status::DataLoss(where + ": expected " + std::to_string(rows * cols) + " values (" + std::to_string(rows) +
                                " x " + std::to_string(cols) + ": " + what + "), found " + std::to_string(count));
-    return Status::Ok();
+    return Status::OK();
   }
 
  private:
@@ -72,7 +72,7 @@ StatusOr<std::vector<double>> Numbers(const std::string& file, const std::string
       size_t used = 0;
       out.push_back(std::stod(Trim(tok), &used));
     } catch (const std::exception&) {
-      return Status::Corrupted(file + ": " + key + " = '" + value + "': not a comma-separated list of numbers");
+      return Status::DataLoss(file + ": " + key + " = '" + value + "': not a comma-separated list of numbers");
     }
   }
   return out;
@@ -91,7 +91,7 @@ StatusOr<std::vector<std::pair<std::string, std::string>>> ReadKeyValueFile(cons
     const std::string t = Trim(line.substr(0, line.find('#')));
     if (t.empty()) continue;
     const size_t eq = t.find('=');
-    if (eq == std::string::npos) return Status::Corrupted(path + ":" + std::to_string(n) + ": expected key=value");
+    if (eq == std::string::npos) return Status::DataLoss(path + ":" + std::to_string(n) + ": expected key=value");
     out.emplace_back(Trim(t.substr(0, eq)), Trim(t.substr(eq + 1)));
   }
   return out;
@@ -113,14 +113,14 @@ StatusOr<Model> ImportNrlModel(const NrlImportOptions& options) {
     }
   }
   for (const char* key : {"d", "z", "t", "w", "activejoints"})
-    if (!num.count(key)) return Status::Corrupted(pf + ": property '" + key + "' missing");
+    if (!num.count(key)) return Status::DataLoss(pf + ": property '" + key + "' missing");
   if (text.count("network") && text["network"] != "pvrnn")
-    return Status::Unsupported(pf + ": network=" + text["network"] + ", only pvrnn can be imported");
+    return Status::Unimplemented(pf + ": network=" + text["network"] + ", only pvrnn can be imported");
   if (text.count("robot") && text["robot"] != "cartesian")
-    return Status::Unsupported(pf + ": robot=" + text["robot"] + ", only the cartesian robot (joints -50..50) is supported");
+    return Status::Unimplemented(pf + ": robot=" + text["robot"] + ", only the cartesian robot (joints -50..50) is supported");
   const size_t K = num["d"].size();
   if (num["z"].size() != K || num["t"].size() != K || num["w"].size() != K)
-    return Status::Corrupted(pf + ": d, z, t and w must list the same number of layers");
+    return Status::DataLoss(pf + ": d, z, t and w must list the same number of layers");
   ModelSpec spec;
   for (size_t k = 0; k < K; ++k)
     spec.layers.push_back({static_cast<int>(num["d"][k]), static_cast<int>(num["z"][k]), num["t"][k], num["w"][k]});
@@ -128,7 +128,7 @@ StatusOr<Model> ImportNrlModel(const NrlImportOptions& options) {
     if (a == 1) spec.output.dofs.push_back({-50, 50});
   spec.output.dsoft = num.count("dsoft") ? num["dsoft"][0] : 10;
   spec.output.sigma = num.count("sigma") ? num["sigma"][0] : 0.2;
-  if (Status s = spec.Validate(); !s.ok()) return Status::Corrupted(pf + ": " + s.message());
+  if (Status s = spec.Validate(); !s.ok()) return Status::DataLoss(pf + ": " + s.message());
 
   auto data = LoadNrlDataset(options.dataset_dir);
   if (!data.ok()) return data.status();

@@ -115,7 +115,7 @@ Status ApplyOverride(YAML::Node root, const std::string& spec) {
   } else {
     node[parts.back()] = parsed;
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 }  // namespace

@@ -26,7 +26,7 @@ Status OutputFile::Open(const std::string& path) {
   path_ = path;
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) return Status::IOError(path_, Errno("open for writing"));
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status OutputFile::Write(std::span<const iovec> buffers) {
@@ -59,18 +59,18 @@ Status OutputFile::Write(std::span<const iovec> buffers) {
       iov->iov_len -= left;
     }
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status OutputFile::Sync() {
   if (::fdatasync(fd_) != 0) return Status::IOError(path_, Errno("fdatasync"));
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status OutputFile::Close() {
   int fd = std::exchange(fd_, -1);
   if (fd >= 0 && ::close(fd) != 0) return Status::IOError(path_, Errno("close"));
-  return Status::Ok();
+  return Status::OK();
 }
 
 InputFile::~InputFile() {
@@ -98,7 +98,7 @@ Status InputFile::Open(const std::string& path) {
   if (::fstat(fd_, &st) != 0) return Status::IOError(path_, Errno("stat"));
   if (!S_ISREG(st.st_mode)) return Status::InvalidArgument(path_, "not a regular file");
   size_ = static_cast<std::uint64_t>(st.st_size);
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status InputFile::ReadAt(std::uint64_t offset, std::span<std::uint8_t> out) const {
@@ -114,7 +114,7 @@ Status InputFile::ReadAt(std::uint64_t offset, std::span<std::uint8_t> out) cons
     }
     done += static_cast<std::size_t>(n);
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 }  // namespace dyad::mcap

@@ -10,7 +10,7 @@
 #include <span>
 #include <string>
 
-#include "dyad/mcap/status.hpp"
+#include "dyad/status.hpp"
 
 namespace dyad::mcap {
 

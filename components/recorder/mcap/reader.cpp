@@ -129,7 +129,7 @@ Status Reader::Impl::Open(const std::string& path, const ReaderOptions& options)
     recovery_.stop_reason = "file ends inside the leading magic";
     recovery_.summary_problem = "no footer";
     recovery_.valid_up_to = size;
-    return Status::Ok();
+    return Status::OK();
   }
 
   // Header record.
@@ -153,17 +153,17 @@ Status Reader::Impl::Open(const std::string& path, const ReaderOptions& options)
   if (header_end == 8) {
     recovery_.summary_problem = "no footer";
     recovery_.valid_up_to = 8;
-    return Status::Ok();
+    return Status::OK();
   }
 
   if (options.use_summary) {
     recovery_.summary_problem = ReadSummary(header_end);
-    if (recovery_.summary_problem.empty()) return Status::Ok();
+    if (recovery_.summary_problem.empty()) return Status::OK();
   } else {
     recovery_.summary_problem = "summary not requested";
   }
   Scan(header_end);
-  return Status::Ok();
+  return Status::OK();
 }
 
 bool Reader::Impl::EndsWithFooter() {
@@ -463,7 +463,7 @@ Status Reader::Impl::LoadChunk(const ChunkInfo& info, std::vector<std::uint8_t>*
   if (std::string damage = DecodeChunkRecords(chunk, out); !damage.empty()) {
     return Status::DataLoss(where, damage);
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status Reader::Impl::ReadMessages(const ReadOptions& options,
@@ -563,9 +563,9 @@ Status Reader::Impl::ReadMessages(const ReadOptions& options,
       std::stable_sort(pending.begin(), pending.end(),
                        [](const Pending& a, const Pending& b) { return a.log_time < b.log_time; });
     }
-    if (!deliver()) return Status::Ok();
+    if (!deliver()) return Status::OK();
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status Reader::Impl::VerifyDataCrc() {
@@ -585,7 +585,7 @@ Status Reader::Impl::VerifyDataCrc() {
     std::snprintf(text, sizeof(text), "data-section CRC mismatch (stored 0x%08x, computed 0x%08x)", data_crc_, crc);
     return Status::DataLoss(file_.path(), text);
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 Reader::Reader(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

@@ -39,7 +39,7 @@ Status WriterOptions::Validate() const {
     return Status::InvalidArgument("WriterOptions",
                                    "zstd_level = " + std::to_string(zstd_level) + ": must be 1..19");
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 class Writer::Impl {
@@ -122,7 +122,7 @@ Status Writer::Impl::Open(const std::string& path, const WriterOptions& options)
 Status Writer::Impl::Usable(const char* call) const {
   if (!failed_.ok()) return failed_;
   if (closed_) return Status::FailedPrecondition(path(), std::string(call) + " after Close");
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status Writer::Impl::Emit(std::span<const iovec> buffers, bool in_data_section) {
@@ -131,7 +131,7 @@ Status Writer::Impl::Emit(std::span<const iovec> buffers, bool in_data_section) 
     if (in_data_section) data_crc_ = Crc32(data_crc_, b.iov_base, b.iov_len);
     pos_ += b.iov_len;
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 StatusOr<SchemaId> Writer::Impl::AddSchema(std::string_view name, std::string_view encoding,
@@ -200,11 +200,11 @@ Status Writer::Impl::Write(ChannelId channel_id, std::uint32_t sequence, std::ui
   ++message_count_;
 
   if (chunk_.size() >= options_.chunk_size) return CloseChunk();
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status Writer::Impl::CloseChunk() {
-  if (chunk_.size() == 0) return Status::Ok();
+  if (chunk_.size() == 0) return Status::OK();
   const std::uint32_t crc = Crc32(0, chunk_.data(), chunk_.size());
 
   // Compress (or not) into `body`.
@@ -266,7 +266,7 @@ Status Writer::Impl::CloseChunk() {
   const iovec parts[] = {Iov(chunk_prefix_), body, Iov(message_indexes_)};
   if (Status s = Emit(parts, true); !s.ok()) return s;
   chunk_indexes_.push_back(std::move(index));
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status Writer::Impl::AddMetadata(std::string_view name, const std::map<std::string, std::string>& entries) {
@@ -277,7 +277,7 @@ Status Writer::Impl::AddMetadata(std::string_view name, const std::map<std::stri
   iovec iov = Iov(scratch_);
   if (Status s = Emit({&iov, 1}, true); !s.ok()) return s;
   metadata_indexes_.push_back(std::move(index));
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status Writer::Impl::Flush() {
@@ -286,7 +286,7 @@ Status Writer::Impl::Flush() {
   if (options_.sync_on_flush) {
     if (Status s = file_.Sync(); !s.ok()) return Fail(s);
   }
-  return Status::Ok();
+  return Status::OK();
 }
 
 Status Writer::Impl::Close() {

@@ -24,7 +24,7 @@
 namespace {
 
 using dyad::mcap::ChannelId;
-using dyad::mcap::Status;
+using dyad::Status;
 using dyad::mcap::Writer;
 using dyad::mcap::WriterOptions;
 

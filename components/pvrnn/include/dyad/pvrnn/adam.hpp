@@ -6,7 +6,7 @@
 #include <string>
 
 #include "dyad/pvrnn/parameters.hpp"
-#include "dyad/pvrnn/status.hpp"
+#include "dyad/status.hpp"
 
 namespace dyad::pvrnn {
 

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "dyad/pvrnn/status.hpp"
+#include "dyad/status.hpp"
 
 namespace dyad::pvrnn {
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "dyad/pvrnn/status.hpp"
+#include "dyad/status.hpp"
 
 namespace dyad::pvrnn {
 

@@ -26,7 +26,7 @@
 
 #include "dyad/pvrnn/adam.hpp"
 #include "dyad/pvrnn/model_spec.hpp"
-#include "dyad/pvrnn/status.hpp"
+#include "dyad/status.hpp"
 
 namespace dyad::pvrnn {
 

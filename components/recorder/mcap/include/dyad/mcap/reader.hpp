@@ -22,10 +22,10 @@
 //     they do not run at the same time (ReadMessages uses internal buffers).
 //
 // Usage:
-//   dyad::mcap::StatusOr<dyad::mcap::Reader> r = dyad::mcap::Reader::Open("run.mcap");
+//   dyad::StatusOr<dyad::mcap::Reader> r = dyad::mcap::Reader::Open("run.mcap");
 //   if (!r.ok()) return r.status();
 //   if (r->recovery().truncated) std::cerr << r->recovery().Describe() << "\n";
-//   dyad::mcap::Status s = r->ReadMessages({}, [](const dyad::mcap::MessageView& m) {
+//   dyad::Status s = r->ReadMessages({}, [](const dyad::mcap::MessageView& m) {
 //     std::cout << m.channel->topic << " " << m.log_time << "\n";
 //     return true;  // false stops early
 //   });
@@ -40,7 +40,7 @@
 #include <vector>
 
 #include "dyad/mcap/records.hpp"
-#include "dyad/mcap/status.hpp"
+#include "dyad/status.hpp"
 
 namespace dyad::mcap {
 

@@ -24,15 +24,15 @@
 //   - Not thread-safe: one thread writes (the recorder's writer thread).
 //
 // Usage:
-//   dyad::mcap::StatusOr<dyad::mcap::Writer> w = dyad::mcap::Writer::Open("run.mcap", {});
+//   dyad::StatusOr<dyad::mcap::Writer> w = dyad::mcap::Writer::Open("run.mcap", {});
 //   if (!w.ok()) return w.status();
-//   dyad::mcap::StatusOr<dyad::mcap::SchemaId> schema =
+//   dyad::StatusOr<dyad::mcap::SchemaId> schema =
 //       w->AddSchema("dyad::msg::Pose2", "omgidl", idl_text);
-//   dyad::mcap::StatusOr<dyad::mcap::ChannelId> channel =
+//   dyad::StatusOr<dyad::mcap::ChannelId> channel =
 //       w->AddChannel("/robot/pose", "cdr", *schema, {});
 //   w->Write(*channel, seq, receive_ns, source_ns, cdr_bytes);
 //   w->AddMetadata("dyad.graph", {{"yaml", graph_text}});
-//   dyad::mcap::Status s = w->Close();
+//   dyad::Status s = w->Close();
 #pragma once
 
 #include <cstdint>
@@ -43,7 +43,7 @@
 #include <string_view>
 
 #include "dyad/mcap/records.hpp"
-#include "dyad/mcap/status.hpp"
+#include "dyad/status.hpp"
 
 namespace dyad::mcap {
 
