@@ -57,6 +57,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <dyad/message_traits.hpp>
@@ -135,18 +136,23 @@ class Input final : public InputBase {
   // Samples received since the previous step, oldest first (at most the topic's history depth).
   const std::vector<T>& received() const { return received_; }
   // The newest sample ever received; nullptr before the first.
-  const T* latest() const { return has_latest_ ? &latest_ : nullptr; }
+  const T* latest() const {
+    if (!received_.empty()) return &received_.back();
+    return has_latest_ ? &latest_ : nullptr;
+  }
 
   size_t Poll(int64_t now_ns) override {
-    received_.clear();
-    if (endpoint_ == nullptr) return 0;
-    while (endpoint_->TakeNext(&scratch_)) received_.push_back(scratch_);
-    new_count_ = received_.size();
+    // Keep the newest sample for latest() before the vector is reused; moves, no copies.
     if (!received_.empty()) {
-      latest_ = received_.back();
+      latest_ = std::move(received_.back());
       has_latest_ = true;
-      last_receive_ns_ = now_ns;
     }
+    received_.clear();
+    new_count_ = 0;
+    if (endpoint_ == nullptr) return 0;
+    while (endpoint_->TakeNext(&scratch_)) received_.push_back(std::move(scratch_));
+    new_count_ = received_.size();
+    if (new_count_ > 0) last_receive_ns_ = now_ns;
     return new_count_;
   }
 
