@@ -95,6 +95,22 @@ class ProcessTest : public ::testing::Test {
   int domain_ = 1;
 };
 
+// One line of counter_sink's file.
+struct Received {
+  int64_t value;
+  std::string source;
+  uint64_t sequence;
+  int64_t stamp_ns;
+};
+
+std::vector<Received> ReadSink(const fs::path& file) {
+  std::istringstream lines(Child::Read(file));
+  std::vector<Received> out;
+  Received r;
+  while (lines >> r.value >> r.source >> r.sequence >> r.stamp_ns) out.push_back(r);
+  return out;
+}
+
 std::string SteppedGraph(const fs::path& out, int domain) {
   return "graph: det\nclock: stepped\nseed: 42\ndomain_id: " + std::to_string(domain) +
          "\ncomponents:\n"
@@ -107,9 +123,10 @@ std::string SteppedGraph(const fs::path& out, int domain) {
 TEST_F(ProcessTest, SteppedModeGivesByteIdenticalOutputTwice) {
   std::string files[2];
   for (int i = 0; i < 2; ++i) {
-    const fs::path out = dir_ / ("run" + std::to_string(i) + ".txt");
-    const fs::path g = Write("g" + std::to_string(i) + ".yaml", SteppedGraph(out, domain_));
-    Child c(Dyad({"run", g.string(), "--steps", "2000", "--quiet"}), dir_, "run" + std::to_string(i));
+    const std::string run = i == 0 ? "run0" : "run1";
+    const fs::path out = dir_ / (run + ".txt");
+    const fs::path g = Write(run + ".yaml", SteppedGraph(out, domain_));
+    Child c(Dyad({"run", g.string(), "--steps", "2000", "--quiet"}), dir_, run);
     ASSERT_EQ(c.Wait(60), 0) << c.err();
     files[i] = Child::Read(out);
   }
@@ -133,19 +150,13 @@ TEST_F(ProcessTest, TwoComponentsExchangeSamplesInOneProcess) {
                                          ", expect: 50}, inputs: {in: count}}\n");
   Child c(Dyad({"run", g.string()}), dir_, "one");
   ASSERT_EQ(c.Wait(30), 0) << c.err();
-  std::istringstream lines(Child::Read(out));
-  int64_t value;
-  std::string source;
-  uint64_t seq;
-  int64_t stamp;
-  int n = 0;
-  while (lines >> value >> source >> seq >> stamp) {
-    EXPECT_EQ(value, n);  // in order, none lost
-    EXPECT_EQ(seq, static_cast<uint64_t>(n + 1));
-    EXPECT_EQ(source, "src");
-    ++n;
+  const auto received = ReadSink(out);
+  ASSERT_EQ(received.size(), 50u);
+  for (size_t i = 0; i < received.size(); ++i) {
+    EXPECT_EQ(received[i].value, static_cast<int64_t>(i));  // in order, none lost
+    EXPECT_EQ(received[i].sequence, i + 1);
+    EXPECT_EQ(received[i].source, "src");
   }
-  EXPECT_EQ(n, 50);
   EXPECT_NE(c.out().find("timing (process main)"), std::string::npos);
 }
 
@@ -162,18 +173,10 @@ TEST_F(ProcessTest, TwoComponentsExchangeSamplesAcrossTwoOsProcesses) {
   ASSERT_EQ(b.Wait(30), 0) << b.err();
   a.Signal(SIGINT);
   ASSERT_EQ(a.Wait(10), 0) << a.err();
-  std::istringstream lines(Child::Read(out));
-  int64_t value, prev = -1;
-  std::string source;
-  uint64_t seq;
-  int64_t stamp;
-  int n = 0;
-  while (lines >> value >> source >> seq >> stamp) {
-    EXPECT_GT(value, prev);  // increasing (the first few may be missed while discovery completes)
-    prev = value;
-    ++n;
-  }
-  EXPECT_EQ(n, 30);
+  const auto received = ReadSink(out);
+  ASSERT_EQ(received.size(), 30u);
+  for (size_t i = 1; i < received.size(); ++i)  // increasing (the first few may be missed while discovery completes)
+    EXPECT_GT(received[i].value, received[i - 1].value);
   EXPECT_NE(a.out().find("timing (process a)"), std::string::npos);
 }
 
@@ -224,6 +227,62 @@ TEST_F(ProcessTest, TypeMismatchWithAPeerIsReportedNamingBoth) {
   EXPECT_NE(e.find("'dyad/mm/main'"), std::string::npos) << e;
   peer.Signal(SIGTERM);
   peer.Wait(10);
+}
+
+}  // namespace
+
+namespace {
+
+TEST_F(ProcessTest, PluginThatDoesNotLoadIsAGraphErrorWithItsLine) {
+  const fs::path g = Write("g.yaml", "graph: p\nplugins: [missing/plugin.so]\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 10}\n");
+  Child c(Dyad({"validate", g.string()}), dir_, "validate");
+  ASSERT_EQ(c.Wait(30), 2);
+  EXPECT_NE(c.err().find(g.string() + ":2:11: plugins: " + (dir_ / "missing/plugin.so").string() + ": no such plugin"),
+            std::string::npos)
+      << c.err();
+  Child d(Dyad({"run", (dir_ / "absent.yaml").string()}), dir_, "absent");
+  ASSERT_EQ(d.Wait(30), 2);
+  EXPECT_NE(d.err().find((dir_ / "absent.yaml").string() + ": cannot open graph file"), std::string::npos) << d.err();
+}
+
+// topics, echo and hz join the domain from outside and see a running graph.
+TEST_F(ProcessTest, IntrospectionSeesARunningGraph) {
+  const std::string domain = std::to_string(domain_);
+  const fs::path g = Write("g.yaml", "graph: intro\ndomain_id: " + domain +
+                                         "\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 50, params: {start: 1000}, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, inputs: {in: count}}\n");
+  Child run(Dyad({"run", g.string(), "--duration", "20", "--stats-period", "0.5"}), dir_, "run");
+
+  Child topics(Dyad({"topics", "--domain", domain, "--wait", "2"}), dir_, "topics");
+  ASSERT_EQ(topics.Wait(30), 0) << topics.err();
+  EXPECT_NE(topics.out().find("count  dyad::msg::Counter#"), std::string::npos) << topics.out();
+  EXPECT_NE(topics.out().find("dyad/intro/main"), std::string::npos) << topics.out();
+
+  Child echo(Dyad({"echo", "count", "--domain", domain, "-n", "3"}), dir_, "echo");
+  ASSERT_EQ(echo.Wait(30), 0) << echo.err();
+  const std::string e = echo.out();
+  EXPECT_EQ(std::count(e.begin(), e.end(), '\n'), 3) << e;
+  EXPECT_NE(e.find("{\"header\":{\"source\":\"src\",\"sequence_number\":"), std::string::npos) << e;
+  EXPECT_NE(e.find("\"value\":1"), std::string::npos) << e;  // values start at 1000
+
+  Child stats(Dyad({"echo", "dyad/stats", "--domain", domain, "-n", "1"}), dir_, "stats");
+  ASSERT_EQ(stats.Wait(30), 0) << stats.err();
+  EXPECT_NE(stats.out().find("\"process_name\":\"main\""), std::string::npos) << stats.out();
+
+  Child hz(Dyad({"hz", "count", "--domain", domain, "--duration", "2.5"}), dir_, "hz");
+  ASSERT_EQ(hz.Wait(30), 0) << hz.err();
+  double rate = 0;
+  ASSERT_EQ(std::sscanf(hz.out().c_str(), "rate %lf Hz", &rate), 1) << hz.out();
+  EXPECT_NEAR(rate, 50.0, 5.0) << hz.out();
+
+  Child none(Dyad({"echo", "no/such/topic", "--domain", domain, "--wait", "1"}), dir_, "none");
+  EXPECT_EQ(none.Wait(30), 1);
+  EXPECT_NE(none.err().find("no writer of topic 'no/such/topic'"), std::string::npos) << none.err();
+
+  run.Signal(SIGINT);
+  EXPECT_EQ(run.Wait(15), 0) << run.err();
 }
 
 }  // namespace

@@ -27,7 +27,9 @@ class Catalog::Registry final : public PluginRegistry {
   std::string file_;
 };
 
-Catalog::Catalog() = default;
+Catalog::Catalog() {
+  for (const TypeInfo* t : msg::AllTypes()) AddMessageType(t);
+}
 
 Catalog::~Catalog() {
   // Entries hold function pointers into the libraries: drop them first. Libraries are not
@@ -70,6 +72,8 @@ Status Catalog::LoadFile(const std::string& file) {
     CatalogEntry e;
     e.type = t;
     t.describe(e.spec);
+    for (const auto& p : e.spec.inputs()) AddMessageType(p.type);
+    for (const auto& p : e.spec.outputs()) AddMessageType(p.type);
     entries_.emplace(t.name, std::move(e));
   }
   std::string c = conflicts.str();
@@ -121,20 +125,12 @@ const CatalogEntry* Catalog::Find(const std::string& type_name) const {
   return it == entries_.end() ? nullptr : &it->second;
 }
 
-std::vector<const TypeInfo*> Catalog::MessageTypes() const {
-  std::vector<const TypeInfo*> out;
-  auto add = [&](const TypeInfo* t) {
-    for (const auto* o : out)
-      if (o->name == t->name) return;
-    out.push_back(t);
-  };
-  for (const TypeInfo* t : msg::AllTypes()) add(t);
-  for (const auto& [_, e] : entries_) {
-    for (const auto& p : e.spec.inputs()) add(p.type);
-    for (const auto& p : e.spec.outputs()) add(p.type);
-  }
-  std::sort(out.begin(), out.end(), [](const TypeInfo* a, const TypeInfo* b) { return a->name < b->name; });
-  return out;
+void Catalog::AddMessageType(const TypeInfo* type) {
+  for (const TypeInfo* t : message_types_)
+    if (t->name == type->name) return;
+  message_types_.insert(std::upper_bound(message_types_.begin(), message_types_.end(), type,
+                                         [](const TypeInfo* a, const TypeInfo* b) { return a->name < b->name; }),
+                        type);
 }
 
 const TypeInfo* Catalog::FindMessageType(const std::string& name) const {

@@ -26,6 +26,19 @@ uint64_t MixSeed(uint64_t seed, const std::string& name) {
   return z ^ (z >> 31);
 }
 
+// The topic the graph binds `port` to; empty when unbound.
+std::string BoundTopic(const std::vector<PortBinding>& bindings, const std::string& port) {
+  for (const auto& b : bindings)
+    if (b.port == port) return b.topic;
+  return "";
+}
+
+// QoS from the graph's `topics:` entry, defaults when the topic is not declared there.
+TopicQos QosOf(const ResolvedTopic& topic) {
+  if (topic.config == nullptr) return TopicQos{};
+  return TopicQos{topic.config->reliability, topic.config->depth, topic.config->deadline_ms, false};
+}
+
 }  // namespace
 
 class Executor::ClockImpl final : public Clock {
@@ -163,14 +176,10 @@ Status Executor::Setup() {
     Instance* raw = inst.get();
     for (const auto& ps : spec.inputs()) {
       auto port = ps.make_input();
-      std::string topic;
-      for (const auto& b : rc.config->inputs)
-        if (b.port == ps.name) topic = b.topic;
+      const std::string topic = BoundTopic(rc.config->inputs, ps.name);
       DdsReader* reader = nullptr;
       if (!topic.empty()) {
-        const ResolvedTopic& rt = resolved_.topics.at(topic);
-        TopicQos qos;
-        if (rt.config) qos = TopicQos{rt.config->reliability, rt.config->depth, rt.config->deadline_ms, false};
+        const TopicQos qos = QosOf(resolved_.topics.at(topic));
         std::function<void()> on_data;
         if (!stepped && rc.config->trigger == ps.name) on_data = [this, raw] { TriggerStep(*raw); };
         auto r = participant_->CreateReader(topic, *ps.type, qos, on_data);
@@ -184,15 +193,10 @@ Status Executor::Setup() {
     }
     for (const auto& ps : spec.outputs()) {
       auto port = ps.make_output();
-      std::string topic;
-      for (const auto& b : rc.config->outputs)
-        if (b.port == ps.name) topic = b.topic;
+      const std::string topic = BoundTopic(rc.config->outputs, ps.name);
       DdsWriter* writer = nullptr;
       if (!topic.empty()) {
-        const ResolvedTopic& rt = resolved_.topics.at(topic);
-        TopicQos qos;
-        if (rt.config) qos = TopicQos{rt.config->reliability, rt.config->depth, rt.config->deadline_ms, false};
-        auto w = participant_->CreateWriter(topic, *ps.type, qos);
+        auto w = participant_->CreateWriter(topic, *ps.type, QosOf(resolved_.topics.at(topic)));
         if (!w.ok()) return Status::Internal(rc.config->name + "." + ps.name + ": " + w.status().message());
         writer = w.value().get();
         inst->writers.push_back(std::move(w.value()));

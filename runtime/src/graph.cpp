@@ -9,24 +9,18 @@
 namespace dyad {
 namespace {
 
-SourceMark MarkOf(const std::string& file, const YAML::Node& node) {
-  const YAML::Mark m = node.Mark();
-  if (m.is_null()) return SourceMark{file, 0, 0};
-  return SourceMark{file, m.line + 1, m.column + 1};
-}
-
 // Collects diagnostics for one file.
 class Reader {
  public:
   Reader(std::string file, std::vector<Diagnostic>* out) : file_(std::move(file)), out_(out) {}
 
   void Error(const YAML::Node& node, const std::string& key, const std::string& message) {
-    out_->push_back(Diagnostic{MarkOf(file_, node), key, message});
+    out_->push_back(Diagnostic{SourceMark::Of(file_, node), key, message});
   }
   void Error(const SourceMark& mark, const std::string& key, const std::string& message) {
     out_->push_back(Diagnostic{mark, key, message});
   }
-  SourceMark Mark(const YAML::Node& node) const { return MarkOf(file_, node); }
+  SourceMark Mark(const YAML::Node& node) const { return SourceMark::Of(file_, node); }
 
   // Checks `node` is a map, reports keys outside `allowed` and duplicate keys.
   bool Map(const YAML::Node& node, const std::string& key, const std::set<std::string>& allowed) {
@@ -194,6 +188,12 @@ void ApplyOverrides(const std::vector<Override>& overrides, Graph* g, std::vecto
 
 }  // namespace
 
+SourceMark SourceMark::Of(const std::string& file, const YAML::Node& node) {
+  const YAML::Mark m = node.Mark();
+  if (m.is_null()) return SourceMark{file, 0, 0};
+  return SourceMark{file, m.line + 1, m.column + 1};
+}
+
 std::string SourceMark::ToString() const {
   if (line <= 0) return file;
   return file + ":" + std::to_string(line) + ":" + std::to_string(column);
@@ -262,6 +262,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
         if (!r.String(p, "plugins", &s)) continue;
         std::filesystem::path fp(s);
         g.plugins.push_back(fp.is_absolute() ? s : (base / fp).lexically_normal().string());
+        g.plugin_marks.push_back(r.Mark(p));
       }
     }
   }

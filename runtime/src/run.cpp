@@ -32,10 +32,13 @@ bool LoadAndValidate(const std::string& path, const std::vector<Override>& overr
                      const std::vector<std::string>& plugin_paths, Loaded* l, std::ostream& err) {
   std::vector<Diagnostic> diags;
   l->graph = LoadGraph(path, overrides, &diags);
-  std::vector<std::string> plugins = l->graph.plugins;
-  plugins.insert(plugins.end(), plugin_paths.begin(), plugin_paths.end());
-  Status loaded = l->catalog.LoadDefault(plugins);
-  if (!loaded.ok()) err << "warning: " << loaded.message() << "\n";
+  // Plugins the graph or the command line names must load: their problems are the graph's.
+  for (size_t i = 0; i < l->graph.plugins.size(); ++i)
+    if (Status s = l->catalog.Load(l->graph.plugins[i]); !s.ok()) diags.push_back({l->graph.plugin_marks[i], "plugins", s.message()});
+  for (const auto& p : plugin_paths)
+    if (Status s = l->catalog.Load(p); !s.ok()) diags.push_back({SourceMark{"--plugins " + p, 0, 0}, "", s.message()});
+  // DYAD_PLUGIN_PATH and the built-in folder: a stray file there is worth a warning only.
+  if (Status s = l->catalog.LoadDefault({}); !s.ok()) err << "warning: " << s.message() << "\n";
   if (!l->graph.components.empty()) l->resolved = ValidateGraph(l->graph, l->catalog, &diags);
   for (const auto& d : diags) err << d.ToString() << "\n";
   if (!diags.empty()) err << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", nothing was started\n";

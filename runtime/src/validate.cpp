@@ -1,6 +1,7 @@
 // Graph validation: every check in one pass, every problem reported.
 #include "dyad/validate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -14,10 +15,12 @@ std::string Join(const std::vector<std::string>& v) {
   return s;
 }
 
-SourceMark MarkOf(const std::string& file, const YAML::Node& node) {
-  const YAML::Mark m = node.Mark();
-  if (m.is_null()) return SourceMark{file, 0, 0};
-  return SourceMark{file, m.line + 1, m.column + 1};
+// "a, b, c" of the `name`s of params or ports, or "none".
+template <class Spec>
+std::string Names(const std::vector<Spec>& specs) {
+  std::vector<std::string> names;
+  for (const auto& s : specs) names.push_back(s.name);
+  return names.empty() ? "none" : Join(names);
 }
 
 bool ScalarAs(const YAML::Node& node, double* out) {
@@ -168,13 +171,11 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
         const std::string pname = kv.first.Scalar();
         const std::string pkey = key + ".params." + pname;
         auto set = c.overridden.find(pname);
-        const SourceMark at = set != c.overridden.end() ? SourceMark{"--set " + set->second, 0, 0} : MarkOf(graph.file, kv.second);
+        const SourceMark at = set != c.overridden.end() ? SourceMark{"--set " + set->second, 0, 0} : SourceMark::Of(graph.file, kv.second);
         const ParamSpec* ps = spec.FindParam(pname);
         if (ps == nullptr) {
-          std::vector<std::string> known;
-          for (const auto& p : spec.params()) known.push_back(p.name);
-          error(set != c.overridden.end() ? at : MarkOf(graph.file, kv.first), pkey,
-                "unknown parameter of " + c.type + " (known: " + (known.empty() ? "none" : Join(known)) + ")");
+          error(set != c.overridden.end() ? at : SourceMark::Of(graph.file, kv.first), pkey,
+                "unknown parameter of " + c.type + " (known: " + Names(spec.params()) + ")");
           continue;
         }
         ParamValue v;
@@ -196,9 +197,7 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
     for (const auto& b : c.inputs) {
       const PortSpec* ps = spec.FindInput(b.port);
       if (ps == nullptr) {
-        std::vector<std::string> known;
-        for (const auto& p : spec.inputs()) known.push_back(p.name);
-        error(b.mark, key + ".inputs." + b.port, "no input '" + b.port + "' on type " + c.type + " (inputs: " + (known.empty() ? "none" : Join(known)) + ")");
+        error(b.mark, key + ".inputs." + b.port, "no input '" + b.port + "' on type " + c.type + " (inputs: " + Names(spec.inputs()) + ")");
         continue;
       }
       bound_inputs.insert(b.port);
@@ -210,9 +209,7 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
     for (const auto& b : c.outputs) {
       const PortSpec* ps = spec.FindOutput(b.port);
       if (ps == nullptr) {
-        std::vector<std::string> known;
-        for (const auto& p : spec.outputs()) known.push_back(p.name);
-        error(b.mark, key + ".outputs." + b.port, "no output '" + b.port + "' on type " + c.type + " (outputs: " + (known.empty() ? "none" : Join(known)) + ")");
+        error(b.mark, key + ".outputs." + b.port, "no output '" + b.port + "' on type " + c.type + " (outputs: " + Names(spec.outputs()) + ")");
         continue;
       }
       writers[b.topic].push_back({ps->type, key + ".outputs." + b.port, b.mark});

@@ -1,6 +1,8 @@
 #include "introspection_commands.hpp"
 
 #include <iomanip>
+#include <map>
+#include <memory>
 #include <iostream>
 #include <sstream>
 
@@ -10,16 +12,25 @@
 namespace dyad::cli {
 namespace {
 
-// One sample as JSON, decoded with the type's own IDL text; hex if that fails.
-std::string JsonPrinter(const TypeInfo& type, const uint8_t* data, size_t size) {
-  std::string error;
-  cdr::Schema schema = cdr::Schema::Parse(type.idl, &error);
-  std::vector<cdr::Field> fields;
-  if (error.empty() && cdr::Decode(schema, type.name, data, size, &fields, &error)) return cdr::ToJson(fields);
-  std::ostringstream os;
-  os << type.short_name() << " (" << error << ") " << size << " bytes:";
-  for (size_t i = 0; i < size; ++i) os << (i % 4 == 0 ? " " : "") << std::hex << std::setw(2) << std::setfill('0') << int(data[i]);
-  return os.str();
+// Prints samples as JSON, decoded with each type's own IDL text (parsed once per type); as hex
+// with the reason when that fails.
+SamplePrinter JsonPrinter() {
+  auto schemas = std::make_shared<std::map<std::string, std::pair<cdr::Schema, std::string>>>();
+  return [schemas](const TypeInfo& type, const uint8_t* data, size_t size) {
+    auto it = schemas->find(type.name);
+    if (it == schemas->end()) {
+      std::string error;
+      cdr::Schema schema = cdr::Schema::Parse(type.idl, &error);
+      it = schemas->emplace(type.name, std::make_pair(std::move(schema), error)).first;
+    }
+    std::string error = it->second.second;
+    std::vector<cdr::Field> fields;
+    if (error.empty() && cdr::Decode(it->second.first, type.name, data, size, &fields, &error)) return cdr::ToJson(fields);
+    std::ostringstream os;
+    os << type.short_name() << " (" << error << ") " << size << " bytes:";
+    for (size_t i = 0; i < size; ++i) os << (i % 4 == 0 ? " " : "") << std::hex << std::setw(2) << std::setfill('0') << int(data[i]);
+    return os.str();
+  };
 }
 
 }  // namespace
@@ -49,7 +60,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   echo->callback([&exit_code] {
     Catalog catalog;
     catalog.LoadDefault(plugins);
-    exit_code = EchoTopic(opts, catalog, topic, count, duration, JsonPrinter, std::cout, std::cerr);
+    exit_code = EchoTopic(opts, catalog, topic, count, duration, JsonPrinter(), std::cout, std::cerr);
   });
 
   auto* hz = app.add_subcommand("hz", "Measure the publication rate of a topic");

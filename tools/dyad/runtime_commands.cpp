@@ -1,6 +1,8 @@
 #include "runtime_commands.hpp"
 
+#include <cmath>
 #include <iomanip>
+#include <sstream>
 #include <iostream>
 
 #include <dyad/catalog.hpp>
@@ -28,8 +30,11 @@ void PrintTypes(const Catalog& catalog, std::ostream& out) {
       out << "  param  " << p.name << ": " << ToString(p.type);
       out << (p.default_value ? " = " + ToYamlText(*p.default_value) : " (required)");
       if (!p.unit.empty()) out << " [" << p.unit << "]";
-      if (p.min || p.max)
-        out << " range " << (p.min ? std::to_string(*p.min) : "-inf") << ".." << (p.max ? std::to_string(*p.max) : "inf");
+      if (p.min || p.max) {
+        std::ostringstream range;
+        range << (p.min ? *p.min : -INFINITY) << ".." << (p.max ? *p.max : INFINITY);
+        out << " range " << range.str();
+      }
       if (!p.choices.empty()) {
         out << " one of";
         for (const auto& c : p.choices) out << " " << c;

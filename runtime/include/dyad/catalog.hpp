@@ -43,7 +43,8 @@ class Catalog {
   const std::map<std::string, CatalogEntry>& entries() const { return entries_; }
   // Every message type seen on some component's port, by IDL name and by short name.
   const TypeInfo* FindMessageType(const std::string& name) const;
-  std::vector<const TypeInfo*> MessageTypes() const;
+  // Sorted by name; built-in IDL types first known, then those of loaded plugins' ports.
+  const std::vector<const TypeInfo*>& MessageTypes() const { return message_types_; }
 
   // The folder holding the built-in plugins of this build (or installation).
   static std::string BuiltinPluginDir();
@@ -51,9 +52,11 @@ class Catalog {
  private:
   class Registry;
   Status LoadFile(const std::string& file);
+  void AddMessageType(const TypeInfo* type);
   std::map<std::string, CatalogEntry> entries_;
   std::vector<void*> handles_;
   std::vector<std::string> loaded_files_;
+  std::vector<const TypeInfo*> message_types_;
 };
 
 }  // namespace dyad

@@ -41,6 +41,8 @@ struct SourceMark {
   int line = 0;
   int column = 0;
   std::string ToString() const;  // "file:line:col" or "file"
+  // Where `node` starts in `file` (yaml-cpp counts from 0; we count from 1).
+  static SourceMark Of(const std::string& file, const YAML::Node& node);
 };
 
 struct Diagnostic {
@@ -94,6 +96,7 @@ struct Graph {
   ClockMode clock = ClockMode::kWall;
   uint64_t seed = 1;
   std::vector<std::string> plugins;  // resolved against the file's folder
+  std::vector<SourceMark> plugin_marks;  // where each of `plugins` is written
   std::vector<ProcessConfig> processes;
   std::vector<TopicConfig> topics;
   std::vector<ComponentConfig> components;
