@@ -286,3 +286,38 @@ TEST_F(ProcessTest, IntrospectionSeesARunningGraph) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(ProcessTest, LauncherStartsOnlyThisHostsProcessesAndSaysWhereTheOthersGo) {
+  const fs::path out = dir_ / "sink.txt";
+  const fs::path g = Write("g.yaml", "graph: hosts\ndomain_id: " + std::to_string(domain_) +
+                                         "\nprocesses: {here: {}, robot: {host: robot-pc-elsewhere}}\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 50, process: here, params: {limit: 20}, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: robot, params: {file: " +
+                                         out.string() + "}, inputs: {in: count}}\n");
+  Child c(Dyad({"run", g.string()}), dir_, "hosts");
+  ASSERT_EQ(c.Wait(30), 0) << c.err();
+  EXPECT_NE(c.err().find("process 'robot' runs on host 'robot-pc-elsewhere': start it there with `dyad run " + g.string() +
+                         " --process robot`"),
+            std::string::npos)
+      << c.err();
+  EXPECT_NE(c.out().find("timing (process here)"), std::string::npos) << c.out();
+  EXPECT_FALSE(fs::exists(out));  // the robot's process was not started here
+}
+
+TEST_F(ProcessTest, OneFailingProcessEndsTheWholeExperiment) {
+  const fs::path g = Write("g.yaml", "graph: fail\ndomain_id: " + std::to_string(domain_) +
+                                         "\nprocesses: {a: {}, b: {}}\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 50, process: a, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " +
+                                         (dir_ / "no/such/dir/sink.txt").string() + "}, inputs: {in: count}}\n");
+  Child c(Dyad({"run", g.string()}), dir_, "fail");  // a alone would run forever
+  ASSERT_EQ(c.Wait(30), 1) << "launcher hung or exited wrongly\n" << c.err();
+  EXPECT_NE(c.err().find("sink: activate failed: " + (dir_ / "no/such/dir/sink.txt").string() + ": cannot open for writing"),
+            std::string::npos)
+      << c.err();
+  EXPECT_NE(c.err().find("process 'b' exited with 1"), std::string::npos) << c.err();
+}
+
+}  // namespace
