@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <iomanip>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <set>
 #include <thread>
@@ -135,6 +136,34 @@ class RawReader {
   eprosima::fastrtps::rtps::SerializedPayload_t payload_;
 };
 
+// A participant reading one topic of a running graph, with the type its writers use.
+struct TopicTap {
+  std::unique_ptr<DdsParticipant> participant;
+  const TypeInfo* type = nullptr;
+  std::unique_ptr<RawReader> reader;  // declared last: destroyed before the participant
+};
+
+// Joins the domain, waits for a writer of `topic`, resolves its type and opens a reader;
+// nullopt (after saying why on `err`) when any of that fails.
+std::optional<TopicTap> Tap(const IntrospectOptions& o, const Catalog& catalog, const std::string& topic, std::ostream& err) {
+  TopicTap tap;
+  tap.participant = Join(o, err);
+  if (!tap.participant) return std::nullopt;
+  const std::string dds_type = DiscoverType(*tap.participant, topic, o.wait_s);
+  if (dds_type.empty()) {
+    err << "no writer of topic '" << topic << "' found on domain " << o.domain_id << " within " << o.wait_s << " s\n";
+    return std::nullopt;
+  }
+  tap.type = ResolveType(catalog, dds_type, topic, err);
+  if (tap.type == nullptr) return std::nullopt;
+  tap.reader = std::make_unique<RawReader>(*tap.participant, *tap.type, topic);
+  if (!tap.reader->ok()) {
+    err << "cannot create a reader on '" << topic << "'\n";
+    return std::nullopt;
+  }
+  return tap;
+}
+
 }  // namespace
 
 int ListTopics(const IntrospectOptions& o, std::ostream& out) {
@@ -167,20 +196,10 @@ int ListTopics(const IntrospectOptions& o, std::ostream& out) {
 int EchoTopic(const IntrospectOptions& o, const Catalog& catalog, const std::string& topic, uint64_t count, double duration_s,
               const SamplePrinter& printer, std::ostream& out, std::ostream& err) {
   InterruptScope scope;
-  auto p = Join(o, err);
-  if (!p) return 1;
-  const std::string dds_type = DiscoverType(*p, topic, o.wait_s);
-  if (dds_type.empty()) {
-    err << "no writer of topic '" << topic << "' found on domain " << o.domain_id << " within " << o.wait_s << " s\n";
-    return 1;
-  }
-  const TypeInfo* type = ResolveType(catalog, dds_type, topic, err);
-  if (type == nullptr) return 1;
-  RawReader reader(*p, *type, topic);
-  if (!reader.ok()) {
-    err << "cannot create a reader on '" << topic << "'\n";
-    return 1;
-  }
+  auto tap = Tap(o, catalog, topic, err);
+  if (!tap) return 1;
+  const TypeInfo* type = tap->type;
+  RawReader& reader = *tap->reader;
   const auto end = duration_s > 0 ? Steady::now() + std::chrono::duration<double>(duration_s) : Steady::time_point::max();
   uint64_t n = 0;
   std::vector<uint8_t> bytes;
@@ -197,17 +216,9 @@ int EchoTopic(const IntrospectOptions& o, const Catalog& catalog, const std::str
 int TopicHz(const IntrospectOptions& o, const Catalog& catalog, const std::string& topic, double duration_s, std::ostream& out,
             std::ostream& err) {
   InterruptScope scope;
-  auto p = Join(o, err);
-  if (!p) return 1;
-  const std::string dds_type = DiscoverType(*p, topic, o.wait_s);
-  if (dds_type.empty()) {
-    err << "no writer of topic '" << topic << "' found on domain " << o.domain_id << " within " << o.wait_s << " s\n";
-    return 1;
-  }
-  const TypeInfo* type = ResolveType(catalog, dds_type, topic, err);
-  if (type == nullptr) return 1;
-  RawReader reader(*p, *type, topic);
-  if (!reader.ok()) return 1;
+  auto tap = Tap(o, catalog, topic, err);
+  if (!tap) return 1;
+  RawReader& reader = *tap->reader;
   const auto start = Steady::now();
   const auto end = duration_s > 0 ? start + std::chrono::duration<double>(duration_s) : Steady::time_point::max();
   auto next_report = start + std::chrono::seconds(1);
