@@ -28,7 +28,9 @@ constexpr std::size_t kPayload = 48;
 
 double Seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
 
-// A plausible 48-byte CDR sample: encapsulation header, stamp, 4 slowly varying doubles, counter.
+// A plausible 48-byte CDR sample (little endian): encapsulation header, then the body of
+// `struct Sample { unsigned long long stamp_ns; double v[4]; unsigned long counter; }`, 4 slowly
+// varying doubles.
 void MakeSample(std::uint64_t i, std::uint8_t* out) {
   const std::uint8_t header[4] = {0x00, 0x01, 0x00, 0x00};
   std::memcpy(out, header, 4);
@@ -70,7 +72,11 @@ Result RunMcap(const std::string& path, std::uint64_t samples, const dyad::mcap:
     std::fprintf(stderr, "%s\n", writer.status().ToString().c_str());
     std::exit(1);
   }
-  auto schema = writer->AddSchema("dyad::msg::Sample", "omgidl", "struct Sample { double v[4]; };");
+  // The IDL that MakeSample's bytes follow, so `dyad bag export` decodes a kept bench file.
+  auto schema = writer->AddSchema("dyad::bench::Sample", "omgidl",
+                                  "module dyad { module bench { struct Sample {\n"
+                                  "  unsigned long long stamp_ns; double v[4]; unsigned long counter;\n"
+                                  "}; }; };\n");
   dyad::mcap::ChannelId channels[3];
   for (int c = 0; c < 3; ++c) channels[c] = *writer->AddChannel("/bench/" + std::to_string(c), "cdr", *schema);
   std::uint32_t sequence[3] = {};

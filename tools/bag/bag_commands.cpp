@@ -4,6 +4,7 @@
 
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,25 +38,43 @@ int RunInfo(const std::string& path, bool scan) {
   return reader->recovery().damaged_chunks.empty() ? kOk : kFailure;
 }
 
+// The decoder of a channel whose schema is omgidl text (what dyad records): one column per field
+// (cdr::Columns). nullopt, for data_hex, when the schema is not omgidl; also when its text does not
+// parse or does not define the schema's type, and then *problem says why.
+std::optional<bag::PayloadDecoder> CdrDecoder(const mcap::Schema* schema, std::string* problem) {
+  if (schema == nullptr || schema->encoding != "omgidl") return std::nullopt;
+  const std::string what = "schema " + std::to_string(schema->id) + " \"" + schema->name + "\" (omgidl)";
+  std::string error;
+  cdr::Schema parsed = cdr::Schema::Parse(schema->data, &error);
+  if (!error.empty()) {
+    *problem = what + ": " + error;
+    return std::nullopt;
+  }
+  if (!parsed.HasType(schema->name)) {
+    *problem = what + ": its IDL defines no struct \"" + schema->name + "\"";
+    return std::nullopt;
+  }
+  bag::PayloadDecoder decoder;
+  decoder.columns = cdr::Columns(parsed, schema->name);
+  decoder.decode = [parsed, type = schema->name](std::span<const std::uint8_t> data,
+                                                 std::vector<std::string>* cells, std::string* err) {
+    return cdr::DecodeRow(parsed, type, data.data(), data.size(), cells, err);
+  };
+  return decoder;
+}
+
 int RunExport(const std::string& path, const std::string& dir, const std::vector<std::string>& topics) {
   auto reader = OpenRecording(path, false);
   if (!reader) return kBadInput;
   if (reader->recovery().truncated) std::cerr << "dyad bag: " << path << ": " << reader->recovery().Describe() << "\n";
   bag::CsvExportOptions options;
   options.topics.insert(topics.begin(), topics.end());
-  // omgidl schemas (what dyad records) are decoded into one column per field.
-  options.decoder_factory = [](const mcap::Schema* schema, const mcap::Channel&) -> std::optional<bag::PayloadDecoder> {
-    if (schema == nullptr || schema->encoding != "omgidl") return std::nullopt;
-    std::string error;
-    auto parsed = std::make_shared<cdr::Schema>(cdr::Schema::Parse(schema->data, &error));
-    if (!error.empty() || !parsed->HasType(schema->name)) return std::nullopt;
-    bag::PayloadDecoder d;
-    d.columns = cdr::Columns(*parsed, schema->name);
-    d.decode = [parsed, type = schema->name](std::span<const std::uint8_t> data, std::vector<std::string>* cells,
-                                             std::string* err) {
-      return cdr::DecodeRow(*parsed, type, data.data(), data.size(), cells, err);
-    };
-    return d;
+  std::vector<std::string> schema_problems;  // One per channel exported as hex against its schema.
+  options.decoder_factory = [&](const mcap::Schema* schema, const mcap::Channel& channel) {
+    std::string problem;
+    std::optional<bag::PayloadDecoder> decoder = CdrDecoder(schema, &problem);
+    if (!problem.empty()) schema_problems.push_back(channel.topic + ": " + problem + "; exported as data_hex");
+    return decoder;
   };
   for (const std::string& topic : topics) {
     bool known = false;
@@ -75,12 +94,18 @@ int RunExport(const std::string& path, const std::string& dir, const std::vector
     return kFailure;
   }
   int code = kOk;
+  for (const std::string& problem : schema_problems) {
+    std::cerr << "dyad bag: " << path << ": " << problem << "\n";
+    code = kFailure;
+  }
   if (summary.skipped_chunks > 0) {
-    std::cerr << "dyad bag: " << path << ": skipped " << summary.skipped_chunks << " damaged chunk(s)\n";
+    std::cerr << "dyad bag: " << path << ": skipped " << summary.skipped_chunks
+              << " damaged chunk(s); `dyad bag info --scan " << path << "` lists them\n";
     code = kFailure;
   }
   if (summary.undecodable > 0) {
-    std::cerr << "dyad bag: " << summary.undecodable << " payload(s) could not be decoded; first: "
+    std::cerr << "dyad bag: " << path << ": " << summary.undecodable
+              << " payload(s) could not be decoded (their cells are left empty); first: "
               << summary.first_decode_error << "\n";
     code = kFailure;
   }

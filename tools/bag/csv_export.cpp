@@ -25,6 +25,7 @@ struct ChannelOutput {
   std::ofstream file;
   std::string path;
   PayloadDecoder decoder;
+  std::vector<std::string> cells;  // The last row's payload cells, reused by the next.
   std::uint64_t rows = 0;
 };
 
@@ -33,12 +34,13 @@ struct ChannelOutput {
 PayloadDecoder HexDecoder() {
   return {{"data_hex"}, [](std::span<const std::uint8_t> data, std::vector<std::string>* cells, std::string*) {
             static constexpr char kDigits[] = "0123456789abcdef";
-            std::string hex(data.size() * 2, '0');
+            cells->resize(1);
+            std::string& hex = (*cells)[0];
+            hex.resize(data.size() * 2);
             for (std::size_t i = 0; i < data.size(); ++i) {
               hex[2 * i] = kDigits[data[i] >> 4];
               hex[2 * i + 1] = kDigits[data[i] & 0xF];
             }
-            cells->push_back(std::move(hex));
             return true;
           }};
 }
@@ -56,7 +58,7 @@ std::string FileNameForTopic(const std::string& topic) {
 }
 
 Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const CsvExportOptions& options,
-                       CsvExportSummary* summary) {
+                 CsvExportSummary* summary) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return Status::IOError(dir, "cannot create directory: " + ec.message());
@@ -92,17 +94,17 @@ Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const CsvEx
   read.topics = options.topics;
   read.skip_damaged = true;
   read.skipped_chunks = &summary->skipped_chunks;
-  std::vector<std::string> cells;
+  std::string error;
   Status status = reader.ReadMessages(read, [&](const mcap::MessageView& m) {
     ChannelOutput& out = *outputs.at(m.channel->id);
+    std::vector<std::string>& cells = out.cells;
     out.file << m.log_time << ',' << m.publish_time << ',' << m.sequence;
-    cells.clear();
-    std::string error;
     if (!out.decoder.decode(m.data, &cells, &error) || cells.size() != out.decoder.columns.size()) {
       if (summary->undecodable++ == 0) {
         summary->first_decode_error = m.channel->topic + " seq " + std::to_string(m.sequence) + ": " +
                                       (error.empty() ? "decoder returned the wrong number of cells" : error);
       }
+      error.clear();
       cells.assign(out.decoder.columns.size(), "");
     }
     for (const std::string& cell : cells) {

@@ -3,14 +3,15 @@
 // Each CSV starts with the header `log_time,publish_time,sequence,<payload columns>` and has one
 // row per message in log-time order; times are integer nanoseconds. The payload columns come from
 // a PayloadDecoder chosen per channel by CsvExportOptions::decoder_factory; without one (or when
-// it declines a channel) the payload is one `data_hex` column.
+// it declines a channel) the payload is one `data_hex` column. `dyad bag export` plugs in the
+// IDL-driven CDR decoder (dyad/cdr_decoder.hpp) for omgidl schemas: see bag_commands.cpp.
 //
-// Usage (a CDR decoder for dyad's IDL types, when it exists):
+// Usage:
 //   dyad::bag::CsvExportOptions options;
 //   options.decoder_factory = [&](const dyad::mcap::Schema* schema, const dyad::mcap::Channel&)
 //       -> std::optional<dyad::bag::PayloadDecoder> {
 //     if (schema == nullptr || schema->encoding != "omgidl") return std::nullopt;  // -> hex
-//     return MakeCdrDecoder(*schema);  // columns: stamp_ns, x, y, ...
+//     return MakeMyDecoder(*schema);  // columns: stamp_ns, x, y, ...
 //   };
 //   dyad::bag::CsvExportSummary summary;
 //   dyad::Status s = dyad::bag::ExportCsv(reader, "out/", options, &summary);
@@ -32,8 +33,10 @@ namespace dyad::bag {
 struct PayloadDecoder {
   // Header names of the payload columns (at least one).
   std::vector<std::string> columns;
-  // Appends exactly columns.size() cells for `data` to *cells (already cleared by the caller), or
-  // returns false and sets *error. Cells are written as given, CSV-quoted when needed.
+  // Replaces *cells with exactly columns.size() cells for `data`, or returns false and sets
+  // *error. *cells holds the previous row of the same channel: assign into its strings rather than
+  // clearing it, so a row costs no allocation once they have grown. Cells are written as given,
+  // CSV-quoted when needed.
   std::function<bool(std::span<const std::uint8_t> data, std::vector<std::string>* cells, std::string* error)>
       decode;
 };
@@ -65,7 +68,7 @@ struct CsvExportSummary {
 // Damaged chunks are skipped and counted rather than failing the export.
 // Fails: IOError naming the CSV that cannot be written; errors of Reader::ReadMessages.
 Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const CsvExportOptions& options,
-                       CsvExportSummary* summary);
+                 CsvExportSummary* summary);
 
 // "robot_pose" for "/robot/pose": letters, digits, '-', '.', '_' kept, the rest '_'.
 std::string FileNameForTopic(const std::string& topic);

@@ -40,6 +40,27 @@ bool ForEachRecord(Bytes bytes, Fn&& fn) {
   return true;
 }
 
+// Adds one message to the message counts and time range of *s.
+void CountMessage(ChannelId channel, std::uint64_t log_time, Statistics* s) {
+  if (s->message_count == 0 || log_time < s->message_start_time) s->message_start_time = log_time;
+  if (s->message_count == 0 || log_time > s->message_end_time) s->message_end_time = log_time;
+  ++s->message_count;
+  ++s->channel_message_counts[channel];
+}
+
+// Adds the message counts and time range of `part` to *total.
+void AddMessageCounts(const Statistics& part, Statistics* total) {
+  if (part.message_count == 0) return;
+  if (total->message_count == 0 || part.message_start_time < total->message_start_time) {
+    total->message_start_time = part.message_start_time;
+  }
+  if (total->message_count == 0 || part.message_end_time > total->message_end_time) {
+    total->message_end_time = part.message_end_time;
+  }
+  total->message_count += part.message_count;
+  for (const auto& [channel, count] : part.channel_message_counts) total->channel_message_counts[channel] += count;
+}
+
 struct ZstdDCtxDeleter {
   void operator()(ZSTD_DCtx* ctx) const { ZSTD_freeDCtx(ctx); }
 };
@@ -87,6 +108,10 @@ class Reader::Impl {
   bool EndsWithFooter();
   // Decompresses a chunk's records into *out and checks its CRC; "" or what is wrong.
   std::string DecodeChunkRecords(const codec::ChunkRecord& chunk, std::vector<std::uint8_t>* out);
+  // DataLoss "<path>: chunk at offset N: <detail>".
+  Status ChunkDamaged(std::uint64_t offset, const std::string& detail) const {
+    return Status::DataLoss(file_.path() + ": " + At("chunk", offset), detail);
+  }
   // Reads and decodes the chunk described by `info` into *out. DataLoss names the chunk.
   Status LoadChunk(const ChunkInfo& info, std::vector<std::uint8_t>* out);
   Status ReadRecordContent(std::uint64_t offset, std::uint64_t length, std::vector<std::uint8_t>* out);
@@ -287,14 +312,22 @@ std::string Reader::Impl::ReadSummary(std::uint64_t header_end) {
 }
 
 std::string Reader::Impl::DecodeChunkRecords(const codec::ChunkRecord& chunk, std::vector<std::uint8_t>* out) {
-  if (chunk.uncompressed_size > kMaxUncompressedChunk) {
-    return "declared uncompressed size " + std::to_string(chunk.uncompressed_size) + " is implausible";
-  }
-  out->resize(chunk.uncompressed_size);
+  // The declared size is checked against what the stored bytes can hold before it is allocated:
+  // a damaged size field must not cost gigabytes.
+  auto declared = [&] { return "declared uncompressed size " + std::to_string(chunk.uncompressed_size); };
   if (chunk.compression.empty()) {
-    if (chunk.records.size() != chunk.uncompressed_size) return "stored size differs from uncompressed size";
-    std::memcpy(out->data(), chunk.records.data(), chunk.records.size());
+    if (chunk.records.size() != chunk.uncompressed_size) {
+      return declared() + " differs from the " + std::to_string(chunk.records.size()) + " bytes stored";
+    }
+    out->assign(chunk.records.begin(), chunk.records.end());
   } else if (chunk.compression == "zstd") {
+    const unsigned long long frame_size = ZSTD_getFrameContentSize(chunk.records.data(), chunk.records.size());
+    if (frame_size == ZSTD_CONTENTSIZE_ERROR) return "zstd: not a zstd frame";
+    if (frame_size != ZSTD_CONTENTSIZE_UNKNOWN && frame_size != chunk.uncompressed_size) {
+      return declared() + " differs from the zstd frame's " + std::to_string(frame_size) + " bytes";
+    }
+    if (chunk.uncompressed_size > kMaxUncompressedChunk) return declared() + " is implausible";
+    out->resize(chunk.uncompressed_size);
     std::size_t n = ZSTD_decompressDCtx(zstd_.get(), out->data(), out->size(), chunk.records.data(),
                                         chunk.records.size());
     if (ZSTD_isError(n)) return std::string("zstd: ") + ZSTD_getErrorName(n);
@@ -379,8 +412,9 @@ void Reader::Impl::Scan(std::uint64_t pos) {
         std::string damage = codec::DecodeChunk(record_, &chunk) ? DecodeChunkRecords(chunk, &records)
                                                                    : "undecodable Chunk record";
         if (damage.empty()) {
-          // Schemas and channels may live inside chunks (other writers put them there).
-          std::uint64_t count = 0;
+          // Schemas and channels may live inside chunks (other writers put them there). The
+          // messages count only once the whole chunk has proved well framed.
+          Statistics in_chunk;
           bool framed = ForEachRecord(records, [&](std::uint8_t inner, Bytes content, std::uint64_t) {
             if (inner == format::kSchema) {
               Schema s;
@@ -391,19 +425,15 @@ void Reader::Impl::Scan(std::uint64_t pos) {
             } else if (inner == format::kMessage) {
               codec::MessageRecord m;
               if (!codec::DecodeMessage(content, &m)) return false;
-              if (stats.message_count + count == 0 || m.log_time < stats.message_start_time) {
-                stats.message_start_time = m.log_time;
-              }
-              if (stats.message_count + count == 0 || m.log_time > stats.message_end_time) {
-                stats.message_end_time = m.log_time;
-              }
-              ++stats.channel_message_counts[m.channel_id];
-              ++count;
+              CountMessage(m.channel_id, m.log_time, &in_chunk);
             }
             return true;
           });
-          if (!framed) damage = "records inside the chunk are misframed";
-          stats.message_count += count;
+          if (framed) {
+            AddMessageCounts(in_chunk, &stats);
+          } else {
+            damage = "records inside the chunk are misframed";
+          }
         }
         if (damage.empty()) {
           ChunkInfo info;
@@ -450,19 +480,16 @@ void Reader::Impl::Scan(std::uint64_t pos) {
 }
 
 Status Reader::Impl::LoadChunk(const ChunkInfo& info, std::vector<std::uint8_t>* out) {
-  const std::string where = file_.path() + ": " + At("chunk", info.offset);
-  if (info.length < format::kRecordPrefix) return Status::DataLoss(where, "too short");
+  if (info.length < format::kRecordPrefix) return ChunkDamaged(info.offset, "too short");
   if (Status s = ReadRecordContent(info.offset, info.length, &record_); !s.ok()) return s;
   std::uint64_t len = 0;
   std::memcpy(&len, record_.data() + 1, 8);
   codec::ChunkRecord chunk;
   if (record_[0] != format::kChunk || len != info.length - format::kRecordPrefix ||
       !codec::DecodeChunk(Bytes(record_).subspan(format::kRecordPrefix), &chunk)) {
-    return Status::DataLoss(where, "no valid Chunk record there");
+    return ChunkDamaged(info.offset, "no valid Chunk record there");
   }
-  if (std::string damage = DecodeChunkRecords(chunk, out); !damage.empty()) {
-    return Status::DataLoss(where, damage);
-  }
+  if (std::string damage = DecodeChunkRecords(chunk, out); !damage.empty()) return ChunkDamaged(info.offset, damage);
   return Status::OK();
 }
 
@@ -471,7 +498,7 @@ Status Reader::Impl::ReadMessages(const ReadOptions& options,
   if (!recovery_.damaged_chunks.empty()) {
     if (!options.skip_damaged) {
       const auto& [offset, why] = *recovery_.damaged_chunks.begin();
-      return Status::DataLoss(file_.path() + ": " + At("chunk", offset), why);
+      return ChunkDamaged(offset, why);
     }
     if (options.skipped_chunks) *options.skipped_chunks += recovery_.damaged_chunks.size();
   }
@@ -502,15 +529,14 @@ Status Reader::Impl::ReadMessages(const ReadOptions& options,
         return true;
       }
       if (!channels_.count(m.channel_id)) {
-        status = Status::DataLoss(file_.path() + ": " + At("chunk", info.offset),
-                                  "message on unknown channel " + std::to_string(m.channel_id));
+        status = ChunkDamaged(info.offset, "message on unknown channel " + std::to_string(m.channel_id));
         return false;
       }
       pending.push_back({m.log_time, m});
       return true;
     });
     if (!framed && status.ok()) {
-      status = Status::DataLoss(file_.path() + ": " + At("chunk", info.offset), "misframed records");
+      status = ChunkDamaged(info.offset, "misframed records");
     }
   };
   // Delivers `pending`; false when the visitor asked to stop.
@@ -558,10 +584,9 @@ Status Reader::Impl::ReadMessages(const ReadOptions& options,
       collect(chunk_buffers_[i], *group[i]);
       if (!status.ok()) return status;
     }
-    if (options.order == ReadOptions::Order::kLogTime &&
-        !std::is_sorted(pending.begin(), pending.end(), [](const Pending& a, const Pending& b) { return a.log_time < b.log_time; })) {
-      std::stable_sort(pending.begin(), pending.end(),
-                       [](const Pending& a, const Pending& b) { return a.log_time < b.log_time; });
+    auto earlier = [](const Pending& a, const Pending& b) { return a.log_time < b.log_time; };
+    if (options.order == ReadOptions::Order::kLogTime && !std::is_sorted(pending.begin(), pending.end(), earlier)) {
+      std::stable_sort(pending.begin(), pending.end(), earlier);
     }
     if (!deliver()) return Status::OK();
   }

@@ -517,6 +517,9 @@ struct BadIdl {
   const char* idl;
   const char* error;
 };
+// Names each case by its expected error in the test output and in CTest (stable across runs,
+// unlike gtest's default byte dump of the two pointers).
+void PrintTo(const BadIdl& bad, std::ostream* os) { *os << bad.error; }
 
 class CdrSchemaError : public testing::TestWithParam<BadIdl> {};
 

@@ -1,10 +1,14 @@
-// `dyad bag info` and `dyad bag export`: reports, CSV contents, decoders and exit codes.
+// `dyad bag info` and `dyad bag export`: reports, CSV contents, decoders, errors and exit codes.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include <fastdds/rtps/common/SerializedPayload.h>
+
+#include <dyad/msg/types.hpp>
 
 #include "bag_commands.hpp"
 #include "bag_info.hpp"
@@ -22,12 +26,14 @@ std::string TempPath(const std::string& name) {
 }
 
 // Two channels (/robot/pose x 4, /human/pose x 2), one Flush() per 3 messages, a graph YAML.
+// The payloads are 3 opaque bytes, not CDR: for the data_hex path (ExportCsv without a decoder).
 std::string WriteSample(const std::string& path) {
   mcap::WriterOptions options;
   options.chunk_size = 1 << 20;
   auto writer = mcap::Writer::Open(path, options);
   EXPECT_TRUE(writer.ok());
-  auto schema = writer->AddSchema("dyad::msg::Pose2", "omgidl", "struct Pose2 { double x; };");
+  auto schema = writer->AddSchema("dyad::msg::Pose2", "omgidl",
+                                  "module dyad { module msg { struct Pose2 { double x; }; }; };");
   auto robot = writer->AddChannel("/robot/pose", "cdr", *schema);
   auto human = writer->AddChannel("/human/pose", "cdr", *schema);
   EXPECT_TRUE(writer->AddMetadata("dyad.graph", {{"yaml", "nodes: []\n"}}).ok());
@@ -50,14 +56,18 @@ std::string ReadText(const std::string& path) {
   return s.str();
 }
 
-int RunCli(std::vector<std::string> args) {
+// Runs `dyad ARGS...` and returns its exit code; *err (if given) receives what it wrote to stderr.
+int RunCli(std::vector<std::string> args, std::string* err = nullptr) {
   CLI::App app{"dyad"};
   int exit_code = -1;
   dyad::cli::AddBagCommands(app, exit_code);
   args.insert(args.begin(), "dyad");
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
+  ::testing::internal::CaptureStderr();
   app.parse(static_cast<int>(argv.size()), argv.data());
+  const std::string captured = ::testing::internal::GetCapturedStderr();
+  if (err) *err = captured;
   return exit_code;
 }
 
@@ -124,8 +134,7 @@ TEST(CsvExport, UsesTheDecoderTheFactoryPicksPerSchema) {
                               *error = "index 3 is cursed";
                               return false;
                             }
-                            cells->push_back(std::to_string(data[1]));
-                            cells->push_back("a,\"b\"");
+                            *cells = {std::to_string(data[1]), "a,\"b\""};
                             return true;
                           }};
   };
@@ -149,15 +158,127 @@ TEST(CsvExport, TopicNamesBecomeSafeFileNames) {
   EXPECT_EQ(FileNameForTopic("/"), "topic");
 }
 
+// A recording of dyad::msg::Counter as the recorder writes it: the type's IDL text as an omgidl
+// schema, samples serialized by the generated PubSubType (real CDR). `idl` replaces the schema
+// text; `garble` cuts the payload of the message with that sequence number short.
+std::string WriteCounters(const std::string& path, const std::string& idl = MessageTraits<msg::Counter>::kIdl,
+                          std::uint32_t garble = UINT32_MAX) {
+  auto writer = mcap::Writer::Open(path);
+  EXPECT_TRUE(writer.ok()) << writer.status().ToString();
+  auto schema = writer->AddSchema(MessageTraits<msg::Counter>::kName, "omgidl", idl);
+  auto channel = writer->AddChannel("/counter", "cdr", *schema);
+  MessageTraits<msg::Counter>::PubSubType type;
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    msg::Counter m;
+    m.header().source(i == 1 ? "say \"hi\", twice" : "counter");
+    m.header().sequence_number(i + 1);
+    m.header().stamp_ns(-5 + static_cast<std::int64_t>(i));
+    m.value(std::int64_t{1} << (40 + i));
+    eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(&m)());
+    EXPECT_TRUE(type.serialize(&m, &payload));
+    const std::uint32_t size = i == garble ? payload.length - 3 : payload.length;
+    EXPECT_TRUE(writer->Write(*channel, i, 1000 * (i + 1), 900 * (i + 1), {payload.data, size}).ok());
+  }
+  EXPECT_TRUE(writer->Close().ok());
+  return path;
+}
+
 TEST(BagCommands, ExitCodesSayOkFailureOrBadInput) {
-  const std::string path = WriteSample(TempPath("a.mcap"));
+  const std::string path = WriteCounters(TempPath("a.mcap"));
+  std::string err;
   EXPECT_EQ(RunCli({"bag", "info", path}), 0);
   EXPECT_EQ(RunCli({"bag", "info", "--scan", path}), 0);
-  EXPECT_EQ(RunCli({"bag", "info", TempPath("missing.mcap")}), 2);
-  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", TempPath("out")}), 0);
-  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", TempPath("out2"), "--topic", "/nope"}), 2);
+  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", TempPath("out")}, &err), 0) << err;
+
+  EXPECT_EQ(RunCli({"bag", "info", TempPath("missing.mcap")}, &err), 2);
+  EXPECT_EQ(err.rfind("dyad bag: " + TempPath("missing.mcap") + ": open for reading: ", 0), 0u) << err;
+  EXPECT_EQ(RunCli({"bag", "info", ::testing::TempDir()}, &err), 2);
+  EXPECT_EQ(err, "dyad bag: " + ::testing::TempDir() + ": not a regular file\n");
+  const std::string text = TempPath("text.mcap");
+  std::ofstream(text) << "not a recording\n";
+  EXPECT_EQ(RunCli({"bag", "export", text, "--csv", TempPath("out3")}, &err), 2);
+  EXPECT_EQ(err, "dyad bag: " + text + ": not an MCAP file (wrong magic bytes)\n");
+  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", TempPath("out2"), "--topic", "/nope"}, &err), 2);
+  EXPECT_EQ(err, "dyad bag: " + path + ": no channel with topic \"/nope\"\n");
   // A directory that cannot be created: its parent is a regular file.
-  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", path + "/sub"}), 1);
+  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", path + "/sub"}, &err), 1);
+  EXPECT_EQ(err.rfind("dyad bag: " + path + "/sub: cannot create directory: ", 0), 0u) << err;
+}
+
+TEST(BagCommands, ExportOfADamagedRecordingSkipsTheChunkAndFails) {
+  const std::string path = WriteCounters(TempPath("a.mcap"));
+  std::uint64_t chunk = 0;
+  {
+    auto reader = mcap::Reader::Open(path);
+    ASSERT_TRUE(reader.ok());
+    ASSERT_EQ(reader->chunks().size(), 1u);
+    chunk = reader->chunks()[0].offset;
+  }
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(chunk + 1 + 8 + 8 + 8 + 8));  // Its CRC field.
+    f.write("\xde\xad", 2);
+  }
+  std::string err;
+  const std::string dir = TempPath("out");
+  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", dir}, &err), 1);
+  EXPECT_EQ(err, "dyad bag: " + path + ": skipped 1 damaged chunk(s); `dyad bag info --scan " + path +
+                     "` lists them\n");
+  EXPECT_EQ(ReadText(dir + "/counter.csv"),
+            "log_time,publish_time,sequence,header.source,header.sequence_number,header.stamp_ns,value\n");
+  std::string report;
+  ::testing::internal::CaptureStdout();
+  EXPECT_EQ(RunCli({"bag", "info", "--scan", path}), 1);
+  report = ::testing::internal::GetCapturedStdout();
+  EXPECT_NE(report.find("damaged:     1 chunk(s)\n  at offset " + std::to_string(chunk) + ": CRC mismatch"),
+            std::string::npos)
+      << report;
+}
+
+TEST(BagCommands, ExportDecodesOmgidlCdrIntoOneColumnPerField) {
+  const std::string path = WriteCounters(TempPath("counter.mcap"));
+  const std::string dir = TempPath("out");
+  std::string err;
+  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", dir}, &err), 0) << err;
+  EXPECT_EQ(err, "");
+  EXPECT_EQ(ReadText(dir + "/counter.csv"),
+            "log_time,publish_time,sequence,header.source,header.sequence_number,header.stamp_ns,value\n"
+            "1000,900,0,counter,1,-5,1099511627776\n"
+            "2000,1800,1,\"say \"\"hi\"\", twice\",2,-4,2199023255552\n"
+            "3000,2700,2,counter,3,-3,4398046511104\n");
+}
+
+TEST(BagCommands, ExportLeavesUndecodablePayloadsEmptyAndFails) {
+  const std::string path = WriteCounters(TempPath("counter.mcap"), MessageTraits<msg::Counter>::kIdl, 2);
+  const std::string dir = TempPath("out");
+  std::string err;
+  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", dir}, &err), 1);
+  EXPECT_NE(err.find("dyad bag: " + path + ": 1 payload(s) could not be decoded (their cells are left empty); "
+                     "first: /counter seq 2: offset 32 (value): truncated: long long needs 8 bytes, 5 left"),
+            std::string::npos)
+      << err;
+  EXPECT_NE(ReadText(dir + "/counter.csv").find("\n3000,2700,2,,,,\n"), std::string::npos);
+}
+
+TEST(BagCommands, ExportNamesAnOmgidlSchemaThatDoesNotParseAndFallsBackToHex) {
+  const std::string path =
+      WriteCounters(TempPath("counter.mcap"), "module dyad { module msg {\nstruct Counter { union u; };\n}; };\n");
+  const std::string dir = TempPath("out");
+  std::string err;
+  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", dir}, &err), 1);
+  EXPECT_EQ(err, "dyad bag: " + path +
+                     ": /counter: schema 1 \"dyad::msg::Counter\" (omgidl): line 2: 'union' is not supported; "
+                     "exported as data_hex\n");
+  EXPECT_EQ(ReadText(dir + "/counter.csv").rfind("log_time,publish_time,sequence,data_hex\n", 0), 0u);
+}
+
+TEST(BagCommands, ExportNamesAnOmgidlSchemaWithoutItsType) {
+  const std::string path = WriteCounters(TempPath("counter.mcap"), "struct Other { long x; };\n");
+  std::string err;
+  EXPECT_EQ(RunCli({"bag", "export", path, "--csv", TempPath("out")}, &err), 1);
+  EXPECT_EQ(err, "dyad bag: " + path +
+                     ": /counter: schema 1 \"dyad::msg::Counter\" (omgidl): its IDL defines no struct "
+                     "\"dyad::msg::Counter\"; exported as data_hex\n");
 }
 
 }  // namespace

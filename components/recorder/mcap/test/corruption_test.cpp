@@ -22,12 +22,9 @@ WriterOptions FlushDelimited(Compression compression) {
 
 TEST(Corruption, FlippedByteInAnUncompressedChunkFailsItsCrc) {
   auto file = testing::WriteChunkedFile(TempPath("f.mcap"), FlushDelimited(Compression::kNone), 3, 10);
-  ChunkInfo second;
-  {
-    auto intact = Reader::Open(file.path);
-    ASSERT_TRUE(intact.ok());
-    second = intact->chunks()[1];
-  }
+  const std::vector<ChunkInfo> chunks = testing::Chunks(file.path);
+  ASSERT_EQ(chunks.size(), 3u);
+  const ChunkInfo second = chunks[1];
   testing::FlipByte(file.path, second.offset + second.length - 5);  // Inside the last payload.
   auto reader = Reader::Open(file.path);
   ASSERT_TRUE(reader.ok());
@@ -51,12 +48,9 @@ TEST(Corruption, FlippedByteInAnUncompressedChunkFailsItsCrc) {
 
 TEST(Corruption, FlippedByteInAZstdChunkIsDataLoss) {
   auto file = testing::WriteChunkedFile(TempPath("f.mcap"), FlushDelimited(Compression::kZstd), 3, 10);
-  ChunkInfo first;
-  {
-    auto intact = Reader::Open(file.path);
-    ASSERT_TRUE(intact.ok());
-    first = intact->chunks()[0];
-  }
+  const std::vector<ChunkInfo> chunks = testing::Chunks(file.path);
+  ASSERT_EQ(chunks.size(), 3u);
+  const ChunkInfo first = chunks[0];
   testing::FlipByte(file.path, first.offset + first.length - first.compressed_size / 2);
   auto reader = Reader::Open(file.path);
   ASSERT_TRUE(reader.ok());
@@ -68,12 +62,9 @@ TEST(Corruption, FlippedByteInAZstdChunkIsDataLoss) {
 
 TEST(Corruption, LinearScanListsDamagedChunksAndReadsTheRest) {
   auto file = testing::WriteChunkedFile(TempPath("f.mcap"), FlushDelimited(Compression::kNone), 3, 10);
-  ChunkInfo first;
-  {
-    auto intact = Reader::Open(file.path);
-    ASSERT_TRUE(intact.ok());
-    first = intact->chunks()[0];
-  }
+  const std::vector<ChunkInfo> chunks = testing::Chunks(file.path);
+  ASSERT_EQ(chunks.size(), 3u);
+  const ChunkInfo first = chunks[0];
   testing::FlipByte(file.path, first.offset + first.length - 5);
   const auto size = std::filesystem::file_size(file.path);
   ASSERT_EQ(::truncate(file.path.c_str(), static_cast<off_t>(size - 10)), 0);  // Forces a scan.
@@ -90,6 +81,56 @@ TEST(Corruption, LinearScanListsDamagedChunksAndReadsTheRest) {
   skip.skip_damaged = true;
   EXPECT_EQ(ReadAll(*reader, skip, &status).size(), 20u);
   EXPECT_TRUE(status.ok());
+}
+
+// Chunk record layout: opcode, length, start time, end time, uncompressed size, CRC, ...
+constexpr std::uint64_t kChunkUncompressedSizeAt = 1 + 8 + 8 + 8;
+constexpr std::uint64_t kChunkCrcAt = kChunkUncompressedSizeAt + 8;
+// ... compression (empty: its length only), records size, then the records.
+constexpr std::uint64_t kChunkRecordsAt = kChunkCrcAt + 4 + 4 + 8;
+
+TEST(Corruption, DamagedSizeFieldIsDataLossNotAHugeAllocation) {
+  for (Compression compression : {Compression::kZstd, Compression::kNone}) {
+    auto file = testing::WriteChunkedFile(TempPath("f.mcap"), FlushDelimited(compression), 3, 10);
+    const std::vector<ChunkInfo> chunks = testing::Chunks(file.path);
+    ASSERT_EQ(chunks.size(), 3u);
+    const std::uint64_t three_gib = std::uint64_t{3} << 30;
+    testing::OverwriteU64(file.path, chunks[0].offset + kChunkUncompressedSizeAt, three_gib);
+    auto reader = Reader::Open(file.path);
+    ASSERT_TRUE(reader.ok());
+    Status status;
+    EXPECT_TRUE(ReadAll(*reader, {}, &status).empty());
+    EXPECT_EQ(status.code(), Status::Code::kDataLoss);
+    const std::string expected = file.path + ": chunk at offset " + std::to_string(chunks[0].offset) +
+                                 ": declared uncompressed size 3221225472 differs from the " +
+                                 (compression == Compression::kZstd ? "zstd frame's " : "") +
+                                 std::to_string(chunks[0].uncompressed_size) +
+                                 (compression == Compression::kZstd ? " bytes" : " bytes stored");
+    EXPECT_EQ(status.message(), expected);
+  }
+}
+
+TEST(Corruption, ScanCountsNoMessageOfAMisframedChunk) {
+  auto file = testing::WriteChunkedFile(TempPath("f.mcap"), FlushDelimited(Compression::kNone), 3, 10);
+  const std::vector<ChunkInfo> chunks = testing::Chunks(file.path);
+  ASSERT_EQ(chunks.size(), 3u);
+  // Without a CRC (other writers may leave it 0) only the framing betrays the second message's
+  // damaged length; the first message of that chunk must not be counted either.
+  testing::OverwriteU32(file.path, chunks[1].offset + kChunkCrcAt, 0);
+  const std::uint64_t first_message_length = file.messages[0].data.size() + 2 + 4 + 8 + 8;
+  testing::FlipByte(file.path, chunks[1].offset + kChunkRecordsAt + 1 + 8 + first_message_length + 1 + 7);
+  ReaderOptions scan;
+  scan.use_summary = false;
+  auto reader = Reader::Open(file.path, scan);
+  ASSERT_TRUE(reader.ok());
+  ASSERT_EQ(reader->recovery().damaged_chunks.count(chunks[1].offset), 1u);
+  EXPECT_EQ(reader->recovery().damaged_chunks.at(chunks[1].offset), "records inside the chunk are misframed");
+  const Statistics& stats = reader->statistics();
+  EXPECT_EQ(stats.message_count, 20u);
+  EXPECT_EQ(stats.channel_message_counts.at(1) + stats.channel_message_counts.at(2) +
+                stats.channel_message_counts.at(3),
+            20u);
+  EXPECT_EQ(stats.message_end_time, file.messages.back().log_time);
 }
 
 TEST(Corruption, DamagedSummaryFallsBackToALinearScan) {

@@ -69,14 +69,41 @@ std::vector<TestMessage> ReadAll(const Reader& reader, const ReadOptions& option
   return out;
 }
 
-void FlipByte(const std::string& path, std::uint64_t offset) {
+std::vector<ChunkInfo> Chunks(const std::string& path) {
+  auto reader = Reader::Open(path);
+  EXPECT_TRUE(reader.ok()) << reader.status().ToString();
+  return reader.ok() ? reader->chunks() : std::vector<ChunkInfo>{};
+}
+
+namespace {
+
+// Replaces bytes of a file in place (the host is little-endian, as dyad_mcap requires).
+void Overwrite(const std::string& path, std::uint64_t offset, const void* bytes, std::size_t size) {
   std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
-  f.seekg(static_cast<std::streamoff>(offset));
-  char c = 0;
-  f.read(&c, 1);
-  c = static_cast<char>(c ^ 0xFF);
   f.seekp(static_cast<std::streamoff>(offset));
-  f.write(&c, 1);
+  f.write(static_cast<const char*>(bytes), static_cast<std::streamsize>(size));
+  EXPECT_TRUE(f.good()) << path << " at " << offset;
+}
+
+}  // namespace
+
+void FlipByte(const std::string& path, std::uint64_t offset) {
+  char c = 0;
+  {
+    std::ifstream f(path, std::ios::binary);
+    f.seekg(static_cast<std::streamoff>(offset));
+    f.read(&c, 1);
+  }
+  c = static_cast<char>(c ^ 0xFF);
+  Overwrite(path, offset, &c, 1);
+}
+
+void OverwriteU32(const std::string& path, std::uint64_t offset, std::uint32_t value) {
+  Overwrite(path, offset, &value, sizeof(value));
+}
+
+void OverwriteU64(const std::string& path, std::uint64_t offset, std::uint64_t value) {
+  Overwrite(path, offset, &value, sizeof(value));
 }
 
 }  // namespace dyad::mcap::testing

@@ -44,7 +44,13 @@ std::vector<std::uint8_t> Payload(std::uint32_t i, std::size_t size);
 std::vector<TestMessage> ReadAll(const Reader& reader, const ReadOptions& options = {},
                                  Status* status = nullptr);
 
+// The chunks of an intact file, as its summary lists them (fails the test if it cannot be read).
+std::vector<ChunkInfo> Chunks(const std::string& path);
+
 // Overwrites one byte of a file (XORs it with 0xFF).
 void FlipByte(const std::string& path, std::uint64_t offset);
+// Overwrites a little-endian field of a file.
+void OverwriteU32(const std::string& path, std::uint64_t offset, std::uint32_t value);
+void OverwriteU64(const std::string& path, std::uint64_t offset, std::uint64_t value);
 
 }  // namespace dyad::mcap::testing

@@ -25,11 +25,7 @@ TEST(Truncation, EveryCutKeepsExactlyTheMessagesOfTheCompleteChunks) {
   constexpr int kPerChunk = 4;
   auto file = testing::WriteChunkedFile(TempPath("full.mcap"), FlushDelimited(), 5, kPerChunk);
   std::vector<std::uint64_t> chunk_ends;
-  {
-    auto intact = Reader::Open(file.path);
-    ASSERT_TRUE(intact.ok());
-    for (const ChunkInfo& c : intact->chunks()) chunk_ends.push_back(c.offset + c.length);
-  }
+  for (const ChunkInfo& c : testing::Chunks(file.path)) chunk_ends.push_back(c.offset + c.length);
   ASSERT_EQ(chunk_ends.size(), 5u);
   const std::string cut_path = TempPath("cut.mcap");
   std::filesystem::copy_file(file.path, cut_path);
@@ -56,13 +52,9 @@ TEST(Truncation, EveryCutKeepsExactlyTheMessagesOfTheCompleteChunks) {
 
 TEST(Truncation, ReportsWhereItStoppedAndWhy) {
   auto file = testing::WriteChunkedFile(TempPath("f.mcap"), FlushDelimited(), 3, 10);
-  std::uint64_t second_chunk = 0, second_end = 0;
-  {
-    auto intact = Reader::Open(file.path);
-    ASSERT_TRUE(intact.ok());
-    second_chunk = intact->chunks()[1].offset;
-    second_end = intact->chunks()[1].offset + intact->chunks()[1].length;
-  }
+  const std::vector<ChunkInfo> chunks = testing::Chunks(file.path);
+  ASSERT_EQ(chunks.size(), 3u);
+  const std::uint64_t second_chunk = chunks[1].offset, second_end = chunks[1].offset + chunks[1].length;
   const std::uint64_t cut = second_chunk + 20;
   ASSERT_EQ(::truncate(file.path.c_str(), static_cast<off_t>(cut)), 0);
   auto reader = Reader::Open(file.path);

@@ -10,7 +10,8 @@
 //     stops at the first record that does not fit in the file. recovery() says which path was
 //     taken, whether the file was cut short, and the offset up to which it is valid.
 //     A truncated file yields exactly the messages of the chunks that are complete before the cut.
-//   - A chunk whose CRC32 does not match, or that does not decompress, is damaged: ReadMessages
+//   - A chunk whose CRC32 does not match, that does not decompress, or whose declared size
+//     disagrees with its stored bytes (checked before anything is allocated) is damaged: ReadMessages
 //     fails with DataLoss naming the file and the chunk's offset, unless ReadOptions::skip_damaged
 //     is set, in which case the chunk is skipped and counted. Chunks a scan already found damaged
 //     (recovery().damaged_chunks) make ReadMessages fail before delivering anything, likewise.
@@ -89,8 +90,9 @@ struct ReadOptions {
 
 class Reader {
  public:
-  // Opens `path`. Fails: IOError (cannot open/read), DataLoss (not an MCAP file: wrong magic or
-  // an unreadable Header). A file cut short succeeds, with recovery().truncated set.
+  // Opens `path`. Fails: IOError (cannot open/read), InvalidArgument (not a regular file, e.g. a
+  // directory), DataLoss (not an MCAP file: wrong magic or an unreadable Header). A file cut short
+  // succeeds, with recovery().truncated set.
   static StatusOr<Reader> Open(const std::string& path, const ReaderOptions& options = {});
 
   Reader(Reader&&) noexcept;
