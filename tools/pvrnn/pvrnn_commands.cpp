@@ -163,6 +163,9 @@ int Train(const std::string& config_path, bool resume, const std::vector<std::st
   if (!c.ok()) return Fail(kBadInput, c.status().message());
   auto data = LoadNrlDataset(c->dataset);
   if (!data.ok()) return Fail(kBadInput, data.status().message());
+  if (data->dofs() != c->spec.num_dofs())
+    return Fail(kBadInput, config_path + ": encoding.dofs lists " + std::to_string(c->spec.num_dofs()) +
+                               " DOFs, the data set " + c->dataset + " has " + std::to_string(data->dofs()));
   return c->scalar == "double" ? RunTraining<double>(c.value(), config_path, data.value(), resume)
                                : RunTraining<float>(c.value(), config_path, data.value(), resume);
 }
@@ -182,7 +185,9 @@ int GenerateModel(const std::string& path, int primitive, int steps, const std::
   if (primitive < 0 || primitive >= m->sequences())
     return Fail(kBadInput, "--primitive " + std::to_string(primitive) + ": the model has primitives 0.." +
                                std::to_string(m->sequences() - 1));
-  if (steps <= 0) return Fail(kBadInput, "--steps must be > 0");
+  constexpr int kMaxSteps = 1'000'000;  // 28 h at 100 ms; bounds the memory of the trajectory
+  if (steps <= 0 || steps > kMaxSteps)
+    return Fail(kBadInput, "--steps " + std::to_string(steps) + ": must be in 1.." + std::to_string(kMaxSteps));
   GenerateOptions g;
   g.noise = !no_noise;
   g.seed = seed;

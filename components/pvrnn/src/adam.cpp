@@ -5,17 +5,24 @@
 
 namespace dyad::pvrnn {
 
-Status AdamOptions::Validate() const {
-  auto bad = [](const char* field, double v, const char* rule) {
+std::vector<FieldProblem> AdamOptions::Problems() const {
+  std::vector<FieldProblem> out;
+  auto check = [&out](bool ok, const char* field, double v, const char* rule) {
+    if (ok) return;
     std::ostringstream s;
-    s << "adam." << field << " = " << v << ": " << rule;
-    return Status::InvalidArgument(s.str());
+    s << rule << ", got " << v;
+    out.push_back({std::string("adam.") + field, s.str()});
   };
-  if (!(lr > 0)) return bad("lr", lr, "must be > 0");
-  if (!(beta1 >= 0 && beta1 < 1)) return bad("beta1", beta1, "must be in [0, 1)");
-  if (!(beta2 >= 0 && beta2 < 1)) return bad("beta2", beta2, "must be in [0, 1)");
-  if (!(epsilon > 0)) return bad("epsilon", epsilon, "must be > 0");
-  return Status::OK();
+  check(std::isfinite(lr) && lr > 0, "lr", lr, "must be finite and > 0");
+  check(beta1 >= 0 && beta1 < 1, "beta1", beta1, "must be in [0, 1)");
+  check(beta2 >= 0 && beta2 < 1, "beta2", beta2, "must be in [0, 1)");
+  check(std::isfinite(epsilon) && epsilon > 0, "epsilon", epsilon, "must be finite and > 0");
+  return out;
+}
+
+Status AdamOptions::Validate() const {
+  const std::vector<FieldProblem> p = Problems();
+  return p.empty() ? Status::OK() : Status::InvalidArgument(p.front().ToString());
 }
 
 template <typename Scalar>

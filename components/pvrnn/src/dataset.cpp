@@ -1,36 +1,13 @@
 #include "dyad/pvrnn/dataset.hpp"
 
-#include <charconv>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "dyad/pvrnn/nrl_import.hpp"
+#include "nrl_text.hpp"
 
 namespace dyad::pvrnn {
 namespace fs = std::filesystem;
-
-namespace {
-
-// Parses comma-separated doubles; false on any malformed field.
-bool ParseRow(const std::string& line, std::vector<double>* out) {
-  out->clear();
-  std::stringstream ss(line);
-  std::string field;
-  while (std::getline(ss, field, ',')) {
-    size_t b = field.find_first_not_of(" \t\r"), e = field.find_last_not_of(" \t\r");
-    if (b == std::string::npos) return false;
-    const char* first = field.data() + b;
-    const char* last = field.data() + e + 1;
-    double v = 0;
-    auto res = std::from_chars(first, last, v);
-    if (res.ec != std::errc() || res.ptr != last) return false;
-    out->push_back(v);
-  }
-  return !out->empty();
-}
-
-}  // namespace
 
 StatusOr<Dataset> LoadNrlDataset(const std::string& dir) {
   const std::string meta = (fs::path(dir) / "dataset.d").string();
@@ -39,18 +16,20 @@ StatusOr<Dataset> LoadNrlDataset(const std::string& dir) {
   Dataset data;
   data.name = fs::path(dir).filename().string();
   if (data.name.empty()) data.name = fs::path(dir).parent_path().filename().string();
-  int steps = -1, prims = -1;
+  int64_t steps = -1, prims = -1;
   for (const auto& [k, v] : kv.value()) {
-    try {
-      if (k == "samplingperiod") data.sampling_period_ms = std::stod(v);
-      if (k == "numbertimes") steps = std::stoi(v);
-      if (k == "numberprims") prims = std::stoi(v);
-    } catch (const std::exception&) {
-      return Status::DataLoss(meta + ": " + k + " = '" + v + "': not a number");
-    }
+    auto bad = [&](const char* rule) { return Status::DataLoss(meta + ": " + k + " = '" + v + "': " + rule); };
+    std::vector<double> period;
+    if (k == "samplingperiod" && !(internal::ParseNumberList(v, &period) && period.size() == 1 && period[0] > 0))
+      return bad("must be a number > 0");
+    if (k == "samplingperiod") data.sampling_period_ms = period[0];
+    if (k == "numbertimes" && !internal::ParseInteger(v, 1, 10'000'000, &steps))
+      return bad("must be a whole number in 1..10000000");
+    if (k == "numberprims" && !internal::ParseInteger(v, 1, 100'000, &prims))
+      return bad("must be a whole number in 1..100000");
   }
-  if (steps <= 0) return Status::DataLoss(meta + ": numbertimes missing or not > 0");
-  if (prims <= 0) return Status::DataLoss(meta + ": numberprims missing or not > 0");
+  if (steps <= 0) return Status::DataLoss(meta + ": numbertimes missing");
+  if (prims <= 0) return Status::DataLoss(meta + ": numberprims missing");
   std::vector<double> row;
   for (int p = 0; p < prims; ++p) {
     const std::string file = (fs::path(dir) / ("primitive_" + std::to_string(p) + "_0.csv")).string();
@@ -62,14 +41,15 @@ StatusOr<Dataset> LoadNrlDataset(const std::string& dir) {
     while (std::getline(in, line)) {
       ++line_no;
       if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-      if (!ParseRow(line, &row))
-        return Status::DataLoss(file + ":" + std::to_string(line_no) + ": not a comma-separated row of numbers");
+      if (std::string bad; !internal::ParseNumberList(line, &row, &bad))
+        return Status::DataLoss(file + ":" + std::to_string(line_no) + ": '" + bad +
+                                "' is not a finite number (expected a comma-separated row of numbers)");
       if (!rows.empty() && row.size() != rows[0].size())
         return Status::DataLoss(file + ":" + std::to_string(line_no) + ": " + std::to_string(row.size()) +
                                  " values, earlier rows have " + std::to_string(rows[0].size()));
       rows.push_back(row);
     }
-    if (static_cast<int>(rows.size()) != steps)
+    if (static_cast<int64_t>(rows.size()) != steps)
       return Status::DataLoss(file + ": " + std::to_string(rows.size()) + " rows, dataset.d says numbertimes=" +
                                std::to_string(steps));
     Eigen::MatrixXd seq(rows[0].size(), steps);

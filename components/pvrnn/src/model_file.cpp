@@ -151,9 +151,16 @@ Status SaveModel(const Model& model, const std::string& path) {
 }
 
 StatusOr<Model> LoadModel(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return Status::InvalidArgument(path + ": is a folder, not a model file");
   std::ifstream f(path, std::ios::binary);
   if (!f) return Status::NotFound(path + ": cannot open");
-  std::string in((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  std::string in;
+  try {
+    in.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+  } catch (const std::exception& e) {  // libstdc++ throws on a read error
+    return Status::IOError(path + ": read failed: " + e.what());
+  }
   if (in.size() < 8 || std::memcmp(in.data(), kMagic, 8) != 0)
     return Status::DataLoss(path + ": not a dyad PV-RNN model file (bad magic)");
   if (in.size() < kFixedHeader + kTrailer)
@@ -193,6 +200,13 @@ StatusOr<Model> LoadModel(const std::string& path) {
     const int steps = header.at("steps").get<int>(), sequences = header.at("sequences").get<int>();
     if (steps < 0 || sequences < 0) return Status::DataLoss(path + ": negative steps or sequences");
     NetworkLayout layout(m.spec);
+    // Every tensor was checked against the payload above; check the shapes it claims before
+    // allocating them (a consistent, checksummed header could still claim too much).
+    uint64_t stored = 0;  // the file holds the named groups, not R's structural zeros
+    for (const auto& g : layout.groups()) stored += static_cast<uint64_t>(g.rows) * static_cast<uint64_t>(g.cols);
+    const uint64_t a_cols = static_cast<uint64_t>(steps) * static_cast<uint64_t>(sequences);
+    if (a_cols > needed || stored + 2 * a_cols * static_cast<uint64_t>(layout.total_z()) > needed)
+      return Status::DataLoss(path + ": the spec, steps and sequences need more values than the tensors hold");
     m.weights = Weights<double>(layout);
     m.adaptive = AdaptiveVariables<double>(layout.total_z(), steps, sequences);
     auto read = [&](const std::string& name, int rows, int cols, auto&& sink) -> Status {

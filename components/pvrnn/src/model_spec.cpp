@@ -29,32 +29,66 @@ int ModelSpec::total_z() const {
   return n;
 }
 
-Status ModelSpec::Validate() const {
-  auto bad = [](const std::string& field, double value, const char* rule) {
-    std::ostringstream s;
-    s << field << " = " << value << ": " << rule;
-    return Status::InvalidArgument(s.str());
+namespace {
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+std::vector<FieldProblem> ModelSpec::Problems() const {
+  std::vector<FieldProblem> out;
+  auto bad = [&out](std::string field, const std::string& rule, double value) {
+    out.push_back({std::move(field), rule + ", got " + Num(value)});
   };
-  if (layers.empty()) return Status::InvalidArgument("layers: must list at least one layer");
+  if (layers.empty()) out.push_back({"layers", "must list at least one layer"});
   for (size_t k = 0; k < layers.size(); ++k) {
     const std::string p = "layers[" + std::to_string(k) + "].";
-    if (layers[k].d <= 0 || layers[k].d > 100000) return bad(p + "d", layers[k].d, "must be in 1..100000");
-    if (layers[k].z <= 0 || layers[k].z > 100000) return bad(p + "z", layers[k].z, "must be in 1..100000");
-    if (!(layers[k].tau >= 1.0)) return bad(p + "tau", layers[k].tau, "must be >= 1");
-    if (!(layers[k].w >= 0.0)) return bad(p + "w", layers[k].w, "must be >= 0");
+    const LayerSpec& l = layers[k];
+    if (l.d < 1 || l.d > 100000) bad(p + "d", "must be in 1..100000", l.d);
+    if (l.z < 1 || l.z > 100000) bad(p + "z", "must be in 1..100000", l.z);
+    if (!(std::isfinite(l.tau) && l.tau >= 1.0)) bad(p + "tau", "must be finite and >= 1", l.tau);
+    if (!(std::isfinite(l.w) && l.w >= 0.0)) bad(p + "w", "must be finite and >= 0", l.w);
   }
-  if (output.dofs.empty()) return Status::InvalidArgument("output.dofs: must list at least one DOF");
+  if (output.dofs.empty()) out.push_back({"output.dofs", "must list at least one DOF"});
+  bool ranges_ok = true;
   for (size_t i = 0; i < output.dofs.size(); ++i) {
-    if (!(output.dofs[i].max > output.dofs[i].min) || !std::isfinite(output.dofs[i].max - output.dofs[i].min))
-      return bad("output.dofs[" + std::to_string(i) + "].max", output.dofs[i].max, "must be finite and > min");
+    const DofRange& r = output.dofs[i];
+    if (!(std::isfinite(r.min) && std::isfinite(r.max) && r.max > r.min)) {
+      ranges_ok = false;
+      out.push_back({"output.dofs[" + std::to_string(i) + "]",
+                     "must be [min, max] with finite min < max, got [" + Num(r.min) + ", " + Num(r.max) + "]"});
+    }
   }
-  if (!(output.dsoft > 0)) return bad("output.dsoft", output.dsoft, "must be > 0");
-  if (!(output.sigma > 0)) return bad("output.sigma", output.sigma, "must be > 0");
-  for (size_t i = 0; i < output.dofs.size(); ++i) {
-    if ((output.dofs[i].max - output.dofs[i].min) / output.dsoft > 10000)
-      return bad("output.dsoft", output.dsoft, "gives more than 10000 softmax units per DOF");
+  if (!(std::isfinite(output.dsoft) && output.dsoft > 0)) {
+    bad("output.dsoft", "must be finite and > 0", output.dsoft);
+  } else if (ranges_ok) {
+    for (const DofRange& r : output.dofs)
+      if ((r.max - r.min) / output.dsoft > 10000) {
+        bad("output.dsoft", "gives more than 10000 softmax units per DOF", output.dsoft);
+        break;
+      }
   }
-  return Status::OK();
+  if (!(std::isfinite(output.sigma) && output.sigma > 0)) bad("output.sigma", "must be finite and > 0", output.sigma);
+  if (out.empty()) {  // sizes are ints throughout the engine: bound the whole model
+    int64_t td = 0, tz = 0, units = 0;
+    for (const LayerSpec& l : layers) td += l.d, tz += l.z;
+    for (int i = 0; i < num_dofs(); ++i) units += output.UnitsFor(i);
+    const int64_t rr = td + 4 * tz;
+    const int64_t weights = rr * td + rr + td * tz + units * layers[0].d + units;
+    if (weights > kMaxWeights)
+      out.push_back({"layers", "the model would have " + std::to_string(weights) + " weights, more than " +
+                                   std::to_string(kMaxWeights)});
+  }
+  return out;
+}
+
+Status ModelSpec::Validate() const {
+  const std::vector<FieldProblem> p = Problems();
+  return p.empty() ? Status::OK() : Status::InvalidArgument(p.front().ToString());
 }
 
 ModelSpec ModelSpec::MacawBot() {

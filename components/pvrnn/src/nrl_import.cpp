@@ -1,25 +1,25 @@
 #include "dyad/pvrnn/nrl_import.hpp"
 
-#include <charconv>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
+
+#include "nrl_text.hpp"
 
 namespace dyad::pvrnn {
 namespace fs = std::filesystem;
 
 namespace {
 
-std::string Trim(const std::string& s) {
-  const size_t b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
-  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
-}
+using internal::Trim;
 
 // A text file of NRL matrices: one comma-separated line per matrix.
 class NrlMatrixFile {
  public:
   static StatusOr<NrlMatrixFile> Open(const std::string& path) {
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) return Status::InvalidArgument(path + ": is a folder, not a file");
     std::ifstream in(path);
     if (!in) return Status::NotFound(path + ": cannot open");
     NrlMatrixFile f;
@@ -35,52 +35,34 @@ class NrlMatrixFile {
     if (next_ >= lines_.size())
       return Status::DataLoss(where + ": missing line for " + what + " (file has " + std::to_string(lines_.size()) + " lines)");
     const std::string& line = lines_[next_++];
-    out->resize(rows, cols);
-    size_t count = 0, pos = 0;
-    while (pos <= line.size()) {
-      size_t end = line.find(',', pos);
-      if (end == std::string::npos) end = line.size();
-      const std::string tok = Trim(line.substr(pos, end - pos));
-      if (!tok.empty()) {
-        double v = 0;
-        auto r = std::from_chars(tok.data(), tok.data() + tok.size(), v);
-        if (r.ec != std::errc() || r.ptr != tok.data() + tok.size())
-          return Status::DataLoss(where + ": '" + tok + "' is not a number (" + what + ")");
-        if (count < static_cast<size_t>(rows) * cols) out->data()[count] = v;
-        ++count;
-      }
-      pos = end + 1;
-    }
-    if (count != static_cast<size_t>(rows) * cols)
+    if (std::string bad; !internal::ParseNumberList(line, &values_, &bad))
+      return Status::DataLoss(where + ": '" + bad + "' is not a finite number (" + what + ")");
+    if (values_.size() != static_cast<size_t>(rows) * cols)
       return Status::DataLoss(where + ": expected " + std::to_string(rows * cols) + " values (" + std::to_string(rows) +
-                               " x " + std::to_string(cols) + ": " + what + "), found " + std::to_string(count));
+                              " x " + std::to_string(cols) + ": " + what + "), found " + std::to_string(values_.size()));
+    *out = Eigen::Map<const Eigen::MatrixXd>(values_.data(), rows, cols);
     return Status::OK();
   }
 
  private:
   std::string path_, name_;
   std::vector<std::string> lines_;
+  std::vector<double> values_;
   size_t next_ = 0;
 };
 
 StatusOr<std::vector<double>> Numbers(const std::string& file, const std::string& key, const std::string& value) {
   std::vector<double> out;
-  std::stringstream ss(value);
-  std::string tok;
-  while (std::getline(ss, tok, ',')) {
-    try {
-      size_t used = 0;
-      out.push_back(std::stod(Trim(tok), &used));
-    } catch (const std::exception&) {
-      return Status::DataLoss(file + ": " + key + " = '" + value + "': not a comma-separated list of numbers");
-    }
-  }
+  if (!internal::ParseNumberList(value, &out))
+    return Status::DataLoss(file + ": " + key + " = '" + value + "': not a comma-separated list of finite numbers");
   return out;
 }
 
 }  // namespace
 
 StatusOr<std::vector<std::pair<std::string, std::string>>> ReadKeyValueFile(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return Status::InvalidArgument(path + ": is a folder, not a file");
   std::ifstream in(path);
   if (!in) return Status::NotFound(path + ": cannot open");
   std::vector<std::pair<std::string, std::string>> out;
@@ -88,10 +70,10 @@ StatusOr<std::vector<std::pair<std::string, std::string>>> ReadKeyValueFile(cons
   int n = 0;
   while (std::getline(in, line)) {
     ++n;
-    const std::string t = Trim(line.substr(0, line.find('#')));
+    const std::string_view t = Trim(std::string_view(line).substr(0, line.find('#')));
     if (t.empty()) continue;
     const size_t eq = t.find('=');
-    if (eq == std::string::npos) return Status::DataLoss(path + ":" + std::to_string(n) + ": expected key=value");
+    if (eq == std::string_view::npos) return Status::DataLoss(path + ":" + std::to_string(n) + ": expected key=value");
     out.emplace_back(Trim(t.substr(0, eq)), Trim(t.substr(eq + 1)));
   }
   return out;
@@ -121,6 +103,10 @@ StatusOr<Model> ImportNrlModel(const NrlImportOptions& options) {
   const size_t K = num["d"].size();
   if (num["z"].size() != K || num["t"].size() != K || num["w"].size() != K)
     return Status::DataLoss(pf + ": d, z, t and w must list the same number of layers");
+  for (const char* key : {"d", "z"})
+    for (double v : num[key])
+      if (!(v >= 1 && v <= 100000 && v == std::floor(v)))
+        return Status::DataLoss(pf + ": " + key + " = '" + text[key] + "': each entry must be a whole number in 1..100000");
   ModelSpec spec;
   for (size_t k = 0; k < K; ++k)
     spec.layers.push_back({static_cast<int>(num["d"][k]), static_cast<int>(num["z"][k]), num["t"][k], num["w"][k]});

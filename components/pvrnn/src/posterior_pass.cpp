@@ -13,12 +13,7 @@ PosteriorPass<Scalar>::PosteriorPass(const NetworkLayout& layout, int steps, int
     : layout_(layout), steps_(steps), sequences_(sequences), cols_(steps * sequences) {
   const int td = layout.total_d(), tz = layout.total_z(), rr = layout.recurrent_rows();
   const int nx = layout.output_units(), d0 = layout.d0();
-  rate_.resize(td);
-  keep_.resize(td);
-  for (int i = 0; i < td; ++i) {
-    rate_[i] = static_cast<Scalar>(layout.rate()[i]);
-    keep_[i] = Scalar(1) - rate_[i];
-  }
+  internal::LeakRates(layout, &rate_, &keep_);
   kl_coef_.resize(tz);
   r_t_.resize(td, rr);
   wz_t_.resize(tz, td);
@@ -31,7 +26,6 @@ PosteriorPass<Scalar>::PosteriorPass(const NetworkLayout& layout, int steps, int
   d_.resize(td, (steps + 1) * sequences);
   for (auto* m : {&mu_p_, &ls_p_, &mu_q_, &ls_q_, &sig_p_, &sig_q_, &z_}) m->resize(tz, cols_);
   pre_.resize(rr, sequences);
-  logits_.resize(nx, cols_);
   x_.resize(nx, cols_);
   log_x_.resize(nx, cols_);
   g_pre_.resize(rr, cols_);
@@ -39,10 +33,11 @@ PosteriorPass<Scalar>::PosteriorPass(const NetworkLayout& layout, int steps, int
   g_d0_.resize(d0, cols_);
   for (auto* m : {&g_d_, &g_h_, &g_h_next_, &g_start_h_, &g_start_d_}) m->resize(td, sequences);
   g_z_.resize(tz, sequences);
+  terms_.kl_per_layer.assign(layout.num_layers(), 0.0);
 }
 
 template <typename Scalar>
-LossTerms PosteriorPass<Scalar>::Forward(const Weights<Scalar>& weights,
+const LossTerms& PosteriorPass<Scalar>::Forward(const Weights<Scalar>& weights,
                                          const AdaptiveVariables<Scalar>& a,
                                          const MatrixT<Scalar>& eps,
                                          const MatrixT<Scalar>& targets,
@@ -75,30 +70,14 @@ LossTerms PosteriorPass<Scalar>::Forward(const Weights<Scalar>& weights,
   }
   // Output layer for all steps at once (one large product).
   const int d0 = layout_.d0();
-  logits_.noalias() = weights.Wx() * d_.block(0, S, d0, cols_);
-  logits_.colwise() += weights.Bx().col(0);
-  for (int dof = 0; dof < layout_.spec().num_dofs(); ++dof) {
-    const int off = layout_.output_offset(dof), n = layout_.output_units(dof);
-    for (int j = 0; j < cols_; ++j) {
-      auto l = logits_.col(j).segment(off, n);
-      const Scalar m = l.maxCoeff();
-      auto lx = log_x_.col(j).segment(off, n);
-      lx.array() = l.array() - m;
-    }
-    auto lx = log_x_.middleRows(off, n);
-    x_.middleRows(off, n) = lx.array().exp().matrix();
-    for (int j = 0; j < cols_; ++j) {
-      auto xc = x_.col(j).segment(off, n);
-      const Scalar sum = xc.sum();
-      xc /= sum;
-      log_x_.col(j).segment(off, n).array() -= std::log(sum);
-    }
-  }
-  LossTerms terms;
+  x_.noalias() = weights.Wx() * d_.block(0, S, d0, cols_);
+  x_.colwise() += weights.Bx().col(0);
+  internal::SoftmaxPerDof(layout_, x_, &log_x_);
+  LossTerms& terms = terms_;
+  terms.regulation = 0;
   // KL(target || x); targets are strictly positive codes.
   terms.reconstruction = static_cast<double>(
       (targets.array() * (targets.array().log() - log_x_.array())).sum());
-  terms.kl_per_layer.assign(layout_.num_layers(), 0.0);
   for (int k = 0; k < layout_.num_layers(); ++k) {
     const int off = layout_.z_offset(k), n = layout_.spec().layers[k].z;
     const auto lp = ls_p_.middleRows(off, n).array();
@@ -112,7 +91,7 @@ LossTerms PosteriorPass<Scalar>::Forward(const Weights<Scalar>& weights,
     terms.regulation += meta_prior[k] * terms.kl_per_layer[k];
   }
   terms.loss = terms.reconstruction / layout_.spec().num_dofs() + terms.regulation / tz;
-  return terms;
+  return terms_;
 }
 
 template <typename Scalar>

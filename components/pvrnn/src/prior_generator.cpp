@@ -12,12 +12,7 @@ PriorGenerator<Scalar>::PriorGenerator(const Weights<Scalar>& weights, int colum
     : w_(weights), columns_(columns) {
   const auto& layout = w_.layout();
   const int td = layout.total_d(), tz = layout.total_z();
-  rate_.resize(td);
-  keep_.resize(td);
-  for (int i = 0; i < td; ++i) {
-    rate_[i] = static_cast<Scalar>(layout.rate()[i]);
-    keep_[i] = Scalar(1) - rate_[i];
-  }
+  internal::LeakRates(layout, &rate_, &keep_);
   state_ = NetworkState<Scalar>::Zero(td, columns);
   next_ = state_;
   pre_.resize(layout.recurrent_rows(), columns);
@@ -53,39 +48,47 @@ const MatrixT<Scalar>& PriorGenerator<Scalar>::Step(const MatrixT<Scalar>* a_mu,
   std::swap(state_, next_);
   x_.noalias() = w_.Wx() * state_.d.topRows(layout.d0());
   x_.colwise() += w_.Bx().col(0);
-  for (int dof = 0; dof < layout.spec().num_dofs(); ++dof) {
-    auto blk = x_.middleRows(layout.output_offset(dof), layout.output_units(dof));
-    for (int j = 0; j < columns_; ++j) {
-      auto c = blk.col(j);
-      c.array() = (c.array() - c.maxCoeff()).exp();
-      c /= c.sum();
-    }
-  }
+  internal::SoftmaxPerDof<Scalar>(layout, x_, nullptr);
   return x_;
+}
+
+template <typename Scalar>
+MatrixT<Scalar> GenerateCodes(const Weights<Scalar>& weights, const AdaptiveVariables<Scalar>& a,
+                              const std::vector<int>& sequences, int steps,
+                              const GenerateOptions& options) {
+  const int cols = static_cast<int>(sequences.size()), tz = a.total_z();
+  PriorGenerator<Scalar> gen(weights, cols);
+  MatrixT<Scalar> eps = MatrixT<Scalar>::Zero(tz, cols), a_mu(tz, cols), a_ls(tz, cols);
+  std::mt19937_64 rng(options.seed);
+  std::normal_distribution<double> n01;
+  MatrixT<Scalar> codes(weights.layout().output_units(), static_cast<Eigen::Index>(steps) * cols);
+  for (int t = 0; t < steps; ++t) {
+    if (options.noise)
+      for (Eigen::Index i = 0; i < eps.size(); ++i) eps.data()[i] = static_cast<Scalar>(n01(rng));
+    const bool use_a = t < options.a_steps && t < a.steps();
+    if (use_a) {
+      for (int c = 0; c < cols; ++c) {
+        a_mu.col(c) = a.mu().col(a.Column(t, sequences[c]));
+        a_ls.col(c) = a.log_sigma().col(a.Column(t, sequences[c]));
+      }
+    }
+    codes.middleCols(static_cast<Eigen::Index>(t) * cols, cols) =
+        gen.Step(use_a ? &a_mu : nullptr, use_a ? &a_ls : nullptr, eps);
+  }
+  return codes;
 }
 
 Eigen::MatrixXd GeneratePrimitive(const Model& model, int primitive, int steps,
                                   const GenerateOptions& options) {
-  PriorGenerator<double> gen(model.weights, 1);
-  const int tz = model.adaptive.total_z();
-  Eigen::MatrixXd eps = Eigen::MatrixXd::Zero(tz, 1), a_mu(tz, 1), a_ls(tz, 1);
-  std::mt19937_64 rng(options.seed);
-  std::normal_distribution<double> n01;
-  Eigen::MatrixXd codes(model.weights.layout().output_units(), steps);
-  for (int t = 0; t < steps; ++t) {
-    if (options.noise)
-      for (int i = 0; i < tz; ++i) eps(i, 0) = n01(rng);
-    const bool use_a = t < options.a_steps && t < model.steps();
-    if (use_a) {
-      a_mu = model.adaptive.mu().col(model.adaptive.Column(t, primitive));
-      a_ls = model.adaptive.log_sigma().col(model.adaptive.Column(t, primitive));
-    }
-    codes.col(t) = gen.Step(use_a ? &a_mu : nullptr, use_a ? &a_ls : nullptr, eps);
-  }
-  return DecodePositions(model.spec.output, codes);
+  return DecodePositions(model.spec.output,
+                         GenerateCodes(model.weights, model.adaptive, {primitive}, steps, options));
 }
 
 template class PriorGenerator<float>;
 template class PriorGenerator<double>;
+template MatrixT<float> GenerateCodes(const Weights<float>&, const AdaptiveVariables<float>&,
+                                      const std::vector<int>&, int, const GenerateOptions&);
+template MatrixT<double> GenerateCodes(const Weights<double>&, const AdaptiveVariables<double>&,
+                                       const std::vector<int>&, int, const GenerateOptions&);
 
 }  // namespace dyad::pvrnn

@@ -9,34 +9,43 @@
 namespace dyad::pvrnn {
 namespace {
 
-// Collects every error of a config with its position; one instance per load.
+// Collects every error of a config with its position, at most one per key; one per load.
 class Reader {
  public:
   Reader(std::string file, std::set<std::string> overridden)
       : file_(std::move(file)), overridden_(std::move(overridden)) {}
 
+  // "file:line:col: key" (1-based), "--set key" for a value from the command line, or
+  // "file: key" where the node has no position (an empty file).
   std::string Where(const YAML::Node& n, const std::string& key) const {
+    if (Overridden(key)) return "--set " + key;
     const YAML::Mark m = n.Mark();
-    // A value from --set has no position in the file.
-    if (m.line < 0 || overridden_.count(key)) return "--set " + key;
+    if (m.is_null() || m.line < 0) return file_ + ": " + key;
     return file_ + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1) + ": " + key;
   }
   void Error(const YAML::Node& n, const std::string& key, const std::string& msg) {
+    if (!reported_.insert(key).second) return;
     errors_.push_back(Where(n, key) + ": " + msg);
   }
-  void Keys(const YAML::Node& map, const std::string& prefix, const std::set<std::string>& allowed) {
+  // Checks that `map` (at `key`, "" for the top level) is a mapping of allowed, distinct keys.
+  bool Keys(const YAML::Node& map, const std::string& key, const std::set<std::string>& allowed) {
     if (!map.IsMap()) {
-      Error(map, prefix.empty() ? "(top level)" : prefix, "must be a mapping");
-      return;
+      Error(map, key.empty() ? "(top level)" : key, "must be a mapping");
+      return false;
     }
+    std::set<std::string> seen;
     for (const auto& kv : map) {
       const std::string k = kv.first.as<std::string>();
+      const std::string child = key.empty() ? k : key + "." + k;
       if (!allowed.count(k)) {
         std::string list;
         for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        Error(kv.first, prefix + k, "unknown key (allowed: " + list + ")");
+        Error(kv.first, child, "unknown key (allowed: " + list + ")");
+      } else if (!seen.insert(k).second) {
+        Error(kv.first, child, "duplicate key");
       }
     }
+    return true;
   }
   template <typename T>
   bool Get(const YAML::Node& parent, const std::string& name, const std::string& key, const char* type, T* out,
@@ -50,25 +59,81 @@ class Reader {
       *out = n.as<T>();
       return true;
     } catch (const YAML::Exception&) {
-      Error(n, key, std::string("must be ") + type);
+      Error(n, key, std::string("must be ") + type + (n.IsScalar() ? ", got " + n.Scalar() : ""));
       return false;
     }
   }
-  void Check(bool ok, const YAML::Node& parent, const std::string& name, const std::string& key, const std::string& msg) {
+  template <typename T>
+  bool Get(const YAML::Node& list, size_t index, const std::string& key, const char* type, T* out) {
+    try {
+      *out = list[index].template as<T>();
+      return true;
+    } catch (const YAML::Exception&) {
+      Error(list[index], key, std::string("must be ") + type);
+      return false;
+    }
+  }
+  // A rule of a config-only field (one no settings struct validates).
+  template <typename T>
+  void Check(bool ok, const YAML::Node& parent, const std::string& name, const std::string& key, const char* rule,
+             const T& value) {
     if (ok) return;
-    const YAML::Node n = parent[name];
     std::ostringstream s;
-    if (n && n.IsScalar()) s << "= " << n.Scalar() << ": ";
-    s << msg;
+    s << rule << ", got " << value;
+    const YAML::Node n = parent[name];
     Error(n ? n : parent, key, s.str());
   }
   const std::vector<std::string>& errors() const { return errors_; }
 
  private:
+  // True when --set replaced the value at `key`, at a key containing it ("adam" for
+  // "adam.lr") or inside it ("adam.lr.x" for "adam.lr").
+  bool Overridden(const std::string& key) const {
+    auto within = [](const std::string& inner, const std::string& outer) {
+      return inner == outer || (inner.size() > outer.size() && inner.rfind(outer, 0) == 0 &&
+                                (inner[outer.size()] == '.' || inner[outer.size()] == '['));
+    };
+    for (const auto& o : overridden_)
+      if (within(key, o) || within(o, key)) return true;
+    return false;
+  }
   std::string file_;
   std::set<std::string> overridden_;
+  std::set<std::string> reported_;
   std::vector<std::string> errors_;
 };
+
+// The config key of a settings field: the spec's output encoding is `encoding` in the config.
+std::string ConfigKey(const std::string& field) {
+  return field.rfind("output", 0) == 0 ? "encoding" + field.substr(6) : field;
+}
+
+// The node at a config key ("layers[1].d", "encoding.dofs[0]"), or, where the key is absent,
+// its deepest present ancestor (for a position).
+YAML::Node NodeAt(const YAML::Node& root, const std::string& key) {
+  YAML::Node n;
+  n.reset(root);
+  size_t pos = 0;
+  while (pos < key.size()) {
+    if (key[pos] == '.') ++pos;
+    YAML::Node next;
+    if (key[pos] == '[') {
+      const size_t close = key.find(']', pos);
+      const size_t idx = std::stoul(key.substr(pos + 1, close - pos - 1));
+      if (!n.IsSequence() || idx >= n.size()) return n;
+      next.reset(static_cast<const YAML::Node&>(n)[idx]);
+      pos = close + 1;
+    } else {
+      const size_t end = std::min(key.find_first_of(".[", pos), key.size());
+      const std::string name = key.substr(pos, end - pos);
+      if (!n.IsMap() || !static_cast<const YAML::Node&>(n)[name]) return n;
+      next.reset(static_cast<const YAML::Node&>(n)[name]);
+      pos = end;
+    }
+    n.reset(next);
+  }
+  return n;
+}
 
 // "layers.1.d" -> "layers[1].d", the spelling used in messages.
 std::string MessageKey(const std::string& dotted) {
@@ -89,63 +154,59 @@ Status ApplyOverride(YAML::Node root, const std::string& spec) {
   std::vector<std::string> parts;
   std::stringstream ss(key);
   for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
-  YAML::Node node = root;
-  for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    const std::string& p = parts[i];
-    YAML::Node next;
-    if (node.IsSequence()) {
-      size_t idx = 0;
-      try { idx = std::stoul(p); } catch (const std::exception&) { return Status::InvalidArgument("--set " + key + ": '" + p + "' is not a list index"); }
-      if (idx >= node.size()) return Status::InvalidArgument("--set " + key + ": index " + p + " out of range");
-      next = node[idx];
-    } else {
-      next = node[p];
-    }
-    node.reset(next);
-  }
   YAML::Node parsed;
-  try { parsed = YAML::Load(value); } catch (const YAML::Exception& e) {
+  try {
+    parsed = YAML::Load(value);
+  } catch (const YAML::Exception&) {
     return Status::InvalidArgument("--set " + key + ": value '" + value + "' is not valid YAML");
   }
-  if (node.IsSequence()) {
-    size_t idx = 0;
-    try { idx = std::stoul(parts.back()); } catch (const std::exception&) { return Status::InvalidArgument("--set " + key + ": not a list index"); }
-    if (idx >= node.size()) return Status::InvalidArgument("--set " + key + ": index out of range");
-    node[idx] = parsed;
-  } else {
-    node[parts.back()] = parsed;
+  // Index into a list, or key of a mapping (created when absent); never into a scalar.
+  auto child = [&key](YAML::Node node, const std::string& part, YAML::Node* out) -> Status {
+    if (node.IsSequence()) {
+      size_t idx = 0;
+      if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos)
+        return Status::InvalidArgument("--set " + key + ": '" + part + "' is not a list index");
+      idx = std::stoul(part);
+      if (idx >= node.size()) return Status::InvalidArgument("--set " + key + ": index " + part + " out of range");
+      out->reset(node[idx]);
+    } else if (node.IsMap() || !node.IsDefined() || node.IsNull()) {
+      out->reset(node[part]);
+    } else {
+      return Status::InvalidArgument("--set " + key + ": cannot set '" + part + "' inside a " +
+                                     (node.IsScalar() ? "scalar" : "value"));
+    }
+    return Status::OK();
+  };
+  try {
+    YAML::Node node = root;
+    for (const std::string& part : parts) {
+      YAML::Node next;
+      if (Status s = child(node, part, &next); !s.ok()) return s;
+      node.reset(next);
+    }
+    node = parsed;
+  } catch (const YAML::Exception& e) {
+    return Status::InvalidArgument("--set " + key + ": " + e.msg);
   }
   return Status::OK();
 }
 
 }  // namespace
 
-StatusOr<TrainConfig> LoadTrainConfig(const std::string& path, const std::vector<std::string>& overrides) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    return Status::NotFound(path + ": cannot open");
-  } catch (const YAML::ParserException& e) {
-    return Status::InvalidArgument(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                                   ": " + e.msg);
-  }
-  std::set<std::string> overridden;
-  for (const auto& o : overrides) {
-    if (Status s = ApplyOverride(root, o); !s.ok()) return s;
-    overridden.insert(MessageKey(o.substr(0, o.find('='))));
-  }
+namespace {
 
-  Reader r(path, overridden);
+TrainConfig Read(const YAML::Node& root, const std::string& path, Reader& r) {
   TrainConfig c;
-  r.Keys(root, "", {"dataset", "layers", "encoding", "epochs", "adam", "seed", "scalar", "noise", "log_every",
-                    "checkpoint_every", "output", "checkpoint", "log_csv"});
-  if (!root.IsMap()) return Status::InvalidArgument(r.errors().front());
+  if (!r.Keys(root, "", {"dataset", "layers", "encoding", "epochs", "adam", "seed", "scalar", "noise", "log_every",
+                         "checkpoint_every", "output", "checkpoint", "log_csv"}))
+    return c;
   if (r.Get(root, "dataset", "dataset", "a path", &c.dataset, true)) {
     std::filesystem::path p(c.dataset);
     if (p.is_relative()) p = std::filesystem::path(path).parent_path() / p;
     c.dataset = p.lexically_normal().string();
   }
+  // Types here; value rules come from ModelSpec/AdamOptions::Problems() (one place), below.
+  // Entries that cannot be read keep a valid default so that indices stay aligned.
   const YAML::Node layers = root["layers"];
   if (!layers) {
     r.Error(root, "layers", "required key missing");
@@ -154,69 +215,96 @@ StatusOr<TrainConfig> LoadTrainConfig(const std::string& path, const std::vector
   } else {
     for (size_t k = 0; k < layers.size(); ++k) {
       const YAML::Node l = layers[k];
-      const std::string p = "layers[" + std::to_string(k) + "].";
-      r.Keys(l, p, {"d", "z", "tau", "w"});
-      if (!l.IsMap()) continue;
+      const std::string p = "layers[" + std::to_string(k) + "]";
       LayerSpec ls;
-      if (r.Get(l, "d", p + "d", "an integer", &ls.d, true)) r.Check(ls.d > 0, l, "d", p + "d", "must be > 0");
-      if (r.Get(l, "z", p + "z", "an integer", &ls.z, true)) r.Check(ls.z > 0, l, "z", p + "z", "must be > 0");
-      if (r.Get(l, "tau", p + "tau", "a number", &ls.tau, true)) r.Check(ls.tau >= 1, l, "tau", p + "tau", "must be >= 1");
-      if (r.Get(l, "w", p + "w", "a number", &ls.w, true)) r.Check(ls.w >= 0, l, "w", p + "w", "must be >= 0");
+      if (r.Keys(l, p, {"d", "z", "tau", "w"})) {
+        r.Get(l, "d", p + ".d", "an integer", &ls.d, true);
+        r.Get(l, "z", p + ".z", "an integer", &ls.z, true);
+        r.Get(l, "tau", p + ".tau", "a number", &ls.tau, true);
+        r.Get(l, "w", p + ".w", "a number", &ls.w, true);
+      }
       c.spec.layers.push_back(ls);
     }
   }
   c.spec.output.dofs = {{-50, 50}, {-50, 50}};
-  if (const YAML::Node e = root["encoding"]) {
-    r.Keys(e, "encoding.", {"dofs", "dsoft", "sigma"});
-    if (e.IsMap()) {
-      std::vector<std::vector<double>> dofs;
-      if (r.Get(e, "dofs", "encoding.dofs", "a list of [min, max]", &dofs)) {
+  if (const YAML::Node e = root["encoding"]; e && r.Keys(e, "encoding", {"dofs", "dsoft", "sigma"})) {
+    if (const YAML::Node dofs = e["dofs"]) {
+      if (!dofs.IsSequence()) {
+        r.Error(dofs, "encoding.dofs", "must be a list of [min, max]");
+      } else {
         c.spec.output.dofs.clear();
-        for (const auto& d : dofs) {
-          const bool ok = d.size() == 2 && d[1] > d[0];
-          r.Check(ok, e, "dofs", "encoding.dofs", "each entry must be [min, max] with max > min");
-          if (ok) c.spec.output.dofs.push_back({d[0], d[1]});
+        for (size_t i = 0; i < dofs.size(); ++i) {
+          std::vector<double> range;
+          if (r.Get(dofs, i, "encoding.dofs[" + std::to_string(i) + "]", "[min, max]", &range) && range.size() != 2)
+            r.Error(dofs[i], "encoding.dofs[" + std::to_string(i) + "]", "must be [min, max]");
+          c.spec.output.dofs.push_back(range.size() == 2 ? DofRange{range[0], range[1]} : DofRange{});
         }
-        r.Check(!dofs.empty(), e, "dofs", "encoding.dofs", "must list at least one DOF");
       }
-      if (r.Get(e, "dsoft", "encoding.dsoft", "a number", &c.spec.output.dsoft))
-        r.Check(c.spec.output.dsoft > 0, e, "dsoft", "encoding.dsoft", "must be > 0");
-      if (r.Get(e, "sigma", "encoding.sigma", "a number", &c.spec.output.sigma))
-        r.Check(c.spec.output.sigma > 0, e, "sigma", "encoding.sigma", "must be > 0");
     }
+    r.Get(e, "dsoft", "encoding.dsoft", "a number", &c.spec.output.dsoft);
+    r.Get(e, "sigma", "encoding.sigma", "a number", &c.spec.output.sigma);
   }
-  if (r.Get(root, "epochs", "epochs", "an integer", &c.epochs)) r.Check(c.epochs > 0, root, "epochs", "epochs", "must be > 0");
-  if (const YAML::Node a = root["adam"]) {
-    r.Keys(a, "adam.", {"lr", "beta1", "beta2", "epsilon"});
-    if (a.IsMap()) {
-      if (r.Get(a, "lr", "adam.lr", "a number", &c.adam.lr)) r.Check(c.adam.lr > 0, a, "lr", "adam.lr", "must be > 0");
-      if (r.Get(a, "beta1", "adam.beta1", "a number", &c.adam.beta1))
-        r.Check(c.adam.beta1 >= 0 && c.adam.beta1 < 1, a, "beta1", "adam.beta1", "must be in [0, 1)");
-      if (r.Get(a, "beta2", "adam.beta2", "a number", &c.adam.beta2))
-        r.Check(c.adam.beta2 >= 0 && c.adam.beta2 < 1, a, "beta2", "adam.beta2", "must be in [0, 1)");
-      if (r.Get(a, "epsilon", "adam.epsilon", "a number", &c.adam.epsilon))
-        r.Check(c.adam.epsilon > 0, a, "epsilon", "adam.epsilon", "must be > 0");
-    }
+  if (r.Get(root, "epochs", "epochs", "an integer", &c.epochs)) r.Check(c.epochs > 0, root, "epochs", "epochs", "must be > 0", c.epochs);
+  if (const YAML::Node a = root["adam"]; a && r.Keys(a, "adam", {"lr", "beta1", "beta2", "epsilon"})) {
+    r.Get(a, "lr", "adam.lr", "a number", &c.adam.lr);
+    r.Get(a, "beta1", "adam.beta1", "a number", &c.adam.beta1);
+    r.Get(a, "beta2", "adam.beta2", "a number", &c.adam.beta2);
+    r.Get(a, "epsilon", "adam.epsilon", "a number", &c.adam.epsilon);
   }
   r.Get(root, "seed", "seed", "a non-negative integer", &c.seed);
   if (r.Get(root, "scalar", "scalar", "a string", &c.scalar))
-    r.Check(c.scalar == "float" || c.scalar == "double", root, "scalar", "scalar", "must be float or double");
+    r.Check(c.scalar == "float" || c.scalar == "double", root, "scalar", "scalar", "must be float or double", c.scalar);
   r.Get(root, "noise", "noise", "true or false", &c.noise);
   if (r.Get(root, "log_every", "log_every", "an integer", &c.log_every))
-    r.Check(c.log_every > 0, root, "log_every", "log_every", "must be > 0");
+    r.Check(c.log_every > 0, root, "log_every", "log_every", "must be > 0", c.log_every);
   if (r.Get(root, "checkpoint_every", "checkpoint_every", "an integer", &c.checkpoint_every))
-    r.Check(c.checkpoint_every >= 0, root, "checkpoint_every", "checkpoint_every", "must be >= 0");
+    r.Check(c.checkpoint_every >= 0, root, "checkpoint_every", "checkpoint_every", "must be >= 0", c.checkpoint_every);
   r.Get(root, "output", "output", "a path", &c.output, true);
   r.Get(root, "checkpoint", "checkpoint", "a path", &c.checkpoint);
   r.Get(root, "log_csv", "log_csv", "a path", &c.log_csv);
   if (c.checkpoint.empty() && !c.output.empty()) c.checkpoint = c.output + ".ckpt";
   if (c.log_csv.empty() && !c.output.empty()) c.log_csv = c.output + ".csv";
+  std::vector<FieldProblem> problems = c.spec.Problems();
+  for (FieldProblem& p : c.adam.Problems()) problems.push_back(std::move(p));
+  for (const FieldProblem& p : problems) {
+    const std::string key = ConfigKey(p.field);
+    r.Error(NodeAt(root, key), key, p.message);
+  }
+  return c;
+}
+
+}  // namespace
+
+StatusOr<TrainConfig> LoadTrainConfig(const std::string& path, const std::vector<std::string>& overrides) {
+  YAML::Node root;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return Status::InvalidArgument(path + ": is a folder, not a config file");
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    return Status::NotFound(path + ": cannot open");
+  } catch (const YAML::Exception& e) {
+    if (e.mark.is_null()) return Status::InvalidArgument(path + ": " + e.msg);
+    return Status::InvalidArgument(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                                   ": " + e.msg);
+  }
+  std::set<std::string> overridden;
+  for (const auto& o : overrides) {
+    if (Status s = ApplyOverride(root, o); !s.ok()) return s;
+    overridden.insert(MessageKey(o.substr(0, o.find('='))));
+  }
+  Reader r(path, overridden);
+  TrainConfig c;
+  try {
+    c = Read(root, path, r);
+  } catch (const YAML::Exception& e) {  // e.g. a key that is itself a list: not our format
+    return Status::InvalidArgument(path + ": " + e.msg);
+  }
   if (!r.errors().empty()) {
     std::string all;
     for (const auto& e : r.errors()) all += (all.empty() ? "" : "\n") + e;
     return Status::InvalidArgument(all);
   }
-  if (Status s = c.spec.Validate(); !s.ok()) return Status::InvalidArgument(path + ": " + s.message());
   return c;
 }
 

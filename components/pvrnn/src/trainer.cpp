@@ -1,5 +1,6 @@
 #include "dyad/pvrnn/trainer.hpp"
 
+#include <numeric>
 #include <sstream>
 
 #include "dyad/pvrnn/prior_generator.hpp"
@@ -23,6 +24,21 @@ StatusOr<std::unique_ptr<Trainer<Scalar>>> Trainer<Scalar>::Create(const Model& 
                                    std::to_string(model.sequences()) + " x " + std::to_string(model.steps()));
   for (const auto& s : data.sequences)
     if (s.cols() != data.steps()) return Status::InvalidArgument("dataset " + data.name + ": sequences differ in length");
+  // Far outside its DOF's range a position's softmax code underflows to 0 and the loss to NaN.
+  // NRL's data sets overshoot a little (Macaw: up to 51.4 on -50..50): allow half the range.
+  for (int p = 0; p < data.size(); ++p)
+    for (int t = 0; t < data.steps(); ++t)
+      for (int i = 0; i < data.dofs(); ++i) {
+        const DofRange& r = model.spec.output.dofs[i];
+        const double v = data.sequences[p](i, t), margin = 0.5 * (r.max - r.min);
+        if (!(v >= r.min - margin && v <= r.max + margin)) {
+          std::ostringstream m;
+          m << "dataset " << data.name << ": primitive " << p << ", step " << t << " (row " << t + 1 << "), DOF " << i
+            << " = " << v << ": outside the encoding range [" << r.min << ", " << r.max
+            << "] by more than half its width";
+          return Status::InvalidArgument(m.str());
+        }
+      }
   return std::unique_ptr<Trainer>(new Trainer(model, data, options));
 }
 
@@ -63,12 +79,12 @@ Trainer<Scalar>::Trainer(const Model& model, const Dataset& data, const TrainerO
 }
 
 template <typename Scalar>
-LossTerms Trainer<Scalar>::Epoch() {
+const LossTerms& Trainer<Scalar>::Epoch() {
   if (options_.sample_noise) {
     Scalar* e = eps_.data();
     for (int i = 0; i < eps_.size(); ++i) e[i] = static_cast<Scalar>(normal_(rng_));
   }
-  LossTerms terms = pass_.Forward(w_, a_, eps_, targets_, start_, meta_prior_);
+  const LossTerms& terms = pass_.Forward(w_, a_, eps_, targets_, start_, meta_prior_);
   pass_.Backward(&grad_w_, &grad_a_);
   adam_w_.Step(w_.flat(), grad_w_.flat());
   adam_a_.Step(a_.flat(), grad_a_.flat());
@@ -77,25 +93,11 @@ LossTerms Trainer<Scalar>::Epoch() {
 
 template <typename Scalar>
 double Trainer<Scalar>::PriorReconstruction(bool noise, uint64_t seed, int a_steps) const {
-  const int S = a_.sequences(), T = a_.steps(), tz = layout_.total_z();
-  PriorGenerator<Scalar> gen(w_, S);
-  MatrixT<Scalar> eps = MatrixT<Scalar>::Zero(tz, S), a_mu(tz, S), a_ls(tz, S);
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> n01;
-  double rec = 0;
-  for (int t = 0; t < T; ++t) {
-    if (noise)
-      for (int i = 0; i < eps.size(); ++i) eps.data()[i] = static_cast<Scalar>(n01(rng));
-    const bool use_a = t < a_steps;
-    if (use_a) {
-      a_mu = a_.mu().middleCols(t * S, S);
-      a_ls = a_.log_sigma().middleCols(t * S, S);
-    }
-    const auto& x = gen.Step(use_a ? &a_mu : nullptr, use_a ? &a_ls : nullptr, eps);
-    const auto y = targets_.middleCols(t * S, S).array();
-    rec += static_cast<double>((y * (y.log() - x.array().log())).sum());
-  }
-  return rec;
+  std::vector<int> all(a_.sequences());
+  std::iota(all.begin(), all.end(), 0);
+  const MatrixT<Scalar> x = GenerateCodes(w_, a_, all, a_.steps(), GenerateOptions{a_steps, noise, seed});
+  const auto y = targets_.array();
+  return static_cast<double>((y * (y.log() - x.array().log())).sum());
 }
 
 template <typename Scalar>

@@ -25,9 +25,9 @@ void WindowObjective<Scalar>::SetWindow(const MatrixT<Scalar>& targets,
 }
 
 template <typename Scalar>
-LossTerms WindowObjective<Scalar>::Evaluate(const AdaptiveVariables<Scalar>& a,
+const LossTerms& WindowObjective<Scalar>::Evaluate(const AdaptiveVariables<Scalar>& a,
                                             AdaptiveVariables<Scalar>* grad) {
-  LossTerms terms = pass_.Forward(weights_, a, eps_, targets_, start_, meta_prior_);
+  const LossTerms& terms = pass_.Forward(weights_, a, eps_, targets_, start_, meta_prior_);
   if (grad != nullptr) pass_.Backward(nullptr, grad);
   return terms;
 }

@@ -5,6 +5,7 @@
 
 #include "dyad/pvrnn/posterior_pass.hpp"
 #include "dyad/pvrnn/softmax_encoding.hpp"
+#include "finite_difference.hpp"
 
 namespace dyad::pvrnn {
 namespace {
@@ -55,10 +56,8 @@ double Loss(Problem& p, PosteriorPass<double>& pass) {
   return pass.Forward(p.w, p.a, p.eps, p.targets, p.start, p.meta_prior).loss;
 }
 
-double RelativeError(const Eigen::VectorXd& analytic, const Eigen::VectorXd& numeric) {
-  const double scale = std::max(analytic.norm() + numeric.norm(), 1e-300);
-  return (analytic - numeric).norm() / scale;
-}
+using testing::CentralDifference;
+using testing::RelativeError;
 
 TEST(Gradient, EveryWeightGroupMatchesCentralDifferences) {
   Problem p = MakeProblem(7);
@@ -67,20 +66,13 @@ TEST(Gradient, EveryWeightGroupMatchesCentralDifferences) {
   Weights<double> gw(*p.layout);
   AdaptiveVariables<double> ga(p.layout->total_z(), p.steps, p.sequences);
   pass.Backward(&gw, &ga);
-  const double h = 1e-6;
   for (const auto& g : p.layout->groups()) {
     auto view = p.w.Group(g);
     Eigen::VectorXd analytic(g.rows * g.cols), numeric(g.rows * g.cols);
     const auto gview = gw.Group(g);
     for (int c = 0; c < g.cols; ++c) {
       for (int r = 0; r < g.rows; ++r) {
-        const double keep = view(r, c);
-        view(r, c) = keep + h;
-        const double up = Loss(p, pass);
-        view(r, c) = keep - h;
-        const double down = Loss(p, pass);
-        view(r, c) = keep;
-        numeric[c * g.rows + r] = (up - down) / (2 * h);
+        numeric[c * g.rows + r] = CentralDifference(view(r, c), [&] { return Loss(p, pass); });
         analytic[c * g.rows + r] = gview(r, c);
       }
     }
@@ -95,19 +87,11 @@ TEST(Gradient, AdaptiveVariablesMatchCentralDifferences) {
   Loss(p, pass);
   AdaptiveVariables<double> ga(p.layout->total_z(), p.steps, p.sequences);
   pass.Backward(nullptr, &ga);
-  const double h = 1e-6;
   const int half = static_cast<int>(p.a.flat().size() / 2);
   for (int part = 0; part < 2; ++part) {
     Eigen::VectorXd analytic(half), numeric(half);
     for (int i = 0; i < half; ++i) {
-      double& v = p.a.flat()[part * half + i];
-      const double keep = v;
-      v = keep + h;
-      const double up = Loss(p, pass);
-      v = keep - h;
-      const double down = Loss(p, pass);
-      v = keep;
-      numeric[i] = (up - down) / (2 * h);
+      numeric[i] = CentralDifference(p.a.flat()[part * half + i], [&] { return Loss(p, pass); });
       analytic[i] = ga.flat()[part * half + i];
     }
     EXPECT_LT(RelativeError(analytic, numeric), 1e-6) << (part == 0 ? "A_mu" : "A_logsigma");
@@ -120,19 +104,11 @@ TEST(Gradient, StartStateGradientMatchesCentralDifferences) {
   Loss(p, pass);
   AdaptiveVariables<double> ga(p.layout->total_z(), p.steps, p.sequences);
   pass.Backward(nullptr, &ga);
-  const double h = 1e-6;
   for (auto* which : {&p.start.h, &p.start.d}) {
     Eigen::VectorXd analytic(which->size()), numeric(which->size());
     const Md& g = which == &p.start.h ? pass.grad_start_h() : pass.grad_start_d();
     for (int i = 0; i < which->size(); ++i) {
-      double& v = which->data()[i];
-      const double keep = v;
-      v = keep + h;
-      const double up = Loss(p, pass);
-      v = keep - h;
-      const double down = Loss(p, pass);
-      v = keep;
-      numeric[i] = (up - down) / (2 * h);
+      numeric[i] = CentralDifference(which->data()[i], [&] { return Loss(p, pass); });
       analytic[i] = g.data()[i];
     }
     EXPECT_LT(RelativeError(analytic, numeric), 1e-6) << (which == &p.start.h ? "h" : "d");

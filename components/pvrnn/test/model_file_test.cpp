@@ -52,6 +52,19 @@ TEST(ModelFile, RoundTripsEverything) {
   std::filesystem::remove(path);
 }
 
+// What `dyad train` writes as its output: no optimiser state.
+TEST(ModelFile, RoundTripsAModelWithoutTrainingState) {
+  const std::string path = testing::TempPath("plain.dpvrnn");
+  const Model m = SmallModel();
+  ASSERT_TRUE(SaveModel(m, path).ok());
+  auto back = LoadModel(path);
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_EQ(back->weights.flat(), m.weights.flat());
+  EXPECT_EQ(back->adaptive.flat(), m.adaptive.flat());
+  EXPECT_FALSE(back->training.has_value());
+  std::filesystem::remove(path);
+}
+
 TEST(ModelFile, MissingFileNamesThePath) {
   auto r = LoadModel("/nonexistent/x.dpvrnn");
   ASSERT_FALSE(r.ok());
@@ -110,6 +123,15 @@ TEST(ModelFile, OtherFileIsNotAModel) {
   WriteAll(path, "d=40,10\nz=4,1\n");
   EXPECT_EQ(LoadModel(path).status().message(), path + ": not a dyad PV-RNN model file (bad magic)");
   std::filesystem::remove(path);
+}
+
+TEST(ModelSpec, DefaultShapeIsValid) { EXPECT_TRUE(ModelSpec::MacawBot().Validate().ok()); }
+
+// Sizes are ints in the engine: a model too large to index is refused, not overflowed.
+TEST(ModelSpec, RefusesAModelWithTooManyWeights) {
+  ModelSpec spec = ModelSpec::MacawBot();
+  spec.layers[0].d = 100000;
+  EXPECT_EQ(spec.Validate().message(), "layers: the model would have 10006600400 weights, more than 100000000");
 }
 
 }  // namespace

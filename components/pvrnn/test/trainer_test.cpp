@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "dyad/pvrnn/analytic_dataset.hpp"
+#include "dyad/pvrnn/prior_generator.hpp"
+#include "dyad/pvrnn/softmax_encoding.hpp"
 
 namespace dyad::pvrnn {
 namespace {
@@ -64,12 +66,41 @@ TEST(Trainer, RejectsADataSetOfAnotherShape) {
       << t.status().message();
 }
 
+// A position far outside its DOF's range would make the softmax target 0 and the loss NaN.
+TEST(Trainer, RejectsAPositionFarOutsideTheEncodingRange) {
+  Dataset d = MakeAnalyticDataset();
+  const Model m = SmallModel(d, 1);
+  d.sequences[2](1, 5) = 51.4;  // NRL's data overshoot a little: accepted
+  EXPECT_TRUE(Trainer<float>::Create(m, d, TrainerOptions{}).ok());
+  d.sequences[2](1, 5) = 300;
+  auto t = Trainer<float>::Create(m, d, TrainerOptions{});
+  ASSERT_FALSE(t.ok());
+  EXPECT_EQ(t.status().message(),
+            "dataset analytic: primitive 2, step 5 (row 6), DOF 1 = 300: outside the encoding range [-50, 50] by more "
+            "than half its width");
+}
+
+// RE_P is the reconstruction error of generating every primitive from the prior (first 3 steps
+// on its A), summed: the same as GenerateCodes primitive by primitive.
+TEST(Trainer, PriorReconstructionIsTheErrorOfPriorGeneration) {
+  const Dataset d = MakeAnalyticDataset();
+  const Model m = SmallModel(d, 4);
+  auto t = Trainer<double>::Create(m, d, TrainerOptions{}).value();
+  double expected = 0;
+  for (int p = 0; p < d.size(); ++p) {
+    const Eigen::MatrixXd x = GenerateCodes(m.weights, m.adaptive, {p}, d.steps(), GenerateOptions{});
+    const Eigen::MatrixXd y = EncodePositions(m.spec.output, d.sequences[p]);
+    expected += (y.array() * (y.array().log() - x.array().log())).sum();
+  }
+  EXPECT_NEAR(t->PriorReconstruction(false, 1), expected, 1e-9 * expected);
+}
+
 TEST(AdamOptions, DefaultsAreValid) { EXPECT_TRUE(AdamOptions{}.Validate().ok()); }
 
 TEST(AdamOptions, NamesTheBrokenField) {
   AdamOptions o;
   o.beta2 = 1.0;
-  EXPECT_EQ(o.Validate().message(), "adam.beta2 = 1: must be in [0, 1)");
+  EXPECT_EQ(o.Validate().message(), "adam.beta2: must be in [0, 1), got 1");
 }
 
 }  // namespace

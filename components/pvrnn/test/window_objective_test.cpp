@@ -7,6 +7,7 @@
 
 #include "dyad/pvrnn/model.hpp"
 #include "dyad/pvrnn/softmax_encoding.hpp"
+#include "finite_difference.hpp"
 
 namespace dyad::pvrnn {
 namespace {
@@ -40,18 +41,10 @@ TEST(WindowObjective, GradientWithRespectToAMatchesFiniteDifferences) {
   std::normal_distribution<double> n01;
   for (int i = 0; i < a.flat().size(); ++i) a.flat()[i] = 0.3 * n01(rng);
   f.Evaluate(a, &g);
-  const double h = 1e-6;
   Eigen::VectorXd numeric(a.flat().size());
-  for (int i = 0; i < a.flat().size(); ++i) {
-    const double keep = a.flat()[i];
-    a.flat()[i] = keep + h;
-    const double up = f.Evaluate(a, nullptr).loss;
-    a.flat()[i] = keep - h;
-    const double down = f.Evaluate(a, nullptr).loss;
-    a.flat()[i] = keep;
-    numeric[i] = (up - down) / (2 * h);
-  }
-  const double rel = (numeric - g.flat()).norm() / (numeric.norm() + g.flat().norm());
+  for (int i = 0; i < a.flat().size(); ++i)
+    numeric[i] = testing::CentralDifference(a.flat()[i], [&] { return f.Evaluate(a, nullptr).loss; });
+  const double rel = testing::RelativeError(g.flat(), numeric);
   EXPECT_LT(rel, 1e-6);
 }
 

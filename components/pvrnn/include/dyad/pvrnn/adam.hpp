@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "dyad/pvrnn/parameters.hpp"
 #include "dyad/status.hpp"
@@ -11,10 +12,12 @@
 namespace dyad::pvrnn {
 
 struct AdamOptions {
-  double lr = 0.001;      // step size alpha; REQUIRES > 0
+  double lr = 0.001;      // step size alpha; REQUIRES finite, > 0
   double beta1 = 0.9;     // REQUIRES in [0, 1)
   double beta2 = 0.999;   // REQUIRES in [0, 1)
-  double epsilon = 1e-8;  // added to sqrt(v_hat); REQUIRES > 0
+  double epsilon = 1e-8;  // added to sqrt(v_hat); REQUIRES finite, > 0
+  // Every broken constraint ("adam.lr": "must be finite and > 0, got 0"); Validate: the first.
+  std::vector<FieldProblem> Problems() const;
   Status Validate() const;
 };
 

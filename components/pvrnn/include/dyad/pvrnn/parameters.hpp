@@ -6,7 +6,7 @@
 //   `R()`, `RBias()`, `Wz()`, `Wx()`, `Bx()` are the stacked pieces; `Group(g)` a named block.
 // - `AdaptiveVariables<Scalar>` holds A for `sequences` columns and `steps` steps:
 //   `mu()` and `log_sigma()` are total_z x (steps*sequences) with column t*sequences + s, so the
-//   A of one step for all sequences is one contiguous block (`MuStep(t)`).
+//   A of one step for all sequences is one contiguous block (`mu().middleCols(t * sequences, sequences)`).
 // - Both are regular values (copyable); `Cast<T>()` converts the scalar type.
 #pragma once
 

@@ -55,7 +55,8 @@ class PosteriorPass {
   int steps() const { return steps_; }
   int sequences() const { return sequences_; }
 
-  LossTerms Forward(const Weights<Scalar>& weights, const AdaptiveVariables<Scalar>& a,
+  // The returned terms live in this pass until the next Forward.
+  const LossTerms& Forward(const Weights<Scalar>& weights, const AdaptiveVariables<Scalar>& a,
                     const MatrixT<Scalar>& eps, const MatrixT<Scalar>& targets,
                     const NetworkState<Scalar>& start, const std::vector<double>& meta_prior);
   void Backward(Weights<Scalar>* grad_w, AdaptiveVariables<Scalar>* grad_a);
@@ -81,6 +82,7 @@ class PosteriorPass {
   const Weights<Scalar>* w_ = nullptr;
   const MatrixT<Scalar>* eps_ = nullptr;
   const MatrixT<Scalar>* targets_ = nullptr;
+  LossTerms terms_;  // kl_per_layer sized once: Forward allocates nothing
   VectorT<Scalar> rate_, keep_, kl_coef_;
   MatrixT<Scalar> r_t_, wz_t_, wx_t_;      // transposed copies for the backward products
   MatrixT<Scalar> r_maskf_, wz_maskf_;
@@ -88,7 +90,7 @@ class PosteriorPass {
   MatrixT<Scalar> h_, d_;
   MatrixT<Scalar> mu_p_, ls_p_, mu_q_, ls_q_, sig_p_, sig_q_, z_;  // total_z x cols
   MatrixT<Scalar> pre_;                                            // recurrent_rows x sequences
-  MatrixT<Scalar> logits_, x_, log_x_;                             // output_units x cols
+  MatrixT<Scalar> x_, log_x_;                                      // output_units x cols
   // Backward buffers.
   MatrixT<Scalar> g_pre_;          // recurrent_rows x cols
   MatrixT<Scalar> g_out_, g_d0_;   // output_units x cols, d0 x cols

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "dyad/pvrnn/model.hpp"
 #include "dyad/pvrnn/posterior_pass.hpp"
@@ -49,6 +50,17 @@ struct GenerateOptions {
   bool noise = false;     // false: means only (reproducible); true: eps ~ N(0,1) from seed
   uint64_t seed = 1;
 };
+
+// Softmax codes generated from the prior for the listed sequences (primitives) side by side:
+// output_units x (steps * sequences.size()), column t * sequences.size() + c. Step t < a_steps
+// (and < a.steps()) uses sequence c's trained A, later steps the prior. With noise, each step
+// draws total_z x sequences.size() values (column-major) from one generator seeded with `seed`.
+// The one generation loop behind GeneratePrimitive and Trainer::PriorReconstruction.
+// REQUIRES every entry of `sequences` in [0, a.sequences()).
+template <typename Scalar>
+MatrixT<Scalar> GenerateCodes(const Weights<Scalar>& weights, const AdaptiveVariables<Scalar>& a,
+                              const std::vector<int>& sequences, int steps,
+                              const GenerateOptions& options);
 
 // Positions (num_dofs x steps) of primitive `primitive` generated from the prior in double.
 // REQUIRES 0 <= primitive < model.sequences(); A steps beyond model.steps() are not used.

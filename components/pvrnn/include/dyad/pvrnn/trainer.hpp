@@ -11,7 +11,7 @@
 //
 // Example:
 //   auto trainer = Trainer<float>::Create(Model::Initialize(spec, 72, 7, 1), data, {}).value();
-//   for (int e = 0; e < 1000; ++e) LossTerms l = trainer->Epoch();
+//   for (int e = 0; e < 1000; ++e) const LossTerms& l = trainer->Epoch();
 //   SaveModel(trainer->Snapshot(false), "out.dpvrnn");
 #pragma once
 
@@ -37,7 +37,8 @@ class Trainer {
   static StatusOr<std::unique_ptr<Trainer>> Create(const Model& model, const Dataset& data,
                                                    const TrainerOptions& options);
 
-  LossTerms Epoch();
+  // The returned terms live in this trainer until the next Epoch.
+  const LossTerms& Epoch();
   int64_t epoch() const { return adam_w_.step(); }
 
   // NRL's RE_P: sum over sequences of KL(target || x) when generating from the prior with the

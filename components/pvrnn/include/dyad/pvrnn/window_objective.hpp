@@ -28,8 +28,9 @@ class WindowObjective {
   // eps: total_z x W (zeros = means only); meta_prior: one per layer.
   void SetWindow(const MatrixT<Scalar>& targets, const NetworkState<Scalar>& start,
                  const MatrixT<Scalar>& eps, const std::vector<double>& meta_prior);
-  // a: total_z x W (one sequence). grad may be null (loss only).
-  LossTerms Evaluate(const AdaptiveVariables<Scalar>& a, AdaptiveVariables<Scalar>* grad);
+  // a: total_z x W (one sequence). grad may be null (loss only). No allocation. The returned
+  // terms live in this object until the next Evaluate.
+  const LossTerms& Evaluate(const AdaptiveVariables<Scalar>& a, AdaptiveVariables<Scalar>* grad);
   const PosteriorPass<Scalar>& pass() const { return pass_; }
 
  private:

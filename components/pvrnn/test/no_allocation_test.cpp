@@ -1,0 +1,72 @@
+// The hot loops promise no heap allocation: Trainer::Epoch (training), PriorGenerator::Step
+// (generation) and WindowObjective::Evaluate (online error regression, issue 4). This binary
+// replaces the global operator new to count allocations while one of them runs.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "dyad/pvrnn/analytic_dataset.hpp"
+#include "dyad/pvrnn/prior_generator.hpp"
+#include "dyad/pvrnn/trainer.hpp"
+#include "dyad/pvrnn/window_objective.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace dyad::pvrnn {
+namespace {
+
+// Allocations made by f().
+template <typename F>
+long CountAllocations(F&& f) {
+  const long before = g_allocations.load();
+  f();
+  return g_allocations.load() - before;
+}
+
+TEST(NoAllocation, TrainingEpochAllocatesNothing) {
+  const Dataset d = MakeAnalyticDataset();
+  auto t = Trainer<float>::Create(Model::Initialize(ModelSpec::MacawBot(), d.steps(), d.size(), 1), d,
+                                  TrainerOptions{}).value();
+  t->Epoch();
+  EXPECT_EQ(CountAllocations([&] { for (int e = 0; e < 3; ++e) t->Epoch(); }), 0);
+}
+
+TEST(NoAllocation, PriorGeneratorStepAllocatesNothing) {
+  const Model m = Model::Initialize(ModelSpec::MacawBot(), 4, 2, 1);
+  PriorGenerator<float> g(m.weights.Cast<float>(), 2);
+  const MatrixT<float> a = MatrixT<float>::Zero(m.adaptive.total_z(), 2);
+  const MatrixT<float> eps = MatrixT<float>::Zero(m.adaptive.total_z(), 2);
+  g.Step(&a, &a, eps);
+  EXPECT_EQ(CountAllocations([&] {
+              g.Step(&a, &a, eps);
+              g.Step(nullptr, nullptr, eps);
+            }),
+            0);
+}
+
+TEST(NoAllocation, WindowObjectiveEvaluateAllocatesNothing) {
+  const Model m = Model::Initialize(ModelSpec::MacawBot(), 4, 2, 1);
+  const Weights<float> w = m.weights.Cast<float>();
+  const int window = 15, tz = m.adaptive.total_z();
+  WindowObjective<float> f(w, window);
+  f.SetWindow(MatrixT<float>::Constant(w.layout().output_units(), window, 0.1f),
+              NetworkState<float>::Zero(w.layout().total_d(), 1), MatrixT<float>::Zero(tz, window), {1e-4, 1e-4});
+  AdaptiveVariables<float> a(tz, window, 1), g(tz, window, 1);
+  f.Evaluate(a, &g);
+  EXPECT_EQ(CountAllocations([&] { f.Evaluate(a, &g); }), 0);
+}
+
+}  // namespace
+}  // namespace dyad::pvrnn
