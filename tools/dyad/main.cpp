@@ -4,8 +4,10 @@
 
 #include <iostream>
 
+#include "analyze_commands.hpp"
 #include "bag_commands.hpp"
 #include "introspection_commands.hpp"
+#include "observer_commands.hpp"
 #include "pvrnn_commands.hpp"
 #include "runtime_commands.hpp"
 
@@ -18,6 +20,8 @@ int main(int argc, char** argv) {
   dyad::cli::AddIntrospectionCommands(app, exit_code);
   dyad::cli::AddBagCommands(app, exit_code);
   dyad::cli::AddPvrnnCommands(app, exit_code);
+  dyad::cli::AddObserverCommands(app, exit_code);
+  dyad::cli::AddAnalyzeCommands(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
