@@ -24,7 +24,7 @@ void Observer::Describe(ComponentSpec& spec) {
   spec.Param("lowpass_steps", int64_t{10}).Range(1, 100000).Unit("steps")
       .Doc("Y: P(C_t) is the moving average of the instantaneous congruence over the last Y steps");
   spec.Input<msg::HumanInput>("human").Doc("the human's position and engaged flag");
-  spec.Input<msg::Intention>("robot").Doc("the robot's intended position");
+  spec.Input<msg::Intention>("robot").Optional().Doc("the robot's intended position (unbound: robot stays empty)");
   spec.Output<msg::IntentionLabel>("labels").Doc("class probabilities of both and the congruence P(C_t), one per step");
 }
 

@@ -6,7 +6,8 @@
 /// trigger: robot (or rate_hz 10)
 /// inputs:
 ///   human (HumanInput): the human's position and engaged flag
-///   robot (Intention): the robot's intended position
+///   robot (Intention, optional): the robot's intended position; left unbound, only the human
+///          is classified (robot stays empty, congruence NaN), e.g. to label a human-only run
 /// outputs:
 ///   labels (IntentionLabel), one per step:
 ///     robot: sigmoid outputs (one per primitive) for the last `window` robot positions; empty

@@ -5,7 +5,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
+#include "dyad/pvrnn/analytic_dataset.hpp"
 #include "fake_context.hpp"
 #include "observer_component.hpp"
 
@@ -123,6 +125,28 @@ TEST(ObserverComponent, ConfigureErrorsNameTheParameter) {
   testing::FakeContext ctx2(&Observer::Describe, {{"model", std::string("/nonexistent.dobs")}});
   Observer o2;
   EXPECT_EQ(o2.Configure(ctx2).message(), "model: /nonexistent.dobs: cannot open");
+}
+
+// Loaded by type name in a real `dyad run`: a synthetic human feeds the observer (robot unbound).
+TEST(ObserverPlugin, RunsInDyadWithASyntheticHuman) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("dyad_observer_run_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  ASSERT_TRUE(pvrnn::WriteNrlDataset(pvrnn::MakeAnalyticDataset(), (dir / "data").string()).ok());
+  const fs::path g = dir / "g.yaml", err = dir / "err.txt";
+  std::ofstream(g) << "graph: observe\nclock: stepped\ndomain_id: " << 1 + getpid() % 200
+                   << "\ncomponents:\n"
+                      "  human: {type: human_synthetic, rate_hz: 10, params: {dataset: "
+                   << (dir / "data").string()
+                   << ", events: [{start: 2, end: 20, primitive: 1}]}, outputs: {out: human/input}}\n"
+                      "  observer: {type: observer, trigger: human, params: {model: "
+                   << ObserverPath() << ", lowpass_steps: 10}, inputs: {human: human/input}, outputs: {labels: observer/labels}}\n";
+  const std::string cmd = std::string(DYAD_EXE) + " run " + g.string() + " --steps 30 --quiet > /dev/null 2> " + err.string();
+  const int rc = std::system(cmd.c_str());
+  std::ifstream in(err);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(rc, 0) << text;
+  fs::remove_all(dir);
 }
 
 }  // namespace
