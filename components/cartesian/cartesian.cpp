@@ -39,7 +39,7 @@ Status VirtualCartesian::Configure(Context& ctx) {
   const auto& xl = p.DoubleList("x_limits");
   const auto& yl = p.DoubleList("y_limits");
   const auto& init = p.DoubleList("initial_position");
-  const std::string prefix = ctx.name() + ".params.";
+  const std::string prefix = "components." + ctx.name() + ".params.";
   if (xl.size() != 2) return Status::InvalidArgument(prefix + "x_limits: must be [min, max]");
   if (yl.size() != 2) return Status::InvalidArgument(prefix + "y_limits: must be [min, max]");
   if (!init.empty() && init.size() != 2) return Status::InvalidArgument(prefix + "initial_position: must be [] or [x, y]");
@@ -104,7 +104,7 @@ Status UdpCartesian::Configure(Context& ctx) {
   ctx_ = &ctx;
   const Params& p = ctx.params();
   auto addr = UdpSocket::Resolve(p.String("controller_host"), static_cast<uint16_t>(p.Int("controller_port")));
-  if (!addr.ok()) return Status::InvalidArgument(ctx.name() + ".params.controller_host", addr.status().message());
+  if (!addr.ok()) return Status::InvalidArgument("components." + ctx.name() + ".params.controller_host", addr.status().message());
   controller_ = *addr;
   local_port_ = static_cast<uint16_t>(p.Int("local_port"));
   timeout_ns_ = SecondsToNs(p.Double("timeout_s"));
@@ -234,7 +234,7 @@ Status CartesianPattern::Configure(Context& ctx) {
   const Params& p = ctx.params();
   figure8_ = p.String("shape") == "figure8";
   const auto& c = p.DoubleList("center");
-  if (c.size() != 2) return Status::InvalidArgument(ctx.name() + ".params.center: must be [x, y]");
+  if (c.size() != 2) return Status::InvalidArgument("components." + ctx.name() + ".params.center: must be [x, y]");
   cx_ = c[0], cy_ = c[1];
   radius_ = p.Double("radius");
   period_s_ = p.Double("period_s");

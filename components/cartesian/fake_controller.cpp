@@ -159,7 +159,7 @@ int main(int argc, char** argv) {
       (void)socket->SendTo(tx.data(), tx.size(), from);
     }
   }
-  std::printf("commands received %llu, applied %u (last seq), dropped %llu, delayed %llu, malformed replies %llu, "
+  std::printf("commands received %llu, last applied sequence %u, dropped %llu, delayed %llu, malformed replies %llu, "
               "malformed commands %llu, out of order %llu\n",
               static_cast<unsigned long long>(received), applied, static_cast<unsigned long long>(dropped),
               static_cast<unsigned long long>(delayed), static_cast<unsigned long long>(malformed_out),

@@ -39,14 +39,14 @@ Status ComplianceMixer::Configure(Context& ctx) {
   o.ki = p.Double("ki");
   o.integral_limit = p.Double("integral_limit");
   o.stale_timeout_ns = static_cast<int64_t>(std::llround(p.Double("stale_timeout_s") * 1e9));
-  if (Status s = o.Validate(); !s.ok()) return Status::InvalidArgument(ctx.name() + ".params." + s.message());
+  if (Status s = o.Validate(); !s.ok()) return Status::InvalidArgument("components." + ctx.name() + ".params." + s.message());
   z_ = p.Double("z");
   human_ = &ctx.input<msg::HumanInput>("human");
   robot_ = &ctx.input<msg::Intention>("robot");
   state_ = &ctx.input<msg::CartesianState>("state");
   command_ = &ctx.output<msg::CartesianCommand>("command");
   if (o.mode == Mode::kPi && !state_->bound())
-    return Status::InvalidArgument(ctx.name() + ".params.mode = pi: needs input 'state' bound to the driver's state topic");
+    return Status::InvalidArgument("components." + ctx.name() + ".params.mode = pi: needs input 'state' bound to the driver's state topic");
   core_.emplace(o);
   return Status::OK();
 }

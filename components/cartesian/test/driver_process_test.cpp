@@ -253,48 +253,71 @@ TEST_F(DriverProcessTest, UdpDriverEndsTheRunWhenTheControllerIsSilent) {
 }
 
 // The mixer and the virtual driver together, stepped: blend while engaged, 5 units per step,
-// hold when the human goes silent; the driver reaches every command within its step.
+// hold when the human goes silent; the driver reaches every command within its step. The mixer
+// triggered by `robot` (the demo) and the mixer at rate_hz 10 (after the robot in graph order)
+// publish the same commands.
 TEST_F(DriverProcessTest, MixerBlendsSaturatesAndHoldsWhenTheHumanGoesSilent) {
-  const fs::path clog = dir_ / "commands.txt", slog = dir_ / "states.txt";
-  const fs::path g = dir_ / "mix.yaml";
-  std::ofstream(g) << "graph: mix\nclock: stepped\ndomain_id: " << domain_ << "\ncomponents:\n"
-                   << "  human: {type: test_human, rate_hz: 10, params: {position: [20, 0], engaged_from: 10, "
-                      "engaged_to: 30, silent_from: 40}, outputs: {out: human/input}}\n"
-                   << "  robot: {type: test_intention, rate_hz: 10, params: {start: [0, 0], speed: 0}, outputs: {out: robot/intention}}\n"
-                   << "  mixer: {type: compliance_mixer, trigger: robot, params: {stale_timeout_s: 0.25}, "
-                      "inputs: {human: human/input, robot: robot/intention, state: robot/state}, outputs: {command: robot/command}}\n"
-                   << "  driver: {type: virtual_cartesian, trigger: command, inputs: {command: robot/command}, outputs: {state: robot/state}}\n"
-                   << "  clog: {type: test_command_log, trigger: command, params: {file: " << clog.string()
-                   << "}, inputs: {command: robot/command}}\n"
-                   << "  slog: {type: test_state_log, trigger: state, params: {file: " << slog.string()
-                   << "}, inputs: {state: robot/state}}\n";
-  Child c(Dyad({"run", g.string(), "--steps", "60", "--quiet"}), dir_, "mix");
-  ASSERT_EQ(c.Wait(60), 0) << c.err();
-  std::istringstream in(Read(clog));
-  std::vector<std::array<double, 4>> cmds;
-  std::array<double, 4> r{};
-  while (in >> r[0] >> r[1] >> r[2] >> r[3]) cmds.push_back(r);
-  ASSERT_EQ(cmds.size(), 60u);
-  EXPECT_EQ(cmds[9][1], 0);  // disengaged: the robot's intention (0, 0)
-  // Engaged from step 10: target 0.9*20 = 18, reached in 5-unit steps: 5, 10, 15, 18.
-  EXPECT_DOUBLE_EQ(cmds[10][1], 5);
-  EXPECT_DOUBLE_EQ(cmds[11][1], 10);
-  EXPECT_DOUBLE_EQ(cmds[12][1], 15);
-  EXPECT_DOUBLE_EQ(cmds[13][1], 18);
-  EXPECT_DOUBLE_EQ(cmds[29][1], 18);
-  EXPECT_DOUBLE_EQ(cmds[30][1], 13);  // released: back towards 0, 5 per step
-  EXPECT_DOUBLE_EQ(cmds[34][1], 0);
-  // Human's last sample at step 39 (t = 3.9 s); stale after 0.25 s: from step 42 (4.2 s) on, hold.
-  EXPECT_EQ(cmds[41][3], 0);
-  EXPECT_EQ(cmds[42][3], 1);
-  EXPECT_DOUBLE_EQ(cmds[42][1], cmds[41][1]);
-  EXPECT_EQ(cmds[59][3], 1);
-  EXPECT_NE(c.err().find("input 'human' stale (no sample for more than 250 ms): holding the last command"), std::string::npos)
-      << c.err();
-  // The driver followed every command within its step.
-  const auto states = ReadStates(slog);
-  ASSERT_EQ(states.size(), 60u);
-  for (size_t k = 0; k < 60; ++k) EXPECT_NEAR(states[k].x, cmds[k][1], 1e-9) << k;
+  std::string command_files[2];
+  for (int periodic = 0; periodic < 2; ++periodic) {
+    SCOPED_TRACE(periodic ? "mixer periodic" : "mixer triggered by robot");
+    const std::string tag = periodic ? "periodic" : "triggered";
+    const fs::path clog = dir_ / (tag + "_commands.txt"), slog = dir_ / (tag + "_states.txt");
+    const fs::path g = dir_ / (tag + ".yaml");
+    std::ofstream(g) << "graph: mix\nclock: stepped\ndomain_id: " << domain_ << "\ncomponents:\n"
+                     << "  human: {type: test_human, rate_hz: 10, params: {position: [20, 0], engaged_from: 10, "
+                        "engaged_to: 30, silent_from: 40}, outputs: {out: human/input}}\n"
+                     << "  robot: {type: test_intention, rate_hz: 10, params: {start: [0, 0], speed: 0}, outputs: {out: robot/intention}}\n"
+                     << "  mixer: {type: compliance_mixer, " << (periodic ? "rate_hz: 10" : "trigger: robot")
+                     << ", params: {stale_timeout_s: 0.25}, "
+                        "inputs: {human: human/input, robot: robot/intention, state: robot/state}, outputs: {command: robot/command}}\n"
+                     << "  driver: {type: virtual_cartesian, trigger: command, inputs: {command: robot/command}, outputs: {state: robot/state}}\n"
+                     << "  clog: {type: test_command_log, trigger: command, params: {file: " << clog.string()
+                     << "}, inputs: {command: robot/command}}\n"
+                     << "  slog: {type: test_state_log, trigger: state, params: {file: " << slog.string()
+                     << "}, inputs: {state: robot/state}}\n";
+    Child c(Dyad({"run", g.string(), "--steps", "60", "--quiet"}), dir_, tag);
+    ASSERT_EQ(c.Wait(60), 0) << c.err();
+    command_files[periodic] = Read(clog);
+    std::istringstream in(command_files[periodic]);
+    std::vector<std::array<double, 4>> cmds;  // stamp x y hold
+    std::array<double, 4> r{};
+    while (in >> r[0] >> r[1] >> r[2] >> r[3]) cmds.push_back(r);
+    ASSERT_EQ(cmds.size(), 60u);
+    EXPECT_EQ(cmds[9][1], 0);  // disengaged: the robot's intention (0, 0)
+    // Engaged from step 10: target 0.9*20 + 0.1*0 = 18, reached in 5-unit steps: 5, 10, 15, 18.
+    EXPECT_DOUBLE_EQ(cmds[10][1], 5);
+    EXPECT_DOUBLE_EQ(cmds[11][1], 10);
+    EXPECT_DOUBLE_EQ(cmds[12][1], 15);
+    EXPECT_DOUBLE_EQ(cmds[13][1], 18);
+    EXPECT_DOUBLE_EQ(cmds[29][1], 18);
+    EXPECT_DOUBLE_EQ(cmds[30][1], 13);  // released: back towards 0, 5 per step
+    EXPECT_DOUBLE_EQ(cmds[33][1], 0);
+    // Human's last sample at step 39 (t = 3.9 s); stale after 0.25 s: from step 42 (4.2 s) on, hold.
+    EXPECT_EQ(cmds[41][3], 0);
+    EXPECT_EQ(cmds[42][3], 1);
+    EXPECT_EQ(cmds[59][3], 1);
+    EXPECT_DOUBLE_EQ(cmds[42][1], cmds[41][1]);
+    EXPECT_NE(c.err().find("input 'human' stale (no sample for more than 250 ms): holding the last command"), std::string::npos)
+        << c.err();
+    EXPECT_NE(c.err().find("60 commands published, 18 held, 6 saturated"), std::string::npos) << c.err();
+    // The driver followed every command within its step.
+    const auto states = ReadStates(slog);
+    ASSERT_EQ(states.size(), 60u);
+    for (size_t k = 0; k < 60; ++k) EXPECT_NEAR(states[k].x, cmds[k][1], 1e-9) << k;
+  }
+  EXPECT_EQ(command_files[0], command_files[1]);
+}
+
+TEST_F(DriverProcessTest, MixerInPiModeWithoutStateIsAConfigurationError) {
+  const fs::path g = dir_ / "pi.yaml";
+  std::ofstream(g) << "graph: pi\nclock: stepped\ndomain_id: " << domain_ << "\ncomponents:\n"
+                   << "  human: {type: test_human, rate_hz: 10, outputs: {out: h}}\n"
+                   << "  robot: {type: test_intention, rate_hz: 10, outputs: {out: r}}\n"
+                   << "  mixer: {type: compliance_mixer, trigger: robot, params: {mode: pi}, inputs: {human: h, robot: r}, "
+                      "outputs: {command: c}}\n";
+  Child c(Dyad({"run", g.string(), "--steps", "3", "--quiet"}), dir_, "pi");
+  EXPECT_NE(c.Wait(30), 0);
+  EXPECT_NE(c.err().find("components.mixer.params.mode = pi: needs input 'state' bound"), std::string::npos) << c.err();
 }
 
 }  // namespace
