@@ -252,6 +252,46 @@ TEST_F(DriverProcessTest, UdpDriverEndsTheRunWhenTheControllerIsSilent) {
       << u.err();
 }
 
+// virtual_cartesian stepped periodically (20 Hz) while commands (10 Hz, 2 units per step =
+// 20 units/s, the speed limit: the robot moves all the time) stop after 1 s: the watchdog
+// (0.3 s) stops the robot, under both clocks.
+TEST_F(DriverProcessTest, VirtualDriverWatchdogStopsTheRobotWhenCommandsStop) {
+  for (const std::string clock : {"stepped", "wall"}) {
+    SCOPED_TRACE(clock);
+    const fs::path log = dir_ / (clock + ".txt");
+    const fs::path g = dir_ / (clock + ".yaml");
+    std::ofstream(g) << "graph: wd\nclock: " << clock << "\ndomain_id: " << domain_ << "\ncomponents:\n"
+                     << "  cmd: {type: test_command, rate_hz: 10, params: {speed: 2, silent_from: 10}, outputs: {out: robot/command}}\n"
+                     << "  driver: {type: virtual_cartesian, rate_hz: 20, params: {watchdog_s: 0.3, max_velocity: 20, initial_position: [0, 0]}, "
+                        "inputs: {command: robot/command}, outputs: {state: robot/state}}\n"
+                     << "  log: {type: test_state_log, trigger: state, params: {file: " << log.string()
+                     << "}, inputs: {state: robot/state}}\n";
+    Child c(Dyad(clock == "wall" ? std::vector<std::string>{"run", g.string(), "--duration", "2.2", "--quiet"}
+                                 : std::vector<std::string>{"run", g.string(), "--steps", "40", "--quiet"}),
+            dir_, clock);
+    ASSERT_EQ(c.Wait(60), 0) << c.err();
+    const auto states = ReadStates(log);
+    ASSERT_GE(states.size(), 30u);
+    const int64_t t0 = states.front().stamp;
+    double moving_x = 0;
+    for (const State& s : states) {
+      const double t = (s.stamp - t0) * 1e-9;
+      if (t > 0.2 && t < 0.9) {  // commands flowing: moving, not stopped
+        EXPECT_EQ(s.stopped, 0) << t;
+        EXPECT_GT(s.vx, 5) << t;
+      }
+      if (t < 1.0) moving_x = s.x;
+      if (t > 1.5) {  // last command at 0.9 s, watchdog 0.3 s, braking within one step
+        EXPECT_EQ(s.stopped, 1) << t;
+        EXPECT_EQ(s.vx, 0) << t;
+        EXPECT_GE(s.x, moving_x) << t;
+        EXPECT_LE(s.x, 18 + 1e-9) << t;  // never past the last command (9 * 2)
+      }
+    }
+    EXPECT_NE(c.err().find("watchdog: no command for more than the watchdog timeout: stopping"), std::string::npos) << c.err();
+  }
+}
+
 // The mixer and the virtual driver together, stepped: blend while engaged, 5 units per step,
 // hold when the human goes silent; the driver reaches every command within its step. The mixer
 // triggered by `robot` (the demo) and the mixer at rate_hz 10 (after the robot in graph order)

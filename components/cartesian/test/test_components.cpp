@@ -4,6 +4,8 @@
 //   test_human       HumanInput at a fixed position, engaged during [engaged_from, engaged_to)
 //                    steps, silent from step `silent_from` (-1: never)
 //   test_intention   Intention moving along x by `speed` units per step from `start`
+//   test_command     CartesianCommand moving along x by `speed` units per step, silent from
+//                    step `silent_from` (-1: never)
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>
@@ -143,6 +145,34 @@ class Intention final : public Component {
   Output<msg::Intention>* out_ = nullptr;
 };
 
+class Command final : public Component {
+ public:
+  static void Describe(ComponentSpec& spec) {
+    spec.Summary("test: a command moving along x, then silence");
+    spec.Param("speed", 1.0).Doc("units per step along x");
+    spec.Param("silent_from", int64_t{-1});
+    spec.Output<msg::CartesianCommand>("out");
+  }
+  Status Configure(Context& ctx) override {
+    speed_ = ctx.params().Double("speed");
+    silent_ = ctx.params().Int("silent_from");
+    out_ = &ctx.output<msg::CartesianCommand>("out");
+    return Status::OK();
+  }
+  Status Step(const StepInfo& info) override {
+    const auto k = static_cast<int64_t>(info.index);
+    if (silent_ >= 0 && k >= silent_) return Status::OK();
+    msg::CartesianCommand c;
+    c.x(speed_ * static_cast<double>(k));
+    return out_->Publish(c);
+  }
+
+ private:
+  double speed_ = 1;
+  int64_t silent_ = -1;
+  Output<msg::CartesianCommand>* out_ = nullptr;
+};
+
 }  // namespace
 
 DYAD_PLUGIN(registry) {
@@ -150,4 +180,5 @@ DYAD_PLUGIN(registry) {
   registry.Add<CommandLog>("test_command_log");
   registry.Add<Human>("test_human");
   registry.Add<Intention>("test_intention");
+  registry.Add<Command>("test_command");
 }
