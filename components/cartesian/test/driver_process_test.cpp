@@ -252,8 +252,9 @@ TEST_F(DriverProcessTest, UdpDriverEndsTheRunWhenTheControllerIsSilent) {
       << u.err();
 }
 
-// virtual_cartesian stepped periodically (20 Hz) while commands (10 Hz, 2 units per step =
-// 20 units/s, the speed limit: the robot moves all the time) stop after 1 s: the watchdog
+// virtual_cartesian stepped periodically (20 Hz) while commands (10 Hz, 3 units per step =
+// 30 units/s, above the 20 units/s speed limit: the robot never catches up, so it moves all the
+// time) stop after 1 s: the watchdog
 // (0.3 s) stops the robot, under both clocks.
 TEST_F(DriverProcessTest, VirtualDriverWatchdogStopsTheRobotWhenCommandsStop) {
   for (const std::string clock : {"stepped", "wall"}) {
@@ -261,7 +262,7 @@ TEST_F(DriverProcessTest, VirtualDriverWatchdogStopsTheRobotWhenCommandsStop) {
     const fs::path log = dir_ / (clock + ".txt");
     const fs::path g = dir_ / (clock + ".yaml");
     std::ofstream(g) << "graph: wd\nclock: " << clock << "\ndomain_id: " << domain_ << "\ncomponents:\n"
-                     << "  cmd: {type: test_command, rate_hz: 10, params: {speed: 2, silent_from: 10}, outputs: {out: robot/command}}\n"
+                     << "  cmd: {type: test_command, rate_hz: 10, params: {speed: 3, silent_from: 10}, outputs: {out: robot/command}}\n"
                      << "  driver: {type: virtual_cartesian, rate_hz: 20, params: {watchdog_s: 0.3, max_velocity: 20, initial_position: [0, 0]}, "
                         "inputs: {command: robot/command}, outputs: {state: robot/state}}\n"
                      << "  log: {type: test_state_log, trigger: state, params: {file: " << log.string()
@@ -285,7 +286,7 @@ TEST_F(DriverProcessTest, VirtualDriverWatchdogStopsTheRobotWhenCommandsStop) {
         EXPECT_EQ(s.stopped, 1) << t;
         EXPECT_EQ(s.vx, 0) << t;
         EXPECT_GE(s.x, moving_x) << t;
-        EXPECT_LE(s.x, 18 + 1e-9) << t;  // never past the last command (9 * 2)
+        EXPECT_LE(s.x, 27 + 1e-9) << t;  // never past the last command (9 * 3)
       }
     }
     EXPECT_NE(c.err().find("watchdog: no command for more than the watchdog timeout: stopping"), std::string::npos) << c.err();
