@@ -72,8 +72,8 @@ const VirtualRobot::State& VirtualRobot::Advance(int64_t now_ns) {
   if (fresh) {
     const Vec2 d{target_.x - p.x, target_.y - p.y};
     const double dist = Norm(d);
-    // Braking bound, exact for discrete steps: from speed m*a*dt the robot stops after
-    // a*dt^2*m(m+1)/2 units, so m <= sqrt(1/4 + 2*dist/(a*dt^2)) - 1/2.
+    // Braking bound for discrete steps: from speed m*a*dt the robot stops after
+    // a*dt^2*m(m+1)/2 units (exact for whole m), so m <= sqrt(1/4 + 2*dist/(a*dt^2)) - 1/2.
     const double adt = o_.max_acceleration * dt;
     const double brake = adt * (std::sqrt(0.25 + 2 * dist / (adt * dt)) - 0.5);
     const double speed = std::min({dist / dt, o_.max_velocity, brake});

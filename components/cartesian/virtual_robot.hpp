@@ -6,8 +6,8 @@
 /// timeout) towards the latest target:
 ///   target clamped to the workspace box;  d = target - p
 ///   v_des = d/dt, shortened (vector norm) to min(max_velocity, braking bound), the braking
-///           bound being the highest speed from which steps of max_acceleration*dt less speed
-///           each stop within |d|: a*dt*(sqrt(1/4 + 2|d|/(a*dt^2)) - 1/2)
+///           bound being the speed from which steps of max_acceleration*dt less speed each stop
+///           within |d|: a*dt*(sqrt(1/4 + 2|d|/(a*dt^2)) - 1/2) (exact for whole multiples of a*dt)
 ///   v    += (v_des - v), shortened (norm) to max_acceleration*dt
 ///   p    += v*dt, clamped to the workspace (the velocity component into a wall is zeroed)
 /// Limits are on the vector norm, not per axis: a diagonal move is as fast as an axis-aligned
