@@ -118,7 +118,10 @@ Status UdpCartesian::Activate() {
   auto s = UdpSocket::Open(local_port_);
   if (!s.ok()) return s.status();
   socket_.emplace(std::move(*s));
-  ctx_->log().Info("controller " + ToString(controller_) + ", local port " + std::to_string(socket_->local_port()));
+  session_ = udp::NewSession();
+  sent_seq_ = 0;
+  ctx_->log().Info("controller " + ToString(controller_) + ", local port " + std::to_string(socket_->local_port()) +
+                   ", session " + std::to_string(session_));
   return Status::OK();
 }
 
@@ -151,7 +154,10 @@ Status UdpCartesian::Drain() {
       }
       continue;
     }
+    const uint64_t sessions = tracker_.counts().sessions;
     if (tracker_.Offer(s, awaiting_) == udp::StateTracker::Verdict::kOutOfOrder) continue;
+    if (sessions > 0 && tracker_.counts().sessions != sessions)
+      ctx_->log().Warn("controller session changed to " + std::to_string(s.session) + " (controller restarted?)");
     newest_ = s;
     has_newest_ = true;
     waiting_since_ns_ = -1;
@@ -171,6 +177,7 @@ Status UdpCartesian::Step(const StepInfo& info) {
   if (command_->new_count() > 0) {
     const msg::CartesianCommand& c = command_->received().back();
     udp::CommandPacket packet;
+    packet.session = session_;
     packet.sequence = ++sent_seq_;
     packet.stamp_ns = info.now_ns;
     packet.x = c.x(), packet.y = c.y(), packet.z = c.z();
@@ -211,7 +218,8 @@ Status UdpCartesian::Deactivate() {
                    " states accepted, " + std::to_string(c.late) + " late, " + std::to_string(c.gaps) + " lost, " +
                    std::to_string(c.out_of_order) + " out of order, " + std::to_string(c.malformed) + " malformed, " +
                    std::to_string(missed_replies_) + " replies missed, " + std::to_string(foreign_) + " foreign, " +
-                   std::to_string(socket_errors_) + " socket errors");
+                   std::to_string(socket_errors_) + " socket errors, " + std::to_string(c.sessions) +
+                   " controller sessions");
   return Status::OK();
 }
 

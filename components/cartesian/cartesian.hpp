@@ -76,7 +76,7 @@ class UdpCartesian final : public Component {
   static void Describe(ComponentSpec& spec);
   // Reads params and resolves the controller's address; inactive afterwards.
   Status Configure(Context& ctx) override;
-  // Opens the socket.
+  // Opens the socket and starts a new session (sequence numbers from 1).
   Status Activate() override;
   // Receives (publishing what arrived), sends the newest command, waits for its reply (bounded)
   // and publishes it. Fails when the controller stays silent past timeout_s.
@@ -99,6 +99,7 @@ class UdpCartesian final : public Component {
   std::optional<UdpSocket> socket_;
   std::array<uint8_t, udp::kCommandSize> tx_{};
   std::array<uint8_t, udp::kMaxPacket> rx_{};
+  uint32_t session_ = 0;   // ours, drawn at Activate
   uint32_t sent_seq_ = 0;
   uint32_t awaiting_ = 0;  // command whose reply is being waited for; 0: none
   udp::StateTracker tracker_;

@@ -7,10 +7,12 @@
 //
 // Each valid command (sequence newer than the last applied) sets the robot's target and
 // advances the simulation to the command's stamp_ns (so a stepped run stays deterministic);
-// the reply is a state packet acknowledging it, sent to the command's sender.
+// the reply is a state packet acknowledging it, sent to the command's sender. A command of a
+// new driver session (a driver started again) restarts the simulation, as a new virtual robot.
 // Fault injection, by the command's sequence number N:
 //   --drop N      the command is lost: not applied, no reply
 //   --delay N:MS  applied at once, the reply is sent MS milliseconds later (other replies are not held up)
+// (N counts in every driver session.)
 //   --malform N   applied, but the reply is garbage (bad magic)
 // Prints "listening on port P" once bound, and its counts on SIGINT/SIGTERM or after
 // --idle-exit seconds without a packet; exits 0.
@@ -23,6 +25,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -93,7 +96,10 @@ int main(int argc, char** argv) {
   std::printf("listening on port %ld\n", port);
   std::fflush(stdout);
 
-  dyad::cartesian::VirtualRobot robot(options);
+  std::optional<dyad::cartesian::VirtualRobot> robot;
+  const uint32_t session = udp::NewSession();
+  uint32_t driver_session = 0;
+  uint64_t sessions = 0;
   std::array<uint8_t, udp::kMaxPacket> rx{};
   std::array<uint8_t, udp::kStateSize> tx{};
   std::vector<Delayed> pending;
@@ -129,15 +135,20 @@ int main(int argc, char** argv) {
       ++dropped;
       continue;
     }
-    if (has_applied && !udp::Newer(c.sequence, applied)) {
+    if (!has_applied || c.session != driver_session) {  // a (new) driver: start afresh
+      driver_session = c.session;
+      robot.emplace(options);
+      ++sessions;
+    } else if (!udp::Newer(c.sequence, applied)) {
       ++out_of_order;
       continue;
     }
     has_applied = true;
     applied = c.sequence;
-    robot.SetTarget({c.x, c.y}, c.stamp_ns);
-    const auto& s = robot.Advance(c.stamp_ns);
+    robot->SetTarget({c.x, c.y}, c.stamp_ns);
+    const auto& s = robot->Advance(c.stamp_ns);
     udp::StatePacket st;
+    st.session = session;
     st.sequence = ++state_seq;
     st.ack = c.sequence;
     st.stopped = s.stopped;
@@ -159,9 +170,9 @@ int main(int argc, char** argv) {
       (void)socket->SendTo(tx.data(), tx.size(), from);
     }
   }
-  std::printf("commands received %llu, last applied sequence %u, dropped %llu, delayed %llu, malformed replies %llu, "
-              "malformed commands %llu, out of order %llu\n",
-              static_cast<unsigned long long>(received), applied, static_cast<unsigned long long>(dropped),
+  std::printf("commands received %llu, driver sessions %llu, last applied sequence %u, dropped %llu, delayed %llu, "
+              "malformed replies %llu, malformed commands %llu, out of order %llu\n",
+              static_cast<unsigned long long>(received), static_cast<unsigned long long>(sessions), applied, static_cast<unsigned long long>(dropped),
               static_cast<unsigned long long>(delayed), static_cast<unsigned long long>(malformed_out),
               static_cast<unsigned long long>(malformed_in), static_cast<unsigned long long>(out_of_order));
   return 0;

@@ -1,6 +1,7 @@
 #include "udp_protocol.hpp"
 
 #include <cstring>
+#include <random>
 
 namespace dyad::cartesian::udp {
 
@@ -27,22 +28,30 @@ double GetF64(const uint8_t* p) {
   std::memcpy(&d, &u, 8);
   return d;
 }
-void PutHeader(uint8_t* p, uint16_t kind, uint32_t sequence, uint32_t length) {
+void PutHeader(uint8_t* p, uint8_t kind, uint16_t length, uint32_t session, uint32_t sequence) {
   PutU<uint32_t>(p, kMagic);
-  PutU<uint16_t>(p + 4, kVersion);
-  PutU<uint16_t>(p + 6, kind);
-  PutU<uint32_t>(p + 8, sequence);
-  PutU<uint32_t>(p + 12, length);
+  p[4] = kVersion;
+  p[5] = kind;
+  PutU<uint16_t>(p + 6, length);
+  PutU<uint32_t>(p + 8, session);
+  PutU<uint32_t>(p + 12, sequence);
 }
-Decode CheckHeader(const uint8_t* p, size_t size, uint16_t kind, size_t expected) {
+Decode CheckHeader(const uint8_t* p, size_t size, uint8_t kind, size_t expected) {
   if (size < kHeaderSize) return Decode::kTooShort;
   if (GetU<uint32_t>(p) != kMagic) return Decode::kBadMagic;
-  if (GetU<uint16_t>(p + 4) != kVersion) return Decode::kBadVersion;
-  if (GetU<uint16_t>(p + 6) != kind) return Decode::kBadKind;
-  if (GetU<uint32_t>(p + 12) != expected || size != expected) return Decode::kBadLength;
+  if (p[4] != kVersion) return Decode::kBadVersion;
+  if (p[5] != kind) return Decode::kBadKind;
+  if (GetU<uint16_t>(p + 6) != expected || size != expected) return Decode::kBadLength;
   return Decode::kOk;
 }
 }  // namespace
+
+uint32_t NewSession() {
+  std::random_device rd;
+  uint32_t s = 0;
+  while (s == 0) s = static_cast<uint32_t>(rd());
+  return s;
+}
 
 const char* ToString(Decode d) {
   switch (d) {
@@ -58,7 +67,7 @@ const char* ToString(Decode d) {
 
 void Encode(const CommandPacket& c, std::array<uint8_t, kCommandSize>& out) {
   uint8_t* p = out.data();
-  PutHeader(p, kKindCommand, c.sequence, kCommandSize);
+  PutHeader(p, kKindCommand, kCommandSize, c.session, c.sequence);
   PutU<uint64_t>(p + 16, static_cast<uint64_t>(c.stamp_ns));
   PutF64(p + 24, c.x);
   PutF64(p + 32, c.y);
@@ -69,7 +78,7 @@ void Encode(const CommandPacket& c, std::array<uint8_t, kCommandSize>& out) {
 
 void Encode(const StatePacket& s, std::array<uint8_t, kStateSize>& out) {
   uint8_t* p = out.data();
-  PutHeader(p, kKindState, s.sequence, kStateSize);
+  PutHeader(p, kKindState, kStateSize, s.session, s.sequence);
   PutU<uint32_t>(p + 16, s.ack);
   PutU<uint32_t>(p + 20, s.stopped ? kFlagStopped : 0);
   PutU<uint64_t>(p + 24, static_cast<uint64_t>(s.stamp_ns));
@@ -83,7 +92,8 @@ void Encode(const StatePacket& s, std::array<uint8_t, kStateSize>& out) {
 
 Decode DecodeCommand(const uint8_t* p, size_t size, CommandPacket* c) {
   if (Decode d = CheckHeader(p, size, kKindCommand, kCommandSize); d != Decode::kOk) return d;
-  c->sequence = GetU<uint32_t>(p + 8);
+  c->session = GetU<uint32_t>(p + 8);
+  c->sequence = GetU<uint32_t>(p + 12);
   c->stamp_ns = static_cast<int64_t>(GetU<uint64_t>(p + 16));
   c->x = GetF64(p + 24);
   c->y = GetF64(p + 32);
@@ -94,7 +104,8 @@ Decode DecodeCommand(const uint8_t* p, size_t size, CommandPacket* c) {
 
 Decode DecodeState(const uint8_t* p, size_t size, StatePacket* s) {
   if (Decode d = CheckHeader(p, size, kKindState, kStateSize); d != Decode::kOk) return d;
-  s->sequence = GetU<uint32_t>(p + 8);
+  s->session = GetU<uint32_t>(p + 8);
+  s->sequence = GetU<uint32_t>(p + 12);
   s->ack = GetU<uint32_t>(p + 16);
   s->stopped = (GetU<uint32_t>(p + 20) & kFlagStopped) != 0;
   s->stamp_ns = static_cast<int64_t>(GetU<uint64_t>(p + 24));

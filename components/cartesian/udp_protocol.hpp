@@ -4,10 +4,13 @@
 ///
 /// Every packet starts with a 16-byte header:
 ///   0  u32 magic    0x43525944 (the bytes "DYRC")
-///   4  u16 version  1
-///   6  u16 kind     1 = command (driver -> controller), 2 = state (controller -> driver)
-///   8  u32 sequence per sender, starting at 1, +1 per packet sent
-///  12  u32 length   total packet length in bytes (56 for a command, 80 for a state)
+///   4  u8  version  1
+///   5  u8  kind     1 = command (driver -> controller), 2 = state (controller -> driver)
+///   6  u16 length   total packet length in bytes (56 for a command, 80 for a state)
+///   8  u32 session  random, non-zero, drawn by the sender when it starts; a packet of another
+///                   session than the receiver's current one starts a new session (sequence
+///                   checks begin afresh): a restarted driver or controller is followed at once
+///  12  u32 sequence per sender and session, starting at 1, +1 per packet sent
 /// Command (kind 1), after the header:
 ///  16  i64 stamp_ns driver's runtime clock when the command was sent
 ///  24  f64 x, 32 f64 y, 40 f64 z   target position, workspace units
@@ -27,9 +30,9 @@
 namespace dyad::cartesian::udp {
 
 inline constexpr uint32_t kMagic = 0x43525944;  // "DYRC" in memory order
-inline constexpr uint16_t kVersion = 1;
-inline constexpr uint16_t kKindCommand = 1;
-inline constexpr uint16_t kKindState = 2;
+inline constexpr uint8_t kVersion = 1;
+inline constexpr uint8_t kKindCommand = 1;
+inline constexpr uint8_t kKindState = 2;
 inline constexpr size_t kHeaderSize = 16;
 inline constexpr size_t kCommandSize = 56;
 inline constexpr size_t kStateSize = 80;
@@ -38,6 +41,7 @@ inline constexpr uint32_t kFlagHold = 1;
 inline constexpr uint32_t kFlagStopped = 1;
 
 struct CommandPacket {
+  uint32_t session = 0;
   uint32_t sequence = 0;
   int64_t stamp_ns = 0;
   double x = 0, y = 0, z = 0;
@@ -45,6 +49,7 @@ struct CommandPacket {
 };
 
 struct StatePacket {
+  uint32_t session = 0;
   uint32_t sequence = 0;
   uint32_t ack = 0;
   bool stopped = false;
@@ -61,6 +66,9 @@ void Encode(const StatePacket& p, std::array<uint8_t, kStateSize>& out);
 // Check the header (magic, version, kind, length == size == the kind's size), then fill *out.
 Decode DecodeCommand(const uint8_t* data, size_t size, CommandPacket* out);
 Decode DecodeState(const uint8_t* data, size_t size, StatePacket* out);
+
+// A random non-zero session number.
+uint32_t NewSession();
 
 // True when sequence `a` is newer than `b` (serial-number arithmetic: survives the u32 wrap).
 inline bool Newer(uint32_t a, uint32_t b) { return static_cast<int32_t>(a - b) > 0; }
@@ -80,17 +88,22 @@ class StateTracker {
     uint64_t out_of_order = 0;  // dropped: not newer than the newest accepted (or a duplicate)
     uint64_t gaps = 0;          // controller sequence numbers never seen (states lost on the way)
     uint64_t malformed = 0;     // dropped: failed to decode (counted by the caller via Malformed())
+    uint64_t sessions = 0;      // controller sessions seen (more than 1: the controller restarted)
   };
 
   // A decoded state arrived while the driver was waiting for the reply to command `awaiting`
   // (0: not waiting, between steps).
   Verdict Offer(const StatePacket& s, uint32_t awaiting) {
-    if (has_ && !Newer(s.sequence, newest_)) {
+    if (!has_ || s.session != session_) {  // first state, or a restarted controller
+      has_ = true;
+      session_ = s.session;
+      ++counts_.sessions;
+    } else if (!Newer(s.sequence, newest_)) {
       ++counts_.out_of_order;
       return Verdict::kOutOfOrder;
+    } else {
+      counts_.gaps += s.sequence - newest_ - 1;
     }
-    if (has_) counts_.gaps += s.sequence - newest_ - 1;
-    has_ = true;
     newest_ = s.sequence;
     ++counts_.accepted;
     if (s.ack != awaiting) {
@@ -104,6 +117,7 @@ class StateTracker {
 
  private:
   bool has_ = false;
+  uint32_t session_ = 0;
   uint32_t newest_ = 0;
   Counts counts_;
 };

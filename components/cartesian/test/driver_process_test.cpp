@@ -240,6 +240,25 @@ TEST_F(DriverProcessTest, UdpDriverPublishesALateReplyAtTheNextStep) {
   EXPECT_NE(u.err().find(" 1 late, 0 lost, 0 out of order, 0 malformed, 1 replies missed"), std::string::npos) << u.err();
 }
 
+// A driver started again against a controller that kept running: its sequence numbers restart
+// at 1 in a new session, which the controller follows at once.
+TEST_F(DriverProcessTest, UdpDriverRunTwiceAgainstOneControllerStartsANewSessionEachTime) {
+  Child fake = FakeController({});
+  ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
+  for (int run = 0; run < 2; ++run) {
+    const fs::path log = dir_ / ("udp" + std::to_string(run) + ".txt");
+    const fs::path g = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"), "udp.yaml", log);
+    Child u(Dyad({"run", g.string(), "--steps", "30", "--quiet", "--set", PortSet(), "--set", "driver.reply_wait_ms=1000"}),
+            dir_, "udp" + std::to_string(run));
+    ASSERT_EQ(u.Wait(60), 0) << u.err();
+    EXPECT_EQ(ReadStates(log).size(), 30u) << run;
+  }
+  fake.Signal(SIGTERM);
+  ASSERT_EQ(fake.Wait(10), 0);
+  EXPECT_NE(fake.out().find("commands received 60, driver sessions 2, last applied sequence 30"), std::string::npos)
+      << fake.out();
+}
+
 TEST_F(DriverProcessTest, UdpDriverEndsTheRunWhenTheControllerIsSilent) {
   const fs::path log = dir_ / "udp.txt";
   const fs::path g = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"), "udp.yaml", log);

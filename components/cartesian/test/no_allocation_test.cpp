@@ -163,6 +163,7 @@ TEST(NoAllocation, UdpCartesianStepAllocatesNothing) {
     ASSERT_EQ(udp::DecodeCommand(rx.data(), static_cast<size_t>(n), &c), udp::Decode::kOk);
     EXPECT_EQ(c.sequence, k + 1);
     udp::StatePacket s;
+    s.session = 7;
     s.sequence = ++state_seq;
     s.ack = c.sequence;
     s.stamp_ns = c.stamp_ns;

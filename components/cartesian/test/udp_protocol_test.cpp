@@ -11,13 +11,14 @@ namespace {
 
 TEST(UdpProtocol, CommandLayoutIsTheDocumentedLittleEndianOne) {
   CommandPacket c;
+  c.session = 0xA1B2C3D4;
   c.sequence = 0x01020304;
   c.stamp_ns = 0x1122334455667788;
   c.x = 1.5, c.y = -2.0, c.z = 0.25;
   c.hold = true;
   std::array<uint8_t, kCommandSize> b{};
   Encode(c, b);
-  const uint8_t head[16] = {'D', 'Y', 'R', 'C', 1, 0, 1, 0, 4, 3, 2, 1, 56, 0, 0, 0};
+  const uint8_t head[16] = {'D', 'Y', 'R', 'C', 1, 1, 56, 0, 0xD4, 0xC3, 0xB2, 0xA1, 4, 3, 2, 1};
   EXPECT_EQ(std::memcmp(b.data(), head, 16), 0);
   EXPECT_EQ(b[16], 0x88);
   EXPECT_EQ(b[23], 0x11);
@@ -26,6 +27,7 @@ TEST(UdpProtocol, CommandLayoutIsTheDocumentedLittleEndianOne) {
   EXPECT_EQ(b[48], 1);  // hold
   CommandPacket d;
   ASSERT_EQ(DecodeCommand(b.data(), b.size(), &d), Decode::kOk);
+  EXPECT_EQ(d.session, c.session);
   EXPECT_EQ(d.sequence, c.sequence);
   EXPECT_EQ(d.stamp_ns, c.stamp_ns);
   EXPECT_EQ(d.x, 1.5);
@@ -36,14 +38,15 @@ TEST(UdpProtocol, CommandLayoutIsTheDocumentedLittleEndianOne) {
 
 TEST(UdpProtocol, StateRoundTrips) {
   StatePacket s;
-  s.sequence = 7, s.ack = 6, s.stopped = true, s.stamp_ns = -5;
+  s.session = 9, s.sequence = 7, s.ack = 6, s.stopped = true, s.stamp_ns = -5;
   s.x = 1, s.y = 2, s.z = 3, s.vx = 4, s.vy = 5, s.vz = 6;
   std::array<uint8_t, kStateSize> b{};
   Encode(s, b);
-  EXPECT_EQ(b[6], kKindState);
-  EXPECT_EQ(b[12], 80);
+  EXPECT_EQ(b[5], kKindState);
+  EXPECT_EQ(b[6], 80);
   StatePacket d;
   ASSERT_EQ(DecodeState(b.data(), b.size(), &d), Decode::kOk);
+  EXPECT_EQ(d.session, 9u);
   EXPECT_EQ(d.sequence, 7u);
   EXPECT_EQ(d.ack, 6u);
   EXPECT_TRUE(d.stopped);
@@ -65,7 +68,7 @@ TEST(UdpProtocol, MalformedPacketsAreRejectedWithTheReason) {
   bad[4] = 2;
   EXPECT_EQ(DecodeState(bad.data(), bad.size(), &d), Decode::kBadVersion);
   bad = b;
-  bad[12] = 81;
+  bad[6] = 81;
   EXPECT_EQ(DecodeState(bad.data(), bad.size(), &d), Decode::kBadLength);
   // A command is not a state.
   std::array<uint8_t, kCommandSize> c{};
@@ -81,8 +84,9 @@ TEST(UdpProtocol, SequenceComparisonSurvivesWrapAround) {
   EXPECT_TRUE(Newer(5, 0xFFFFFFF0));
 }
 
-StatePacket State(uint32_t seq, uint32_t ack) {
+StatePacket State(uint32_t seq, uint32_t ack, uint32_t session = 1) {
   StatePacket s;
+  s.session = session;
   s.sequence = seq;
   s.ack = ack;
   return s;
@@ -103,6 +107,18 @@ TEST(StateTracker, CountsLateLostAndOutOfOrder) {
   EXPECT_EQ(c.gaps, 1u);
   EXPECT_EQ(c.out_of_order, 2u);
   EXPECT_EQ(c.malformed, 1u);
+  EXPECT_EQ(c.sessions, 1u);
+}
+
+TEST(StateTracker, ARestartedControllerStartsANewSession) {
+  StateTracker t;
+  using V = StateTracker::Verdict;
+  EXPECT_EQ(t.Offer(State(500, 500, 1), 500), V::kAccepted);
+  EXPECT_EQ(t.Offer(State(1, 501, 2), 501), V::kAccepted);  // sequence 1 again: new session, not out of order
+  EXPECT_EQ(t.Offer(State(2, 502, 2), 502), V::kAccepted);
+  EXPECT_EQ(t.counts().sessions, 2u);
+  EXPECT_EQ(t.counts().gaps, 0u);
+  EXPECT_EQ(t.counts().out_of_order, 0u);
 }
 
 }  // namespace
