@@ -163,6 +163,7 @@ int Train(const std::string& config_path, bool resume, const std::vector<std::st
   if (!c.ok()) return Fail(kBadInput, c.status().message());
   auto data = LoadNrlDataset(c->dataset);
   if (!data.ok()) return Fail(kBadInput, data.status().message());
+  if (c->loops > 1) data = RepeatSequences(*data, static_cast<int>(c->loops));
   if (data->dofs() != c->spec.num_dofs())
     return Fail(kBadInput, config_path + ": encoding.dofs lists " + std::to_string(c->spec.num_dofs()) +
                                " DOFs, the data set " + c->dataset + " has " + std::to_string(data->dofs()));

@@ -88,4 +88,10 @@ Status WriteNrlDataset(const Dataset& data, const std::string& dir) {
   return Status::OK();
 }
 
+Dataset RepeatSequences(const Dataset& data, int loops) {
+  Dataset out = data;
+  for (Eigen::MatrixXd& s : out.sequences) s = s.replicate(1, loops).eval();
+  return out;
+}
+
 }  // namespace dyad::pvrnn

@@ -197,7 +197,7 @@ namespace {
 
 TrainConfig Read(const YAML::Node& root, const std::string& path, Reader& r) {
   TrainConfig c;
-  if (!r.Keys(root, "", {"dataset", "layers", "encoding", "epochs", "adam", "seed", "scalar", "noise", "log_every",
+  if (!r.Keys(root, "", {"dataset", "loops", "layers", "encoding", "epochs", "adam", "seed", "scalar", "noise", "log_every",
                          "checkpoint_every", "output", "checkpoint", "log_csv"}))
     return c;
   if (r.Get(root, "dataset", "dataset", "a path", &c.dataset, true)) {
@@ -205,6 +205,8 @@ TrainConfig Read(const YAML::Node& root, const std::string& path, Reader& r) {
     if (p.is_relative()) p = std::filesystem::path(path).parent_path() / p;
     c.dataset = p.lexically_normal().string();
   }
+  if (r.Get(root, "loops", "loops", "an integer", &c.loops))
+    r.Check(c.loops >= 1 && c.loops <= 100, root, "loops", "loops", "must be in 1..100", c.loops);
   // Types here; value rules come from ModelSpec/AdamOptions::Problems() (one place), below.
   // Entries that cannot be read keep a valid default so that indices stay aligned.
   const YAML::Node layers = root["layers"];

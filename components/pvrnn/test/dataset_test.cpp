@@ -34,6 +34,16 @@ TEST(AnalyticDataset, SevenClosedPrimitivesInsideTheWorkspace) {
   }
 }
 
+TEST(Dataset, RepeatSequencesTilesEachPrimitive) {
+  const Dataset d = MakeAnalyticDataset();
+  const Dataset r = RepeatSequences(d, 3);
+  ASSERT_EQ(r.size(), d.size());
+  ASSERT_EQ(r.steps(), 3 * d.steps());
+  for (int i = 0; i < d.size(); ++i) {
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(r.sequences[i].middleCols(k * d.steps(), d.steps()), d.sequences[i]);
+  }
+}
+
 TEST(Dataset, WrittenAnalyticSetReadsBackIdentically) {
   const Dataset d = MakeAnalyticDataset();
   const std::string dir = testing::TempPath("analytic_set");

@@ -64,6 +64,18 @@ TEST(TrainConfig, OverridesReplaceValues) {
   EXPECT_EQ(c->epochs, 7);
 }
 
+TEST(TrainConfig, LoopsDefaultsToOneAndIsRangeChecked) {
+  auto c = LoadTrainConfig(kDir + "/valid_train.yaml");
+  ASSERT_TRUE(c.ok()) << c.status().message();
+  EXPECT_EQ(c->loops, 1);
+  auto two = LoadTrainConfig(kDir + "/valid_train.yaml", {"loops=2"});
+  ASSERT_TRUE(two.ok()) << two.status().message();
+  EXPECT_EQ(two->loops, 2);
+  auto zero = LoadTrainConfig(kDir + "/valid_train.yaml", {"loops=0"});
+  ASSERT_FALSE(zero.ok());
+  EXPECT_EQ(zero.status().message(), "--set loops: must be in 1..100, got 0");
+}
+
 TEST(TrainConfig, BadOverrideIsNamed) {
   auto c = LoadTrainConfig(kDir + "/valid_train.yaml", {"epochs=-3"});
   ASSERT_FALSE(c.ok());

@@ -28,6 +28,8 @@ struct Dataset {
 };
 
 StatusOr<Dataset> LoadNrlDataset(const std::string& dir);
+// Each sequence repeated `loops` times end to end (loops >= 1).
+Dataset RepeatSequences(const Dataset& data, int loops);
 Status WriteNrlDataset(const Dataset& data, const std::string& dir);
 
 }  // namespace dyad::pvrnn

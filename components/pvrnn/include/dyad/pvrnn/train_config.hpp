@@ -1,6 +1,7 @@
 // dyad/pvrnn/train_config.hpp: the YAML file of `dyad train`.
 //
 //   dataset: ../../../shared/data/vcbot/dataset/Macaw   # relative to this file's folder
+//   loops: 1                                   # train on each primitive repeated N times
 //   layers:                                    # bottom (fast) first
 //     - {d: 40, z: 4, tau: 2, w: 0.01}
 //     - {d: 10, z: 1, tau: 10, w: 0.01}
@@ -32,6 +33,9 @@ namespace dyad::pvrnn {
 
 struct TrainConfig {
   std::string dataset;             // resolved path
+  // Each sequence is trained as `loops` copies of itself end to end (1..100). For closed
+  // primitives: with 2 the prior learns to go round again instead of drifting after one loop.
+  int64_t loops = 1;
   ModelSpec spec;
   int64_t epochs = 50000;          // REQUIRES > 0
   AdamOptions adam;
