@@ -13,9 +13,9 @@ WindowObjective<Scalar>::WindowObjective(const Weights<Scalar>& weights, int win
 }
 
 template <typename Scalar>
-void WindowObjective<Scalar>::SetWindow(const MatrixT<Scalar>& targets,
+void WindowObjective<Scalar>::SetWindow(const Eigen::Ref<const MatrixT<Scalar>>& targets,
                                         const NetworkState<Scalar>& start,
-                                        const MatrixT<Scalar>& eps,
+                                        const Eigen::Ref<const MatrixT<Scalar>>& eps,
                                         const std::vector<double>& meta_prior) {
   targets_ = targets;
   start_.h = start.h;
