@@ -5,6 +5,7 @@ namespace dyad::pvrnn {
 template <typename Scalar>
 WindowObjective<Scalar>::WindowObjective(const Weights<Scalar>& weights, int window)
     : weights_(weights), window_(window), pass_(weights.layout(), window, 1) {
+  pass_.AssumeWeightsFrozen();
   const auto& l = weights.layout();
   targets_ = MatrixT<Scalar>::Zero(l.output_units(), window);
   eps_ = MatrixT<Scalar>::Zero(l.total_z(), window);

@@ -20,7 +20,7 @@ namespace dyad::pvrnn {
 template <typename Scalar>
 class WindowObjective {
  public:
-  // `weights` must outlive this object.
+  // `weights` must outlive this object and stay unchanged (its transposes are cached).
   WindowObjective(const Weights<Scalar>& weights, int window);
 
   int window() const { return window_; }
