@@ -146,6 +146,7 @@ ErrorRegression<Scalar>::ErrorRegression(const Model& model, const ErrorRegressi
     objectives_.push_back(std::make_unique<WindowObjective<Scalar>>(weights_, n));
     work_a_.emplace_back(total_z_, n, 1);
     best_a_.emplace_back(total_z_, n, 1);
+    start_a_.emplace_back(total_z_, n, 1);
   }
   function_ = std::make_unique<Function>(this);
   if (options.optimizer == OptimizerKind::kCeres)
@@ -289,6 +290,7 @@ const StepResult& ErrorRegression<Scalar>::Step(const double* executed, SteadyCl
   AdaptiveVariables<Scalar>& a = work_a_[n - 1];
   a.mu() = a_mu_.leftCols(n);
   a.log_sigma() = a_ls_.leftCols(n);
+  start_a_[n - 1].flat() = a.flat();
   function_->Begin(n);
   const SolveReport rep = optimizer_->Minimize(*function_, a, SolveBudget{options_.iterations, deadline});
   const AdaptiveVariables<Scalar>& best = best_a_[n - 1];

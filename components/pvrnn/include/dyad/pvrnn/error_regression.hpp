@@ -132,9 +132,12 @@ class ErrorRegression {
   const ErrorRegressionOptions& options() const { return options_; }
   const ModelSpec& spec() const { return spec_; }
   int num_dofs() const { return spec_.num_dofs(); }
-  // Window contents (tests, tools): targets output_units x W (first window_fill() used).
   int window_fill() const { return fill_; }
-  const MatrixT<Scalar>& window_a_mu() const { return a_mu_; }
+  // The window problem of the last Step (benchmarks, tests: to solve it again from the same
+  // start): its objective (window data as set) and the A the optimiser started from.
+  // REQUIRES at least one Step.
+  const WindowObjective<Scalar>& last_objective() const { return *objectives_[fill_ - 1]; }
+  const AdaptiveVariables<Scalar>& last_start_a() const { return start_a_[fill_ - 1]; }
 
  private:
   class Function;
@@ -159,7 +162,7 @@ class ErrorRegression {
   NetworkState<Scalar> start_, end_, best_first_, best_end_;
   // Per window size n = 1..W (index n-1): objective and working A.
   std::vector<std::unique_ptr<WindowObjective<Scalar>>> objectives_;
-  std::vector<AdaptiveVariables<Scalar>> work_a_, best_a_;
+  std::vector<AdaptiveVariables<Scalar>> work_a_, best_a_, start_a_;
   std::unique_ptr<Function> function_;
   std::unique_ptr<WindowOptimizer<Scalar>> optimizer_;
   PriorGenerator<Scalar> generator_;

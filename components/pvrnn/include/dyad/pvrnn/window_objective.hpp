@@ -33,6 +33,12 @@ class WindowObjective {
   // terms live in this object until the next Evaluate.
   const LossTerms& Evaluate(const AdaptiveVariables<Scalar>& a, AdaptiveVariables<Scalar>* grad);
   const PosteriorPass<Scalar>& pass() const { return pass_; }
+  // The window as last set (benchmarks rebuild the same problem from these).
+  const Weights<Scalar>& weights() const { return weights_; }
+  const MatrixT<Scalar>& targets() const { return targets_; }
+  const MatrixT<Scalar>& eps() const { return eps_; }
+  const NetworkState<Scalar>& start() const { return start_; }
+  const std::vector<double>& meta_prior() const { return meta_prior_; }
 
  private:
   const Weights<Scalar>& weights_;
