@@ -38,7 +38,7 @@ constexpr int kHead = 1, kBeak = 2, kLeadIn = 72, kHuman = 100, kRelease = 100;
 struct Trace {
   std::vector<std::array<double, 2>> executed;
   std::vector<double> step_ms, loss;
-  std::vector<int> iterations;
+  std::vector<int> iterations, evaluations;
 };
 
 double Percentile(std::vector<double> v, double p) {
@@ -80,6 +80,7 @@ Trace Run(const Model& model, const Eigen::MatrixXd& beak, const ErrorRegression
       tr.step_ms.push_back(ms);
       tr.loss.push_back(r.loss.loss);
       tr.iterations.push_back(r.iterations);
+      tr.evaluations.push_back(r.evaluations);
     }
   }
   return tr;
@@ -144,26 +145,28 @@ int main(int argc, char** argv) {
   const Eigen::MatrixXd& beak = data->sequences[kBeak];
   std::printf("MacawBot, switching workload (%d human + %d release steps after a %d-step lead-in), %d runs, one thread\n\n",
               kHuman, kRelease, kLeadIn, runs);
-  std::printf("%-6s %-6s %-7s %10s %10s %10s %12s %11s\n", "window", "scalar", "optim", "median ms", "p99 ms", "it/step",
-              "of 100 ms", "mean loss");
+  std::printf("%-6s %-6s %-7s %10s %10s %8s %9s %12s %11s\n", "window", "scalar", "optim", "median ms", "p99 ms", "it/step",
+              "eval/step", "of 100 ms", "mean loss");
   double adam_float_median[2] = {0, 0};
   for (int wi = 0; wi < 2; ++wi) {
     const int window = wi == 0 ? 5 : 15;
     for (int si = 0; si < 2; ++si) {
       for (auto kind : {OptimizerKind::kAdam, OptimizerKind::kCeres}) {
         std::vector<double> ms;
-        double its = 0, loss = 0;
+        double its = 0, evals = 0, loss = 0;
         for (int r = 0; r < runs; ++r) {
           const Trace tr = si == 0 ? Run<float>(*model, beak, Options(window, kind), nullptr, 0)
                                    : Run<double>(*model, beak, Options(window, kind), nullptr, 0);
           ms.insert(ms.end(), tr.step_ms.begin(), tr.step_ms.end());
           for (int it : tr.iterations) its += it;
+          for (int e : tr.evaluations) evals += e;
           loss += Mean(tr.loss) / runs;
         }
         const double med = Percentile(ms, 0.5);
         if (si == 0 && kind == OptimizerKind::kAdam) adam_float_median[wi] = med;
-        std::printf("%-6d %-6s %-7s %10.4f %10.4f %10.1f %11.2f%% %11.5f\n", window, si == 0 ? "float" : "double",
-                    ToString(kind), med, Percentile(ms, 0.99), its / static_cast<double>(ms.size()), med / 100 * 100, loss);
+        std::printf("%-6d %-6s %-7s %10.4f %10.4f %8.1f %9.1f %11.2f%% %11.5f\n", window, si == 0 ? "float" : "double",
+                    ToString(kind), med, Percentile(ms, 0.99), its / static_cast<double>(ms.size()),
+                    evals / static_cast<double>(ms.size()), med / 100 * 100, loss);
       }
     }
   }
