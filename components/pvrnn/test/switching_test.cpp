@@ -185,5 +185,27 @@ TEST_F(Switching, WithoutTheHumanTheRobotKeepsTheHead) {
   EXPECT_EQ(f.head_after_release, 100);
 }
 
+// Not a check: prints the figures for presets x a_init x noise x optimiser, with and without the
+// lead-in and the human (how the defaults and the docs' statements were chosen). Run with
+// DYAD_SWITCH_EXPLORE=1 dyad_pvrnn_test --gtest_filter=Switching.Explore
+TEST_F(Switching, Explore) {
+  if (std::getenv("DYAD_SWITCH_EXPLORE") == nullptr) GTEST_SKIP() << "exploration; set DYAD_SWITCH_EXPLORE=1 to run";
+  for (int lead : {0, kLeadIn})
+    for (double gain : {0.0, 0.9})
+      for (const char* preset : {"vcbot", "reference"})
+        for (auto init : {AInit::kZero, AInit::kCopy, AInit::kPrior})
+          for (auto noise : {NoiseMode::kOff, NoiseMode::kFixed, NoiseMode::kResample})
+            for (auto opt : {OptimizerKind::kAdam, OptimizerKind::kCeres}) {
+              ErrorRegressionOptions o = *ErrorRegressionOptions::Preset(preset);
+              o.a_init = init;
+              o.noise = noise;
+              o.optimizer = opt;
+              char name[96];
+              std::snprintf(name, sizeof name, "lead %2d g %.1f %-9s %-5s %-8s %-5s", lead, gain, preset, ToString(init),
+                            ToString(noise), ToString(opt));
+              Print(name, Run(o, lead, gain));
+            }
+}
+
 }  // namespace
 }  // namespace dyad::pvrnn
