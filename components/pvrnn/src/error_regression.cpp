@@ -182,7 +182,7 @@ Status ErrorRegression<Scalar>::Reset(int start_primitive, uint64_t seed) {
     s->h.setZero();
     s->d.setZero();
   }
-  const auto kl = std::move(result_.loss.kl_per_layer);
+  std::vector<double> kl = std::move(result_.loss.kl_per_layer);  // keep its storage
   result_ = StepResult{};
   result_.loss.kl_per_layer = std::move(kl);
   std::fill(result_.loss.kl_per_layer.begin(), result_.loss.kl_per_layer.end(), 0.0);
