@@ -2,17 +2,23 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "dyad/pvrnn/analytic_dataset.hpp"
+#include "dyad/pvrnn/error_regression.hpp"
 #include "dyad/pvrnn/model_file.hpp"
 #include "dyad/pvrnn/nrl_import.hpp"
 #include "dyad/pvrnn/prior_generator.hpp"
@@ -203,6 +209,133 @@ int GenerateModel(const std::string& path, int primitive, int steps, const std::
   return kOk;
 }
 
+// A trajectory CSV: `x,y` rows without a header, or a header naming columns `x` and `y` (as
+// `dyad bag export` writes for CartesianState; other columns ignored). Errors: `file:line: ...`.
+StatusOr<std::vector<std::array<double, 2>>> ReadTrajectory(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Status::InvalidArgument(path + ": cannot open for reading");
+  std::vector<std::array<double, 2>> out;
+  std::string line;
+  int line_no = 0, col_x = 0, col_y = 1;
+  size_t min_cells = 2;
+  auto split = [](const std::string& l) {
+    std::vector<std::string> cells;
+    std::stringstream ss(l);
+    std::string c;
+    while (std::getline(ss, c, ',')) cells.push_back(c);
+    if (!l.empty() && l.back() == ',') cells.emplace_back();
+    return cells;
+  };
+  auto number = [](std::string c, double* v) {
+    while (!c.empty() && (c.back() == '\r' || c.back() == ' ')) c.pop_back();
+    while (!c.empty() && c.front() == ' ') c.erase(c.begin());
+    if (c.empty()) return false;
+    char* end = nullptr;
+    *v = std::strtod(c.c_str(), &end);
+    return end == c.c_str() + c.size() && std::isfinite(*v);
+  };
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line == "\r") continue;
+    const std::vector<std::string> cells = split(line);
+    double v = 0;
+    if (out.empty() && line_no == 1 && !number(cells[0], &v)) {  // a header
+      col_x = col_y = -1;
+      for (size_t i = 0; i < cells.size(); ++i) {
+        std::string c = cells[i];
+        while (!c.empty() && (c.back() == '\r' || c.back() == ' ')) c.pop_back();
+        if (c == "x") col_x = static_cast<int>(i);
+        if (c == "y") col_y = static_cast<int>(i);
+      }
+      if (col_x < 0 || col_y < 0)
+        return Status::InvalidArgument(path + ":1: header has no columns named x and y (got: " + line + ")");
+      min_cells = static_cast<size_t>(std::max(col_x, col_y)) + 1;
+      continue;
+    }
+    if (cells.size() < min_cells)
+      return Status::InvalidArgument(path + ":" + std::to_string(line_no) + ": expected at least " +
+                                     std::to_string(min_cells) + " comma-separated values, got " + std::to_string(cells.size()));
+    std::array<double, 2> xy{};
+    if (!number(cells[col_x], &xy[0]) || !number(cells[col_y], &xy[1]))
+      return Status::InvalidArgument(path + ":" + std::to_string(line_no) + ": x and y must be finite numbers, got '" +
+                                     cells[col_x] + "', '" + cells[col_y] + "'");
+    out.push_back(xy);
+  }
+  if (out.empty()) return Status::InvalidArgument(path + ": no positions (expected x,y rows)");
+  return out;
+}
+
+struct RegressArgs {
+  std::string model, trajectory, out, preset = "vcbot", optimizer, a_init, noise;
+  std::optional<int> window, iterations;
+  std::optional<double> lr, beta1, beta2;
+  int start_primitive = 0;
+  double budget_ms = 0;
+  std::vector<double> meta_prior;
+  uint64_t seed = 1;
+};
+
+int Regress(const RegressArgs& a) {
+  auto o = ErrorRegressionOptions::Preset(a.preset);
+  if (!o) return Fail(kBadInput, "--preset " + a.preset + ": must be vcbot or reference");
+  if (a.window) o->window = *a.window;
+  if (a.iterations) o->iterations = *a.iterations;
+  if (!a.optimizer.empty()) {
+    auto k = ParseOptimizerKind(a.optimizer);
+    if (!k) return Fail(kBadInput, "--optimizer " + a.optimizer + ": must be adam or ceres");
+    o->optimizer = *k;
+  }
+  if (!a.a_init.empty()) {
+    auto k = ParseAInit(a.a_init);
+    if (!k) return Fail(kBadInput, "--a-init " + a.a_init + ": must be zero, copy or prior");
+    o->a_init = *k;
+  }
+  if (!a.noise.empty()) {
+    auto k = ParseNoiseMode(a.noise);
+    if (!k) return Fail(kBadInput, "--noise " + a.noise + ": must be off, fixed or resample");
+    o->noise = *k;
+  }
+  if (a.lr) o->adam.lr = *a.lr;
+  if (a.beta1) o->adam.beta1 = *a.beta1;
+  if (a.beta2) o->adam.beta2 = *a.beta2;
+  if (!a.meta_prior.empty()) o->meta_prior = a.meta_prior;
+  if (a.budget_ms < 0) return Fail(kBadInput, "--budget-ms: must be >= 0 (0: no cap)");
+  auto model = LoadModel(a.model);
+  if (!model.ok()) return Fail(kBadInput, model.status().message());
+  if (model->spec.num_dofs() != 2)
+    return Fail(kBadInput, a.model + ": has " + std::to_string(model->spec.num_dofs()) + " DOFs; regress reads x,y (2)");
+  if (auto p = o->Problems(model->spec.num_layers()); !p.empty()) {
+    // Name the option as spelled on the command line.
+    std::string field = p.front().field;
+    for (auto& ch : field) if (ch == '_') ch = '-';
+    if (field.rfind("adam.", 0) == 0) field = field.substr(5);
+    return Fail(kBadInput, "--" + field + ": " + p.front().message);
+  }
+  auto trajectory = ReadTrajectory(a.trajectory);
+  if (!trajectory.ok()) return Fail(kBadInput, trajectory.status().message());
+  auto er = ErrorRegression<float>::Create(model.value(), o.value());
+  if (!er.ok()) return Fail(kBadInput, er.status().message());
+  if (Status s = (*er)->Reset(a.start_primitive, a.seed); !s.ok())
+    return Fail(kBadInput, "--" + std::string("start-primitive ") + std::to_string(a.start_primitive) + ": " + a.model +
+                               " has primitives 0.." + std::to_string(model->sequences() - 1));
+  std::FILE* f = a.out.empty() ? stdout : std::fopen(a.out.c_str(), "w");
+  if (f == nullptr) return Fail(kFailure, a.out + ": cannot open for writing");
+  std::fprintf(f, "step,executed_x,executed_y,intended_x,intended_y,nelbo,reconstruction,regulation,iterations,evaluations,time_ms\n");
+  std::fprintf(f, "-1,,,%.9g,%.9g,,,,0,0,0\n", (*er)->intention()[0], (*er)->intention()[1]);
+  for (const auto& xy : trajectory.value()) {
+    const auto deadline = a.budget_ms > 0
+                              ? SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                                                         std::chrono::duration<double, std::milli>(a.budget_ms))
+                              : SteadyClock::time_point::max();
+    const StepResult& r = (*er)->Step(xy.data(), deadline);
+    std::fprintf(f, "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%.6f\n", static_cast<long long>(r.step), xy[0], xy[1],
+                 r.intention[0], r.intention[1], r.loss.loss, r.loss.reconstruction, r.loss.regulation, r.iterations,
+                 r.evaluations, 1e3 * r.optimisation_s);
+  }
+  if (f != stdout && std::fclose(f) != 0) return Fail(kFailure, a.out + ": write failed");
+  return kOk;
+}
+
 }  // namespace
 
 void AddPvrnnCommands(CLI::App& app, int& exit_code) {
@@ -255,6 +388,27 @@ void AddPvrnnCommands(CLI::App& app, int& exit_code) {
       exit_code = s.ok() ? kOk : Fail(kFailure, s.message());
       if (s.ok()) std::printf("wrote 7 primitives x 72 steps to %s\n", dir->c_str());
     });
+  }
+  {
+    auto* cmd = app.add_subcommand("regress", "Offline error regression over a trajectory CSV (x,y per step); per-step CSV out");
+    auto a = std::make_shared<RegressArgs>();
+    cmd->add_option("model", a->model, "Model file (.dpvrnn)")->required();
+    cmd->add_option("trajectory", a->trajectory, "Executed positions: x,y rows, or a CSV with columns named x and y (dyad bag export)")->required();
+    cmd->add_option("-o,--output", a->out, "Per-step CSV (default: stdout)");
+    cmd->add_option("--preset", a->preset, "vcbot (W 5, 15 it, Adam 0.3/0.1/0.95, w 1e-5) or reference (W 15, 15 it, Adam 0.1, training w)");
+    cmd->add_option("--window", a->window, "Window W (default: the preset's)");
+    cmd->add_option("--iterations", a->iterations, "Optimiser iterations per step (default: the preset's)");
+    cmd->add_option("--optimizer", a->optimizer, "adam or ceres");
+    cmd->add_option("--lr", a->lr, "Adam step size");
+    cmd->add_option("--beta1", a->beta1, "Adam beta1");
+    cmd->add_option("--beta2", a->beta2, "Adam beta2");
+    cmd->add_option("--meta-prior", a->meta_prior, "Online meta-prior per layer, e.g. --meta-prior 1e-5 1e-5")->expected(1, 100);
+    cmd->add_option("--a-init", a->a_init, "A of the newest window step: zero, copy or prior (default prior)");
+    cmd->add_option("--noise", a->noise, "off, fixed or resample (default off)");
+    cmd->add_option("--start-primitive", a->start_primitive, "Primitive the robot starts on (default 0)");
+    cmd->add_option("--seed", a->seed, "Noise seed (default 1)");
+    cmd->add_option("--budget-ms", a->budget_ms, "Wall-time cap per step in ms (default: none)");
+    cmd->callback([&exit_code, a] { exit_code = Regress(*a); });
   }
 }
 

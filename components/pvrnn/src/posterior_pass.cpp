@@ -98,9 +98,12 @@ template <typename Scalar>
 void PosteriorPass<Scalar>::Backward(Weights<Scalar>* grad_w, AdaptiveVariables<Scalar>* grad_a) {
   const int S = sequences_, td = layout_.total_d(), tz = layout_.total_z(), d0 = layout_.d0();
   const Weights<Scalar>& w = *w_;
-  r_t_ = w.R().transpose();
-  wz_t_ = w.Wz().transpose();
-  wx_t_ = w.Wx().transpose();
+  if (!weights_frozen_ || transposed_ != &w) {
+    r_t_ = w.R().transpose();
+    wz_t_ = w.Wz().transpose();
+    wx_t_ = w.Wx().transpose();
+    transposed_ = &w;
+  }
   const Scalar inv_dofs = Scalar(1) / static_cast<Scalar>(layout_.spec().num_dofs());
   g_out_ = (x_ - *targets_) * inv_dofs;
   g_d0_.noalias() = wx_t_ * g_out_;
@@ -119,7 +122,10 @@ void PosteriorPass<Scalar>::Backward(Weights<Scalar>* grad_w, AdaptiveVariables<
                .matrix();
     auto gp = g_pre_.middleCols(c0, S);
     gp.topRows(td) = (g_h_.array().colwise() * rate_.array()).matrix();
-    g_z_.noalias() = wz_t_.lazyProduct(gp.topRows(td));
+    if (S == 1)  // GEMV (see StepForward)
+      g_z_.col(0).noalias() = wz_t_ * gp.col(0).head(td);
+    else
+      g_z_.noalias() = wz_t_.lazyProduct(gp.topRows(td));
     const auto mup = mu_p_.middleCols(c0, S).array();
     const auto muq = mu_q_.middleCols(c0, S).array();
     const auto sp = sig_p_.middleCols(c0, S).array();
@@ -137,7 +143,10 @@ void PosteriorPass<Scalar>::Backward(Weights<Scalar>* grad_w, AdaptiveVariables<
         ((Scalar(1) - (diff.square() + sq.square()) * inv_vp).colwise() * c).matrix();
     a_mu_g.middleCols(c0, S) = gp.middleRows(zq, tz);
     a_ls_g.middleCols(c0, S) = gp.middleRows(zlq, tz);
-    g_start_d_.noalias() = r_t_.lazyProduct(gp);
+    if (S == 1)
+      g_start_d_.col(0).noalias() = r_t_ * gp.col(0);
+    else
+      g_start_d_.noalias() = r_t_.lazyProduct(gp);
     g_h_next_ = g_h_;
   }
   g_start_h_ = (g_h_next_.array().colwise() * keep_.array()).matrix();

@@ -42,4 +42,43 @@ Eigen::MatrixXd DecodePositions(const OutputEncoding& enc, const Eigen::MatrixXd
   return pos;
 }
 
+template <typename Scalar>
+void EncodePosition(const OutputEncoding& enc, const double* position, Scalar* code) {
+  int off = 0;
+  const double inv_s2 = 1.0 / (enc.sigma * enc.sigma);
+  for (int dof = 0; dof < static_cast<int>(enc.dofs.size()); ++dof) {
+    const int n = enc.UnitsFor(dof);
+    const double lo = enc.dofs[dof].min, span = enc.dofs[dof].max - lo;
+    const double v = (position[dof] - lo) / span;
+    double sum = 0;
+    for (int i = 0; i < n; ++i) {
+      const double r = static_cast<double>(i) / (n - 1);
+      sum += std::exp(-(r - v) * (r - v) * inv_s2);
+    }
+    for (int i = 0; i < n; ++i) {
+      const double r = static_cast<double>(i) / (n - 1);
+      code[off + i] = static_cast<Scalar>(std::exp(-(r - v) * (r - v) * inv_s2) / sum);
+    }
+    off += n;
+  }
+}
+
+template <typename Scalar>
+void DecodePosition(const OutputEncoding& enc, const Scalar* code, double* position) {
+  int off = 0;
+  for (int dof = 0; dof < static_cast<int>(enc.dofs.size()); ++dof) {
+    const int n = enc.UnitsFor(dof);
+    const double lo = enc.dofs[dof].min, span = enc.dofs[dof].max - lo;
+    double v = 0;
+    for (int i = 0; i < n; ++i) v += static_cast<double>(code[off + i]) * static_cast<double>(i) / (n - 1);
+    position[dof] = lo + span * v;
+    off += n;
+  }
+}
+
+template void EncodePosition(const OutputEncoding&, const double*, float*);
+template void EncodePosition(const OutputEncoding&, const double*, double*);
+template void DecodePosition(const OutputEncoding&, const float*, double*);
+template void DecodePosition(const OutputEncoding&, const double*, double*);
+
 }  // namespace dyad::pvrnn

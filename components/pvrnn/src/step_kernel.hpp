@@ -37,7 +37,12 @@ inline void StepForward(const RMat& r, const BVec& rbias, const WzMat& wz, const
                         In<Scalar> eps, Out<Scalar> pre, Out<Scalar> mu_p, Out<Scalar> ls_p,
                         Out<Scalar> sig_p, Out<Scalar> mu_q, Out<Scalar> ls_q, Out<Scalar> sig_q,
                         Out<Scalar> z, Out<Scalar> h, Out<Scalar> d) {
-  pre.noalias() = r.lazyProduct(d_prev);
+  // One column (online regression, generation): GEMV, whose independent accumulators beat the
+  // lazy product's single FMA chain (measured 1.4x on 70x50 float); several: the lazy product.
+  if (d_prev.cols() == 1)
+    pre.col(0).noalias() = r * d_prev.col(0);
+  else
+    pre.noalias() = r.lazyProduct(d_prev);
   pre.colwise() += rbias;
   const int zp = total_d, zlp = total_d + total_z, zq = total_d + 2 * total_z,
             zlq = total_d + 3 * total_z;
@@ -53,7 +58,10 @@ inline void StepForward(const RMat& r, const BVec& rbias, const WzMat& wz, const
     z = (mu_p.array() + sig_p.array() * eps.array()).matrix();
   }
   auto u = pre.topRows(total_d);
-  u.noalias() += wz.lazyProduct(z);
+  if (z.cols() == 1)
+    u.col(0).noalias() += wz * z.col(0);
+  else
+    u.noalias() += wz.lazyProduct(z);
   h = ((h_prev.array().colwise() * keep.array()) + (u.array().colwise() * rate.array())).matrix();
   d = h.array().tanh().matrix();
 }

@@ -5,6 +5,7 @@ namespace dyad::pvrnn {
 template <typename Scalar>
 WindowObjective<Scalar>::WindowObjective(const Weights<Scalar>& weights, int window)
     : weights_(weights), window_(window), pass_(weights.layout(), window, 1) {
+  pass_.AssumeWeightsFrozen();
   const auto& l = weights.layout();
   targets_ = MatrixT<Scalar>::Zero(l.output_units(), window);
   eps_ = MatrixT<Scalar>::Zero(l.total_z(), window);
@@ -13,9 +14,9 @@ WindowObjective<Scalar>::WindowObjective(const Weights<Scalar>& weights, int win
 }
 
 template <typename Scalar>
-void WindowObjective<Scalar>::SetWindow(const MatrixT<Scalar>& targets,
+void WindowObjective<Scalar>::SetWindow(const Eigen::Ref<const MatrixT<Scalar>>& targets,
                                         const NetworkState<Scalar>& start,
-                                        const MatrixT<Scalar>& eps,
+                                        const Eigen::Ref<const MatrixT<Scalar>>& eps,
                                         const std::vector<double>& meta_prior) {
   targets_ = targets;
   start_.h = start.h;

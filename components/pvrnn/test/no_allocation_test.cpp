@@ -1,5 +1,6 @@
 // The hot loops promise no heap allocation: Trainer::Epoch (training), PriorGenerator::Step
-// (generation) and WindowObjective::Evaluate (online error regression, issue 4). This binary
+// (generation), WindowObjective::Evaluate and ErrorRegression::Step with Adam (online error
+// regression, issue 4). This binary
 // replaces the global operator new to count allocations while one of them runs.
 #include <gtest/gtest.h>
 
@@ -8,6 +9,7 @@
 #include <new>
 
 #include "dyad/pvrnn/analytic_dataset.hpp"
+#include "dyad/pvrnn/error_regression.hpp"
 #include "dyad/pvrnn/prior_generator.hpp"
 #include "dyad/pvrnn/trainer.hpp"
 #include "dyad/pvrnn/window_objective.hpp"
@@ -66,6 +68,22 @@ TEST(NoAllocation, WindowObjectiveEvaluateAllocatesNothing) {
   AdaptiveVariables<float> a(tz, window, 1), g(tz, window, 1);
   f.Evaluate(a, &g);
   EXPECT_EQ(CountAllocations([&] { f.Evaluate(a, &g); }), 0);
+}
+
+// The deliberation step with Adam: nothing allocated once every window size has been seen.
+TEST(NoAllocation, ErrorRegressionStepWithAdamAllocatesNothing) {
+  for (auto noise : {NoiseMode::kOff, NoiseMode::kFixed, NoiseMode::kResample})
+    for (auto init : {AInit::kZero, AInit::kCopy, AInit::kPrior}) {
+      ErrorRegressionOptions o = ErrorRegressionOptions::Reference();
+      o.noise = noise;
+      o.a_init = init;
+      auto er = ErrorRegression<float>::Create(Model::Initialize(ModelSpec::MacawBot(), 72, 7, 1), o).value();
+      ASSERT_TRUE(er->Reset(1, 1).ok());
+      const double xy[2] = {1, 2};
+      for (int t = 0; t < o.window + 1; ++t) er->Step(xy);
+      EXPECT_EQ(CountAllocations([&] { for (int t = 0; t < 5; ++t) er->Step(xy); }), 0)
+          << ToString(noise) << "/" << ToString(init);
+    }
 }
 
 }  // namespace

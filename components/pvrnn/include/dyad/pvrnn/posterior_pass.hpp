@@ -54,6 +54,9 @@ class PosteriorPass {
 
   int steps() const { return steps_; }
   int sequences() const { return sequences_; }
+  // Promise that the weights passed to Forward neither change nor move from now on (online
+  // error regression: weights frozen). Backward then transposes them once instead of per call.
+  void AssumeWeightsFrozen() { weights_frozen_ = true; }
 
   // The returned terms live in this pass until the next Forward.
   const LossTerms& Forward(const Weights<Scalar>& weights, const AdaptiveVariables<Scalar>& a,
@@ -83,6 +86,8 @@ class PosteriorPass {
   const MatrixT<Scalar>* eps_ = nullptr;
   const MatrixT<Scalar>* targets_ = nullptr;
   LossTerms terms_;  // kl_per_layer sized once: Forward allocates nothing
+  bool weights_frozen_ = false;
+  const Weights<Scalar>* transposed_ = nullptr;  // weights whose transposes r_t_, wz_t_, wx_t_ hold
   VectorT<Scalar> rate_, keep_, kl_coef_;
   MatrixT<Scalar> r_t_, wz_t_, wx_t_;      // transposed copies for the backward products
   MatrixT<Scalar> r_maskf_, wz_maskf_;

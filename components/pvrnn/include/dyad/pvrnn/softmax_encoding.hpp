@@ -16,4 +16,11 @@ Eigen::MatrixXd EncodePositions(const OutputEncoding& enc, const Eigen::MatrixXd
 // codes: TotalUnits() x N. Returns num_dofs x N positions.
 Eigen::MatrixXd DecodePositions(const OutputEncoding& enc, const Eigen::MatrixXd& codes);
 
+// One sample, no allocation (the online path): `position` has num_dofs entries, `code`
+// TotalUnits() entries. Same numbers as the matrix versions.
+template <typename Scalar>
+void EncodePosition(const OutputEncoding& enc, const double* position, Scalar* code);
+template <typename Scalar>
+void DecodePosition(const OutputEncoding& enc, const Scalar* code, double* position);
+
 }  // namespace dyad::pvrnn

@@ -20,18 +20,25 @@ namespace dyad::pvrnn {
 template <typename Scalar>
 class WindowObjective {
  public:
-  // `weights` must outlive this object.
+  // `weights` must outlive this object and stay unchanged (its transposes are cached).
   WindowObjective(const Weights<Scalar>& weights, int window);
 
   int window() const { return window_; }
   // targets: output_units x W softmax codes of the observed positions; start: total_d x 1;
-  // eps: total_z x W (zeros = means only); meta_prior: one per layer.
-  void SetWindow(const MatrixT<Scalar>& targets, const NetworkState<Scalar>& start,
-                 const MatrixT<Scalar>& eps, const std::vector<double>& meta_prior);
+  // eps: total_z x W (zeros = means only); meta_prior: one per layer. Blocks of larger
+  // matrices (e.g. `m.leftCols(W)`) are accepted without a copy; no allocation.
+  void SetWindow(const Eigen::Ref<const MatrixT<Scalar>>& targets, const NetworkState<Scalar>& start,
+                 const Eigen::Ref<const MatrixT<Scalar>>& eps, const std::vector<double>& meta_prior);
   // a: total_z x W (one sequence). grad may be null (loss only). No allocation. The returned
   // terms live in this object until the next Evaluate.
   const LossTerms& Evaluate(const AdaptiveVariables<Scalar>& a, AdaptiveVariables<Scalar>* grad);
   const PosteriorPass<Scalar>& pass() const { return pass_; }
+  // The window as last set (benchmarks rebuild the same problem from these).
+  const Weights<Scalar>& weights() const { return weights_; }
+  const MatrixT<Scalar>& targets() const { return targets_; }
+  const MatrixT<Scalar>& eps() const { return eps_; }
+  const NetworkState<Scalar>& start() const { return start_; }
+  const std::vector<double>& meta_prior() const { return meta_prior_; }
 
  private:
   const Weights<Scalar>& weights_;

@@ -1,0 +1,219 @@
+// The deliberator component: configured through a fake Context (params, ports), and run in a
+// stepped graph by the real `dyad` executable with test components around it.
+#include "deliberator.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "dyad/pvrnn/model_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace dyad::deliberator {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// A fake runtime: declared params with defaults, ports bound to in-memory endpoints.
+
+class FakeClock final : public Clock {
+ public:
+  int64_t now_ns() const override { return 0; }
+};
+class FakeLogger final : public Logger {
+ public:
+  void Write(Level, std::string_view m) override { lines.emplace_back(m); }
+  std::vector<std::string> lines;
+};
+class QueueReader final : public detail::ReaderEndpoint {
+ public:
+  bool TakeNext(void* sample) override {
+    if (queue.empty()) return false;
+    *static_cast<msg::CartesianState*>(sample) = queue.front();
+    queue.pop_front();
+    return true;
+  }
+  std::deque<msg::CartesianState> queue;
+};
+class VectorWriter final : public detail::WriterEndpoint {
+ public:
+  Status Write(const void* sample) override {
+    samples.push_back(*static_cast<const msg::Intention*>(sample));
+    return Status::OK();
+  }
+  std::vector<msg::Intention> samples;
+};
+
+class FakeContext final : public Context {
+ public:
+  explicit FakeContext(std::map<std::string, ParamValue> overrides) {
+    ComponentSpec spec;
+    Deliberator::Describe(spec);
+    std::map<std::string, ParamValue> values;
+    for (const auto& p : spec.params())
+      if (p.default_value) values[p.name] = *p.default_value;
+    for (auto& [k, v] : overrides) values[k] = v;
+    params_ = Params(values);
+    executed_.Bind("executed", "robot/state", &reader);
+    intention_.Bind("intention", "robot/intention", "mind", &writer, &clock_);
+  }
+  const std::string& name() const override { return name_; }
+  const Params& params() const override { return params_; }
+  const Clock& clock() const override { return clock_; }
+  Logger& log() override { return logger; }
+  uint64_t seed() const override { return 7; }
+  int64_t period_ns() const override { return 100'000'000; }
+  void RequestStop(std::string) override {}
+  size_t Poll() { return executed_.Poll(0); }
+
+  QueueReader reader;
+  VectorWriter writer;
+  FakeLogger logger;
+
+ protected:
+  InputBase* FindInput(std::string_view, const TypeInfo&) override { return &executed_; }
+  OutputBase* FindOutput(std::string_view, const TypeInfo&) override { return &intention_; }
+
+ private:
+  std::string name_ = "mind";
+  Params params_;
+  FakeClock clock_;
+  Input<msg::CartesianState> executed_;
+  Output<msg::Intention> intention_;
+};
+
+// A random MacawBot-shaped model file (no data needed).
+std::string RandomModelFile() {
+  static const std::string path = [] {
+    const std::string p = (fs::temp_directory_path() / ("dyad_deliberator_test_" + std::to_string(getpid()) + ".dpvrnn")).string();
+    EXPECT_TRUE(pvrnn::SaveModel(pvrnn::Model::Initialize(pvrnn::ModelSpec::MacawBot(), 72, 7, 3), p).ok());
+    return p;
+  }();
+  return path;
+}
+
+TEST(Deliberator, PublishesAnIntentionEveryStepWithTheWindowLoss) {
+  FakeContext ctx({{"model", RandomModelFile()}, {"start_primitive", int64_t{2}}});
+  Deliberator d;
+  ASSERT_TRUE(d.Configure(ctx).ok());
+  for (int t = 0; t < 10; ++t) {
+    msg::CartesianState s;
+    s.x(t);
+    s.y(-t);
+    if (t > 0 && t != 5) ctx.reader.queue.push_back(s);  // none at step 5: own intention used
+    ctx.Poll();
+    ASSERT_TRUE(d.Step(StepInfo{0, static_cast<uint64_t>(t), 100'000'000}).ok());
+  }
+  ASSERT_EQ(ctx.writer.samples.size(), 10u);
+  EXPECT_EQ(ctx.writer.samples[0].iterations(), 0u);  // step 0: nothing executed yet
+  for (size_t i = 1; i < 10; ++i) {
+    const msg::Intention& r = ctx.writer.samples[i];
+    EXPECT_EQ(r.iterations(), 15u);
+    EXPECT_GT(r.nelbo(), 0);
+    EXPECT_NEAR(r.nelbo(), r.reconstruction() / 2 + r.regulation() / 5, 1e-6 * r.nelbo());
+    EXPECT_GT(r.optimisation_s(), 0);
+    EXPECT_FALSE(r.deadline_missed());
+    EXPECT_EQ(r.header().sequence_number(), i + 1);
+  }
+  EXPECT_EQ(d.steps_without_executed(), 1u);
+  EXPECT_EQ(d.deadline_misses(), 0u);
+}
+
+TEST(Deliberator, ATinyBudgetPublishesOnTimeAndCountsTheMisses) {
+  FakeContext ctx({{"model", RandomModelFile()}, {"time_budget_ms", 1e-6}, {"iterations", int64_t{1000}}});
+  Deliberator d;
+  ASSERT_TRUE(d.Configure(ctx).ok());
+  for (int t = 0; t < 5; ++t) ASSERT_TRUE(d.Step(StepInfo{0, static_cast<uint64_t>(t), 100'000'000}).ok());
+  ASSERT_EQ(ctx.writer.samples.size(), 5u);
+  EXPECT_TRUE(ctx.writer.samples[4].deadline_missed());
+  EXPECT_LE(ctx.writer.samples[4].iterations(), 1u);
+  EXPECT_EQ(d.deadline_misses(), 4u);
+  bool warned = false;
+  for (const auto& l : ctx.logger.lines) warned |= l.find("time cap") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST(Deliberator, CeresIsSelectedByParam) {
+  FakeContext ctx({{"model", RandomModelFile()}, {"optimizer", std::string("ceres")},
+                   {"ceres", std::string("{lbfgs_rank: 5}")}, {"preset", std::string("reference")}});
+  Deliberator d;
+  ASSERT_TRUE(d.Configure(ctx).ok());
+  for (int t = 0; t < 3; ++t) ASSERT_TRUE(d.Step(StepInfo{0, static_cast<uint64_t>(t), 100'000'000}).ok());
+  EXPECT_GE(ctx.writer.samples[2].iterations(), 1u);
+}
+
+struct BadParam {
+  std::map<std::string, ParamValue> params;
+  std::string message_start;
+};
+
+TEST(Deliberator, BadParamsGiveErrorsNamingTheParam) {
+  const std::string bad_file = (fs::temp_directory_path() / "dyad_deliberator_not_a_model.dpvrnn").string();
+  std::ofstream(bad_file) << "not a model";
+  const std::vector<BadParam> cases = {
+      {{{"model", std::string("/nonexistent/m.dpvrnn")}}, "params.model: /nonexistent/m.dpvrnn"},
+      {{{"model", bad_file}}, "params.model: " + bad_file},
+      {{{"start_primitive", int64_t{9}}}, "params.start_primitive: 9: "},
+      {{{"meta_prior", std::vector<double>{1e-5}}}, "params.meta_prior: needs one value per layer (2), got 1"},
+      {{{"adam", std::string("{lr: -1}")}}, "params.adam.lr: must be finite and > 0, got -1"},
+      {{{"adam", std::string("{learning_rate: 0.1}")}}, "params.adam.learning_rate: unknown key"},
+      {{{"adam", std::string("{lr: fast}")}}, "params.adam.lr: must be a number"},
+      {{{"ceres", std::string("[1, 2]")}}, "params.ceres: must be a map"},
+      {{{"ceres", std::string("{lbfgs_rank: 0}")}}, "params.ceres.lbfgs_rank: must be in 1..100, got 0"},
+  };
+  for (const auto& c : cases) {
+    std::map<std::string, ParamValue> p = c.params;
+    if (!p.count("model")) p["model"] = RandomModelFile();
+    FakeContext ctx(p);
+    Deliberator d;
+    const Status s = d.Configure(ctx);
+    ASSERT_FALSE(s.ok()) << c.message_start;
+    EXPECT_EQ(s.message().rfind(c.message_start, 0), 0u) << "got: " << s.message();
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The real thing: `dyad run` on a stepped graph (driver stand-in -> deliberator -> file).
+
+TEST(Deliberator, RunsInASteppedGraphAndPublishesEveryStep) {
+  const fs::path dir = fs::temp_directory_path() / ("dyad_deliberator_graph_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  const fs::path out = dir / "intentions.txt", graph = dir / "g.yaml";
+  std::ofstream(graph) << "graph: mind\nclock: stepped\nseed: 3\ndomain_id: " << (1 + getpid() % 200)
+                       << "\nplugins: [" << DYAD_DELIBERATOR_TEST_PLUGIN << "]\ncomponents:\n"
+                       << "  driver: {type: executed_script, rate_hz: 10, outputs: {state: robot/state}}\n"
+                       << "  mind:\n    type: deliberator\n    rate_hz: 10\n    params: {model: " << RandomModelFile()
+                       << ", start_primitive: 1, optimizer: adam}\n"
+                       << "    inputs: {executed: robot/state}\n    outputs: {intention: robot/intention}\n"
+                       << "  sink: {type: intention_file, trigger: in, params: {file: " << out.string()
+                       << "}, inputs: {in: robot/intention}}\n"
+                       << "topics:\n  robot/state: {type: CartesianState, depth: 4}\n"
+                       << "  robot/intention: {type: Intention, depth: 4}\n";
+  const std::string cmd = std::string(DYAD_EXE) + " run " + graph.string() + " --steps 40 > " + (dir / "log").string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << std::ifstream(dir / "log").rdbuf();
+  std::ifstream in(out);
+  std::string line;
+  int lines = 0, optimised = 0;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    double x, y, nelbo;
+    unsigned it;
+    int missed;
+    ASSERT_TRUE(s >> x >> y >> nelbo >> it >> missed) << line;
+    EXPECT_TRUE(std::isfinite(x) && std::isfinite(y));
+    EXPECT_EQ(missed, 0);
+    optimised += it > 0;
+    ++lines;
+  }
+  EXPECT_GE(lines, 39);
+  EXPECT_GE(optimised, 38);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace dyad::deliberator
