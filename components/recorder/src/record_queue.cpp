@@ -5,7 +5,8 @@
 
 namespace dyad::recorder {
 
-RecordQueue::RecordQueue(size_t capacity_bytes) : arena_bytes_(std::max<size_t>(capacity_bytes / 2, 1024)) {
+RecordQueue::RecordQueue(size_t capacity_bytes)
+    : arena_bytes_(std::max<size_t>(capacity_bytes / 2, 1024)), wake_bytes_(std::min<size_t>(arena_bytes_ / 4, 256 * 1024)) {
   filling_.bytes_.reserve(arena_bytes_);
 }
 
@@ -28,7 +29,9 @@ bool RecordQueue::Push(const RecordEntry& entry, std::span<const uint8_t> payloa
   if (!payload.empty()) std::memcpy(b.data() + at + sizeof e, payload.data(), payload.size());
   ++filling_.count_;
   high_water_ = std::max(high_water_, b.size());
-  if (consumer_waiting_) {
+  // Wake an idle consumer only once there is a worthwhile batch: a wake-up per sample would cost
+  // the publisher a futex call each time. Below the threshold the consumer's timeout collects it.
+  if (consumer_waiting_ && b.size() >= wake_bytes_) {
     consumer_waiting_ = false;
     not_empty_.notify_one();
   }
@@ -39,9 +42,9 @@ bool RecordQueue::TakeBatch(RecordBatch* batch, int timeout_ms) {
   batch->bytes_.clear();
   batch->count_ = 0;
   std::unique_lock<std::mutex> lock(mutex_);
-  if (filling_.bytes_.empty() && !closed_) {
+  if (filling_.bytes_.size() < wake_bytes_ && !closed_) {
     consumer_waiting_ = true;
-    not_empty_.wait_for(lock, std::chrono::milliseconds(timeout_ms), [&] { return closed_ || !filling_.bytes_.empty(); });
+    not_empty_.wait_for(lock, std::chrono::milliseconds(timeout_ms), [&] { return closed_ || filling_.bytes_.size() >= wake_bytes_; });
     consumer_waiting_ = false;
   }
   if (filling_.bytes_.empty()) return !closed_;

@@ -6,8 +6,9 @@
 /// the filling arena full waits until the consumer swaps (back-pressure on the publisher rather
 /// than loss). A single record larger than an arena is accepted into an empty arena, which grows.
 ///
-/// Steady state does not allocate (the arenas keep their capacity). The consumer is woken only
-/// when it is idle, not on every push, so a push costs a lock, a memcpy and an unlock.
+/// Steady state does not allocate (the arenas keep their capacity). An idle consumer is woken
+/// only once a quarter of an arena (at most 256 KiB) has filled, or by its own timeout, never per
+/// push: a push costs a lock, a memcpy and an unlock.
 ///
 /// Thread-safety: Push() from any number of threads; TakeBatch() from one consumer thread.
 #pragma once
@@ -62,8 +63,8 @@ class RecordQueue {
   // the caller must care about) only after Close().
   bool Push(const RecordEntry& entry, std::span<const uint8_t> payload);
 
-  // Waits up to `timeout_ms` for records (or Close()), then swaps them into *batch (whose previous
-  // contents are discarded). Returns false when the queue is closed and empty: the consumer is done.
+  // Waits up to `timeout_ms` for a worthwhile batch (or Close()), then swaps what there is into
+  // *batch (whose previous contents are discarded); the timeout bounds the hand-over latency. Returns false when the queue is closed and empty: the consumer is done.
   bool TakeBatch(RecordBatch* batch, int timeout_ms);
 
   // After Close(), Push() refuses and TakeBatch() returns what is left, then false.
@@ -75,6 +76,7 @@ class RecordQueue {
 
  private:
   const size_t arena_bytes_;
+  const size_t wake_bytes_;
   mutable std::mutex mutex_;
   std::condition_variable not_empty_, not_full_;
   RecordBatch filling_;

@@ -134,7 +134,7 @@ void Recorder::WriterLoop() {
   using Clock = std::chrono::steady_clock;
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(flush_period_s_));
   auto next_flush = Clock::now() + period;
-  while (queue_->TakeBatch(&batch, 50)) {
+  while (queue_->TakeBatch(&batch, 20)) {
     if (!failed_.load(std::memory_order_relaxed)) {
       batch.ForEach([&](const RecordEntry& e, std::span<const uint8_t> data) {
         if (failed_.load(std::memory_order_relaxed)) return;
