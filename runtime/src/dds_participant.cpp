@@ -152,7 +152,17 @@ bool DdsReader::TakeNext(void* sample) {
 
 uint64_t DdsReader::Unread() const { return reader_->get_unread_count(); }
 
+namespace {
+// A reliable writer deleted with samples in flight loses them for remote readers (a recorder in
+// another process): give acknowledgments a moment first. Returns at once when all are acked,
+// when nothing matched, or for best-effort writers.
+void AwaitAcks(fdds::DataWriter* w) {
+  if (w != nullptr) w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0.5));
+}
+}  // namespace
+
 DdsWriter::~DdsWriter() {
+  AwaitAcks(writer_);
   if (on_delete_) on_delete_();
 }
 
@@ -243,6 +253,7 @@ void DdsSerializedReader::Drain() {
 
 DdsSerializedWriter::DdsSerializedWriter() = default;
 DdsSerializedWriter::~DdsSerializedWriter() {
+  AwaitAcks(writer_);
   if (on_delete_) on_delete_();
 }
 
