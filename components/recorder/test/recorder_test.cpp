@@ -266,6 +266,19 @@ class RecorderTest : public ::testing::Test {
     return "";
   }
 
+  // Decodes every message with Foxglove's omgidl parser and CDR reader (decode_omgidl.mjs).
+  // Returns "" or what went wrong.
+  std::string DecodeWithFoxglove(const fs::path& file) {
+    const std::string node = DYAD_NODE;
+    if (node.empty() || node.find("NOTFOUND") != std::string::npos) return "node not found: install Node.js >= 18";
+    if (!fs::exists(fs::path(DYAD_NODE_DIR) / "node_modules/@foxglove/omgidl-serialization/package.json"))
+      return std::string("@foxglove/omgidl-serialization missing: run `npm ci --prefix ") + DYAD_NODE_DIR + "`";
+    Child c({node, std::string(DYAD_NODE_DIR) + "/decode_omgidl.mjs", file.string()}, dir_, "foxglove" + std::to_string(runs_++));
+    const int code = c.Wait(60);
+    if (code != 0) return "Foxglove's decoder failed (exit " + std::to_string(code) + "): " + c.err() + c.out();
+    return "";
+  }
+
   fs::path dir_;
   int domain_ = 1;
   int runs_ = 0;
@@ -313,6 +326,7 @@ TEST_F(RecorderTest, SteppedGraphRecordsEverySampleOfThreePublishersReadBackByMc
   EXPECT_TRUE(has_graph);
   EXPECT_EQ(CheckWithNode(file, r, false), "");
   EXPECT_EQ(CheckWithNode(file, r, true), "");
+  EXPECT_EQ(DecodeWithFoxglove(file), "") << "every message decodes with its omgidl schema, header sequence = MCAP sequence";
 }
 
 TEST_F(RecorderTest, SteppedRecordingsOfTheSameGraphAreByteIdentical) {
