@@ -1,7 +1,137 @@
 #include "analyze_commands.hpp"
 
-namespace dyad::cli {
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
-void AddAnalyzeCommands(CLI::App& /*app*/, int& /*exit_code*/) {}
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dyad/mcap/reader.hpp"
+#include "experiment_analysis.hpp"
+#include "recording_tables.hpp"
+#include "report_writer.hpp"
+
+extern char** environ;
+
+namespace dyad::cli {
+namespace {
+
+constexpr int kOk = 0, kFailure = 1, kBadInput = 2;
+
+struct Options {
+  std::string recording, out, dataset;
+  bool plots = true;
+};
+
+// share/dyad/plot_report.py next to the executable's bin/ (build tree and installed tree alike).
+std::string PlotScript() {
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return {};
+  return (exe.parent_path().parent_path() / "share" / "dyad" / "plot_report.py").string();
+}
+
+// Runs argv, waits; returns its exit status (127 when it cannot start).
+int Spawn(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return 127;
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0) return 127;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+int RunAnalyze(const Options& o) {
+  if (!o.dataset.empty() && !std::filesystem::is_directory(o.dataset)) {
+    std::cerr << "dyad analyze: --dataset " << o.dataset << ": not a folder\n";
+    return kBadInput;
+  }
+  auto reader = mcap::Reader::Open(o.recording);
+  if (!reader.ok()) {
+    std::cerr << "dyad analyze: " << reader.status().message() << "\n";
+    return kBadInput;
+  }
+  if (reader->recovery().truncated) std::cerr << "dyad analyze: " << o.recording << ": " << reader->recovery().Describe() << "\n";
+  analyze::Report report;
+  report.recording = o.recording;
+  report.graph_yaml = analyze::GraphYaml(*reader);
+  auto plan = analyze::PlanFromGraphYaml(report.graph_yaml);
+  if (!plan.ok()) {
+    std::cerr << "dyad analyze: " << o.recording << ": " << plan.status().message() << "\n";
+    return kBadInput;
+  }
+  report.plan = *plan;
+  auto tables = analyze::ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels"});
+  if (!tables.ok()) {
+    std::cerr << "dyad analyze: " << tables.status().message() << "\n";
+    return kBadInput;
+  }
+  auto timeline = analyze::BuildTimeline(*tables, report.plan);
+  if (!timeline.ok()) {
+    std::cerr << "dyad analyze: " << o.recording << ": " << timeline.status().message() << "\n";
+    return kBadInput;
+  }
+  report.timeline = std::move(*timeline);
+  const auto events = analyze::Events(report.timeline, report.plan);
+  report.events = analyze::SummariseEvents(report.timeline, events);
+  report.confusion = analyze::HumanConfusion(report.timeline, events);
+
+  std::string out = o.out;
+  if (out.empty()) {
+    std::filesystem::path p(o.recording);
+    out = (p.parent_path() / (p.stem().string() + "_report")).string();
+  }
+  if (Status s = analyze::WriteReport(report, out); !s.ok()) {
+    std::cerr << "dyad analyze: " << s.message() << "\n";
+    return kFailure;
+  }
+  std::cout << "report: " << out << "/report.md (" << report.timeline.steps.size() << " steps, "
+            << report.events.size() << " events)\n";
+  if (!o.plots) return kOk;
+  const std::string script = PlotScript();
+  if (script.empty() || !std::filesystem::exists(script)) {
+    std::cerr << "dyad analyze: plot script not found at " << script << "\n";
+    return kFailure;
+  }
+  // Debian's interpreter first: python3-matplotlib is installed for it, whatever else is on PATH.
+  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  std::vector<std::string> args = {python, script, out};
+  std::string dataset = o.dataset.empty() ? report.plan.dataset : o.dataset;
+  if (!dataset.empty()) {
+    if (std::filesystem::is_directory(dataset)) {
+      args.push_back("--dataset");
+      args.push_back(dataset);
+    } else {
+      std::cerr << "dyad analyze: the graph's dataset " << dataset
+                << " is not a folder from here; plots drawn without the watermark (pass --dataset)\n";
+    }
+  }
+  const int code = Spawn(args);
+  if (code != 0) {
+    std::cerr << "dyad analyze: " << script << " failed (exit " << code
+              << "); is python3-matplotlib installed (tools/setup.sh)?\n";
+    return kFailure;
+  }
+  std::cout << "plots: " << out << "/workspace.png, nelbo.png, congruence.png\n";
+  return kOk;
+}
+
+}  // namespace
+
+void AddAnalyzeCommands(CLI::App& app, int& exit_code) {
+  auto options = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("analyze", "Write a report folder (tables, PNG plots) for an experiment recording");
+  cmd->add_option("recording", options->recording, "MCAP file written by the recorder")->required();
+  cmd->add_option("-o,--out", options->out, "report folder (default: RECORDING without .mcap + _report)");
+  cmd->add_option("--dataset", options->dataset, "data set folder drawn as watermark (default: the graph's human dataset)");
+  cmd->add_flag("!--no-plots", options->plots, "write tables only");
+  cmd->callback([options, &exit_code] { exit_code = RunAnalyze(*options); });
+}
 
 }  // namespace dyad::cli

@@ -1,7 +1,11 @@
-// tools/analyze/analyze_commands.hpp: the analysis subcommands of the `dyad` CLI.
+// tools/analyze/analyze_commands.hpp: the analysis subcommand of the `dyad` CLI.
 //
-// Each subcommand's callback stores its process exit code in `exit_code`: 0 success,
-// 1 runtime failure, 2 bad input or usage.
+//   dyad analyze RECORDING.mcap [-o DIR] [--dataset DIR] [--no-plots]
+//
+// Writes a report folder (see report_writer.hpp): report.md with the events table and the
+// observer's confusion on the human's traces, CSV tables, and PNG plots drawn by
+// share/dyad/plot_report.py (python3-matplotlib). Default DIR: RECORDING without ".mcap" + "_report".
+// Exit code (stored in `exit_code`): 0 success, 1 runtime failure (plots), 2 bad input.
 #pragma once
 
 #include <CLI/CLI.hpp>

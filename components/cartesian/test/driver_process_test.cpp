@@ -1,0 +1,383 @@
+// Process-level tests of the drivers: real `dyad run` processes, and dyad_fake_controller on
+// loopback for udp_cartesian (lost, late, out-of-order and malformed packets).
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A started child process with stdout/stderr in files; killed if still running at the end.
+class Child {
+ public:
+  Child(std::vector<std::string> args, const fs::path& dir, const std::string& tag)
+      : out_(dir / (tag + ".out")), err_(dir / (tag + ".err")) {
+    pid_ = fork();
+    if (pid_ == 0) {
+      const int o = open(out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      const int e = open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(o, 1);
+      dup2(e, 2);
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+  }
+  ~Child() {
+    if (pid_ > 0 && !done_) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  void Signal(int sig) { kill(pid_, sig); }
+  // Exit code (128+signal if killed), or -1 if still running after `timeout_s`.
+  int Wait(double timeout_s) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < end) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        done_ = true;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return -1;
+  }
+  // Waits until stdout contains `text`.
+  bool WaitForOutput(const std::string& text, double timeout_s) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < end) {
+      if (out().find(text) != std::string::npos) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  }
+  std::string out() const { return Read(out_); }
+  std::string err() const { return Read(err_); }
+
+ private:
+  pid_t pid_ = -1;
+  bool done_ = false;
+  fs::path out_, err_;
+};
+
+struct State {
+  int64_t stamp;
+  double x, y, vx, vy;
+  int stopped;
+};
+
+std::vector<State> ReadStates(const fs::path& file) {
+  std::istringstream in(Read(file));
+  std::vector<State> out;
+  State s{};
+  while (in >> s.stamp >> s.x >> s.y >> s.vx >> s.vy >> s.stopped) out.push_back(s);
+  return out;
+}
+
+class DriverProcessTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("dyad_driver_test_" + std::to_string(getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    domain_ = 1 + static_cast<int>(getpid() % 200);
+    // A port of its own per test process (and per test: the counter), so parallel runs don't collide.
+    static int counter = 0;
+    port_ = 40000 + static_cast<int>(getpid() % 5000) * 4 + (counter++ % 4);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  // The driver config with this test's domain and a state log appended.
+  fs::path Graph(const std::string& config_text, const std::string& name, const fs::path& log) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << "domain_id: " << domain_ << "\n"
+                     << config_text
+                     << "  log: {type: test_state_log, trigger: state, params: {file: " << log.string()
+                     << "}, inputs: {state: robot/state}}\n";
+    return p;
+  }
+  std::vector<std::string> Dyad(std::vector<std::string> args) {
+    args.insert(args.begin(), DYAD_EXE);
+    args.push_back("--plugins");
+    args.push_back(DYAD_CARTESIAN_TEST_PLUGIN);
+    return args;
+  }
+  Child FakeController(std::vector<std::string> extra) {
+    std::vector<std::string> args{DYAD_FAKE_CONTROLLER, "--port", std::to_string(port_), "--idle-exit", "60"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return Child(args, dir_, "fake");
+  }
+  std::string PortSet() { return "driver.controller_port=" + std::to_string(port_); }
+
+  fs::path dir_;
+  int domain_ = 1, port_ = 40000;
+};
+
+const std::string kVirtualLine = "    type: virtual_cartesian\n";
+const std::string kUdpLine = "    type: udp_cartesian\n";
+
+TEST_F(DriverProcessTest, ConfigsDifferOnlyInTheDriversType) {
+  const std::string v = Read(fs::path(DYAD_CONFIG_DIR) / "drivers/virtual.yaml");
+  const std::string u = Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml");
+  ASSERT_NE(v.find(kVirtualLine), std::string::npos);
+  std::string swapped = v;
+  swapped.replace(swapped.find(kVirtualLine), kVirtualLine.size(), kUdpLine);
+  EXPECT_EQ(swapped, u);
+}
+
+// The same graph, once with each driver: the robot's states are published every step, follow the
+// pattern (reached within each step), and are bit-identical between the virtual robot and the
+// fake controller (both run VirtualRobot on the runtime clock's stamps).
+TEST_F(DriverProcessTest, SwappingTheDriverByTypeGivesTheSameRobotStates) {
+  const fs::path vlog = dir_ / "virtual.txt", ulog = dir_ / "udp.txt";
+  const fs::path vg = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/virtual.yaml"), "virtual.yaml", vlog);
+  const fs::path ug = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"), "udp.yaml", ulog);
+
+  Child v(Dyad({"run", vg.string(), "--steps", "100", "--quiet"}), dir_, "virtual");
+  ASSERT_EQ(v.Wait(60), 0) << v.err();
+
+  Child fake = FakeController({});
+  ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
+  // Port: this test's own; reply wait: generous, as a 2-core machine under a parallel ctest can be slow.
+  Child u(Dyad({"run", ug.string(), "--steps", "100", "--quiet", "--set", PortSet(), "--set", "driver.reply_wait_ms=1000"}),
+          dir_, "udp");
+  ASSERT_EQ(u.Wait(120), 0) << u.err();
+  fake.Signal(SIGTERM);
+  EXPECT_EQ(fake.Wait(10), 0);
+
+  const auto vs = ReadStates(vlog), us = ReadStates(ulog);
+  ASSERT_EQ(vs.size(), 100u);
+  ASSERT_EQ(us.size(), 100u);
+  EXPECT_EQ(Read(vlog), Read(ulog));
+  // The figure eight of radius 30 (period 8 s): 10 Hz commands are reached within their step.
+  for (size_t k = 0; k < vs.size(); ++k) {
+    const double phase = 2 * M_PI * (k * 0.1) / 8;
+    EXPECT_NEAR(vs[k].x, 30 * std::cos(phase), 1e-9) << k;
+    EXPECT_NEAR(vs[k].y, 15 * std::sin(2 * phase), 1e-9) << k;
+    EXPECT_EQ(vs[k].stamp, static_cast<int64_t>(k) * 100'000'000);
+    EXPECT_EQ(vs[k].stopped, 0);
+  }
+  EXPECT_NE(u.err().find("udp link: 100 commands sent, 100 states accepted, 0 late, 0 lost, 0 out of order, 0 malformed, 0 replies missed"),
+            std::string::npos)
+      << u.err();
+}
+
+// Stepped clock: command 10 is lost, the reply to 20 comes 150 ms late (after the driver's
+// 100 ms wait and after the reply to 21: out of order; it arrives while the driver waits in vain
+// for the reply to 30), the reply to 30 is garbage. The run goes on; exactly those three states
+// are missing.
+TEST_F(DriverProcessTest, UdpDriverSurvivesALostAnOutOfOrderAndAMalformedPacket) {
+  const fs::path log = dir_ / "udp.txt";
+  const fs::path g = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"), "udp.yaml", log);
+  Child fake = FakeController({"--drop", "10", "--delay", "20:150", "--malform", "30"});
+  ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
+  Child u(Dyad({"run", g.string(), "--steps", "50", "--quiet", "--set", PortSet(), "--set", "driver.reply_wait_ms=100"}),
+          dir_, "udp");
+  ASSERT_EQ(u.Wait(120), 0) << u.err();
+  fake.Signal(SIGTERM);
+  ASSERT_EQ(fake.Wait(10), 0);
+  EXPECT_NE(fake.out().find("dropped 1, delayed 1, malformed replies 1"), std::string::npos) << fake.out();
+
+  const auto states = ReadStates(log);
+  ASSERT_EQ(states.size(), 47u) << u.err();
+  for (const State& s : states) {
+    const int64_t step = s.stamp / 100'000'000;  // command k (1-based) is sent at step k-1
+    EXPECT_NE(step, 9);
+    EXPECT_NE(step, 19);
+    EXPECT_NE(step, 29);
+  }
+  // The state after the lost command: the robot still reaches command 11 (200 ms to get there).
+  EXPECT_NE(u.err().find("malformed packet from the controller (bad magic, 80 bytes)"), std::string::npos) << u.err();
+  EXPECT_NE(u.err().find("udp link: 50 commands sent, 47 states accepted, 0 late, 2 lost, 1 out of order, 1 malformed, 3 replies missed"),
+            std::string::npos)
+      << u.err();
+}
+
+// Wall clock, 10 Hz: the reply to command 5 is 70 ms late, after the driver's 40 ms wait; it is
+// taken (and published, before the next reply) at the next step.
+TEST_F(DriverProcessTest, UdpDriverPublishesALateReplyAtTheNextStep) {
+  const fs::path log = dir_ / "udp.txt";
+  std::string config = Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml");
+  config.replace(config.find("clock: stepped"), 14, "clock: wall");
+  const fs::path g = Graph(config, "udp.yaml", log);
+  Child fake = FakeController({"--delay", "5:70"});
+  ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
+  Child u(Dyad({"run", g.string(), "--duration", "2.05", "--quiet", "--set", PortSet(), "--set", "driver.reply_wait_ms=40"}),
+          dir_, "udp");
+  ASSERT_EQ(u.Wait(30), 0) << u.err();
+  fake.Signal(SIGTERM);
+  ASSERT_EQ(fake.Wait(10), 0);
+  const auto states = ReadStates(log);
+  ASSERT_GE(states.size(), 15u) << u.err();
+  // Every command's state arrived, in order.
+  for (size_t k = 1; k < states.size(); ++k) EXPECT_GT(states[k].stamp, states[k - 1].stamp);
+  EXPECT_NE(u.err().find(" 1 late, 0 lost, 0 out of order, 0 malformed, 1 replies missed"), std::string::npos) << u.err();
+}
+
+// A driver started again against a controller that kept running: its sequence numbers restart
+// at 1 in a new session, which the controller follows at once.
+TEST_F(DriverProcessTest, UdpDriverRunTwiceAgainstOneControllerStartsANewSessionEachTime) {
+  Child fake = FakeController({});
+  ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
+  for (int run = 0; run < 2; ++run) {
+    const fs::path log = dir_ / ("udp" + std::to_string(run) + ".txt");
+    const fs::path g = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"), "udp.yaml", log);
+    Child u(Dyad({"run", g.string(), "--steps", "30", "--quiet", "--set", PortSet(), "--set", "driver.reply_wait_ms=1000"}),
+            dir_, "udp" + std::to_string(run));
+    ASSERT_EQ(u.Wait(60), 0) << u.err();
+    EXPECT_EQ(ReadStates(log).size(), 30u) << run;
+  }
+  fake.Signal(SIGTERM);
+  ASSERT_EQ(fake.Wait(10), 0);
+  EXPECT_NE(fake.out().find("commands received 60, driver sessions 2, last applied sequence 30"), std::string::npos)
+      << fake.out();
+}
+
+TEST_F(DriverProcessTest, UdpDriverEndsTheRunWhenTheControllerIsSilent) {
+  const fs::path log = dir_ / "udp.txt";
+  const fs::path g = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"), "udp.yaml", log);
+  Child u(Dyad({"run", g.string(), "--steps", "100", "--quiet", "--set", PortSet()}), dir_, "udp");  // no controller
+  const int rc = u.Wait(60);
+  EXPECT_NE(rc, 0);
+  EXPECT_NE(rc, -1);
+  EXPECT_NE(u.err().find("controller 127.0.0.1:" + std::to_string(port_) + ": no state for 600 ms after a command"),
+            std::string::npos)
+      << u.err();
+}
+
+// virtual_cartesian stepped periodically (20 Hz) while commands (10 Hz, 3 units per step =
+// 30 units/s, above the 20 units/s speed limit: the robot never catches up, so it moves all the
+// time) stop after 1 s: the watchdog
+// (0.3 s) stops the robot, under both clocks.
+TEST_F(DriverProcessTest, VirtualDriverWatchdogStopsTheRobotWhenCommandsStop) {
+  for (const std::string clock : {"stepped", "wall"}) {
+    SCOPED_TRACE(clock);
+    const fs::path log = dir_ / (clock + ".txt");
+    const fs::path g = dir_ / (clock + ".yaml");
+    std::ofstream(g) << "graph: wd\nclock: " << clock << "\ndomain_id: " << domain_ << "\ncomponents:\n"
+                     << "  cmd: {type: test_command, rate_hz: 10, params: {speed: 3, silent_from: 10}, outputs: {out: robot/command}}\n"
+                     << "  driver: {type: virtual_cartesian, rate_hz: 20, params: {watchdog_s: 0.3, max_velocity: 20, initial_position: [0, 0]}, "
+                        "inputs: {command: robot/command}, outputs: {state: robot/state}}\n"
+                     << "  log: {type: test_state_log, trigger: state, params: {file: " << log.string()
+                     << "}, inputs: {state: robot/state}}\n";
+    Child c(Dyad(clock == "wall" ? std::vector<std::string>{"run", g.string(), "--duration", "2.2", "--quiet"}
+                                 : std::vector<std::string>{"run", g.string(), "--steps", "40", "--quiet"}),
+            dir_, clock);
+    ASSERT_EQ(c.Wait(60), 0) << c.err();
+    const auto states = ReadStates(log);
+    ASSERT_GE(states.size(), 30u);
+    const int64_t t0 = states.front().stamp;
+    double moving_x = 0;
+    for (const State& s : states) {
+      const double t = (s.stamp - t0) * 1e-9;
+      if (t > 0.2 && t < 0.9) {  // commands flowing: moving, not stopped
+        EXPECT_EQ(s.stopped, 0) << t;
+        EXPECT_GT(s.vx, 5) << t;
+      }
+      if (t < 1.0) moving_x = s.x;
+      if (t > 1.5) {  // last command at 0.9 s, watchdog 0.3 s, braking within one step
+        EXPECT_EQ(s.stopped, 1) << t;
+        EXPECT_EQ(s.vx, 0) << t;
+        EXPECT_GE(s.x, moving_x) << t;
+        EXPECT_LE(s.x, 27 + 1e-9) << t;  // never past the last command (9 * 3)
+      }
+    }
+    EXPECT_NE(c.err().find("watchdog: no command for more than the watchdog timeout: stopping"), std::string::npos) << c.err();
+  }
+}
+
+// The mixer and the virtual driver together, stepped: blend while engaged, 5 units per step,
+// hold when the human goes silent; the driver reaches every command within its step. The mixer
+// triggered by `robot` (the demo) and the mixer at rate_hz 10 (after the robot in graph order)
+// publish the same commands.
+TEST_F(DriverProcessTest, MixerBlendsSaturatesAndHoldsWhenTheHumanGoesSilent) {
+  std::string command_files[2];
+  for (int periodic = 0; periodic < 2; ++periodic) {
+    SCOPED_TRACE(periodic ? "mixer periodic" : "mixer triggered by robot");
+    const std::string tag = periodic ? "periodic" : "triggered";
+    const fs::path clog = dir_ / (tag + "_commands.txt"), slog = dir_ / (tag + "_states.txt");
+    const fs::path g = dir_ / (tag + ".yaml");
+    std::ofstream(g) << "graph: mix\nclock: stepped\ndomain_id: " << domain_ << "\ncomponents:\n"
+                     << "  human: {type: test_human, rate_hz: 10, params: {position: [20, 0], engaged_from: 10, "
+                        "engaged_to: 30, silent_from: 40}, outputs: {out: human/input}}\n"
+                     << "  robot: {type: test_intention, rate_hz: 10, params: {start: [0, 0], speed: 0}, outputs: {out: robot/intention}}\n"
+                     << "  mixer: {type: compliance_mixer, " << (periodic ? "rate_hz: 10" : "trigger: robot")
+                     << ", params: {stale_timeout_s: 0.25}, "
+                        "inputs: {human: human/input, robot: robot/intention, state: robot/state}, outputs: {command: robot/command}}\n"
+                     << "  driver: {type: virtual_cartesian, trigger: command, inputs: {command: robot/command}, outputs: {state: robot/state}}\n"
+                     << "  clog: {type: test_command_log, trigger: command, params: {file: " << clog.string()
+                     << "}, inputs: {command: robot/command}}\n"
+                     << "  slog: {type: test_state_log, trigger: state, params: {file: " << slog.string()
+                     << "}, inputs: {state: robot/state}}\n";
+    Child c(Dyad({"run", g.string(), "--steps", "60", "--quiet"}), dir_, tag);
+    ASSERT_EQ(c.Wait(60), 0) << c.err();
+    command_files[periodic] = Read(clog);
+    std::istringstream in(command_files[periodic]);
+    std::vector<std::array<double, 4>> cmds;  // stamp x y hold
+    std::array<double, 4> r{};
+    while (in >> r[0] >> r[1] >> r[2] >> r[3]) cmds.push_back(r);
+    ASSERT_EQ(cmds.size(), 60u);
+    EXPECT_EQ(cmds[9][1], 0);  // disengaged: the robot's intention (0, 0)
+    // Engaged from step 10: target 0.9*20 + 0.1*0 = 18, reached in 5-unit steps: 5, 10, 15, 18.
+    EXPECT_DOUBLE_EQ(cmds[10][1], 5);
+    EXPECT_DOUBLE_EQ(cmds[11][1], 10);
+    EXPECT_DOUBLE_EQ(cmds[12][1], 15);
+    EXPECT_DOUBLE_EQ(cmds[13][1], 18);
+    EXPECT_DOUBLE_EQ(cmds[29][1], 18);
+    EXPECT_DOUBLE_EQ(cmds[30][1], 13);  // released: back towards 0, 5 per step
+    EXPECT_DOUBLE_EQ(cmds[33][1], 0);
+    // Human's last sample at step 39 (t = 3.9 s); stale after 0.25 s: from step 42 (4.2 s) on, hold.
+    EXPECT_EQ(cmds[41][3], 0);
+    EXPECT_EQ(cmds[42][3], 1);
+    EXPECT_EQ(cmds[59][3], 1);
+    EXPECT_DOUBLE_EQ(cmds[42][1], cmds[41][1]);
+    EXPECT_NE(c.err().find("input 'human' stale (no sample for more than 250 ms): holding the last command"), std::string::npos)
+        << c.err();
+    EXPECT_NE(c.err().find("60 commands published, 18 held, 6 saturated"), std::string::npos) << c.err();
+    // The driver followed every command within its step.
+    const auto states = ReadStates(slog);
+    ASSERT_EQ(states.size(), 60u);
+    for (size_t k = 0; k < 60; ++k) EXPECT_NEAR(states[k].x, cmds[k][1], 1e-9) << k;
+  }
+  EXPECT_EQ(command_files[0], command_files[1]);
+}
+
+TEST_F(DriverProcessTest, MixerInPiModeWithoutStateIsAConfigurationError) {
+  const fs::path g = dir_ / "pi.yaml";
+  std::ofstream(g) << "graph: pi\nclock: stepped\ndomain_id: " << domain_ << "\ncomponents:\n"
+                   << "  human: {type: test_human, rate_hz: 10, outputs: {out: h}}\n"
+                   << "  robot: {type: test_intention, rate_hz: 10, outputs: {out: r}}\n"
+                   << "  mixer: {type: compliance_mixer, trigger: robot, params: {mode: pi}, inputs: {human: h, robot: r}, "
+                      "outputs: {command: c}}\n";
+  Child c(Dyad({"run", g.string(), "--steps", "3", "--quiet"}), dir_, "pi");
+  EXPECT_NE(c.Wait(30), 0);
+  EXPECT_NE(c.err().find("components.mixer.params.mode = pi: needs input 'state' bound"), std::string::npos) << c.err();
+}
+
+}  // namespace

@@ -1,0 +1,92 @@
+#include "compliance_mixer.hpp"
+
+#include <cinttypes>
+#include <cmath>
+#include <string>
+
+namespace dyad::mixer {
+
+void ComplianceMixer::Describe(ComponentSpec& spec) {
+  spec.Summary("Blends human and robot positions into the driver's command (g*human + (1-g)*robot while engaged), "
+               "saturates its change per step, holds it when inputs go stale.");
+  spec.Param("gain", 0.9).Range(0, 1).Doc("weight of the human while engaged (the study: 0.9)");
+  spec.Param("max_step", 5.0).Min(0).Unit("workspace units").Doc(
+      "max change of the command per step, vector norm (the study: 5; 0: no limit)");
+  spec.Param("mode", "blend").OneOf({"blend", "pi"}).Doc(
+      "blend: command = blend; pi: command = state + kp*e + ki*integral(e), e = blend - state");
+  spec.Param("kp", 1.0).Min(0).Doc("mode pi: proportional gain (kp 1, ki 0 = plain blend)");
+  spec.Param("ki", 0.0).Min(0).Unit("1/s").Doc("mode pi: integral gain");
+  spec.Param("integral_limit", 10.0).Min(0).Unit("workspace units * s").Doc(
+      "mode pi: anti-windup clamp of the integral per axis (also frozen while the command saturates)");
+  spec.Param("stale_timeout_s", 0.5).Min(1e-6).Unit("s").Doc(
+      "an input without a sample for longer is stale (runtime clock): hold the last command");
+  spec.Param("z", 0.0).Unit("workspace units").Doc("z of every command (planar robot)");
+  spec.Input<msg::HumanInput>("human").Doc("the human's hand position and engaged flag");
+  spec.Input<msg::Intention>("robot").Doc("the robot's intended position");
+  spec.Input<msg::CartesianState>("state").Optional().Doc(
+      "measured position: required by mode pi; saturates the first command");
+  spec.Output<msg::CartesianCommand>("command").Doc("target position for the driver; hold while inputs are stale");
+}
+
+Status ComplianceMixer::Configure(Context& ctx) {
+  ctx_ = &ctx;
+  const Params& p = ctx.params();
+  MixerOptions o;
+  o.gain = p.Double("gain");
+  o.max_step = p.Double("max_step");
+  o.mode = p.String("mode") == "pi" ? Mode::kPi : Mode::kBlend;
+  o.kp = p.Double("kp");
+  o.ki = p.Double("ki");
+  o.integral_limit = p.Double("integral_limit");
+  o.stale_timeout_ns = static_cast<int64_t>(std::llround(p.Double("stale_timeout_s") * 1e9));
+  if (Status s = o.Validate(); !s.ok()) return Status::InvalidArgument("components." + ctx.name() + ".params." + s.message());
+  z_ = p.Double("z");
+  human_ = &ctx.input<msg::HumanInput>("human");
+  robot_ = &ctx.input<msg::Intention>("robot");
+  state_ = &ctx.input<msg::CartesianState>("state");
+  command_ = &ctx.output<msg::CartesianCommand>("command");
+  if (o.mode == Mode::kPi && !state_->bound())
+    return Status::InvalidArgument("components." + ctx.name() + ".params.mode = pi: needs input 'state' bound to the driver's state topic");
+  core_.emplace(o);
+  return Status::OK();
+}
+
+Status ComplianceMixer::Step(const StepInfo& info) {
+  MixerCore::Inputs in;
+  if (const msg::Intention* r = robot_->latest()) in.robot = {{r->x(), r->y()}, robot_->last_receive_ns()};
+  if (const msg::HumanInput* h = human_->latest()) {
+    in.human = {{h->x(), h->y()}, human_->last_receive_ns()};
+    in.engaged = h->engaged();
+  }
+  if (const msg::CartesianState* s = state_->latest()) in.state = {{s->x(), s->y()}, state_->last_receive_ns()};
+
+  const MixerCore::Result r = core_->Update(in, info.now_ns);
+  if (r.hold && !holding_) {
+    holding_ = true;
+    ctx_->log().Warn(std::string("input '") + ToString(r.stale) + "' stale (no sample for more than " +
+                     std::to_string(core_->options().stale_timeout_ns / 1'000'000) + " ms): " +
+                     (r.has_command ? "holding the last command" : "no command yet"));
+  } else if (!r.hold && holding_) {
+    holding_ = false;
+    ctx_->log().Info("inputs fresh again: mixing resumed");
+  }
+  if (!r.has_command) return Status::OK();
+  held_ += r.hold;
+  saturated_ += r.saturated;
+  ++published_;
+  out_.x(r.position.x);
+  out_.y(r.position.y);
+  out_.z(z_);
+  out_.hold(r.hold);
+  return command_->Publish(out_);
+}
+
+Status ComplianceMixer::Deactivate() {
+  ctx_->log().Info(std::to_string(published_) + " commands published, " + std::to_string(held_) + " held, " +
+                   std::to_string(saturated_) + " saturated");
+  return Status::OK();
+}
+
+}  // namespace dyad::mixer
+
+DYAD_PLUGIN(registry) { registry.Add<dyad::mixer::ComplianceMixer>("compliance_mixer"); }

@@ -1,0 +1,100 @@
+/// MixerCore: the compliance mixer's math, free of DDS and clocks (times are passed in), so that
+/// it is tested on its own (test/mixer_core_test.cpp) and the component stays a thin shell.
+///
+/// Each Update() turns the latest human and robot samples into one command position:
+///   target = g*human + (1-g)*robot   while the human is engaged (g = `gain`, the study: 0.9)
+///          = robot                   otherwise
+///   mode kBlend: command = target
+///   mode kPi:    command = state + kp*e + ki*I,  e = target - state,  I = sum of e*dt
+///                (a PI loop closed around the driver's measured position; kp = 1, ki = 0
+///                gives the plain blend back; anti-windup: I is clamped per axis to
+///                +-integral_limit and not accumulated on an update whose command saturated)
+///   then the change from the previous command is saturated to `max_step` (vector norm, so the
+///   direction of motion is kept; the study: 5 units per step). The first command is saturated
+///   against the measured state when one is known, else taken as is.
+/// Stale inputs: if the robot or human sample (or, in kPi, the state) is older than
+/// `stale_timeout_ns` or missing, Update() repeats the previous command with hold = true (or
+/// returns no command at all before the first one).
+///
+///   MixerCore mixer(options);            // options.Validate() must be OK
+///   MixerCore::Inputs in;
+///   in.robot = {{10, 0}, now};  in.human = {{0, 0}, now};  in.engaged = true;
+///   MixerCore::Result r = mixer.Update(in, now);   // r.has_command, r.position, r.hold
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <dyad/status.hpp>
+
+namespace dyad::mixer {
+
+struct Vec2 {
+  double x = 0, y = 0;
+};
+
+enum class Mode { kBlend, kPi };
+
+struct MixerOptions {
+  double gain = 0.9;                     // weight of the human while engaged, [0, 1]
+  double max_step = 5.0;                 // max change of the command per update, workspace units (norm); 0 = none
+  Mode mode = Mode::kBlend;
+  double kp = 1.0;                       // kPi: proportional gain, >= 0
+  double ki = 0.0;                       // kPi: integral gain, 1/s, >= 0
+  double integral_limit = 10.0;          // kPi: |I| per axis, workspace units * s, >= 0
+  int64_t stale_timeout_ns = 500'000'000;  // an input older than this is stale, > 0
+
+  // OK, or InvalidArgument naming the field, its value and the broken constraint.
+  Status Validate() const;
+};
+
+class MixerCore {
+ public:
+  // A timestamped position; `receive_ns` < 0 means never received.
+  struct Sample {
+    Vec2 position;
+    int64_t receive_ns = -1;
+  };
+  struct Inputs {
+    Sample robot;          // the robot's intention
+    Sample human;          // the human's hand position
+    bool engaged = false;  // the human's newest engaged flag
+    Sample state;          // measured position; receive_ns < 0 when unbound or not yet received
+  };
+  enum class Stale { kNone, kRobot, kHuman, kState };
+  struct Result {
+    bool has_command = false;  // false only before the first command while inputs are stale
+    Vec2 position;
+    bool hold = false;         // inputs stale: `position` repeats the previous command
+    bool saturated = false;    // the step limit shortened the change
+    Stale stale = Stale::kNone;  // which input made it hold (the first found)
+  };
+
+  // REQUIRES: options.Validate().ok().
+  explicit MixerCore(const MixerOptions& options);
+
+  // One control update at runtime-clock time `now_ns` (never decreasing).
+  Result Update(const Inputs& in, int64_t now_ns);
+
+  const MixerOptions& options() const { return options_; }
+  Vec2 integral() const { return integral_; }
+
+ private:
+  bool Fresh(const Sample& s, int64_t now_ns) const {
+    return s.receive_ns >= 0 && now_ns - s.receive_ns <= options_.stale_timeout_ns;
+  }
+
+  MixerOptions options_;
+  bool has_last_ = false;
+  Vec2 last_;                 // previous command
+  Vec2 integral_;             // kPi: sum of e*dt
+  int64_t last_update_ns_ = -1;
+};
+
+// Shortens `delta` to norm `max_norm` (unchanged when shorter or max_norm <= 0). Sets *clipped.
+Vec2 SaturateNorm(Vec2 delta, double max_norm, bool* clipped);
+
+const char* ToString(MixerCore::Stale stale);
+
+}  // namespace dyad::mixer

@@ -1,0 +1,218 @@
+// MixerCore: blend, saturation, stale hold, PI against closed forms.
+#include "mixer_core.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace dyad::mixer {
+namespace {
+
+constexpr int64_t kStep = 100'000'000;  // 100 ms
+
+MixerCore::Inputs Fresh(Vec2 robot, Vec2 human, bool engaged, int64_t now) {
+  MixerCore::Inputs in;
+  in.robot = {robot, now};
+  in.human = {human, now};
+  in.engaged = engaged;
+  return in;
+}
+
+MixerOptions NoLimit() {
+  MixerOptions o;
+  o.max_step = 0;
+  return o;
+}
+
+TEST(MixerOptions, DefaultsAreValidAndTheStudys) {
+  MixerOptions o;
+  EXPECT_TRUE(o.Validate().ok());
+  EXPECT_EQ(o.gain, 0.9);
+  EXPECT_EQ(o.max_step, 5.0);
+}
+
+TEST(MixerOptions, ErrorsNameFieldValueAndConstraint) {
+  MixerOptions o;
+  o.gain = 1.5;
+  EXPECT_EQ(o.Validate().message(), "gain = 1.5: must be in [0, 1]");
+  o = MixerOptions();
+  o.stale_timeout_ns = 0;
+  EXPECT_EQ(o.Validate().message(), "stale_timeout_s = 0: must be > 0");
+  o = MixerOptions();
+  o.ki = -1;
+  EXPECT_EQ(o.Validate().message(), "ki = -1: must be >= 0");
+}
+
+TEST(MixerCore, EngagedHumanBlendsWithGain) {
+  MixerCore m(NoLimit());
+  const auto r = m.Update(Fresh({10, -20}, {30, 40}, true, 0), 0);
+  ASSERT_TRUE(r.has_command);
+  EXPECT_FALSE(r.hold);
+  EXPECT_DOUBLE_EQ(r.position.x, 0.9 * 30 + 0.1 * 10);
+  EXPECT_DOUBLE_EQ(r.position.y, 0.9 * 40 + 0.1 * -20);
+}
+
+TEST(MixerCore, DisengagedHumanLeavesTheRobotsIntention) {
+  MixerCore m(NoLimit());
+  const auto r = m.Update(Fresh({10, -20}, {30, 40}, false, 0), 0);
+  EXPECT_DOUBLE_EQ(r.position.x, 10);
+  EXPECT_DOUBLE_EQ(r.position.y, -20);
+}
+
+TEST(SaturateNorm, KeepsDirectionAndShortensToTheLimit) {
+  bool clipped = false;
+  Vec2 d = SaturateNorm({30, 40}, 5, &clipped);  // norm 50
+  EXPECT_TRUE(clipped);
+  EXPECT_DOUBLE_EQ(d.x, 3);
+  EXPECT_DOUBLE_EQ(d.y, 4);
+  d = SaturateNorm({3, 4}, 5, &clipped);
+  EXPECT_FALSE(clipped);
+  EXPECT_DOUBLE_EQ(d.x, 3);
+  d = SaturateNorm({300, 400}, 0, &clipped);  // 0: no limit
+  EXPECT_FALSE(clipped);
+  EXPECT_DOUBLE_EQ(d.x, 300);
+}
+
+TEST(MixerCore, ChangePerStepIsSaturatedToFiveUnitsByNorm) {
+  MixerCore m{MixerOptions()};
+  auto r = m.Update(Fresh({0, 0}, {0, 0}, false, 0), 0);  // first command: no reference, taken as is
+  EXPECT_DOUBLE_EQ(r.position.x, 0);
+  // The robot jumps to (30, 40): the command walks there 5 units per step along the line.
+  for (int k = 1; k <= 10; ++k) {
+    r = m.Update(Fresh({30, 40}, {0, 0}, false, k * kStep), k * kStep);
+    EXPECT_EQ(r.saturated, k < 10) << k;  // the last step is exactly 5 units
+    EXPECT_NEAR(r.position.x, 3.0 * k, 1e-12);
+    EXPECT_NEAR(r.position.y, 4.0 * k, 1e-12);
+  }
+  r = m.Update(Fresh({30, 40}, {0, 0}, false, 11 * kStep), 11 * kStep);
+  EXPECT_FALSE(r.saturated);
+  EXPECT_DOUBLE_EQ(r.position.x, 30);
+}
+
+TEST(MixerCore, FirstCommandIsSaturatedAgainstTheMeasuredState) {
+  MixerCore m{MixerOptions()};
+  auto in = Fresh({20, 0}, {0, 0}, false, 0);
+  in.state = {{0, 0}, 0};
+  const auto r = m.Update(in, 0);
+  EXPECT_TRUE(r.saturated);
+  EXPECT_DOUBLE_EQ(r.position.x, 5);
+}
+
+TEST(MixerCore, StaleHumanHoldsTheLastCommandThenResumes) {
+  MixerOptions o = NoLimit();
+  o.stale_timeout_ns = 250'000'000;
+  MixerCore m(o);
+  auto r = m.Update(Fresh({1, 2}, {0, 0}, false, 0), 0);
+  ASSERT_FALSE(r.hold);
+  // The robot keeps publishing; the human's last sample was at t = 0.
+  MixerCore::Inputs in = Fresh({7, 8}, {0, 0}, false, 0);
+  in.robot.receive_ns = 2 * kStep;
+  r = m.Update(in, 2 * kStep);  // 200 ms old: still fresh
+  EXPECT_FALSE(r.hold);
+  EXPECT_DOUBLE_EQ(r.position.x, 7);
+  in.robot.receive_ns = 3 * kStep;
+  r = m.Update(in, 3 * kStep);  // 300 ms > 250 ms: stale
+  EXPECT_TRUE(r.hold);
+  EXPECT_EQ(r.stale, MixerCore::Stale::kHuman);
+  EXPECT_TRUE(r.has_command);
+  EXPECT_DOUBLE_EQ(r.position.x, 7);  // the last command, not the new intention
+  EXPECT_DOUBLE_EQ(r.position.y, 8);
+  in = Fresh({9, 9}, {0, 0}, false, 4 * kStep);
+  r = m.Update(in, 4 * kStep);
+  EXPECT_FALSE(r.hold);
+  EXPECT_DOUBLE_EQ(r.position.x, 9);
+}
+
+TEST(MixerCore, NoCommandBeforeAnyInputArrived) {
+  MixerCore m{MixerOptions()};
+  MixerCore::Inputs in;  // nothing received
+  const auto r = m.Update(in, 0);
+  EXPECT_FALSE(r.has_command);
+  EXPECT_TRUE(r.hold);
+  EXPECT_EQ(r.stale, MixerCore::Stale::kRobot);
+}
+
+TEST(MixerCore, PiWithUnitProportionalGainIsThePlainBlend) {
+  MixerOptions o = NoLimit();
+  o.mode = Mode::kPi;
+  MixerCore m(o);
+  auto in = Fresh({10, 0}, {30, 40}, true, 0);
+  in.state = {{-3, 7}, 0};
+  const auto r = m.Update(in, 0);
+  EXPECT_NEAR(r.position.x, 0.9 * 30 + 0.1 * 10, 1e-12);
+  EXPECT_NEAR(r.position.y, 0.9 * 40, 1e-12);
+}
+
+TEST(MixerCore, PiWithStateHeldMatchesClosedFormRamp) {
+  // State fixed at 0, target T: c_k = kp*T + ki*T*k*dt (the first update has dt = 0).
+  MixerOptions o = NoLimit();
+  o.mode = Mode::kPi;
+  o.kp = 0.5;
+  o.ki = 2.0;
+  o.integral_limit = 1e9;
+  MixerCore m(o);
+  const double T = 4, dt = 0.1;
+  for (int k = 0; k < 20; ++k) {
+    auto in = Fresh({T, -T}, {0, 0}, false, k * kStep);
+    in.state = {{0, 0}, k * kStep};
+    const auto r = m.Update(in, k * kStep);
+    EXPECT_NEAR(r.position.x, o.kp * T + o.ki * T * k * dt, 1e-9) << k;
+    EXPECT_NEAR(r.position.y, -(o.kp * T + o.ki * T * k * dt), 1e-9) << k;
+  }
+}
+
+TEST(MixerCore, PiProportionalLoopAroundAPerfectDriverConvergesGeometrically) {
+  // Driver reaches each command: s_k = c_{k-1}. With ki = 0: T - c_k = (1 - kp)^(k+1) * (T - s_0).
+  MixerOptions o = NoLimit();
+  o.mode = Mode::kPi;
+  o.kp = 0.3;
+  MixerCore m(o);
+  const double T = 10;
+  Vec2 s{0, 0};
+  for (int k = 0; k < 15; ++k) {
+    auto in = Fresh({T, 0}, {0, 0}, false, k * kStep);
+    in.state = {s, k * kStep};
+    const auto r = m.Update(in, k * kStep);
+    EXPECT_NEAR(T - r.position.x, std::pow(1 - o.kp, k + 1) * T, 1e-9) << k;
+    s = r.position;
+  }
+}
+
+TEST(MixerCore, PiIntegralIsClampedAndFrozenWhileSaturated) {
+  MixerOptions o = NoLimit();
+  o.mode = Mode::kPi;
+  o.kp = 0;
+  o.ki = 1;
+  o.integral_limit = 0.5;
+  MixerCore m(o);
+  for (int k = 0; k < 30; ++k) {
+    auto in = Fresh({2, 0}, {0, 0}, false, k * kStep);
+    in.state = {{0, 0}, k * kStep};
+    m.Update(in, k * kStep);
+  }
+  EXPECT_DOUBLE_EQ(m.integral().x, 0.5);  // 2 * 0.1 * 29 = 5.8 without the clamp
+
+  // Saturated commands: the integral does not accumulate.
+  o.integral_limit = 100;
+  o.max_step = 0.01;
+  MixerCore sat(o);
+  for (int k = 0; k < 10; ++k) {
+    auto in = Fresh({50, 0}, {0, 0}, false, k * kStep);
+    in.state = {{0, 0}, k * kStep};
+    sat.Update(in, k * kStep);
+  }
+  EXPECT_DOUBLE_EQ(sat.integral().x, 0.0);
+}
+
+TEST(MixerCore, PiHoldsWhenTheStateIsStale) {
+  MixerOptions o = NoLimit();
+  o.mode = Mode::kPi;
+  MixerCore m(o);
+  auto in = Fresh({1, 1}, {0, 0}, false, 0);  // no state ever
+  const auto r = m.Update(in, 0);
+  EXPECT_TRUE(r.hold);
+  EXPECT_EQ(r.stale, MixerCore::Stale::kState);
+}
+
+}  // namespace
+}  // namespace dyad::mixer

@@ -1,0 +1,116 @@
+// A Context for component unit tests, without DDS: params from the component's Describe()
+// defaults plus overrides, outputs that keep every published sample, inputs fed by the test.
+// Shared by the human_input and observer tests.
+#pragma once
+
+#include <deque>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <dyad/component.hpp>
+
+namespace dyad::testing {
+
+template <class T>
+class CapturingWriter final : public detail::WriterEndpoint {
+ public:
+  Status Write(const void* sample) override {
+    samples.push_back(*static_cast<const T*>(sample));
+    return Status::OK();
+  }
+  std::vector<T> samples;
+};
+
+template <class T>
+class QueueReader final : public detail::ReaderEndpoint {
+ public:
+  bool TakeNext(void* sample) override {
+    if (queue.empty()) return false;
+    *static_cast<T*>(sample) = queue.front();
+    queue.pop_front();
+    return true;
+  }
+  std::deque<T> queue;
+};
+
+class FakeClock final : public Clock {
+ public:
+  int64_t now_ns() const override { return now; }
+  int64_t now = 0;
+};
+
+class NullLogger final : public Logger {
+ public:
+  void Write(Level, std::string_view m) override { lines.emplace_back(m); }
+  std::vector<std::string> lines;
+};
+
+class FakeContext final : public Context {
+ public:
+  // `describe` is the component's Describe; `overrides` replace defaults (required params too).
+  FakeContext(void (*describe)(ComponentSpec&), std::map<std::string, ParamValue> overrides, uint64_t seed = 42)
+      : seed_(seed) {
+    describe(spec_);
+    std::map<std::string, ParamValue> values;
+    for (const ParamSpec& p : spec_.params())
+      if (p.default_value) values[p.name] = *p.default_value;
+    for (auto& [k, v] : overrides) values[k] = v;
+    params_ = Params(std::move(values));
+    for (const PortSpec& p : spec_.inputs()) inputs_[p.name] = p.make_input();
+    for (const PortSpec& p : spec_.outputs()) {
+      outputs_[p.name] = p.make_output();
+    }
+  }
+
+  // Binds output `name` to a capturing writer and returns it.
+  template <class T>
+  CapturingWriter<T>& Capture(const std::string& name) {
+    auto w = std::make_unique<CapturingWriter<T>>();
+    auto* raw = w.get();
+    outputs_.at(name)->Bind(name, name, "test", raw, &clock_);
+    writers_.push_back(std::move(w));
+    return *raw;
+  }
+  // Binds input `name` to a queue the test fills; call Poll(now) before each Step.
+  template <class T>
+  QueueReader<T>& Feed(const std::string& name) {
+    auto r = std::make_unique<QueueReader<T>>();
+    auto* raw = r.get();
+    inputs_.at(name)->Bind(name, name, raw);
+    readers_.push_back(std::move(r));
+    return *raw;
+  }
+  void PollInputs() {
+    for (auto& [n, in] : inputs_) in->Poll(clock_.now);
+  }
+
+  const std::string& name() const override { return name_; }
+  const Params& params() const override { return params_; }
+  const Clock& clock() const override { return clock_; }
+  Logger& log() override { return log_; }
+  uint64_t seed() const override { return seed_; }
+  int64_t period_ns() const override { return 100'000'000; }
+  void RequestStop(std::string reason) override { stop_reason = std::move(reason); }
+
+  std::string stop_reason;
+  FakeClock clock_;
+  NullLogger log_;
+
+ protected:
+  InputBase* FindInput(std::string_view name, const TypeInfo&) override { return inputs_.at(std::string(name)).get(); }
+  OutputBase* FindOutput(std::string_view name, const TypeInfo&) override { return outputs_.at(std::string(name)).get(); }
+
+ private:
+  std::string name_ = "under_test";
+  uint64_t seed_;
+  ComponentSpec spec_;
+  Params params_;
+  std::map<std::string, std::unique_ptr<InputBase>> inputs_;
+  std::map<std::string, std::unique_ptr<OutputBase>> outputs_;
+  std::vector<std::unique_ptr<detail::WriterEndpoint>> writers_;
+  std::vector<std::unique_ptr<detail::ReaderEndpoint>> readers_;
+};
+
+}  // namespace dyad::testing

@@ -1,0 +1,265 @@
+#include "experiment_analysis.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+namespace dyad::analyze {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+StepSample EmptyStep(int64_t step) {
+  StepSample s;
+  s.step = step;
+  s.human_x = s.human_y = s.robot_x = s.robot_y = s.nelbo = s.reconstruction = s.regulation = kNaN;
+  s.optimisation_s = s.executed_x = s.executed_y = s.congruence = kNaN;
+  return s;
+}
+
+int Argmax(const std::vector<double>& p) {
+  if (p.empty()) return -1;
+  return static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin());
+}
+
+// Reads a table's cells by column name; a missing column is a clear DataLoss.
+class Cells {
+ public:
+  Cells(const std::string& topic, const TopicTable& table) : topic_(topic), table_(table) {}
+  Status Need(const std::vector<std::string>& names) {
+    for (const std::string& n : names) {
+      const int c = table_.Column(n);
+      if (c < 0) return Status::DataLoss("topic " + topic_, "has no field \"" + n + "\"");
+      index_[n] = c;
+    }
+    return Status::OK();
+  }
+  StatusOr<double> Number(size_t row, const std::string& name) const {
+    double v = 0;
+    const std::string& cell = table_.rows[row][index_.at(name)];
+    if (!ParseNumber(cell, &v)) return Bad(row, name, cell);
+    return v;
+  }
+  StatusOr<bool> Bool(size_t row, const std::string& name) const {
+    bool v = false;
+    const std::string& cell = table_.rows[row][index_.at(name)];
+    if (!ParseBool(cell, &v)) return Bad(row, name, cell);
+    return v;
+  }
+  Status List(size_t row, const std::string& name, std::vector<double>* out) const {
+    const std::string& cell = table_.rows[row][index_.at(name)];
+    if (!ParseNumberList(cell, out)) return Bad(row, name, cell);
+    return Status::OK();
+  }
+
+ private:
+  Status Bad(size_t row, const std::string& name, const std::string& cell) const {
+    return Status::DataLoss("topic " + topic_ + " message " + std::to_string(row + 1),
+                            "field \"" + name + "\" holds \"" + cell + "\"");
+  }
+  std::string topic_;
+  const TopicTable& table_;
+  std::map<std::string, int> index_;
+};
+
+}  // namespace
+
+StatusOr<ExperimentPlan> PlanFromGraphYaml(const std::string& yaml) {
+  ExperimentPlan plan;
+  if (yaml.empty()) return plan;
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml);
+  } catch (const YAML::Exception& e) {
+    return Status::InvalidArgument("graph metadata", std::string("YAML does not parse: ") + e.what());
+  }
+  try {
+    if (root["graph"]) plan.graph_name = root["graph"].as<std::string>();
+    const YAML::Node components = root["components"];
+    if (!components || !components.IsMap()) return plan;
+    for (const auto& entry : components) {
+      const YAML::Node c = entry.second;
+      const std::string type = c["type"] ? c["type"].as<std::string>() : "";
+      if (type != "human_synthetic" && type != "human_replay") continue;
+      if (c["rate_hz"]) plan.period_ns = std::llround(1e9 / c["rate_hz"].as<double>());
+      const YAML::Node params = c["params"];
+      if (!params) break;
+      if (params["dataset"]) plan.dataset = params["dataset"].as<std::string>();
+      if (params["events"] && params["events"].IsSequence()) {
+        for (const YAML::Node& e : params["events"]) {
+          PlannedEvent ev;
+          ev.start_step = e["start"].as<int64_t>();
+          ev.end_step = e["end"].as<int64_t>();
+          ev.primitive = e["primitive"].as<int>();
+          plan.events.push_back(ev);
+        }
+      }
+      break;
+    }
+  } catch (const YAML::Exception& e) {
+    return Status::InvalidArgument("graph metadata", std::string("unexpected YAML: ") + e.what());
+  }
+  return plan;
+}
+
+StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan) {
+  Timeline timeline;
+  const char* const kTopics[] = {"human/input", "robot/intention", "robot/state", "observer/labels"};
+  for (const char* t : kTopics) {
+    auto it = tables.find(t);
+    if (it == tables.end() || it->second.size() == 0) timeline.missing_topics.push_back(t);
+  }
+  // t0: the first human sample, else the first sample of any topic.
+  int64_t t0 = std::numeric_limits<int64_t>::max();
+  for (const char* t : kTopics) {
+    auto it = tables.find(t);
+    if (it == tables.end() || it->second.size() == 0) continue;
+    Cells cells(t, it->second);
+    if (Status s = cells.Need({"header.stamp_ns"}); !s.ok()) return s;
+    auto stamp = cells.Number(0, "header.stamp_ns");
+    if (!stamp.ok()) return stamp.status();
+    if (std::string(t) == "human/input") { t0 = static_cast<int64_t>(*stamp); break; }
+    t0 = std::min(t0, static_cast<int64_t>(*stamp));
+  }
+  if (t0 == std::numeric_limits<int64_t>::max()) return timeline;
+
+  auto at = [&](double stamp) -> StepSample* {
+    const int64_t step = std::llround((stamp - static_cast<double>(t0)) / static_cast<double>(plan.period_ns));
+    if (step < 0) return nullptr;
+    while (static_cast<int64_t>(timeline.steps.size()) <= step) {
+      timeline.steps.push_back(EmptyStep(static_cast<int64_t>(timeline.steps.size())));
+    }
+    return &timeline.steps[step];
+  };
+  // Each topic fills its fields; `fill` gets the row's cells and the step's sample.
+  auto each = [&](const char* topic, const std::vector<std::string>& fields,
+                  const std::function<Status(const Cells&, size_t, StepSample&)>& fill) -> Status {
+    auto it = tables.find(topic);
+    if (it == tables.end()) return Status::OK();
+    Cells cells(topic, it->second);
+    std::vector<std::string> need = fields;
+    need.push_back("header.stamp_ns");
+    if (Status s = cells.Need(need); !s.ok()) return s;
+    for (size_t r = 0; r < it->second.size(); ++r) {
+      auto stamp = cells.Number(r, "header.stamp_ns");
+      if (!stamp.ok()) return stamp.status();
+      StepSample* s = at(*stamp);
+      if (s == nullptr) continue;
+      if (Status st = fill(cells, r, *s); !st.ok()) return st;
+    }
+    return Status::OK();
+  };
+  Status s = each("human/input", {"x", "y", "engaged"}, [](const Cells& c, size_t r, StepSample& s) -> Status {
+    auto x = c.Number(r, "x"); auto y = c.Number(r, "y"); auto e = c.Bool(r, "engaged");
+    if (!x.ok()) return x.status();
+    if (!y.ok()) return y.status();
+    if (!e.ok()) return e.status();
+    s.human_x = *x; s.human_y = *y; s.engaged = *e;
+    return Status::OK();
+  });
+  if (!s.ok()) return s;
+  s = each("robot/intention", {"x", "y", "nelbo", "reconstruction", "regulation", "optimisation_s"},
+           [](const Cells& c, size_t r, StepSample& s) -> Status {
+             double* dst[] = {&s.robot_x, &s.robot_y, &s.nelbo, &s.reconstruction, &s.regulation, &s.optimisation_s};
+             const char* names[] = {"x", "y", "nelbo", "reconstruction", "regulation", "optimisation_s"};
+             for (int i = 0; i < 6; ++i) {
+               auto v = c.Number(r, names[i]);
+               if (!v.ok()) return v.status();
+               *dst[i] = *v;
+             }
+             return Status::OK();
+           });
+  if (!s.ok()) return s;
+  s = each("robot/state", {"x", "y"}, [](const Cells& c, size_t r, StepSample& s) -> Status {
+    auto x = c.Number(r, "x"); auto y = c.Number(r, "y");
+    if (!x.ok()) return x.status();
+    if (!y.ok()) return y.status();
+    s.executed_x = *x; s.executed_y = *y;
+    return Status::OK();
+  });
+  if (!s.ok()) return s;
+  s = each("observer/labels", {"human", "robot", "congruence"}, [&](const Cells& c, size_t r, StepSample& s) -> Status {
+    auto g = c.Number(r, "congruence");
+    if (!g.ok()) return g.status();
+    s.congruence = *g;
+    if (Status st = c.List(r, "human", &s.p_human); !st.ok()) return st;
+    if (Status st = c.List(r, "robot", &s.p_robot); !st.ok()) return st;
+    timeline.classes = std::max<int>(timeline.classes, static_cast<int>(std::max(s.p_human.size(), s.p_robot.size())));
+    return Status::OK();
+  });
+  if (!s.ok()) return s;
+  return timeline;
+}
+
+std::vector<PlannedEvent> Events(const Timeline& timeline, const ExperimentPlan& plan) {
+  if (!plan.events.empty()) return plan.events;
+  std::vector<PlannedEvent> events;
+  for (size_t i = 0; i < timeline.steps.size(); ++i) {
+    if (!timeline.steps[i].engaged) continue;
+    if (events.empty() || events.back().end_step != static_cast<int64_t>(i)) {
+      events.push_back(PlannedEvent{static_cast<int64_t>(i), static_cast<int64_t>(i), -1});
+    }
+    events.back().end_step = static_cast<int64_t>(i) + 1;
+  }
+  return events;
+}
+
+std::vector<EventSummary> SummariseEvents(const Timeline& timeline, const std::vector<PlannedEvent>& events) {
+  std::vector<EventSummary> out;
+  for (size_t e = 0; e < events.size(); ++e) {
+    EventSummary sum;
+    sum.index = static_cast<int>(e);
+    sum.event = events[e];
+    sum.mean_congruence = sum.final_congruence = sum.human_accuracy = sum.robot_follows = kNaN;
+    double congruence_total = 0, human_hits = 0, robot_hits = 0;
+    int labelled = 0;
+    const int64_t end = std::min<int64_t>(events[e].end_step, static_cast<int64_t>(timeline.steps.size()));
+    for (int64_t t = std::max<int64_t>(events[e].start_step, 0); t < end; ++t) {
+      const StepSample& s = timeline.steps[t];
+      if (std::isnan(s.congruence)) continue;
+      ++labelled;
+      congruence_total += s.congruence;
+      sum.final_congruence = s.congruence;
+      if (events[e].primitive >= 0) {
+        human_hits += Argmax(s.p_human) == events[e].primitive;
+        if (Argmax(s.p_robot) == events[e].primitive) {
+          robot_hits += 1;
+          if (sum.robot_switch_after < 0) sum.robot_switch_after = t - events[e].start_step;
+        }
+      }
+    }
+    if (labelled > 0) {
+      sum.mean_congruence = congruence_total / labelled;
+      if (events[e].primitive >= 0) {
+        sum.human_accuracy = human_hits / labelled;
+        sum.robot_follows = robot_hits / labelled;
+      }
+    }
+    out.push_back(sum);
+  }
+  return out;
+}
+
+std::vector<std::vector<int64_t>> HumanConfusion(const Timeline& timeline, const std::vector<PlannedEvent>& events) {
+  std::vector<std::vector<int64_t>> counts;
+  if (timeline.classes == 0) return counts;
+  counts.assign(timeline.classes, std::vector<int64_t>(timeline.classes, 0));
+  bool any = false;
+  for (const PlannedEvent& e : events) {
+    if (e.primitive < 0 || e.primitive >= timeline.classes) continue;
+    const int64_t end = std::min<int64_t>(e.end_step, static_cast<int64_t>(timeline.steps.size()));
+    for (int64_t t = std::max<int64_t>(e.start_step, 0); t < end; ++t) {
+      const int predicted = Argmax(timeline.steps[t].p_human);
+      if (predicted < 0 || predicted >= timeline.classes) continue;
+      ++counts[e.primitive][predicted];
+      any = true;
+    }
+  }
+  if (!any) counts.clear();
+  return counts;
+}
+
+}  // namespace dyad::analyze

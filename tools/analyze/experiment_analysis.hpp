@@ -1,0 +1,83 @@
+// tools/analyze/experiment_analysis.hpp: what `dyad analyze` computes from a recording of the
+// study's experiment graph (topics as in configs/demo.yaml, see docs/components.md).
+//
+//   human/input      HumanInput      -> human position, engagement
+//   robot/intention  Intention       -> robot intention, N-ELBO and its terms
+//   robot/state      CartesianState  -> executed position
+//   observer/labels  IntentionLabel  -> class probabilities of human and robot, congruence P(C_t)
+//
+// Samples are put on one step grid: step = round((stamp - t0) / period), t0 the first human
+// sample's stamp, period from the graph (the human source's rate_hz; 100 ms if unknown). A topic
+// missing from the recording leaves its fields NaN; the report says which topics were missing.
+//
+// Events are the human's interventions: taken from the graph's human_synthetic `events` (with the
+// primitive the human traced, so confusion and "robot follows" can be scored), else from runs of
+// engaged steps (primitive unknown: -1).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "dyad/status.hpp"
+#include "recording_tables.hpp"
+
+namespace dyad::analyze {
+
+struct PlannedEvent {
+  int64_t start_step = 0;  // first engaged step
+  int64_t end_step = 0;    // one past the last
+  int primitive = -1;      // traced primitive; -1 unknown
+};
+
+// What the graph YAML says about the experiment; every field has a usable default.
+struct ExperimentPlan {
+  std::string graph_name;
+  int64_t period_ns = 100'000'000;
+  std::vector<PlannedEvent> events;  // empty when the human is not human_synthetic
+  std::string dataset;               // the human's dataset param, "" if none
+};
+
+// Tolerant: a recording without graph metadata, or a graph without a synthetic human, gives the
+// defaults. Fails (InvalidArgument) only on YAML that does not parse.
+StatusOr<ExperimentPlan> PlanFromGraphYaml(const std::string& yaml);
+
+struct StepSample {
+  int64_t step = 0;
+  double human_x, human_y;  // NaN when no sample this step
+  bool engaged = false;
+  double robot_x, robot_y, nelbo, reconstruction, regulation, optimisation_s;
+  double executed_x, executed_y;
+  double congruence;
+  std::vector<double> p_human, p_robot;  // empty when no label this step
+};
+
+struct Timeline {
+  std::vector<StepSample> steps;  // steps[i].step == i
+  std::vector<std::string> missing_topics;
+  int classes = 0;  // length of the observer's probability vectors (0: no observer)
+};
+
+StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan);
+
+// Events of the plan, or engaged runs of the timeline when the plan has none.
+std::vector<PlannedEvent> Events(const Timeline& timeline, const ExperimentPlan& plan);
+
+struct EventSummary {
+  int index = 0;
+  PlannedEvent event;
+  double mean_congruence = 0;   // over the event's steps that carry a label (NaN: none)
+  double final_congruence = 0;  // at its last labelled step
+  double human_accuracy = 0;    // fraction of labelled steps where argmax(p_human) == primitive
+  double robot_follows = 0;     // fraction where argmax(p_robot) == primitive
+  int64_t robot_switch_after = -1;  // steps from start to the first such step; -1 never
+};
+
+std::vector<EventSummary> SummariseEvents(const Timeline& timeline, const std::vector<PlannedEvent>& events);
+
+// Confusion of the observer on the human's traces: counts[true primitive][argmax p_human] over
+// the labelled steps of events with a known primitive. Empty when there are none.
+std::vector<std::vector<int64_t>> HumanConfusion(const Timeline& timeline, const std::vector<PlannedEvent>& events);
+
+}  // namespace dyad::analyze

@@ -1,0 +1,164 @@
+#include "report_writer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace dyad::analyze {
+namespace {
+
+std::string Num(double v, int precision = 3) {
+  if (std::isnan(v)) return "";
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(precision);
+  s << v;
+  return s.str();
+}
+
+int Argmax(const std::vector<double>& p) {
+  if (p.empty()) return -1;
+  return static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin());
+}
+
+Status WriteFile(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) return Status::IOError(path, "cannot write");
+  return Status::OK();
+}
+
+std::string EventsCsv(const Report& r) {
+  std::ostringstream s;
+  s << "event,start_step,end_step,primitive,mean_congruence,final_congruence,human_accuracy,robot_follows,"
+       "robot_switch_after\n";
+  for (const EventSummary& e : r.events) {
+    s << e.index << ',' << e.event.start_step << ',' << e.event.end_step << ',' << e.event.primitive << ','
+      << Num(e.mean_congruence, 6) << ',' << Num(e.final_congruence, 6) << ',' << Num(e.human_accuracy, 6) << ','
+      << Num(e.robot_follows, 6) << ',' << e.robot_switch_after << '\n';
+  }
+  return s.str();
+}
+
+std::string ConfusionCsv(const Report& r) {
+  std::ostringstream s;
+  s << "true,predicted,count\n";
+  for (size_t t = 0; t < r.confusion.size(); ++t) {
+    for (size_t p = 0; p < r.confusion[t].size(); ++p) s << t << ',' << p << ',' << r.confusion[t][p] << '\n';
+  }
+  return s.str();
+}
+
+std::string TimelineCsv(const Report& r) {
+  std::ostringstream s;
+  s << "step,time_s,human_x,human_y,engaged,robot_x,robot_y,executed_x,executed_y,nelbo,reconstruction,"
+       "regulation,optimisation_s,congruence,human_class,robot_class\n";
+  const double period_s = static_cast<double>(r.plan.period_ns) * 1e-9;
+  for (const StepSample& x : r.timeline.steps) {
+    s << x.step << ',' << Num(static_cast<double>(x.step) * period_s, 3) << ',' << Num(x.human_x, 4) << ','
+      << Num(x.human_y, 4) << ',' << (x.engaged ? 1 : 0) << ',' << Num(x.robot_x, 4) << ',' << Num(x.robot_y, 4)
+      << ',' << Num(x.executed_x, 4) << ',' << Num(x.executed_y, 4) << ',' << Num(x.nelbo, 6) << ','
+      << Num(x.reconstruction, 6) << ',' << Num(x.regulation, 6) << ',' << Num(x.optimisation_s, 7) << ','
+      << Num(x.congruence, 6) << ',' << Argmax(x.p_human) << ',' << Argmax(x.p_robot) << '\n';
+  }
+  return s.str();
+}
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  return v[static_cast<size_t>(std::min<double>(v.size() - 1, std::floor(q * static_cast<double>(v.size()))))];
+}
+
+}  // namespace
+
+std::string FormatMarkdown(const Report& r) {
+  std::ostringstream s;
+  s << "# Experiment report\n\n";
+  s << "- recording: `" << r.recording << "`\n";
+  if (!r.plan.graph_name.empty()) s << "- graph: `" << r.plan.graph_name << "`\n";
+  s << "- steps: " << r.timeline.steps.size() << " of " << Num(static_cast<double>(r.plan.period_ns) * 1e-6, 1)
+    << " ms\n";
+  if (!r.timeline.missing_topics.empty()) {
+    s << "- missing topics (their columns are empty):";
+    for (const std::string& t : r.timeline.missing_topics) s << " `" << t << "`";
+    s << "\n";
+  }
+  std::vector<double> opt_ms, c_engaged, c_free, nelbo;
+  int64_t engaged_steps = 0;
+  for (const StepSample& x : r.timeline.steps) {
+    engaged_steps += x.engaged;
+    if (!std::isnan(x.optimisation_s)) opt_ms.push_back(x.optimisation_s * 1e3);
+    if (!std::isnan(x.nelbo)) nelbo.push_back(x.nelbo);
+    if (!std::isnan(x.congruence)) (x.engaged ? c_engaged : c_free).push_back(x.congruence);
+  }
+  auto mean = [](const std::vector<double>& v) {
+    double t = 0;
+    for (double x : v) t += x;
+    return v.empty() ? std::nan("") : t / static_cast<double>(v.size());
+  };
+  s << "- engaged steps: " << engaged_steps << "\n";
+  s << "- N-ELBO: mean " << Num(mean(nelbo)) << ", median " << Num(Percentile(nelbo, 0.5)) << "\n";
+  s << "- deliberation time per step: median " << Num(Percentile(opt_ms, 0.5)) << " ms, p99 "
+    << Num(Percentile(opt_ms, 0.99)) << " ms, max " << Num(Percentile(opt_ms, 1.0)) << " ms\n";
+  s << "- congruence P(C_t): mean " << Num(mean(c_engaged)) << " while engaged, " << Num(mean(c_free))
+    << " otherwise\n\n";
+
+  s << "## Events\n\n";
+  if (r.events.empty()) {
+    s << "No interventions (the human never engaged).\n\n";
+  } else {
+    s << "| event | steps | primitive | mean P(C) | final P(C) | observer on human | robot follows | robot switched after |\n";
+    s << "|---|---|---|---|---|---|---|---|\n";
+    for (const EventSummary& e : r.events) {
+      s << "| " << e.index << " | " << e.event.start_step << "-" << e.event.end_step << " | "
+        << (e.event.primitive < 0 ? std::string("?") : std::to_string(e.event.primitive)) << " | "
+        << Num(e.mean_congruence) << " | " << Num(e.final_congruence) << " | " << Num(e.human_accuracy) << " | "
+        << Num(e.robot_follows) << " | "
+        << (e.robot_switch_after < 0 ? std::string("never") : std::to_string(e.robot_switch_after) + " steps")
+        << " |\n";
+    }
+    s << "\n\"observer on human\": fraction of the event's steps where the observer's most likely class of the "
+         "human's motion is the primitive the human traced; \"robot follows\": the same for the robot's intention.\n\n";
+  }
+  s << "## Observer confusion on the human's traces\n\n";
+  if (r.confusion.empty()) {
+    s << "Not available: the recording has no observer labels during events with a known primitive.\n";
+  } else {
+    s << "Rows: primitive the human traced; columns: the observer's most likely class; row-normalised "
+         "(counts in confusion.csv).\n\n|   |";
+    for (size_t p = 0; p < r.confusion.size(); ++p) s << ' ' << p << " |";
+    s << "\n|---|";
+    for (size_t p = 0; p < r.confusion.size(); ++p) s << "---|";
+    s << "\n";
+    for (size_t t = 0; t < r.confusion.size(); ++t) {
+      int64_t total = 0;
+      for (int64_t c : r.confusion[t]) total += c;
+      if (total == 0) continue;
+      s << "| **" << t << "** |";
+      for (int64_t c : r.confusion[t]) s << ' ' << Num(static_cast<double>(c) / static_cast<double>(total), 2) << " |";
+      s << "\n";
+    }
+  }
+  s << "\n## Plots\n\n![workspace](workspace.png)\n\n![N-ELBO](nelbo.png)\n\n![congruence](congruence.png)\n";
+  return s.str();
+}
+
+Status WriteReport(const Report& r, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return Status::IOError(dir, "cannot create the report folder: " + ec.message());
+  const std::pair<const char*, std::string> files[] = {
+      {"report.md", FormatMarkdown(r)}, {"events.csv", EventsCsv(r)},     {"confusion.csv", ConfusionCsv(r)},
+      {"timeline.csv", TimelineCsv(r)}, {"graph.yaml", r.graph_yaml},
+  };
+  for (const auto& [name, text] : files) {
+    if (Status s = WriteFile(dir + "/" + name, text); !s.ok()) return s;
+  }
+  return Status::OK();
+}
+
+}  // namespace dyad::analyze

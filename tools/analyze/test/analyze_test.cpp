@@ -1,0 +1,271 @@
+// `dyad analyze`: step alignment, event scores and confusion against hand-computed values on a
+// synthetic recording written with the real IDL schemas and CDR; the CLI's report folder (PNG
+// files checked by their magic bytes) and its errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fastdds/rtps/common/SerializedPayload.h>
+
+#include <dyad/msg/types.hpp>
+
+#include "analyze_commands.hpp"
+#include "dyad/mcap/writer.hpp"
+#include "experiment_analysis.hpp"
+#include "recording_tables.hpp"
+#include "report_writer.hpp"
+
+namespace dyad::analyze {
+namespace {
+
+constexpr int64_t kPeriod = 100'000'000;
+
+std::string TempPath(const std::string& name) {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string path = ::testing::TempDir() + "dyad_analyze_" + info->name() + "_" + name;
+  std::filesystem::remove_all(path);
+  return path;
+}
+
+const char* kGraph = R"(graph: unit
+clock: stepped
+components:
+  human:
+    type: human_synthetic
+    rate_hz: 10
+    params:
+      dataset: /nonexistent/dataset
+      events:
+        - {start: 10, end: 20, primitive: 2}
+        - {start: 30, end: 34, primitive: 5}
+)";
+
+template <class T>
+class Channel {
+ public:
+  Channel(mcap::Writer& w, const std::string& topic) : w_(w) {
+    auto schema = w.AddSchema(MessageTraits<T>::kName, "omgidl", MessageTraits<T>::kIdl);
+    EXPECT_TRUE(schema.ok());
+    auto channel = w.AddChannel(topic, "cdr", *schema);
+    EXPECT_TRUE(channel.ok());
+    id_ = *channel;
+  }
+  void Write(T& m, int64_t step) {
+    m.header().stamp_ns(1'000'000'000 + step * kPeriod);  // t0 != 0: alignment subtracts it
+    m.header().sequence_number(++seq_);
+    eprosima::fastrtps::rtps::SerializedPayload_t payload(type_.getSerializedSizeProvider(&m)());
+    ASSERT_TRUE(type_.serialize(&m, &payload));
+    const auto t = static_cast<uint64_t>(m.header().stamp_ns());
+    ASSERT_TRUE(w_.Write(id_, static_cast<uint32_t>(seq_), t, t, {payload.data, payload.length}).ok());
+  }
+
+ private:
+  mcap::Writer& w_;
+  mcap::ChannelId id_ = 0;
+  uint64_t seq_ = 0;
+  typename MessageTraits<T>::PubSubType type_;
+};
+
+std::vector<double> OneHot(int k, int n = 7) {
+  std::vector<double> p(n, 0.02);
+  p[k] = 0.9;
+  return p;
+}
+
+// 40 steps. Human engaged during the graph's two events. Observer: the human's class is right
+// except at steps 12 and 13 (says 3); the robot's class is 1 until step 15, then 2 until 25,
+// then 1. Congruence = step / 100.
+std::string WriteExperiment(const std::string& path, bool with_observer = true) {
+  auto writer = mcap::Writer::Open(path);
+  EXPECT_TRUE(writer.ok());
+  EXPECT_TRUE(writer->AddMetadata("dyad.graph", {{"yaml", kGraph}}).ok());
+  Channel<msg::HumanInput> human(*writer, "human/input");
+  Channel<msg::Intention> robot(*writer, "robot/intention");
+  Channel<msg::CartesianState> state(*writer, "robot/state");
+  Channel<msg::IntentionLabel> labels(*writer, "observer/labels");
+  for (int t = 0; t < 40; ++t) {
+    const bool engaged = (t >= 10 && t < 20) || (t >= 30 && t < 34);
+    msg::HumanInput h; h.x(t); h.y(-t); h.engaged(engaged);
+    human.Write(h, t);
+    msg::Intention i; i.x(2 * t); i.y(1); i.nelbo(0.5 + t); i.reconstruction(0.25); i.regulation(0.25);
+    i.optimisation_s(1e-4); i.iterations(15);
+    robot.Write(i, t);
+    msg::CartesianState s; s.x(3 * t); s.y(2);
+    state.Write(s, t);
+    if (with_observer) {
+      msg::IntentionLabel l;
+      const int truth = t < 25 ? 2 : 5;
+      l.human(OneHot((t == 12 || t == 13) ? 3 : truth));
+      l.robot(OneHot(t >= 15 && t < 25 ? 2 : 1));
+      l.congruence(t / 100.0);
+      labels.Write(l, t);
+    }
+  }
+  EXPECT_TRUE(writer->Close().ok());
+  return path;
+}
+
+Report Analyse(const std::string& path) {
+  auto reader = mcap::Reader::Open(path);
+  EXPECT_TRUE(reader.ok());
+  Report r;
+  r.recording = path;
+  r.graph_yaml = GraphYaml(*reader);
+  auto plan = PlanFromGraphYaml(r.graph_yaml);
+  EXPECT_TRUE(plan.ok()) << plan.status().ToString();
+  r.plan = *plan;
+  auto tables = ReadTables(*reader, {});
+  EXPECT_TRUE(tables.ok()) << tables.status().ToString();
+  auto timeline = BuildTimeline(*tables, r.plan);
+  EXPECT_TRUE(timeline.ok()) << timeline.status().ToString();
+  r.timeline = *timeline;
+  auto events = Events(r.timeline, r.plan);
+  r.events = SummariseEvents(r.timeline, events);
+  r.confusion = HumanConfusion(r.timeline, events);
+  return r;
+}
+
+TEST(Analyze, PlanComesFromTheRecordedGraph) {
+  auto plan = PlanFromGraphYaml(kGraph);
+  ASSERT_TRUE(plan.ok());
+  EXPECT_EQ(plan->graph_name, "unit");
+  EXPECT_EQ(plan->period_ns, kPeriod);
+  EXPECT_EQ(plan->dataset, "/nonexistent/dataset");
+  ASSERT_EQ(plan->events.size(), 2u);
+  EXPECT_EQ(plan->events[1].start_step, 30);
+  EXPECT_EQ(plan->events[1].primitive, 5);
+  EXPECT_FALSE(PlanFromGraphYaml("components: [unclosed").ok());
+  auto empty = PlanFromGraphYaml("");
+  ASSERT_TRUE(empty.ok());
+  EXPECT_TRUE(empty->events.empty());
+}
+
+TEST(Analyze, TimelineAlignsEveryTopicOnTheStepGrid) {
+  Report r = Analyse(WriteExperiment(TempPath("a.mcap")));
+  ASSERT_EQ(r.timeline.steps.size(), 40u);
+  EXPECT_TRUE(r.timeline.missing_topics.empty());
+  EXPECT_EQ(r.timeline.classes, 7);
+  const StepSample& s = r.timeline.steps[17];
+  EXPECT_EQ(s.step, 17);
+  EXPECT_DOUBLE_EQ(s.human_x, 17);
+  EXPECT_TRUE(s.engaged);
+  EXPECT_DOUBLE_EQ(s.robot_x, 34);
+  EXPECT_DOUBLE_EQ(s.nelbo, 17.5);
+  EXPECT_DOUBLE_EQ(s.executed_x, 51);
+  EXPECT_DOUBLE_EQ(s.congruence, 0.17);
+  EXPECT_FALSE(r.timeline.steps[20].engaged);
+}
+
+TEST(Analyze, EventScoresMatchHandComputedValues) {
+  Report r = Analyse(WriteExperiment(TempPath("a.mcap")));
+  ASSERT_EQ(r.events.size(), 2u);
+  const EventSummary& a = r.events[0];  // steps 10..19, primitive 2
+  EXPECT_NEAR(a.mean_congruence, 0.145, 1e-12);  // mean of 0.10..0.19
+  EXPECT_NEAR(a.final_congruence, 0.19, 1e-12);
+  EXPECT_NEAR(a.human_accuracy, 0.8, 1e-12);     // wrong at 12 and 13
+  EXPECT_NEAR(a.robot_follows, 0.5, 1e-12);      // 15..19
+  EXPECT_EQ(a.robot_switch_after, 5);
+  const EventSummary& b = r.events[1];  // steps 30..33, primitive 5: robot never follows
+  EXPECT_NEAR(b.human_accuracy, 1.0, 1e-12);
+  EXPECT_NEAR(b.robot_follows, 0.0, 1e-12);
+  EXPECT_EQ(b.robot_switch_after, -1);
+}
+
+TEST(Analyze, ConfusionCountsTheHumansTracedSteps) {
+  Report r = Analyse(WriteExperiment(TempPath("a.mcap")));
+  ASSERT_EQ(r.confusion.size(), 7u);
+  EXPECT_EQ(r.confusion[2][2], 8);
+  EXPECT_EQ(r.confusion[2][3], 2);
+  EXPECT_EQ(r.confusion[5][5], 4);
+  int64_t total = 0;
+  for (const auto& row : r.confusion) for (int64_t c : row) total += c;
+  EXPECT_EQ(total, 14);
+  const std::string md = FormatMarkdown(r);
+  EXPECT_NE(md.find("| 0 | 10-20 | 2 | 0.145 | 0.190 | 0.800 | 0.500 | 5 steps |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| **2** | 0.00 | 0.00 | 0.80 | 0.20 |"), std::string::npos) << md;
+}
+
+TEST(Analyze, WithoutObserverTheReportSaysWhatIsMissing) {
+  Report r = Analyse(WriteExperiment(TempPath("a.mcap"), /*with_observer=*/false));
+  ASSERT_EQ(r.timeline.missing_topics.size(), 1u);
+  EXPECT_EQ(r.timeline.missing_topics[0], "observer/labels");
+  EXPECT_TRUE(r.confusion.empty());
+  EXPECT_TRUE(std::isnan(r.events[0].mean_congruence));
+  const std::string md = FormatMarkdown(r);
+  EXPECT_NE(md.find("missing topics (their columns are empty): `observer/labels`"), std::string::npos) << md;
+  EXPECT_NE(md.find("Not available"), std::string::npos) << md;
+}
+
+TEST(Analyze, CellParsersRejectWhatIsNotANumber) {
+  double v = 0;
+  EXPECT_TRUE(ParseNumber("-1.5e3", &v));
+  EXPECT_EQ(v, -1500);
+  EXPECT_FALSE(ParseNumber("12x", &v));
+  EXPECT_FALSE(ParseNumber("", &v));
+  std::vector<double> list;
+  EXPECT_TRUE(ParseNumberList("[0.25,0.75]", &list));
+  EXPECT_EQ(list, (std::vector<double>{0.25, 0.75}));
+  EXPECT_TRUE(ParseNumberList("[]", &list));
+  EXPECT_TRUE(list.empty());
+  EXPECT_FALSE(ParseNumberList("[1,,2]", &list));
+  EXPECT_FALSE(ParseNumberList("1,2", &list));
+}
+
+int RunCli(std::vector<std::string> args, std::string* err = nullptr) {
+  CLI::App app{"dyad"};
+  int exit_code = -1;
+  dyad::cli::AddAnalyzeCommands(app, exit_code);
+  args.insert(args.begin(), "dyad");
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  ::testing::internal::CaptureStderr();
+  app.parse(static_cast<int>(argv.size()), argv.data());
+  const std::string captured = ::testing::internal::GetCapturedStderr();
+  if (err) *err = captured;
+  return exit_code;
+}
+
+std::string Head(const std::string& path, size_t n) {
+  std::ifstream in(path, std::ios::binary);
+  std::string s(n, '\0');
+  in.read(s.data(), static_cast<std::streamsize>(n));
+  return s.substr(0, static_cast<size_t>(in.gcount()));
+}
+
+// The CLI end to end through the `dyad` executable (it finds share/dyad/plot_report.py).
+TEST(AnalyzeCli, WritesTablesAndPngPlots) {
+  const std::string rec = WriteExperiment(TempPath("exp.mcap"));
+  const std::string out = TempPath("report");
+  const std::string cmd = std::string(DYAD_BIN_DIR) + "/dyad analyze " + rec + " -o " + out + " > " + out + ".log 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << Head(out + ".log", 4000);
+  for (const char* f : {"report.md", "events.csv", "confusion.csv", "timeline.csv", "graph.yaml"}) {
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + f)) << f;
+  }
+  for (const char* f : {"workspace.png", "nelbo.png", "congruence.png"}) {
+    EXPECT_EQ(Head(out + "/" + f, 8), "\x89PNG\r\n\x1a\n") << f;
+  }
+  EXPECT_NE(Head(out + ".log", 4000).find("not a folder from here"), std::string::npos);  // graph's dataset
+  std::ifstream timeline(out + "/timeline.csv");
+  int lines = 0;
+  for (std::string line; std::getline(timeline, line);) ++lines;
+  EXPECT_EQ(lines, 41);
+}
+
+TEST(AnalyzeCli, BadInputExitsTwoNamingTheFile) {
+  std::string err;
+  EXPECT_EQ(RunCli({"analyze", TempPath("missing.mcap")}, &err), 2);
+  EXPECT_NE(err.find(TempPath("missing.mcap")), std::string::npos) << err;
+  const std::string text = TempPath("text.mcap");
+  std::ofstream(text) << "not a recording\n";
+  EXPECT_EQ(RunCli({"analyze", text}, &err), 2);
+  EXPECT_NE(err.find("not an MCAP file"), std::string::npos) << err;
+  const std::string rec = WriteExperiment(TempPath("exp.mcap"));
+  EXPECT_EQ(RunCli({"analyze", rec, "-o", TempPath("r"), "--dataset", TempPath("nope")}, &err), 2);
+  EXPECT_NE(err.find("--dataset"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace dyad::analyze
