@@ -100,6 +100,13 @@ Status Recorder::Configure(Context& ctx) {
 }
 
 Status Recorder::Activate() {
+  Status s = OpenFile();
+  // Without a writer thread a full queue would block publishers forever: refuse pushes instead.
+  if (!s.ok()) queue_->Close();
+  return s;
+}
+
+Status Recorder::OpenFile() {
   std::error_code ec;
   const auto parent = std::filesystem::path(path_).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent, ec);

@@ -68,6 +68,7 @@ class Recorder final : public Component {
     const TopicInfo* topic = nullptr;  // owned by the runtime
     std::atomic<uint64_t> received{0};
   };
+  Status OpenFile();  // Activate(): file, schemas, channels, metadata, writer thread
   void WriterLoop();
   void SetFailure(const Status& s);
   Status failure() const;

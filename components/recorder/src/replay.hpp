@@ -17,7 +17,7 @@
 /// Each topic's type must be known to this process with the recorded definition (the channel's
 /// dds_type "name#hash", else the IDL text, must match); otherwise Configure fails naming the topic.
 /// When the last message has been published the component asks the run to stop.
-/// The chosen messages are loaded into memory in Activate (the recording's uncompressed size).
+/// The chosen messages are loaded into memory in Configure (their uncompressed size).
 #pragma once
 
 #include <cstdint>

@@ -33,7 +33,9 @@ std::string ReadFile(const fs::path& p) {
 // A started child process with stdout/stderr in files and optional extra environment.
 class Child {
  public:
-  Child(std::vector<std::string> args, const fs::path& dir, const std::string& tag, std::vector<std::string> env = {}) {
+  // Runs in `cwd` when given.
+  Child(std::vector<std::string> args, const fs::path& dir, const std::string& tag, std::vector<std::string> env = {},
+        const fs::path& cwd = {}) {
     out_ = dir / (tag + ".out");
     err_ = dir / (tag + ".err");
     for (char** e = environ; *e != nullptr; ++e) env.push_back(*e);
@@ -43,6 +45,7 @@ class Child {
       const int e = open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
       dup2(o, 1);
       dup2(e, 2);
+      if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
       std::vector<char*> argv, envp;
       for (auto& a : args) argv.push_back(a.data());
       argv.push_back(nullptr);
@@ -557,6 +560,28 @@ TEST_F(RecorderTest, RecordsTopicsPublishedInAnotherProcessWithoutGaps) {
         break;
       }
   }
+}
+
+}  // namespace
+
+namespace {
+
+// The example graphs of components/recorder/examples run as their comments say.
+TEST_F(RecorderTest, ExampleGraphsRecordAndReplayAsDocumented) {
+  const std::string examples = DYAD_RECORDER_EXAMPLES;
+  Child rec(Dyad({"run", examples + "/record.yaml", "--steps", "100", "--quiet"}), dir_, "record", {}, dir_);
+  ASSERT_EQ(rec.Wait(60), 0) << rec.err();
+  Child play(Dyad({"run", examples + "/replay.yaml", "--quiet"}), dir_, "replay", {}, dir_);
+  ASSERT_EQ(play.Wait(60), 0) << play.err();
+  const Recording a = Read(dir_ / "counters.mcap");
+  const Recording b = Read(dir_ / "counters_replayed.mcap");
+  EXPECT_EQ(a.topics, (std::vector<std::string>{"ca", "cb", "cc", "dyad/stats"}));
+  EXPECT_EQ(a.by_topic.at("cb").size(), 100u);
+  EXPECT_EQ(a.by_topic.at("cc").size(), 50u);
+  ASSERT_EQ(b.by_topic.count("replayed/cb"), 1u);
+  ASSERT_EQ(b.by_topic.at("replayed/cb").size(), 100u);
+  for (size_t i = 0; i < 100; ++i) EXPECT_EQ(a.by_topic.at("cb")[i].data, b.by_topic.at("replayed/cb")[i].data);
+  EXPECT_EQ(b.by_topic.at("ca").size(), 100u);
 }
 
 }  // namespace

@@ -333,20 +333,21 @@ class Context {
   // Ends the run cleanly after the current step (e.g. a replay reached its end).
   virtual void RequestStop(std::string reason) = 0;
 
-  // Generic topics (see the file comment). Call these in Configure() only.
-  virtual const std::string& graph_name() const = 0;
-  virtual const std::string& graph_yaml() const = 0;  // the graph file as read
-  virtual bool stepped() const = 0;                   // `clock: stepped`
+  // Generic topics (see the file comment). Call these in Configure() only. The runtime implements
+  // them all; the defaults (empty graph, Unimplemented) serve test fakes of Context.
+  virtual const std::string& graph_name() const;
+  virtual const std::string& graph_yaml() const;  // the graph file as read
+  virtual bool stepped() const { return false; }  // `clock: stepped`
   // Every topic of the graph, sorted by name, `dyad/stats` included.
-  virtual const std::vector<TopicInfo>& graph_topics() const = 0;
+  virtual const std::vector<TopicInfo>& graph_topics() const;
   // A message type known in this process, by IDL name ("dyad::msg::Counter") or short name; null if none.
-  virtual const TypeInfo* FindMessageType(std::string_view name) const = 0;
+  virtual const TypeInfo* FindMessageType(std::string_view /*name*/) const { return nullptr; }
   // Calls `callback` for every sample of `topic` (a graph topic) from now until just before
   // Deactivate(). Fails: NotFound (not a graph topic), Internal (DDS), FailedPrecondition (after Configure).
-  virtual Status SubscribeSerialized(const std::string& topic, SerializedCallback callback) = 0;
+  virtual Status SubscribeSerialized(const std::string& topic, SerializedCallback callback);
   // A writer of `type` on `topic`, with the topic's graph QoS (defaults if not a graph topic).
   // Fails: InvalidArgument (the topic carries another type in this process), Internal (DDS).
-  virtual StatusOr<SerializedWriter*> AdvertiseSerialized(const std::string& topic, const TypeInfo& type) = 0;
+  virtual StatusOr<SerializedWriter*> AdvertiseSerialized(const std::string& topic, const TypeInfo& type);
 
   // The port declared under `name` with type T. Asking for an undeclared port or another type is
   // a programming error: it aborts naming the component and port.
