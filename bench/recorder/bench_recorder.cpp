@@ -13,8 +13,8 @@
 // costs them (intra-process delivery is synchronous, so the copy into the queue is on their time).
 //
 //   bench_recorder [--steps N] [--burst B] [--wall-burst B] [--duration S] [--repeats R] [--dir DIR]
-// Defaults: 2000 steps of 100 samples per publisher (stepped: 600,000 samples); wall: 1000 samples
-// per step per publisher at 100 Hz (offered: 300,000 samples/s) for 3 s; 3 repeats.
+// Defaults: 2000 steps of 100 samples per publisher (stepped: 600,000 samples); wall: 3000 samples
+// per step per publisher at 100 Hz (offered: 900,000 samples/s) for 3 s; 3 repeats.
 #include <unistd.h>
 
 #include <algorithm>
@@ -128,7 +128,7 @@ Result RunCase(const Case& c, int steps, int burst, double duration, const fs::p
 }  // namespace
 
 int main(int argc, char** argv) {
-  int steps = 2000, burst = 100, wall_burst = 1000, repeats = 3;
+  int steps = 2000, burst = 100, wall_burst = 3000, repeats = 3;
   double duration = 3.0;
   fs::path dir = fs::temp_directory_path() / ("dyad_bench_recorder_" + std::to_string(getpid()));
   for (int i = 1; i < argc; ++i) {

@@ -61,8 +61,11 @@
 //     thread (inside the publisher's Publish() for a publisher in this process, so delivery is
 //     synchronous and deterministic under the stepped clock), from subscription until just before
 //     Deactivate(); never concurrently for one subscription, concurrently across subscriptions.
-//     The reader is RELIABLE (if the topic is) with KEEP_ALL history: nothing is dropped on the
-//     reader's side. Keep the callback short (copy the bytes, hand them to another thread).
+//     The reader has KEEP_ALL history: nothing is dropped on the reader's side. It is RELIABLE
+//     if the topic is, except when every writer is in this process (TopicInfo::writers_local):
+//     intra-process delivery is synchronous, so reliability would only add protocol overhead
+//     (3x the cost per sample, measured in bench/recorder). Keep the callback short (copy the
+//     bytes, hand them to another thread).
 //   - AdvertiseSerialized(topic, type): a writer that publishes CDR bytes of `type` on `topic`.
 //   Both endpoints are owned by the runtime and live until Shutdown() returns.
 //
@@ -292,6 +295,8 @@ struct TopicInfo {
   // "component.port" of every output bound to it in the graph (any process); "runtime" for
   // dyad/stats; empty for a topic only declared under `topics:` (published from outside).
   std::vector<std::string> writers;
+  // Every writer the graph knows is in this process (at least one): delivery is intra-process.
+  bool writers_local = false;
 };
 
 // One sample delivered by a serialized subscription. `cdr` is valid during the callback only.
