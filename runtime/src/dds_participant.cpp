@@ -395,6 +395,13 @@ StatusOr<std::unique_ptr<DdsSerializedReader>> DdsParticipant::CreateSerializedR
   if (!t.ok()) return t.status();
   fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
   ApplyQos(rq, qos);
+  if (qos.keep_all) {
+    // KEEP_ALL alone still caps the history (5000 samples, 400 per instance by default): samples
+    // that pile up while the callback waits (a full recorder queue) must not be refused.
+    rq.resource_limits().max_samples = fdds::LENGTH_UNLIMITED;
+    rq.resource_limits().max_samples_per_instance = fdds::LENGTH_UNLIMITED;
+    rq.resource_limits().max_instances = fdds::LENGTH_UNLIMITED;
+  }
   std::unique_ptr<DdsSerializedReader> r(new DdsSerializedReader());
   r->topic_ = topic;
   r->clock_ = clock;
