@@ -64,7 +64,7 @@
 //     The reader has KEEP_ALL history: nothing is dropped on the reader's side. It is RELIABLE
 //     if the topic is, except when every writer is in this process (TopicInfo::writers_local):
 //     intra-process delivery is synchronous, so reliability would only add protocol overhead
-//     (3x the cost per sample, measured in bench/recorder). Keep the callback short (copy the
+//     (2.7x the cost per sample, measured in bench/recorder). Keep the callback short (copy the
 //     bytes, hand them to another thread).
 //   - AdvertiseSerialized(topic, type): a writer that publishes CDR bytes of `type` on `topic`.
 //   Both endpoints are owned by the runtime and live until Shutdown() returns.
