@@ -11,6 +11,25 @@ std::string TypeInfo::short_name() const {
   return pos == std::string::npos ? name : name.substr(pos + 2);
 }
 
+const std::string& Context::graph_name() const {
+  static const std::string empty;
+  return empty;
+}
+const std::string& Context::graph_yaml() const {
+  static const std::string empty;
+  return empty;
+}
+const std::vector<TopicInfo>& Context::graph_topics() const {
+  static const std::vector<TopicInfo> none;
+  return none;
+}
+Status Context::SubscribeSerialized(const std::string& topic, SerializedCallback) {
+  return Status::Unimplemented("SubscribeSerialized('" + topic + "'): this context has no DDS topics");
+}
+StatusOr<SerializedWriter*> Context::AdvertiseSerialized(const std::string& topic, const TypeInfo&) {
+  return Status::Unimplemented("AdvertiseSerialized('" + topic + "'): this context has no DDS topics");
+}
+
 ParamSpec& ComponentSpec::AddParam(std::string name, ParamType type, std::optional<ParamValue> default_value) {
   if (FindParam(name) != nullptr) {
     std::fprintf(stderr, "dyad: parameter '%s' declared twice\n", name.c_str());

@@ -152,13 +152,131 @@ bool DdsReader::TakeNext(void* sample) {
 
 uint64_t DdsReader::Unread() const { return reader_->get_unread_count(); }
 
+namespace {
+// A reliable writer deleted with samples in flight loses them for remote readers (a recorder in
+// another process): give acknowledgments a moment first. Returns at once when all are acked,
+// when nothing matched, or for best-effort writers.
+void AwaitAcks(fdds::DataWriter* w) {
+  if (w != nullptr) w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0.5));
+}
+}  // namespace
+
 DdsWriter::~DdsWriter() {
+  AwaitAcks(writer_);
   if (on_delete_) on_delete_();
 }
 
 Status DdsWriter::Write(const void* sample) {
   if (!writer_->write(const_cast<void*>(sample)))
     return Status::IOError("topic '" + topic_ + "': DDS write failed");
+  return Status::OK();
+}
+
+namespace {
+eprosima::fastrtps::Time_t TimeOfNs(int64_t ns) {
+  if (ns < 0) ns = 0;
+  return eprosima::fastrtps::Time_t(static_cast<int32_t>(ns / 1'000'000'000), static_cast<uint32_t>(ns % 1'000'000'000));
+}
+}  // namespace
+
+Status DdsWriter::WriteStamped(const void* sample, int64_t stamp_ns) {
+  if (writer_->write_w_timestamp(const_cast<void*>(sample), fdds::HANDLE_NIL, TimeOfNs(stamp_ns)) != ReturnCode_t::RETCODE_OK)
+    return Status::IOError("topic '" + topic_ + "': DDS write failed");
+  return Status::OK();
+}
+
+// What a serialized endpoint reuses for every sample: its own (unregistered) type support for
+// (de)serialising, one sample object and one payload buffer.
+struct SerializedScratch {
+  explicit SerializedScratch(const TypeInfo& type) : support(type.make_type_support()) {
+    sample = support->createData();
+    payload.reserve(support->m_typeSize + 64);
+  }
+  ~SerializedScratch() {
+    if (sample) support->deleteData(sample);
+  }
+  fdds::TypeSupport support;
+  void* sample = nullptr;
+  eprosima::fastrtps::rtps::SerializedPayload_t payload;
+};
+struct DdsSerializedReader::Scratch : SerializedScratch {
+  using SerializedScratch::SerializedScratch;
+};
+struct DdsSerializedWriter::Scratch : SerializedScratch {
+  using SerializedScratch::SerializedScratch;
+};
+
+class DdsSerializedReader::Listener final : public fdds::DataReaderListener {
+ public:
+  explicit Listener(DdsSerializedReader* owner) : owner_(owner) {}
+  void on_data_available(fdds::DataReader*) override {
+    std::lock_guard<std::mutex> lock(owner_->mutex_);
+    if (!owner_->closed_) owner_->Drain();
+  }
+
+ private:
+  DdsSerializedReader* owner_;
+};
+
+DdsSerializedReader::DdsSerializedReader() = default;
+DdsSerializedReader::~DdsSerializedReader() {
+  Close();
+  if (on_delete_) on_delete_();
+}
+
+void DdsSerializedReader::Close() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (closed_) return;
+  if (reader_ != nullptr) Drain();
+  closed_ = true;
+}
+
+void DdsSerializedReader::Drain() {
+  Scratch& s = *scratch_;
+  fdds::SampleInfo info;
+  while (reader_->take_next_sample(s.sample, &info) == ReturnCode_t::RETCODE_OK) {
+    if (!info.valid_data) continue;
+    const uint32_t need = s.support->getSerializedSizeProvider(s.sample)();
+    if (s.payload.max_size < need) s.payload.reserve(need);
+    s.payload.length = 0;
+    s.payload.pos = 0;
+    if (!s.support->serialize(s.sample, &s.payload)) continue;  // cannot happen for a sample we just decoded
+    SerializedSample out;
+    out.cdr = std::span<const uint8_t>(s.payload.data, s.payload.length);
+    out.source_stamp_ns = info.source_timestamp.to_ns();
+    out.receive_ns = clock_->now_ns();
+    out.sequence = info.sample_identity.sequence_number().to64long();
+    callback_(out);
+    delivered_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+DdsSerializedWriter::DdsSerializedWriter() = default;
+DdsSerializedWriter::~DdsSerializedWriter() {
+  AwaitAcks(writer_);
+  if (on_delete_) on_delete_();
+}
+
+Status DdsSerializedWriter::Write(std::span<const uint8_t> cdr, int64_t source_stamp_ns) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Scratch& s = *scratch_;
+  if (cdr.size() > UINT32_MAX) return Status::InvalidArgument("topic '" + topic_ + "': sample of " + std::to_string(cdr.size()) + " bytes is too large");
+  if (s.payload.max_size < cdr.size()) s.payload.reserve(static_cast<uint32_t>(cdr.size()));
+  std::copy(cdr.begin(), cdr.end(), s.payload.data);
+  s.payload.length = static_cast<uint32_t>(cdr.size());
+  s.payload.pos = 0;
+  bool decoded = false;
+  try {  // fastcdr throws on short input; nothing may escape to the component
+    decoded = s.support->deserialize(&s.payload, s.sample);
+  } catch (...) {
+    decoded = false;
+  }
+  if (!decoded)
+    return Status::InvalidArgument("topic '" + topic_ + "': " + std::to_string(cdr.size()) + " bytes do not decode as " + type_->name);
+  const int64_t stamp = source_stamp_ns >= 0 ? source_stamp_ns : clock_->now_ns();
+  if (writer_->write_w_timestamp(s.sample, fdds::HANDLE_NIL, TimeOfNs(stamp)) != ReturnCode_t::RETCODE_OK)
+    return Status::IOError("topic '" + topic_ + "': DDS write failed");
+  ++written_;
   return Status::OK();
 }
 
@@ -260,6 +378,66 @@ StatusOr<std::unique_ptr<DdsWriter>> DdsParticipant::CreateWriter(const std::str
   ApplyQos(wq, qos);
   std::unique_ptr<DdsWriter> w(new DdsWriter());
   w->topic_ = topic;
+  w->writer_ = publisher_->create_datawriter(*t, wq);
+  if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'");
+  auto* pub = publisher_;
+  auto* raw = w->writer_;
+  w->on_delete_ = [pub, raw] { pub->delete_datawriter(raw); };
+  return w;
+}
+
+StatusOr<std::unique_ptr<DdsSerializedReader>> DdsParticipant::CreateSerializedReader(const std::string& topic,
+                                                                                      const TypeInfo& type,
+                                                                                      const TopicQos& qos,
+                                                                                      const Clock* clock,
+                                                                                      SerializedCallback callback) {
+  auto t = GetTopic(topic, type);
+  if (!t.ok()) return t.status();
+  fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
+  ApplyQos(rq, qos);
+  if (qos.keep_all) {
+    // KEEP_ALL alone still caps the history (5000 samples, 400 per instance by default): samples
+    // that pile up while the callback waits (a full recorder queue) must not be refused.
+    rq.resource_limits().max_samples = fdds::LENGTH_UNLIMITED;
+    rq.resource_limits().max_samples_per_instance = fdds::LENGTH_UNLIMITED;
+    rq.resource_limits().max_instances = fdds::LENGTH_UNLIMITED;
+  }
+  std::unique_ptr<DdsSerializedReader> r(new DdsSerializedReader());
+  r->topic_ = topic;
+  r->clock_ = clock;
+  r->callback_ = std::move(callback);
+  r->scratch_ = std::make_unique<DdsSerializedReader::Scratch>(type);
+  r->listener_ = std::make_unique<DdsSerializedReader::Listener>(r.get());
+  r->reader_ = subscriber_->create_datareader(*t, rq, nullptr, fdds::StatusMask::none());
+  if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
+  auto* sub = subscriber_;
+  auto* raw = r->reader_;
+  r->on_delete_ = [sub, raw] {
+    raw->set_listener(nullptr);
+    sub->delete_datareader(raw);
+  };
+  // The listener is attached once reader_ is set; samples that came in between are drained here.
+  r->reader_->set_listener(r->listener_.get(), fdds::StatusMask::data_available());
+  {
+    std::lock_guard<std::mutex> lock(r->mutex_);
+    r->Drain();
+  }
+  return r;
+}
+
+StatusOr<std::unique_ptr<DdsSerializedWriter>> DdsParticipant::CreateSerializedWriter(const std::string& topic,
+                                                                                      const TypeInfo& type,
+                                                                                      const TopicQos& qos,
+                                                                                      const Clock* clock) {
+  auto t = GetTopic(topic, type);
+  if (!t.ok()) return t.status();
+  fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
+  ApplyQos(wq, qos);
+  std::unique_ptr<DdsSerializedWriter> w(new DdsSerializedWriter());
+  w->topic_ = topic;
+  w->type_ = &type;
+  w->clock_ = clock;
+  w->scratch_ = std::make_unique<DdsSerializedWriter::Scratch>(type);
   w->writer_ = publisher_->create_datawriter(*t, wq);
   if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'");
   auto* pub = publisher_;

@@ -60,11 +60,68 @@ class DdsWriter final : public detail::WriterEndpoint {
  public:
   ~DdsWriter() override;
   Status Write(const void* sample) override;
+  // Sets the DDS source timestamp to stamp_ns (the header's stamp), so readers see the writer's
+  // runtime clock (simulated time under the stepped clock) rather than the wall clock.
+  Status WriteStamped(const void* sample, int64_t stamp_ns) override;
   int matched() const;
 
  private:
   friend class DdsParticipant;
   std::string topic_;
+  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;  // owned by the participant's publisher
+  std::function<void()> on_delete_;
+};
+
+// A reader that hands every sample to a callback as CDR bytes (Context::SubscribeSerialized).
+// The sample is taken as the type's C++ object and serialised again (Fast DDS 2.9 offers no
+// public access to the received payload); the callback runs on the delivering thread under a
+// per-reader mutex, so never concurrently with itself.
+class DdsSerializedReader {
+ public:
+  ~DdsSerializedReader();
+  // Delivers what is still unread, then stops calling back. Idempotent; waits for a running callback.
+  void Close();
+  const std::string& topic() const { return topic_; }
+  uint64_t delivered() const { return delivered_.load(std::memory_order_relaxed); }
+
+ private:
+  friend class DdsParticipant;
+  class Listener;
+  DdsSerializedReader();
+  void Drain();  // REQUIRES: mutex_ held
+  std::string topic_;
+  const Clock* clock_ = nullptr;  // owned by the executor
+  SerializedCallback callback_;
+  std::mutex mutex_;
+  bool closed_ = false;
+  std::atomic<uint64_t> delivered_{0};
+  struct Scratch;
+  std::unique_ptr<Scratch> scratch_;  // type support, sample, payload: reused for every sample
+  std::unique_ptr<Listener> listener_;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;  // owned by the participant's subscriber
+  std::function<void()> on_delete_;
+};
+
+// Publishes CDR bytes (Context::AdvertiseSerialized): decodes them into the type's C++ object
+// and writes that, with the given source timestamp.
+class DdsSerializedWriter final : public SerializedWriter {
+ public:
+  ~DdsSerializedWriter() override;
+  const std::string& topic() const override { return topic_; }
+  const TypeInfo& type() const override { return *type_; }
+  Status Write(std::span<const uint8_t> cdr, int64_t source_stamp_ns) override;
+  uint64_t written() const override { return written_; }
+
+ private:
+  friend class DdsParticipant;
+  DdsSerializedWriter();
+  std::string topic_;
+  const TypeInfo* type_ = nullptr;
+  const Clock* clock_ = nullptr;
+  std::mutex mutex_;
+  uint64_t written_ = 0;
+  struct Scratch;
+  std::unique_ptr<Scratch> scratch_;
   eprosima::fastdds::dds::DataWriter* writer_ = nullptr;  // owned by the participant's publisher
   std::function<void()> on_delete_;
 };
@@ -91,6 +148,12 @@ class DdsParticipant {
   StatusOr<std::unique_ptr<DdsReader>> CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
                                                     std::function<void()> on_data);
   StatusOr<std::unique_ptr<DdsWriter>> CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos);
+  // `clock` stamps receive times; both it and the callback must outlive the reader.
+  StatusOr<std::unique_ptr<DdsSerializedReader>> CreateSerializedReader(const std::string& topic, const TypeInfo& type,
+                                                                        const TopicQos& qos, const Clock* clock,
+                                                                        SerializedCallback callback);
+  StatusOr<std::unique_ptr<DdsSerializedWriter>> CreateSerializedWriter(const std::string& topic, const TypeInfo& type,
+                                                                        const TopicQos& qos, const Clock* clock);
   const std::string& name() const { return name_; }
   // Every remote (or local) endpoint discovered so far that is still alive.
   std::vector<DiscoveredEndpoint> Discovered() const;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <set>
 
 #include <dyad/msg/types.hpp>
 
@@ -11,6 +12,9 @@
 
 namespace dyad {
 namespace {
+
+constexpr const char* kStatsTopic = "dyad/stats";
+constexpr int kStatsDepth = 16;
 
 int64_t SteadyNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -64,6 +68,9 @@ struct Executor::Instance {
   std::vector<std::unique_ptr<OutputBase>> outputs;
   std::vector<std::unique_ptr<DdsReader>> readers;
   std::vector<std::unique_ptr<DdsWriter>> writers;
+  std::vector<std::unique_ptr<DdsSerializedReader>> serialized_readers;
+  std::vector<std::unique_ptr<DdsSerializedWriter>> serialized_writers;
+  bool configuring = false;  // generic-topic calls are allowed only in Configure()
   DdsReader* trigger = nullptr;
   StepStats stats;
   std::atomic<bool> active{false};
@@ -87,6 +94,45 @@ class Executor::ContextImpl final : public Context {
   uint64_t seed() const override { return seed_; }
   int64_t period_ns() const override { return inst_->rc->period_ns; }
   void RequestStop(std::string reason) override { ex_->RequestStop(inst_->name() + ": " + reason); }
+
+  const std::string& graph_name() const override { return ex_->graph_.name; }
+  const std::string& graph_yaml() const override { return ex_->graph_.yaml_text; }
+  bool stepped() const override { return ex_->clock_->stepped(); }
+  const std::vector<TopicInfo>& graph_topics() const override { return ex_->topics_; }
+  const TypeInfo* FindMessageType(std::string_view name) const override {
+    for (const auto& t : ex_->topics_)
+      if (t.type->name == name || t.type->short_name() == name) return t.type;
+    return ex_->catalog_ ? ex_->catalog_->FindMessageType(std::string(name)) : nullptr;
+  }
+  Status SubscribeSerialized(const std::string& topic, SerializedCallback callback) override {
+    if (!inst_->configuring) return Status::FailedPrecondition(inst_->name() + ": SubscribeSerialized('" + topic + "') outside Configure()");
+    const TopicInfo* info = ex_->FindTopic(topic);
+    if (info == nullptr) return Status::NotFound("topic '" + topic + "' is not a topic of graph '" + ex_->graph_.name + "'");
+    // KEEP_ALL: the reader never drops a sample. Reliability follows the topic's writers, except
+    // that writers all in this process deliver synchronously inside write(): a BEST_EFFORT reader
+    // then loses nothing and costs a third of a RELIABLE one (bench/recorder).
+    const bool reliable = info->reliable && !info->writers_local;
+    TopicQos qos{reliable ? Reliability::kReliable : Reliability::kBestEffort, info->depth, 0, true};
+    auto r = ex_->participant_->CreateSerializedReader(topic, *info->type, qos, ex_->clock_.get(), std::move(callback));
+    if (!r.ok()) return r.status();
+    inst_->serialized_readers.push_back(std::move(r.value()));
+    return Status::OK();
+  }
+  StatusOr<SerializedWriter*> AdvertiseSerialized(const std::string& topic, const TypeInfo& type) override {
+    if (!inst_->configuring) return Status::FailedPrecondition(inst_->name() + ": AdvertiseSerialized('" + topic + "') outside Configure()");
+    TopicQos qos;
+    if (const TopicInfo* info = ex_->FindTopic(topic)) {
+      if (info->type->name != type.name)
+        return Status::InvalidArgument("topic '" + topic + "' carries " + info->type->name + " in graph '" + ex_->graph_.name +
+                                       "', not " + type.name);
+      qos = TopicQos{info->reliable ? Reliability::kReliable : Reliability::kBestEffort, info->depth, info->deadline_ms, false};
+    }
+    auto w = ex_->participant_->CreateSerializedWriter(topic, type, qos, ex_->clock_.get());
+    if (!w.ok()) return w.status();
+    SerializedWriter* raw = w.value().get();
+    inst_->serialized_writers.push_back(std::move(w.value()));
+    return raw;
+  }
 
  protected:
   InputBase* FindInput(std::string_view port, const TypeInfo& type) override {
@@ -121,8 +167,8 @@ class Executor::ContextImpl final : public Context {
   uint64_t seed_;
 };
 
-Executor::Executor(const Graph& graph, const ResolvedGraph& resolved, Options options)
-    : graph_(graph), resolved_(resolved), options_(std::move(options)),
+Executor::Executor(const Graph& graph, const ResolvedGraph& resolved, const Catalog* catalog, Options options)
+    : graph_(graph), resolved_(resolved), catalog_(catalog), options_(std::move(options)),
       clock_(std::make_unique<ClockImpl>(graph.clock == ClockMode::kStepped)) {}
 
 Executor::~Executor() {
@@ -131,6 +177,8 @@ Executor::~Executor() {
   // Ports and endpoints before the participant; components before their ports.
   for (auto& inst : instances_) {
     inst->component.reset();
+    inst->serialized_readers.clear();
+    inst->serialized_writers.clear();
     inst->inputs.clear();
     inst->outputs.clear();
     inst->readers.clear();
@@ -211,14 +259,17 @@ Status Executor::Setup() {
   if (instances_.empty()) return Status::InvalidArgument("no component is placed in process '" + options_.process + "'");
 
   // The runtime's own output: timing of this process's components.
-  auto w = participant_->CreateWriter("dyad/stats", TypeInfoOf<msg::ComponentStats>(), TopicQos{Reliability::kReliable, 16, 0, false});
+  auto w = participant_->CreateWriter(kStatsTopic, TypeInfoOf<msg::ComponentStats>(), TopicQos{Reliability::kReliable, kStatsDepth, 0, false});
   if (!w.ok()) return w.status();
   stats_writer_ = std::move(w.value());
   stats_output_ = std::make_unique<Output<msg::ComponentStats>>();
-  stats_output_->Bind("stats", "dyad/stats", "dyad/" + options_.process, stats_writer_.get(), clock_.get());
+  stats_output_->Bind("stats", kStatsTopic, "dyad/" + options_.process, stats_writer_.get(), clock_.get());
 
+  BuildTopicList();
   for (auto& inst : instances_) {
+    inst->configuring = true;
     Status s = inst->component->Configure(*inst->ctx);
+    inst->configuring = false;
     if (!s.ok()) return Status::FailedPrecondition(inst->name() + ": configure failed: " + s.message());
     inst->configured = true;
   }
@@ -396,15 +447,17 @@ Status Executor::Run() {
     if (inst->thread.joinable()) inst->thread.join();
     while (inst->busy.load(std::memory_order_acquire)) std::this_thread::yield();
   }
+  // The last stats, while every subscriber (a recorder) still listens.
+  if (participant_ && stats_output_) PublishStats();
   for (auto it = instances_.rbegin(); it != instances_.rend(); ++it) {
     Instance& inst = **it;
+    for (auto& r : inst.serialized_readers) r->Close();
     if (!inst.activated) continue;
     Status d = inst.component->Deactivate();
     if (!d.ok() && s.ok()) s = Status::Internal(inst.name() + ": deactivate failed: " + d.message());
   }
   for (auto it = instances_.rbegin(); it != instances_.rend(); ++it)
     if ((*it)->configured) (*it)->component->Shutdown();
-  if (participant_) PublishStats();
   std::lock_guard<std::mutex> lock(mutex_);
   if (!s.ok()) return s;
   return failure_;
@@ -427,6 +480,47 @@ void Executor::PublishStats() {
     m.deadline_misses(snap.deadline_misses);
     out->Publish(m);
   }
+}
+
+void Executor::BuildTopicList() {
+  topics_.clear();
+  for (const auto& [name, rt] : resolved_.topics) {
+    TopicInfo t;
+    t.name = name;
+    t.type = rt.type;
+    const TopicQos q = QosOf(rt);
+    t.reliable = q.reliability == Reliability::kReliable;
+    t.depth = q.depth;
+    t.deadline_ms = q.deadline_ms;
+    bool all_here = true;
+    for (const auto& c : graph_.components)
+      for (const auto& b : c.outputs)
+        if (b.topic == name) {
+          t.writers.push_back(c.name + "." + b.port);
+          all_here = all_here && graph_.ProcessOf(c) == options_.process;
+        }
+    t.writers_local = !t.writers.empty() && all_here;
+    topics_.push_back(std::move(t));
+  }
+  if (!resolved_.topics.count(kStatsTopic)) {
+    TopicInfo t;
+    t.name = kStatsTopic;
+    t.type = &TypeInfoOf<msg::ComponentStats>();
+    t.reliable = true;
+    t.depth = kStatsDepth;
+    t.writers = {"runtime"};
+    std::set<std::string> processes;
+    for (const auto& c : graph_.components) processes.insert(graph_.ProcessOf(c));
+    t.writers_local = processes.size() == 1;  // every process's runtime writes it
+    topics_.push_back(std::move(t));
+  }
+  std::sort(topics_.begin(), topics_.end(), [](const TopicInfo& a, const TopicInfo& b) { return a.name < b.name; });
+}
+
+const TopicInfo* Executor::FindTopic(const std::string& name) const {
+  for (const auto& t : topics_)
+    if (t.name == name) return &t;
+  return nullptr;
 }
 
 std::vector<Executor::Row> Executor::Report() const {

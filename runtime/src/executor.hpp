@@ -12,6 +12,10 @@
 // step in graph order; after each step, triggered components whose trigger input has unread
 // samples step (in graph order, repeatedly until none has). Samples between components in one
 // process are delivered inside write(), so the same graph and seed give the same samples.
+//
+// Serialized subscriptions (Context::SubscribeSerialized) call back on the delivering thread; each
+// is closed (unread samples delivered first) just before its component's Deactivate(). The last
+// stats are published before any component is deactivated, so a recorder sees them.
 #pragma once
 
 #include <atomic>
@@ -22,6 +26,7 @@
 #include <thread>
 #include <vector>
 
+#include <dyad/catalog.hpp>
 #include <dyad/graph.hpp>
 #include <dyad/validate.hpp>
 
@@ -39,7 +44,8 @@ class Executor {
     double stats_period_s = 1.0;
   };
 
-  Executor(const Graph& graph, const ResolvedGraph& resolved, Options options);
+  // `catalog` (may be null) answers Context::FindMessageType beyond the graph's own types.
+  Executor(const Graph& graph, const ResolvedGraph& resolved, const Catalog* catalog, Options options);
   ~Executor();
 
   // Runs to the end. Returns OK, or the first failure.
@@ -60,6 +66,8 @@ class Executor {
   class ClockImpl;
 
   Status Setup();
+  void BuildTopicList();
+  const TopicInfo* FindTopic(const std::string& name) const;
   Status StepOnce(Instance& inst, int64_t scheduled_ns, bool periodic);
   void TriggerStep(Instance& inst);
   void PeriodicLoop(Instance& inst);
@@ -71,7 +79,9 @@ class Executor {
 
   const Graph& graph_;
   const ResolvedGraph& resolved_;
+  const Catalog* catalog_;
   Options options_;
+  std::vector<TopicInfo> topics_;  // Context::graph_topics()
   std::unique_ptr<ClockImpl> clock_;
   std::unique_ptr<DdsParticipant> participant_;
   std::vector<std::unique_ptr<Instance>> instances_;

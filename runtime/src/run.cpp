@@ -202,7 +202,7 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
       pending_signal.store(sig);
       if (Executor* ex = current.load()) ex->RequestStop(sig == SIGINT ? "SIGINT" : "SIGTERM");
     });
-    Executor ex(l.graph, l.resolved, eo);
+    Executor ex(l.graph, l.resolved, &l.catalog, eo);
     current.store(&ex);
     if (const int sig = pending_signal.load()) ex.RequestStop(sig == SIGINT ? "SIGINT" : "SIGTERM");
     result = ex.Run();

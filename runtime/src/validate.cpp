@@ -227,9 +227,13 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
   }
 
   // Topic types agree; every read topic has a writer.
+  // A topic declared under `topics:` with a type is part of the graph even when no port writes it:
+  // something outside the ports publishes it (a replay, another program).
   std::set<std::string> all_topics;
   for (const auto& [t, _] : writers) all_topics.insert(t);
   for (const auto& [t, _] : readers) all_topics.insert(t);
+  for (const auto& t : graph.topics)
+    if (!t.type.empty() && catalog.FindMessageType(t.type) != nullptr) all_topics.insert(t.name);
   for (const auto& name : all_topics) {
     ResolvedTopic rt;
     rt.name = name;
@@ -237,6 +241,7 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
     const TypeInfo* declared = rt.config && !rt.config->type.empty() ? catalog.FindMessageType(rt.config->type) : nullptr;
     std::vector<PortUse> uses = writers[name];
     uses.insert(uses.end(), readers[name].begin(), readers[name].end());
+    if (declared == nullptr && uses.empty()) continue;
     const TypeInfo* first = declared ? declared : uses.front().type;
     const std::string first_who = declared ? "topics." + name + ".type" : uses.front().who;
     for (const auto& u : uses) {
@@ -245,7 +250,7 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
                                  u.type->short_name());
     }
     rt.type = first;
-    if (writers[name].empty())
+    if (writers[name].empty() && declared == nullptr)
       for (const auto& u : readers[name])
         error(u.mark, u.who, "nothing publishes topic '" + name + "' (no component output is bound to it)");
     out.topics[name] = rt;

@@ -49,12 +49,34 @@
 //
 // Build it as a shared library linking `dyad::runtime` (find_package(dyad)), put it where the
 // graph's `plugins:` list or DYAD_PLUGIN_PATH points, and name `type: doubler` in a graph.
+//
+// Generic topics (ABI 2). Tools such as the recorder and replay handle topics they do not know at
+// compile time. In Configure() they may ask the Context for:
+//   - graph_topics(): every topic of the graph (port-bound, declared under `topics:` with a type,
+//     and the runtime's `dyad/stats`), with its TypeInfo (IDL text, hash) and QoS;
+//     graph_yaml() / graph_name(): the graph file as read; stepped(): the clock mode;
+//     FindMessageType(name): any message type this process knows (IDL or short name).
+//   - SubscribeSerialized(topic, callback): the callback receives every sample of the topic as CDR
+//     bytes with its source stamp, receive time and sequence number. It runs on the delivering
+//     thread (inside the publisher's Publish() for a publisher in this process, so delivery is
+//     synchronous and deterministic under the stepped clock), from subscription until just before
+//     Deactivate(); never concurrently for one subscription, concurrently across subscriptions.
+//     The reader has KEEP_ALL history: nothing is dropped on the reader's side. It is RELIABLE
+//     if the topic is, except when every writer is in this process (TopicInfo::writers_local):
+//     intra-process delivery is synchronous, so reliability would only add protocol overhead
+//     (2.7x the cost per sample, measured in bench/recorder). Keep the callback short (copy the
+//     bytes, hand them to another thread).
+//   - AdvertiseSerialized(topic, type): a writer that publishes CDR bytes of `type` on `topic`.
+//   Both endpoints are owned by the runtime and live until Shutdown() returns.
+//
+// ABI history: 1 = typed ports only; 2 = generic topics (above), DDS source timestamp = header stamp.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -68,7 +90,7 @@ namespace dyad {
 
 // Bump when anything in this header changes layout or meaning; plugins built against another
 // version are refused at load time with a message naming both versions.
-inline constexpr uint32_t kPluginAbiVersion = 1;
+inline constexpr uint32_t kPluginAbiVersion = 2;
 
 // The runtime clock: wall time (ns since the Unix epoch) in `clock: wall` graphs, simulated time
 // (ns since start) in `clock: stepped` graphs. Thread-safe.
@@ -102,6 +124,8 @@ class WriterEndpoint {
  public:
   virtual ~WriterEndpoint() = default;
   virtual Status Write(const void* sample) = 0;
+  // Same, with the DDS source timestamp set to `stamp_ns` (the header's stamp) where supported.
+  virtual Status WriteStamped(const void* sample, int64_t /*stamp_ns*/) { return Write(sample); }
 };
 }  // namespace detail
 
@@ -193,9 +217,10 @@ class Output final : public OutputBase {
     auto& h = sample.header();
     h.source(source_);
     h.sequence_number(++sequence_);
-    h.stamp_ns(clock_ ? clock_->now_ns() : 0);
+    const int64_t now = clock_ ? clock_->now_ns() : 0;
+    h.stamp_ns(now);
     if (endpoint_ == nullptr) return Status::OK();
-    return endpoint_->Write(&sample);
+    return endpoint_->WriteStamped(&sample, now);
   }
 };
 
@@ -260,6 +285,44 @@ class ComponentSpec {
   std::vector<PortSpec> inputs_, outputs_;
 };
 
+// A topic of the graph as the runtime wires it (Context::graph_topics()).
+struct TopicInfo {
+  std::string name;
+  const TypeInfo* type = nullptr;  // static storage
+  bool reliable = true;            // RELIABLE, else BEST_EFFORT
+  int depth = 1;                   // KEEP_LAST depth of the graph's ports on this topic
+  double deadline_ms = 0;          // 0: none
+  // "component.port" of every output bound to it in the graph (any process); "runtime" for
+  // dyad/stats; empty for a topic only declared under `topics:` (published from outside).
+  std::vector<std::string> writers;
+  // Every writer the graph knows is in this process (at least one): delivery is intra-process.
+  bool writers_local = false;
+};
+
+// One sample delivered by a serialized subscription. `cdr` is valid during the callback only.
+struct SerializedSample {
+  std::span<const uint8_t> cdr;  // CDR with its 4-byte encapsulation header, as on the wire
+  int64_t source_stamp_ns = 0;   // DDS source timestamp: for dyad writers the header's stamp
+                                 // (writer's runtime clock: Unix ns under wall, sim ns under stepped)
+  int64_t receive_ns = 0;        // this runtime's clock at delivery (same clock kinds)
+  uint64_t sequence = 0;         // DDS sequence number within its writer: 1, 2, ... (= header's)
+};
+using SerializedCallback = std::function<void(const SerializedSample&)>;
+
+// Publishes CDR bytes of one type on one topic (Context::AdvertiseSerialized). Owned by the runtime.
+class SerializedWriter {
+ public:
+  virtual ~SerializedWriter() = default;
+  virtual const std::string& topic() const = 0;
+  virtual const TypeInfo& type() const = 0;
+  // Publishes one sample given as CDR with its encapsulation header (e.g. as recorded). The DDS
+  // source timestamp is `source_stamp_ns`, or the runtime clock's now when it is negative. The
+  // bytes are published as they are: the header inside keeps its source, sequence and stamp.
+  // Fails: InvalidArgument when the bytes do not decode as the type, IOError when DDS refuses.
+  virtual Status Write(std::span<const uint8_t> cdr, int64_t source_stamp_ns = -1) = 0;
+  virtual uint64_t written() const = 0;
+};
+
 // What the runtime hands a component in Configure(). Valid until Shutdown() returns.
 class Context {
  public:
@@ -274,6 +337,22 @@ class Context {
   virtual int64_t period_ns() const = 0;
   // Ends the run cleanly after the current step (e.g. a replay reached its end).
   virtual void RequestStop(std::string reason) = 0;
+
+  // Generic topics (see the file comment). Call these in Configure() only. The runtime implements
+  // them all; the defaults (empty graph, Unimplemented) serve test fakes of Context.
+  virtual const std::string& graph_name() const;
+  virtual const std::string& graph_yaml() const;  // the graph file as read
+  virtual bool stepped() const { return false; }  // `clock: stepped`
+  // Every topic of the graph, sorted by name, `dyad/stats` included.
+  virtual const std::vector<TopicInfo>& graph_topics() const;
+  // A message type known in this process, by IDL name ("dyad::msg::Counter") or short name; null if none.
+  virtual const TypeInfo* FindMessageType(std::string_view /*name*/) const { return nullptr; }
+  // Calls `callback` for every sample of `topic` (a graph topic) from now until just before
+  // Deactivate(). Fails: NotFound (not a graph topic), Internal (DDS), FailedPrecondition (after Configure).
+  virtual Status SubscribeSerialized(const std::string& topic, SerializedCallback callback);
+  // A writer of `type` on `topic`, with the topic's graph QoS (defaults if not a graph topic).
+  // Fails: InvalidArgument (the topic carries another type in this process), Internal (DDS).
+  virtual StatusOr<SerializedWriter*> AdvertiseSerialized(const std::string& topic, const TypeInfo& type);
 
   // The port declared under `name` with type T. Asking for an undeclared port or another type is
   // a programming error: it aborts naming the component and port.

@@ -2,7 +2,8 @@
 //
 // Reports every problem at once (file:line:col: key: message): unknown component types, unknown
 // or missing or mistyped or out-of-range params, unknown ports, inputs bound to a topic that no
-// component publishes, required inputs left unbound, topic type mismatches (between writer and
+// component publishes (unless `topics:` declares it with a type: published from outside the ports,
+// e.g. by a replay), required inputs left unbound, topic type mismatches (between writer and
 // reader ports, and against the type declared under `topics:`), rates that are not positive, a
 // component with neither rate_hz nor trigger, processes that are not declared, stepped clock
 // across several processes.
@@ -33,7 +34,8 @@ struct ResolvedTopic {
 
 struct ResolvedGraph {
   std::vector<ResolvedComponent> components;   // graph order
-  std::map<std::string, ResolvedTopic> topics; // every topic some port binds
+  // Every topic some port binds, and every topic declared under `topics:` with a known type.
+  std::map<std::string, ResolvedTopic> topics;
 };
 
 // Appends problems to *diagnostics; the result is complete only when none were added.
