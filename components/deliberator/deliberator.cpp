@@ -63,7 +63,7 @@ void Deliberator::Describe(ComponentSpec& spec) {
   spec.YamlParam("ceres", "{}").Doc("Ceres settings: lbfgs_rank, function_tolerance, gradient_tolerance, "
                                      "parameter_tolerance, max_line_search_iterations");
   spec.Param("meta_prior", std::vector<double>{}).Min(0).Doc("online meta-prior w per layer, bottom first ([]: the preset's)");
-  spec.Param("a_init", "copy").OneOf({"zero", "copy", "prior"}).Doc("A of the newest window step");
+  spec.Param("a_init", "prior").OneOf({"zero", "copy", "prior"}).Doc("A of the newest window step");
   spec.Param("noise", "off").OneOf({"off", "fixed", "resample"}).Doc("eps of the window: off (means), fixed per step, resampled each step");
   spec.Param("a_steps", int64_t{3}).Range(0, 1000).Unit("steps").Doc("first steps on the start primitive's trained A");
   spec.Param("time_budget_ms", 0.0).Min(0).Unit("ms")

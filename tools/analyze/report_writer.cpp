@@ -104,8 +104,9 @@ std::string FormatMarkdown(const Report& r) {
   s << "- N-ELBO: mean " << Num(mean(nelbo)) << ", median " << Num(Percentile(nelbo, 0.5)) << "\n";
   s << "- deliberation time per step: median " << Num(Percentile(opt_ms, 0.5)) << " ms, p99 "
     << Num(Percentile(opt_ms, 0.99)) << " ms, max " << Num(Percentile(opt_ms, 1.0)) << " ms\n";
-  s << "- congruence P(C_t): mean " << Num(mean(c_engaged)) << " while engaged, " << Num(mean(c_free))
-    << " otherwise\n\n";
+  const double free = mean(c_free);
+  s << "- congruence P(C_t): mean " << Num(mean(c_engaged)) << " while engaged, "
+    << (std::isnan(free) ? std::string("not measured") : Num(free)) << " otherwise\n\n";
 
   s << "## Events\n\n";
   if (r.events.empty()) {
