@@ -141,6 +141,32 @@ TEST_F(ProcessTest, SteppedModeGivesByteIdenticalOutputTwice) {
   EXPECT_NE(Child::Read(out), files[0]);
 }
 
+// A stepped run is hermetic: a wall-clock graph publishing on the same domain and topic, and
+// listening there, neither changes its output nor hears it.
+TEST_F(ProcessTest, SteppedRunIgnoresOtherProcessesOnItsDomain) {
+  const fs::path alone = dir_ / "alone.txt";
+  Child a(Dyad({"run", Write("a.yaml", SteppedGraph(alone, domain_)).string(), "--steps", "2000", "--quiet"}), dir_, "a");
+  ASSERT_EQ(a.Wait(60), 0) << a.err();
+
+  const fs::path heard = dir_ / "heard.txt";
+  const fs::path intruder = Write("intruder.yaml", "graph: intruder\ndomain_id: " + std::to_string(domain_) +
+                                                      "\ncomponents:\n"
+                                                      "  src: {type: counter_source, rate_hz: 200, params: {start: 5000000}, outputs: {out: count}}\n"
+                                                      "  sink: {type: counter_sink, trigger: in, params: {file: " + heard.string() +
+                                                      "}, inputs: {in: count}}\n");
+  Child noisy(Dyad({"run", intruder.string(), "--duration", "30", "--quiet"}), dir_, "intruder");
+  // Wait until the intruder is publishing (its own sink hears it), then run the stepped graph.
+  for (int i = 0; i < 100 && ReadSink(heard).size() < 20; ++i) usleep(50'000);
+  ASSERT_GE(ReadSink(heard).size(), 20u) << noisy.err();
+  const fs::path with = dir_ / "with.txt";
+  Child b(Dyad({"run", Write("b.yaml", SteppedGraph(with, domain_)).string(), "--steps", "2000", "--quiet"}), dir_, "b");
+  ASSERT_EQ(b.Wait(60), 0) << b.err();
+  noisy.Signal(SIGINT);
+  EXPECT_EQ(noisy.Wait(30), 0) << noisy.err();
+  EXPECT_EQ(Child::Read(with), Child::Read(alone));
+  for (const Received& r : ReadSink(heard)) ASSERT_GE(r.value, 5000000) << "the intruder heard the stepped run";
+}
+
 TEST_F(ProcessTest, TwoComponentsExchangeSamplesInOneProcess) {
   const fs::path out = dir_ / "sink.txt";
   const fs::path g = Write("g.yaml", "graph: one\ndomain_id: " + std::to_string(domain_) +

@@ -287,7 +287,7 @@ int DdsWriter::matched() const {
 }
 
 StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, const std::string& name,
-                                                                  ProblemHandler on_problem) {
+                                                                  ProblemHandler on_problem, Scope scope) {
   std::unique_ptr<DdsParticipant> p(new DdsParticipant());
   p->name_ = name;
   p->listener_ = std::make_unique<DiscoveryListener>(p.get(), std::move(on_problem));
@@ -295,6 +295,12 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
   factory->load_profiles();  // profiles load lazily; load them before reading defaults
   fdds::DomainParticipantQos qos = factory->get_default_participant_qos();
   qos.name(name);
+  if (scope == Scope::kProcessOnly) {
+    // Discovery ignores participants of other processes: nothing matches across the process
+    // boundary, while this participant's own endpoints match and deliver intra-process.
+    qos.wire_protocol().builtin.discovery_config.ignoreParticipantFlags =
+        eprosima::fastrtps::rtps::ParticipantFilteringFlags_t::FILTER_DIFFERENT_PROCESS;
+  }
   fdds::StatusMask mask = fdds::StatusMask::none();
   mask << fdds::StatusMask::requested_incompatible_qos() << fdds::StatusMask::offered_incompatible_qos();
   p->participant_ = factory->create_participant(domain_id, qos, p->listener_.get(), mask);

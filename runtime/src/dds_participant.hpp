@@ -140,7 +140,12 @@ class DdsParticipant {
   // Reports type mismatches and incompatible QoS; called from Fast DDS threads.
   using ProblemHandler = std::function<void(const std::string& message)>;
 
-  static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, ProblemHandler on_problem);
+  // kNetwork: a normal participant of the domain. kProcessOnly: no transports, so its endpoints
+  // talk only to each other: a stepped (deterministic) run that no other process on the domain
+  // can disturb, and that disturbs no one.
+  enum class Scope { kNetwork, kProcessOnly };
+  static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, ProblemHandler on_problem,
+                                                          Scope scope = Scope::kNetwork);
   ~DdsParticipant();  // REQUIRES: every reader and writer created here was destroyed first
   DdsParticipant(const DdsParticipant&) = delete;
   DdsParticipant& operator=(const DdsParticipant&) = delete;

@@ -211,7 +211,8 @@ Status Executor::Setup() {
                                   [this](const std::string& msg) {
                                     ++problems_;
                                     StderrLogger("dds").Error(msg);
-                                  });
+                                  },
+                                  clock_->stepped() ? DdsParticipant::Scope::kProcessOnly : DdsParticipant::Scope::kNetwork);
   if (!p.ok()) return p.status();
   participant_ = std::move(p.value());
   const bool stepped = clock_->stepped();
