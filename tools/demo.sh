@@ -3,15 +3,17 @@
 #
 #   bash tools/demo.sh          the demo: a model dyad trains itself, nothing needed beside the clone
 #     1. the analytic 7-primitive data set  -> build/data/analytic         (dyad generate dataset)
-#     2. the robot's PV-RNN, study settings -> build/models/demo.dpvrnn    (dyad train, ~1 min)
+#     2. the robot's PV-RNN, study settings -> build/models/demo.dpvrnn    (dyad train, ~1-2 min)
 #     3. the intention observer             -> build/models/demo.dobs      (dyad train-observer)
 #   bash tools/demo.sh macaw    the same experiment with the study's MacawBot from ../shared/data
 #     1-2. dyad import-nrl ../shared/data/vcbot/...  -> build/models/macawbot.dpvrnn
 #     3.   the observer                              -> build/models/macawbot.dobs
-#   then: 4. the experiment, 2,000 steps of 100 ms, stepped clock -> out/<name>/<name>.mcap
-#         5. the report (tables, plots)                           -> out/<name>/report/
+#   then: 4. the experiment (configs/<name>.yaml), 2,000 steps of 100 ms, stepped -> out/<name>/<name>.mcap
+#         5. the report (tables, plots)                                          -> out/<name>/report/
 # Steps 1-3 are cached: they rerun only when their inputs (config, data set, model, dyad) change.
-# DEMO_STEPS=N shortens step 4.
+#
+# For tests: DEMO_STEPS=N shortens step 4; DEMO_EPOCHS=N shortens both trainings; DEMO_WORK=DIR
+# puts data, models and outputs under DIR; DEMO_SKIP_SETUP=1 skips setup and build.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 name="${1:-demo}"
@@ -19,13 +21,21 @@ case "$name" in
   demo | macaw) ;;
   *) echo "usage: bash tools/demo.sh [demo|macaw]" >&2; exit 2 ;;
 esac
-bash "$here/tools/setup.sh"
-bash "$here/tools/build.sh"
-cd "$here"   # the graphs name their files relative to the repository root
+if [ "${DEMO_SKIP_SETUP:-0}" != 1 ]; then
+  bash "$here/tools/setup.sh"
+  bash "$here/tools/build.sh"
+fi
+cd "$here"
 dyad="$here/build/bin/dyad"
 steps="${DEMO_STEPS:-2000}"
-out="out/$name"
-mkdir -p build/data build/models "$out"
+work="${DEMO_WORK:-$here/build}"
+out="${DEMO_WORK:-$here/out}/$name"
+train_sets=() observer_opts=()
+if [ -n "${DEMO_EPOCHS:-}" ]; then
+  train_sets=(--set "epochs=$DEMO_EPOCHS" --set "log_every=$DEMO_EPOCHS")
+  observer_opts=(--epochs "$DEMO_EPOCHS")
+fi
+mkdir -p "$work/data" "$work/models" "$out"
 
 # cached KEY_FILE KEY CMD...: runs CMD unless KEY_FILE holds KEY (a hash of CMD's inputs).
 cached() {
@@ -37,36 +47,38 @@ cached() {
   "$@"
   echo "$key" > "$key_file"
 }
-hash_of() { cat "$@" | sha256sum | cut -d' ' -f1; }
+hash_of() { { cat "$@"; echo "${DEMO_EPOCHS:-}"; } | sha256sum | cut -d' ' -f1; }
 
 if [ "$name" = demo ]; then
-  dataset=build/data/analytic
-  cached build/data/analytic.key "$(hash_of "$dyad")" "$dyad" generate dataset --out "$dataset"
-  cached build/models/demo.dpvrnn.key "$(hash_of configs/train/demo.yaml "$dataset"/*)" \
-    "$dyad" train configs/train/demo.yaml
-  model=build/models/demo.dpvrnn
-  observer=build/models/demo.dobs
+  dataset="$work/data/analytic"
+  model="$work/models/demo.dpvrnn"
+  observer="$work/models/demo.dobs"
+  cached "$dataset.key" "$(hash_of "$dyad")" "$dyad" generate dataset --out "$dataset"
+  cached "$model.key" "$(hash_of configs/train/demo.yaml "$dataset"/*)" \
+    "$dyad" train configs/train/demo.yaml --set "dataset=$dataset" --set "output=$model" "${train_sets[@]}"
 else
-  vcbot=../shared/data/vcbot
+  vcbot="$(cd "$here/.." && pwd)/shared/data/vcbot"
   if [ ! -d "$vcbot/model/MacawBot" ]; then
-    echo "demo: the macaw experiment needs the study's data in $(cd .. && pwd)/shared/data/vcbot (not found)" >&2
+    echo "demo: the macaw experiment needs the study's data in $vcbot (not found)" >&2
     exit 2
   fi
   dataset="$vcbot/dataset/Macaw"
-  model=build/models/macawbot.dpvrnn
-  observer=build/models/macawbot.dobs
+  model="$work/models/macawbot.dpvrnn"
+  observer="$work/models/macawbot.dobs"
   cached "$model.key" "$(hash_of "$vcbot"/model/MacawBot/*_p.d "$dataset"/*)" \
     "$dyad" import-nrl "$vcbot/model/MacawBot" --properties "$vcbot/config/properties_MacawBot.d" \
     --dataset "$dataset" -o "$model"
 fi
-cached "$observer.key" "$(hash_of "$model")" "$dyad" train-observer "$model" -o "$observer"
+cached "$observer.key" "$(hash_of "$model")" "$dyad" train-observer "$model" -o "$observer" "${observer_opts[@]}"
 
 graph="configs/$name.yaml"
-"$dyad" validate "$graph"
+sets=(--set "human.dataset=$dataset" --set "mind.model=$model" --set "observer.model=$observer"
+      --set "recorder.file=$out/$name.mcap")
+"$dyad" validate "$graph" "${sets[@]}"
 start=$(date +%s%N)
-"$dyad" run "$graph" --steps "$steps" --set "recorder.file=$out/$name.mcap"
+"$dyad" run "$graph" --steps "$steps" "${sets[@]}"
 ms=$(( ($(date +%s%N) - start) / 1000000 ))
 echo "demo: $steps steps of 100 ms ran in $((ms / 1000)).$(printf %03d $((ms % 1000))) s wall time (stepped clock)"
 "$dyad" analyze "$out/$name.mcap" -o "$out/report" --dataset "$dataset"
-echo "demo: recording $here/$out/$name.mcap"
-echo "demo: report    $here/$out/report/report.md (plots: $here/$out/report/*.png)"
+echo "demo: recording $out/$name.mcap"
+echo "demo: report    $out/report/report.md (plots: $out/report/*.png)"

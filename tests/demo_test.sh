@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# The README's demo, shortened (300 steps, 200 training epochs), run twice from an empty work
+# folder: the first run must produce a complete recording and report, the second must reuse the
+# cached data set, model and observer. With `macaw`, the MacawBot variant (skipped, exit 77,
+# when ../shared/data/vcbot is missing).
+# usage: demo_test.sh REPO WORK_DIR [macaw]
+set -euo pipefail
+repo=$1 work=$2 name=${3:-demo}
+if [ "$name" = macaw ] && [ ! -d "$repo/../shared/data/vcbot/model/MacawBot" ]; then
+  echo "SKIP: the macaw demo needs ../shared/data/vcbot beside the repository (not found)"
+  exit 77
+fi
+rm -rf "$work"
+run() { DEMO_SKIP_SETUP=1 DEMO_STEPS=300 DEMO_EPOCHS=200 DEMO_WORK="$work" bash "$repo/tools/demo.sh" "$name"; }
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+first=$(run 2>&1) || { echo "$first"; fail "first run exited non-zero"; }
+rec="$work/$name/$name.mcap"
+[ -f "$rec" ] || fail "no recording at $rec"
+info=$("$repo/build/bin/dyad" bag info "$rec")
+echo "$info" | grep -q "state:       complete" || fail "recording not complete: $info"
+for topic in human/input robot/intention robot/command robot/state observer/labels; do
+  echo "$info" | grep -Eq "^  [0-9]+  $topic  300 msgs" || fail "$topic does not have 300 messages: $info"
+done
+report="$work/$name/report"
+grep -q "^- steps: 300 of 100.0 ms" "$report/report.md" || fail "report.md: $(head -20 "$report/report.md")"
+[ "$(grep -c '^| [0-9]' "$report/report.md")" -ge 8 ] || fail "report.md lacks the 8 events"
+for png in workspace nelbo congruence; do
+  [ "$(head -c 8 "$report/$png.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || fail "$png.png is not a PNG"
+done
+echo "$first" | grep -q "wall time (stepped clock)" || fail "no wall time line"
+
+second=$(run 2>&1) || { echo "$second"; fail "second run exited non-zero"; }
+cached=$(echo "$second" | grep -c "is up to date (cached)" || true)
+expected=3
+[ "$name" = macaw ] && expected=2
+[ "$cached" -eq "$expected" ] || { echo "$second"; fail "second run reused $cached of $expected cached steps"; }
+echo "PASS: $name demo (300 steps) recorded, reported, and cached on the second run"
