@@ -281,23 +281,26 @@ TEST_F(ProcessTest, IntrospectionSeesARunningGraph) {
                                          "  sink: {type: counter_sink, trigger: in, inputs: {in: count}}\n");
   Child run(Dyad({"run", g.string(), "--duration", "20", "--stats-period", "0.5"}), dir_, "run");
 
-  Child topics(Dyad({"topics", "--domain", domain, "--wait", "2"}), dir_, "topics");
-  ASSERT_EQ(topics.Wait(30), 0) << topics.err();
-  EXPECT_NE(topics.out().find("count  dyad::msg::Counter#"), std::string::npos) << topics.out();
-  EXPECT_NE(topics.out().find("dyad/intro/main"), std::string::npos) << topics.out();
-
-  Child echo(Dyad({"echo", "count", "--domain", domain, "-n", "3"}), dir_, "echo");
+  // Generous discovery waits (they end at the first writer found): a loaded CI machine may take
+  // seconds to start the graph. `topics` goes after `echo`, which proves the graph is up.
+  Child echo(Dyad({"echo", "count", "--domain", domain, "-n", "3", "--wait", "20"}), dir_, "echo");
   ASSERT_EQ(echo.Wait(30), 0) << echo.err();
   const std::string e = echo.out();
   EXPECT_EQ(std::count(e.begin(), e.end(), '\n'), 3) << e;
   EXPECT_NE(e.find("{\"header\":{\"source\":\"src\",\"sequence_number\":"), std::string::npos) << e;
   EXPECT_NE(e.find("\"value\":1"), std::string::npos) << e;  // values start at 1000
 
-  Child stats(Dyad({"echo", "dyad/stats", "--domain", domain, "-n", "1"}), dir_, "stats");
+  Child stats(Dyad({"echo", "dyad/stats", "--domain", domain, "-n", "1", "--wait", "20"}), dir_, "stats");
   ASSERT_EQ(stats.Wait(30), 0) << stats.err();
   EXPECT_NE(stats.out().find("\"process_name\":\"main\""), std::string::npos) << stats.out();
 
-  Child hz(Dyad({"hz", "count", "--domain", domain, "--duration", "2.5"}), dir_, "hz");
+  Child topics(Dyad({"topics", "--domain", domain, "--wait", "4"}), dir_, "topics");
+  ASSERT_EQ(topics.Wait(30), 0) << topics.err() << topics.out();
+  EXPECT_NE(topics.out().find("count  dyad::msg::Counter#"), std::string::npos) << topics.out();
+  EXPECT_NE(topics.out().find("dyad/intro/main"), std::string::npos) << topics.out();
+
+
+  Child hz(Dyad({"hz", "count", "--domain", domain, "--duration", "2.5", "--wait", "20"}), dir_, "hz");
   ASSERT_EQ(hz.Wait(30), 0) << hz.err();
   double rate = 0;
   ASSERT_EQ(std::sscanf(hz.out().c_str(), "rate %lf Hz", &rate), 1) << hz.out();

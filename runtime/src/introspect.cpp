@@ -190,7 +190,12 @@ int ListTopics(const IntrospectOptions& o, std::ostream& out) {
     for (const auto& pp : r.participants) out << (first ? "" : ", ") << pp, first = false;
     out << "]" << (r.types.size() > 1 ? "  TYPE MISMATCH" : "") << "\n";
   }
-  return rows.empty() ? 1 : 0;
+  if (rows.empty()) {
+    std::cerr << "dyad topics: no endpoint discovered on domain " << o.domain_id << " within " << o.wait_s
+              << " s (a longer --wait helps on a loaded machine or network)\n";
+    return 1;
+  }
+  return 0;
 }
 
 int EchoTopic(const IntrospectOptions& o, const Catalog& catalog, const std::string& topic, uint64_t count, double duration_s,
