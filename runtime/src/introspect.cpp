@@ -7,6 +7,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <iomanip>
+#include <iostream>
 #include <map>
 #include <optional>
 #include <ostream>
