@@ -10,7 +10,10 @@
 #     3.   the observer                              -> build/models/macawbot.dobs
 #   then: 4. the experiment (configs/<name>.yaml), 2,000 steps of 100 ms, stepped -> out/<name>/<name>.mcap
 #         5. the report (tables, plots)                                          -> out/<name>/report/
-# Steps 1-3 are cached: they rerun only when their inputs (config, data set, model, dyad) change.
+# Steps 1-3 are cached by a hash of their inputs: the data set reruns when the dyad binary
+# changes, the model when its training config or the data set changes, the observer when the
+# model changes. A change to the training code alone retrains nothing: delete the *.key files
+# next to the models to force it.
 #
 # For tests: DEMO_STEPS=N shortens step 4; DEMO_EPOCHS=N shortens both trainings; DEMO_WORK=DIR
 # puts data, models and outputs under DIR; DEMO_SKIP_SETUP=1 skips setup and build.

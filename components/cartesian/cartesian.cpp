@@ -10,6 +10,13 @@ namespace dyad::cartesian {
 
 namespace {
 int64_t SecondsToNs(double s) { return static_cast<int64_t>(std::llround(s * 1e9)); }
+bool FiniteCommand(const msg::CartesianCommand& c) {
+  return std::isfinite(c.x()) && std::isfinite(c.y()) && std::isfinite(c.z());
+}
+std::string NonFiniteMessage(const msg::CartesianCommand& c) {
+  return "command (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) + ", " + std::to_string(c.z()) +
+         ") is not finite: rejected, the robot keeps its last target (logged once)";
+}
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -56,8 +63,14 @@ Status VirtualCartesian::Configure(Context& ctx) {
 Status VirtualCartesian::Step(const StepInfo& info) {
   if (command_->new_count() > 0) {
     const msg::CartesianCommand& c = command_->received().back();
-    robot_->SetTarget({c.x(), c.y()}, info.now_ns);
-    z_ = c.z();
+    if (!FiniteCommand(c)) {
+      if (!nonfinite_logged_) {
+        nonfinite_logged_ = true;
+        ctx_->log().Warn(NonFiniteMessage(c));
+      }
+    } else if (robot_->SetTarget({c.x(), c.y()}, info.now_ns)) {
+      z_ = c.z();
+    }
     if (robot_->state().clamped && !clamp_logged_) {
       clamp_logged_ = true;
       ctx_->log().Warn("target (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) +
@@ -174,7 +187,13 @@ Status UdpCartesian::Drain() {
 
 Status UdpCartesian::Step(const StepInfo& info) {
   if (Status s = Drain(); !s.ok()) return s;
-  if (command_->new_count() > 0) {
+  if (command_->new_count() > 0 && !FiniteCommand(command_->received().back())) {
+    ++nonfinite_;
+    if (!nonfinite_logged_) {
+      nonfinite_logged_ = true;
+      ctx_->log().Warn(NonFiniteMessage(command_->received().back()) + "; not sent");
+    }
+  } else if (command_->new_count() > 0) {
     const msg::CartesianCommand& c = command_->received().back();
     udp::CommandPacket packet;
     packet.session = session_;
@@ -219,7 +238,7 @@ Status UdpCartesian::Deactivate() {
                    std::to_string(c.out_of_order) + " out of order, " + std::to_string(c.malformed) + " malformed, " +
                    std::to_string(missed_replies_) + " replies missed, " + std::to_string(foreign_) + " foreign, " +
                    std::to_string(socket_errors_) + " socket errors, " + std::to_string(c.sessions) +
-                   " controller sessions");
+                   " controller sessions, " + std::to_string(nonfinite_) + " non-finite commands not sent");
   return Status::OK();
 }
 

@@ -5,6 +5,8 @@
 /// trigger: command (the demo), or rate_hz (periodic; needed for the watchdog to act on silence)
 /// inputs:  command (CartesianCommand): target position
 /// outputs: state (CartesianState): simulated position and velocity, stopped = watchdog stop
+/// A command with a NaN or infinite coordinate is rejected (logged once): the robot keeps its
+/// last target, and the watchdog is not fed.
 /// params:
 ///   max_velocity (double, 100, > 0, units/s): speed limit, vector norm
 ///   max_acceleration (double, 2000, > 0, units/s^2): acceleration limit, vector norm
@@ -20,6 +22,7 @@
 /// @component udp_cartesian
 /// trigger: command (the demo), or rate_hz
 /// inputs:  command (CartesianCommand): sent to the controller, one packet per new sample
+///          (never one with a NaN or infinite coordinate: dropped, logged once, counted)
 /// outputs: state (CartesianState): the controller's measured state, each at most once
 /// params:
 ///   controller_host (string, "127.0.0.1"), controller_port (int, 47000): the controller
@@ -67,7 +70,7 @@ class VirtualCartesian final : public Component {
   Output<msg::CartesianState>* state_ = nullptr;     // owned by the runtime
   std::optional<VirtualRobot> robot_;
   double z_ = 0;
-  bool stopped_logged_ = false, clamp_logged_ = false;
+  bool stopped_logged_ = false, clamp_logged_ = false, nonfinite_logged_ = false;
   msg::CartesianState out_;  // reused: no allocation per step
 };
 
@@ -106,8 +109,8 @@ class UdpCartesian final : public Component {
   udp::StatePacket newest_{};
   bool has_newest_ = false;
   int64_t waiting_since_ns_ = -1;  // first command sent since the last accepted state
-  uint64_t missed_replies_ = 0, foreign_ = 0, socket_errors_ = 0;
-  bool malformed_logged_ = false, error_logged_ = false;
+  uint64_t missed_replies_ = 0, foreign_ = 0, socket_errors_ = 0, nonfinite_ = 0;
+  bool malformed_logged_ = false, error_logged_ = false, nonfinite_logged_ = false;
   msg::CartesianState out_;
 };
 

@@ -1,6 +1,8 @@
 #include "udp_protocol.hpp"
 
+#include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <random>
 
 namespace dyad::cartesian::udp {
@@ -44,6 +46,11 @@ Decode CheckHeader(const uint8_t* p, size_t size, uint8_t kind, size_t expected)
   if (GetU<uint16_t>(p + 6) != expected || size != expected) return Decode::kBadLength;
   return Decode::kOk;
 }
+bool Finite(std::initializer_list<double> values) {
+  for (double v : values)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
 }  // namespace
 
 uint32_t NewSession() {
@@ -61,6 +68,7 @@ const char* ToString(Decode d) {
     case Decode::kBadVersion: return "unsupported version";
     case Decode::kBadKind: return "unexpected kind";
     case Decode::kBadLength: return "bad length";
+    case Decode::kNotFinite: return "a number is NaN or infinite";
   }
   return "?";
 }
@@ -99,7 +107,7 @@ Decode DecodeCommand(const uint8_t* p, size_t size, CommandPacket* c) {
   c->y = GetF64(p + 32);
   c->z = GetF64(p + 40);
   c->hold = (GetU<uint32_t>(p + 48) & kFlagHold) != 0;
-  return Decode::kOk;
+  return Finite({c->x, c->y, c->z}) ? Decode::kOk : Decode::kNotFinite;
 }
 
 Decode DecodeState(const uint8_t* p, size_t size, StatePacket* s) {
@@ -115,7 +123,7 @@ Decode DecodeState(const uint8_t* p, size_t size, StatePacket* s) {
   s->vx = GetF64(p + 56);
   s->vy = GetF64(p + 64);
   s->vz = GetF64(p + 72);
-  return Decode::kOk;
+  return Finite({s->x, s->y, s->z, s->vx, s->vy, s->vz}) ? Decode::kOk : Decode::kNotFinite;
 }
 
 }  // namespace dyad::cartesian::udp

@@ -58,12 +58,13 @@ struct StatePacket {
 };
 
 // Why a datagram was rejected.
-enum class Decode { kOk, kTooShort, kBadMagic, kBadVersion, kBadKind, kBadLength };
+enum class Decode { kOk, kTooShort, kBadMagic, kBadVersion, kBadKind, kBadLength, kNotFinite };
 const char* ToString(Decode d);
 
 void Encode(const CommandPacket& p, std::array<uint8_t, kCommandSize>& out);
 void Encode(const StatePacket& p, std::array<uint8_t, kStateSize>& out);
-// Check the header (magic, version, kind, length == size == the kind's size), then fill *out.
+// Check the header (magic, version, kind, length == size == the kind's size), then fill *out;
+// kNotFinite when a position or velocity is NaN or infinite (*out is filled all the same).
 Decode DecodeCommand(const uint8_t* data, size_t size, CommandPacket* out);
 Decode DecodeState(const uint8_t* data, size_t size, StatePacket* out);
 

@@ -48,7 +48,8 @@ Vec2 VirtualRobot::Clamp(Vec2 p, bool* clamped) const {
   return c;
 }
 
-void VirtualRobot::SetTarget(Vec2 target, int64_t now_ns) {
+bool VirtualRobot::SetTarget(Vec2 target, int64_t now_ns) {
+  if (!std::isfinite(target.x) || !std::isfinite(target.y)) return false;
   target_ = Clamp(target, &state_.clamped);
   has_target_ = true;
   target_ns_ = now_ns;
@@ -56,6 +57,7 @@ void VirtualRobot::SetTarget(Vec2 target, int64_t now_ns) {
     state_.position = target_;
     started_ = true;
   }
+  return true;
 }
 
 const VirtualRobot::State& VirtualRobot::Advance(int64_t now_ns) {

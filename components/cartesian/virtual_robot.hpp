@@ -57,8 +57,10 @@ class VirtualRobot {
   // REQUIRES: options.Validate().ok().
   explicit VirtualRobot(const VirtualRobotOptions& options);
 
-  // A new target at runtime-clock time `now_ns`; feeds the watchdog.
-  void SetTarget(Vec2 target, int64_t now_ns);
+  // A new target at runtime-clock time `now_ns`; feeds the watchdog. A target with a NaN or
+  // infinite coordinate is rejected (returns false, changes nothing, does not feed the
+  // watchdog): clamping cannot make it safe, and one would poison the position for good.
+  bool SetTarget(Vec2 target, int64_t now_ns);
   // Moves the robot to time `now_ns` (never decreasing) and returns its state.
   const State& Advance(int64_t now_ns);
 

@@ -63,8 +63,10 @@ Status ComplianceMixer::Step(const StepInfo& info) {
   const MixerCore::Result r = core_->Update(in, info.now_ns);
   if (r.hold && !holding_) {
     holding_ = true;
-    ctx_->log().Warn(std::string("input '") + ToString(r.stale) + "' stale (no sample for more than " +
-                     std::to_string(core_->options().stale_timeout_ns / 1'000'000) + " ms): " +
+    const std::string why = r.non_finite ? "' not finite (NaN or infinite position)"
+                                         : "' stale (no sample for more than " +
+                                               std::to_string(core_->options().stale_timeout_ns / 1'000'000) + " ms)";
+    ctx_->log().Warn(std::string("input '") + ToString(r.stale) + why + ": " +
                      (r.has_command ? "holding the last command" : "no command yet"));
   } else if (!r.hold && holding_) {
     holding_ = false;

@@ -10,7 +10,8 @@
 ///   state (CartesianState, optional): the measured position; needed by mode: pi, used by both
 ///     modes to saturate the very first command
 /// outputs:
-///   command (CartesianCommand): target position; hold = true while inputs are stale
+///   command (CartesianCommand): target position; hold = true while inputs are stale (or a
+///     position it needs is NaN or infinite)
 /// params:
 ///   gain (double, 0.9, [0, 1]): weight of the human while engaged
 ///   max_step (double, 5, >= 0, workspace units): max change of the command per step, vector

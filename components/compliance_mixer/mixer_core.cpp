@@ -58,6 +58,14 @@ MixerCore::Result MixerCore::Update(const Inputs& in, int64_t now_ns) {
   if (!Fresh(in.robot, now_ns)) r.stale = Stale::kRobot;
   else if (!Fresh(in.human, now_ns)) r.stale = Stale::kHuman;
   else if (pi && !Fresh(in.state, now_ns)) r.stale = Stale::kState;
+  if (r.stale == Stale::kNone) {  // fresh, but a position it uses must be a number
+    auto finite = [](const Sample& s) { return std::isfinite(s.position.x) && std::isfinite(s.position.y); };
+    const bool state_used = pi || (!has_last_ && in.state.receive_ns >= 0);
+    if (!finite(in.robot)) r.stale = Stale::kRobot;
+    else if (in.engaged && !finite(in.human)) r.stale = Stale::kHuman;
+    else if (state_used && !finite(in.state)) r.stale = Stale::kState;
+    r.non_finite = r.stale != Stale::kNone;
+  }
   const double dt = last_update_ns_ >= 0 ? (now_ns - last_update_ns_) * 1e-9 : 0.0;
   last_update_ns_ = now_ns;
 
@@ -69,8 +77,9 @@ MixerCore::Result MixerCore::Update(const Inputs& in, int64_t now_ns) {
   }
 
   const Vec2 robot = in.robot.position, human = in.human.position;
-  const double g = in.engaged ? options_.gain : 0.0;
-  const Vec2 target{g * human.x + (1 - g) * robot.x, g * human.y + (1 - g) * robot.y};
+  const double g = options_.gain;
+  // Not engaged: the robot alone (not a blend with g = 0, which would turn 0 * inf into NaN).
+  const Vec2 target = in.engaged ? Vec2{g * human.x + (1 - g) * robot.x, g * human.y + (1 - g) * robot.y} : robot;
 
   Vec2 desired = target;
   Vec2 next_integral = integral_;  // kPi: kept below only if the command does not saturate (anti-windup)

@@ -14,7 +14,9 @@
 ///   against the measured state when one is known, else taken as is.
 /// Stale inputs: if the robot or human sample (or, in kPi, the state) is older than
 /// `stale_timeout_ns` or missing, Update() repeats the previous command with hold = true (or
-/// returns no command at all before the first one).
+/// returns no command at all before the first one). An input whose position it would use
+/// holds the same way when that position is NaN or infinite (non_finite = true): one such
+/// sample would otherwise become the previous command and poison every later one.
 ///
 ///   MixerCore mixer(options);            // options.Validate() must be OK
 ///   MixerCore::Inputs in;
@@ -69,6 +71,7 @@ class MixerCore {
     bool hold = false;         // inputs stale: `position` repeats the previous command
     bool saturated = false;    // the step limit shortened the change
     Stale stale = Stale::kNone;  // which input made it hold (the first found)
+    bool non_finite = false;     // it held because that input's position is NaN or infinite
   };
 
   // REQUIRES: options.Validate().ok().

@@ -195,8 +195,17 @@ StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables
 }
 
 std::vector<PlannedEvent> Events(const Timeline& timeline, const ExperimentPlan& plan) {
-  if (!plan.events.empty()) return plan.events;
   std::vector<PlannedEvent> events;
+  const auto recorded = static_cast<int64_t>(timeline.steps.size());
+  if (!plan.events.empty()) {
+    // A run shorter than the plan (--steps): later events never happened, the last may be cut.
+    for (PlannedEvent e : plan.events) {
+      if (e.start_step >= recorded) continue;
+      e.end_step = std::min(e.end_step, recorded);
+      events.push_back(e);
+    }
+    return events;
+  }
   for (size_t i = 0; i < timeline.steps.size(); ++i) {
     if (!timeline.steps[i].engaged) continue;
     if (events.empty() || events.back().end_step != static_cast<int64_t>(i)) {

@@ -61,7 +61,9 @@ struct Timeline {
 
 StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan);
 
-// Events of the plan, or engaged runs of the timeline when the plan has none.
+// Events of the plan, or engaged runs of the timeline when the plan has none. Planned events are
+// limited to the recorded steps: one starting after the last recorded step is left out (the run
+// ended before it), one running past it ends there.
 std::vector<PlannedEvent> Events(const Timeline& timeline, const ExperimentPlan& plan);
 
 struct EventSummary {

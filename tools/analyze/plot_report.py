@@ -69,7 +69,11 @@ def plot_workspace(rows, shapes, out):
     fig, ax = plt.subplots(figsize=(7, 7))
     for i, (xs, ys) in enumerate(shapes):
         ax.plot(xs + xs[:1], ys + ys[:1], color="0.85", lw=6, zorder=0, solid_capstyle="round")
-        ax.annotate(str(i), (sum(xs) / len(xs), sum(ys) / len(ys)), color="0.6", ha="center", va="center")
+    for i, (xs, ys) in enumerate(shapes):
+        # At the primitive's first point (where a human tracing it starts), above the lines: at
+        # the centroid, the labels of shapes around the origin fell on one spot under the traces.
+        ax.annotate(f"p{i}", (xs[0], ys[0]), color="0.25", fontsize=8, ha="center", va="center", zorder=5,
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="0.6", lw=0.5, alpha=0.9))
     ax.plot(column(rows, "robot_x"), column(rows, "robot_y"), color="tab:blue", lw=0.6, alpha=0.7, label="robot intention")
     ax.plot(column(rows, "executed_x"), column(rows, "executed_y"), color="black", lw=0.8, label="executed")
     hx = [number(r["human_x"]) if r["engaged"] == "1" else math.nan for r in rows]
@@ -78,8 +82,9 @@ def plot_workspace(rows, shapes, out):
     ax.set_aspect("equal")
     ax.set_xlabel("x (workspace units)")
     ax.set_ylabel("y (workspace units)")
-    ax.set_title("Trajectories in the workspace" + (" (data set in grey)" if shapes else ""))
-    ax.legend(loc="upper right", fontsize=8)
+    ax.set_title("Trajectories in the workspace" + (" (data set in grey, pN at primitive N's start)" if shapes else ""),
+                 fontsize=10)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=3, fontsize=8)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     plt.close(fig)
@@ -100,7 +105,7 @@ def plot_nelbo(rows, out):
     ax.set_xlabel("time (s)")
     ax.set_ylabel("free energy of the window")
     ax.set_title("Robot's N-ELBO after each step's error regression")
-    ax.legend(loc="upper right", fontsize=8)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     plt.close(fig)
@@ -114,7 +119,7 @@ def plot_congruence(rows, events, out):
     top.set_ylim(-0.02, 1.02)
     top.set_xlabel("time (s)")
     top.set_ylabel("intention congruence")
-    top.legend(loc="upper right", fontsize=8)
+    top.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
     labels = [f"{e['event']}\n(p{e['primitive']})" for e in events]
     means = [number(e["mean_congruence"]) for e in events]
     finals = [number(e["final_congruence"]) for e in events]
@@ -126,7 +131,7 @@ def plot_congruence(rows, events, out):
     bottom.set_ylim(0, 1)
     bottom.set_ylabel("P(C)")
     bottom.set_xlabel("event (primitive traced by the human)")
-    bottom.legend(loc="upper right", fontsize=8)
+    bottom.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     plt.close(fig)

@@ -106,9 +106,13 @@ std::string FormatMarkdown(const Report& r) {
     << Num(Percentile(opt_ms, 0.99)) << " ms, max " << Num(Percentile(opt_ms, 1.0)) << " ms\n";
   const double free = mean(c_free);
   s << "- congruence P(C_t): mean " << Num(mean(c_engaged)) << " while engaged, "
-    << (std::isnan(free) ? std::string("not measured") : Num(free)) << " otherwise\n\n";
+    << (std::isnan(free) ? std::string("not measured") : Num(free)) << " otherwise\n";
 
-  s << "## Events\n\n";
+  if (r.plan.events.size() > r.events.size()) {
+    const size_t n = r.plan.events.size() - r.events.size();
+    s << "- " << n << " planned event" << (n == 1 ? "" : "s") << " after the end of the recording (not scored)\n";
+  }
+  s << "\n## Events\n\n";
   if (r.events.empty()) {
     s << "No interventions (the human never engaged).\n\n";
   } else {

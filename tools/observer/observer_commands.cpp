@@ -50,6 +50,9 @@ int TrainObserver(const TrainObserverArgs& a) {
     return Fail(kBadInput, "--input " + a.input + ": must be positions or displacements");
   spec.window = a.window;
   if (Status s = spec.Validate(); !s.ok()) return Fail(kBadInput, "--" + s.message());
+  if (a.drop >= a.steps)
+    return Fail(kBadInput, "--drop " + std::to_string(a.drop) + ": must be < --steps " + std::to_string(a.steps) +
+                               " (the generated steps that remain are the training data)");
   for (uint64_t v : a.validation_seeds)
     for (uint64_t t : a.seeds)
       if (v == t) return Fail(kBadInput, "--validation-seeds: seed " + std::to_string(v) + " is also a training seed");
@@ -124,12 +127,18 @@ struct EvaluateArgs {
 // The confusion matrix of the data set's primitives traced as a synthetic human would (looped,
 // with noise): how the observer will see a human who follows the data set.
 int EvaluateObserver(const EvaluateArgs& a) {
+  for (double noise : a.noise) {  // all checked before the first table is printed
+    if (!(noise >= 0)) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "--noise %g: must be >= 0", noise);
+      return Fail(kBadInput, buf);
+    }
+  }
   auto obs = LoadObserver(a.observer);
   if (!obs.ok()) return Fail(kBadInput, obs.status().message());
   auto data = pvrnn::LoadNrlDataset(a.dataset);
   if (!data.ok()) return Fail(kBadInput, data.status().message());
   for (double noise : a.noise) {
-    if (!(noise >= 0)) return Fail(kBadInput, "--noise: must be >= 0");
     auto cm = EvaluateTrajectories(obs->classifier, DatasetTraces(data.value(), a.loops, noise, a.seed));
     if (!cm.ok()) return Fail(kBadInput, a.dataset + ": " + cm.status().message());
     std::printf("%s traced %d times, noise std %g (seed %llu); rows: true primitive, row-normalised:\n%s",

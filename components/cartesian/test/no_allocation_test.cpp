@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <deque>
 #include <new>
@@ -17,6 +18,12 @@ namespace {
 std::atomic<long> g_allocations{0};
 }  // namespace
 
+// GCC 12 pairs the inlined malloc/free of these replacements and warns (-Wmismatched-new-delete)
+// wherever a test's container is built and freed in one function; the pairing is correct.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+#endif
 void* operator new(std::size_t n) {
   g_allocations.fetch_add(1, std::memory_order_relaxed);
   if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
@@ -24,6 +31,9 @@ void* operator new(std::size_t n) {
 }
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
 
 namespace dyad::cartesian {
 namespace {
@@ -174,6 +184,58 @@ TEST(NoAllocation, UdpCartesianStepAllocatesNothing) {
   EXPECT_EQ(ctx.states.written, 299);  // the last reply is still in flight
   EXPECT_NEAR(ctx.states.last.x(), 29.8, 1e-9);
   ASSERT_TRUE(driver.Deactivate().ok());
+  driver.Shutdown();
+}
+
+// A command with a NaN coordinate (e.g. a diverged deliberator upstream) must neither reach the
+// simulated robot nor go out to a real controller.
+TEST(NonFiniteCommand, VirtualCartesianKeepsItsLastTargetAndSaysSo) {
+  FakeContext ctx(VirtualParams());
+  VirtualCartesian driver;
+  ASSERT_TRUE(driver.Configure(ctx).ok());
+  ctx.commands.queue.push_back(Command(10));
+  ASSERT_TRUE(ctx.StepOnce(driver, 0).ok());
+  for (uint64_t k = 1; k < 4; ++k) {
+    ctx.time.now = static_cast<int64_t>(k) * 100'000'000;
+    msg::CartesianCommand bad = Command(std::nan(""));
+    ctx.commands.queue.push_back(bad);
+    ASSERT_TRUE(ctx.StepOnce(driver, k).ok());
+    EXPECT_EQ(ctx.states.last.x(), 10) << k;
+    EXPECT_TRUE(std::isfinite(ctx.states.last.z())) << k;
+  }
+  ASSERT_EQ(ctx.logger.lines.size(), 1u);
+  EXPECT_NE(ctx.logger.lines[0].find("not finite"), std::string::npos) << ctx.logger.lines[0];
+}
+
+TEST(NonFiniteCommand, UdpCartesianDoesNotSendIt) {
+  auto controller = UdpSocket::Open(0);
+  ASSERT_TRUE(controller.ok()) << controller.status().ToString();
+  FakeContext ctx({{"controller_host", std::string("127.0.0.1")},
+                   {"controller_port", int64_t{controller->local_port()}},
+                   {"local_port", int64_t{0}},
+                   {"timeout_s", 5.0},
+                   {"reply_wait_ms", int64_t{0}}});
+  UdpCartesian driver;
+  ASSERT_TRUE(driver.Configure(ctx).ok());
+  ASSERT_TRUE(driver.Activate().ok());
+  msg::CartesianCommand bad = Command(1);
+  bad.y(INFINITY);
+  ctx.commands.queue.push_back(bad);
+  ASSERT_TRUE(ctx.StepOnce(driver, 0).ok());
+  EXPECT_FALSE(controller->WaitReadable(200)) << "a non-finite command was sent to the controller";
+  ctx.commands.queue.push_back(Command(2));  // the next good one goes out as sequence 1
+  ASSERT_TRUE(ctx.StepOnce(driver, 1).ok());
+  ASSERT_TRUE(controller->WaitReadable(1000));
+  std::array<uint8_t, udp::kMaxPacket> rx{};
+  sockaddr_in from{};
+  const long n = controller->Receive(rx.data(), rx.size(), &from);
+  udp::CommandPacket c;
+  ASSERT_EQ(udp::DecodeCommand(rx.data(), static_cast<size_t>(n), &c), udp::Decode::kOk);
+  EXPECT_EQ(c.sequence, 1u);
+  EXPECT_EQ(c.x, 2);
+  bool logged = false;
+  for (const auto& l : ctx.logger.lines) logged |= l.find("not finite") != std::string::npos;
+  EXPECT_TRUE(logged);
   driver.Shutdown();
 }
 

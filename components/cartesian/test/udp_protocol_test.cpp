@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <cstring>
 
 namespace dyad::cartesian::udp {
@@ -74,6 +76,24 @@ TEST(UdpProtocol, MalformedPacketsAreRejectedWithTheReason) {
   std::array<uint8_t, kCommandSize> c{};
   Encode(CommandPacket(), c);
   EXPECT_EQ(DecodeState(c.data(), c.size(), &d), Decode::kBadKind);
+}
+
+// A controller that reports a NaN position (or a driver that sends one) is faulty: the packet is
+// dropped as malformed rather than published to the deliberator or applied to the robot.
+TEST(UdpProtocol, NonFiniteNumbersAreMalformed) {
+  StatePacket s;
+  s.vy = std::nan("");
+  std::array<uint8_t, kStateSize> b{};
+  Encode(s, b);
+  StatePacket d;
+  EXPECT_EQ(DecodeState(b.data(), b.size(), &d), Decode::kNotFinite);
+  CommandPacket c;
+  c.z = INFINITY;
+  std::array<uint8_t, kCommandSize> cb{};
+  Encode(c, cb);
+  CommandPacket dc;
+  EXPECT_EQ(DecodeCommand(cb.data(), cb.size(), &dc), Decode::kNotFinite);
+  EXPECT_STREQ(ToString(Decode::kNotFinite), "a number is NaN or infinite");
 }
 
 TEST(UdpProtocol, SequenceComparisonSurvivesWrapAround) {

@@ -174,5 +174,22 @@ TEST(VirtualRobot, ElapsedTimeIsCappedAtTheWatchdogTimeout) {
   EXPECT_NEAR(r.Advance(100 * kStep).position.x, 5, 1e-9);  // 0.5 s at 10 units/s
 }
 
+// A NaN or infinite target (a diverged upstream, a corrupt packet) must not move the robot:
+// std::clamp passes NaN through, and one NaN position never recovers.
+TEST(VirtualRobot, NonFiniteTargetsAreRejectedAndDoNotFeedTheWatchdog) {
+  VirtualRobot r{VirtualRobotOptions()};
+  EXPECT_FALSE(r.SetTarget({std::nan(""), 0}, 0));
+  EXPECT_FALSE(r.started());  // a rejected first target does not place the robot
+  ASSERT_TRUE(r.SetTarget({10, 0}, 0));
+  r.Advance(0);
+  for (int64_t k = 1; k <= 10; ++k) {
+    EXPECT_FALSE(r.SetTarget({k % 2 ? std::nan("") : 0.0, k % 2 ? 0.0 : INFINITY}, k * kStep));
+    const auto& s = r.Advance(k * kStep);
+    ASSERT_TRUE(std::isfinite(s.position.x) && std::isfinite(s.position.y)) << k;
+    EXPECT_EQ(s.position.x, 10) << k;
+    EXPECT_EQ(s.stopped, k * kStep > VirtualRobotOptions().watchdog_ns) << k;  // only the valid target fed it
+  }
+}
+
 }  // namespace
 }  // namespace dyad::cartesian

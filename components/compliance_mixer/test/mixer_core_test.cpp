@@ -123,6 +123,27 @@ TEST(MixerCore, StaleHumanHoldsTheLastCommandThenResumes) {
   EXPECT_DOUBLE_EQ(r.position.x, 9);
 }
 
+// One NaN intention (a diverged deliberator) must not become the previous command: before the
+// fix every later command was NaN, since each is saturated against the previous one.
+TEST(MixerCore, NonFiniteInputHoldsTheLastCommandAndDoesNotPoisonLaterOnes) {
+  MixerCore m{MixerOptions()};
+  auto r = m.Update(Fresh({1, 2}, {0, 0}, false, 0), 0);
+  ASSERT_FALSE(r.hold);
+  r = m.Update(Fresh({std::nan(""), 2}, {0, 0}, false, kStep), kStep);
+  EXPECT_TRUE(r.hold);
+  EXPECT_TRUE(r.non_finite);
+  EXPECT_EQ(r.stale, MixerCore::Stale::kRobot);
+  EXPECT_DOUBLE_EQ(r.position.x, 1);
+  r = m.Update(Fresh({3, 2}, {INFINITY, 0}, true, 2 * kStep), 2 * kStep);  // engaged human: used
+  EXPECT_TRUE(r.hold);
+  EXPECT_EQ(r.stale, MixerCore::Stale::kHuman);
+  r = m.Update(Fresh({3, 2}, {INFINITY, 0}, false, 3 * kStep), 3 * kStep);  // disengaged: not used
+  EXPECT_FALSE(r.hold);
+  EXPECT_FALSE(r.non_finite);
+  EXPECT_DOUBLE_EQ(r.position.x, 3);
+  EXPECT_DOUBLE_EQ(r.position.y, 2);
+}
+
 TEST(MixerCore, NoCommandBeforeAnyInputArrived) {
   MixerCore m{MixerOptions()};
   MixerCore::Inputs in;  // nothing received

@@ -188,6 +188,24 @@ TEST(Analyze, ConfusionCountsTheHumansTracedSteps) {
   EXPECT_NE(md.find("| **2** | 0.00 | 0.00 | 0.80 | 0.20 |"), std::string::npos) << md;
 }
 
+// A run shorter than the graph's plan (`dyad run --steps N`): events after the last recorded
+// step never happened and must not be scored ("robot switched after: never"); an event the run
+// cut short is scored over its recorded steps only.
+TEST(Analyze, EventsAfterTheEndOfTheRecordingAreNotScored) {
+  Report r = Analyse(WriteExperiment(TempPath("a.mcap")));  // 40 steps
+  r.plan.events.push_back({36, 50, 1});   // cut by the end of the recording
+  r.plan.events.push_back({60, 80, 4});   // entirely after it
+  const auto events = Events(r.timeline, r.plan);
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[2].start_step, 36);
+  EXPECT_EQ(events[2].end_step, 40);
+  r.events = SummariseEvents(r.timeline, events);
+  const std::string md = FormatMarkdown(r);
+  EXPECT_EQ(md.find("| 3 | 60-80"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 2 | 36-40 | 1 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("1 planned event after the end of the recording (not scored)"), std::string::npos) << md;
+}
+
 TEST(Analyze, WithoutObserverTheReportSaysWhatIsMissing) {
   Report r = Analyse(WriteExperiment(TempPath("a.mcap"), /*with_observer=*/false));
   ASSERT_EQ(r.timeline.missing_topics.size(), 1u);
