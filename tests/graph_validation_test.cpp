@@ -159,6 +159,20 @@ TEST(GraphValidation, OverrideSetsParamAndIsValidated) {
   EXPECT_EQ(Check(kValid, {"garbage"}).size(), 1u);
 }
 
+// What a recorder stores: the file as read, or with --set, the graph as run.
+TEST(GraphValidation, OverridesAreInTheRecordedGraphText) {
+  std::vector<Diagnostic> diags;
+  EXPECT_EQ(ParseGraph(kValid, "g.yaml", {}, &diags).yaml_text, kValid);
+  const Graph g = ParseGraph(kValid, "g.yaml", {{"src.noise=2.5"}, {"sink.limit=7"}}, &diags);
+  ASSERT_TRUE(diags.empty());
+  EXPECT_EQ(g.yaml_text.rfind("# the graph as run: g.yaml with --set src.noise=2.5 --set sink.limit=7\n", 0), 0u)
+      << g.yaml_text;
+  const YAML::Node run = YAML::Load(g.yaml_text);
+  EXPECT_EQ(run["components"]["src"]["params"]["noise"].as<double>(), 2.5);
+  EXPECT_EQ(run["components"]["sink"]["params"]["limit"].as<int>(), 7);
+  EXPECT_EQ(run["components"]["src"]["rate_hz"].as<double>(), 10);  // the rest as written
+}
+
 TEST(GraphValidation, FillsDefaultsAndResolvesPeriods) {
   std::vector<Diagnostic> diags;
   Graph g = ParseGraph(kValid, "g.yaml", {}, &diags);

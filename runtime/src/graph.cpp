@@ -221,6 +221,27 @@ std::string Graph::ProcessOf(const ComponentConfig& c) const {
   return "main";
 }
 
+// With overrides, yaml_text becomes the graph as run: the file's document with the overridden
+// params replaced, re-emitted (comments are lost), headed by the --set list. Recordings store it,
+// so analyses see what ran, not what the file said.
+void RecordOverrides(const std::vector<Override>& overrides, YAML::Node root, Graph* g) {
+  if (overrides.empty() || !root.IsMap() || !root["components"].IsMap()) return;
+  bool changed = false;
+  for (const ComponentConfig& c : g->components) {
+    if (c.overridden.empty()) continue;
+    YAML::Node node = root["components"][c.name];
+    if (!node.IsMap()) continue;
+    for (const auto& [param, text] : c.overridden) node["params"][param] = YAML::Clone(c.params[param]);
+    changed = true;
+  }
+  if (!changed) return;
+  YAML::Emitter out;
+  out << root;
+  std::string header = "# the graph as run: " + g->file + " with";
+  for (const Override& o : overrides) header += " --set " + o.text;
+  g->yaml_text = header + "\n" + out.c_str() + "\n";
+}
+
 Graph ParseGraph(const std::string& yaml_text, const std::string& path, const std::vector<Override>& overrides,
                  std::vector<Diagnostic>* diagnostics) {
   Graph g;
@@ -283,6 +304,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, &g);
   else r.Error(SourceMark{path, 1, 1}, "components", "missing: a graph needs at least one component");
   ApplyOverrides(overrides, &g, diagnostics);
+  RecordOverrides(overrides, root, &g);
   return g;
 }
 

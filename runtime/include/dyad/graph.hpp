@@ -100,7 +100,9 @@ struct Graph {
   std::vector<ProcessConfig> processes;
   std::vector<TopicConfig> topics;
   std::vector<ComponentConfig> components;
-  std::string yaml_text;  // the file as read (recorded as metadata)
+  // The file as read; with --set overrides, the graph as run (overridden params replaced,
+  // re-emitted under a comment listing them). Recorders store it as metadata.
+  std::string yaml_text;
 
   const ComponentConfig* FindComponent(const std::string& name) const;
   const TopicConfig* FindTopic(const std::string& name) const;
