@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "dyad/pvrnn/model_file.hpp"
@@ -137,10 +138,11 @@ Status Deliberator::Step(const StepInfo&) {
   const pvrnn::StepResult* r = nullptr;
   if (steps_ > 0) {  // step 0 publishes r_0: nothing executed yet
     double xy[2];
-    if (!executed_->received().empty()) {
-      xy[0] = executed_->received().back().x();
-      xy[1] = executed_->received().back().y();
-    } else {
+    const msg::CartesianState* s = executed_->received().empty() ? nullptr : &executed_->received().back();
+    if (s != nullptr && std::isfinite(s->x()) && std::isfinite(s->y())) {
+      xy[0] = s->x();
+      xy[1] = s->y();
+    } else {  // none, or a bad reading: the robot's own last intention
       xy[0] = er_->intention()[0];
       xy[1] = er_->intention()[1];
       ++without_executed_;

@@ -7,7 +7,8 @@
 /// inputs:
 ///   executed (CartesianState, optional): the executed robot position s_{t-1}. The newest sample
 ///     received since the previous step is taken into the window; without one (unbound input,
-///     late driver) the robot's own last intention is taken instead, and counted.
+///     late driver) or with a non-finite x or y, the robot's own last intention is taken
+///     instead, and counted.
 /// outputs:
 ///   intention (Intention): r_t with nelbo/reconstruction/regulation of the best iterate,
 ///     optimisation_s, iterations and deadline_missed. Published every step, on time: the solve

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <deque>
 #include <filesystem>
@@ -136,6 +137,24 @@ TEST(Deliberator, ATinyBudgetPublishesOnTimeAndCountsTheMisses) {
   bool warned = false;
   for (const auto& l : ctx.logger.lines) warned |= l.find("time cap") != std::string::npos;
   EXPECT_TRUE(warned);
+}
+
+// A non-finite executed position (a controller's bad reading) is treated like a missing one.
+TEST(Deliberator, ANonFiniteExecutedPositionIsTakenAsMissing) {
+  FakeContext ctx({{"model", RandomModelFile()}});
+  Deliberator d;
+  ASSERT_TRUE(d.Configure(ctx).ok());
+  for (int t = 0; t < 8; ++t) {
+    msg::CartesianState s;
+    s.x(t == 3 ? std::nan("") : 1.0 * t);
+    s.y(0);
+    if (t > 0) ctx.reader.queue.push_back(s);
+    ctx.Poll();
+    ASSERT_TRUE(d.Step(StepInfo{0, static_cast<uint64_t>(t), 100'000'000}).ok());
+    EXPECT_TRUE(std::isfinite(ctx.writer.samples.back().x())) << "step " << t;
+    EXPECT_TRUE(std::isfinite(ctx.writer.samples.back().nelbo())) << "step " << t;
+  }
+  EXPECT_EQ(d.steps_without_executed(), 1u);
 }
 
 TEST(Deliberator, CeresIsSelectedByParam) {
