@@ -13,6 +13,8 @@
 ///   intention (Intention): r_t with nelbo/reconstruction/regulation of the best iterate,
 ///     optimisation_s, iterations and deadline_missed. Published every step, on time: the solve
 ///     stops before `time_budget_ms` with the best iterate so far (deadline_missed = true).
+///     Under the stepped clock there is no time cap (only `iterations`): simulated time does not
+///     pass during a step, and a wall-time cap would make the run depend on the machine's load.
 /// params:
 ///   model (string, required): .dpvrnn model file (2 DOF: x, y)
 ///   start_primitive (int, 0): the primitive the robot starts drawing
@@ -27,7 +29,8 @@
 ///   a_init (string, copy): zero | copy | prior: A of the newest window step
 ///   noise (string, off): off | fixed | resample
 ///   a_steps (int, 3): first steps on the start primitive's trained A
-///   time_budget_ms (double, 0 = 20% of the period, 20 ms when triggered): optimisation cap per step
+///   time_budget_ms (double, 0 = 20% of the period, 20 ms when triggered): optimisation cap per
+///     step (wall clock only)
 ///   seed (int, -1 = the graph's seed for this instance)
 /// @endcomponent
 ///
@@ -62,6 +65,7 @@ class Deliberator final : public Component {
   Output<msg::Intention>* intention_ = nullptr;     // owned by the runtime
   std::unique_ptr<pvrnn::ErrorRegression<float>> er_;
   double budget_s_ = 0.02;
+  bool stepped_ = false;  // stepped clock: no wall-time cap (see Step)
   uint64_t deadline_misses_ = 0, without_executed_ = 0, steps_ = 0;
   msg::Intention out_;
 };
