@@ -19,14 +19,14 @@
 ///   model (string, required): .dpvrnn model file (2 DOF: x, y)
 ///   start_primitive (int, 0): the primitive the robot starts drawing
 ///   preset (string, vcbot): vcbot (W 5, 15 it, Adam 0.3/0.1/0.95, w 1e-5) | reference (W 15,
-///     15 it, Adam 0.1/0.9/0.999, w 1e-5); the params below override it
+///     15 it, Adam 0.1/0.9/0.999, w = the model's training meta-prior); the params below override it
 ///   window (int, 0 = preset), iterations (int, 0 = preset)
 ///   optimizer (string, adam): adam | ceres
 ///   adam (map, {}): lr, beta1, beta2, epsilon (keys override the preset)
 ///   ceres (map, {}): lbfgs_rank, function_tolerance, gradient_tolerance, parameter_tolerance,
 ///     max_line_search_iterations
 ///   meta_prior (list, [] = preset): online w per layer, bottom first
-///   a_init (string, copy): zero | copy | prior: A of the newest window step
+///   a_init (string, prior): zero | copy | prior: A of the newest window step
 ///   noise (string, off): off | fixed | resample
 ///   a_steps (int, 3): first steps on the start primitive's trained A
 ///   time_budget_ms (double, 0 = 20% of the period, 20 ms when triggered): optimisation cap per
