@@ -4,6 +4,7 @@
 #include <dyad/catalog.hpp>
 #include <dyad/graph.hpp>
 #include <dyad/validate.hpp>
+#include <yaml-cpp/yaml.h>
 
 namespace dyad {
 namespace {
@@ -157,6 +158,22 @@ TEST(GraphValidation, OverrideSetsParamAndIsValidated) {
   ASSERT_EQ(unknown.size(), 1u);
   EXPECT_NE(unknown[0].message.find("no such component"), std::string::npos);
   EXPECT_EQ(Check(kValid, {"garbage"}).size(), 1u);
+}
+
+// yaml_text is what the recorder stores as the run's graph (metadata dyad.graph) and what
+// `dyad analyze` reads events and data set from: with --set it must hold the values that ran.
+TEST(GraphValidation, YamlTextHoldsTheOverriddenValues) {
+  std::vector<Diagnostic> diags;
+  const Graph plain = ParseGraph(kValid, "g.yaml", {}, &diags);
+  EXPECT_EQ(plain.yaml_text, kValid);  // no override: the file as read, comments and all
+  const Graph g = ParseGraph(kValid, "g.yaml", {{"src.noise=2"}, {"sink.limit=[1, 2]"}}, &diags);
+  ASSERT_TRUE(diags.empty());
+  const YAML::Node root = YAML::Load(g.yaml_text);
+  EXPECT_EQ(root["components"]["src"]["params"]["noise"].as<int>(), 2);
+  EXPECT_EQ(root["components"]["sink"]["params"]["limit"][1].as<int>(), 2);  // sink had no params
+  EXPECT_EQ(root["components"]["src"]["rate_hz"].as<int>(), 10);
+  EXPECT_EQ(root["graph"].as<std::string>(), "ok");
+  EXPECT_NE(g.yaml_text.find("--set src.noise=2"), std::string::npos);  // says it was overridden
 }
 
 TEST(GraphValidation, FillsDefaultsAndResolvesPeriods) {

@@ -282,7 +282,21 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   if (const YAML::Node topics = root["topics"]) ReadTopics(r, topics, &g);
   if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, &g);
   else r.Error(SourceMark{path, 1, 1}, "components", "missing: a graph needs at least one component");
+  const size_t problems_before = diagnostics->size();
   ApplyOverrides(overrides, &g, diagnostics);
+  // yaml_text is the run's graph for whoever reads it later (the recorder's dyad.graph metadata,
+  // `dyad analyze`): with --set overrides, the file with them applied, re-emitted.
+  if (!overrides.empty() && diagnostics->size() == problems_before) {
+    YAML::Node components = root["components"];
+    for (const auto& c : g.components)
+      if (!c.overridden.empty() && components && components.IsMap() && components[c.name].IsMap())
+        components[c.name]["params"] = c.params;
+    YAML::Emitter out;
+    out << root;
+    std::string head = "# " + path + " as run, with";
+    for (const auto& o : overrides) head += " --set " + o.text;
+    g.yaml_text = head + "\n" + out.c_str() + "\n";
+  }
   return g;
 }
 

@@ -100,7 +100,9 @@ struct Graph {
   std::vector<ProcessConfig> processes;
   std::vector<TopicConfig> topics;
   std::vector<ComponentConfig> components;
-  std::string yaml_text;  // the file as read (recorded as metadata)
+  // The graph as run (recorded as metadata): the file as read; with --set overrides, the file
+  // with them applied, re-emitted (comments dropped) after a comment line naming the overrides.
+  std::string yaml_text;
 
   const ComponentConfig* FindComponent(const std::string& name) const;
   const TopicConfig* FindTopic(const std::string& name) const;
