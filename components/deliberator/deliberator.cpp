@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "dyad/pvrnn/model_file.hpp"
@@ -67,7 +68,7 @@ void Deliberator::Describe(ComponentSpec& spec) {
   spec.Param("noise", "off").OneOf({"off", "fixed", "resample"}).Doc("eps of the window: off (means), fixed per step, resampled each step");
   spec.Param("a_steps", int64_t{3}).Range(0, 1000).Unit("steps").Doc("first steps on the start primitive's trained A");
   spec.Param("time_budget_ms", 0.0).Min(0).Unit("ms")
-      .Doc("optimisation cap per step (0: 20% of the period, 20 ms when triggered)");
+      .Doc("wall clock: optimisation cap per step (0: 20% of the period, 20 ms when triggered); stepped: none");
   spec.Param("seed", int64_t{-1}).Min(-1).Doc("noise seed (-1: the graph's seed for this instance)");
   spec.Input<msg::CartesianState>("executed").Optional().Doc("executed robot position s_{t-1}");
   spec.Output<msg::Intention>("intention").Doc("intended position r_t and the window's N-ELBO");
@@ -119,35 +120,44 @@ Status Deliberator::Configure(Context& ctx) {
   if (Status s = er_->Reset(static_cast<int>(start), seed); !s.ok()) return Status::InvalidArgument("params." + s.message());
   const double budget_ms = p.Double("time_budget_ms");
   budget_s_ = budget_ms > 0 ? budget_ms * 1e-3 : (ctx.period_ns() > 0 ? 0.2 * ctx.period_ns() * 1e-9 : 0.02);
+  stepped_ = ctx.stepped();
   executed_ = &ctx.input<msg::CartesianState>("executed");
   intention_ = &ctx.output<msg::Intention>("intention");
   std::ostringstream info;
   info << "model " << path << ", start primitive " << start << ", window " << o.window << ", " << o.iterations
-       << " iterations of " << pvrnn::ToString(o.optimizer) << ", budget " << budget_s_ * 1e3 << " ms";
+       << " iterations of " << pvrnn::ToString(o.optimizer);
+  if (stepped_)
+    info << ", no time cap (stepped clock: simulated time stands still during a step)";
+  else
+    info << ", budget " << budget_s_ * 1e3 << " ms";
   ctx.log().Info(info.str());
   return Status::OK();
 }
 
 Status Deliberator::Step(const StepInfo&) {
-  const auto t0 = pvrnn::SteadyClock::now();
-  const auto deadline = t0 + std::chrono::duration_cast<pvrnn::SteadyClock::duration>(
-                                 std::chrono::duration<double>(budget_s_));
+  // Under the stepped clock the step takes no simulated time however long it runs: a wall-time
+  // cap would only make the result depend on the machine's load, so the iteration cap alone
+  // applies and a stepped run stays deterministic.
+  const auto deadline = stepped_ ? pvrnn::SteadyClock::time_point::max()
+                                 : pvrnn::SteadyClock::now() + std::chrono::duration_cast<pvrnn::SteadyClock::duration>(
+                                                                   std::chrono::duration<double>(budget_s_));
   double optimisation_s = 0;
   bool missed = false;
   const pvrnn::StepResult* r = nullptr;
   if (steps_ > 0) {  // step 0 publishes r_0: nothing executed yet
     double xy[2];
-    if (!executed_->received().empty()) {
-      xy[0] = executed_->received().back().x();
-      xy[1] = executed_->received().back().y();
-    } else {
+    const msg::CartesianState* s = executed_->received().empty() ? nullptr : &executed_->received().back();
+    if (s != nullptr && std::isfinite(s->x()) && std::isfinite(s->y())) {
+      xy[0] = s->x();
+      xy[1] = s->y();
+    } else {  // none, or a bad reading: the robot's own last intention
       xy[0] = er_->intention()[0];
       xy[1] = er_->intention()[1];
       ++without_executed_;
     }
     r = &er_->Step(xy, deadline);
     optimisation_s = r->optimisation_s;
-    missed = r->stopped_by_deadline || optimisation_s > budget_s_;
+    missed = !stepped_ && (r->stopped_by_deadline || optimisation_s > budget_s_);
     if (missed && (deadline_misses_++ % 100) == 0) {
       std::ostringstream w;
       w << "step " << steps_ << ": optimisation stopped at its time cap (" << budget_s_ * 1e3 << " ms) after "

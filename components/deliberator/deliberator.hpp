@@ -7,26 +7,30 @@
 /// inputs:
 ///   executed (CartesianState, optional): the executed robot position s_{t-1}. The newest sample
 ///     received since the previous step is taken into the window; without one (unbound input,
-///     late driver) the robot's own last intention is taken instead, and counted.
+///     late driver) or with a non-finite x or y, the robot's own last intention is taken
+///     instead, and counted.
 /// outputs:
 ///   intention (Intention): r_t with nelbo/reconstruction/regulation of the best iterate,
 ///     optimisation_s, iterations and deadline_missed. Published every step, on time: the solve
 ///     stops before `time_budget_ms` with the best iterate so far (deadline_missed = true).
+///     Under the stepped clock there is no time cap (only `iterations`): simulated time does not
+///     pass during a step, and a wall-time cap would make the run depend on the machine's load.
 /// params:
 ///   model (string, required): .dpvrnn model file (2 DOF: x, y)
 ///   start_primitive (int, 0): the primitive the robot starts drawing
 ///   preset (string, vcbot): vcbot (W 5, 15 it, Adam 0.3/0.1/0.95, w 1e-5) | reference (W 15,
-///     15 it, Adam 0.1/0.9/0.999, w 1e-5); the params below override it
+///     15 it, Adam 0.1/0.9/0.999, w = the model's training meta-prior); the params below override it
 ///   window (int, 0 = preset), iterations (int, 0 = preset)
 ///   optimizer (string, adam): adam | ceres
 ///   adam (map, {}): lr, beta1, beta2, epsilon (keys override the preset)
 ///   ceres (map, {}): lbfgs_rank, function_tolerance, gradient_tolerance, parameter_tolerance,
 ///     max_line_search_iterations
 ///   meta_prior (list, [] = preset): online w per layer, bottom first
-///   a_init (string, copy): zero | copy | prior: A of the newest window step
+///   a_init (string, prior): zero | copy | prior: A of the newest window step
 ///   noise (string, off): off | fixed | resample
 ///   a_steps (int, 3): first steps on the start primitive's trained A
-///   time_budget_ms (double, 0 = 20% of the period, 20 ms when triggered): optimisation cap per step
+///   time_budget_ms (double, 0 = 20% of the period, 20 ms when triggered): optimisation cap per
+///     step (wall clock only)
 ///   seed (int, -1 = the graph's seed for this instance)
 /// @endcomponent
 ///
@@ -61,6 +65,7 @@ class Deliberator final : public Component {
   Output<msg::Intention>* intention_ = nullptr;     // owned by the runtime
   std::unique_ptr<pvrnn::ErrorRegression<float>> er_;
   double budget_s_ = 0.02;
+  bool stepped_ = false;  // stepped clock: no wall-time cap (see Step)
   uint64_t deadline_misses_ = 0, without_executed_ = 0, steps_ = 0;
   msg::Intention out_;
 };

@@ -140,9 +140,10 @@ class DdsParticipant {
   // Reports type mismatches and incompatible QoS; called from Fast DDS threads.
   using ProblemHandler = std::function<void(const std::string& message)>;
 
-  // kNetwork: a normal participant of the domain. kProcessOnly: no transports, so its endpoints
-  // talk only to each other: a stepped (deterministic) run that no other process on the domain
-  // can disturb, and that disturbs no one.
+  // kNetwork: a normal participant of the domain. kProcessOnly: discovery ignores participants
+  // of other processes (ignoreParticipantFlags = FILTER_DIFFERENT_PROCESS; the transports stay
+  // up), so its endpoints match only endpoints in this process: a stepped (deterministic) run
+  // that no other process on the domain can disturb, and that disturbs no one.
   enum class Scope { kNetwork, kProcessOnly };
   static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, ProblemHandler on_problem,
                                                           Scope scope = Scope::kNetwork);

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <deque>
 #include <filesystem>
@@ -69,7 +70,10 @@ class FakeContext final : public Context {
   uint64_t seed() const override { return 7; }
   int64_t period_ns() const override { return 100'000'000; }
   void RequestStop(std::string) override {}
+  bool stepped() const override { return stepped_clock; }
   size_t Poll() { return executed_.Poll(0); }
+
+  bool stepped_clock = false;
 
   QueueReader reader;
   VectorWriter writer;
@@ -136,6 +140,41 @@ TEST(Deliberator, ATinyBudgetPublishesOnTimeAndCountsTheMisses) {
   bool warned = false;
   for (const auto& l : ctx.logger.lines) warned |= l.find("time cap") != std::string::npos;
   EXPECT_TRUE(warned);
+}
+
+// Under the stepped clock simulated time stands still during a step: a wall-time cap would only
+// make the result depend on the machine's load (a descheduled process cuts the solve), breaking
+// "same graph and seed, same recording". The iteration cap alone applies.
+TEST(Deliberator, UnderTheSteppedClockTheWallBudgetDoesNotCutTheSolve) {
+  FakeContext ctx({{"model", RandomModelFile()}, {"time_budget_ms", 1e-6}, {"iterations", int64_t{40}}});
+  ctx.stepped_clock = true;
+  Deliberator d;
+  ASSERT_TRUE(d.Configure(ctx).ok());
+  for (int t = 0; t < 4; ++t) ASSERT_TRUE(d.Step(StepInfo{0, static_cast<uint64_t>(t), 100'000'000}).ok());
+  ASSERT_EQ(ctx.writer.samples.size(), 4u);
+  for (size_t i = 1; i < 4; ++i) {
+    EXPECT_EQ(ctx.writer.samples[i].iterations(), 40u);
+    EXPECT_FALSE(ctx.writer.samples[i].deadline_missed());
+  }
+  EXPECT_EQ(d.deadline_misses(), 0u);
+}
+
+// A non-finite executed position (a controller's bad reading) is treated like a missing one.
+TEST(Deliberator, ANonFiniteExecutedPositionIsTakenAsMissing) {
+  FakeContext ctx({{"model", RandomModelFile()}});
+  Deliberator d;
+  ASSERT_TRUE(d.Configure(ctx).ok());
+  for (int t = 0; t < 8; ++t) {
+    msg::CartesianState s;
+    s.x(t == 3 ? std::nan("") : 1.0 * t);
+    s.y(0);
+    if (t > 0) ctx.reader.queue.push_back(s);
+    ctx.Poll();
+    ASSERT_TRUE(d.Step(StepInfo{0, static_cast<uint64_t>(t), 100'000'000}).ok());
+    EXPECT_TRUE(std::isfinite(ctx.writer.samples.back().x())) << "step " << t;
+    EXPECT_TRUE(std::isfinite(ctx.writer.samples.back().nelbo())) << "step " << t;
+  }
+  EXPECT_EQ(d.steps_without_executed(), 1u);
 }
 
 TEST(Deliberator, CeresIsSelectedByParam) {

@@ -273,10 +273,13 @@ const StepResult& ErrorRegression<Scalar>::Step(const double* executed, SteadyCl
   }
   const int n = fill_, col = n - 1;
   // Clamp to the encoding range widened by half its width (further out the code underflows).
+  // A non-finite value (a bad reading) is replaced by the intention for this step: one NaN in
+  // the targets would make every A, state and later intention NaN for good.
   for (int k = 0; k < spec_.num_dofs(); ++k) {
     const DofRange& r = spec_.output.dofs[k];
     const double half = 0.5 * (r.max - r.min);
-    executed_code_d_[k] = std::clamp(executed[k], r.min - half, r.max + half);
+    const double v = std::isfinite(executed[k]) ? executed[k] : intention_[k];
+    executed_code_d_[k] = std::clamp(v, r.min - half, r.max + half);
   }
   EncodePosition<Scalar>(spec_.output, executed_code_d_.data(), targets_.col(col).data());
   switch (options_.noise) {

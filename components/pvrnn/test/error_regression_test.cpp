@@ -169,5 +169,26 @@ TEST(ErrorRegression, EveryAInitAndNoiseModeRuns) {
     }
 }
 
+// One bad reading (a driver or controller sending NaN or inf) must not poison the latent state:
+// the window, the inferred states and every later intention would stay NaN for good.
+TEST(ErrorRegression, ANonFiniteExecutedPositionDoesNotPoisonTheRun) {
+  for (auto kind : {OptimizerKind::kAdam, OptimizerKind::kCeres}) {
+    ErrorRegressionOptions o;
+    o.optimizer = kind;
+    o.window = 3;
+    auto er = ErrorRegression<float>::Create(RandomModel(), o).value();
+    ASSERT_TRUE(er->Reset(0, 1).ok());
+    for (int t = 0; t < 10; ++t) {
+      double xy[2] = {2.0 * t, -1.0 * t};
+      if (t == 2) xy[0] = std::nan("");
+      if (t == 3) xy[1] = INFINITY;
+      const StepResult& r = er->Step(xy);
+      EXPECT_TRUE(std::isfinite(r.loss.loss)) << ToString(kind) << " step " << t;
+      EXPECT_TRUE(std::isfinite(er->intention()[0]) && std::isfinite(er->intention()[1]))
+          << ToString(kind) << " step " << t;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace dyad::pvrnn

@@ -23,7 +23,8 @@
 /// depth), messages with log_time = receive time and publish_time = the sample's DDS source
 /// timestamp (= its header stamp for dyad writers; both Unix ns under the wall clock, simulated
 /// ns under the stepped clock), sequence = the writer's sequence number (low 32 bits); zstd
-/// chunks; a summary section; metadata "dyad.graph" {name, clock, yaml} with the graph file.
+/// chunks; a summary section; metadata "dyad.graph" {name, clock, yaml} with the graph file as
+/// run (--set overrides applied).
 ///
 /// Threads: samples are copied into a RecordQueue on the delivering thread (a lock and a memcpy);
 /// one writer thread owned by the recorder writes and compresses chunks. Deactivate() (normal end,

@@ -54,7 +54,7 @@
 // compile time. In Configure() they may ask the Context for:
 //   - graph_topics(): every topic of the graph (port-bound, declared under `topics:` with a type,
 //     and the runtime's `dyad/stats`), with its TypeInfo (IDL text, hash) and QoS;
-//     graph_yaml() / graph_name(): the graph file as read; stepped(): the clock mode;
+//     graph_yaml() / graph_name(): the graph file as run (--set overrides applied); stepped(): the clock mode;
 //     FindMessageType(name): any message type this process knows (IDL or short name).
 //   - SubscribeSerialized(topic, callback): the callback receives every sample of the topic as CDR
 //     bytes with its source stamp, receive time and sequence number. It runs on the delivering
@@ -341,7 +341,7 @@ class Context {
   // Generic topics (see the file comment). Call these in Configure() only. The runtime implements
   // them all; the defaults (empty graph, Unimplemented) serve test fakes of Context.
   virtual const std::string& graph_name() const;
-  virtual const std::string& graph_yaml() const;  // the graph file as read
+  virtual const std::string& graph_yaml() const;  // the graph file as run (Graph::yaml_text)
   virtual bool stepped() const { return false; }  // `clock: stepped`
   // Every topic of the graph, sorted by name, `dyad/stats` included.
   virtual const std::vector<TopicInfo>& graph_topics() const;

@@ -124,6 +124,7 @@ class ErrorRegression {
   Status Reset(int start_primitive, uint64_t seed);
   // Takes the executed position (num_dofs values) of the step last intended, optimises until
   // `deadline` at the latest, and computes the next intention. REQUIRES Reset() first.
+  // A non-finite value is replaced by the intention for that step (it would poison the state).
   const StepResult& Step(const double* executed,
                          SteadyClock::time_point deadline = SteadyClock::time_point::max());
 
