@@ -1,6 +1,8 @@
 // Process-level tests: real `dyad` processes started, signalled, killed and waited for.
 #include <gtest/gtest.h>
 
+#include "dyad/testing/child_process.hpp"
+
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -16,59 +18,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A started child process with stdout/stderr in files.
-class Child {
- public:
-  Child(std::vector<std::string> args, const fs::path& dir, const std::string& tag) {
-    out_ = dir / (tag + ".out");
-    err_ = dir / (tag + ".err");
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int o = open(out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      const int e = open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(o, 1);
-      dup2(e, 2);
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(argv[0], argv.data());
-      _exit(127);
-    }
-  }
-  ~Child() {
-    if (pid_ > 0 && !done_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  void Signal(int sig) { kill(pid_, sig); }
-  // Exit code (128+signal if killed), or -1 if still running after `timeout_s` (then killed).
-  int Wait(double timeout_s) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (std::chrono::steady_clock::now() < end) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        done_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return -1;
-  }
-  std::string out() const { return Read(out_); }
-  std::string err() const { return Read(err_); }
-  static std::string Read(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  }
-
- private:
-  pid_t pid_ = -1;
-  bool done_ = false;
-  fs::path out_, err_;
-};
+using Child = dyad::testing::ChildProcess;
 
 class ProcessTest : public ::testing::Test {
  protected:
@@ -104,7 +54,7 @@ struct Received {
 };
 
 std::vector<Received> ReadSink(const fs::path& file) {
-  std::istringstream lines(Child::Read(file));
+  std::istringstream lines(dyad::testing::ReadFile(file));
   std::vector<Received> out;
   Received r;
   while (lines >> r.value >> r.source >> r.sequence >> r.stamp_ns) out.push_back(r);
@@ -128,7 +78,7 @@ TEST_F(ProcessTest, SteppedModeGivesByteIdenticalOutputTwice) {
     const fs::path g = Write(run + ".yaml", SteppedGraph(out, domain_));
     Child c(Dyad({"run", g.string(), "--steps", "2000", "--quiet"}), dir_, run);
     ASSERT_EQ(c.Wait(60), 0) << c.err();
-    files[i] = Child::Read(out);
+    files[i] = dyad::testing::ReadFile(out);
   }
   // 20 s of simulated time: 2000 steps of src, and slow (period 33333333 ns) steps at k*period < 20 s: 601.
   EXPECT_EQ(std::count(files[0].begin(), files[0].end(), '\n'), 2000 + 601);
@@ -138,7 +88,7 @@ TEST_F(ProcessTest, SteppedModeGivesByteIdenticalOutputTwice) {
   const fs::path g = Write("seed.yaml", SteppedGraph(out, domain_));
   Child c(Dyad({"run", g.string(), "--steps", "2000", "--quiet", "--set", "src.noise=6"}), dir_, "seed");
   ASSERT_EQ(c.Wait(60), 0) << c.err();
-  EXPECT_NE(Child::Read(out), files[0]);
+  EXPECT_NE(dyad::testing::ReadFile(out), files[0]);
 }
 
 // A stepped run is hermetic: a wall-clock graph publishing on the same domain and topic, and
@@ -163,7 +113,7 @@ TEST_F(ProcessTest, SteppedRunIgnoresOtherProcessesOnItsDomain) {
   ASSERT_EQ(b.Wait(60), 0) << b.err();
   noisy.Signal(SIGINT);
   EXPECT_EQ(noisy.Wait(30), 0) << noisy.err();
-  EXPECT_EQ(Child::Read(with), Child::Read(alone));
+  EXPECT_EQ(dyad::testing::ReadFile(with), dyad::testing::ReadFile(alone));
   for (const Received& r : ReadSink(heard)) ASSERT_GE(r.value, 5000000) << "the intruder heard the stepped run";
 }
 
@@ -220,7 +170,7 @@ TEST_F(ProcessTest, SigintStopsEveryProcessCleanly) {
   const std::string o = launcher.out();
   EXPECT_NE(o.find("timing (process a)"), std::string::npos) << o;
   EXPECT_NE(o.find("timing (process b)"), std::string::npos) << o;
-  const std::string received = Child::Read(out);
+  const std::string received = dyad::testing::ReadFile(out);
   EXPECT_GT(std::count(received.begin(), received.end(), '\n'), 10);
 }
 

@@ -2,6 +2,8 @@
 // loopback for udp_cartesian (lost, late, out-of-order and malformed packets).
 #include <gtest/gtest.h>
 
+#include "dyad/testing/child_process.hpp"
+
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -21,68 +23,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string Read(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string Read(const fs::path& p) { return dyad::testing::ReadFile(p); }
 
-// A started child process with stdout/stderr in files; killed if still running at the end.
-class Child {
- public:
-  Child(std::vector<std::string> args, const fs::path& dir, const std::string& tag)
-      : out_(dir / (tag + ".out")), err_(dir / (tag + ".err")) {
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int o = open(out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      const int e = open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(o, 1);
-      dup2(e, 2);
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(argv[0], argv.data());
-      _exit(127);
-    }
-  }
-  ~Child() {
-    if (pid_ > 0 && !done_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  void Signal(int sig) { kill(pid_, sig); }
-  // Exit code (128+signal if killed), or -1 if still running after `timeout_s`.
-  int Wait(double timeout_s) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (std::chrono::steady_clock::now() < end) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        done_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return -1;
-  }
-  // Waits until stdout contains `text`.
-  bool WaitForOutput(const std::string& text, double timeout_s) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (std::chrono::steady_clock::now() < end) {
-      if (out().find(text) != std::string::npos) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return false;
-  }
-  std::string out() const { return Read(out_); }
-  std::string err() const { return Read(err_); }
-
- private:
-  pid_t pid_ = -1;
-  bool done_ = false;
-  fs::path out_, err_;
-};
+using Child = dyad::testing::ChildProcess;
 
 struct State {
   int64_t stamp;

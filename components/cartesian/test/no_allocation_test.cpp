@@ -3,37 +3,17 @@
 // talks to a controller played by the test on loopback.
 #include <gtest/gtest.h>
 
-#include <atomic>
+#include "dyad/testing/allocation_counter.hpp"
+
 #include <cmath>
 #include <cstdlib>
 #include <deque>
-#include <new>
 
 #include <dyad/component.hpp>
 #include <dyad/msg/types.hpp>
 
 #include "cartesian.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-// GCC 12 pairs the inlined malloc/free of these replacements and warns (-Wmismatched-new-delete)
-// wherever a test's container is built and freed in one function; the pairing is correct.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-#endif
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic pop
-#endif
 
 namespace dyad::cartesian {
 namespace {
@@ -132,10 +112,10 @@ TEST(NoAllocation, VirtualCartesianStepAllocatesNothing) {
   for (uint64_t k = 0; k < 300; ++k) {
     ctx.time.now = static_cast<int64_t>(k) * 100'000'000;
     ctx.commands.queue.push_back(Command(static_cast<double>(k) * 0.1));  // one command per step
-    const long before = g_allocations.load();
+    const long before = dyad::testing::AllocationCount();
     ASSERT_TRUE(ctx.StepOnce(driver, k).ok());
     if (k >= 2) {  // after warm-up
-      ASSERT_EQ(g_allocations.load() - before, 0) << "step " << k;
+      ASSERT_EQ(dyad::testing::AllocationCount() - before, 0) << "step " << k;
     }
   }
   EXPECT_TRUE(ctx.logger.lines.empty());
@@ -160,10 +140,10 @@ TEST(NoAllocation, UdpCartesianStepAllocatesNothing) {
   for (uint64_t k = 0; k < 300; ++k) {
     ctx.time.now = static_cast<int64_t>(k) * 100'000'000;
     ctx.commands.queue.push_back(Command(static_cast<double>(k) * 0.1));  // one command per step
-    const long before = g_allocations.load();
+    const long before = dyad::testing::AllocationCount();
     ASSERT_TRUE(ctx.StepOnce(driver, k).ok());
     if (k >= 2) {
-      ASSERT_EQ(g_allocations.load() - before, 0) << "step " << k;
+      ASSERT_EQ(dyad::testing::AllocationCount() - before, 0) << "step " << k;
     }
     // The controller: answer the command just sent (taken by the driver at its next step).
     ASSERT_TRUE(controller->WaitReadable(1000));

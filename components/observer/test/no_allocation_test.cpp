@@ -1,27 +1,16 @@
 // The observer's Step promises no heap allocation once configured (10 Hz hot path). This binary
 // replaces the global operator new to count allocations while Step runs.
 #include <gtest/gtest.h>
+
+#include "dyad/testing/allocation_counter.hpp"
 #include <unistd.h>
 
-#include <atomic>
 #include <cstdlib>
 #include <filesystem>
-#include <new>
 
 #include "fake_context.hpp"
 #include "observer_component.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace dyad::observer {
 namespace {
@@ -59,9 +48,9 @@ TEST(NoAllocation, ObserverStepAllocatesNothing) {
     human.queue.push_back(h);
     robot.queue.push_back(r);
     ctx.PollInputs();
-    const long before = g_allocations.load();
+    const long before = dyad::testing::AllocationCount();
     ASSERT_TRUE(o.Step({.now_ns = 0, .index = static_cast<uint64_t>(k)}).ok());
-    if (k >= 10) during_steps += g_allocations.load() - before;  // after every buffer has been used once
+    if (k >= 10) during_steps += dyad::testing::AllocationCount() - before;  // after every buffer has been used once
   }
   EXPECT_EQ(during_steps, 0);
   std::filesystem::remove(path);

@@ -4,9 +4,9 @@
 // replaces the global operator new to count allocations while one of them runs.
 #include <gtest/gtest.h>
 
-#include <atomic>
+#include "dyad/testing/allocation_counter.hpp"
+
 #include <cstdlib>
-#include <new>
 
 #include "dyad/pvrnn/analytic_dataset.hpp"
 #include "dyad/pvrnn/error_regression.hpp"
@@ -14,27 +14,16 @@
 #include "dyad/pvrnn/trainer.hpp"
 #include "dyad/pvrnn/window_objective.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-
 namespace dyad::pvrnn {
 namespace {
 
-// Allocations made by f().
-template <typename F>
-long CountAllocations(F&& f) {
-  const long before = g_allocations.load();
-  f();
-  return g_allocations.load() - before;
+using dyad::testing::CountAllocations;
+
+// The counter is live in this binary (otherwise every "allocates nothing" below passes vacuously).
+std::vector<double>* volatile g_escape = nullptr;
+TEST(NoAllocation, CounterSeesAnAllocation) {
+  EXPECT_GE(CountAllocations([] { g_escape = new std::vector<double>(100); }), 2);
+  delete g_escape;
 }
 
 TEST(NoAllocation, TrainingEpochAllocatesNothing) {

@@ -3,6 +3,8 @@
 // replay reproduces a recording, and bad params are rejected naming the param.
 #include <gtest/gtest.h>
 
+#include "dyad/testing/child_process.hpp"
+
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -19,70 +21,12 @@
 #include "dyad/mcap/reader.hpp"
 
 namespace fs = std::filesystem;
-extern char** environ;
 
 namespace {
 
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using dyad::testing::ReadFile;
 
-// A started child process with stdout/stderr in files and optional extra environment.
-class Child {
- public:
-  // Runs in `cwd` when given.
-  Child(std::vector<std::string> args, const fs::path& dir, const std::string& tag, std::vector<std::string> env = {},
-        const fs::path& cwd = {}) {
-    out_ = dir / (tag + ".out");
-    err_ = dir / (tag + ".err");
-    for (char** e = environ; *e != nullptr; ++e) env.push_back(*e);
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int o = open(out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      const int e = open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(o, 1);
-      dup2(e, 2);
-      if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
-      std::vector<char*> argv, envp;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      for (auto& v : env) envp.push_back(v.data());
-      envp.push_back(nullptr);
-      execve(argv[0], argv.data(), envp.data());
-      _exit(127);
-    }
-  }
-  ~Child() {
-    if (pid_ > 0 && !done_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  void Signal(int sig) { kill(pid_, sig); }
-  // Exit code (128+signal if killed), or -1 if still running after `timeout_s`.
-  int Wait(double timeout_s) {
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-    while (std::chrono::steady_clock::now() < end) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        done_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return -1;
-  }
-  std::string out() const { return ReadFile(out_); }
-  std::string err() const { return ReadFile(err_); }
-
- private:
-  pid_t pid_ = -1;
-  bool done_ = false;
-  fs::path out_, err_;
-};
+using Child = dyad::testing::ChildProcess;
 
 // One recorded message.
 struct Msg {

@@ -1,33 +1,12 @@
 // Writer::Write does not allocate in steady state (the recorder's hot path).
 #include <gtest/gtest.h>
 
-#include <atomic>
+#include "dyad/testing/allocation_counter.hpp"
+
 #include <cstdlib>
-#include <new>
 
 #include "test_files.hpp"
 
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-// Counting replacements of the global allocation functions (all malloc-backed so every delete
-// matches), for this test binary only.
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
-}
-void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept { return operator new(size, tag); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace dyad::mcap {
 namespace {
@@ -48,12 +27,12 @@ TEST(Writer, SteadyStateWritesDoNotAllocate) {
     return true;
   };
   ASSERT_TRUE(write(5000));  // Warm up: buffers and per-channel indexes reach their size.
-  const long before = g_allocations.load();
+  const long before = dyad::testing::AllocationCount();
   ASSERT_TRUE(write(100));   // Within one chunk: nothing at all.
-  EXPECT_EQ(g_allocations.load() - before, 0);
-  const long before_chunks = g_allocations.load();
+  EXPECT_EQ(dyad::testing::AllocationCount() - before, 0);
+  const long before_chunks = dyad::testing::AllocationCount();
   ASSERT_TRUE(write(20000));  // ~100 chunks: only the per-chunk index entry may allocate.
-  EXPECT_LE(g_allocations.load() - before_chunks, 2 * 100 + 10);
+  EXPECT_LE(dyad::testing::AllocationCount() - before_chunks, 2 * 100 + 10);
   ASSERT_TRUE(writer->Close().ok());
 }
 

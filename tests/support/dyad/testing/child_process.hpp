@@ -1,0 +1,102 @@
+// dyad/testing/child_process.hpp: a child process for process-level tests (test code only).
+//
+// Starts `args[0]` (a path, not searched on PATH) with stdout and stderr in DIR/TAG.out and
+// DIR/TAG.err, optionally with extra environment entries ("NAME=value", added to the test's
+// own) and another working directory. A child still running when the object dies is SIGKILLed
+// and reaped, so a failing test never leaves processes behind.
+//
+//   dyad::testing::ChildProcess run({DYAD_EXE, "run", "g.yaml"}, dir, "run");
+//   run.Signal(SIGINT);
+//   ASSERT_EQ(run.Wait(30), 0) << run.err();
+#pragma once
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace dyad::testing {
+
+// The whole file; empty when it cannot be read.
+inline std::string ReadFile(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+class ChildProcess {
+ public:
+  ChildProcess(std::vector<std::string> args, const std::filesystem::path& dir, const std::string& tag,
+               std::vector<std::string> env = {}, const std::filesystem::path& cwd = {})
+      : out_(dir / (tag + ".out")), err_(dir / (tag + ".err")) {
+    for (char** e = environ; *e != nullptr; ++e) env.push_back(*e);
+    pid_ = fork();
+    if (pid_ == 0) {
+      const int o = open(out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      const int e = open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(o, 1);
+      dup2(e, 2);
+      if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
+      std::vector<char*> argv, envp;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      for (auto& v : env) envp.push_back(v.data());
+      envp.push_back(nullptr);
+      execve(argv[0], argv.data(), envp.data());
+      _exit(127);
+    }
+  }
+  ~ChildProcess() {
+    if (pid_ > 0 && !done_) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, nullptr, 0);
+    }
+  }
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+
+  pid_t pid() const { return pid_; }
+  void Signal(int sig) { kill(pid_, sig); }
+  // Exit code (128 + signal if killed by one), or -1 if still running after `timeout_s`.
+  int Wait(double timeout_s) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < end) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        done_ = true;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return -1;
+  }
+  // True once stdout contains `text` (e.g. a server's "listening" line); false after `timeout_s`.
+  bool WaitForOutput(const std::string& text, double timeout_s) const {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < end) {
+      if (out().find(text) != std::string::npos) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
+  }
+  std::string out() const { return ReadFile(out_); }
+  std::string err() const { return ReadFile(err_); }
+
+ private:
+  pid_t pid_ = -1;
+  bool done_ = false;
+  std::filesystem::path out_, err_;
+};
+
+}  // namespace dyad::testing
