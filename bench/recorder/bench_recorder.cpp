@@ -68,7 +68,7 @@ Result RunCase(const Case& c, int steps, int burst, double duration, const fs::p
   g << "graph: benchrec\nclock: " << c.clock << "\ndomain_id: " << domain << "\ncomponents:\n";
   for (int i = 1; i <= 3; ++i)
     g << "  p" << i << ": {type: bench_burst, rate_hz: 100, params: {burst: " << burst << "}, outputs: {out: t" << i << "}}\n";
-  if (c.record) g << "  rec: {type: recorder, rate_hz: 1, params: {file: " << file.string() << ", topics: [t1, t2, t3]}}\n";
+  if (c.record) g << "  rec: {type: recorder, rate_hz: 1, params: {file: " << file.string() << ", overwrite: true, topics: [t1, t2, t3]}}\n";
   g.close();
 
   dyad::RunOptions o;

@@ -42,6 +42,7 @@ uint64_t NonNegative(int64_t v) { return v < 0 ? 0 : static_cast<uint64_t>(v); }
 void Recorder::Describe(ComponentSpec& spec) {
   spec.Summary("Records graph topics (names or regexes, default all) into an MCAP file: omgidl schemas, CDR, zstd chunks.");
   spec.Param("file", "{graph}-{time}.mcap").Doc("output path; {graph} = graph name, {time} = local start time YYYYMMDD-HHMMSS");
+  spec.Param("overwrite", false).Doc("replace an existing file (false: an existing file is an error, nothing is recorded over it)");
   spec.Param("topics", std::vector<std::string>{}).Doc("topic names or regexes (whole-name match); empty: every graph topic");
   spec.Param("chunk_size", int64_t{256 * 1024}).Range(1024, 1024.0 * 1024 * 1024).Unit("bytes").Doc("uncompressed bytes per chunk");
   spec.Param("compression", "zstd").OneOf({"zstd", "none"}).Doc("chunk compression");
@@ -62,6 +63,10 @@ Status Recorder::Configure(Context& ctx) {
   const Params& p = ctx.params();
   path_ = ExpandFileName(p.String("file"), ctx.graph_name(), LocalTimeStamp());
   if (path_.empty()) return Status::InvalidArgument("params.file: must not be empty");
+  // Checked before anything runs: a recording is never silently replaced by the next run.
+  if (!p.Bool("overwrite") && std::filesystem::exists(path_))
+    return Status::InvalidArgument("params.file = '" + path_ +
+                                   "': exists; set params.overwrite: true to replace it, or put {time} in the name");
   options_.chunk_size = static_cast<uint64_t>(p.Int("chunk_size"));
   options_.compression = p.String("compression") == "none" ? mcap::Compression::kNone : mcap::Compression::kZstd;
   options_.zstd_level = static_cast<int>(p.Int("compression_level"));

@@ -279,9 +279,15 @@ TEST_F(RecorderTest, SteppedGraphRecordsEverySampleOfThreePublishersReadBackByMc
 TEST_F(RecorderTest, SteppedRecordingsOfTheSameGraphAreByteIdentical) {
   const fs::path graph = Write("g.yaml", ThreePublishers("stepped", 100, 100, 50, "file: " + (dir_ / "out.mcap").string() +
                                                                                       ", topics: ['c.'], chunk_size: 2048"));
-  ASSERT_EQ(Run({"run", graph.string(), "--steps", "500", "--quiet"}), 0);
-  fs::rename(dir_ / "out.mcap", dir_ / "first.mcap");
-  ASSERT_EQ(Run({"run", graph.string(), "--steps", "500", "--quiet"}), 0);
+  // Both runs with the same --set: the recorded graph (metadata) is the graph as run.
+  ASSERT_EQ(Run({"run", graph.string(), "--steps", "500", "--quiet", "--set", "rec.overwrite=true"}), 0);
+  fs::copy_file(dir_ / "out.mcap", dir_ / "first.mcap");
+  // A run records over an existing file only when told to.
+  std::string err;
+  EXPECT_NE(Run({"run", graph.string(), "--steps", "500", "--quiet"}, nullptr, &err), 0);
+  EXPECT_NE(err.find("out.mcap': exists; set params.overwrite: true"), std::string::npos) << err;
+  EXPECT_EQ(ReadFile(dir_ / "out.mcap"), ReadFile(dir_ / "first.mcap")) << "the refused run touched the file";
+  ASSERT_EQ(Run({"run", graph.string(), "--steps", "500", "--quiet", "--set", "rec.overwrite=true"}), 0);
   const std::string a = ReadFile(dir_ / "first.mcap"), b = ReadFile(dir_ / "out.mcap");
   EXPECT_GT(a.size(), 10000u);
   EXPECT_TRUE(a == b) << "stepped recordings differ (" << a.size() << " vs " << b.size() << " bytes)";
@@ -453,6 +459,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "params.topics[0] = 'c[a': neither a topic nor a valid regular expression"},
         BadParam{"UnwritableFile", "{type: recorder, rate_hz: 1, params: {file: /proc/dyad/x.mcap}}",
                  "x: activate failed: params.file = '/proc/dyad/x.mcap'"},
+        BadParam{"ExistingFileNotOverwritten", "{type: recorder, rate_hz: 1, params: {file: DIR/not.mcap}}",
+                 "params.file = '"},
         BadParam{"UnknownCompression", "{type: recorder, rate_hz: 1, params: {compression: lz4}}",
                  "components.x.params.compression: must be one of: zstd, none"},
         BadParam{"ChunkTooSmall", "{type: recorder, rate_hz: 1, params: {chunk_size: 10}}",
