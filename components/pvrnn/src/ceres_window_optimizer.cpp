@@ -64,11 +64,13 @@ class Adapter final : public ceres::FirstOrderFunction {
   int* evaluations_;
 };
 
-// Ends the solve when the next iteration would end after the deadline.
+// Ends the solve when the next iteration would end after the deadline. After the last allowed
+// iteration there is no next one: Ceres stops for the iteration cap, and that is no deadline miss.
 class DeadlineCallback final : public ceres::IterationCallback {
  public:
-  DeadlineCallback(SteadyClock::time_point deadline, double* iteration_s, bool* stopped)
-      : deadline_(deadline), iteration_s_(iteration_s), stopped_(stopped), last_(SteadyClock::now()) {}
+  DeadlineCallback(SteadyClock::time_point deadline, int max_iterations, double* iteration_s, bool* stopped)
+      : deadline_(deadline), max_iterations_(max_iterations), iteration_s_(iteration_s), stopped_(stopped),
+        last_(SteadyClock::now()) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
     const auto now = SteadyClock::now();
     if (summary.iteration > 0) {
@@ -76,7 +78,7 @@ class DeadlineCallback final : public ceres::IterationCallback {
       *iteration_s_ = *iteration_s_ == 0 ? s : 0.9 * *iteration_s_ + 0.1 * s;
     }
     last_ = now;
-    if (now + std::chrono::duration<double>(*iteration_s_) > deadline_) {
+    if (summary.iteration < max_iterations_ && now + std::chrono::duration<double>(*iteration_s_) > deadline_) {
       *stopped_ = true;
       return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
     }
@@ -85,6 +87,7 @@ class DeadlineCallback final : public ceres::IterationCallback {
 
  private:
   SteadyClock::time_point deadline_;
+  int max_iterations_;
   double* iteration_s_;
   bool* stopped_;
   SteadyClock::time_point last_;
@@ -124,7 +127,7 @@ SolveReport CeresWindowOptimizer<Scalar>::Minimize(WindowFunction<Scalar>& f, Ad
   const auto now = SteadyClock::now();
   if (budget.deadline != SteadyClock::time_point::max())
     o.max_solver_time_in_seconds = std::max(0.0, std::chrono::duration<double>(budget.deadline - now).count());
-  DeadlineCallback callback(budget.deadline, &iteration_s_, &r.stopped_by_deadline);
+  DeadlineCallback callback(budget.deadline, budget.max_iterations, &iteration_s_, &r.stopped_by_deadline);
   o.callbacks.push_back(&callback);
   Eigen::VectorXd params = a.flat().template cast<double>();
   ceres::GradientProblemSolver::Summary summary;
