@@ -101,6 +101,12 @@ Status Deliberator::Configure(Context& ctx) {
                                    {"max_line_search_iterations", &ls}});
       !s.ok())
     return s;
+  // Integer options: a fraction or a value beyond int is an error, not a silent truncation.
+  for (const auto& [key, value] : {std::pair<const char*, double>{"lbfgs_rank", rank}, {"max_line_search_iterations", ls}}) {
+    if (value != std::floor(value) || std::abs(value) > 1e9)  // ranges: ErrorRegressionOptions::Problems
+      return Status::InvalidArgument(std::string("params.ceres.") + key + ": must be a whole number, got " +
+                                     std::to_string(value));
+  }
   o.ceres.lbfgs_rank = static_cast<int>(rank);
   o.ceres.max_line_search_iterations = static_cast<int>(ls);
   if (!p.DoubleList("meta_prior").empty()) o.meta_prior = p.DoubleList("meta_prior");

@@ -116,10 +116,10 @@ std::string FormatMarkdown(const Report& r) {
   if (r.events.empty()) {
     s << "No interventions (the human never engaged).\n\n";
   } else {
-    s << "| event | steps | primitive | mean P(C) | final P(C) | observer on human | robot follows | robot switched after |\n";
+    s << "| event | steps (first-last) | primitive | mean P(C) | final P(C) | observer on human | robot follows | robot switched after |\n";
     s << "|---|---|---|---|---|---|---|---|\n";
     for (const EventSummary& e : r.events) {
-      s << "| " << e.index << " | " << e.event.start_step << "-" << e.event.end_step << " | "
+      s << "| " << e.index << " | " << e.event.start_step << "-" << e.event.end_step - 1 << " | "
         << (e.event.primitive < 0 ? std::string("?") : std::to_string(e.event.primitive)) << " | "
         << Num(e.mean_congruence) << " | " << Num(e.final_congruence) << " | " << Num(e.human_accuracy) << " | "
         << Num(e.robot_follows) << " | "

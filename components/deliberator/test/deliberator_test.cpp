@@ -204,6 +204,8 @@ TEST(Deliberator, BadParamsGiveErrorsNamingTheParam) {
       {{{"adam", std::string("{lr: fast}")}}, "params.adam.lr: must be a number"},
       {{{"ceres", std::string("[1, 2]")}}, "params.ceres: must be a map"},
       {{{"ceres", std::string("{lbfgs_rank: 0}")}}, "params.ceres.lbfgs_rank: must be in 1..100, got 0"},
+      {{{"ceres", std::string("{lbfgs_rank: 2.5}")}}, "params.ceres.lbfgs_rank: must be a whole number, got 2.5"},
+      {{{"ceres", std::string("{max_line_search_iterations: 1e30}")}}, "params.ceres.max_line_search_iterations: must be a whole number"},
   };
   for (const auto& c : cases) {
     std::map<std::string, ParamValue> p = c.params;
