@@ -1,43 +1,16 @@
 #include "dyad/observer/observer_file.hpp"
 
-#include <zlib.h>
-
 #include <cmath>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
+
+#include "dyad/pvrnn/checked_file.hpp"
 
 namespace dyad::observer {
 namespace {
 
 using nlohmann::json;
 constexpr char kMagic[8] = {'D', 'Y', 'A', 'D', 'O', 'B', 'S', 'V'};
-constexpr size_t kFixedHeader = 8 + 4 + 4 + 8;
-constexpr size_t kTrailer = 4;
-
-template <typename T>
-void Put(std::string& out, T v) {
-  for (size_t i = 0; i < sizeof(T); ++i) out.push_back(static_cast<char>((static_cast<uint64_t>(v) >> (8 * i)) & 0xff));
-}
-
-template <typename T>
-T Get(const std::string& in, size_t at) {
-  uint64_t v = 0;
-  for (size_t i = 0; i < sizeof(T); ++i) v |= static_cast<uint64_t>(static_cast<unsigned char>(in[at + i])) << (8 * i);
-  return static_cast<T>(v);
-}
-
-uint32_t Crc(const char* data, size_t n) {
-  uLong crc = crc32(0L, Z_NULL, 0);
-  while (n > 0) {
-    const uInt chunk = static_cast<uInt>(std::min<size_t>(n, 1u << 30));
-    crc = crc32(crc, reinterpret_cast<const Bytef*>(data), chunk);
-    data += chunk;
-    n -= chunk;
-  }
-  return static_cast<uint32_t>(crc);
-}
 
 json Num(double v) { return std::isnan(v) ? json(nullptr) : json(v); }
 double NumFrom(const json& j) { return j.is_null() ? std::numeric_limits<double>::quiet_NaN() : j.get<double>(); }
@@ -62,66 +35,25 @@ Status SaveObserver(const ObserverFile& observer, const std::string& path) {
         {"seed", p.seed}, {"validation_min_diagonal", Num(p.validation_min_diagonal)},
         {"validation_accuracy", Num(p.validation_accuracy)}}},
   };
-  const std::string js = header.dump(1);
-  std::string out;
-  out.reserve(kFixedHeader + js.size() + static_cast<size_t>(params.size()) * 8 + kTrailer);
-  out.append(kMagic, 8);
-  Put<uint32_t>(out, kObserverFileVersion);
-  Put<uint32_t>(out, 0);
-  Put<uint64_t>(out, js.size());
-  out += js;
-  for (Eigen::Index i = 0; i < params.size(); ++i) {
-    uint64_t bits;
-    std::memcpy(&bits, &params(i), 8);
-    Put<uint64_t>(out, bits);
-  }
-  Put<uint32_t>(out, Crc(out.data(), out.size()));
-
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) return Status::IOError(path + ": cannot open " + tmp + " for writing");
-    f.write(out.data(), static_cast<std::streamsize>(out.size()));
-    f.flush();
-    if (!f) return Status::IOError(path + ": write failed (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) return Status::IOError(path + ": cannot rename " + tmp + ": " + ec.message());
-  return Status::OK();
+  std::string out = pvrnn::BeginCheckedFile(kMagic, kObserverFileVersion, header.dump(1));
+  out.reserve(out.size() + static_cast<size_t>(params.size()) * 8 + 4);
+  for (Eigen::Index i = 0; i < params.size(); ++i) pvrnn::AppendDouble(out, params(i));
+  return pvrnn::FinishCheckedFile(out, path);
 }
 
 StatusOr<ObserverFile> LoadObserver(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) return Status::InvalidArgument(path + ": is a folder, not an observer file");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return Status::NotFound(path + ": cannot open");
-  std::string in;
-  try {
-    in.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-  } catch (const std::exception& e) {
-    return Status::IOError(path + ": read failed: " + e.what());
-  }
-  if (in.size() < 8 || std::memcmp(in.data(), kMagic, 8) != 0)
-    return Status::DataLoss(path + ": not a dyad observer file (bad magic)");
-  if (in.size() < kFixedHeader + kTrailer)
-    return Status::DataLoss(path + ": truncated: " + std::to_string(in.size()) + " bytes, less than the fixed header");
-  const uint32_t version = Get<uint32_t>(in, 8);
-  if (version != kObserverFileVersion)
-    return Status::Unimplemented(path + ": format version " + std::to_string(version) + ", this build reads version " +
-                                 std::to_string(kObserverFileVersion));
-  const uint64_t jlen = Get<uint64_t>(in, 16);
-  if (jlen > in.size() - kFixedHeader - kTrailer)
-    return Status::DataLoss(path + ": truncated: header of " + std::to_string(jlen) + " bytes does not fit in " +
-                            std::to_string(in.size()) + " bytes");
-  if (Get<uint32_t>(in, in.size() - kTrailer) != Crc(in.data(), in.size() - kTrailer))
-    return Status::DataLoss(path + ": corrupted or truncated (checksum mismatch)");
-  const size_t payload_at = kFixedHeader + jlen;
-  const size_t payload_bytes = in.size() - kTrailer - payload_at;
+  auto bytes = pvrnn::ReadWholeFile(path, "observer file");
+  if (!bytes.ok()) return bytes.status();
+  const std::string& in = *bytes;
+  auto view = pvrnn::OpenCheckedFile(in, path, kMagic, kObserverFileVersion, "dyad observer file");
+  if (!view.ok()) return view.status();
+  if (!view->crc_ok) return Status::DataLoss(path + ": corrupted or truncated (checksum mismatch)");
+  const size_t payload_at = view->payload_at;
+  const size_t payload_bytes = view->payload_bytes;
   ObserverFile out;
   ClassifierSpec spec;
   try {
-    const json header = json::parse(in.begin() + kFixedHeader, in.begin() + static_cast<std::ptrdiff_t>(payload_at));
+    const json header = json::parse(view->json);
     const json& s = header.at("spec");
     spec.window = s.at("window").get<int>();
     spec.hidden = s.at("hidden").get<std::vector<int>>();
@@ -157,8 +89,7 @@ StatusOr<ObserverFile> LoadObserver(const std::string& path) {
                             std::to_string(n * 8));
   Eigen::VectorXd params(n);
   for (int64_t i = 0; i < n; ++i) {
-    const uint64_t bits = Get<uint64_t>(in, payload_at + static_cast<size_t>(i) * 8);
-    std::memcpy(&params(i), &bits, 8);
+    params(i) = pvrnn::ReadDouble(in, payload_at + static_cast<size_t>(i) * 8);
     if (!std::isfinite(params(i))) return Status::DataLoss(path + ": parameter " + std::to_string(i) + " is not finite");
   }
   auto c = Classifier::FromParameters(spec, std::move(params));

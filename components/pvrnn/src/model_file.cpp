@@ -1,58 +1,16 @@
 #include "dyad/pvrnn/model_file.hpp"
 
-#include <zlib.h>
-
-#include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
+
 #include <sstream>
+
+#include "dyad/pvrnn/checked_file.hpp"
 
 namespace dyad::pvrnn {
 namespace {
 
 using nlohmann::json;
 constexpr char kMagic[8] = {'D', 'Y', 'A', 'D', 'P', 'V', 'R', 'N'};
-constexpr size_t kFixedHeader = 8 + 4 + 4 + 8;
-constexpr size_t kTrailer = 4;
-
-template <typename T>
-void Put(std::string& out, T v) {
-  unsigned char b[sizeof(T)];
-  for (size_t i = 0; i < sizeof(T); ++i) b[i] = static_cast<unsigned char>((static_cast<uint64_t>(v) >> (8 * i)) & 0xff);
-  out.append(reinterpret_cast<const char*>(b), sizeof(T));
-}
-
-template <typename T>
-T Get(const std::string& in, size_t at) {
-  uint64_t v = 0;
-  for (size_t i = 0; i < sizeof(T); ++i) v |= static_cast<uint64_t>(static_cast<unsigned char>(in[at + i])) << (8 * i);
-  return static_cast<T>(v);
-}
-
-void PutDouble(std::string& out, double d) {
-  uint64_t bits;
-  std::memcpy(&bits, &d, 8);
-  Put<uint64_t>(out, bits);
-}
-
-double GetDouble(const std::string& in, size_t at) {
-  const uint64_t bits = Get<uint64_t>(in, at);
-  double d;
-  std::memcpy(&d, &bits, 8);
-  return d;
-}
-
-uint32_t Crc(const char* data, size_t n) {
-  uLong crc = crc32(0L, Z_NULL, 0);
-  while (n > 0) {  // zlib takes uInt lengths
-    const uInt chunk = static_cast<uInt>(std::min<size_t>(n, 1u << 30));
-    crc = crc32(crc, reinterpret_cast<const Bytef*>(data), chunk);
-    data += chunk;
-    n -= chunk;
-  }
-  return static_cast<uint32_t>(crc);
-}
 
 json SpecToJson(const ModelSpec& s) {
   json layers = json::array();
@@ -124,66 +82,28 @@ Status SaveModel(const Model& model, const std::string& path) {
       {"tensors", table},
       {"training", training},
   };
-  const std::string js = header.dump(1);
-  std::string out;
-  out.reserve(kFixedHeader + js.size() + offset * 8 + kTrailer);
-  out.append(kMagic, 8);
-  Put<uint32_t>(out, kModelFileVersion);
-  Put<uint32_t>(out, 0);
-  Put<uint64_t>(out, js.size());
-  out += js;
+  std::string out = BeginCheckedFile(kMagic, kModelFileVersion, header.dump(1));
+  out.reserve(out.size() + offset * 8 + 4);
   for (const auto& t : tensors)
-    for (int64_t i = 0; i < static_cast<int64_t>(t.rows) * t.cols; ++i) PutDouble(out, t.data[i]);
-  Put<uint32_t>(out, Crc(out.data(), out.size()));
-
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) return Status::IOError(path + ": cannot open " + tmp + " for writing");
-    f.write(out.data(), static_cast<std::streamsize>(out.size()));
-    f.flush();
-    if (!f) return Status::IOError(path + ": write failed (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) return Status::IOError(path + ": cannot rename " + tmp + ": " + ec.message());
-  return Status::OK();
+    for (int64_t i = 0; i < static_cast<int64_t>(t.rows) * t.cols; ++i) AppendDouble(out, t.data[i]);
+  return FinishCheckedFile(out, path);
 }
 
 StatusOr<Model> LoadModel(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) return Status::InvalidArgument(path + ": is a folder, not a model file");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return Status::NotFound(path + ": cannot open");
-  std::string in;
-  try {
-    in.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-  } catch (const std::exception& e) {  // libstdc++ throws on a read error
-    return Status::IOError(path + ": read failed: " + e.what());
-  }
-  if (in.size() < 8 || std::memcmp(in.data(), kMagic, 8) != 0)
-    return Status::DataLoss(path + ": not a dyad PV-RNN model file (bad magic)");
-  if (in.size() < kFixedHeader + kTrailer)
-    return Status::DataLoss(path + ": truncated: " + std::to_string(in.size()) + " bytes, less than the fixed header");
-  const uint32_t version = Get<uint32_t>(in, 8);
-  if (version != kModelFileVersion)
-    return Status::Unimplemented(path + ": format version " + std::to_string(version) + ", this build reads version " +
-                               std::to_string(kModelFileVersion));
-  const uint64_t jlen = Get<uint64_t>(in, 16);
-  if (jlen > in.size() - kFixedHeader - kTrailer)
-    return Status::DataLoss(path + ": truncated: header of " + std::to_string(jlen) + " bytes does not fit in " +
-                             std::to_string(in.size()) + " bytes");
-  const uint32_t stored_crc = Get<uint32_t>(in, in.size() - kTrailer);
-  const uint32_t crc = Crc(in.data(), in.size() - kTrailer);
+  auto bytes = ReadWholeFile(path, "model file");
+  if (!bytes.ok()) return bytes.status();
+  const std::string& in = *bytes;
+  auto view = OpenCheckedFile(in, path, kMagic, kModelFileVersion, "dyad PV-RNN model file");
+  if (!view.ok()) return view.status();
   json header;
   try {
-    header = json::parse(in.begin() + kFixedHeader, in.begin() + kFixedHeader + static_cast<std::ptrdiff_t>(jlen));
+    header = json::parse(view->json);
   } catch (const std::exception& e) {
-    if (crc != stored_crc) return Status::DataLoss(path + ": corrupted or truncated (checksum mismatch)");
+    if (!view->crc_ok) return Status::DataLoss(path + ": corrupted or truncated (checksum mismatch)");
     return Status::DataLoss(path + ": unreadable header: " + e.what());
   }
-  const size_t payload_at = kFixedHeader + jlen;
-  const size_t payload_bytes = in.size() - kTrailer - payload_at;
+  const size_t payload_at = view->payload_at;
+  const size_t payload_bytes = view->payload_bytes;
   Model m;
   try {
     uint64_t needed = 0;
@@ -192,7 +112,7 @@ StatusOr<Model> LoadModel(const std::string& path) {
     if (needed * 8 > payload_bytes)
       return Status::DataLoss(path + ": truncated: tensors need " + std::to_string(needed * 8) + " bytes, file has " +
                                std::to_string(payload_bytes));
-    if (crc != stored_crc) return Status::DataLoss(path + ": corrupted (checksum mismatch)");
+    if (!view->crc_ok) return Status::DataLoss(path + ": corrupted (checksum mismatch)");
     if (needed * 8 != payload_bytes)
       return Status::DataLoss(path + ": " + std::to_string(payload_bytes - needed * 8) + " unexpected bytes after the tensors");
     m.spec = SpecFromJson(header.at("spec"));
@@ -218,7 +138,7 @@ StatusOr<Model> LoadModel(const std::string& path) {
                                    " x " + std::to_string(cols));
         const size_t at = payload_at + t.at("offset").get<size_t>() * 8;
         for (int c = 0; c < cols; ++c)
-          for (int r = 0; r < rows; ++r) sink(r, c, GetDouble(in, at + (static_cast<size_t>(c) * rows + r) * 8));
+          for (int r = 0; r < rows; ++r) sink(r, c, ReadDouble(in, at + (static_cast<size_t>(c) * rows + r) * 8));
         return Status::OK();
       }
       return Status::DataLoss(path + ": tensor " + name + " missing");
