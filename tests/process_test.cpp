@@ -1,6 +1,8 @@
 // Process-level tests: real `dyad` processes started, signalled, killed and waited for.
 #include <gtest/gtest.h>
 
+#include "dyad/testing/dds_domain.hpp"
+
 #include "dyad/testing/child_process.hpp"
 
 #include <fcntl.h>
@@ -28,7 +30,7 @@ class ProcessTest : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     // A domain of its own per test process, so parallel ctest runs don't hear each other.
-    domain_ = 1 + static_cast<int>(getpid() % 200);
+    domain_ = dyad::testing::DomainForThisProcess();
   }
   void TearDown() override {
     if (!HasFailure()) fs::remove_all(dir_);

@@ -20,11 +20,6 @@ StepSample EmptyStep(int64_t step) {
   return s;
 }
 
-int Argmax(const std::vector<double>& p) {
-  if (p.empty()) return -1;
-  return static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin());
-}
-
 // Reads a table's cells by column name; a missing column is a clear DataLoss.
 class Cells {
  public:
@@ -194,6 +189,11 @@ StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables
   return timeline;
 }
 
+int MostLikelyClass(const std::vector<double>& p) {
+  if (p.empty()) return -1;
+  return static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin());
+}
+
 std::vector<PlannedEvent> Events(const Timeline& timeline, const ExperimentPlan& plan) {
   std::vector<PlannedEvent> events;
   const auto recorded = static_cast<int64_t>(timeline.steps.size());
@@ -233,8 +233,8 @@ std::vector<EventSummary> SummariseEvents(const Timeline& timeline, const std::v
       congruence_total += s.congruence;
       sum.final_congruence = s.congruence;
       if (events[e].primitive >= 0) {
-        human_hits += Argmax(s.p_human) == events[e].primitive;
-        if (Argmax(s.p_robot) == events[e].primitive) {
+        human_hits += MostLikelyClass(s.p_human) == events[e].primitive;
+        if (MostLikelyClass(s.p_robot) == events[e].primitive) {
           robot_hits += 1;
           if (sum.robot_switch_after < 0) sum.robot_switch_after = t - events[e].start_step;
         }
@@ -261,7 +261,7 @@ std::vector<std::vector<int64_t>> HumanConfusion(const Timeline& timeline, const
     if (e.primitive < 0 || e.primitive >= timeline.classes) continue;
     const int64_t end = std::min<int64_t>(e.end_step, static_cast<int64_t>(timeline.steps.size()));
     for (int64_t t = std::max<int64_t>(e.start_step, 0); t < end; ++t) {
-      const int predicted = Argmax(timeline.steps[t].p_human);
+      const int predicted = MostLikelyClass(timeline.steps[t].p_human);
       if (predicted < 0 || predicted >= timeline.classes) continue;
       ++counts[e.primitive][predicted];
       any = true;

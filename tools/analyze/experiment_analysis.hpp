@@ -66,6 +66,9 @@ StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables
 // ended before it), one running past it ends there.
 std::vector<PlannedEvent> Events(const Timeline& timeline, const ExperimentPlan& plan);
 
+// Index of the largest probability (the first on ties); -1 for an empty vector (no label).
+int MostLikelyClass(const std::vector<double>& p);
+
 struct EventSummary {
   int index = 0;
   PlannedEvent event;

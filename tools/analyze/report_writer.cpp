@@ -18,11 +18,6 @@ std::string Num(double v, int precision = 3) {
   return s.str();
 }
 
-int Argmax(const std::vector<double>& p) {
-  if (p.empty()) return -1;
-  return static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin());
-}
-
 Status WriteFile(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out << text;
@@ -62,7 +57,7 @@ std::string TimelineCsv(const Report& r) {
       << Num(x.human_y, 4) << ',' << (x.engaged ? 1 : 0) << ',' << Num(x.robot_x, 4) << ',' << Num(x.robot_y, 4)
       << ',' << Num(x.executed_x, 4) << ',' << Num(x.executed_y, 4) << ',' << Num(x.nelbo, 6) << ','
       << Num(x.reconstruction, 6) << ',' << Num(x.regulation, 6) << ',' << Num(x.optimisation_s, 7) << ','
-      << Num(x.congruence, 6) << ',' << Argmax(x.p_human) << ',' << Argmax(x.p_robot) << '\n';
+      << Num(x.congruence, 6) << ',' << MostLikelyClass(x.p_human) << ',' << MostLikelyClass(x.p_robot) << '\n';
   }
   return s.str();
 }

@@ -2,6 +2,8 @@
 // loopback for udp_cartesian (lost, late, out-of-order and malformed packets).
 #include <gtest/gtest.h>
 
+#include "dyad/testing/dds_domain.hpp"
+
 #include "dyad/testing/child_process.hpp"
 
 #include <fcntl.h>
@@ -48,7 +50,7 @@ class DriverProcessTest : public ::testing::Test {
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    domain_ = 1 + static_cast<int>(getpid() % 200);
+    domain_ = dyad::testing::DomainForThisProcess();
     // A port of its own per test process (and per test: the counter), so parallel runs don't collide.
     static int counter = 0;
     port_ = 40000 + static_cast<int>(getpid() % 5000) * 4 + (counter++ % 4);

@@ -3,6 +3,8 @@
 #include "deliberator.hpp"
 
 #include <gtest/gtest.h>
+
+#include "dyad/testing/dds_domain.hpp"
 #include <unistd.h>
 
 #include <cmath>
@@ -225,7 +227,7 @@ TEST(Deliberator, RunsInASteppedGraphAndPublishesEveryStep) {
   const fs::path dir = fs::temp_directory_path() / ("dyad_deliberator_graph_" + std::to_string(getpid()));
   fs::create_directories(dir);
   const fs::path out = dir / "intentions.txt", graph = dir / "g.yaml";
-  std::ofstream(graph) << "graph: mind\nclock: stepped\nseed: 3\ndomain_id: " << (1 + getpid() % 200)
+  std::ofstream(graph) << "graph: mind\nclock: stepped\nseed: 3\ndomain_id: " << dyad::testing::DomainForThisProcess()
                        << "\nplugins: [" << DYAD_DELIBERATOR_TEST_PLUGIN << "]\ncomponents:\n"
                        << "  driver: {type: executed_script, rate_hz: 10, outputs: {state: robot/state}}\n"
                        << "  mind:\n    type: deliberator\n    rate_hz: 10\n    params: {model: " << RandomModelFile()

@@ -1,6 +1,8 @@
 // The human_synthetic and human_replay components: through a fake context (no DDS) and, once
 // each, loaded by name and run by a real `dyad run`.
 #include <gtest/gtest.h>
+
+#include "dyad/testing/dds_domain.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -119,7 +121,7 @@ TEST(HumanInputPlugin, LoadsByTypeNameAndRunsInDyad) {
   const fs::path dir = TempDir("run");
   const fs::path csv = dir / "h.csv";
   std::ofstream(csv) << "x,y,engaged\n1,2,false\n3,4,true\n";
-  const std::string domain = std::to_string(1 + getpid() % 200);
+  const std::string domain = std::to_string(dyad::testing::DomainForThisProcess());
   std::string err;
   EXPECT_EQ(RunDyad(dir,
                     "graph: replay\nclock: stepped\ndomain_id: " + domain +

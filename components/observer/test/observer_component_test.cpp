@@ -1,6 +1,8 @@
 // The observer component through a fake context (no DDS): what it publishes while the human is
 // engaged or not, the window restart, and the low-pass filtered congruence.
 #include <gtest/gtest.h>
+
+#include "dyad/testing/dds_domain.hpp"
 #include <unistd.h>
 
 #include <cmath>
@@ -134,7 +136,7 @@ TEST(ObserverPlugin, RunsInDyadWithASyntheticHuman) {
   fs::create_directories(dir);
   ASSERT_TRUE(pvrnn::WriteNrlDataset(pvrnn::MakeAnalyticDataset(), (dir / "data").string()).ok());
   const fs::path g = dir / "g.yaml", err = dir / "err.txt";
-  std::ofstream(g) << "graph: observe\nclock: stepped\ndomain_id: " << 1 + getpid() % 200
+  std::ofstream(g) << "graph: observe\nclock: stepped\ndomain_id: " << dyad::testing::DomainForThisProcess()
                    << "\ncomponents:\n"
                       "  human: {type: human_synthetic, rate_hz: 10, params: {dataset: "
                    << (dir / "data").string()

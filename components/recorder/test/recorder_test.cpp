@@ -3,6 +3,8 @@
 // replay reproduces a recording, and bad params are rejected naming the param.
 #include <gtest/gtest.h>
 
+#include "dyad/testing/dds_domain.hpp"
+
 #include "dyad/testing/child_process.hpp"
 
 #include <fcntl.h>
@@ -150,7 +152,7 @@ class RecorderTest : public ::testing::Test {
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    domain_ = 1 + static_cast<int>(getpid() % 200);
+    domain_ = dyad::testing::DomainForThisProcess();
   }
   void TearDown() override {
     if (!HasFailure()) fs::remove_all(dir_);

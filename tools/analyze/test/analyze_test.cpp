@@ -13,6 +13,7 @@
 #include <dyad/msg/types.hpp>
 
 #include "analyze_commands.hpp"
+#include "dyad/testing/cli.hpp"
 #include "dyad/mcap/writer.hpp"
 #include "experiment_analysis.hpp"
 #include "recording_tables.hpp"
@@ -233,17 +234,9 @@ TEST(Analyze, CellParsersRejectWhatIsNotANumber) {
 }
 
 int RunCli(std::vector<std::string> args, std::string* err = nullptr) {
-  CLI::App app{"dyad"};
-  int exit_code = -1;
-  dyad::cli::AddAnalyzeCommands(app, exit_code);
-  args.insert(args.begin(), "dyad");
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  ::testing::internal::CaptureStderr();
-  app.parse(static_cast<int>(argv.size()), argv.data());
-  const std::string captured = ::testing::internal::GetCapturedStderr();
-  if (err) *err = captured;
-  return exit_code;
+  const auto r = dyad::testing::RunCommand(dyad::cli::AddAnalyzeCommands, std::move(args));
+  if (err) *err = r.err;
+  return r.code;
 }
 
 std::string Head(const std::string& path, size_t n) {

@@ -11,6 +11,7 @@
 #include <dyad/msg/types.hpp>
 
 #include "bag_commands.hpp"
+#include "dyad/testing/cli.hpp"
 #include "bag_info.hpp"
 #include "csv_export.hpp"
 #include "dyad/mcap/writer.hpp"
@@ -58,17 +59,9 @@ std::string ReadText(const std::string& path) {
 
 // Runs `dyad ARGS...` and returns its exit code; *err (if given) receives what it wrote to stderr.
 int RunCli(std::vector<std::string> args, std::string* err = nullptr) {
-  CLI::App app{"dyad"};
-  int exit_code = -1;
-  dyad::cli::AddBagCommands(app, exit_code);
-  args.insert(args.begin(), "dyad");
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  ::testing::internal::CaptureStderr();
-  app.parse(static_cast<int>(argv.size()), argv.data());
-  const std::string captured = ::testing::internal::GetCapturedStderr();
-  if (err) *err = captured;
-  return exit_code;
+  const auto r = dyad::testing::RunCommand(dyad::cli::AddBagCommands, std::move(args));
+  if (err) *err = r.err;
+  return r.code;
 }
 
 TEST(BagInfo, ListsChannelsCountsChunksAndMetadata) {
@@ -226,10 +219,9 @@ TEST(BagCommands, ExportOfADamagedRecordingSkipsTheChunkAndFails) {
                      "` lists them\n");
   EXPECT_EQ(ReadText(dir + "/counter.csv"),
             "log_time,publish_time,sequence,header.source,header.sequence_number,header.stamp_ns,value\n");
-  std::string report;
-  ::testing::internal::CaptureStdout();
-  EXPECT_EQ(RunCli({"bag", "info", "--scan", path}), 1);
-  report = ::testing::internal::GetCapturedStdout();
+  const auto info = dyad::testing::RunCommand(dyad::cli::AddBagCommands, {"bag", "info", "--scan", path});
+  EXPECT_EQ(info.code, 1);
+  const std::string& report = info.out;
   EXPECT_NE(report.find("damaged:     1 chunk(s)\n  at offset " + std::to_string(chunk) + ": CRC mismatch"),
             std::string::npos)
       << report;

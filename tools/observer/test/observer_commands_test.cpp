@@ -12,6 +12,7 @@
 #include "dyad/pvrnn/analytic_dataset.hpp"
 #include "dyad/pvrnn/dataset.hpp"
 #include "dyad/pvrnn/model_file.hpp"
+#include "dyad/testing/cli.hpp"
 #include "observer_commands.hpp"
 
 namespace dyad::cli {
@@ -32,25 +33,9 @@ const fs::path& Dir() {
   return dir;
 }
 
-struct CliRun {
-  int code = -1;
-  std::string out, err;
-};
+using dyad::testing::CliRun;
 
-CliRun Cli(std::vector<std::string> args) {
-  CLI::App app{"dyad"};
-  CliRun r;
-  AddObserverCommands(app, r.code);
-  args.insert(args.begin(), "dyad");
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  ::testing::internal::CaptureStdout();
-  ::testing::internal::CaptureStderr();
-  app.parse(static_cast<int>(argv.size()), argv.data());
-  r.err = ::testing::internal::GetCapturedStderr();
-  r.out = ::testing::internal::GetCapturedStdout();
-  return r;
-}
+CliRun Cli(std::vector<std::string> args) { return dyad::testing::RunCommand(AddObserverCommands, std::move(args)); }
 
 std::string Model() { return (Dir() / "m.dpvrnn").string(); }
 
