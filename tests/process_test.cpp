@@ -258,6 +258,11 @@ TEST_F(ProcessTest, IntrospectionSeesARunningGraph) {
   ASSERT_EQ(std::sscanf(hz.out().c_str(), "rate %lf Hz", &rate), 1) << hz.out();
   EXPECT_NEAR(rate, 50.0, 5.0) << hz.out();
 
+  // Domain 231 is outside the tests' 1..200: nothing there, and `topics` says so.
+  Child empty(Dyad({"topics", "--domain", "231", "--wait", "0.3"}), dir_, "empty");
+  EXPECT_EQ(empty.Wait(30), 1);
+  EXPECT_NE(empty.err().find("no endpoint discovered on domain 231 within 0.3 s"), std::string::npos) << empty.err();
+
   Child none(Dyad({"echo", "no/such/topic", "--domain", domain, "--wait", "1"}), dir_, "none");
   EXPECT_EQ(none.Wait(30), 1);
   EXPECT_NE(none.err().find("no writer of topic 'no/such/topic'"), std::string::npos) << none.err();
