@@ -5,11 +5,11 @@
 #include <gtest/gtest.h>
 
 #include "dyad/testing/dds_domain.hpp"
+#include "dyad/testing/fake_context.hpp"
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
-#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -21,76 +21,24 @@ namespace fs = std::filesystem;
 namespace dyad::deliberator {
 namespace {
 
-// ---------------------------------------------------------------------------------------------
-// A fake runtime: declared params with defaults, ports bound to in-memory endpoints.
-
-class FakeClock final : public Clock {
+// The shared fake Context (tests/support) with the deliberator's ports bound: `reader` feeds
+// `executed`, `writer` keeps every published intention.
+class FakeContext {
  public:
-  int64_t now_ns() const override { return 0; }
-};
-class FakeLogger final : public Logger {
- public:
-  void Write(Level, std::string_view m) override { lines.emplace_back(m); }
-  std::vector<std::string> lines;
-};
-class QueueReader final : public detail::ReaderEndpoint {
- public:
-  bool TakeNext(void* sample) override {
-    if (queue.empty()) return false;
-    *static_cast<msg::CartesianState*>(sample) = queue.front();
-    queue.pop_front();
-    return true;
-  }
-  std::deque<msg::CartesianState> queue;
-};
-class VectorWriter final : public detail::WriterEndpoint {
- public:
-  Status Write(const void* sample) override {
-    samples.push_back(*static_cast<const msg::Intention*>(sample));
-    return Status::OK();
-  }
-  std::vector<msg::Intention> samples;
-};
+  explicit FakeContext(std::map<std::string, ParamValue> params)
+      : ctx(&Deliberator::Describe, std::move(params), 7),
+        reader(ctx.Feed<msg::CartesianState>("executed")),
+        writer(ctx.Capture<msg::Intention>("intention")),
+        logger(ctx.log_),
+        stepped_clock(ctx.stepped_clock) {}
+  operator Context&() { return ctx; }
+  void Poll() { ctx.PollInputs(); }
 
-class FakeContext final : public Context {
- public:
-  explicit FakeContext(std::map<std::string, ParamValue> overrides) {
-    ComponentSpec spec;
-    Deliberator::Describe(spec);
-    std::map<std::string, ParamValue> values;
-    for (const auto& p : spec.params())
-      if (p.default_value) values[p.name] = *p.default_value;
-    for (auto& [k, v] : overrides) values[k] = v;
-    params_ = Params(values);
-    executed_.Bind("executed", "robot/state", &reader);
-    intention_.Bind("intention", "robot/intention", "mind", &writer, &clock_);
-  }
-  const std::string& name() const override { return name_; }
-  const Params& params() const override { return params_; }
-  const Clock& clock() const override { return clock_; }
-  Logger& log() override { return logger; }
-  uint64_t seed() const override { return 7; }
-  int64_t period_ns() const override { return 100'000'000; }
-  void RequestStop(std::string) override {}
-  bool stepped() const override { return stepped_clock; }
-  size_t Poll() { return executed_.Poll(0); }
-
-  bool stepped_clock = false;
-
-  QueueReader reader;
-  VectorWriter writer;
-  FakeLogger logger;
-
- protected:
-  InputBase* FindInput(std::string_view, const TypeInfo&) override { return &executed_; }
-  OutputBase* FindOutput(std::string_view, const TypeInfo&) override { return &intention_; }
-
- private:
-  std::string name_ = "mind";
-  Params params_;
-  FakeClock clock_;
-  Input<msg::CartesianState> executed_;
-  Output<msg::Intention> intention_;
+  dyad::testing::FakeContext ctx;
+  dyad::testing::QueueReader<msg::CartesianState>& reader;
+  dyad::testing::CapturingWriter<msg::Intention>& writer;
+  dyad::testing::NullLogger& logger;
+  bool& stepped_clock;
 };
 
 // A random MacawBot-shaped model file (no data needed).

@@ -11,7 +11,7 @@
 #include <fstream>
 
 #include "dyad/pvrnn/analytic_dataset.hpp"
-#include "fake_context.hpp"
+#include "dyad/testing/fake_context.hpp"
 #include "human_input.hpp"
 
 namespace dyad::human_input {

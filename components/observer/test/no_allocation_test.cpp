@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "fake_context.hpp"
+#include "dyad/testing/fake_context.hpp"
 #include "observer_component.hpp"
 
 

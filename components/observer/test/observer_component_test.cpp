@@ -10,7 +10,7 @@
 #include <fstream>
 
 #include "dyad/pvrnn/analytic_dataset.hpp"
-#include "fake_context.hpp"
+#include "dyad/testing/fake_context.hpp"
 #include "observer_component.hpp"
 
 namespace dyad::observer {

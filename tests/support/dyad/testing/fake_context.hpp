@@ -1,6 +1,6 @@
 // A Context for component unit tests, without DDS: params from the component's Describe()
 // defaults plus overrides, outputs that keep every published sample, inputs fed by the test.
-// Shared by the human_input and observer tests.
+// Shared by the component tests (human_input, observer, deliberator).
 #pragma once
 
 #include <deque>
@@ -93,8 +93,10 @@ class FakeContext final : public Context {
   uint64_t seed() const override { return seed_; }
   int64_t period_ns() const override { return 100'000'000; }
   void RequestStop(std::string reason) override { stop_reason = std::move(reason); }
+  bool stepped() const override { return stepped_clock; }
 
   std::string stop_reason;
+  bool stepped_clock = false;
   FakeClock clock_;
   NullLogger log_;
 
