@@ -314,6 +314,15 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
 }
 
 DdsParticipant::~DdsParticipant() {
+  // No callback after this block: serialized subscriptions closed (their last samples delivered),
+  // typed readers' listeners detached. Then endpoints, then the participant.
+  for (auto& r : serialized_readers_) r->Close();
+  for (auto& r : readers_)
+    if (r->reader_ != nullptr) r->reader_->set_listener(nullptr);
+  serialized_readers_.clear();
+  readers_.clear();
+  serialized_writers_.clear();
+  writers_.clear();
   if (participant_ == nullptr) return;
   participant_->set_listener(nullptr);
   participant_->delete_contained_entities();
@@ -356,8 +365,8 @@ void ApplyQos(Q& q, const TopicQos& qos) {
 }
 }  // namespace
 
-StatusOr<std::unique_ptr<DdsReader>> DdsParticipant::CreateReader(const std::string& topic, const TypeInfo& type,
-                                                                  const TopicQos& qos, std::function<void()> on_data) {
+StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
+                                                    std::function<void()> on_data) {
   auto t = GetTopic(topic, type);
   if (!t.ok()) return t.status();
   fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
@@ -370,14 +379,14 @@ StatusOr<std::unique_ptr<DdsReader>> DdsParticipant::CreateReader(const std::str
   auto* sub = subscriber_;
   auto* raw = r->reader_;
   r->on_delete_ = [sub, raw] {
-    const_cast<fdds::DataReader*>(raw)->set_listener(nullptr);
+    raw->set_listener(nullptr);
     sub->delete_datareader(raw);
   };
-  return r;
+  readers_.push_back(std::move(r));
+  return readers_.back().get();
 }
 
-StatusOr<std::unique_ptr<DdsWriter>> DdsParticipant::CreateWriter(const std::string& topic, const TypeInfo& type,
-                                                                  const TopicQos& qos) {
+StatusOr<TypedWriter*> DdsParticipant::CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos) {
   auto t = GetTopic(topic, type);
   if (!t.ok()) return t.status();
   fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
@@ -389,10 +398,11 @@ StatusOr<std::unique_ptr<DdsWriter>> DdsParticipant::CreateWriter(const std::str
   auto* pub = publisher_;
   auto* raw = w->writer_;
   w->on_delete_ = [pub, raw] { pub->delete_datawriter(raw); };
-  return w;
+  writers_.push_back(std::move(w));
+  return writers_.back().get();
 }
 
-StatusOr<std::unique_ptr<DdsSerializedReader>> DdsParticipant::CreateSerializedReader(const std::string& topic,
+StatusOr<SerializedSubscription*> DdsParticipant::CreateSerializedReader(const std::string& topic,
                                                                                       const TypeInfo& type,
                                                                                       const TopicQos& qos,
                                                                                       const Clock* clock,
@@ -428,10 +438,11 @@ StatusOr<std::unique_ptr<DdsSerializedReader>> DdsParticipant::CreateSerializedR
     std::lock_guard<std::mutex> lock(r->mutex_);
     r->Drain();
   }
-  return r;
+  serialized_readers_.push_back(std::move(r));
+  return serialized_readers_.back().get();
 }
 
-StatusOr<std::unique_ptr<DdsSerializedWriter>> DdsParticipant::CreateSerializedWriter(const std::string& topic,
+StatusOr<SerializedWriter*> DdsParticipant::CreateSerializedWriter(const std::string& topic,
                                                                                       const TypeInfo& type,
                                                                                       const TopicQos& qos,
                                                                                       const Clock* clock) {
@@ -449,7 +460,8 @@ StatusOr<std::unique_ptr<DdsSerializedWriter>> DdsParticipant::CreateSerializedW
   auto* pub = publisher_;
   auto* raw = w->writer_;
   w->on_delete_ = [pub, raw] { pub->delete_datawriter(raw); };
-  return w;
+  serialized_writers_.push_back(std::move(w));
+  return serialized_writers_.back().get();
 }
 
 }  // namespace dyad

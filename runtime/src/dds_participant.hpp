@@ -1,5 +1,6 @@
-// DdsParticipant — RAII owner of one Fast DDS DomainParticipant and the topics, writers and
-// readers the runtime creates on it. Internal to the runtime.
+// DdsParticipant — RAII owner of one Fast DDS DomainParticipant and of every topic, writer and
+// reader created on it (the Transport of the runtime, see transport.hpp for the ownership and
+// delivery contract). Internal to the runtime.
 //
 // Every type is registered under TypeInfo::dds_name() ("name#hash"). Discovery callbacks compare
 // remote endpoints' type names with ours per topic; a remote endpoint on one of our topics with
@@ -20,6 +21,8 @@
 #include <dyad/graph.hpp>
 #include <dyad/status.hpp>
 
+#include "transport.hpp"
+
 namespace eprosima::fastdds::dds {
 class DomainParticipant;
 class Publisher;
@@ -31,42 +34,37 @@ class DataWriter;
 
 namespace dyad {
 
-struct TopicQos {
-  Reliability reliability = Reliability::kReliable;
-  int depth = 1;
-  double deadline_ms = 0;
-  bool keep_all = false;  // KEEP_ALL history (recorders); depth then sizes resource limits only
-};
-
 // A reader the runtime polls; `on_data` (may be empty) is called from Fast DDS's delivery thread
-// whenever samples arrive.
-class DdsReader final : public detail::ReaderEndpoint {
+// whenever samples arrive. Created and destroyed by DdsParticipant only.
+class DdsReader final : public TypedReader {
  public:
   ~DdsReader() override;
   bool TakeNext(void* sample) override;
-  uint64_t Unread() const;
+  uint64_t Unread() const override;
   const std::string& topic() const { return topic_; }
 
  private:
   friend class DdsParticipant;
   class Listener;
+  DdsReader() = default;
   std::string topic_;
   eprosima::fastdds::dds::DataReader* reader_ = nullptr;  // owned by the participant's subscriber
   std::unique_ptr<Listener> listener_;
   std::function<void()> on_delete_;
 };
 
-class DdsWriter final : public detail::WriterEndpoint {
+class DdsWriter final : public TypedWriter {
  public:
   ~DdsWriter() override;
   Status Write(const void* sample) override;
   // Sets the DDS source timestamp to stamp_ns (the header's stamp), so readers see the writer's
   // runtime clock (simulated time under the stepped clock) rather than the wall clock.
   Status WriteStamped(const void* sample, int64_t stamp_ns) override;
-  int matched() const;
+  int matched() const override;
 
  private:
   friend class DdsParticipant;
+  DdsWriter() = default;
   std::string topic_;
   eprosima::fastdds::dds::DataWriter* writer_ = nullptr;  // owned by the participant's publisher
   std::function<void()> on_delete_;
@@ -76,13 +74,12 @@ class DdsWriter final : public detail::WriterEndpoint {
 // The sample is taken as the type's C++ object and serialised again (Fast DDS 2.9 offers no
 // public access to the received payload); the callback runs on the delivering thread under a
 // per-reader mutex, so never concurrently with itself.
-class DdsSerializedReader {
+class DdsSerializedReader final : public SerializedSubscription {
  public:
-  ~DdsSerializedReader();
-  // Delivers what is still unread, then stops calling back. Idempotent; waits for a running callback.
-  void Close();
+  ~DdsSerializedReader() override;
+  void Close() override;
   const std::string& topic() const { return topic_; }
-  uint64_t delivered() const { return delivered_.load(std::memory_order_relaxed); }
+  uint64_t delivered() const override { return delivered_.load(std::memory_order_relaxed); }
 
  private:
   friend class DdsParticipant;
@@ -135,7 +132,7 @@ struct DiscoveredEndpoint {
   std::string guid;
 };
 
-class DdsParticipant {
+class DdsParticipant final : public Transport {
  public:
   // Reports type mismatches and incompatible QoS; called from Fast DDS threads.
   using ProblemHandler = std::function<void(const std::string& message)>;
@@ -147,23 +144,24 @@ class DdsParticipant {
   enum class Scope { kNetwork, kProcessOnly };
   static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, ProblemHandler on_problem,
                                                           Scope scope = Scope::kNetwork);
-  ~DdsParticipant();  // REQUIRES: every reader and writer created here was destroyed first
+  // Stops every callback, deletes every endpoint created here, then the participant.
+  ~DdsParticipant() override;
   DdsParticipant(const DdsParticipant&) = delete;
   DdsParticipant& operator=(const DdsParticipant&) = delete;
 
-  StatusOr<std::unique_ptr<DdsReader>> CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
-                                                    std::function<void()> on_data);
-  StatusOr<std::unique_ptr<DdsWriter>> CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos);
-  // `clock` stamps receive times; both it and the callback must outlive the reader.
-  StatusOr<std::unique_ptr<DdsSerializedReader>> CreateSerializedReader(const std::string& topic, const TypeInfo& type,
-                                                                        const TopicQos& qos, const Clock* clock,
-                                                                        SerializedCallback callback);
-  StatusOr<std::unique_ptr<DdsSerializedWriter>> CreateSerializedWriter(const std::string& topic, const TypeInfo& type,
-                                                                        const TopicQos& qos, const Clock* clock);
+  // Transport. Endpoints are owned by the participant (see transport.hpp).
+  StatusOr<TypedReader*> CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
+                                      std::function<void()> on_data) override;
+  StatusOr<TypedWriter*> CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos) override;
+  StatusOr<SerializedSubscription*> CreateSerializedReader(const std::string& topic, const TypeInfo& type,
+                                                           const TopicQos& qos, const Clock* clock,
+                                                           SerializedCallback callback) override;
+  StatusOr<SerializedWriter*> CreateSerializedWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
+                                                     const Clock* clock) override;
+
   const std::string& name() const { return name_; }
   // Every remote (or local) endpoint discovered so far that is still alive.
   std::vector<DiscoveredEndpoint> Discovered() const;
-  eprosima::fastdds::dds::DomainParticipant* raw() { return participant_; }
 
  private:
   class DiscoveryListener;
@@ -178,6 +176,11 @@ class DdsParticipant {
   std::mutex mutex_;  // guards the maps below (discovery reads them from Fast DDS threads)
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
   std::map<std::string, std::string> topic_types_;  // topic -> dds type name
+  // Every endpoint created here; destroyed (in this order) by the destructor only.
+  std::vector<std::unique_ptr<DdsSerializedReader>> serialized_readers_;
+  std::vector<std::unique_ptr<DdsReader>> readers_;
+  std::vector<std::unique_ptr<DdsSerializedWriter>> serialized_writers_;
+  std::vector<std::unique_ptr<DdsWriter>> writers_;
 };
 
 }  // namespace dyad

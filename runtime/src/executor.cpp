@@ -8,6 +8,7 @@
 
 #include <dyad/msg/types.hpp>
 
+#include "dds_participant.hpp"
 #include "logger.hpp"
 
 namespace dyad {
@@ -36,6 +37,42 @@ std::string BoundTopic(const std::vector<PortBinding>& bindings, const std::stri
     if (b.port == port) return b.topic;
   return "";
 }
+
+// Time spent in steps and callbacks nested inside the current one on this thread (a triggered
+// component steps inside its upstream's Publish(), a recorder's callback too): each region
+// charges its whole duration to the enclosing one, which subtracts it from its own time.
+struct NestFrame {
+  int64_t nested_ns = 0;
+  NestFrame* parent = nullptr;
+};
+thread_local NestFrame* t_frame = nullptr;
+
+class NestedTimer {
+ public:
+  NestedTimer() : start_(SteadyNs()) {
+    frame_.parent = t_frame;
+    t_frame = &frame_;
+  }
+  NestedTimer(const NestedTimer&) = delete;
+  NestedTimer& operator=(const NestedTimer&) = delete;
+  ~NestedTimer() {
+    if (!stopped_) Stop();
+  }
+  int64_t start_ns() const { return start_; }
+  // Ends the region; returns its own time (its duration minus the regions nested in it).
+  int64_t Stop() {
+    stopped_ = true;
+    const int64_t total = SteadyNs() - start_;
+    t_frame = frame_.parent;
+    if (frame_.parent != nullptr) frame_.parent->nested_ns += total;
+    return total - frame_.nested_ns;
+  }
+
+ private:
+  NestFrame frame_;
+  int64_t start_;
+  bool stopped_ = false;
+};
 
 // QoS from the graph's `topics:` entry, defaults when the topic is not declared there.
 TopicQos QosOf(const ResolvedTopic& topic) {
@@ -66,12 +103,9 @@ struct Executor::Instance {
   std::unique_ptr<ContextImpl> ctx;
   std::vector<std::unique_ptr<InputBase>> inputs;
   std::vector<std::unique_ptr<OutputBase>> outputs;
-  std::vector<std::unique_ptr<DdsReader>> readers;
-  std::vector<std::unique_ptr<DdsWriter>> writers;
-  std::vector<std::unique_ptr<DdsSerializedReader>> serialized_readers;
-  std::vector<std::unique_ptr<DdsSerializedWriter>> serialized_writers;
+  std::vector<SerializedSubscription*> serialized_readers;  // owned by the transport
   bool configuring = false;  // generic-topic calls are allowed only in Configure()
-  DdsReader* trigger = nullptr;
+  TypedReader* trigger = nullptr;                            // owned by the transport
   StepStats stats;
   std::atomic<bool> active{false};
   std::atomic<bool> busy{false};
@@ -113,9 +147,16 @@ class Executor::ContextImpl final : public Context {
     // then loses nothing and costs a third of a RELIABLE one (bench/recorder).
     const bool reliable = info->reliable && !info->writers_local;
     TopicQos qos{reliable ? Reliability::kReliable : Reliability::kBestEffort, info->depth, 0, true};
-    auto r = ex_->participant_->CreateSerializedReader(topic, *info->type, qos, ex_->clock_.get(), std::move(callback));
-    if (!r.ok()) return r.status();
-    inst_->serialized_readers.push_back(std::move(r.value()));
+    // The callback's time is the subscriber's, not that of the step whose Publish() delivers it.
+    StepStats* stats = &inst_->stats;
+    SerializedCallback timed = [cb = std::move(callback), stats](const SerializedSample& sample) {
+      NestedTimer timer;
+      cb(sample);
+      stats->RecordDelivery(timer.Stop());
+    };
+    auto r = ex_->transport_->CreateSerializedReader(topic, *info->type, qos, ex_->clock_.get(), std::move(timed));
+    if (!r.ok()) return r.status().WithContext(inst_->name() + ": SubscribeSerialized('" + topic + "')");
+    inst_->serialized_readers.push_back(r.value());
     return Status::OK();
   }
   StatusOr<SerializedWriter*> AdvertiseSerialized(const std::string& topic, const TypeInfo& type) override {
@@ -127,11 +168,9 @@ class Executor::ContextImpl final : public Context {
                                        "', not " + type.name);
       qos = TopicQos{info->reliable ? Reliability::kReliable : Reliability::kBestEffort, info->depth, info->deadline_ms, false};
     }
-    auto w = ex_->participant_->CreateSerializedWriter(topic, type, qos, ex_->clock_.get());
-    if (!w.ok()) return w.status();
-    SerializedWriter* raw = w.value().get();
-    inst_->serialized_writers.push_back(std::move(w.value()));
-    return raw;
+    auto w = ex_->transport_->CreateSerializedWriter(topic, type, qos, ex_->clock_.get());
+    if (!w.ok()) return w.status().WithContext(inst_->name() + ": AdvertiseSerialized('" + topic + "')");
+    return w.value();
   }
 
  protected:
@@ -172,21 +211,14 @@ Executor::Executor(const Graph& graph, const ResolvedGraph& resolved, const Cata
       clock_(std::make_unique<ClockImpl>(graph.clock == ClockMode::kStepped)) {}
 
 Executor::~Executor() {
-  for (auto& inst : instances_)
-    if (inst->thread.joinable()) inst->thread.join();
-  // Ports and endpoints before the participant; components before their ports.
+  stop_.store(true, std::memory_order_release);
+  cv_.notify_all();
   for (auto& inst : instances_) {
-    inst->component.reset();
-    inst->serialized_readers.clear();
-    inst->serialized_writers.clear();
-    inst->inputs.clear();
-    inst->outputs.clear();
-    inst->readers.clear();
-    inst->writers.clear();
+    inst->active.store(false, std::memory_order_release);
+    if (inst->thread.joinable()) inst->thread.join();
   }
-  stats_writer_.reset();
-  instances_.clear();
-  participant_.reset();
+  // The transport first (no callback after it), then components and ports (member order).
+  transport_.reset();
 }
 
 void Executor::RequestStop(const std::string& reason) {
@@ -207,15 +239,22 @@ void Executor::Fail(const Status& status) {
 }
 
 Status Executor::Setup() {
-  auto p = DdsParticipant::Create(graph_.domain_id, "dyad/" + graph_.name + "/" + options_.process,
-                                  [this](const std::string& msg) {
-                                    ++problems_;
-                                    StderrLogger("dds").Error(msg);
-                                  },
-                                  clock_->stepped() ? DdsParticipant::Scope::kProcessOnly : DdsParticipant::Scope::kNetwork);
-  if (!p.ok()) return p.status();
-  participant_ = std::move(p.value());
   const bool stepped = clock_->stepped();
+  const std::string participant_name = "dyad/" + graph_.name + "/" + options_.process;
+  if (options_.transport) {
+    auto t = options_.transport(participant_name, stepped);
+    if (!t.ok()) return t.status();
+    transport_ = std::move(t.value());
+  } else {
+    auto p = DdsParticipant::Create(graph_.domain_id, participant_name,
+                                    [this](const std::string& msg) {
+                                      ++problems_;
+                                      StderrLogger("dds").Error(msg);
+                                    },
+                                    stepped ? DdsParticipant::Scope::kProcessOnly : DdsParticipant::Scope::kNetwork);
+    if (!p.ok()) return p.status();
+    transport_ = std::move(p.value());
+  }
 
   for (const auto& rc : resolved_.components) {
     if (graph_.ProcessOf(*rc.config) != options_.process) continue;
@@ -226,15 +265,14 @@ Status Executor::Setup() {
     for (const auto& ps : spec.inputs()) {
       auto port = ps.make_input();
       const std::string topic = BoundTopic(rc.config->inputs, ps.name);
-      DdsReader* reader = nullptr;
+      TypedReader* reader = nullptr;
       if (!topic.empty()) {
         const TopicQos qos = QosOf(resolved_.topics.at(topic));
         std::function<void()> on_data;
         if (!stepped && rc.config->trigger == ps.name) on_data = [this, raw] { TriggerStep(*raw); };
-        auto r = participant_->CreateReader(topic, *ps.type, qos, on_data);
-        if (!r.ok()) return Status::Internal(rc.config->name + "." + ps.name + ": " + r.status().message());
-        reader = r.value().get();
-        inst->readers.push_back(std::move(r.value()));
+        auto r = transport_->CreateReader(topic, *ps.type, qos, on_data);
+        if (!r.ok()) return r.status().WithContext(rc.config->name + "." + ps.name);
+        reader = r.value();
         if (rc.config->trigger == ps.name) inst->trigger = reader;
       }
       port->Bind(ps.name, topic, reader);
@@ -243,12 +281,11 @@ Status Executor::Setup() {
     for (const auto& ps : spec.outputs()) {
       auto port = ps.make_output();
       const std::string topic = BoundTopic(rc.config->outputs, ps.name);
-      DdsWriter* writer = nullptr;
+      TypedWriter* writer = nullptr;
       if (!topic.empty()) {
-        auto w = participant_->CreateWriter(topic, *ps.type, QosOf(resolved_.topics.at(topic)));
-        if (!w.ok()) return Status::Internal(rc.config->name + "." + ps.name + ": " + w.status().message());
-        writer = w.value().get();
-        inst->writers.push_back(std::move(w.value()));
+        auto w = transport_->CreateWriter(topic, *ps.type, QosOf(resolved_.topics.at(topic)));
+        if (!w.ok()) return w.status().WithContext(rc.config->name + "." + ps.name);
+        writer = w.value();
       }
       port->Bind(ps.name, topic, rc.config->name, writer, clock_.get());
       inst->outputs.push_back(std::move(port));
@@ -260,37 +297,40 @@ Status Executor::Setup() {
   if (instances_.empty()) return Status::InvalidArgument("no component is placed in process '" + options_.process + "'");
 
   // The runtime's own output: timing of this process's components.
-  auto w = participant_->CreateWriter(kStatsTopic, TypeInfoOf<msg::ComponentStats>(), TopicQos{Reliability::kReliable, kStatsDepth, 0, false});
-  if (!w.ok()) return w.status();
-  stats_writer_ = std::move(w.value());
+  auto w = transport_->CreateWriter(kStatsTopic, TypeInfoOf<msg::ComponentStats>(), TopicQos{Reliability::kReliable, kStatsDepth, 0, false});
+  if (!w.ok()) return w.status().WithContext(kStatsTopic);
   stats_output_ = std::make_unique<Output<msg::ComponentStats>>();
-  stats_output_->Bind("stats", kStatsTopic, "dyad/" + options_.process, stats_writer_.get(), clock_.get());
+  stats_output_->Bind("stats", kStatsTopic, "dyad/" + options_.process, w.value(), clock_.get());
 
   BuildTopicList();
   for (auto& inst : instances_) {
     inst->configuring = true;
     Status s = inst->component->Configure(*inst->ctx);
     inst->configuring = false;
-    if (!s.ok()) return Status::FailedPrecondition(inst->name() + ": configure failed: " + s.message());
+    if (!s.ok()) return s.WithContext(inst->name() + ": configure failed");
     inst->configured = true;
   }
   return Status::OK();
 }
 
 Status Executor::StepOnce(Instance& inst, int64_t scheduled_steady_ns, bool periodic) {
-  const int64_t t0 = SteadyNs();
+  NestedTimer timer;
+  const int64_t t0 = timer.start_ns();
   const int64_t now = clock_->now_ns();
   for (auto& in : inst.inputs) in->Poll(now);
   Status s = inst.component->Step(StepInfo{now, inst.index++, inst.rc->period_ns});
-  const int64_t t1 = SteadyNs();
+  const int64_t own = timer.Stop();
   int64_t jitter = 0;
   bool missed = false;
   if (periodic && !clock_->stepped()) {
-    jitter = std::abs(t0 - scheduled_steady_ns);
-    missed = t1 > scheduled_steady_ns + inst.rc->period_ns;
+    const int64_t late = t0 - scheduled_steady_ns;
+    jitter = std::abs(late);
+    // Downstream work nested in this step is charged to the downstream components; if it delays
+    // this component's next period, that shows as this component's start jitter.
+    missed = std::max<int64_t>(late, 0) + own > inst.rc->period_ns;
   }
-  inst.stats.Record(t1 - t0, jitter, missed);
-  if (!s.ok()) return Status::Internal(inst.name() + ": step " + std::to_string(inst.index - 1) + " failed: " + s.message());
+  inst.stats.Record(own, jitter, missed);
+  if (!s.ok()) return s.WithContext(inst.name() + ": step " + std::to_string(inst.index - 1) + " failed");
   return s;
 }
 
@@ -347,8 +387,9 @@ Status Executor::RunStepped() {
   if (periodic.empty()) return Status::InvalidArgument("stepped clock needs at least one periodic component (rate_hz)");
   int64_t fastest = periodic.front().inst->rc->period_ns;
   for (const auto& d : periodic) fastest = std::min(fastest, d.inst->rc->period_ns);
-  const int64_t end_ns = options_.steps > 0 ? static_cast<int64_t>(options_.steps) * fastest : INT64_MAX;
-  const int64_t wall_end = options_.duration_s > 0 ? SteadyNs() + static_cast<int64_t>(options_.duration_s * 1e9) : INT64_MAX;
+  // Both limits count simulated time, so a stepped run is the same whatever the machine's load.
+  const int64_t steps_end = options_.steps > 0 ? static_cast<int64_t>(options_.steps) * fastest : INT64_MAX;
+  const int64_t duration_end = options_.duration_s > 0 ? static_cast<int64_t>(std::llround(options_.duration_s * 1e9)) : INT64_MAX;
   int64_t last_stats = SteadyNs();
 
   auto run_triggered = [&]() -> Status {
@@ -367,12 +408,12 @@ Status Executor::RunStepped() {
   while (!stopping()) {
     int64_t t = INT64_MAX;
     for (const auto& d : periodic) t = std::min(t, d.next);
-    if (t >= end_ns) {
+    if (t >= steps_end) {
       RequestStop("reached " + std::to_string(options_.steps) + " steps");
       break;
     }
-    if (SteadyNs() > wall_end) {
-      RequestStop("duration reached");
+    if (t >= duration_end) {
+      RequestStop("reached the duration (simulated time)");
       break;
     }
     clock_->Set(t);
@@ -429,7 +470,7 @@ Status Executor::Run() {
     for (auto& inst : instances_) {
       s = inst->component->Activate();
       if (!s.ok()) {
-        s = Status::FailedPrecondition(inst->name() + ": activate failed: " + s.message());
+        s = s.WithContext(inst->name() + ": activate failed");
         break;
       }
       inst->activated = true;
@@ -449,13 +490,13 @@ Status Executor::Run() {
     while (inst->busy.load(std::memory_order_acquire)) std::this_thread::yield();
   }
   // The last stats, while every subscriber (a recorder) still listens.
-  if (participant_ && stats_output_) PublishStats();
+  if (stats_output_) PublishStats();
   for (auto it = instances_.rbegin(); it != instances_.rend(); ++it) {
     Instance& inst = **it;
     for (auto& r : inst.serialized_readers) r->Close();
     if (!inst.activated) continue;
     Status d = inst.component->Deactivate();
-    if (!d.ok() && s.ok()) s = Status::Internal(inst.name() + ": deactivate failed: " + d.message());
+    if (!d.ok() && s.ok()) s = d.WithContext(inst.name() + ": deactivate failed");
   }
   for (auto it = instances_.rbegin(); it != instances_.rend(); ++it)
     if ((*it)->configured) (*it)->component->Shutdown();

@@ -2,6 +2,11 @@
 // participant, drives the lifecycle, steps them on the graph's clock and keeps their timing.
 // Internal to the runtime; RunGraph (run.hpp) is the public entry.
 //
+// Lifecycle: Configure (graph order), Activate (graph order), steps, Deactivate (reverse order),
+// Shutdown (reverse order) all run on the thread that called Run(). A failure in Configure or
+// Activate stops before any step: components already activated are deactivated, every configured
+// one is shut down. A failed step or Deactivate keeps its Status code (context added).
+//
 // Wall clock: one thread per periodic component, sleeping until each period's start (a late
 // step is counted as a deadline miss and the schedule skips the missed periods instead of
 // bursting). Triggered components are stepped on the thread that delivers the triggering
@@ -10,16 +15,27 @@
 //
 // Stepped clock: one thread, simulated time. At each instant the periodic components due then
 // step in graph order; after each step, triggered components whose trigger input has unread
-// samples step (in graph order, repeatedly until none has). Samples between components in one
+// samples step (in graph order, repeatedly until none has; more than 1000 rounds in one instant
+// is a failure: components triggering each other in a cycle). Samples between components in one
 // process are delivered inside write(), so the same graph and seed give the same samples.
+// `duration_s` and `steps` count simulated time there.
+//
+// Timing: each component is charged its own time. A step or serialized callback that runs nested
+// inside another component's step (a triggered component or a recorder callback inside the
+// upstream's Publish()) is measured on its own and subtracted from the enclosing step; a
+// periodic step misses its deadline when its late start plus its own time exceed the period.
 //
 // Serialized subscriptions (Context::SubscribeSerialized) call back on the delivering thread; each
 // is closed (unread samples delivered first) just before its component's Deactivate(). The last
 // stats are published before any component is deactivated, so a recorder sees them.
+//
+// Ownership: the transport owns every endpoint; it is destroyed before components and ports,
+// so no callback can reach a destroyed component whatever happened before.
 #pragma once
 
 #include <atomic>
 #include <condition_variable>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -30,8 +46,8 @@
 #include <dyad/graph.hpp>
 #include <dyad/validate.hpp>
 
-#include "dds_participant.hpp"
 #include "step_stats.hpp"
+#include "transport.hpp"
 
 namespace dyad {
 
@@ -39,9 +55,12 @@ class Executor {
  public:
   struct Options {
     std::string process;
-    double duration_s = 0;
-    uint64_t steps = 0;
+    double duration_s = 0;  // > 0: stop after this long (wall time, or simulated time when stepped)
+    uint64_t steps = 0;     // > 0: stop after the fastest periodic component ran this many steps
     double stats_period_s = 1.0;
+    // Makes the transport (participant name, stepped). Empty: a Fast DDS participant on the
+    // graph's domain (hermetic to this process when stepped). Tests pass an in-memory one.
+    std::function<StatusOr<std::unique_ptr<Transport>>(const std::string& name, bool stepped)> transport;
   };
 
   // `catalog` (may be null) answers Context::FindMessageType beyond the graph's own types.
@@ -83,10 +102,8 @@ class Executor {
   Options options_;
   std::vector<TopicInfo> topics_;  // Context::graph_topics()
   std::unique_ptr<ClockImpl> clock_;
-  std::unique_ptr<DdsParticipant> participant_;
   std::vector<std::unique_ptr<Instance>> instances_;
   std::unique_ptr<OutputBase> stats_output_;
-  std::unique_ptr<DdsWriter> stats_writer_;
 
   std::atomic<bool> stop_{false};
   std::atomic<int> problems_{0};
@@ -94,6 +111,8 @@ class Executor {
   std::condition_variable cv_;
   std::string stop_reason_;
   Status failure_;
+  // Declared last, destroyed first (see Ownership above): owns every endpoint.
+  std::unique_ptr<Transport> transport_;
 };
 
 }  // namespace dyad

@@ -6,26 +6,18 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <ostream>
 #include <set>
 #include <thread>
 
-#include <fastdds/dds/domain/DomainParticipant.hpp>
-#include <fastdds/dds/subscriber/DataReader.hpp>
-#include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <fastdds/dds/subscriber/Subscriber.hpp>
-#include <fastdds/dds/topic/TopicDataType.hpp>
-#include <fastdds/dds/topic/TypeSupport.hpp>
-#include <fastdds/dds/topic/Topic.hpp>
-#include <fastdds/rtps/common/SerializedPayload.h>
 
 #include "dds_participant.hpp"
-
-namespace fdds = eprosima::fastdds::dds;
 
 namespace dyad {
 namespace {
@@ -86,62 +78,61 @@ const TypeInfo* ResolveType(const Catalog& catalog, const std::string& dds_type,
   return nullptr;
 }
 
-// A raw reader: takes samples as the type's C++ object and re-serialises them for printing.
+// A watcher's reader: the participant's serialized subscription (BEST_EFFORT: it matches every
+// writer and never makes one wait), feeding a bounded queue that this thread drains. A watcher
+// is a guest: when it falls behind, the oldest samples are dropped, not the graph slowed.
 class RawReader {
  public:
-  RawReader(DdsParticipant& p, const TypeInfo& type, const std::string& topic) : type_(type) {
-    support_ = fdds::TypeSupport(type.make_type_support());
-    auto* dp = p.raw();
-    if (dp->find_type(type.dds_name()).empty()) support_.register_type(dp, type.dds_name());
-    topic_ = dp->create_topic(topic, type.dds_name(), fdds::TOPIC_QOS_DEFAULT);
-    sub_ = dp->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
-    fdds::DataReaderQos q = fdds::DATAREADER_QOS_DEFAULT;
-    q.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;  // matches every writer
-    q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
-    q.history().depth = 100;
-    if (topic_ && sub_) reader_ = sub_->create_datareader(topic_, q);
-    sample_ = support_->createData();
-    payload_.reserve(support_->m_typeSize + 1024);
+  RawReader(DdsParticipant& p, const TypeInfo& type, const std::string& topic) {
+    auto r = p.CreateSerializedReader(topic, type, TopicQos{Reliability::kBestEffort, kDepth, 0, false}, &clock_,
+                                      [this](const SerializedSample& s) { Push(s.cdr); });
+    ok_ = r.ok();
   }
-  ~RawReader() {
-    if (sample_) support_->deleteData(sample_);
-  }
-  bool ok() const { return reader_ != nullptr; }
+  bool ok() const { return ok_; }
   // Next sample, serialised; false when none is waiting.
   bool Next(std::vector<uint8_t>* bytes) {
-    fdds::SampleInfo info;
-    while (reader_->take_next_sample(sample_, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
-      const uint32_t need = support_->getSerializedSizeProvider(sample_)();
-      if (payload_.max_size < need) payload_.reserve(need);
-      payload_.length = 0;
-      payload_.pos = 0;
-      if (!support_->serialize(sample_, &payload_)) continue;
-      bytes->assign(payload_.data, payload_.data + payload_.length);
-      return true;
-    }
-    return false;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (queue_.empty()) return false;
+    *bytes = std::move(queue_.front());
+    queue_.pop_front();
+    return true;
   }
+  // Waits up to `seconds` for a sample; true when one is waiting.
   bool Wait(double seconds) {
-    eprosima::fastrtps::Duration_t d(seconds);
-    return reader_->wait_for_unread_message(d);
+    std::unique_lock<std::mutex> lock(mutex_);
+    return cv_.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return !queue_.empty(); });
   }
 
  private:
-  const TypeInfo& type_;
-  fdds::TypeSupport support_;
-  fdds::Topic* topic_ = nullptr;
-  fdds::Subscriber* sub_ = nullptr;
-  fdds::DataReader* reader_ = nullptr;
-  void* sample_ = nullptr;
-  eprosima::fastrtps::rtps::SerializedPayload_t payload_;
+  static constexpr int kDepth = 100;
+  class WallClock final : public Clock {
+   public:
+    int64_t now_ns() const override {
+      return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+    }
+  };
+  void Push(std::span<const uint8_t> cdr) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (queue_.size() >= static_cast<size_t>(kDepth)) queue_.pop_front();
+      queue_.emplace_back(cdr.begin(), cdr.end());
+    }
+    cv_.notify_one();
+  }
+  WallClock clock_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<std::vector<uint8_t>> queue_;
+  bool ok_ = false;
 };
 
 // A participant reading one topic of a running graph, with the type its writers use.
+// The reader is declared first, so the participant (which owns the subscription calling into
+// the reader) is destroyed before it.
 struct TopicTap {
+  std::unique_ptr<RawReader> reader;
   std::unique_ptr<DdsParticipant> participant;
   const TypeInfo* type = nullptr;
-  std::unique_ptr<RawReader> reader;  // declared last: destroyed before the participant
 };
 
 // Joins the domain, waits for a writer of `topic`, resolves its type and opens a reader;

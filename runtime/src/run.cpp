@@ -168,6 +168,16 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
 
 }  // namespace
 
+int ExitCodeOf(const Status& status) {
+  switch (status.code()) {
+    case Status::Code::kOk: return 0;
+    case Status::Code::kInvalidArgument:
+    case Status::Code::kNotFound:
+    case Status::Code::kDataLoss: return 2;
+    default: return 1;
+  }
+}
+
 int ValidateGraphFile(const std::string& path, const std::vector<Override>& overrides,
                       const std::vector<std::string>& plugin_paths, std::ostream& out, std::ostream& err) {
   Loaded l;
@@ -191,7 +201,11 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
     err << options.graph_path << ": --process " << process << ": no component is placed there (processes: " << list << ")\n";
     return 2;
   }
-  Executor::Options eo{process, options.duration_s, options.steps, options.stats_period_s};
+  Executor::Options eo;
+  eo.process = process;
+  eo.duration_s = options.duration_s;
+  eo.steps = options.steps;
+  eo.stats_period_s = options.stats_period_s;
   std::atomic<Executor*> current{nullptr};
   std::atomic<int> pending_signal{0};
   Status result;
@@ -213,7 +227,7 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   if (!options.quiet) PrintReport(rows, process, out);
   if (!result.ok()) {
     err << "dyad run: " << result.message() << "\n";
-    return 1;
+    return ExitCodeOf(result);
   }
   if (mismatches > 0) {
     err << "dyad run: " << mismatches << " type/QoS mismatch(es) with peers (see above)\n";

@@ -31,9 +31,21 @@ void StepStats::Record(int64_t duration_ns, int64_t jitter_ns, bool missed_deadl
   if (missed_deadline) ++misses_;
 }
 
+void StepStats::RecordDelivery(int64_t duration_ns) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++deliveries_;
+  delivery_sum_ns_ += static_cast<double>(duration_ns);
+  delivery_max_ns_ = std::max(delivery_max_ns_, duration_ns);
+}
+
 StepStats::Snapshot StepStats::Get() const {
   std::lock_guard<std::mutex> lock(mutex_);
   Snapshot s;
+  s.deliveries = deliveries_;
+  if (deliveries_ > 0) {
+    s.delivery_mean_s = delivery_sum_ns_ / static_cast<double>(deliveries_) * 1e-9;
+    s.delivery_max_s = static_cast<double>(delivery_max_ns_) * 1e-9;
+  }
   s.steps = steps_;
   s.deadline_misses = misses_;
   if (steps_ == 0) return s;

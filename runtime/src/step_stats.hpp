@@ -1,5 +1,6 @@
 // StepStats — timing of one component's steps: count, duration (mean, p99, max), start jitter,
-// deadline misses. O(1) per step, no allocation: durations go into a log-linear histogram
+// deadline misses; and of its serialized-subscription callbacks (count, mean, max), which run
+// outside its steps, on the delivering thread. O(1) per step, no allocation: durations go into a log-linear histogram
 // (16 sub-buckets per power of two, so a percentile is within ~6% of the true value).
 #pragma once
 
@@ -16,10 +17,14 @@ class StepStats {
     double mean_s = 0, p99_s = 0, max_s = 0;
     double jitter_mean_s = 0, jitter_max_s = 0;
     uint64_t deadline_misses = 0;
+    uint64_t deliveries = 0;  // serialized-subscription callbacks
+    double delivery_mean_s = 0, delivery_max_s = 0;
   };
 
   // duration: step wall time; jitter: |actual start - scheduled start| (0 for triggered steps).
   void Record(int64_t duration_ns, int64_t jitter_ns, bool missed_deadline);
+  // duration of one serialized-subscription callback of this component.
+  void RecordDelivery(int64_t duration_ns);
   Snapshot Get() const;  // thread-safe against Record
 
   // Histogram bucket of a duration, and the bucket's upper bound (exposed for tests).
@@ -34,6 +39,9 @@ class StepStats {
   uint64_t steps_ = 0, misses_ = 0;
   double sum_ns_ = 0, jitter_sum_ns_ = 0;
   int64_t max_ns_ = 0, jitter_max_ns_ = 0;
+  uint64_t deliveries_ = 0;
+  double delivery_sum_ns_ = 0;
+  int64_t delivery_max_ns_ = 0;
 };
 
 }  // namespace dyad

@@ -12,7 +12,10 @@
 // dyad::msg::ComponentStats on topic "dyad/stats" every `stats_period_s` while running.
 //
 // Exit codes: 0 clean end, 1 runtime failure (a component failed, DDS error, type mismatch with
-// a peer), 2 invalid graph or options.
+// a peer), 2 invalid graph or options. A component's failure keeps its Status code through the
+// runtime (context is added, the code is not rewritten) and the exit code follows it
+// (ExitCodeOf): InvalidArgument, NotFound and DataLoss (a bad param, a missing or damaged file
+// the graph names) exit 2, every other failure 1.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +24,7 @@
 #include <vector>
 
 #include <dyad/graph.hpp>
+#include <dyad/status.hpp>
 
 namespace dyad {
 
@@ -36,6 +40,9 @@ struct RunOptions {
 };
 
 int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err);
+
+// The exit code for a run that ended with `status` (see above).
+int ExitCodeOf(const Status& status);
 
 // Loads and validates only. Prints "<file>: OK (...)" or every problem; returns 0 or 2.
 int ValidateGraphFile(const std::string& path, const std::vector<Override>& overrides,

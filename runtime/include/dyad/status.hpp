@@ -50,6 +50,12 @@ class Status {
   static Status IOError(std::string_view context, std::string_view detail) { return Join(Code::kIOError, context, detail); }
   static Status DataLoss(std::string_view context, std::string_view detail) { return Join(Code::kDataLoss, context, detail); }
 
+  // The same code, with "context: " before the message: layers add where, never change what.
+  Status WithContext(std::string_view context) const {
+    if (ok()) return *this;
+    return Join(code_, context, message_);
+  }
+
   bool ok() const { return code_ == Code::kOk; }
   Code code() const { return code_; }
   // Empty when ok().
