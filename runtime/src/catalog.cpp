@@ -59,8 +59,13 @@ Status Catalog::LoadFile(const std::string& file) {
   }
   handles_.push_back(handle);
   loaded_files_.push_back(canonical);
-  Registry registry(canonical);
-  reg(registry);
+  return Register(canonical, reg);
+}
+
+Status Catalog::Register(const std::string& origin, void (*register_types)(PluginRegistry&)) {
+  const std::string& file = origin;
+  Registry registry(origin);
+  register_types(registry);
   std::ostringstream conflicts;
   for (auto& t : registry.types) {
     auto it = entries_.find(t.name);

@@ -39,6 +39,11 @@ class Catalog {
   // (missing paths, ABI mismatches, dlopen errors, duplicate type names), one per line.
   Status LoadDefault(const std::vector<std::string>& paths);
 
+  // Registers the types of a plugin linked into this program (tests, programs embedding dyad):
+  // `register_types` is what DYAD_PLUGIN would export; `origin` names it in messages. Same rules
+  // as a loaded plugin (first registration of a name wins, conflicts reported).
+  Status Register(const std::string& origin, void (*register_types)(PluginRegistry&));
+
   const CatalogEntry* Find(const std::string& type_name) const;
   const std::map<std::string, CatalogEntry>& entries() const { return entries_; }
   // Every message type seen on some component's port, by IDL name and by short name.

@@ -5,7 +5,7 @@
 // chosen input receives a sample (`trigger: <input>`). Components never talk to each other
 // directly: every input and output is bound by the graph file to a DDS topic.
 //
-// Lifecycle (each call happens once, on the thread that will step the component):
+// Lifecycle (each call at most once, except Step):
 //   construct -> Configure(ctx) -> Activate() -> Step(info)* -> Deactivate() -> Shutdown()
 //   - Configure: read params, look up ports; the component is then "inactive". An error stops
 //     the whole process before any component is activated.
@@ -14,8 +14,17 @@
 //     (all components are deactivated and shut down) and the process exits non-zero.
 //   - Deactivate: stop motion, flush; back to "inactive". Called even after a failed Step().
 //   - Shutdown: release everything. Called for every configured component.
-// The runtime calls these from one thread per component in wall-clock mode, and from a single
-// thread in stepped mode; a component needs no locks for its own state.
+// Threads: Configure, Activate, Deactivate and Shutdown run on the thread that runs the graph
+// (components in graph order; Deactivate and Shutdown in reverse). Steps never overlap for one
+// component: under the stepped clock they all run on that same thread; under the wall clock a
+// periodic component steps on a thread of its own, and a triggered one on the thread that
+// delivers its trigger sample (inside the publisher's Publish() for a publisher in this process,
+// a DDS thread for a remote one). Every call happens-after the previous one (the runtime
+// synchronises), so a component needs no locks for state only its lifecycle calls touch;
+// serialized-subscription callbacks (below) are the exception: they run on delivering threads,
+// concurrently with Step().
+// Time: the timing the runtime reports for a component (`dyad/stats`, the table at exit) is the
+// time of its own steps and callbacks; downstream work that runs inside its Publish() is not.
 //
 // Writing one (see components/examples/ for complete, tested ones):
 //

@@ -1,0 +1,301 @@
+// The executor on an in-memory transport (memory_transport.hpp), as rclcpp tests its executors:
+// trigger delivery, lifecycle order and threads, the cap on triggered cycles, a failure in each
+// phase (its Status code kept), teardown order, and timing charged to the component that spent it.
+#include "executor.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <mutex>
+#include <thread>
+
+#include <dyad/msg/types.hpp>
+
+#include "memory_transport.hpp"
+
+namespace dyad {
+namespace {
+
+// What the test components did, in order, from every thread.
+struct EventLog {
+  std::mutex mutex;
+  std::vector<std::string> events;
+  std::vector<std::thread::id> lifecycle_threads;  // of configure/activate/deactivate/shutdown
+  void Add(const std::string& e) {
+    std::lock_guard<std::mutex> lock(mutex);
+    events.push_back(e);
+  }
+  void AddLifecycle(const std::string& e) {
+    std::lock_guard<std::mutex> lock(mutex);
+    events.push_back(e);
+    lifecycle_threads.push_back(std::this_thread::get_id());
+  }
+  std::vector<std::string> Matching(const std::string& needle) {
+    std::lock_guard<std::mutex> lock(mutex);
+    std::vector<std::string> out;
+    for (const auto& e : events)
+      if (e.find(needle) != std::string::npos) out.push_back(e);
+    return out;
+  }
+};
+EventLog* g_log = nullptr;
+
+Status Fail(const std::string& code, const std::string& what) {
+  if (code == "io") return Status::IOError(what);
+  if (code == "dataloss") return Status::DataLoss(what);
+  return Status::InvalidArgument(what);
+}
+
+// A test component: logs its lifecycle, fails in the phase `fail` names (with code `code`),
+// publishes `out` = step index, records what `in` received, sleeps `sleep_ms` per step.
+class Probe : public Component {
+ public:
+  static void Describe(ComponentSpec& spec) {
+    spec.Param("fail", "").OneOf({"", "configure", "activate", "step", "deactivate"});
+    spec.Param("code", "invalid");
+    spec.Param("fail_step", 2);
+    spec.Param("sleep_ms", 0.0);
+    spec.Param("tap", "");  // a topic to subscribe serialized (sleeping sleep_ms per callback)
+    spec.Input<msg::Counter>("in").Optional();
+    spec.Output<msg::Counter>("out");
+  }
+  ~Probe() override {
+    if (g_log) g_log->Add(name_ + " destroyed");
+  }
+  Status Configure(Context& ctx) override {
+    name_ = ctx.name();
+    g_log->AddLifecycle(name_ + " configure");
+    fail_ = ctx.params().String("fail");
+    code_ = ctx.params().String("code");
+    fail_step_ = static_cast<uint64_t>(ctx.params().Int("fail_step"));
+    sleep_ = std::chrono::duration<double, std::milli>(ctx.params().Double("sleep_ms"));
+    in_ = &ctx.input<msg::Counter>("in");
+    out_ = &ctx.output<msg::Counter>("out");
+    if (const std::string tap = ctx.params().String("tap"); !tap.empty()) {
+      Status s = ctx.SubscribeSerialized(tap, [this](const SerializedSample&) {
+        std::this_thread::sleep_for(sleep_);
+        ++tapped_;
+      });
+      if (!s.ok()) return s;
+    }
+    if (fail_ == "configure") return Fail(code_, "boom");
+    return Status::OK();
+  }
+  Status Activate() override {
+    g_log->AddLifecycle(name_ + " activate");
+    return fail_ == "activate" ? Fail(code_, "boom") : Status::OK();
+  }
+  Status Step(const StepInfo& info) override {
+    if (busy_.exchange(true)) g_log->Add(name_ + " OVERLAPPING STEP");
+    for (const auto& s : in_->received()) g_log->Add(name_ + " got " + std::to_string(s.value()));
+    g_log->Add(name_ + " step " + std::to_string(info.index));
+    if (sleep_.count() > 0 && tapped_ == 0) std::this_thread::sleep_for(sleep_);
+    msg::Counter c;
+    c.value(static_cast<int64_t>(info.index));
+    Status s = out_->Publish(c);
+    busy_.store(false);
+    if (fail_ == "step" && info.index == fail_step_) return Fail(code_, "boom");
+    return s;
+  }
+  Status Deactivate() override {
+    g_log->AddLifecycle(name_ + " deactivate (tapped " + std::to_string(tapped_) + ")");
+    return fail_ == "deactivate" ? Fail(code_, "boom") : Status::OK();
+  }
+  void Shutdown() override { g_log->AddLifecycle(name_ + " shutdown"); }
+
+ private:
+  std::string name_, fail_, code_;
+  uint64_t fail_step_ = 0;
+  std::chrono::duration<double, std::milli> sleep_{0};
+  Input<msg::Counter>* in_ = nullptr;
+  Output<msg::Counter>* out_ = nullptr;
+  std::atomic<bool> busy_{false};
+  std::atomic<int> tapped_{0};
+};
+
+void RegisterProbe(PluginRegistry& r) { r.Add<Probe>("probe"); }
+
+class ExecutorTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    g_log = &log_;
+    ASSERT_TRUE(catalog_.Register("executor_test", &RegisterProbe).ok());
+  }
+  void TearDown() override { g_log = nullptr; }
+
+  // Parses and validates `yaml`; runs it on a MemoryTransport. Returns Run()'s Status.
+  Status Run(const std::string& yaml, uint64_t steps = 0, double duration_s = 0) {
+    std::vector<Diagnostic> diags;
+    graph_ = ParseGraph(yaml, "test.yaml", {}, &diags);
+    resolved_ = ValidateGraph(graph_, catalog_, &diags);
+    for (const auto& d : diags) ADD_FAILURE() << d.ToString();
+    if (!diags.empty()) return Status::InvalidArgument("invalid test graph");
+    Executor::Options o;
+    o.process = "main";
+    o.steps = steps;
+    o.duration_s = duration_s;
+    o.transport = [this](const std::string&, bool) -> StatusOr<std::unique_ptr<Transport>> {
+      return std::unique_ptr<Transport>(new testing::MemoryTransport([this](const std::string& e) { log_.Add(e); }));
+    };
+    auto ex = std::make_unique<Executor>(graph_, resolved_, &catalog_, o);
+    Status s = ex->Run();
+    rows_ = ex->Report();
+    ex.reset();
+    return s;
+  }
+  // Lifecycle events in order (steps and receptions left out); checks that the transport was
+  // destroyed before any component, then leaves component destructions out too (their relative
+  // order is the container's business).
+  std::vector<std::string> Lifecycle() {
+    std::vector<std::string> out;
+    bool transport_gone = false;
+    for (const auto& e : log_.events) {
+      if (e == "transport destroyed") transport_gone = true;
+      if (e.ends_with(" destroyed") && e != "transport destroyed") {
+        EXPECT_TRUE(transport_gone) << e << " before the transport";
+        continue;
+      }
+      if (e.find(" step") == std::string::npos && e.find(" got") == std::string::npos) out.push_back(e);
+    }
+    return out;
+  }
+  const StepStats::Snapshot& Stats(const std::string& component) {
+    for (const auto& r : rows_)
+      if (r.component == component) return r.stats;
+    ADD_FAILURE() << "no row for " << component;
+    static StepStats::Snapshot none;
+    return none;
+  }
+
+  EventLog log_;
+  Catalog catalog_;
+  Graph graph_;
+  ResolvedGraph resolved_;
+  std::vector<Executor::Row> rows_;
+};
+
+const char* kPair = R"(graph: t
+clock: stepped
+components:
+  a: {type: probe, rate_hz: 10, outputs: {out: ab}, params: {PA}}
+  b: {type: probe, trigger: in, inputs: {in: ab}, outputs: {out: bout}, params: {PB}}
+)";
+
+std::string Pair(const std::string& pa = "", const std::string& pb = "", const std::string& clock = "stepped") {
+  std::string y = kPair;
+  y.replace(y.find("PA"), 2, pa);
+  y.replace(y.find("PB"), 2, pb);
+  y.replace(y.find("stepped"), 7, clock);
+  return y;
+}
+
+TEST_F(ExecutorTest, TriggeredComponentStepsOncePerSampleInOrder) {
+  ASSERT_TRUE(Run(Pair(), 5).ok());
+  EXPECT_EQ(log_.Matching("b got"), (std::vector<std::string>{"b got 0", "b got 1", "b got 2", "b got 3", "b got 4"}));
+  EXPECT_EQ(log_.Matching("b step").size(), 5u);
+  EXPECT_EQ(Stats("a").steps, 5u);
+  EXPECT_EQ(Stats("b").steps, 5u);
+}
+
+TEST_F(ExecutorTest, WallClockTriggeredStepsNeverOverlapAndSeeEverySample) {
+  ASSERT_TRUE(Run(Pair("", "", "wall"), 20).ok());
+  EXPECT_TRUE(log_.Matching("OVERLAPPING").empty());
+  EXPECT_EQ(log_.Matching("b got").size(), 20u);
+}
+
+TEST_F(ExecutorTest, LifecycleOrderAndThreads) {
+  ASSERT_TRUE(Run(Pair(), 2).ok());
+  EXPECT_EQ(Lifecycle(), (std::vector<std::string>{"a configure", "b configure", "a activate", "b activate",
+                                                 "b deactivate (tapped 0)", "a deactivate (tapped 0)", "b shutdown",
+                                                 "a shutdown", "transport destroyed"}));
+  for (const auto& id : log_.lifecycle_threads) EXPECT_EQ(id, std::this_thread::get_id());
+}
+
+TEST_F(ExecutorTest, WallClockLifecycleRunsOnTheCallersThread) {
+  ASSERT_TRUE(Run(Pair("", "", "wall"), 3).ok());
+  ASSERT_EQ(log_.lifecycle_threads.size(), 8u);
+  for (const auto& id : log_.lifecycle_threads) EXPECT_EQ(id, std::this_thread::get_id());
+}
+
+// A failure keeps its code; context names the component and phase; the teardown is complete.
+struct PhaseFailure {
+  const char* name;
+  const char* pa;
+  const char* pb;
+  Status::Code code;
+  const char* message;
+  std::vector<std::string> lifecycle;
+};
+
+class ExecutorFailure : public ExecutorTest, public ::testing::WithParamInterface<PhaseFailure> {};
+
+TEST_P(ExecutorFailure, KeepsTheCodeAndTearsDown) {
+  const PhaseFailure& f = GetParam();
+  Status s = Run(Pair(f.pa, f.pb), 5);
+  EXPECT_EQ(s.code(), f.code) << s.ToString();
+  EXPECT_EQ(s.message(), f.message);
+  EXPECT_EQ(Lifecycle(), f.lifecycle);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Phases, ExecutorFailure,
+    ::testing::Values(
+        PhaseFailure{"Configure", "", "fail: configure, code: invalid", Status::Code::kInvalidArgument,
+                     "b: configure failed: boom",
+                     {"a configure", "b configure", "a shutdown", "transport destroyed"}},
+        PhaseFailure{"Activate", "", "fail: activate, code: io", Status::Code::kIOError, "b: activate failed: boom",
+                     {"a configure", "b configure", "a activate", "b activate", "a deactivate (tapped 0)", "b shutdown",
+                      "a shutdown", "transport destroyed"}},
+        PhaseFailure{"Step", "fail: step, code: dataloss, fail_step: 2", "", Status::Code::kDataLoss,
+                     "a: step 2 failed: boom",
+                     {"a configure", "b configure", "a activate", "b activate", "b deactivate (tapped 0)",
+                      "a deactivate (tapped 0)", "b shutdown", "a shutdown", "transport destroyed"}},
+        PhaseFailure{"Deactivate", "fail: deactivate, code: io", "", Status::Code::kIOError,
+                     "a: deactivate failed: boom",
+                     {"a configure", "b configure", "a activate", "b activate", "b deactivate (tapped 0)",
+                      "a deactivate (tapped 0)", "b shutdown", "a shutdown", "transport destroyed"}}),
+    [](const ::testing::TestParamInfo<PhaseFailure>& i) { return std::string(i.param.name); });
+
+TEST_F(ExecutorTest, TriggeredCycleIsCappedInOneInstant) {
+  Status s = Run(R"(graph: t
+clock: stepped
+components:
+  src: {type: probe, rate_hz: 10, outputs: {out: ping}}
+  p: {type: probe, trigger: in, inputs: {in: ping}, outputs: {out: pong}}
+  q: {type: probe, trigger: in, inputs: {in: pong}, outputs: {out: ping}}
+)", 3);
+  EXPECT_EQ(s.code(), Status::Code::kInternal);
+  EXPECT_NE(s.message().find("kept triggering each other for 1000 rounds"), std::string::npos) << s.message();
+  EXPECT_EQ(Stats("src").steps, 1u);
+}
+
+TEST_F(ExecutorTest, SteppedDurationIsSimulatedTime) {
+  ASSERT_TRUE(Run(Pair("sleep_ms: 5"), 0, 0.35).ok());  // 100 ms period: steps at 0, 0.1, 0.2, 0.3 s
+  EXPECT_EQ(Stats("a").steps, 4u);
+}
+
+// A slow triggered component steps inside its upstream's Publish(): its time is its own.
+TEST_F(ExecutorTest, SlowDownstreamIsChargedToItself) {
+  ASSERT_TRUE(Run(Pair("", "sleep_ms: 20", "wall"), 10).ok());
+  EXPECT_GE(Stats("b").mean_s, 0.019);
+  // The upstream does nothing but publish: far below the downstream's 20 ms (loaded machine: 5 ms).
+  EXPECT_LT(Stats("a").max_s, 0.005) << "upstream charged with its downstream's time";
+  EXPECT_EQ(Stats("a").deadline_misses, 0u);
+}
+
+// A serialized subscription's callback (a recorder's) is charged to the subscriber, not to the
+// step whose Publish() delivers it.
+TEST_F(ExecutorTest, SerializedCallbackIsChargedToTheSubscriber) {
+  ASSERT_TRUE(Run(R"(graph: t
+clock: stepped
+components:
+  a: {type: probe, rate_hz: 10, outputs: {out: ab}}
+  rec: {type: probe, rate_hz: 1, params: {tap: ab, sleep_ms: 10}}
+)", 5).ok());
+  EXPECT_EQ(Stats("rec").deliveries, 5u);
+  EXPECT_GE(Stats("rec").delivery_mean_s, 0.009);
+  EXPECT_LT(Stats("a").max_s, 0.005) << "publisher charged with its subscriber's callback";
+}
+
+}  // namespace
+}  // namespace dyad
