@@ -61,11 +61,21 @@ Status ComplianceMixer::Step(const StepInfo& info) {
   if (const msg::CartesianState* s = state_->latest()) in.state = {{s->x(), s->y()}, state_->last_receive_ns()};
 
   const MixerCore::Result r = core_->Update(in, info.now_ns);
-  if (r.hold && !holding_) {
+  if (first_step_ns_ < 0) first_step_ns_ = info.now_ns;
+  const int64_t timeout = core_->options().stale_timeout_ns;
+  // An input that has not sent its first sample yet is not stale while the graph starts (its
+  // writer may simply step after us): hold silently for one stale timeout, then say so.
+  const InputBase* input = r.stale == MixerCore::Stale::kHuman   ? static_cast<const InputBase*>(human_)
+                           : r.stale == MixerCore::Stale::kRobot ? static_cast<const InputBase*>(robot_)
+                                                                 : static_cast<const InputBase*>(state_);
+  const bool never_received = r.hold && !r.non_finite && input->last_receive_ns() < 0;
+  const bool starting = never_received && info.now_ns - first_step_ns_ <= timeout;
+  if (r.hold && !holding_ && !starting) {
     holding_ = true;
-    const std::string why = r.non_finite ? "' not finite (NaN or infinite position)"
-                                         : "' stale (no sample for more than " +
-                                               std::to_string(core_->options().stale_timeout_ns / 1'000'000) + " ms)";
+    const std::string ms = std::to_string(timeout / 1'000'000);
+    const std::string why = r.non_finite       ? "' not finite (NaN or infinite position)"
+                            : never_received ? "' has sent nothing in the " + ms + " ms since start"
+                                             : "' stale (no sample for more than " + ms + " ms)";
     ctx_->log().Warn(std::string("input '") + ToString(r.stale) + why + ": " +
                      (r.has_command ? "holding the last command" : "no command yet"));
   } else if (!r.hold && holding_) {

@@ -24,7 +24,9 @@
 ///   z (double, 0, workspace units): z of every command (the study's robot is planar)
 /// @endcomponent
 ///
-/// Logs once when it starts holding (naming the stale input) and once when it resumes.
+/// Logs once when it starts holding (naming the stale input) and once when it resumes. An input
+/// that has sent nothing yet is not reported during the first stale_timeout_s after the first
+/// step (its writer may start after the mixer); after that it is, as "has sent nothing".
 #pragma once
 
 #include <dyad/component.hpp>
@@ -54,6 +56,7 @@ class ComplianceMixer final : public Component {
   double z_ = 0;
   msg::CartesianCommand out_;  // reused: no allocation per step
   bool holding_ = false;
+  int64_t first_step_ns_ = -1;
   uint64_t published_ = 0, held_ = 0, saturated_ = 0;
 };
 

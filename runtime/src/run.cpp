@@ -62,6 +62,10 @@ void PrintReport(const std::vector<Executor::Row>& rows, const std::string& proc
         << r.stats.mean_s * 1e3 << std::setw(12) << r.stats.p99_s * 1e3 << std::setw(12) << r.stats.max_s * 1e3
         << std::setw(13) << r.stats.jitter_mean_s * 1e3 << std::setw(15) << r.stats.jitter_max_s * 1e3 << std::setw(8)
         << r.stats.deadline_misses << "\n";
+  for (const auto& r : rows)
+    if (r.stats.deliveries > 0)
+      out << "callbacks " << r.component << ": " << r.stats.deliveries << ", mean " << r.stats.delivery_mean_s * 1e3
+          << " ms, max " << r.stats.delivery_max_s * 1e3 << " ms\n";
   out.unsetf(std::ios::fixed);
 }
 

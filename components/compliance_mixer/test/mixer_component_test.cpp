@@ -1,0 +1,67 @@
+// The compliance_mixer component around MixerCore: what it logs about missing and stale inputs.
+#include "compliance_mixer.hpp"
+
+#include <gtest/gtest.h>
+
+#include <dyad/testing/fake_context.hpp>
+
+namespace dyad::mixer {
+namespace {
+
+constexpr int64_t kStep = 100'000'000;
+
+struct Mixer {
+  testing::FakeContext ctx{&ComplianceMixer::Describe, {}};
+  testing::QueueReader<msg::Intention>& robot = ctx.Feed<msg::Intention>("robot");
+  testing::QueueReader<msg::HumanInput>& human = ctx.Feed<msg::HumanInput>("human");
+  testing::CapturingWriter<msg::CartesianCommand>& out = ctx.Capture<msg::CartesianCommand>("command");
+  ComplianceMixer mixer;
+  uint64_t index = 0;
+
+  Mixer() { EXPECT_TRUE(mixer.Configure(ctx).ok()); }
+  // One step at t = index * 100 ms; `robot`/`human` say whether a sample arrives before it.
+  void Step(bool robot_sample, bool human_sample) {
+    ctx.clock_.now = static_cast<int64_t>(index) * kStep;
+    if (robot_sample) robot.queue.push_back(msg::Intention());
+    if (human_sample) human.queue.push_back(msg::HumanInput());
+    ctx.PollInputs();
+    ASSERT_TRUE(mixer.Step(StepInfo{ctx.clock_.now, index++, kStep}).ok());
+  }
+  std::vector<std::string> Warnings() const { return ctx.log_.lines; }
+};
+
+// A wall-clock run starts every periodic component at once: the human's first sample may come
+// after the mixer's first step. That is not a stale input (it used to warn at every start).
+TEST(MixerComponent, NoWarningWhileAnInputHasNotStartedYet) {
+  Mixer m;
+  m.Step(true, false);
+  m.Step(true, false);
+  m.Step(true, true);
+  for (int i = 0; i < 10; ++i) m.Step(true, true);
+  EXPECT_TRUE(m.Warnings().empty()) << m.Warnings().front();
+  EXPECT_FALSE(m.out.samples.empty());
+}
+
+TEST(MixerComponent, SaysSoWhenAnInputNeverStarts) {
+  Mixer m;  // stale_timeout_s 0.5: silent up to 500 ms after the first step, then one warning
+  for (int i = 0; i <= 5; ++i) m.Step(true, false);
+  EXPECT_TRUE(m.Warnings().empty());
+  m.Step(true, false);
+  ASSERT_EQ(m.Warnings().size(), 1u);
+  EXPECT_NE(m.Warnings()[0].find("input 'human' has sent nothing in the 500 ms since start: no command yet"),
+            std::string::npos)
+      << m.Warnings()[0];
+}
+
+TEST(MixerComponent, AnInputThatStopsIsStale) {
+  Mixer m;
+  m.Step(true, true);
+  for (int i = 0; i < 7; ++i) m.Step(true, false);
+  ASSERT_EQ(m.Warnings().size(), 1u);
+  EXPECT_NE(m.Warnings()[0].find("input 'human' stale (no sample for more than 500 ms): holding the last command"),
+            std::string::npos)
+      << m.Warnings()[0];
+}
+
+}  // namespace
+}  // namespace dyad::mixer
