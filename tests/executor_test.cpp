@@ -124,7 +124,7 @@ class ExecutorTest : public ::testing::Test {
   void TearDown() override { g_log = nullptr; }
 
   // Parses and validates `yaml`; runs it on a MemoryTransport. Returns Run()'s Status.
-  Status Run(const std::string& yaml, uint64_t steps = 0, double duration_s = 0) {
+  Status Run(const std::string& yaml, uint64_t steps = 0, double duration_s = 0, bool spurious = false) {
     std::vector<Diagnostic> diags;
     graph_ = ParseGraph(yaml, "test.yaml", {}, &diags);
     resolved_ = ValidateGraph(graph_, catalog_, &diags);
@@ -134,8 +134,8 @@ class ExecutorTest : public ::testing::Test {
     o.process = "main";
     o.steps = steps;
     o.duration_s = duration_s;
-    o.transport = [this](const std::string&, bool) -> StatusOr<std::unique_ptr<Transport>> {
-      return std::unique_ptr<Transport>(new testing::MemoryTransport([this](const std::string& e) { log_.Add(e); }));
+    o.transport = [this, spurious](const std::string&, bool) -> StatusOr<std::unique_ptr<Transport>> {
+      return std::unique_ptr<Transport>(new testing::MemoryTransport([this](const std::string& e) { log_.Add(e); }, spurious));
     };
     auto ex = std::make_unique<Executor>(graph_, resolved_, &catalog_, o);
     Status s = ex->Run();
@@ -201,6 +201,13 @@ TEST_F(ExecutorTest, WallClockTriggeredStepsNeverOverlapAndSeeEverySample) {
   ASSERT_TRUE(Run(Pair("", "", "wall"), 20).ok());
   EXPECT_TRUE(log_.Matching("OVERLAPPING").empty());
   EXPECT_EQ(log_.Matching("b got").size(), 20u);
+}
+
+// A notification without a new sample (Fast DDS gives some) must not step a triggered component.
+TEST_F(ExecutorTest, WallClockTriggerStepsOncePerSampleDespiteSpuriousNotifications) {
+  ASSERT_TRUE(Run(Pair("", "", "wall"), 10, 0, /*spurious=*/true).ok());
+  EXPECT_EQ(log_.Matching("b got").size(), 10u);
+  EXPECT_EQ(Stats("b").steps, 10u);
 }
 
 TEST_F(ExecutorTest, LifecycleOrderAndThreads) {

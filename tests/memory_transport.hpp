@@ -26,7 +26,8 @@ namespace dyad::testing {
 class MemoryTransport final : public Transport {
  public:
   using Log = std::function<void(const std::string&)>;
-  explicit MemoryTransport(Log log = nullptr) : log_(std::move(log)) {}
+  // `spurious`: readers are notified twice per sample, as Fast DDS sometimes does.
+  explicit MemoryTransport(Log log = nullptr, bool spurious = false) : log_(std::move(log)), spurious_(spurious) {}
   ~MemoryTransport() override {
     for (auto& r : serialized_readers_) r->Close();
     if (log_) log_("transport destroyed");
@@ -35,7 +36,7 @@ class MemoryTransport final : public Transport {
   StatusOr<TypedReader*> CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
                                       std::function<void()> on_data) override {
     if (Status s = CheckType(topic, type); !s.ok()) return s;
-    readers_.push_back(std::make_unique<Reader>(type, qos, std::move(on_data)));
+    readers_.push_back(std::make_unique<Reader>(type, qos, std::move(on_data), spurious_));
     topics_[topic].readers.push_back(readers_.back().get());
     return readers_.back().get();
   }
@@ -63,8 +64,8 @@ class MemoryTransport final : public Transport {
 
   class Reader final : public TypedReader {
    public:
-    Reader(const TypeInfo& type, const TopicQos& qos, std::function<void()> on_data)
-        : support_(type.make_type_support()), qos_(qos), on_data_(std::move(on_data)) {}
+    Reader(const TypeInfo& type, const TopicQos& qos, std::function<void()> on_data, bool spurious)
+        : support_(type.make_type_support()), qos_(qos), on_data_(std::move(on_data)), spurious_(spurious) {}
     ~Reader() override { delete support_; }
     bool TakeNext(void* sample) override {
       Bytes b;
@@ -90,12 +91,14 @@ class MemoryTransport final : public Transport {
         if (!qos_.keep_all && queue_.size() > static_cast<size_t>(qos_.depth)) queue_.pop_front();
       }
       if (on_data_) on_data_();
+      if (on_data_ && spurious_) on_data_();
     }
 
    private:
     eprosima::fastdds::dds::TopicDataType* support_;
     TopicQos qos_;
     std::function<void()> on_data_;
+    bool spurious_;
     mutable std::mutex mutex_;
     std::deque<Bytes> queue_;
   };
@@ -186,6 +189,7 @@ class MemoryTransport final : public Transport {
   }
 
   Log log_;
+  bool spurious_ = false;
   std::map<std::string, Topic> topics_;
   std::vector<std::unique_ptr<Reader>> readers_;
   std::vector<std::unique_ptr<Writer>> writers_;
