@@ -1,0 +1,123 @@
+#include "web_component.hpp"
+
+#include <cstdlib>
+#include <fstream>
+#include <random>
+
+#include "topic_select.hpp"
+
+namespace dyad::web {
+namespace {
+
+bool IsLoopback(const std::string& address) {
+  return address.rfind("127.", 0) == 0 || address == "localhost" || address == "::1";
+}
+
+std::string RandomToken() {
+  std::random_device rd;
+  static const char* hex = "0123456789abcdef";
+  std::string t;
+  for (int i = 0; i < 32; ++i) t.push_back(hex[rd() % 16]);
+  return t;
+}
+
+}  // namespace
+
+void WebComponent::Describe(ComponentSpec& spec) {
+  spec.Summary("Embedded web server with a live Foxglove WebSocket bridge over the graph's topics.");
+  spec.Param("address", "127.0.0.1").Doc("address to bind; anything but loopback requires a token");
+  spec.Param("port", 8765).Range(0, 65535).Doc("TCP port; 0 picks a free one (see port_file)");
+  spec.Param("topics", std::vector<std::string>{}).Doc("topics to advertise, by name or regular expression (empty: all)");
+  spec.Param("writable", std::vector<std::string>{}).Doc("topics Foxglove clients may publish on (empty: none)");
+  spec.Param("token", "").Doc("clients must connect with ?token=...; empty: none on loopback, else generated and printed "
+                              "(or DYAD_WEB_TOKEN)");
+  spec.Param("allowed_origins", std::vector<std::string>{}).Doc("browser origins allowed besides localhost ('*': any)");
+  spec.Param("max_clients", 8).Range(1, 64).Doc("WebSocket clients at once");
+  spec.Param("client_buffer_kb", 4096).Range(16, 1 << 20).Doc("per-client send buffer; past it the busiest channel's oldest samples are dropped");
+  spec.Param("max_frame_kb", 1024).Range(1, 1 << 20).Doc("a larger frame from a client closes it");
+  spec.Param("port_file", "").Doc("write the bound port to this file (tests, scripts)");
+}
+
+Status WebComponent::Configure(Context& ctx) {
+  ctx_ = &ctx;
+  const Params& p = ctx.params();
+  options_.address = p.String("address");
+  options_.port = static_cast<int>(p.Int("port"));
+  options_.allowed_origins = p.StringList("allowed_origins");
+  options_.max_clients = static_cast<int>(p.Int("max_clients"));
+  options_.client_buffer_bytes = static_cast<size_t>(p.Int("client_buffer_kb")) << 10;
+  options_.max_frame_bytes = static_cast<size_t>(p.Int("max_frame_kb")) << 10;
+  options_.subprotocols = {foxglove::kSubprotocol, foxglove::kSubprotocolSdk};
+  options_.token = p.String("token");
+  if (options_.token.empty())
+    if (const char* env = std::getenv("DYAD_WEB_TOKEN")) options_.token = env;
+  if (options_.token.empty() && !IsLoopback(options_.address)) options_.token = RandomToken();
+  port_file_ = p.String("port_file");
+
+  std::vector<std::string> names;
+  for (const auto& t : ctx.graph_topics()) names.push_back(t.name);
+  auto chosen = recorder::SelectTopics(p.StringList("topics"), names, "params.topics");
+  if (!chosen.ok()) return chosen.status();
+  std::vector<foxglove::Channel> channels;
+  for (const auto& name : *chosen)
+    for (const auto& t : ctx.graph_topics())
+      if (t.name == name)
+        channels.push_back(foxglove::Channel{static_cast<uint32_t>(channels.size() + 1), t.name, t.type->name, t.type->idl});
+
+  std::map<std::string, SerializedWriter*> writers;
+  const auto writable = p.StringList("writable");
+  for (size_t i = 0; i < writable.size(); ++i) {
+    const TopicInfo* info = nullptr;
+    for (const auto& t : ctx.graph_topics())
+      if (t.name == writable[i]) info = &t;
+    if (info == nullptr)
+      return Status::InvalidArgument("params.writable[" + std::to_string(i) + "] = '" + writable[i] + "': not a topic of the graph");
+    auto w = ctx.AdvertiseSerialized(info->name, *info->type);
+    if (!w.ok()) return w.status().WithContext("params.writable[" + std::to_string(i) + "]");
+    writers[info->name] = *w;
+  }
+
+  bridge_ = std::make_unique<FoxgloveBridge>("dyad/" + ctx.graph_name(), channels, std::move(writers));
+  FoxgloveBridge* bridge = bridge_.get();
+  for (const auto& c : channels) {
+    const uint32_t id = c.id;
+    Status s = ctx.SubscribeSerialized(c.topic, [bridge, id](const SerializedSample& sample) { bridge->OnSample(id, sample); });
+    if (!s.ok()) return s.WithContext("params.topics: '" + c.topic + "'");
+  }
+  return Status::OK();
+}
+
+Status WebComponent::Activate() {
+  auto s = WebServer::Start(options_, bridge_.get());
+  if (!s.ok()) return s.status().WithContext("params.address/port");
+  server_ = std::move(s.value());
+  bridge_->SetServer(server_.get());
+  const std::string host = options_.address.find(':') != std::string::npos ? "[" + options_.address + "]" : options_.address;
+  std::string url = "ws://" + host + ":" + std::to_string(server_->port());
+  if (!options_.token.empty()) url += "/?token=" + options_.token;
+  ctx_->log().Info("Foxglove WebSocket bridge on " + url);
+  if (!port_file_.empty()) {
+    std::ofstream f(port_file_);
+    f << server_->port() << "\n";
+    if (!f) return Status::IOError("params.port_file = '" + port_file_ + "': cannot write");
+  }
+  return Status::OK();
+}
+
+Status WebComponent::Step(const StepInfo&) {
+  bridge_->ReportDrops();
+  return Status::OK();
+}
+
+Status WebComponent::Deactivate() {
+  // Samples may still arrive until the runtime closes the subscriptions: the bridge keeps its
+  // server pointer valid until the server is gone, so stop routing first.
+  bridge_->SetServer(nullptr);
+  server_.reset();
+  ctx_->log().Info(std::to_string(bridge_->samples_sent()) + " samples sent to clients");
+  return Status::OK();
+}
+
+}  // namespace dyad::web
+
+DYAD_PLUGIN(registry) { registry.Add<dyad::web::WebComponent>("web"); }
