@@ -4,7 +4,11 @@
 #include <fstream>
 #include <random>
 
+#include <dyad/pvrnn/dataset.hpp>
+
+#include "pages.hpp"
 #include "topic_select.hpp"
+#include "web_human.hpp"
 
 namespace dyad::web {
 namespace {
@@ -36,6 +40,12 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Param("client_buffer_kb", 4096).Range(16, 1 << 20).Doc("per-client send buffer; past it the busiest channel's oldest samples are dropped");
   spec.Param("max_frame_kb", 1024).Range(1, 1 << 20).Doc("a larger frame from a client closes it");
   spec.Param("port_file", "").Doc("write the bound port to this file (tests, scripts)");
+  spec.Param("engage_key", "Space").Doc("subject's page: the key (KeyboardEvent.code) that engages while held, besides the mouse button");
+  spec.Param("half_width", 50.0).Min(1e-6).Doc("subject's page: the workspace drawn is [-half_width, half_width]^2 (the study's 50)");
+  spec.Param("show_primitives", false).Doc("subject's page: draw the data set's primitives as a faint watermark");
+  spec.Param("dataset", "").Doc("subject's page: NRL data set folder of the primitives (with show_primitives)");
+  spec.Input<msg::CartesianState>("robot").Optional().Doc("robot state shown on the subject's page");
+  spec.Output<msg::HumanInput>("pointer").Doc("the steering page's pointer, at the browser's event rate (to web_human)");
 }
 
 Status WebComponent::Configure(Context& ctx) {
@@ -47,7 +57,7 @@ Status WebComponent::Configure(Context& ctx) {
   options_.max_clients = static_cast<int>(p.Int("max_clients"));
   options_.client_buffer_bytes = static_cast<size_t>(p.Int("client_buffer_kb")) << 10;
   options_.max_frame_bytes = static_cast<size_t>(p.Int("max_frame_kb")) << 10;
-  options_.subprotocols = {foxglove::kSubprotocol, foxglove::kSubprotocolSdk};
+
   options_.token = p.String("token");
   if (options_.token.empty())
     if (const char* env = std::getenv("DYAD_WEB_TOKEN")) options_.token = env;
@@ -78,6 +88,38 @@ Status WebComponent::Configure(Context& ctx) {
   }
 
   bridge_ = std::make_unique<FoxgloveBridge>("dyad/" + ctx.graph_name(), channels, std::move(writers));
+
+  SubjectChannel::Options so;
+  so.engage_key = p.String("engage_key");
+  so.half_width = p.Double("half_width");
+  so.token = options_.token;
+  if (p.Bool("show_primitives")) {
+    if (p.String("dataset").empty()) return Status::InvalidArgument("params.show_primitives: needs params.dataset (an NRL data set folder)");
+    auto data = pvrnn::LoadNrlDataset(p.String("dataset"));
+    if (!data.ok()) return data.status().WithContext("params.dataset");
+    for (const auto& seq : data->sequences) {
+      if (seq.rows() < 2) return Status::InvalidArgument("params.dataset: primitives need 2 DOFs (x, y), got " + std::to_string(seq.rows()));
+      std::vector<std::array<double, 2>> pts;
+      for (Eigen::Index t = 0; t < seq.cols(); ++t) pts.push_back({seq(0, t), seq(1, t)});
+      so.primitives.push_back(std::move(pts));
+    }
+  }
+  robot_ = &ctx.input<msg::CartesianState>("robot");
+  pointer_ = &ctx.output<msg::HumanInput>("pointer");
+  subject_ = std::make_unique<SubjectChannel>(so, [this](double x, double y, bool engaged) {
+    pointer_sample_.x(x);
+    pointer_sample_.y(y);
+    pointer_sample_.engaged(engaged);
+    pointer_->Publish(pointer_sample_);  // serialised by SubjectChannel
+  });
+
+  options_.pages["/"] = WebServer::Page{"text/html; charset=utf-8", kIndexHtml, ""};
+  options_.pages["/subject"] = WebServer::Page{"text/html; charset=utf-8", kSubjectHtml, ""};
+  options_.pages["/experimenter"] = WebServer::Page{"text/html; charset=utf-8", kExperimenterHtml, ""};
+  options_.endpoints = {
+      WebServer::Endpoint{"/", {foxglove::kSubprotocol, foxglove::kSubprotocolSdk}, bridge_.get()},
+      WebServer::Endpoint{"/subject/ws", {}, subject_.get()},
+  };
   FoxgloveBridge* bridge = bridge_.get();
   for (const auto& c : channels) {
     const uint32_t id = c.id;
@@ -88,14 +130,16 @@ Status WebComponent::Configure(Context& ctx) {
 }
 
 Status WebComponent::Activate() {
-  auto s = WebServer::Start(options_, bridge_.get());
+  auto s = WebServer::Start(options_);
   if (!s.ok()) return s.status().WithContext("params.address/port");
   server_ = std::move(s.value());
   bridge_->SetServer(server_.get());
+  subject_->SetServer(server_.get());
   const std::string host = options_.address.find(':') != std::string::npos ? "[" + options_.address + "]" : options_.address;
-  std::string url = "ws://" + host + ":" + std::to_string(server_->port());
-  if (!options_.token.empty()) url += "/?token=" + options_.token;
-  ctx_->log().Info("Foxglove WebSocket bridge on " + url);
+  const std::string base = host + ":" + std::to_string(server_->port());
+  const std::string query = options_.token.empty() ? "" : "?token=" + options_.token;
+  ctx_->log().Info("subject's page: http://" + base + "/subject" + query + "  experimenter: http://" + base +
+                   "/experimenter" + query + "  Foxglove WebSocket: ws://" + base + "/" + query);
   if (!port_file_.empty()) {
     std::ofstream f(port_file_);
     f << server_->port() << "\n";
@@ -105,6 +149,10 @@ Status WebComponent::Activate() {
 }
 
 Status WebComponent::Step(const StepInfo&) {
+  if (robot_->new_count() > 0) {
+    const msg::CartesianState* r = robot_->latest();
+    subject_->BroadcastState(r->x(), r->y());
+  }
   bridge_->ReportDrops();
   return Status::OK();
 }
@@ -113,6 +161,7 @@ Status WebComponent::Deactivate() {
   // Samples may still arrive until the runtime closes the subscriptions: the bridge keeps its
   // server pointer valid until the server is gone, so stop routing first.
   bridge_->SetServer(nullptr);
+  subject_->SetServer(nullptr);
   server_.reset();
   ctx_->log().Info(std::to_string(bridge_->samples_sent()) + " samples sent to clients");
   return Status::OK();
@@ -120,4 +169,7 @@ Status WebComponent::Deactivate() {
 
 }  // namespace dyad::web
 
-DYAD_PLUGIN(registry) { registry.Add<dyad::web::WebComponent>("web"); }
+DYAD_PLUGIN(registry) {
+  registry.Add<dyad::web::WebComponent>("web");
+  registry.Add<dyad::web::WebHuman>("web_human");
+}

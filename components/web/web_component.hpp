@@ -1,33 +1,27 @@
-/// The `web` component: one embedded web server per process (civetweb) carrying the Foxglove
-/// WebSocket bridge over the graph's topics, so an experimenter can watch a live (wall-clock)
-/// experiment in Foxglove: open a "Foxglove WebSocket" connection to ws://ADDRESS:PORT.
+/// The `web` component: one embedded web server per process (civetweb) with
+///   - `/subject`: the subject's page (steer the robot with the mouse; see web_human.hpp),
+///   - `/experimenter`: the experimenter's page,
+///   - `/`: an index page, and the Foxglove WebSocket bridge over the graph's topics for
+///     Foxglove ("Foxglove WebSocket" connection to ws://ADDRESS:PORT).
+/// Pages are embedded in the plugin. The server binds 127.0.0.1 unless `address` says otherwise;
+/// then a token is required (generated and printed when not given). Its Step (its own rate, the
+/// pages' display rate, <= 60 Hz) sends the robot's newest position to the subject's pages and
+/// reports dropped samples to Foxglove clients; samples reach the bridge through serialized
+/// subscriptions and pointer samples leave on `pointer` as they come: nothing here ever waits
+/// for a browser.
 ///
-/// @component web
-/// Summary: embedded web server with a live Foxglove WebSocket bridge over the graph's topics.
-/// Params:
-///   address (string, 127.0.0.1): address to bind; anything but loopback requires a token
-///   port (int, 8765, 0..65535): TCP port; 0 picks a free one (see port_file)
-///   topics (string list, all): topics to advertise, by name or regular expression
-///   writable (string list, none): topics Foxglove clients may publish on
-///   token (string, ""): required as ?token= by clients; empty: none on loopback, generated
-///     and printed otherwise (or from DYAD_WEB_TOKEN)
-///   allowed_origins (string list): browser origins allowed besides localhost
-///   max_clients (int, 8), client_buffer_kb (int, 4096), max_frame_kb (int, 1024)
-///   port_file (string, ""): write the bound port there (tests, scripts)
-/// @endcomponent
-///
-/// A component is stepped at its rate only to report each client's dropped samples as a status
-/// message; samples reach clients through serialized subscriptions, never through Step().
 /// Why a component and not a runtime service: the runtime stays free of HTTP, a graph places the
-/// server where it wants it (the process the subject's browser reaches), and it is swapped or
-/// left out by YAML like every other part.
+/// server in the process the subject's browser should reach, and it is swapped or left out by
+/// YAML like every other part.
 #pragma once
 
 #include <memory>
 
 #include <dyad/component.hpp>
+#include <dyad/msg/types.hpp>
 
 #include "src/foxglove_bridge.hpp"
+#include "src/subject_channel.hpp"
 #include "src/web_server.hpp"
 
 namespace dyad::web {
@@ -44,8 +38,12 @@ class WebComponent final : public Component {
   Context* ctx_ = nullptr;
   WebServer::Options options_;
   std::string port_file_;
+  Input<msg::CartesianState>* robot_ = nullptr;   // owned by the runtime
+  Output<msg::HumanInput>* pointer_ = nullptr;    // owned by the runtime
   std::unique_ptr<FoxgloveBridge> bridge_;
+  std::unique_ptr<SubjectChannel> subject_;
   std::unique_ptr<WebServer> server_;
+  msg::HumanInput pointer_sample_;
 };
 
 }  // namespace dyad::web

@@ -11,7 +11,7 @@ void SendQueue::PushControl(std::string json) {
   cv_.notify_one();
 }
 
-bool SendQueue::PushData(uint32_t channel, std::string bytes) {
+bool SendQueue::PushData(uint32_t channel, std::string bytes, bool binary) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (closed_) return false;
@@ -34,10 +34,22 @@ bool SendQueue::PushData(uint32_t channel, std::string bytes) {
     }
     bytes_ += size;
     channel_bytes_[channel] += size;
-    data_[channel].push_back(Frame{true, std::move(bytes), channel, next_order_++});
+    data_[channel].push_back(Frame{binary, std::move(bytes), channel, next_order_++});
   }
   cv_.notify_one();
   return true;
+}
+
+void SendQueue::PushLatest(uint32_t channel, std::string bytes, bool binary) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (closed_) return;
+    auto& q = data_[channel];
+    for (const auto& f : q) bytes_ -= f.bytes.size();
+    channel_bytes_[channel] = 0;
+    q.clear();
+  }
+  PushData(channel, std::move(bytes), binary);
 }
 
 bool SendQueue::Pop(Frame* out) {

@@ -36,7 +36,10 @@ class SendQueue {
   void PushControl(std::string json);
   // Queues a data frame of `channel`; drops the busiest channel's oldest frames to stay within
   // the limit. A frame larger than the whole limit is dropped itself. Returns false if dropped.
-  bool PushData(uint32_t channel, std::string bytes);
+  bool PushData(uint32_t channel, std::string bytes, bool binary = true);
+  // Queues a data frame that replaces any frame of `channel` still queued (newest only: a slow
+  // page gets the latest robot state, never a backlog).
+  void PushLatest(uint32_t channel, std::string bytes, bool binary = true);
   // Waits for the next frame; false once closed (frames still queued are discarded).
   bool Pop(Frame* out);
   void Close();

@@ -1,6 +1,6 @@
 /// WebServer — the embedded HTTP + WebSocket server of one `web` component (civetweb, Debian's
-/// libcivetweb). It serves static files from `document_root` (if any) and one WebSocket
-/// endpoint, `/`, speaking the subprotocols given (the Foxglove protocol's two names).
+/// libcivetweb). It serves fixed pages (embedded in the plugin: no files to install, no CDN) and
+/// WebSocket endpoints, each with its own handler and accepted subprotocols.
 ///
 /// Every client gets a SendQueue and a sender thread of its own: producers (the bridge, called
 /// from the graph's delivering threads) only queue, so a slow, stuck or malicious client never
@@ -52,11 +52,21 @@ class ClientHandler {
 
 class WebServer {
  public:
+  struct Page {
+    std::string mime;  // e.g. "text/html; charset=utf-8"
+    std::string body;
+    std::string uri;  // filled by Start()
+  };
+  struct Endpoint {
+    std::string uri;                        // e.g. "/"
+    std::vector<std::string> subprotocols;  // empty: any
+    ClientHandler* handler = nullptr;
+  };
   struct Options {
     std::string address = "127.0.0.1";
     int port = 8765;  // 0: any free port (see port())
-    std::string document_root;  // empty: no static files
-    std::vector<std::string> subprotocols;
+    std::map<std::string, Page> pages;  // by exact URI
+    std::vector<Endpoint> endpoints;
     std::vector<std::string> allowed_origins;
     std::string token;  // empty: none required
     int max_clients = 8;
@@ -65,7 +75,7 @@ class WebServer {
   };
 
   // Starts listening; fails (IOError) when the address/port cannot be bound.
-  static StatusOr<std::unique_ptr<WebServer>> Start(const Options& options, ClientHandler* handler);
+  static StatusOr<std::unique_ptr<WebServer>> Start(const Options& options);
   ~WebServer();  // closes every client, stops the server, joins every thread
   WebServer(const WebServer&) = delete;
   WebServer& operator=(const WebServer&) = delete;
@@ -74,13 +84,17 @@ class WebServer {
   // Queue frames for a client (dropped silently if it is gone).
   void SendText(ClientId client, std::string json);
   void SendData(ClientId client, uint32_t channel, std::string frame);
+  // Newest only (see SendQueue::PushLatest); a text frame unless `binary`.
+  void SendLatest(ClientId client, uint32_t channel, std::string frame, bool binary);
   // Per-channel drops of a client since the last call.
   std::map<uint32_t, uint64_t> TakeDrops(ClientId client);
   std::vector<ClientId> clients() const;
 
  private:
   struct Client;
+  struct EndpointState;
   WebServer() = default;
+  static int OnPage(mg_connection* conn, void* page);
   static int OnConnect(const mg_connection* conn, void* self);
   static void OnReady(mg_connection* conn, void* self);
   static int OnData(mg_connection* conn, int bits, char* data, size_t len, void* self);
@@ -89,14 +103,12 @@ class WebServer {
   std::shared_ptr<Client> Find(ClientId id) const;
 
   Options options_;
-  ClientHandler* handler_ = nullptr;
   mg_context* ctx_ = nullptr;
   int port_ = 0;
-  std::vector<const char*> subprotocol_ptrs_;
-  std::unique_ptr<mg_websocket_subprotocols> subprotocols_;
+  std::vector<std::unique_ptr<EndpointState>> endpoints_;  // civetweb keeps pointers into these
   mutable std::mutex mutex_;
   std::map<ClientId, std::shared_ptr<Client>> clients_;
-  std::map<const mg_connection*, ClientId> by_conn_;
+  std::map<const mg_connection*, std::pair<ClientId, ClientHandler*>> by_conn_;
   ClientId next_id_ = 1;
   std::set<const mg_connection*> admitted_;  // past OnConnect, not yet closed
 };
