@@ -1,8 +1,15 @@
 #include "web_component.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <mutex>
 #include <random>
+
+#include <fastdds/dds/topic/TopicDataType.hpp>
+#include <fastdds/rtps/common/SerializedPayload.h>
+#include <nlohmann/json.hpp>
 
 #include <dyad/pvrnn/dataset.hpp>
 
@@ -25,7 +32,37 @@ std::string RandomToken() {
   return t;
 }
 
+// The newest ComponentStats of every component of the graph, from dyad/stats (any process).
 }  // namespace
+
+struct WebComponent::StatsTable {
+  std::mutex mutex;
+  std::map<std::pair<std::string, std::string>, msg::ComponentStats> rows;  // (process, component)
+  std::unique_ptr<eprosima::fastdds::dds::TopicDataType> support{TypeInfoOf<msg::ComponentStats>().make_type_support()};
+  void Add(std::span<const uint8_t> cdr) {
+    eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<uint32_t>(cdr.size()));
+    std::copy(cdr.begin(), cdr.end(), payload.data);
+    payload.length = static_cast<uint32_t>(cdr.size());
+    msg::ComponentStats s;
+    bool ok = false;
+    try {  // fastcdr throws on short input
+      ok = support->deserialize(&payload, &s);
+    } catch (...) {
+    }
+    if (!ok) return;
+    std::lock_guard<std::mutex> lock(mutex);
+    rows[{s.process_name(), s.component_name()}] = s;
+  }
+  std::string Json() {
+    nlohmann::json list = nlohmann::json::array();
+    std::lock_guard<std::mutex> lock(mutex);
+    for (const auto& [key, s] : rows)
+      list.push_back({{"process", s.process_name()}, {"component", s.component_name()}, {"steps", s.steps()},
+                      {"mean_ms", s.step_mean_s() * 1e3}, {"p99_ms", s.step_p99_s() * 1e3}, {"max_ms", s.step_max_s() * 1e3},
+                      {"misses", s.deadline_misses()}});
+    return nlohmann::json{{"op", "stats"}, {"rows", list}}.dump();
+  }
+};
 
 void WebComponent::Describe(ComponentSpec& spec) {
   spec.Summary("Embedded web server with a live Foxglove WebSocket bridge over the graph's topics.");
@@ -45,6 +82,9 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Param("show_primitives", false).Doc("subject's page: draw the data set's primitives as a faint watermark");
   spec.Param("dataset", "").Doc("subject's page: NRL data set folder of the primitives (with show_primitives)");
   spec.Input<msg::CartesianState>("robot").Optional().Doc("robot state shown on the subject's page");
+  spec.Input<msg::Intention>("intention").Optional().Doc("experimenter's page: the deliberator's N-ELBO");
+  spec.Input<msg::IntentionLabel>("labels").Optional().Doc("experimenter's page: the observer's P(C_t) and labels");
+  spec.Output<msg::Annotation>("notes").Doc("experimenter's notes (record this topic to align them with the run)");
   spec.Output<msg::HumanInput>("pointer").Doc("the steering page's pointer, at the browser's event rate (to web_human)");
 }
 
@@ -113,12 +153,29 @@ Status WebComponent::Configure(Context& ctx) {
     pointer_->Publish(pointer_sample_);  // serialised by SubjectChannel
   });
 
+  intention_ = &ctx.input<msg::Intention>("intention");
+  labels_ = &ctx.input<msg::IntentionLabel>("labels");
+  notes_ = &ctx.output<msg::Annotation>("notes");
+  experimenter_ = std::make_unique<ExperimenterChannel>([this](const std::string& text) {
+    note_.author("experimenter");
+    note_.text(text);
+    notes_->Publish(note_);  // serialised by ExperimenterChannel
+  });
+  stats_ = std::make_shared<StatsTable>();
+  for (const auto& t : ctx.graph_topics())
+    if (t.name == "dyad/stats") {
+      std::shared_ptr<StatsTable> table = stats_;
+      Status s = ctx.SubscribeSerialized(t.name, [table](const SerializedSample& sample) { table->Add(sample.cdr); });
+      if (!s.ok()) return s;
+    }
+
   options_.pages["/"] = WebServer::Page{"text/html; charset=utf-8", kIndexHtml, ""};
   options_.pages["/subject"] = WebServer::Page{"text/html; charset=utf-8", kSubjectHtml, ""};
   options_.pages["/experimenter"] = WebServer::Page{"text/html; charset=utf-8", kExperimenterHtml, ""};
   options_.endpoints = {
       WebServer::Endpoint{"/", {foxglove::kSubprotocol, foxglove::kSubprotocolSdk}, bridge_.get()},
       WebServer::Endpoint{"/subject/ws", {}, subject_.get()},
+      WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get()},
   };
   FoxgloveBridge* bridge = bridge_.get();
   for (const auto& c : channels) {
@@ -135,6 +192,7 @@ Status WebComponent::Activate() {
   server_ = std::move(s.value());
   bridge_->SetServer(server_.get());
   subject_->SetServer(server_.get());
+  experimenter_->SetServer(server_.get());
   const std::string host = options_.address.find(':') != std::string::npos ? "[" + options_.address + "]" : options_.address;
   const std::string base = host + ":" + std::to_string(server_->port());
   const std::string query = options_.token.empty() ? "" : "?token=" + options_.token;
@@ -148,10 +206,29 @@ Status WebComponent::Activate() {
   return Status::OK();
 }
 
-Status WebComponent::Step(const StepInfo&) {
+Status WebComponent::Step(const StepInfo& info) {
   if (robot_->new_count() > 0) {
     const msg::CartesianState* r = robot_->latest();
     subject_->BroadcastState(r->x(), r->y());
+  }
+  if (intention_->new_count() > 0 || labels_->new_count() > 0) {
+    nlohmann::json j{{"op", "series"}, {"t", info.now_ns * 1e-9}, {"nelbo", nullptr}, {"congruence", nullptr},
+                     {"human", nullptr}, {"robot", nullptr}};
+    if (const msg::Intention* i = intention_->latest()) j["nelbo"] = i->nelbo();
+    if (const msg::IntentionLabel* l = labels_->latest()) {
+      if (std::isfinite(l->congruence())) j["congruence"] = l->congruence();
+      auto argmax = [](const std::vector<double>& p) -> nlohmann::json {
+        if (p.empty()) return nullptr;
+        return static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin());
+      };
+      j["human"] = argmax(l->human());
+      j["robot"] = argmax(l->robot());
+    }
+    experimenter_->Broadcast(1, j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  }
+  if (info.now_ns - last_stats_ns_ >= 1'000'000'000) {
+    last_stats_ns_ = info.now_ns;
+    experimenter_->Broadcast(2, stats_->Json());
   }
   bridge_->ReportDrops();
   return Status::OK();
@@ -162,6 +239,7 @@ Status WebComponent::Deactivate() {
   // server pointer valid until the server is gone, so stop routing first.
   bridge_->SetServer(nullptr);
   subject_->SetServer(nullptr);
+  experimenter_->SetServer(nullptr);
   server_.reset();
   ctx_->log().Info(std::to_string(bridge_->samples_sent()) + " samples sent to clients");
   return Status::OK();

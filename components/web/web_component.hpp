@@ -20,6 +20,7 @@
 #include <dyad/component.hpp>
 #include <dyad/msg/types.hpp>
 
+#include "src/experimenter_channel.hpp"
 #include "src/foxglove_bridge.hpp"
 #include "src/subject_channel.hpp"
 #include "src/web_server.hpp"
@@ -40,6 +41,14 @@ class WebComponent final : public Component {
   std::string port_file_;
   Input<msg::CartesianState>* robot_ = nullptr;   // owned by the runtime
   Output<msg::HumanInput>* pointer_ = nullptr;    // owned by the runtime
+  Input<msg::Intention>* intention_ = nullptr;    // owned by the runtime
+  Input<msg::IntentionLabel>* labels_ = nullptr;  // owned by the runtime
+  Output<msg::Annotation>* notes_ = nullptr;      // owned by the runtime
+  std::unique_ptr<ExperimenterChannel> experimenter_;
+  struct StatsTable;
+  std::shared_ptr<StatsTable> stats_;  // filled by the dyad/stats subscription
+  int64_t last_stats_ns_ = 0;
+  msg::Annotation note_;
   std::unique_ptr<FoxgloveBridge> bridge_;
   std::unique_ptr<SubjectChannel> subject_;
   std::unique_ptr<WebServer> server_;

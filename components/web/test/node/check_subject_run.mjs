@@ -6,7 +6,8 @@
 // - engaged exactly while the key was held: samples stamped > 150 ms after a key event show it;
 // - the executed position (robot/state) moves toward the human while engaged;
 // - the tab closed while engaged: the first sample stamped more than one period + 150 ms after the
-//   close is disengaged.
+//   close is disengaged;
+// - the note typed on the experimenter's page is recorded on experiment/notes, stamped when sent.
 import { readFile, open } from "node:fs/promises";
 import { McapIndexedReader } from "@mcap/core";
 import { parseIDL } from "@foxglove/omgidl-parser";
@@ -78,6 +79,12 @@ if (!(dist(after) < dist(before) - 5)) fail(`robot did not move toward the human
 const firstAfter = human.find((h) => h.t > log.closed_at + period + 150);
 if (!firstAfter) fail("no human/input after the tab closed");
 else if (firstAfter.msg.engaged) fail(`still engaged ${firstAfter.t - log.closed_at} ms after the tab closed`);
+// 5. The experimenter's note is recorded, stamped when it was sent.
+const notes = await samples("experiment/notes");
+const note = notes.find((n) => n.msg.text === log.note.text);
+if (!note) fail("the experimenter's note is not in the recording");
+else if (Math.abs(note.t - log.note.t) > 1000 || note.msg.author !== "experimenter") fail(`note stamped ${note.t - log.note.t} ms from when it was sent, author ${note.msg.author}`);
+
 const lastEngaged = [...human].reverse().find((h) => h.msg.engaged);
 const disengageMs = lastEngaged ? lastEngaged.t - log.closed_at : null;
 

@@ -6,7 +6,7 @@
 // 2. rests the mouse released, holds the engage key (Space), moves along a circle of radius 20
 //    (12 points, each held 400 ms), releases the key, rests;
 // 3. engages again, holds still, then closes the tab while engaged;
-// 4. saves screenshots of the subject's page (while engaged) and of the experimenter's page.
+// 4. on the experimenter's page, notes a line; saves screenshots of both pages.
 // The workspace position of every mouse position is computed here from the canvas rectangle and
 // the documented mapping (square of side min(w, h) - 48 px centred, 100 units across, y up), not
 // by the page.
@@ -63,7 +63,12 @@ try {
   await sleep(800);
   const exp = await context.newPage();
   await exp.goto(base + "/experimenter");
+  await exp.waitForFunction(() => document.getElementById("conn").textContent === "live", null, { timeout: 10000 });
   await sleep(1500);
+  log.note = { text: "subject reported fatigue", t: Date.now() };
+  await exp.fill("#note", log.note.text);
+  await exp.click("#send");
+  await sleep(500);
   await exp.screenshot({ path: `${shotDir}/experimenter_page.png` });
 } finally {
   await browser.close();
