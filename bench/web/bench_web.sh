@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# The web component, one run, ratios (bash bench/web/bench_web.sh [BUILD_DIR]):
+#   1. pointer round trip: the subject's page (Chromium) -> web -> published on the graph -> ack
+#      back to the page, 500 moves at 100 Hz; the arrival in the component is at most this;
+#   2. Foxglove bridge throughput to one client: a stepped graph publishing robot/state (~100 B
+#      CDR samples) as fast as the CPU allows, samples/s the client receives;
+#   3. the experiment's step time p99 at 100 Hz (wall) with 0 and with 4 Foxglove clients
+#      subscribed to every topic, 20 s each.
+set -euo pipefail
+here=$(cd "$(dirname "$0")/../.." && pwd)
+build=${1:-$here/build}
+node_dir=$here/components/web/test/node
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+graph() {  # graph CLOCK RATE
+  cat <<YAML
+graph: bench_web
+clock: $1
+domain_id: $(( 1 + $$ % 200 ))
+topics:
+  robot/command: {type: CartesianCommand, reliability: reliable, depth: 4}
+  robot/state: {type: CartesianState, reliability: reliable, depth: 4}
+  web/pointer: {type: HumanInput, depth: 8}
+components:
+  pattern: {type: cartesian_pattern, rate_hz: $2, params: {shape: figure8, radius: 30, period_s: 4}, outputs: {command: robot/command}}
+  driver: {type: virtual_cartesian, trigger: command, params: {max_velocity: 1e6, max_acceleration: 1e9}, inputs: {command: robot/command}, outputs: {state: robot/state}}
+  web: {type: web, rate_hz: 30, params: {port: 0, port_file: web.port}, inputs: {robot: robot/state}, outputs: {pointer: web/pointer}}
+  human: {type: web_human, rate_hz: 100, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
+YAML
+}
+start() {  # start GRAPH ARGS...: runs dyad in the background, waits for the port
+  rm -f web.port
+  "$build/bin/dyad" run "$@" > run.out 2> run.err &
+  pid=$!
+  for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
+  port=$(cat web.port)
+}
+p99() { awk -v c="$1" '$1 == c {print $4}' run.out; }
+
+graph wall 100 > wall.yaml
+start wall.yaml --duration 12
+pointer=$(node "$node_dir/bench_clients.mjs" pointer "http://127.0.0.1:$port" 500)
+kill -INT $pid; wait $pid || true
+
+graph stepped 1000 > stepped.yaml
+start stepped.yaml --steps 100000000
+sleep 1
+throughput=$(node "$node_dir/bench_clients.mjs" foxglove "ws://127.0.0.1:$port" robot/state 5 1)
+kill -INT $pid; wait $pid || true
+
+start wall.yaml --duration 20
+wait $pid
+base_pattern=$(p99 pattern) base_driver=$(p99 driver)
+start wall.yaml --duration 20
+node "$node_dir/bench_clients.mjs" foxglove "ws://127.0.0.1:$port" "" 18 4 > /dev/null
+wait $pid
+four_pattern=$(p99 pattern) four_driver=$(p99 driver)
+
+echo "| what | result |"
+echo "| --- | --- |"
+echo "| pointer round trip page -> component -> page (500 moves) | $pointer |"
+echo "| bridge to one client, robot/state | $throughput |"
+echo "| step p99 at 100 Hz, 0 clients: pattern / driver | $base_pattern / $base_driver ms |"
+echo "| step p99 at 100 Hz, 4 clients: pattern / driver | $four_pattern / $four_driver ms |"
+awk -v a="$base_pattern" -v b="$four_pattern" -v c="$base_driver" -v d="$four_driver" \
+  'BEGIN { printf "| p99 ratio 4 clients / 0: pattern %.2f, driver %.2f |  |\n", b / a, d / c }'
