@@ -2,8 +2,8 @@
 # The web component, one run, ratios (bash bench/web/bench_web.sh [BUILD_DIR]):
 #   1. pointer round trip: the subject's page (Chromium) -> web -> published on the graph -> ack
 #      back to the page, 500 moves at 100 Hz; the arrival in the component is at most this;
-#   2. Foxglove bridge throughput to one client: a stepped graph publishing robot/state (~100 B
-#      CDR samples) as fast as the CPU allows, samples/s the client receives;
+#   2. Foxglove bridge throughput to one client: bench_bridge feeds the bridge 100-byte samples as
+#      fast as one thread can (no graph in the way); samples/s the client receives;
 #   3. the experiment's step time p99 at 100 Hz (wall) with 0 and with 4 Foxglove clients
 #      subscribed to every topic, 20 s each.
 set -euo pipefail
@@ -43,11 +43,11 @@ start wall.yaml --duration 12
 pointer=$(node "$node_dir/bench_clients.mjs" pointer "http://127.0.0.1:$port" 500)
 kill -INT $pid; wait $pid || true
 
-graph stepped 1000 > stepped.yaml
-start stepped.yaml --steps 100000000
-sleep 1
-throughput=$(node "$node_dir/bench_clients.mjs" foxglove "ws://127.0.0.1:$port" robot/state 5 1)
-kill -INT $pid; wait $pid || true
+coproc BRIDGE { "$build/bin/bench_bridge" 6 2> bridge.err; }
+read -r port <&"${BRIDGE[0]}"
+throughput=$(node "$node_dir/bench_clients.mjs" foxglove "ws://127.0.0.1:$port" bench/samples 5 1)
+wait $BRIDGE_PID || true
+throughput="$throughput; bridge: $(cat bridge.err)"
 
 start wall.yaml --duration 20
 wait $pid
@@ -60,7 +60,7 @@ four_pattern=$(p99 pattern) four_driver=$(p99 driver)
 echo "| what | result |"
 echo "| --- | --- |"
 echo "| pointer round trip page -> component -> page (500 moves) | $pointer |"
-echo "| bridge to one client, robot/state | $throughput |"
+echo "| bridge to one client, 100-byte samples | $throughput |"
 echo "| step p99 at 100 Hz, 0 clients: pattern / driver | $base_pattern / $base_driver ms |"
 echo "| step p99 at 100 Hz, 4 clients: pattern / driver | $four_pattern / $four_driver ms |"
 awk -v a="$base_pattern" -v b="$four_pattern" -v c="$base_driver" -v d="$four_driver" \
