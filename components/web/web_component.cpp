@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
@@ -242,6 +243,13 @@ Status WebComponent::Deactivate() {
   experimenter_->SetServer(nullptr);
   server_.reset();
   ctx_->log().Info(std::to_string(bridge_->samples_sent()) + " samples sent to clients");
+  if (auto a = subject_->arrival_ms(); !a.empty()) {
+    std::sort(a.begin(), a.end());
+    char line[160];
+    std::snprintf(line, sizeof line, "pointer event -> published: median %.2f ms, p99 %.2f ms (%zu samples)", a[a.size() / 2],
+                  a[std::min(a.size() - 1, a.size() * 99 / 100)], a.size());
+    ctx_->log().Info(line);
+  }
   return Status::OK();
 }
 

@@ -1,6 +1,7 @@
 #include "subject_channel.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include <nlohmann/json.hpp>
@@ -16,6 +17,11 @@ void SubjectChannel::SetServer(WebServer* server) { server_.store(server); }
 size_t SubjectChannel::pages() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return pages_.size();
+}
+
+std::vector<double> SubjectChannel::arrival_ms() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return arrival_ms_;
 }
 
 void SubjectChannel::BroadcastState(double x, double y) {
@@ -78,6 +84,11 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
       last_x_ = std::clamp(px, -h, h);
       last_y_ = std::clamp(py, -h, h);
       sink_(last_x_, last_y_, engaged->get<bool>());
+      if (auto wall = j.find("wall"); wall != j.end() && wall->is_number() && arrival_ms_.size() < 100000) {
+        const double now_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
+        arrival_ms_.push_back(now_ms - wall->get<double>());
+      }
     }
     if (auto t = j.find("t"); t != j.end() && t->is_number())
       if (WebServer* server = server_.load()) server->SendText(client, json{{"op", "ack"}, {"t", t->get<double>()}}.dump());

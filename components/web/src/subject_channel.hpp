@@ -6,7 +6,8 @@
 /// to take the steering role. Server -> page: {"op":"hello",...} (role, workspace, engage key,
 /// primitives for the watermark), {"op":"role","steering":bool}, {"op":"state","x","y"} (newest
 /// only: a slow page never builds a backlog), {"op":"ack","t":ms} after each pointer sample was
-/// published (the page measures the round trip).
+/// published (the page measures the round trip). A pointer sample may carry "wall" (the event's
+/// time, ms since the epoch): the channel then keeps the event-to-publication delay.
 ///
 /// Several pages may watch; one steers: the first to connect, until it leaves (the oldest page
 /// left then steers) or a page presents the token (when one is set). Only the steering page's
@@ -41,6 +42,10 @@ class SubjectChannel final : public ClientHandler {
   // Sends the robot's position to every page (newest only).
   void BroadcastState(double x, double y);
   size_t pages() const;
+  // Milliseconds from the page's event (its "wall" stamp) to the sample's publication, for every
+  // pointer sample that carried one (meaningful when page and server share a clock); at most
+  // the last 100,000.
+  std::vector<double> arrival_ms() const;
 
   void OnOpen(ClientId client) override;
   Status OnText(ClientId client, std::string_view text) override;
@@ -56,6 +61,7 @@ class SubjectChannel final : public ClientHandler {
   std::vector<ClientId> pages_;  // in connection order
   ClientId steering_ = 0;        // 0: none
   double last_x_ = 0, last_y_ = 0;
+  std::vector<double> arrival_ms_;
 };
 
 }  // namespace dyad::web
