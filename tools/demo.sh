@@ -5,6 +5,8 @@
 #     1. the analytic 7-primitive data set  -> build/data/analytic         (dyad generate dataset)
 #     2. the robot's PV-RNN, study settings -> build/models/demo.dpvrnn    (dyad train, ~1-2 min)
 #     3. the intention observer             -> build/models/demo.dobs      (dyad train-observer)
+#   bash tools/demo.sh interactive   the same models; a person steers from the browser
+#     (configs/interactive.yaml, wall clock, until Ctrl-C; open the printed /subject address)
 #   bash tools/demo.sh macaw    the same experiment with the study's MacawBot from ../shared/data
 #     1-2. dyad import-nrl ../shared/data/vcbot/...  -> build/models/macawbot.dpvrnn
 #     3.   the observer                              -> build/models/macawbot.dobs
@@ -21,8 +23,8 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 name="${1:-demo}"
 case "$name" in
-  demo | macaw) ;;
-  *) echo "usage: bash tools/demo.sh [demo|macaw]" >&2; exit 2 ;;
+  demo | macaw | interactive) ;;
+  *) echo "usage: bash tools/demo.sh [demo|macaw|interactive]" >&2; exit 2 ;;
 esac
 if [ "${DEMO_SKIP_SETUP:-0}" != 1 ]; then
   bash "$here/tools/setup.sh"
@@ -52,7 +54,7 @@ cached() {
 }
 hash_of() { { cat "$@"; echo "${DEMO_EPOCHS:-}"; } | sha256sum | cut -d' ' -f1; }
 
-if [ "$name" = demo ]; then
+if [ "$name" = demo ] || [ "$name" = interactive ]; then
   dataset="$work/data/analytic"
   model="$work/models/demo.dpvrnn"
   observer="$work/models/demo.dobs"
@@ -75,6 +77,18 @@ fi
 cached "$observer.key" "$(hash_of "$model")" "$dyad" train-observer "$model" -o "$observer" "${observer_opts[@]}"
 
 graph="configs/$name.yaml"
+if [ "$name" = interactive ]; then
+  rec="$out/interactive-$(date +%Y%m%d-%H%M%S).mcap"
+  sets=(--set "web.dataset=$dataset" --set "mind.model=$model" --set "observer.model=$observer" --set "recorder.file=$rec")
+  "$dyad" validate "$graph" "${sets[@]}"
+  echo "demo: a person steers: open http://127.0.0.1:8765/subject (hold the mouse button or Space),"
+  echo "demo: the experimenter's page http://127.0.0.1:8765/experimenter, or Foxglove on ws://127.0.0.1:8765"
+  echo "demo: Ctrl-C ends the session"
+  "$dyad" run "$graph" "${sets[@]}" ${DEMO_DURATION:+--duration "$DEMO_DURATION"} || true
+  "$dyad" analyze "$rec" -o "$out/report-$(basename "${rec%.mcap}")" --dataset "$dataset"
+  echo "demo: recording $rec"
+  exit 0
+fi
 sets=(--set "human.dataset=$dataset" --set "mind.model=$model" --set "observer.model=$observer"
       --set "recorder.file=$out/$name.mcap")
 "$dyad" validate "$graph" "${sets[@]}"

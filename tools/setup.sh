@@ -6,8 +6,8 @@ packages=(
   build-essential cmake git pkg-config
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
   libeigen3-dev libceres-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libzstd-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
-  python3 python3-matplotlib
+  libgtest-dev libgmock-dev libbenchmark-dev libcivetweb-dev
+  python3 python3-matplotlib chromium
 )
 # Node.js may come from elsewhere (with its own npm): only ask Debian when the command is missing.
 command -v node > /dev/null || packages+=(nodejs)

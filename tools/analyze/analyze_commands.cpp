@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "demonstrations.hpp"
 #include "dyad/mcap/reader.hpp"
 #include "experiment_analysis.hpp"
 #include "recording_tables.hpp"
@@ -122,9 +123,59 @@ int RunAnalyze(const Options& o) {
   return kOk;
 }
 
+struct FromRecordingOptions {
+  std::string recording, out;
+  analyze::DemonstrationOptions demo;
+};
+
+int RunFromRecording(const FromRecordingOptions& o) {
+  auto reader = mcap::Reader::Open(o.recording);
+  if (!reader.ok()) {
+    std::cerr << "dyad dataset from-recording: " << reader.status().message() << "\n";
+    return kBadInput;
+  }
+  auto tables = analyze::ReadTables(*reader, {o.demo.topic});
+  if (!tables.ok()) {
+    std::cerr << "dyad dataset from-recording: " << o.recording << ": " << tables.status().message() << "\n";
+    return kBadInput;
+  }
+  auto it = tables->find(o.demo.topic);
+  if (it == tables->end()) {
+    std::cerr << "dyad dataset from-recording: " << o.recording << ": no topic '" << o.demo.topic << "' (--topic)\n";
+    return kBadInput;
+  }
+  auto demos = analyze::DemonstrationsFromTable(it->second, o.demo);
+  if (!demos.ok()) {
+    std::cerr << "dyad dataset from-recording: " << o.recording << ": " << demos.status().message() << "\n";
+    return kBadInput;
+  }
+  if (Status s = pvrnn::WriteNrlDataset(demos->dataset, o.out); !s.ok()) {
+    std::cerr << "dyad dataset from-recording: " << s.message() << "\n";
+    return kFailure;
+  }
+  std::cout << o.out << ": " << demos->dataset.size() << " primitive(s) of " << o.demo.steps << " steps from the engaged segments of '"
+            << o.demo.topic << "'";
+  if (demos->skipped > 0) std::cout << " (" << demos->skipped << " shorter than " << o.demo.min_samples << " samples skipped)";
+  std::cout << "\n";
+  return kOk;
+}
+
 }  // namespace
 
 void AddAnalyzeCommands(CLI::App& app, int& exit_code) {
+  {
+    auto o = std::make_shared<FromRecordingOptions>();
+    CLI::App* ds = app.add_subcommand("dataset", "Make data sets");
+    ds->require_subcommand(1);
+    CLI::App* fr = ds->add_subcommand("from-recording",
+                                      "Cut a recording's engaged segments (a person's demonstrations) into an NRL data set");
+    fr->add_option("recording", o->recording, "MCAP file with the human's topic")->required();
+    fr->add_option("--out", o->out, "data set folder (NRL layout: dataset.d, primitive_<id>_0.csv)")->required();
+    fr->add_option("--topic", o->demo.topic, "HumanInput topic (default human/input)");
+    fr->add_option("--steps", o->demo.steps, "steps T of every primitive (default 72)");
+    fr->add_option("--min-samples", o->demo.min_samples, "shorter engaged segments are skipped (default 10)");
+    fr->callback([o, &exit_code] { exit_code = RunFromRecording(*o); });
+  }
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("analyze", "Write a report folder (tables, PNG plots) for an experiment recording");
   cmd->add_option("recording", options->recording, "MCAP file written by the recorder")->required();

@@ -15,6 +15,8 @@
 #include "analyze_commands.hpp"
 #include "dyad/testing/cli.hpp"
 #include "dyad/mcap/writer.hpp"
+#include "demonstrations.hpp"
+#include "dyad/pvrnn/dataset.hpp"
 #include "experiment_analysis.hpp"
 #include "recording_tables.hpp"
 #include "report_writer.hpp"
@@ -276,6 +278,70 @@ TEST(AnalyzeCli, BadInputExitsTwoNamingTheFile) {
   const std::string rec = WriteExperiment(TempPath("exp.mcap"));
   EXPECT_EQ(RunCli({"analyze", rec, "-o", TempPath("r"), "--dataset", TempPath("nope")}, &err), 2);
   EXPECT_NE(err.find("--dataset"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace dyad::analyze
+
+
+namespace dyad::analyze {
+namespace {
+
+// Demonstrations: the recording's engaged segments (steps 10-19 and 30-33 of WriteExperiment,
+// human at (t, -t)) become primitives resampled to T steps by linear interpolation.
+TEST(Demonstrations, EngagedSegmentsBecomeResampledPrimitives) {
+  auto reader = mcap::Reader::Open(WriteExperiment(TempPath("d.mcap")));
+  ASSERT_TRUE(reader.ok());
+  auto tables = ReadTables(*reader, {"human/input"});
+  ASSERT_TRUE(tables.ok());
+  DemonstrationOptions o;
+  o.steps = 5;
+  o.min_samples = 4;
+  auto d = DemonstrationsFromTable(tables->at("human/input"), o);
+  ASSERT_TRUE(d.ok()) << d.status().ToString();
+  ASSERT_EQ(d->dataset.size(), 2);
+  EXPECT_EQ(d->skipped, 0);
+  const double first[] = {10, 12.25, 14.5, 16.75, 19};  // 10 samples 10..19 onto 5 points
+  const double second[] = {30, 30.75, 31.5, 32.25, 33};
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_NEAR(d->dataset.sequences[0](0, k), first[k], 1e-12);
+    EXPECT_NEAR(d->dataset.sequences[0](1, k), -first[k], 1e-12);
+    EXPECT_NEAR(d->dataset.sequences[1](0, k), second[k], 1e-12);
+  }
+  // 9 periods of 100 ms over 4 intervals for the first, 3 over 4 for the second.
+  EXPECT_NEAR(d->dataset.sampling_period_ms, (225.0 + 75.0) / 2, 1e-9);
+  o.min_samples = 5;  // the 4-sample segment is not a demonstration
+  auto d2 = DemonstrationsFromTable(tables->at("human/input"), o);
+  ASSERT_TRUE(d2.ok());
+  EXPECT_EQ(d2->dataset.size(), 1);
+  EXPECT_EQ(d2->skipped, 1);
+}
+
+TEST(Demonstrations, CliWritesAnNrlDataSetTheLoaderReads) {
+  const std::string rec = WriteExperiment(TempPath("d.mcap"));
+  const std::string out = TempPath("demo_set");
+  auto r = dyad::testing::RunCommand(dyad::cli::AddAnalyzeCommands,
+                               {"dataset", "from-recording", rec, "--out", out, "--steps", "72", "--min-samples", "4"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("2 primitive(s) of 72 steps"), std::string::npos) << r.out;
+  auto data = pvrnn::LoadNrlDataset(out);
+  ASSERT_TRUE(data.ok()) << data.status().ToString();
+  EXPECT_EQ(data->size(), 2);
+  EXPECT_EQ(data->steps(), 72);
+  EXPECT_NEAR((*data).sequences[0](0, 71), 19, 1e-6);
+}
+
+TEST(Demonstrations, CliRefusesWhatHasNoDemonstration) {
+  const std::string rec = WriteExperiment(TempPath("d.mcap"));
+  auto r = dyad::testing::RunCommand(dyad::cli::AddAnalyzeCommands,
+                               {"dataset", "from-recording", rec, "--out", TempPath("x"), "--min-samples", "50"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no engaged segment of at least 50 samples (2 shorter ones)"), std::string::npos) << r.err;
+  r = dyad::testing::RunCommand(dyad::cli::AddAnalyzeCommands, {"dataset", "from-recording", rec, "--out", TempPath("x"), "--topic", "robot/state"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("has no x, y and engaged fields"), std::string::npos) << r.err;
+  r = dyad::testing::RunCommand(dyad::cli::AddAnalyzeCommands, {"dataset", "from-recording", TempPath("missing.mcap"), "--out", TempPath("x")});
+  EXPECT_EQ(r.code, 2);
 }
 
 }  // namespace

@@ -1,0 +1,145 @@
+#include "foxglove_bridge.hpp"
+
+#include <variant>
+
+namespace dyad::web {
+
+FoxgloveBridge::FoxgloveBridge(std::string server_name, std::vector<foxglove::Channel> channels,
+                               std::map<std::string, SerializedWriter*> writers)
+    : server_name_(std::move(server_name)), channels_(std::move(channels)), writers_(std::move(writers)) {}
+
+void FoxgloveBridge::OnSample(uint32_t channel_id, const SerializedSample& sample) {
+  std::vector<std::pair<ClientId, uint32_t>> to;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = routes_.find(channel_id);
+    if (it == routes_.end() || it->second.empty()) return;
+    to = it->second;
+    sent_ += to.size();
+  }
+  WebServer* server = server_.load();
+  if (server == nullptr) return;
+  const uint64_t stamp = sample.source_stamp_ns > 0 ? static_cast<uint64_t>(sample.source_stamp_ns) : 0;
+  for (const auto& [client, sub] : to) server->SendData(client, channel_id, foxglove::MessageData(sub, stamp, sample.cdr));
+}
+
+void FoxgloveBridge::ReportDrops() {
+  WebServer* server = server_.load();
+  if (server == nullptr) return;
+  std::vector<ClientId> clients;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [c, _] : clients_) clients.push_back(c);
+  }
+  for (ClientId c : clients) {
+    const auto drops = server->TakeDrops(c);
+    if (drops.empty()) continue;
+    std::string msg = "client too slow: dropped";
+    for (const auto& [channel, n] : drops) {
+      const std::string topic = channel >= 1 && channel <= channels_.size() ? channels_[channel - 1].topic : "?";
+      msg.append(" ").append(std::to_string(n)).append(" samples of '").append(topic).append("'");
+    }
+    SendStatus(c, foxglove::Level::kWarning, msg);
+  }
+}
+
+void FoxgloveBridge::OnOpen(ClientId client) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    clients_[client];
+  }
+  WebServer* server = server_.load();
+  if (server == nullptr) return;
+  server->SendText(client, foxglove::ServerInfo(server_name_, !writers_.empty(), std::to_string(client), {}));
+  server->SendText(client, foxglove::Advertise(channels_));
+}
+
+void FoxgloveBridge::SendStatus(ClientId client, foxglove::Level level, const std::string& message) {
+  if (WebServer* server = server_.load()) server->SendText(client, foxglove::StatusMessage(level, message));
+}
+
+Status FoxgloveBridge::OnText(ClientId client, std::string_view text) {
+  auto parsed = foxglove::ParseClientText(text);
+  if (!parsed.ok()) return parsed.status();
+  std::vector<std::string> problems;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ClientState& st = clients_[client];
+    if (auto* s = std::get_if<foxglove::Subscribe>(&*parsed)) {
+      for (const auto& [sub, channel] : s->subscriptions) {
+        if (channel < 1 || channel > channels_.size()) {
+          problems.push_back("subscribe: no channel " + std::to_string(channel));
+          continue;
+        }
+        if (st.subscriptions.count(sub)) {
+          problems.push_back("subscribe: subscription id " + std::to_string(sub) + " is already in use");
+          continue;
+        }
+        st.subscriptions[sub] = channel;
+        routes_[channel].emplace_back(client, sub);
+      }
+    } else if (auto* u = std::get_if<foxglove::Unsubscribe>(&*parsed)) {
+      for (uint32_t sub : u->subscription_ids) {
+        auto it = st.subscriptions.find(sub);
+        if (it == st.subscriptions.end()) continue;
+        auto& r = routes_[it->second];
+        std::erase(r, std::make_pair(client, sub));
+        st.subscriptions.erase(it);
+      }
+    } else if (auto* a = std::get_if<foxglove::ClientAdvertise>(&*parsed)) {
+      for (const auto& c : a->channels) {
+        auto w = writers_.find(c.topic);
+        if (w == writers_.end()) {
+          problems.push_back("advertise: topic '" + c.topic + "' is not writable" +
+                             (writers_.empty() ? " (this server accepts no client publishing)" : ""));
+        } else if (c.encoding != "cdr") {
+          problems.push_back("advertise: topic '" + c.topic + "': encoding '" + c.encoding + "' is not supported (cdr)");
+        } else {
+          st.publishing[c.id] = w->second;
+        }
+      }
+    } else if (auto* ua = std::get_if<foxglove::ClientUnadvertise>(&*parsed)) {
+      for (uint32_t id : ua->channel_ids) st.publishing.erase(id);
+    } else if (auto* other = std::get_if<foxglove::OtherOp>(&*parsed)) {
+      problems.push_back("op '" + other->op + "' is not supported by this server");
+    }
+  }
+  for (const auto& p : problems) SendStatus(client, foxglove::Level::kError, p);
+  return Status::OK();
+}
+
+Status FoxgloveBridge::OnBinary(ClientId client, std::span<const uint8_t> bytes) {
+  auto d = foxglove::ParseClientBinary(bytes);
+  if (!d.ok()) return d.status();
+  SerializedWriter* writer = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ClientState& st = clients_[client];
+    auto it = st.publishing.find(d->channel_id);
+    if (it != st.publishing.end()) writer = it->second;
+  }
+  if (writer == nullptr) {
+    SendStatus(client, foxglove::Level::kError,
+           "message on client channel " + std::to_string(d->channel_id) + ", which is not advertised or not writable");
+    return Status::OK();
+  }
+  dyad::Status s = writer->Write(d->payload);
+  if (s.code() == dyad::Status::Code::kInvalidArgument) return s;  // not the topic's type: malformed
+  if (!s.ok()) SendStatus(client, foxglove::Level::kError, s.message());
+  return Status::OK();
+}
+
+void FoxgloveBridge::OnClose(ClientId client) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = clients_.find(client);
+  if (it == clients_.end()) return;
+  for (const auto& [sub, channel] : it->second.subscriptions) std::erase(routes_[channel], std::make_pair(client, sub));
+  clients_.erase(it);
+}
+
+uint64_t FoxgloveBridge::samples_sent() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return sent_;
+}
+
+}  // namespace dyad::web

@@ -1,0 +1,70 @@
+/// FoxgloveBridge — the graph's topics over the Foxglove WebSocket protocol, for Foxglove (or
+/// any `@foxglove/ws-protocol` client) watching a live experiment.
+///
+/// Every chosen graph topic is advertised as a channel (`encoding: cdr`, `schemaEncoding:
+/// omgidl`, `schemaName` the scoped IDL name, `schema` the self-contained IDL text). A client's
+/// subscriptions get binary Message Data frames: the sample's CDR bytes as they travel on DDS
+/// (encapsulation header included) stamped with the sample's source time. Samples reach the
+/// bridge through the runtime's serialized subscriptions and are only queued here (WebServer's
+/// per-client SendQueue): the experiment never waits for a client.
+///
+/// Client publishing: only on topics listed as writable; anything else is refused with a status
+/// error. A malformed JSON or binary message closes that client with the reason.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <dyad/component.hpp>
+
+#include "foxglove_protocol.hpp"
+#include "web_server.hpp"
+
+namespace dyad::web {
+
+class FoxgloveBridge final : public ClientHandler {
+ public:
+  // `channels`: the topics to advertise (ids 1..n in order); `writers`: topic -> writer for the
+  // writable ones (owned by the runtime).
+  FoxgloveBridge(std::string server_name, std::vector<foxglove::Channel> channels,
+                 std::map<std::string, SerializedWriter*> writers);
+  // Set once the server runs; null again before it stops. Samples and clients before that are ignored.
+  void SetServer(WebServer* server) { server_.store(server); }
+
+  // A sample of channel `channel_id` (called on the graph's delivering threads).
+  void OnSample(uint32_t channel_id, const SerializedSample& sample);
+  // Reports to each client what it lost since the last call (a status warning per client).
+  void ReportDrops();
+
+  void OnOpen(ClientId client) override;
+  Status OnText(ClientId client, std::string_view text) override;
+  Status OnBinary(ClientId client, std::span<const uint8_t> bytes) override;
+  void OnClose(ClientId client) override;
+
+  uint64_t samples_sent() const;
+
+ private:
+  struct ClientState {
+    std::map<uint32_t, uint32_t> subscriptions;        // subscription id -> channel id
+    std::map<uint32_t, SerializedWriter*> publishing;  // client channel id -> writer
+  };
+  void SendStatus(ClientId client, foxglove::Level level, const std::string& message);
+
+  const std::string server_name_;
+  const std::vector<foxglove::Channel> channels_;
+  const std::map<std::string, SerializedWriter*> writers_;
+  std::atomic<WebServer*> server_{nullptr};
+  mutable std::mutex mutex_;
+  std::map<ClientId, ClientState> clients_;
+  // channel id -> (client, subscription id): what OnSample sends to.
+  std::map<uint32_t, std::vector<std::pair<ClientId, uint32_t>>> routes_;
+  uint64_t sent_ = 0;
+};
+
+}  // namespace dyad::web

@@ -1,0 +1,137 @@
+#include "subject_channel.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+namespace dyad::web {
+namespace {
+using json = nlohmann::json;
+constexpr uint32_t kStateChannel = 1;
+}  // namespace
+
+void SubjectChannel::SetServer(WebServer* server) { server_.store(server); }
+
+size_t SubjectChannel::pages() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return pages_.size();
+}
+
+std::vector<double> SubjectChannel::arrival_ms() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return arrival_ms_;
+}
+
+void SubjectChannel::BroadcastState(double x, double y) {
+  WebServer* server = server_.load();
+  if (server == nullptr) return;
+  std::vector<ClientId> pages;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pages = pages_;
+  }
+  if (pages.empty()) return;
+  const std::string frame = json{{"op", "state"}, {"x", x}, {"y", y}}.dump();
+  for (ClientId c : pages) server->SendLatest(c, kStateChannel, frame, /*binary=*/false);
+}
+
+void SubjectChannel::SendRole(ClientId client, bool steering) {
+  if (WebServer* server = server_.load()) server->SendText(client, json{{"op", "role"}, {"steering", steering}}.dump());
+}
+
+void SubjectChannel::OnOpen(ClientId client) {
+  bool steering = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pages_.push_back(client);
+    if (steering_ == 0) steering_ = client, steering = true;
+  }
+  json prims = json::array();
+  for (const auto& p : options_.primitives) {
+    json pts = json::array();
+    for (const auto& xy : p) pts.push_back({xy[0], xy[1]});
+    prims.push_back(pts);
+  }
+  WebServer* server = server_.load();
+  if (server == nullptr) return;
+  server->SendText(client, json{{"op", "hello"},
+                                {"steering", steering},
+                                {"half_width", options_.half_width},
+                                {"engage_key", options_.engage_key},
+                                {"token_required", !options_.token.empty()},
+                                {"primitives", prims}}
+                               .dump());
+}
+
+Status SubjectChannel::OnText(ClientId client, std::string_view text) {
+  const json j = json::parse(text.begin(), text.end(), nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return Status::InvalidArgument("not a JSON object");
+  auto op = j.find("op");
+  if (op == j.end() || !op->is_string()) return Status::InvalidArgument("no \"op\" string");
+  if (*op == "pointer") {
+    auto x = j.find("x"), y = j.find("y"), engaged = j.find("engaged");
+    if (x == j.end() || y == j.end() || engaged == j.end() || !x->is_number() || !y->is_number() || !engaged->is_boolean())
+      return Status::InvalidArgument("pointer: needs numbers \"x\", \"y\" and a boolean \"engaged\"");
+    const double px = x->get<double>(), py = y->get<double>();
+    if (!std::isfinite(px) || !std::isfinite(py)) return Status::InvalidArgument("pointer: x and y must be finite");
+    // The page clamps to the workspace; a position outside it is clamped here too.
+    const double h = options_.half_width;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (client != steering_) return Status::OK();  // a watching page: ignored
+      last_x_ = std::clamp(px, -h, h);
+      last_y_ = std::clamp(py, -h, h);
+      sink_(last_x_, last_y_, engaged->get<bool>());
+      if (auto wall = j.find("wall"); wall != j.end() && wall->is_number() && arrival_ms_.size() < 100000) {
+        const double now_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
+        arrival_ms_.push_back(now_ms - wall->get<double>());
+      }
+    }
+    if (auto t = j.find("t"); t != j.end() && t->is_number())
+      if (WebServer* server = server_.load()) server->SendText(client, json{{"op", "ack"}, {"t", t->get<double>()}}.dump());
+    return Status::OK();
+  }
+  if (*op == "steer") {
+    auto token = j.find("token");
+    const bool ok = !options_.token.empty() && token != j.end() && token->is_string() && *token == options_.token;
+    if (!ok) {
+      if (WebServer* server = server_.load())
+        server->SendText(client, json{{"op", "error"}, {"message", "steering not taken: wrong or no token"}}.dump());
+      return Status::OK();
+    }
+    ClientId previous;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      previous = steering_;
+      if (previous == client) return Status::OK();
+      steering_ = client;
+      sink_(last_x_, last_y_, false);  // the previous steerer's hold ends now
+    }
+    if (previous != 0) SendRole(previous, false);
+    SendRole(client, true);
+    return Status::OK();
+  }
+  return Status::InvalidArgument("unknown op");
+}
+
+Status SubjectChannel::OnBinary(ClientId, std::span<const uint8_t>) {
+  return Status::InvalidArgument("binary frames are not part of this protocol");
+}
+
+void SubjectChannel::OnClose(ClientId client) {
+  ClientId promoted = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::erase(pages_, client);
+    if (client != steering_) return;
+    sink_(last_x_, last_y_, false);  // the subject left: disengaged at once
+    steering_ = pages_.empty() ? 0 : pages_.front();
+    promoted = steering_;
+  }
+  if (promoted != 0) SendRole(promoted, true);
+}
+
+}  // namespace dyad::web

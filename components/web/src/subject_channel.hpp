@@ -1,0 +1,67 @@
+/// SubjectChannel — the WebSocket behind the subject's page (`/subject/ws`): pointer input from
+/// the page, robot state to it.
+///
+/// Page -> server (JSON text): {"op":"pointer","x":..,"y":..,"engaged":bool,"t":ms} on every
+/// pointer or key event and every 50 ms while engaged (a keepalive); {"op":"steer","token":".."}
+/// to take the steering role. Server -> page: {"op":"hello",...} (role, workspace, engage key,
+/// primitives for the watermark), {"op":"role","steering":bool}, {"op":"state","x","y"} (newest
+/// only: a slow page never builds a backlog), {"op":"ack","t":ms} after each pointer sample was
+/// published (the page measures the round trip). A pointer sample may carry "wall" (the event's
+/// time, ms since the epoch): the channel then keeps the event-to-publication delay.
+///
+/// Several pages may watch; one steers: the first to connect, until it leaves (the oldest page
+/// left then steers) or a page presents the token (when one is set). Only the steering page's
+/// pointer reaches the graph; when it disconnects, a disengaged sample is published at once.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "web_server.hpp"
+
+namespace dyad::web {
+
+class SubjectChannel final : public ClientHandler {
+ public:
+  struct Options {
+    std::string engage_key = "Space";  // KeyboardEvent.code; the mouse button always engages
+    double half_width = 50;            // the workspace is [-half_width, half_width]^2
+    std::string token;                 // empty: no page can take the steering role over
+    std::vector<std::vector<std::array<double, 2>>> primitives;  // watermark; empty: none
+  };
+  // Publishes one pointer sample on the graph (called on civetweb threads, serialised here).
+  using PointerSink = std::function<void(double x, double y, bool engaged)>;
+
+  SubjectChannel(Options options, PointerSink sink) : options_(std::move(options)), sink_(std::move(sink)) {}
+  void SetServer(WebServer* server);
+  // Sends the robot's position to every page (newest only).
+  void BroadcastState(double x, double y);
+  size_t pages() const;
+  // Milliseconds from the page's event (its "wall" stamp) to the sample's publication, for every
+  // pointer sample that carried one (meaningful when page and server share a clock); at most
+  // the last 100,000.
+  std::vector<double> arrival_ms() const;
+
+  void OnOpen(ClientId client) override;
+  Status OnText(ClientId client, std::string_view text) override;
+  Status OnBinary(ClientId client, std::span<const uint8_t> bytes) override;
+  void OnClose(ClientId client) override;
+
+ private:
+  void SendRole(ClientId client, bool steering);
+  const Options options_;
+  const PointerSink sink_;
+  std::atomic<WebServer*> server_{nullptr};
+  mutable std::mutex mutex_;  // guards the members below and serialises sink_ calls
+  std::vector<ClientId> pages_;  // in connection order
+  ClientId steering_ = 0;        // 0: none
+  double last_x_ = 0, last_y_ = 0;
+  std::vector<double> arrival_ms_;
+};
+
+}  // namespace dyad::web

@@ -1,0 +1,255 @@
+#include "web_server.hpp"
+
+#include <civetweb.h>
+
+#include <atomic>
+#include <cstring>
+
+namespace dyad::web {
+namespace {
+
+constexpr int kCloseTooBig = 1009, kCloseUnsupported = 1003, kClosePolicy = 1008;
+
+// Writes a close frame (code + reason) directly; the connection closes when the data handler
+// returns 0.
+void WriteClose(mg_connection* conn, int code, const std::string& reason) {
+  std::string payload;
+  payload.push_back(static_cast<char>((code >> 8) & 0xff));
+  payload.push_back(static_cast<char>(code & 0xff));
+  payload.append(reason.substr(0, 120));  // a close frame's payload is at most 125 bytes
+  mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE, payload.data(), payload.size());
+}
+
+std::string QueryValue(const char* query, const std::string& key) {
+  if (query == nullptr) return "";
+  char buf[512];
+  const int n = mg_get_var(query, std::strlen(query), key.c_str(), buf, sizeof(buf));
+  return n >= 0 ? std::string(buf, static_cast<size_t>(n)) : "";
+}
+
+bool IsLoopback(const std::string& address) {
+  return address.rfind("127.", 0) == 0 || address == "localhost" || address == "::1";
+}
+
+}  // namespace
+
+struct WebServer::EndpointState {
+  WebServer* server = nullptr;
+  ClientHandler* handler = nullptr;
+  std::vector<const char*> protocol_ptrs;
+  mg_websocket_subprotocols protocols{};
+};
+
+struct WebServer::Client {
+  ClientId id = 0;
+  mg_connection* conn = nullptr;
+  SendQueue queue;
+  std::mutex write_mutex;  // held while writing; closing takes it, so no write outlives the connection
+  bool closed = false;
+  std::thread sender;
+  explicit Client(size_t limit) : queue(limit) {}
+};
+
+StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
+  mg_init_library(MG_FEATURES_WEBSOCKET);
+  std::unique_ptr<WebServer> s(new WebServer());
+  s->options_ = options;
+  const std::string ports = (options.address.find(':') != std::string::npos ? "[" + options.address + "]" : options.address) +
+                            ":" + std::to_string(options.port);
+  const std::string threads = std::to_string(options.max_clients + 4);
+  const char* opts[] = {"listening_ports", ports.c_str(), "num_threads", threads.c_str(), "request_timeout_ms", "5000",
+                        "websocket_timeout_ms", "3600000",
+                        // Small frames (pointer samples, acks) go out at once, not after Nagle's 40 ms.
+                        "tcp_nodelay", "1", nullptr};
+  mg_callbacks callbacks{};
+  callbacks.log_message = [](const mg_connection*, const char*) { return 1; };  // no stderr noise per client
+  s->ctx_ = mg_start(&callbacks, s.get(), opts);
+  if (s->ctx_ == nullptr)
+    return Status::IOError("web server: cannot listen on " + ports + " (in use, or not an address of this machine)");
+  mg_server_port sp[4];
+  const int n = mg_get_server_ports(s->ctx_, 4, sp);
+  s->port_ = n > 0 ? sp[0].port : options.port;
+  for (auto& [uri, page] : s->options_.pages) {
+    page.uri = uri;
+    mg_set_request_handler(s->ctx_, uri.c_str(), &WebServer::OnPage, &page);
+  }
+  for (const auto& e : s->options_.endpoints) {
+    auto st = std::make_unique<EndpointState>();
+    st->server = s.get();
+    st->handler = e.handler;
+    for (const auto& p : e.subprotocols) st->protocol_ptrs.push_back(p.c_str());
+    st->protocols.nb_subprotocols = static_cast<int>(st->protocol_ptrs.size());
+    st->protocols.subprotocols = st->protocol_ptrs.data();
+    mg_set_websocket_handler_with_subprotocols(s->ctx_, e.uri.c_str(), st->protocol_ptrs.empty() ? nullptr : &st->protocols,
+                                               &WebServer::OnConnect, &WebServer::OnReady, &WebServer::OnData,
+                                               &WebServer::OnClosed, st.get());
+    s->endpoints_.push_back(std::move(st));
+  }
+  return s;
+}
+
+int WebServer::OnPage(mg_connection* conn, void* page_ptr) {
+  const auto* page = static_cast<const Page*>(page_ptr);
+  const mg_request_info* info = mg_get_request_info(conn);
+  // Exact URIs only: civetweb matches prefixes ("/" would answer every path).
+  // Answered here: civetweb's own file handling is off (no document_root) and must not run.
+  if (info->local_uri == nullptr || page->uri != info->local_uri) {
+    // (mg_send_http_error crashes in libcivetweb 1.15 without a document_root: write it out.)
+    static const char kNotFound[] =
+        "HTTP/1.1 404 Not Found\r\nContent-Type: text/plain\r\nContent-Length: 10\r\nConnection: close\r\n\r\nnot found\n";
+    mg_write(conn, kNotFound, sizeof(kNotFound) - 1);
+    return 404;
+  }
+  mg_send_http_ok(conn, page->mime.c_str(), static_cast<long long>(page->body.size()));
+  mg_write(conn, page->body.data(), page->body.size());
+  return 200;
+}
+
+WebServer::~WebServer() {
+  if (ctx_ != nullptr) mg_stop(ctx_);  // closes every connection (OnClosed joins each sender)
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (auto& [id, c] : clients_) {
+    c->queue.Close();
+    if (c->sender.joinable()) c->sender.join();
+  }
+}
+
+bool WebServer::OriginAllowed(const std::string& origin) const {
+  for (const auto& o : options_.allowed_origins)
+    if (o == "*" || o == origin) return true;
+  if (IsLoopback(options_.address)) {
+    for (const char* local : {"http://localhost", "http://127.0.0.1", "https://localhost", "https://127.0.0.1"}) {
+      const std::string l(local);
+      if (origin == l || origin.rfind(l + ":", 0) == 0) return true;
+    }
+  }
+  return false;
+}
+
+int WebServer::OnConnect(const mg_connection* conn, void* endpoint) {
+  auto* self = static_cast<EndpointState*>(endpoint)->server;
+  const mg_request_info* info = mg_get_request_info(conn);
+  if (const char* origin = mg_get_header(conn, "Origin"); origin != nullptr && !self->OriginAllowed(origin)) return 1;
+  if (!self->options_.token.empty() && QueryValue(info->query_string, "token") != self->options_.token) return 1;
+  std::lock_guard<std::mutex> lock(self->mutex_);
+  if (static_cast<int>(self->admitted_.size()) >= self->options_.max_clients) return 1;
+  self->admitted_.insert(conn);
+  return 0;
+}
+
+void WebServer::OnReady(mg_connection* conn, void* endpoint) {
+  auto* self = static_cast<EndpointState*>(endpoint)->server;
+  ClientHandler* handler = static_cast<EndpointState*>(endpoint)->handler;
+  auto c = std::make_shared<Client>(self->options_.client_buffer_bytes);
+  c->conn = conn;
+  {
+    std::lock_guard<std::mutex> lock(self->mutex_);
+    c->id = self->next_id_++;
+    self->clients_[c->id] = c;
+    self->by_conn_[conn] = {c->id, handler};
+  }
+  Client* raw = c.get();
+  c->sender = std::thread([raw] {
+    Frame f;
+    while (raw->queue.Pop(&f)) {
+      std::lock_guard<std::mutex> lock(raw->write_mutex);
+      if (raw->closed) break;
+      const int op = f.binary ? MG_WEBSOCKET_OPCODE_BINARY : MG_WEBSOCKET_OPCODE_TEXT;
+      if (mg_websocket_write(raw->conn, op, f.bytes.data(), f.bytes.size()) <= 0) break;
+    }
+  });
+  handler->OnOpen(c->id);
+}
+
+int WebServer::OnData(mg_connection* conn, int bits, char* data, size_t len, void* endpoint) {
+  auto* self = static_cast<EndpointState*>(endpoint)->server;
+  ClientHandler* handler = static_cast<EndpointState*>(endpoint)->handler;
+  ClientId id = 0;
+  {
+    std::lock_guard<std::mutex> lock(self->mutex_);
+    auto it = self->by_conn_.find(conn);
+    if (it == self->by_conn_.end()) return 0;
+    id = it->second.first;
+  }
+  const int opcode = bits & 0x0f;
+  const bool fin = (bits & 0x80) != 0;
+  if (opcode == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) return 0;
+  if (opcode == MG_WEBSOCKET_OPCODE_PING) {
+    mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_PONG, data, len);
+    return 1;
+  }
+  if (opcode == MG_WEBSOCKET_OPCODE_PONG) return 1;
+  if (len > self->options_.max_frame_bytes) {
+    WriteClose(conn, kCloseTooBig, "frame of " + std::to_string(len) + " bytes exceeds the limit of " +
+                                       std::to_string(self->options_.max_frame_bytes));
+    return 0;
+  }
+  if (!fin || opcode == MG_WEBSOCKET_OPCODE_CONTINUATION) {
+    WriteClose(conn, kCloseUnsupported, "fragmented messages are not supported");
+    return 0;
+  }
+  Status s;
+  if (opcode == MG_WEBSOCKET_OPCODE_TEXT) s = handler->OnText(id, std::string_view(data, len));
+  else if (opcode == MG_WEBSOCKET_OPCODE_BINARY)
+    s = handler->OnBinary(id, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(data), len));
+  else s = Status::InvalidArgument("unknown opcode " + std::to_string(opcode));
+  if (!s.ok()) {
+    WriteClose(conn, kClosePolicy, s.message());
+    return 0;
+  }
+  return 1;
+}
+
+void WebServer::OnClosed(const mg_connection* conn, void* endpoint) {
+  auto* self = static_cast<EndpointState*>(endpoint)->server;
+  ClientHandler* handler = static_cast<EndpointState*>(endpoint)->handler;
+  std::shared_ptr<Client> c;
+  {
+    std::lock_guard<std::mutex> lock(self->mutex_);
+    self->admitted_.erase(conn);
+    auto it = self->by_conn_.find(conn);
+    if (it == self->by_conn_.end()) return;  // rejected before it was ready
+    c = self->clients_[it->second.first];
+    self->clients_.erase(it->second.first);
+    self->by_conn_.erase(it);
+  }
+  c->queue.Close();
+  {
+    std::lock_guard<std::mutex> lock(c->write_mutex);  // waits for a write in progress
+    c->closed = true;
+  }
+  if (c->sender.joinable()) c->sender.join();
+  handler->OnClose(c->id);
+}
+
+std::shared_ptr<WebServer::Client> WebServer::Find(ClientId id) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto it = clients_.find(id);
+  return it == clients_.end() ? nullptr : it->second;
+}
+
+void WebServer::SendText(ClientId client, std::string json) {
+  if (auto c = Find(client)) c->queue.PushControl(std::move(json));
+}
+
+void WebServer::SendData(ClientId client, uint32_t channel, std::string frame) {
+  if (auto c = Find(client)) c->queue.PushData(channel, std::move(frame));
+}
+
+void WebServer::SendLatest(ClientId client, uint32_t channel, std::string frame, bool binary) {
+  if (auto c = Find(client)) c->queue.PushLatest(channel, std::move(frame), binary);
+}
+
+std::map<uint32_t, uint64_t> WebServer::TakeDrops(ClientId client) {
+  if (auto c = Find(client)) return c->queue.TakeDrops();
+  return {};
+}
+
+std::vector<ClientId> WebServer::clients() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<ClientId> out;
+  for (const auto& [id, c] : clients_) out.push_back(id);
+  return out;
+}
+
+}  // namespace dyad::web

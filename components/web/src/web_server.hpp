@@ -1,0 +1,116 @@
+/// WebServer — the embedded HTTP + WebSocket server of one `web` component (civetweb, Debian's
+/// libcivetweb). It serves fixed pages (embedded in the plugin: no files to install, no CDN) and
+/// WebSocket endpoints, each with its own handler and accepted subprotocols.
+///
+/// Every client gets a SendQueue and a sender thread of its own: producers (the bridge, called
+/// from the graph's delivering threads) only queue, so a slow, stuck or malicious client never
+/// blocks the experiment; it loses samples instead (SendQueue's policy). Received frames larger
+/// than `max_frame_bytes` close the client (1009); a client the handler rejects is closed with
+/// the handler's code and reason.
+///
+/// Admission: at most `max_clients` WebSocket clients; when `token` is set, a client must connect
+/// with `?token=<token>`; a request carrying an Origin header must name an allowed origin
+/// (`allowed_origins`, entries "scheme://host[:port]" or "*"; localhost origins are always
+/// allowed when the server binds a loopback address).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <span>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include <dyad/status.hpp>
+
+#include "send_queue.hpp"
+
+struct mg_context;
+struct mg_connection;
+struct mg_websocket_subprotocols;
+
+namespace dyad::web {
+
+using ClientId = uint64_t;
+
+// What the application does with WebSocket clients. Called from civetweb's threads; one
+// client's calls never overlap, different clients' may.
+class ClientHandler {
+ public:
+  virtual ~ClientHandler() = default;
+  virtual void OnOpen(ClientId client) = 0;
+  // Return a non-OK Status to close the client with its message as the close reason.
+  virtual Status OnText(ClientId client, std::string_view text) = 0;
+  virtual Status OnBinary(ClientId client, std::span<const uint8_t> bytes) = 0;
+  virtual void OnClose(ClientId client) = 0;
+};
+
+class WebServer {
+ public:
+  struct Page {
+    std::string mime;  // e.g. "text/html; charset=utf-8"
+    std::string body;
+    std::string uri;  // filled by Start()
+  };
+  struct Endpoint {
+    std::string uri;                        // e.g. "/"
+    std::vector<std::string> subprotocols;  // empty: any
+    ClientHandler* handler = nullptr;
+  };
+  struct Options {
+    std::string address = "127.0.0.1";
+    int port = 8765;  // 0: any free port (see port())
+    std::map<std::string, Page> pages;  // by exact URI
+    std::vector<Endpoint> endpoints;
+    std::vector<std::string> allowed_origins;
+    std::string token;  // empty: none required
+    int max_clients = 8;
+    size_t max_frame_bytes = 1 << 20;
+    size_t client_buffer_bytes = 4 << 20;
+  };
+
+  // Starts listening; fails (IOError) when the address/port cannot be bound.
+  static StatusOr<std::unique_ptr<WebServer>> Start(const Options& options);
+  ~WebServer();  // closes every client, stops the server, joins every thread
+  WebServer(const WebServer&) = delete;
+  WebServer& operator=(const WebServer&) = delete;
+
+  int port() const { return port_; }
+  // Queue frames for a client (dropped silently if it is gone).
+  void SendText(ClientId client, std::string json);
+  void SendData(ClientId client, uint32_t channel, std::string frame);
+  // Newest only (see SendQueue::PushLatest); a text frame unless `binary`.
+  void SendLatest(ClientId client, uint32_t channel, std::string frame, bool binary);
+  // Per-channel drops of a client since the last call.
+  std::map<uint32_t, uint64_t> TakeDrops(ClientId client);
+  std::vector<ClientId> clients() const;
+
+ private:
+  struct Client;
+  struct EndpointState;
+  WebServer() = default;
+  static int OnPage(mg_connection* conn, void* page);
+  static int OnConnect(const mg_connection* conn, void* self);
+  static void OnReady(mg_connection* conn, void* self);
+  static int OnData(mg_connection* conn, int bits, char* data, size_t len, void* self);
+  static void OnClosed(const mg_connection* conn, void* self);
+  bool OriginAllowed(const std::string& origin) const;
+  std::shared_ptr<Client> Find(ClientId id) const;
+
+  Options options_;
+  mg_context* ctx_ = nullptr;
+  int port_ = 0;
+  std::vector<std::unique_ptr<EndpointState>> endpoints_;  // civetweb keeps pointers into these
+  mutable std::mutex mutex_;
+  std::map<ClientId, std::shared_ptr<Client>> clients_;
+  std::map<const mg_connection*, std::pair<ClientId, ClientHandler*>> by_conn_;
+  ClientId next_id_ = 1;
+  std::set<const mg_connection*> admitted_;  // past OnConnect, not yet closed
+};
+
+}  // namespace dyad::web
