@@ -114,7 +114,7 @@ TEST_F(ProcessTest, SteppedRunIgnoresOtherProcessesOnItsDomain) {
   Child b(Dyad({"run", Write("b.yaml", SteppedGraph(with, domain_)).string(), "--steps", "2000", "--quiet"}), dir_, "b");
   ASSERT_EQ(b.Wait(60), 0) << b.err();
   noisy.Signal(SIGINT);
-  EXPECT_EQ(noisy.Wait(30), 0) << noisy.err();
+  EXPECT_EQ(noisy.Wait(30), 130) << noisy.err();  // interrupted: 128 + SIGINT
   EXPECT_EQ(dyad::testing::ReadFile(with), dyad::testing::ReadFile(alone));
   for (const Received& r : ReadSink(heard)) ASSERT_GE(r.value, 5000000) << "the intruder heard the stepped run";
 }
@@ -150,7 +150,7 @@ TEST_F(ProcessTest, TwoComponentsExchangeSamplesAcrossTwoOsProcesses) {
   Child a(Dyad({"run", g.string(), "--process", "a", "--duration", "20"}), dir_, "a");
   ASSERT_EQ(b.Wait(30), 0) << b.err();
   a.Signal(SIGINT);
-  ASSERT_EQ(a.Wait(10), 0) << a.err();
+  ASSERT_EQ(a.Wait(10), 130) << a.err();
   const auto received = ReadSink(out);
   ASSERT_EQ(received.size(), 30u);
   for (size_t i = 1; i < received.size(); ++i)  // increasing (the first few may be missed while discovery completes)
@@ -168,7 +168,9 @@ TEST_F(ProcessTest, SigintStopsEveryProcessCleanly) {
   Child launcher(Dyad({"run", g.string()}), dir_, "launcher");  // starts a and b as children
   std::this_thread::sleep_for(std::chrono::seconds(3));
   launcher.Signal(SIGINT);
-  ASSERT_EQ(launcher.Wait(15), 0) << "hung or failed after SIGINT\n" << launcher.err();
+  ASSERT_EQ(launcher.Wait(15), 130) << "hung or failed after SIGINT\n" << launcher.err();
+  EXPECT_NE(launcher.err().find("dyad run: interrupted (SIGINT)"), std::string::npos) << launcher.err();
+  EXPECT_EQ(launcher.err().find("exited with"), std::string::npos) << "a child was not stopped cleanly\n" << launcher.err();
   const std::string o = launcher.out();
   EXPECT_NE(o.find("timing (process a)"), std::string::npos) << o;
   EXPECT_NE(o.find("timing (process b)"), std::string::npos) << o;
@@ -268,7 +270,8 @@ TEST_F(ProcessTest, IntrospectionSeesARunningGraph) {
   EXPECT_NE(none.err().find("no writer of topic 'no/such/topic'"), std::string::npos) << none.err();
 
   run.Signal(SIGINT);
-  EXPECT_EQ(run.Wait(15), 0) << run.err();
+  EXPECT_EQ(run.Wait(15), 130) << run.err();
+  EXPECT_NE(run.err().find("dyad run: interrupted (SIGINT)"), std::string::npos) << run.err();
 }
 
 }  // namespace

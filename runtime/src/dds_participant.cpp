@@ -14,6 +14,7 @@
 #include <fastdds/rtps/builtin/data/ParticipantProxyData.h>
 #include <fastdds/rtps/builtin/data/ReaderProxyData.h>
 #include <fastdds/rtps/builtin/data/WriterProxyData.h>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 
 #include <sstream>
 
@@ -295,6 +296,14 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
   factory->load_profiles();  // profiles load lazily; load them before reading defaults
   fdds::DomainParticipantQos qos = factory->get_default_participant_qos();
   qos.name(name);
+  p->scope_ = scope;
+  if (scope == Scope::kWatcher) {
+    qos.transport().use_builtin_transports = false;
+    qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+    // A watcher lives seconds: announce often, so a first discovery exchange that got lost is
+    // repeated within half a second rather than the default 3 s.
+    qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0.5);
+  }
   if (scope == Scope::kProcessOnly) {
     // Discovery ignores participants of other processes: nothing matches across the process
     // boundary, while this participant's own endpoints match and deliver intra-process.
@@ -373,6 +382,7 @@ StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, co
   ApplyQos(rq, qos);
   std::unique_ptr<DdsReader> r(new DdsReader());
   r->topic_ = topic;
+  if (scope_ == Scope::kWatcher) rq.data_sharing().off();
   r->listener_ = std::make_unique<DdsReader::Listener>(std::move(on_data));
   r->reader_ = subscriber_->create_datareader(*t, rq, r->listener_.get(), fdds::StatusMask::data_available());
   if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
@@ -418,6 +428,7 @@ StatusOr<SerializedSubscription*> DdsParticipant::CreateSerializedReader(const s
     rq.resource_limits().max_samples_per_instance = fdds::LENGTH_UNLIMITED;
     rq.resource_limits().max_instances = fdds::LENGTH_UNLIMITED;
   }
+  if (scope_ == Scope::kWatcher) rq.data_sharing().off();
   std::unique_ptr<DdsSerializedReader> r(new DdsSerializedReader());
   r->topic_ = topic;
   r->clock_ = clock;

@@ -141,7 +141,14 @@ class DdsParticipant final : public Transport {
   // of other processes (ignoreParticipantFlags = FILTER_DIFFERENT_PROCESS; the transports stay
   // up), so its endpoints match only endpoints in this process: a stepped (deterministic) run
   // that no other process on the domain can disturb, and that disturbs no one.
-  enum class Scope { kNetwork, kProcessOnly };
+  //
+  // kWatcher: a guest that watches a running graph (`dyad echo/hz/topics`): UDPv4 only, no
+  // shared-memory transport and no data sharing. A watcher may die at any moment (SIGKILL,
+  // SIGPIPE of `| head`): with shared memory, the graph's writers would keep pushing into the
+  // dead watcher's shared-memory port until Fast DDS's port health check gave up (blocking the
+  // writing component's step: steps of 0.3 to 2 s measured), and the next watcher reusing that
+  // port could not be reached for seconds. Over UDP a dead peer costs a lost datagram.
+  enum class Scope { kNetwork, kProcessOnly, kWatcher };
   static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, ProblemHandler on_problem,
                                                           Scope scope = Scope::kNetwork);
   // Stops every callback, deletes every endpoint created here, then the participant.
@@ -176,6 +183,7 @@ class DdsParticipant final : public Transport {
   std::mutex mutex_;  // guards the maps below (discovery reads them from Fast DDS threads)
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
   std::map<std::string, std::string> topic_types_;  // topic -> dds type name
+  Scope scope_ = Scope::kNetwork;
   // Every endpoint created here; destroyed (in this order) by the destructor only.
   std::vector<std::unique_ptr<DdsSerializedReader>> serialized_readers_;
   std::vector<std::unique_ptr<DdsReader>> readers_;

@@ -1,7 +1,5 @@
 #include "dyad/introspect.hpp"
 
-#include <signal.h>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -18,33 +16,15 @@
 
 
 #include "dds_participant.hpp"
+#include "dyad/interrupt.hpp"
 
 namespace dyad {
 namespace {
 
 using Steady = std::chrono::steady_clock;
 
-std::atomic<bool> g_interrupted{false};
-extern "C" void OnInterrupt(int) { g_interrupted.store(true); }
-
-// Ctrl-C ends echo/hz cleanly (participant deleted, no shared-memory leftovers).
-struct InterruptScope {
-  InterruptScope() {
-    g_interrupted.store(false);
-    struct sigaction sa {};
-    sa.sa_handler = OnInterrupt;
-    sigaction(SIGINT, &sa, &old_int);
-    sigaction(SIGTERM, &sa, &old_term);
-  }
-  ~InterruptScope() {
-    sigaction(SIGINT, &old_int, nullptr);
-    sigaction(SIGTERM, &old_term, nullptr);
-  }
-  struct sigaction old_int {}, old_term {};
-};
-
 std::unique_ptr<DdsParticipant> Join(const IntrospectOptions& o, std::ostream& err) {
-  auto p = DdsParticipant::Create(o.domain_id, "dyad/introspect", nullptr);
+  auto p = DdsParticipant::Create(o.domain_id, "dyad/introspect", nullptr, DdsParticipant::Scope::kWatcher);
   if (!p.ok()) {
     err << p.status().message() << "\n";
     return nullptr;
@@ -53,9 +33,9 @@ std::unique_ptr<DdsParticipant> Join(const IntrospectOptions& o, std::ostream& e
 }
 
 // Waits until some writer of `topic` is discovered; returns its DDS type name or "".
-std::string DiscoverType(DdsParticipant& p, const std::string& topic, double wait_s) {
+std::string DiscoverType(DdsParticipant& p, const std::string& topic, double wait_s, const InterruptWatcher& interrupt) {
   const auto end = Steady::now() + std::chrono::duration<double>(wait_s);
-  while (Steady::now() < end && !g_interrupted.load()) {
+  while (Steady::now() < end && !interrupt.interrupted()) {
     for (const auto& e : p.Discovered())
       if (e.writer && e.topic == topic) return e.type;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
@@ -137,11 +117,13 @@ struct TopicTap {
 
 // Joins the domain, waits for a writer of `topic`, resolves its type and opens a reader;
 // nullopt (after saying why on `err`) when any of that fails.
-std::optional<TopicTap> Tap(const IntrospectOptions& o, const Catalog& catalog, const std::string& topic, std::ostream& err) {
+std::optional<TopicTap> Tap(const IntrospectOptions& o, const Catalog& catalog, const std::string& topic, std::ostream& err,
+                            const InterruptWatcher& interrupt) {
   TopicTap tap;
   tap.participant = Join(o, err);
   if (!tap.participant) return std::nullopt;
-  const std::string dds_type = DiscoverType(*tap.participant, topic, o.wait_s);
+  const std::string dds_type = DiscoverType(*tap.participant, topic, o.wait_s, interrupt);
+  if (interrupt.interrupted()) return std::nullopt;
   if (dds_type.empty()) {
     err << "no writer of topic '" << topic << "' found on domain " << o.domain_id << " within " << o.wait_s << " s\n";
     return std::nullopt;
@@ -159,9 +141,12 @@ std::optional<TopicTap> Tap(const IntrospectOptions& o, const Catalog& catalog, 
 }  // namespace
 
 int ListTopics(const IntrospectOptions& o, std::ostream& out) {
+  InterruptWatcher interrupt;  // before the participant: its threads inherit the blocked signals
   auto p = Join(o, out);
   if (!p) return 1;
-  std::this_thread::sleep_for(std::chrono::duration<double>(o.wait_s));
+  const auto end = Steady::now() + std::chrono::duration<double>(o.wait_s);
+  while (Steady::now() < end && !interrupt.interrupted()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (interrupt.interrupted()) return 0;
   struct Row {
     std::set<std::string> types, participants;
     int writers = 0, readers = 0;
@@ -192,18 +177,20 @@ int ListTopics(const IntrospectOptions& o, std::ostream& out) {
 
 int EchoTopic(const IntrospectOptions& o, const Catalog& catalog, const std::string& topic, uint64_t count, double duration_s,
               const SamplePrinter& printer, std::ostream& out, std::ostream& err) {
-  InterruptScope scope;
-  auto tap = Tap(o, catalog, topic, err);
+  InterruptWatcher interrupt;  // before the participant: its threads inherit the blocked signals
+  auto tap = Tap(o, catalog, topic, err, interrupt);
+  if (interrupt.interrupted()) return 0;
   if (!tap) return 1;
   const TypeInfo* type = tap->type;
   RawReader& reader = *tap->reader;
   const auto end = duration_s > 0 ? Steady::now() + std::chrono::duration<double>(duration_s) : Steady::time_point::max();
   uint64_t n = 0;
   std::vector<uint8_t> bytes;
-  while (!g_interrupted.load() && Steady::now() < end && (count == 0 || n < count)) {
+  while (!interrupt.interrupted() && Steady::now() < end && (count == 0 || n < count)) {
     reader.Wait(0.1);
     while (reader.Next(&bytes)) {
       out << printer(*type, bytes.data(), bytes.size()) << "\n" << std::flush;
+      if (!out) return 0;  // the reader of our output went away (`| head`): done, quietly
       if (count != 0 && ++n >= count) break;
     }
   }
@@ -212,8 +199,9 @@ int EchoTopic(const IntrospectOptions& o, const Catalog& catalog, const std::str
 
 int TopicHz(const IntrospectOptions& o, const Catalog& catalog, const std::string& topic, double duration_s, std::ostream& out,
             std::ostream& err) {
-  InterruptScope scope;
-  auto tap = Tap(o, catalog, topic, err);
+  InterruptWatcher interrupt;  // before the participant: its threads inherit the blocked signals
+  auto tap = Tap(o, catalog, topic, err, interrupt);
+  if (interrupt.interrupted()) return 0;
   if (!tap) return 1;
   RawReader& reader = *tap->reader;
   const auto start = Steady::now();
@@ -223,7 +211,7 @@ int TopicHz(const IntrospectOptions& o, const Catalog& catalog, const std::strin
   Steady::time_point last{};
   uint64_t total = 0;
   std::vector<uint8_t> bytes;
-  while (!g_interrupted.load() && Steady::now() < end) {
+  while (!interrupt.interrupted() && Steady::now() < end) {
     reader.Wait(0.05);
     while (reader.Next(&bytes)) {
       const auto now = Steady::now();
@@ -244,6 +232,7 @@ int TopicHz(const IntrospectOptions& o, const Catalog& catalog, const std::strin
           << *std::min_element(periods.begin(), periods.end()) * 1e3 << " ms  max "
           << *std::max_element(periods.begin(), periods.end()) * 1e3 << " ms  samples " << total << "\n"
           << std::flush;
+      if (!out) return 0;  // the reader of our output went away
       out.unsetf(std::ios::fixed);
       periods.clear();
     }

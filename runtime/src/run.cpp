@@ -3,6 +3,7 @@
 #include "dyad/run.hpp"
 
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,10 +12,12 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <mutex>
 #include <set>
 #include <thread>
 
 #include "dyad/catalog.hpp"
+#include "dyad/interrupt.hpp"
 #include "dyad/validate.hpp"
 #include "executor.hpp"
 
@@ -69,42 +72,6 @@ void PrintReport(const std::vector<Executor::Row>& rows, const std::string& proc
   out.unsetf(std::ios::fixed);
 }
 
-// SIGINT/SIGTERM are blocked in every thread and taken here, so no Fast DDS or component thread
-// is interrupted by them. A second signal while stopping ends the process at once.
-class SignalWatcher {
- public:
-  explicit SignalWatcher(std::function<void(int)> on_signal) : on_signal_(std::move(on_signal)) {
-    sigemptyset(&set_);
-    sigaddset(&set_, SIGINT);
-    sigaddset(&set_, SIGTERM);
-    pthread_sigmask(SIG_BLOCK, &set_, &old_);
-    thread_ = std::thread([this] {
-      int count = 0;
-      while (!done_.load()) {
-        timespec ts{0, 50'000'000};
-        const int sig = sigtimedwait(&set_, nullptr, &ts);
-        if (sig <= 0) continue;
-        if (++count > 1) {
-          std::fprintf(stderr, "dyad: second signal, exiting now\n");
-          _exit(128 + sig);
-        }
-        on_signal_(sig);
-      }
-    });
-  }
-  ~SignalWatcher() {
-    done_.store(true);
-    thread_.join();
-    pthread_sigmask(SIG_SETMASK, &old_, nullptr);
-  }
-
- private:
-  sigset_t set_, old_;
-  std::function<void(int)> on_signal_;
-  std::atomic<bool> done_{false};
-  std::thread thread_;
-};
-
 int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err) {
   char host[256] = {0};
   gethostname(host, sizeof(host) - 1);
@@ -121,20 +88,33 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
     }
     names.push_back(p);
   }
-  std::atomic<bool> stopping{false};
-  SignalWatcher watcher([&](int sig) {
-    stopping.store(true);
+  // The signal thread and this one both touch `children`: under `mutex`. A signal that arrives
+  // while children are being started stops the starting too.
+  std::mutex mutex;
+  bool stopping = false;
+  InterruptWatcher interrupt([&](int sig) {
+    std::lock_guard<std::mutex> lock(mutex);
+    stopping = true;
     for (const auto& [pid, _] : children) kill(pid, sig);
   });
   for (const auto& p : names) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (stopping) break;
     std::vector<std::string> args = {"dyad", "run", options.graph_path, "--process", p};
     for (const auto& o : options.overrides) args.insert(args.end(), {"--set", o.text});
     for (const auto& pp : options.plugin_paths) args.insert(args.end(), {"--plugins", pp});
     if (options.duration_s > 0) args.insert(args.end(), {"--duration", std::to_string(options.duration_s)});
     if (options.steps > 0) args.insert(args.end(), {"--steps", std::to_string(options.steps)});
     if (options.quiet) args.push_back("--quiet");
+    const pid_t parent = getpid();
     const pid_t pid = fork();
     if (pid == 0) {
+      // Its own process group: a terminal's Ctrl-C reaches the launcher only, which forwards it
+      // once (a child hit by both would take the second as "exit now" and skip its clean
+      // shutdown). And it ends if the launcher dies (SIGKILL) instead of running on unwatched.
+      setpgid(0, 0);
+      prctl(PR_SET_PDEATHSIG, SIGTERM);
+      if (getppid() != parent) _exit(1);
       sigset_t none;
       sigemptyset(&none);
       pthread_sigmask(SIG_SETMASK, &none, nullptr);
@@ -152,21 +132,30 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
     children[pid] = p;
   }
   int worst = 0;
-  while (!children.empty()) {
+  for (;;) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (children.empty()) break;
+    }
     int status = 0;
     const pid_t pid = waitpid(-1, &status, 0);
     if (pid < 0) break;
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    if (code != 0) {
+    std::lock_guard<std::mutex> lock(mutex);
+    const bool interrupted = interrupt.signal() != 0 && code == ExitCodeForSignal(interrupt.signal());
+    if (code != 0 && !interrupted) {
       err << "process '" << children[pid] << "' exited with " << code << "\n";
       // One process failing ends the experiment.
-      if (!stopping.exchange(true))
+      if (!stopping) {
+        stopping = true;
         for (const auto& [other, _] : children)
           if (other != pid) kill(other, SIGTERM);
+      }
     }
     worst = std::max(worst, code);
     children.erase(pid);
   }
+  if (interrupt.signal() != 0) err << "dyad run: interrupted (" << SignalName(interrupt.signal()) << ")\n";
   return worst;
 }
 
@@ -211,24 +200,28 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   eo.steps = options.steps;
   eo.stats_period_s = options.stats_period_s;
   std::atomic<Executor*> current{nullptr};
-  std::atomic<int> pending_signal{0};
   Status result;
   std::vector<Executor::Row> rows;
-  int mismatches = 0;
+  int mismatches = 0, signal = 0;
   {
-    SignalWatcher watcher([&](int sig) {
-      pending_signal.store(sig);
-      if (Executor* ex = current.load()) ex->RequestStop(sig == SIGINT ? "SIGINT" : "SIGTERM");
+    InterruptWatcher interrupt([&](int sig) {
+      if (Executor* ex = current.load()) ex->RequestStop(SignalName(sig));
     });
     Executor ex(l.graph, l.resolved, &l.catalog, eo);
     current.store(&ex);
-    if (const int sig = pending_signal.load()) ex.RequestStop(sig == SIGINT ? "SIGINT" : "SIGTERM");
+    if (interrupt.signal() != 0) ex.RequestStop(SignalName(interrupt.signal()));  // before `current` was set
     result = ex.Run();
     rows = ex.Report();
     mismatches = ex.type_mismatches();
     current.store(nullptr);
+    signal = interrupt.signal();
   }
   if (!options.quiet) PrintReport(rows, process, out);
+  if (signal != 0) {
+    // A person stopped it: the run ended cleanly (recordings closed), but it did not finish.
+    err << "dyad run: interrupted (" << SignalName(signal) << ")" << (result.ok() ? "" : ": " + result.message()) << "\n";
+    return ExitCodeForSignal(signal);
+  }
   if (!result.ok()) {
     err << "dyad run: " << result.message() << "\n";
     return ExitCodeOf(result);

@@ -36,42 +36,45 @@ SamplePrinter JsonPrinter() {
 }  // namespace
 
 void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
-  static IntrospectOptions opts;
-  static std::string topic;
-  static uint64_t count = 0;
-  static double duration = 0;
-  static std::vector<std::string> plugins;
-
-  auto add_common = [](CLI::App* c) {
-    c->add_option("--domain", opts.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
-    c->add_option("--wait", opts.wait_s, "Seconds of discovery before answering")->check(CLI::NonNegativeNumber);
+  // Owned by this registration (one per CLI::App), not function statics.
+  struct State {
+    IntrospectOptions opts;
+    std::string topic;
+    uint64_t count = 0;
+    double duration = 0;
+    std::vector<std::string> plugins;
+  };
+  auto st = std::make_shared<State>();
+  auto add_common = [st](CLI::App* c) {
+    c->add_option("--domain", st->opts.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+    c->add_option("--wait", st->opts.wait_s, "Seconds of discovery before answering (topics) or giving up on a topic (echo, hz); default 5")->check(CLI::NonNegativeNumber);
   };
 
   auto* topics = app.add_subcommand("topics", "List the topics on the DDS domain with their types and endpoints");
   add_common(topics);
-  topics->callback([&exit_code] { exit_code = ListTopics(opts, std::cout); });
+  topics->callback([st, &exit_code] { exit_code = ListTopics(st->opts, std::cout); });
 
   auto* echo = app.add_subcommand("echo", "Print the samples published on a topic");
   add_common(echo);
-  echo->add_option("topic", topic, "Topic name")->required();
-  echo->add_option("-n,--count", count, "Stop after this many samples (0: until Ctrl-C)");
-  echo->add_option("--duration", duration, "Stop after this many seconds");
-  echo->add_option("--plugins", plugins, "Plugin file or folder whose message types to know (repeatable)");
-  echo->callback([&exit_code] {
+  echo->add_option("topic", st->topic, "Topic name")->required();
+  echo->add_option("-n,--count", st->count, "Stop after this many samples (0: until Ctrl-C)");
+  echo->add_option("--duration", st->duration, "Stop after this many seconds");
+  echo->add_option("--plugins", st->plugins, "Plugin file or folder whose message types to know (repeatable)");
+  echo->callback([st, &exit_code] {
     Catalog catalog;
-    catalog.LoadDefault(plugins);
-    exit_code = EchoTopic(opts, catalog, topic, count, duration, JsonPrinter(), std::cout, std::cerr);
+    catalog.LoadDefault(st->plugins);
+    exit_code = EchoTopic(st->opts, catalog, st->topic, st->count, st->duration, JsonPrinter(), std::cout, std::cerr);
   });
 
   auto* hz = app.add_subcommand("hz", "Measure the publication rate of a topic");
   add_common(hz);
-  hz->add_option("topic", topic, "Topic name")->required();
-  hz->add_option("--duration", duration, "Stop after this many seconds (0: until Ctrl-C)");
-  hz->add_option("--plugins", plugins, "Plugin file or folder whose message types to know (repeatable)");
-  hz->callback([&exit_code] {
+  hz->add_option("topic", st->topic, "Topic name")->required();
+  hz->add_option("--duration", st->duration, "Stop after this many seconds (0: until Ctrl-C)");
+  hz->add_option("--plugins", st->plugins, "Plugin file or folder whose message types to know (repeatable)");
+  hz->callback([st, &exit_code] {
     Catalog catalog;
-    catalog.LoadDefault(plugins);
-    exit_code = TopicHz(opts, catalog, topic, duration, std::cout, std::cerr);
+    catalog.LoadDefault(st->plugins);
+    exit_code = TopicHz(st->opts, catalog, st->topic, st->duration, std::cout, std::cerr);
   });
 }
 

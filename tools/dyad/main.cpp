@@ -2,6 +2,7 @@
 // its own library and adds its subcommands here.
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <iostream>
 
 #include "analyze_commands.hpp"
@@ -12,6 +13,9 @@
 #include "runtime_commands.hpp"
 
 int main(int argc, char** argv) {
+  // A closed output (`dyad echo T | head`) makes writes fail instead of killing the process, so
+  // every command ends cleanly (DDS participants deleted, files closed).
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{"dyad: human-robot interaction experiments as graphs of components over DDS"};
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Show every subcommand's help");

@@ -4,6 +4,7 @@
 #include <iomanip>
 #include <sstream>
 #include <iostream>
+#include <memory>
 
 #include <dyad/catalog.hpp>
 #include <dyad/run.hpp>
@@ -48,17 +49,23 @@ void PrintTypes(const Catalog& catalog, std::ostream& out) {
 }  // namespace
 
 void AddRuntimeCommands(CLI::App& app, int& exit_code) {
-  // Shared between subcommands; CLI11 keeps the pointers.
-  static RunOptions run;
-  static std::vector<std::string> sets;
-  static std::vector<std::string> plugins;
+  // Owned by this registration (one per CLI::App), shared by its subcommands: a second App in
+  // the same process (tests, embedding programs) starts from the defaults again.
+  struct State {
+    RunOptions run;
+    std::vector<std::string> sets, plugins;
+  };
+  auto st = std::make_shared<State>();
+  RunOptions& run = st->run;
+  std::vector<std::string>& sets = st->sets;
+  std::vector<std::string>& plugins = st->plugins;
 
   auto* validate = app.add_subcommand("validate", "Check a graph file; print every problem (exit 2) or OK");
   validate->add_option("graph", run.graph_path, "Graph YAML file")->required();
   validate->add_option("--set", sets, "Override a parameter: COMPONENT.PARAM=VALUE (repeatable)");
   validate->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
-  validate->callback([&exit_code] {
-    exit_code = ValidateGraphFile(run.graph_path, ToOverrides(sets), plugins, std::cout, std::cerr);
+  validate->callback([st, &exit_code] {
+    exit_code = ValidateGraphFile(st->run.graph_path, ToOverrides(st->sets), st->plugins, std::cout, std::cerr);
   });
 
   auto* r = app.add_subcommand("run", "Run a graph (the components of one process, or launch every process)");
@@ -71,17 +78,17 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
   r->add_option("--stats-period", run.stats_period_s, "Seconds between ComponentStats samples on dyad/stats")
       ->check(CLI::PositiveNumber);
   r->add_flag("--quiet", run.quiet, "Do not print the timing table at exit");
-  r->callback([&exit_code] {
-    run.overrides = ToOverrides(sets);
-    run.plugin_paths = plugins;
-    exit_code = RunGraph(run, std::cout, std::cerr);
+  r->callback([st, &exit_code] {
+    st->run.overrides = ToOverrides(st->sets);
+    st->run.plugin_paths = st->plugins;
+    exit_code = RunGraph(st->run, std::cout, std::cerr);
   });
 
   auto* types = app.add_subcommand("types", "List every component type found, with its ports and parameters");
   types->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
-  types->callback([&exit_code] {
+  types->callback([st, &exit_code] {
     Catalog catalog;
-    Status s = catalog.LoadDefault(plugins);
+    Status s = catalog.LoadDefault(st->plugins);
     if (!s.ok()) std::cerr << "warning: " << s.message() << "\n";
     PrintTypes(catalog, std::cout);
     exit_code = catalog.entries().empty() ? 1 : 0;

@@ -6,7 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
+#include "dyad/interrupt.hpp"
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -37,28 +37,6 @@ int Fail(int code, const std::string& msg) {
   std::fprintf(stderr, "error: %s\n", msg.c_str());
   return code;
 }
-
-// Set by SIGINT while training; the loop saves a checkpoint and stops.
-std::atomic<bool> g_interrupted{false};
-extern "C" void OnSigint(int) { g_interrupted.store(true); }
-
-// Restores the previous SIGINT handler when training ends.
-class SigintGuard {
- public:
-  SigintGuard() {
-    g_interrupted.store(false);
-    struct sigaction sa {};
-    sa.sa_handler = OnSigint;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &previous_);
-  }
-  ~SigintGuard() { sigaction(SIGINT, &previous_, nullptr); }
-  SigintGuard(const SigintGuard&) = delete;
-  SigintGuard& operator=(const SigintGuard&) = delete;
-
- private:
-  struct sigaction previous_ {};
-};
 
 std::string Duration(double s) {
   char buf[32];
@@ -120,7 +98,7 @@ int RunTraining(const TrainConfig& c, const std::string& config_path, const Data
     m.provenance.final_regulation = l.regulation;
     return m;
   };
-  SigintGuard guard;
+  InterruptWatcher interrupt;  // Ctrl-C: the loop saves a checkpoint and stops
   const auto t0 = Clock::now();
   LossTerms l;
   while (trainer.epoch() < c.epochs) {
@@ -130,7 +108,7 @@ int RunTraining(const TrainConfig& c, const std::string& config_path, const Data
       std::printf("\n");
       return Fail(kFailure, "training diverged at epoch " + std::to_string(e) + " (loss " + std::to_string(l.loss) + ")");
     }
-    const bool interrupted = g_interrupted.load();
+    const bool interrupted = interrupt.interrupted();
     if (e % c.log_every == 0 || e == c.epochs || interrupted) {
       const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
       const double re_p = trainer.PriorReconstruction(true, c.seed + static_cast<uint64_t>(e));
@@ -150,9 +128,9 @@ int RunTraining(const TrainConfig& c, const std::string& config_path, const Data
       if (Status s = SaveModel(snapshot(true, l), c.checkpoint); !s.ok()) return Fail(kFailure, s.message());
     }
     if (interrupted) {
-      std::printf("\ninterrupted at epoch %lld: checkpoint saved to %s (continue with --resume)\n",
-                  static_cast<long long>(e), c.checkpoint.c_str());
-      return kFailure;
+      std::printf("\ninterrupted (%s) at epoch %lld: checkpoint saved to %s (continue with --resume)\n",
+                  SignalName(interrupt.signal()), static_cast<long long>(e), c.checkpoint.c_str());
+      return ExitCodeForSignal(interrupt.signal());  // stopped by a person: neither done nor failed
     }
   }
   if (tty) std::printf("\n");

@@ -1,5 +1,12 @@
 // dyad/introspect.hpp — looking at a running experiment from outside: `dyad topics`,
-// `dyad echo`, `dyad hz`. Each joins the DDS domain as an ordinary participant.
+// `dyad echo`, `dyad hz`. Each joins the DDS domain as a guest participant (UDP only, BEST_EFFORT
+// readers, no shared memory): whatever a watcher does or however it dies (SIGKILL, `| head`),
+// the graph's writers never wait for it.
+//
+// Ctrl-C (or SIGTERM) ends them cleanly (participant deleted, so the graph forgets it at once)
+// with exit 0: it is how `echo` and `hz` without a count or duration are meant to end. A closed
+// output (`dyad echo T | head -2`) ends them the same way, quietly, exit 0 (SIGPIPE is ignored by
+// the dyad executable, so the write fails instead of killing the process).
 //
 // Types are resolved from the topic's discovered DDS type name ("name#hash") against the
 // message types this dyad knows (built-in IDL and loaded plugins). A topic whose type has the
@@ -18,7 +25,10 @@ namespace dyad {
 
 struct IntrospectOptions {
   int domain_id = 0;
-  double wait_s = 2.0;      // discovery time before answering / giving up on a topic
+  // Discovery time before answering (topics) or giving up on a topic (echo, hz: they start as
+  // soon as a writer is found, typically after ~0.2 s). Fast DDS occasionally loses its first
+  // discovery exchange and repeats it only at the next announcement (up to 3 s): 5 s covers it.
+  double wait_s = 5.0;
 };
 
 // Prints one line per topic: name, type, writers, readers, participants. Returns 0, or 1 when

@@ -1,0 +1,54 @@
+// dyad/interrupt.hpp — Ctrl-C (SIGINT) and SIGTERM for every dyad command, one mechanism.
+//
+// An InterruptWatcher blocks SIGINT and SIGTERM in the thread that creates it, so every thread
+// started afterwards (Fast DDS's, components', trainers') inherits the block, and takes them on
+// a thread of its own with sigtimedwait. So a signal never interrupts a system call of a Fast
+// DDS thread, never runs code in a signal handler, and `on_signal` runs on an ordinary thread
+// (it may lock, log, call Executor::RequestStop). A second signal while the first is being
+// handled ends the process at once (exit 128 + signal): Ctrl-C twice always works.
+//
+// Create it first, before any participant or worker thread; destroy it last. One at a time per
+// process (the block is process-wide in effect). The destructor restores the previous mask.
+//
+//   dyad::InterruptWatcher interrupt([&](int sig) { executor.RequestStop(SignalName(sig)); });
+//   ... run ...
+//   if (interrupt.signal() != 0) return ExitCodeForSignal(interrupt.signal());
+//
+// Exit codes: a command ended by a signal exits 128 + signal (130 for Ctrl-C), the shell's
+// convention, after saying "interrupted (SIGINT)" and finishing cleanly (recordings closed,
+// checkpoints written): scripts can tell "stopped by a person" from success (0) and failure.
+#pragma once
+
+#include <signal.h>
+
+#include <atomic>
+#include <functional>
+#include <thread>
+
+namespace dyad {
+
+class InterruptWatcher {
+ public:
+  explicit InterruptWatcher(std::function<void(int signal)> on_signal = nullptr);
+  ~InterruptWatcher();
+  InterruptWatcher(const InterruptWatcher&) = delete;
+  InterruptWatcher& operator=(const InterruptWatcher&) = delete;
+
+  // The first signal taken (SIGINT or SIGTERM), 0 if none. Thread-safe.
+  int signal() const { return signal_.load(std::memory_order_acquire); }
+  bool interrupted() const { return signal() != 0; }
+
+ private:
+  sigset_t set_, old_;
+  std::function<void(int)> on_signal_;
+  std::atomic<int> signal_{0};
+  std::atomic<bool> done_{false};
+  std::thread thread_;
+};
+
+// "SIGINT", "SIGTERM", or "signal N".
+const char* SignalName(int signal);
+// 128 + signal.
+inline int ExitCodeForSignal(int signal) { return 128 + signal; }
+
+}  // namespace dyad
