@@ -106,9 +106,19 @@ StatusOr<Model> LoadModel(const std::string& path) {
   const size_t payload_bytes = view->payload_bytes;
   Model m;
   try {
+    // Each tensor's extent is checked against the payload before anything is summed or
+    // multiplied: huge offsets or shapes must not wrap around into something that fits.
+    const uint64_t payload_values = payload_bytes / 8;
     uint64_t needed = 0;
-    for (const auto& t : header.at("tensors"))
-      needed = std::max<uint64_t>(needed, t.at("offset").get<uint64_t>() + t.at("rows").get<uint64_t>() * t.at("cols").get<uint64_t>());
+    for (const auto& t : header.at("tensors")) {
+      const uint64_t offset = t.at("offset").get<uint64_t>(), rows = t.at("rows").get<uint64_t>(),
+                     cols = t.at("cols").get<uint64_t>();
+      if ((cols != 0 && rows > payload_values / cols) || offset > payload_values - rows * cols)
+        return Status::DataLoss(path + ": truncated: tensor " + t.at("name").get<std::string>() + " (offset " +
+                                std::to_string(offset) + ", " + std::to_string(rows) + " x " + std::to_string(cols) +
+                                ") does not fit in the payload of " + std::to_string(payload_bytes) + " bytes");
+      needed = std::max<uint64_t>(needed, offset + rows * cols);
+    }
     if (needed * 8 > payload_bytes)
       return Status::DataLoss(path + ": truncated: tensors need " + std::to_string(needed * 8) + " bytes, file has " +
                                std::to_string(payload_bytes));
@@ -132,11 +142,11 @@ StatusOr<Model> LoadModel(const std::string& path) {
     auto read = [&](const std::string& name, int rows, int cols, auto&& sink) -> Status {
       for (const auto& t : header.at("tensors")) {
         if (t.at("name").get<std::string>() != name) continue;
-        if (t.at("rows").get<int>() != rows || t.at("cols").get<int>() != cols)
-          return Status::DataLoss(path + ": tensor " + name + " is " + std::to_string(t.at("rows").get<int>()) + " x " +
-                                   std::to_string(t.at("cols").get<int>()) + ", the spec needs " + std::to_string(rows) +
+        if (t.at("rows").get<uint64_t>() != static_cast<uint64_t>(rows) || t.at("cols").get<uint64_t>() != static_cast<uint64_t>(cols))
+          return Status::DataLoss(path + ": tensor " + name + " is " + std::to_string(t.at("rows").get<uint64_t>()) + " x " +
+                                   std::to_string(t.at("cols").get<uint64_t>()) + ", the spec needs " + std::to_string(rows) +
                                    " x " + std::to_string(cols));
-        const size_t at = payload_at + t.at("offset").get<size_t>() * 8;
+        const size_t at = payload_at + t.at("offset").get<size_t>() * 8;  // checked to fit above
         for (int c = 0; c < cols; ++c)
           for (int r = 0; r < rows; ++r) sink(r, c, ReadDouble(in, at + (static_cast<size_t>(c) * rows + r) * 8));
         return Status::OK();

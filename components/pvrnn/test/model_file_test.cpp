@@ -3,8 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <cstring>
 #include <fstream>
+#include <functional>
 
+#include <nlohmann/json.hpp>
+
+#include "dyad/pvrnn/checked_file.hpp"
 #include "test_paths.hpp"
 
 namespace dyad::pvrnn {
@@ -115,6 +120,45 @@ TEST(ModelFile, WrongVersionIsReportedWithBothVersions) {
   auto r = LoadModel(path);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().message(), path + ": format version 9, this build reads version 1");
+  std::filesystem::remove(path);
+}
+
+// A file whose header was edited (`edit`) and whose checksum was then made right again: what a
+// careless tool or an attacker can write. The magic and version are kept.
+std::string WithEditedHeader(const std::string& good, const std::string& path,
+                             const std::function<void(nlohmann::json&)>& edit) {
+  char magic[8];
+  std::memcpy(magic, good.data(), 8);
+  auto view = OpenCheckedFile(good, path, magic, kModelFileVersion, "model");
+  EXPECT_TRUE(view.ok());
+  nlohmann::json header = nlohmann::json::parse(view->json);
+  edit(header);
+  std::string out = BeginCheckedFile(magic, kModelFileVersion, header.dump());
+  out.append(good, view->payload_at, view->payload_bytes);
+  EXPECT_TRUE(FinishCheckedFile(out, path).ok());
+  return ReadAll(path);
+}
+
+// Found by fuzzing (tests/fuzz/regressions/model_file): a tensor table entry with a huge offset
+// made the sum of offsets wrap around to exactly the payload size, so a real tensor placed past
+// the end of the file was read out of bounds. Every extent is now checked on its own.
+TEST(ModelFile, TensorOffsetsThatWrapAroundAreDataLossNotAnOutOfBoundsRead) {
+  const std::string path = testing::TempPath("wrap.dpvrnn");
+  ASSERT_TRUE(SaveModel(SmallModel(), path).ok());
+  const std::string good = ReadAll(path);
+  WithEditedHeader(good, path, [](nlohmann::json& h) {
+    uint64_t payload_values = 0;
+    for (const auto& t : h["tensors"])
+      payload_values = std::max<uint64_t>(payload_values, t["offset"].get<uint64_t>() + t["rows"].get<uint64_t>() * t["cols"].get<uint64_t>());
+    h["tensors"][0]["offset"] = payload_values;  // the first weights start where the file ends
+    // (1 << 61) + payload_values: times 8 bytes, that wraps to exactly the payload size.
+    h["tensors"].push_back({{"name", "pad"}, {"rows", 0}, {"cols", 0}, {"offset", (uint64_t{1} << 61) + payload_values}});
+  });
+  auto r = LoadModel(path);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), Status::Code::kDataLoss);
+  EXPECT_EQ(r.status().message().rfind(path + ": truncated: tensor ", 0), 0u) << r.status().message();
+  EXPECT_NE(r.status().message().find(") does not fit in the payload of "), std::string::npos) << r.status().message();
   std::filesystem::remove(path);
 }
 
