@@ -33,7 +33,10 @@ configure() {  # configure DIR SANITIZERS EXTRA_CMAKE_ARGS...
 
 # Reports are fatal and symbolized; leaks are reported (LeakSanitizer). Fast DDS and yaml-cpp
 # are not instrumented; tools/sanitizers/*.supp hold the suppressions that needs (and say why).
-export ASAN_OPTIONS="abort_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=0:check_initialization_order=1${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
+# new_delete_type_mismatch=0: Fast DDS 2.9 itself deletes its StatisticsReaderImpl through a base
+# of another size (allocated 64 bytes, sized delete of 56 in RTPSReader::~RTPSReader), on every
+# reader it destroys; ASan can only turn that check off as a whole (no suppression by library).
+export ASAN_OPTIONS="abort_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=0:check_initialization_order=1:new_delete_type_mismatch=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$here/tools/sanitizers/ubsan.supp${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
 export LSAN_OPTIONS="suppressions=$here/tools/sanitizers/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$here/tools/sanitizers/tsan.supp${TSAN_OPTIONS:+:$TSAN_OPTIONS}"
@@ -53,7 +56,7 @@ asan() {
 replay() {
   local dir=$here/build-san
   configure "$dir" "address,undefined" -DDYAD_FUZZ=ON
-  nice -n 10 cmake --build "$dir" -j2 --target $(cd "$here/tests/fuzz" && ls fuzz_*.cpp | sed 's/^fuzz_/dyad_fuzz_/; s/\.cpp$//')
+  nice -n 10 cmake --build "$dir" -j2 --target $(cd "$here/tests/fuzz" && ls fuzz_*.cpp | grep -v "^fuzz_support" | sed 's/^fuzz_/dyad_fuzz_/; s/\.cpp$//')
   (cd "$dir" && nice -n 10 ctest --output-on-failure -L fuzz "$@")
 }
 

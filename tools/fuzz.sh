@@ -15,7 +15,7 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 dir=$here/build-san
-targets=$(cd "$here/tests/fuzz" && ls fuzz_*.cpp | sed 's/^fuzz_//; s/\.cpp$//')
+targets=$(cd "$here/tests/fuzz" && ls fuzz_*.cpp | grep -v "^fuzz_support" | sed 's/^fuzz_//; s/\.cpp$//')
 mode=${1:-list}
 
 build() {
