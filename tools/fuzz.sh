@@ -46,6 +46,7 @@ run() {  # run TARGET SECONDS
   case $t in
     graph) args+=(-dict="$here/tests/fuzz/dict/graph.dict") ;;
     cdr_schema) args+=(-dict="$here/tests/fuzz/dict/idl.dict") ;;
+    model_file | observer_file) args+=(-dict="$here/tests/fuzz/dict/checked_file.dict") ;;
   esac
   local corpora=("$dir/fuzz/corpus/$t" "$dir/fuzz/seeds/$t")
   [ -d "$here/tests/fuzz/regressions/$t" ] && corpora+=("$here/tests/fuzz/regressions/$t")
