@@ -1,6 +1,10 @@
 // Fuzz target: the IDL-driven CDR decoder (`dyad echo`, bag export, recorder) against every
-// message type of idl/: schema fixed, bytes fuzzed. The first byte picks the type; the rest is the
-// serialized sample (encapsulation header first). Decode, ToJson, Columns and DecodeRow all run.
+// message type of idl/, and the decoder test's dyad_cdr_test::Everything (every supported IDL
+// construct): schema fixed, bytes fuzzed. The first byte picks the type (in that order); the rest
+// is the serialized sample (encapsulation header first). Decode, ToJson, Columns and DecodeRow
+// all run.
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -26,6 +30,13 @@ const std::vector<Type>& Types() {
       dyad::fuzz::Require(schema.HasType(info->name), info->name + " not in its schema");
       out.push_back({schema, info->name});
     }
+    std::ifstream in(DYAD_CDR_TEST_IDL);
+    std::stringstream idl;
+    idl << in.rdbuf();
+    std::string error;
+    dyad::cdr::Schema everything = dyad::cdr::Schema::Parse(idl.str(), &error);
+    dyad::fuzz::Require(error.empty() && everything.HasType("dyad_cdr_test::Everything"), DYAD_CDR_TEST_IDL ": " + error);
+    out.push_back({everything, "dyad_cdr_test::Everything"});
     return out;
   }();
   return types;

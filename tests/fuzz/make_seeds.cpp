@@ -129,6 +129,11 @@ void CdrSeeds() {
          std::string(1, static_cast<char>(i)) + std::string(reinterpret_cast<const char*>(payload.data), payload.length));
     Seed("cdr_schema", short_name(types[i]->name) + ".idl", types[i]->idl);
   }
+  // dyad_cdr_test::Everything (the harness's last type): all zeros is a valid sample of it
+  // (empty strings and sequences, first enumerators).
+  std::string everything(1, static_cast<char>(types.size()));
+  everything += std::string("\0\1\0\0", 4) + std::string(400, '\0');
+  Seed("cdr_decode", "Everything.cdr", everything);
 }
 
 void UdpSeeds() {
