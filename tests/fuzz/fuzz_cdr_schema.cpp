@@ -1,6 +1,7 @@
 // Fuzz target: the IDL schema parser of the CDR decoder (schemas come from recordings and peers).
 // A schema that parses is also compiled for decoding: its structs' columns are listed and a small
 // fixed payload is decoded against each (bounded work whatever the IDL says).
+#include <cctype>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // Struct names are not exposed: try the identifiers written after `struct`, with their module.
   static const uint8_t payload[] = {0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 'a', 0, 0, 0,
                                     3, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xf0, 0x3f, 1, 2, 3, 4};
-  std::vector<std::string> modules;
   size_t at = 0;
   int budget = 8;
   while (budget-- > 0 && (at = idl.find("struct ", at)) != std::string::npos) {
