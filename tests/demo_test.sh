@@ -3,21 +3,21 @@
 # folder: the first run must produce a complete recording and report, the second must reuse the
 # cached data set, model and observer. With `macaw`, the MacawBot variant (skipped, exit 77,
 # when ../shared/data/vcbot is missing).
-# usage: demo_test.sh REPO WORK_DIR [macaw]
+# usage: demo_test.sh REPO WORK_DIR [demo|macaw] [BUILD_DIR (default REPO/build)]
 set -euo pipefail
-repo=$1 work=$2 name=${3:-demo}
+repo=$1 work=$2 name=${3:-demo} build=${4:-$1/build}
 if [ "$name" = macaw ] && [ ! -d "$repo/../shared/data/vcbot/model/MacawBot" ]; then
   echo "SKIP: the macaw demo needs ../shared/data/vcbot beside the repository (not found)"
   exit 77
 fi
 rm -rf "$work"
-run() { DEMO_SKIP_SETUP=1 DEMO_STEPS=300 DEMO_EPOCHS=200 DEMO_WORK="$work" bash "$repo/tools/demo.sh" "$name"; }
+run() { DEMO_BUILD="$build" DEMO_SKIP_SETUP=1 DEMO_STEPS=300 DEMO_EPOCHS=200 DEMO_WORK="$work" bash "$repo/tools/demo.sh" "$name"; }
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
 first=$(run 2>&1) || { echo "$first"; fail "first run exited non-zero"; }
 rec="$work/$name/$name.mcap"
 [ -f "$rec" ] || fail "no recording at $rec"
-info=$("$repo/build/bin/dyad" bag info "$rec")
+info=$("$build/bin/dyad" bag info "$rec")
 echo "$info" | grep -q "state:       complete" || fail "recording not complete: $info"
 for topic in human/input robot/intention robot/command robot/state observer/labels; do
   echo "$info" | grep -Eq "^  [0-9]+  $topic  300 msgs" || fail "$topic does not have 300 messages: $info"

@@ -116,6 +116,9 @@ std::vector<BadCase> BadCases() {
       {"BothRateAndTrigger", Replace(v, "    trigger: in", "    trigger: in\n    rate_hz: 5"), "g.yaml:11:14",
        "components.sink.trigger", "either rate_hz or trigger"},
       {"ComponentsNotAMap", "graph: x\ncomponents: [a, b]\n", "g.yaml:2:13", "components", "must be a mapping"},
+      // Tried by hand while fuzzing graphs: yaml-cpp stops deep nesting but said only "bad file".
+      {"NestedTooDeep", "graph: x\ncomponents: " + std::string(3000, '[') + "\n", "g.yaml:3:", "",
+       "YAML syntax error: nested too deeply (500 levels)"},
   };
 }
 

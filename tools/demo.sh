@@ -18,7 +18,8 @@
 # next to the models to force it.
 #
 # For tests: DEMO_STEPS=N shortens step 4; DEMO_EPOCHS=N shortens both trainings; DEMO_WORK=DIR
-# puts data, models and outputs under DIR; DEMO_SKIP_SETUP=1 skips setup and build.
+# puts data, models and outputs under DIR; DEMO_SKIP_SETUP=1 skips setup and build;
+# DEMO_BUILD=DIR runs the dyad of another build folder (the sanitizer build's tests do).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 name="${1:-demo}"
@@ -31,7 +32,7 @@ if [ "${DEMO_SKIP_SETUP:-0}" != 1 ]; then
   bash "$here/tools/build.sh"
 fi
 cd "$here"
-dyad="$here/build/bin/dyad"
+dyad="${DEMO_BUILD:-$here/build}/bin/dyad"
 steps="${DEMO_STEPS:-2000}"
 work="${DEMO_WORK:-$here/build}"
 out="${DEMO_WORK:-$here/out}/$name"

@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Installs what dyad needs on Debian 12 (as root, or with sudo). Idempotent; a second run that
 # finds everything installed does nothing and takes well under a second.
+#   bash tools/setup.sh            what building and testing need
+#   bash tools/setup.sh sanitize   also clang 14 with its sanitizer and libFuzzer runtimes and
+#                                  llvm-symbolizer (tools/check.sh, tools/fuzz.sh)
 set -euo pipefail
 packages=(
   build-essential cmake git pkg-config
@@ -9,6 +12,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libcivetweb-dev
   python3 python3-matplotlib chromium
 )
+if [ "${1:-}" = "sanitize" ]; then
+  packages+=(clang-14 libclang-rt-14-dev llvm-14)
+fi
 # Node.js may come from elsewhere (with its own npm): only ask Debian when the command is missing.
 command -v node > /dev/null || packages+=(nodejs)
 command -v npm > /dev/null || packages+=(npm)

@@ -6,6 +6,8 @@
 #include <set>
 #include <sstream>
 
+#include <yaml-cpp/depthguard.h>
+
 namespace dyad {
 namespace {
 
@@ -251,6 +253,10 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   YAML::Node root;
   try {
     root = YAML::Load(yaml_text);
+  } catch (const YAML::DeepRecursion& e) {  // yaml-cpp says only "bad file"
+    diagnostics->push_back({SourceMark{path, e.mark.line + 1, e.mark.column + 1}, "",
+                            "YAML syntax error: nested too deeply (" + std::to_string(e.depth()) + " levels)"});
+    return g;
   } catch (const YAML::ParserException& e) {
     diagnostics->push_back({SourceMark{path, e.mark.line + 1, e.mark.column + 1}, "", "YAML syntax error: " + e.msg});
     return g;

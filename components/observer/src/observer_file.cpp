@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dyad/pvrnn/checked_file.hpp"
+#include "dyad/pvrnn/json_fields.hpp"
 
 namespace dyad::observer {
 namespace {
@@ -55,9 +56,9 @@ StatusOr<ObserverFile> LoadObserver(const std::string& path) {
   try {
     const json header = json::parse(view->json);
     const json& s = header.at("spec");
-    spec.window = s.at("window").get<int>();
-    spec.hidden = s.at("hidden").get<std::vector<int>>();
-    spec.classes = s.at("classes").get<int>();
+    spec.window = pvrnn::JsonInt<int>(s, "window");
+    spec.hidden = pvrnn::JsonIntArray<int>(s, "hidden");
+    spec.classes = pvrnn::JsonInt<int>(s, "classes");
     const std::string input = s.at("input").get<std::string>();
     if (!ParseInputRepresentation(input, &spec.input))
       return Status::DataLoss(path + ": spec.input: unknown representation \"" + input + "\"");
@@ -67,16 +68,16 @@ StatusOr<ObserverFile> LoadObserver(const std::string& path) {
     auto& pv = out.provenance;
     pv.source = p.at("source").get<std::string>();
     pv.model = p.at("model").get<std::string>();
-    pv.train_seeds = p.at("train_seeds").get<std::vector<uint64_t>>();
-    pv.validation_seeds = p.at("validation_seeds").get<std::vector<uint64_t>>();
-    pv.steps = p.at("steps").get<int>();
-    pv.drop = p.at("drop").get<int>();
-    pv.epochs = p.at("epochs").get<int>();
-    pv.seed = p.at("seed").get<uint64_t>();
+    pv.train_seeds = pvrnn::JsonIntArray<uint64_t>(p, "train_seeds");
+    pv.validation_seeds = pvrnn::JsonIntArray<uint64_t>(p, "validation_seeds");
+    pv.steps = pvrnn::JsonInt<int>(p, "steps");
+    pv.drop = pvrnn::JsonInt<int>(p, "drop");
+    pv.epochs = pvrnn::JsonInt<int>(p, "epochs");
+    pv.seed = pvrnn::JsonInt<uint64_t>(p, "seed");
     pv.validation_min_diagonal = NumFrom(p.at("validation_min_diagonal"));
     pv.validation_accuracy = NumFrom(p.at("validation_accuracy"));
     if (Status st = spec.Validate(); !st.ok()) return Status::DataLoss(path + ": spec." + st.message());
-    const int64_t count = header.at("parameters").get<int64_t>();
+    const int64_t count = pvrnn::JsonInt<int64_t>(header, "parameters");
     if (count != spec.num_parameters())
       return Status::DataLoss(path + ": header lists " + std::to_string(count) + " parameters, the spec needs " +
                               std::to_string(spec.num_parameters()));

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "dyad/observer/observer_file.hpp"
+#include "edit_checked_file.hpp"
 
 namespace dyad::observer {
 namespace {
@@ -80,6 +81,27 @@ TEST(ObserverFile, DamagedFilesGiveErrorsNamingTheFileAndFault) {
   version[8] = 9;
   EXPECT_EQ(message(version), bad + ": format version 9, this build reads version 1");
   EXPECT_EQ(LoadObserver(Temp("missing.dobs")).status().message(), Temp("missing.dobs") + ": cannot open");
+}
+
+// nlohmann's get<int>() of 1e30 is undefined behaviour and of 4294967297 wraps to 1 (the file then
+// loaded): whole-number header fields are read exactly (pvrnn/json_fields.hpp).
+TEST(ObserverFile, HeaderNumbersOutOfRangeAreDataLossNotConvertedOrWrapped) {
+  const std::string p = Temp("range.dobs");
+  ASSERT_TRUE(SaveObserver(Sample(), p).ok());
+  const std::string good = ReadAll(p);
+  const std::vector<std::pair<std::function<void(nlohmann::json&)>, std::string>> cases = {
+      {[](nlohmann::json& h) { h["spec"]["window"] = 1e30; }, "window = 1e+30: not a whole number in -2147483648..2147483647"},
+      {[](nlohmann::json& h) { h["spec"]["window"] = 4294967300u; }, "window = 4294967300: not a whole number in -2147483648..2147483647"},
+      {[](nlohmann::json& h) { h["spec"]["hidden"][1] = 4294967302u; }, "hidden[1] = 4294967302: not a whole number in -2147483648..2147483647"},
+      {[](nlohmann::json& h) { h["provenance"]["train_seeds"][0] = -1; }, "train_seeds[0] = -1: not a whole number in 0..18446744073709551615"},
+  };
+  for (const auto& [edit, message] : cases) {
+    pvrnn::testing::WriteWithEditedHeader(good, kObserverFileVersion, p, edit);
+    auto r = LoadObserver(p);
+    ASSERT_FALSE(r.ok()) << message;
+    EXPECT_EQ(r.status().code(), Status::Code::kDataLoss);
+    EXPECT_EQ(r.status().message(), p + ": unreadable header: " + message);
+  }
 }
 
 }  // namespace

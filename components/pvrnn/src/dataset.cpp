@@ -17,7 +17,9 @@ StatusOr<Dataset> LoadNrlDataset(const std::string& dir) {
   data.name = fs::path(dir).filename().string();
   if (data.name.empty()) data.name = fs::path(dir).parent_path().filename().string();
   int64_t steps = -1, prims = -1;
-  for (const auto& [k, v] : kv.value()) {
+  for (const auto& entry : kv.value()) {
+    const std::string& k = entry.first;  // not a structured binding: clang 14 cannot capture one
+    const std::string& v = entry.second;
     auto bad = [&](const char* rule) { return Status::DataLoss(meta + ": " + k + " = '" + v + "': " + rule); };
     std::vector<double> period;
     if (k == "samplingperiod" && !(internal::ParseNumberList(v, &period) && period.size() == 1 && period[0] > 0))

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "dyad/pvrnn/checked_file.hpp"
+#include "dyad/pvrnn/json_fields.hpp"
 
 namespace dyad::pvrnn {
 namespace {
@@ -23,7 +24,7 @@ json SpecToJson(const ModelSpec& s) {
 ModelSpec SpecFromJson(const json& j) {
   ModelSpec s;
   for (const auto& l : j.at("layers"))
-    s.layers.push_back({l.at("d").get<int>(), l.at("z").get<int>(), l.at("tau").get<double>(), l.at("w").get<double>()});
+    s.layers.push_back({JsonInt<int>(l, "d"), JsonInt<int>(l, "z"), l.at("tau").get<double>(), l.at("w").get<double>()});
   for (const auto& r : j.at("output").at("dofs")) s.output.dofs.push_back({r.at(0).get<double>(), r.at(1).get<double>()});
   s.output.dsoft = j.at("output").at("dsoft").get<double>();
   s.output.sigma = j.at("output").at("sigma").get<double>();
@@ -106,9 +107,19 @@ StatusOr<Model> LoadModel(const std::string& path) {
   const size_t payload_bytes = view->payload_bytes;
   Model m;
   try {
+    // Each tensor's extent is checked against the payload before anything is summed or
+    // multiplied: huge offsets or shapes must not wrap around into something that fits.
+    const uint64_t payload_values = payload_bytes / 8;
     uint64_t needed = 0;
-    for (const auto& t : header.at("tensors"))
-      needed = std::max<uint64_t>(needed, t.at("offset").get<uint64_t>() + t.at("rows").get<uint64_t>() * t.at("cols").get<uint64_t>());
+    for (const auto& t : header.at("tensors")) {
+      const uint64_t offset = JsonInt<uint64_t>(t, "offset"), rows = JsonInt<uint64_t>(t, "rows"),
+                     cols = JsonInt<uint64_t>(t, "cols");
+      if ((cols != 0 && rows > payload_values / cols) || offset > payload_values - rows * cols)
+        return Status::DataLoss(path + ": truncated: tensor " + t.at("name").get<std::string>() + " (offset " +
+                                std::to_string(offset) + ", " + std::to_string(rows) + " x " + std::to_string(cols) +
+                                ") does not fit in the payload of " + std::to_string(payload_bytes) + " bytes");
+      needed = std::max<uint64_t>(needed, offset + rows * cols);
+    }
     if (needed * 8 > payload_bytes)
       return Status::DataLoss(path + ": truncated: tensors need " + std::to_string(needed * 8) + " bytes, file has " +
                                std::to_string(payload_bytes));
@@ -117,7 +128,7 @@ StatusOr<Model> LoadModel(const std::string& path) {
       return Status::DataLoss(path + ": " + std::to_string(payload_bytes - needed * 8) + " unexpected bytes after the tensors");
     m.spec = SpecFromJson(header.at("spec"));
     if (Status s = m.spec.Validate(); !s.ok()) return Status::DataLoss(path + ": spec: " + s.message());
-    const int steps = header.at("steps").get<int>(), sequences = header.at("sequences").get<int>();
+    const int steps = JsonInt<int>(header, "steps"), sequences = JsonInt<int>(header, "sequences");
     if (steps < 0 || sequences < 0) return Status::DataLoss(path + ": negative steps or sequences");
     NetworkLayout layout(m.spec);
     // Every tensor was checked against the payload above; check the shapes it claims before
@@ -132,11 +143,11 @@ StatusOr<Model> LoadModel(const std::string& path) {
     auto read = [&](const std::string& name, int rows, int cols, auto&& sink) -> Status {
       for (const auto& t : header.at("tensors")) {
         if (t.at("name").get<std::string>() != name) continue;
-        if (t.at("rows").get<int>() != rows || t.at("cols").get<int>() != cols)
-          return Status::DataLoss(path + ": tensor " + name + " is " + std::to_string(t.at("rows").get<int>()) + " x " +
-                                   std::to_string(t.at("cols").get<int>()) + ", the spec needs " + std::to_string(rows) +
+        if (JsonInt<uint64_t>(t, "rows") != static_cast<uint64_t>(rows) || JsonInt<uint64_t>(t, "cols") != static_cast<uint64_t>(cols))
+          return Status::DataLoss(path + ": tensor " + name + " is " + std::to_string(JsonInt<uint64_t>(t, "rows")) + " x " +
+                                   std::to_string(JsonInt<uint64_t>(t, "cols")) + ", the spec needs " + std::to_string(rows) +
                                    " x " + std::to_string(cols));
-        const size_t at = payload_at + t.at("offset").get<size_t>() * 8;
+        const size_t at = payload_at + JsonInt<size_t>(t, "offset") * 8;  // checked to fit above
         for (int c = 0; c < cols; ++c)
           for (int r = 0; r < rows; ++r) sink(r, c, ReadDouble(in, at + (static_cast<size_t>(c) * rows + r) * 8));
         return Status::OK();
@@ -154,15 +165,15 @@ StatusOr<Model> LoadModel(const std::string& path) {
     const json& p = header.at("provenance");
     m.provenance.source = p.at("source").get<std::string>();
     m.provenance.dataset = p.at("dataset").get<std::string>();
-    m.provenance.epochs = p.at("epochs").get<int64_t>();
-    m.provenance.seed = p.at("seed").get<uint64_t>();
+    m.provenance.epochs = JsonInt<int64_t>(p, "epochs");
+    m.provenance.seed = JsonInt<uint64_t>(p, "seed");
     m.provenance.scalar = p.at("scalar").get<std::string>();
     m.provenance.final_loss = NumFrom(p.at("final_loss"));
     m.provenance.final_reconstruction = NumFrom(p.at("final_reconstruction"));
     m.provenance.final_regulation = NumFrom(p.at("final_regulation"));
     if (!header.at("training").is_null()) {
       TrainingState t;
-      t.adam_step = header.at("training").at("adam_step").get<int64_t>();
+      t.adam_step = JsonInt<int64_t>(header.at("training"), "adam_step");
       t.rng_state = header.at("training").at("rng_state").get<std::string>();
       const int nw = layout.num_weights(), na = static_cast<int>(m.adaptive.flat().size());
       t.weights_m.resize(nw); t.weights_v.resize(nw); t.adaptive_m.resize(na); t.adaptive_v.resize(na);

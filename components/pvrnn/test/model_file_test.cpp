@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "edit_checked_file.hpp"
 #include "test_paths.hpp"
 
 namespace dyad::pvrnn {
@@ -115,6 +116,57 @@ TEST(ModelFile, WrongVersionIsReportedWithBothVersions) {
   auto r = LoadModel(path);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().message(), path + ": format version 9, this build reads version 1");
+  std::filesystem::remove(path);
+}
+
+// Found reviewing the length checks for the fuzz target (input in tests/fuzz/regressions/
+// model_file; the fuzzer itself did not reach it in short runs): a tensor entry with a huge offset
+// made the sum of offsets wrap around to exactly the payload size, so a real tensor placed past
+// the end of the file was read out of bounds. Every extent is now checked on its own.
+TEST(ModelFile, TensorOffsetsThatWrapAroundAreDataLossNotAnOutOfBoundsRead) {
+  const std::string path = testing::TempPath("wrap.dpvrnn");
+  ASSERT_TRUE(SaveModel(SmallModel(), path).ok());
+  const std::string good = ReadAll(path);
+  testing::WriteWithEditedHeader(good, kModelFileVersion, path, [](nlohmann::json& h) {
+    uint64_t payload_values = 0;
+    for (const auto& t : h["tensors"])
+      payload_values = std::max<uint64_t>(payload_values, t["offset"].get<uint64_t>() + t["rows"].get<uint64_t>() * t["cols"].get<uint64_t>());
+    h["tensors"][0]["offset"] = payload_values;  // the first weights start where the file ends
+    // (1 << 61) + payload_values: times 8 bytes, that wraps to exactly the payload size.
+    h["tensors"].push_back({{"name", "pad"}, {"rows", 0}, {"cols", 0}, {"offset", (uint64_t{1} << 61) + payload_values}});
+  });
+  auto r = LoadModel(path);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), Status::Code::kDataLoss);
+  EXPECT_EQ(r.status().message().rfind(path + ": truncated: tensor ", 0), 0u) << r.status().message();
+  EXPECT_NE(r.status().message().find(") does not fit in the payload of "), std::string::npos) << r.status().message();
+  std::filesystem::remove(path);
+}
+
+// Found by UBSan on a hand-made input while the fuzz target was written: nlohmann's get<int>()
+// of 1e30 is undefined behaviour, and of 4294967301 silently wraps to 5 (the file then loaded).
+// Whole-number header fields are now read exactly (json_fields.hpp).
+TEST(ModelFile, HeaderNumbersOutOfRangeAreDataLossNotConvertedOrWrapped) {
+  const std::string path = testing::TempPath("range.dpvrnn");
+  ASSERT_TRUE(SaveModel(SmallModel(), path).ok());
+  const std::string good = ReadAll(path);
+  struct Case {
+    std::function<void(nlohmann::json&)> edit;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {[](nlohmann::json& h) { h["spec"]["layers"][0]["d"] = 1e30; }, "d = 1e+30: not a whole number in -2147483648..2147483647"},
+      {[](nlohmann::json& h) { h["steps"] = 4294967301u; }, "steps = 4294967301: not a whole number in -2147483648..2147483647"},
+      {[](nlohmann::json& h) { h["tensors"][0]["rows"] = -6; }, "rows = -6: not a whole number in 0..18446744073709551615"},
+      {[](nlohmann::json& h) { h["provenance"]["seed"] = 2.5; }, "seed = 2.5: not a whole number in 0..18446744073709551615"},
+  };
+  for (const Case& c : cases) {
+    testing::WriteWithEditedHeader(good, kModelFileVersion, path, c.edit);
+    auto r = LoadModel(path);
+    ASSERT_FALSE(r.ok()) << c.message;
+    EXPECT_EQ(r.status().code(), Status::Code::kDataLoss);
+    EXPECT_EQ(r.status().message(), path + ": malformed header: " + c.message);
+  }
   std::filesystem::remove(path);
 }
 

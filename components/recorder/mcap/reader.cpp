@@ -327,6 +327,12 @@ std::string Reader::Impl::DecodeChunkRecords(const codec::ChunkRecord& chunk, st
       return declared() + " differs from the zstd frame's " + std::to_string(frame_size) + " bytes";
     }
     if (chunk.uncompressed_size > kMaxUncompressedChunk) return declared() + " is implausible";
+    // A zstd block holds at most 128 KiB and takes at least 3 bytes: what the stored bytes can
+    // really expand to bounds the allocation (a frame header may claim any size, or none).
+    const std::uint64_t expandable = (chunk.records.size() / 3 + 1) * (std::uint64_t{128} << 10);
+    if (chunk.uncompressed_size > expandable) {
+      return declared() + " is more than " + std::to_string(chunk.records.size()) + " zstd bytes can hold";
+    }
     out->resize(chunk.uncompressed_size);
     std::size_t n = ZSTD_decompressDCtx(zstd_.get(), out->data(), out->size(), chunk.records.data(),
                                         chunk.records.size());

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "test_files.hpp"
 
@@ -108,6 +109,25 @@ TEST(Corruption, DamagedSizeFieldIsDataLossNotAHugeAllocation) {
                                  (compression == Compression::kZstd ? " bytes" : " bytes stored");
     EXPECT_EQ(status.message(), expected);
   }
+}
+
+// Found by fuzzing (tests/fuzz/regressions/mcap/zstd_chunk_claims_4_gib, cut short so that the
+// scan reads it): a zstd chunk whose frame states no content size and whose record claims just
+// under 4 GiB was allocated at that size before zstd could say the bytes do not hold it. The claim
+// is now checked against what its compressed bytes can expand to first.
+TEST(Corruption, ZstdChunkClaimingMoreThanItsBytesCanHoldIsDamagedNotAllocated) {
+  std::ifstream in(DYAD_FUZZ_REGRESSIONS "/mcap/zstd_chunk_claims_4_gib", std::ios::binary);
+  const std::string input{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  ASSERT_GT(input.size(), 1u);
+  const std::string path = TempPath("claims.mcap");
+  std::ofstream(path, std::ios::binary) << input.substr(1);  // byte 0: the fuzz harness's options
+  auto reader = Reader::Open(path);
+  ASSERT_TRUE(reader.ok()) << reader.status().message();
+  ASSERT_EQ(reader->recovery().damaged_chunks.size(), 1u);
+  const std::string& why = reader->recovery().damaged_chunks.begin()->second;
+  EXPECT_NE(why.find("declared uncompressed size "), std::string::npos) << why;
+  EXPECT_NE(why.find(" zstd bytes can hold"), std::string::npos) << why;
+  std::filesystem::remove(path);
 }
 
 TEST(Corruption, ScanCountsNoMessageOfAMisframedChunk) {
