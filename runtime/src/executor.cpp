@@ -9,26 +9,14 @@
 #include <dyad/msg/types.hpp>
 
 #include "dds_participant.hpp"
+#include "graph_topics.hpp"
 #include "logger.hpp"
 
 namespace dyad {
 namespace {
 
-constexpr const char* kStatsTopic = "dyad/stats";
-constexpr int kStatsDepth = 16;
-
 int64_t SteadyNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-// splitmix64 of the graph seed and the component name: stable across runs and platforms.
-uint64_t MixSeed(uint64_t seed, const std::string& name) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : name) h = (h ^ c) * 1099511628211ull;
-  uint64_t z = seed + h + 0x9e3779b97f4a7c15ull;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
 }
 
 // The topic the graph binds `port` to; empty when unbound.
@@ -74,12 +62,6 @@ class NestedTimer {
   bool stopped_ = false;
 };
 
-// QoS from the graph's `topics:` entry, defaults when the topic is not declared there.
-TopicQos QosOf(const ResolvedTopic& topic) {
-  if (topic.config == nullptr) return TopicQos{};
-  return TopicQos{topic.config->reliability, topic.config->depth, topic.config->deadline_ms, false};
-}
-
 }  // namespace
 
 class Executor::ClockImpl final : public Clock {
@@ -120,7 +102,7 @@ struct Executor::Instance {
 class Executor::ContextImpl final : public Context {
  public:
   ContextImpl(Executor* ex, Instance* inst)
-      : ex_(ex), inst_(inst), logger_(inst->name()), seed_(MixSeed(ex->graph_.seed, inst->name())) {}
+      : ex_(ex), inst_(inst), logger_(inst->name()), seed_(ComponentSeed(ex->graph_.seed, inst->name())) {}
   const std::string& name() const override { return inst_->name(); }
   const Params& params() const override { return inst_->rc->params; }
   const Clock& clock() const override { return *ex_->clock_; }
@@ -528,40 +510,7 @@ void Executor::PublishStats() {
   }
 }
 
-void Executor::BuildTopicList() {
-  topics_.clear();
-  for (const auto& [name, rt] : resolved_.topics) {
-    TopicInfo t;
-    t.name = name;
-    t.type = rt.type;
-    const TopicQos q = QosOf(rt);
-    t.reliable = q.reliability == Reliability::kReliable;
-    t.depth = q.depth;
-    t.deadline_ms = q.deadline_ms;
-    bool all_here = true;
-    for (const auto& c : graph_.components)
-      for (const auto& b : c.outputs)
-        if (b.topic == name) {
-          t.writers.push_back(c.name + "." + b.port);
-          all_here = all_here && graph_.ProcessOf(c) == options_.process;
-        }
-    t.writers_local = !t.writers.empty() && all_here;
-    topics_.push_back(std::move(t));
-  }
-  if (!resolved_.topics.count(kStatsTopic)) {
-    TopicInfo t;
-    t.name = kStatsTopic;
-    t.type = &TypeInfoOf<msg::ComponentStats>();
-    t.reliable = true;
-    t.depth = kStatsDepth;
-    t.writers = {"runtime"};
-    std::set<std::string> processes;
-    for (const auto& c : graph_.components) processes.insert(graph_.ProcessOf(c));
-    t.writers_local = processes.size() == 1;  // every process's runtime writes it
-    topics_.push_back(std::move(t));
-  }
-  std::sort(topics_.begin(), topics_.end(), [](const TopicInfo& a, const TopicInfo& b) { return a.name < b.name; });
-}
+void Executor::BuildTopicList() { topics_ = GraphTopics(graph_, resolved_, options_.process); }
 
 const TopicInfo* Executor::FindTopic(const std::string& name) const {
   for (const auto& t : topics_)

@@ -42,7 +42,10 @@ bool LoadAndValidate(const std::string& path, const std::vector<Override>& overr
     if (Status s = l->catalog.Load(p); !s.ok()) diags.push_back({SourceMark{"--plugins " + p, 0, 0}, "", s.message()});
   // DYAD_PLUGIN_PATH and the built-in folder: a stray file there is worth a warning only.
   if (Status s = l->catalog.LoadDefault({}); !s.ok()) err << "warning: " << s.message() << "\n";
-  if (!l->graph.components.empty()) l->resolved = ValidateGraph(l->graph, l->catalog, &diags);
+  if (!l->graph.components.empty()) {
+    l->resolved = ValidateGraph(l->graph, l->catalog, &diags);
+    DryConfigure(l->graph, l->resolved, l->catalog, &diags);
+  }
   for (const auto& d : diags) err << d.ToString() << "\n";
   if (!diags.empty()) err << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", nothing was started\n";
   return diags.empty();
@@ -131,7 +134,8 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
     }
     children[pid] = p;
   }
-  int worst = 0;
+  int first_failure = 0;  // the exit code of the first child that failed on its own
+  bool stopped_others = false;
   for (;;) {
     {
       std::lock_guard<std::mutex> lock(mutex);
@@ -142,21 +146,27 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
     if (pid < 0) break;
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     std::lock_guard<std::mutex> lock(mutex);
-    const bool interrupted = interrupt.signal() != 0 && code == ExitCodeForSignal(interrupt.signal());
-    if (code != 0 && !interrupted) {
+    // Stopped by us (the user's signal forwarded, or SIGTERM after another child failed): not a failure.
+    const bool stopped = (interrupt.signal() != 0 && code == ExitCodeForSignal(interrupt.signal())) ||
+                         (stopped_others && code == ExitCodeForSignal(SIGTERM));
+    if (code != 0 && !stopped) {
       err << "process '" << children[pid] << "' exited with " << code << "\n";
+      if (first_failure == 0) first_failure = code;
       // One process failing ends the experiment.
       if (!stopping) {
-        stopping = true;
+        stopping = stopped_others = true;
         for (const auto& [other, _] : children)
           if (other != pid) kill(other, SIGTERM);
       }
     }
-    worst = std::max(worst, code);
     children.erase(pid);
   }
-  if (interrupt.signal() != 0) err << "dyad run: interrupted (" << SignalName(interrupt.signal()) << ")\n";
-  return worst;
+  if (first_failure != 0) return first_failure;
+  if (interrupt.signal() != 0) {
+    err << "dyad run: interrupted (" << SignalName(interrupt.signal()) << ")\n";
+    return ExitCodeForSignal(interrupt.signal());
+  }
+  return 0;
 }
 
 }  // namespace

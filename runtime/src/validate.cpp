@@ -163,6 +163,14 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
       error(c.mark, key, "needs rate_hz (periodic) or trigger: <input> (steps when that input receives)");
     if (!c.trigger.empty() && spec.FindInput(c.trigger) == nullptr)
       error(c.trigger_mark, key + ".trigger", "'" + c.trigger + "' is not an input of type " + c.type);
+    // An optional input left unbound never receives: triggered by it, the component would never step.
+    if (!c.trigger.empty() && spec.FindInput(c.trigger) != nullptr) {
+      bool bound = false;
+      for (const auto& b : c.inputs) bound = bound || b.port == c.trigger;
+      if (!bound)
+        error(c.trigger_mark, key + ".trigger", "input '" + c.trigger + "' is not bound to a topic (inputs:), so it never "
+                                                "receives and the component would never step");
+    }
 
     // Params: unknown, mistyped, out of range, missing.
     std::map<std::string, ParamValue> values;

@@ -1,18 +1,23 @@
 // dyad/run.hpp — running a graph: what `dyad run` and `dyad validate` do.
 //
-// RunGraph loads the graph, loads plugins, validates (printing every problem and returning 2 if
-// there is any), then either
+// RunGraph loads the graph, loads plugins, validates (including each component's own Configure()
+// against a dry context: see validate.hpp's DryConfigure; printing every problem and returning 2
+// if there is any: nothing is started), then either
 //   - runs the components placed in `process` (one DDS participant for them), or
 //   - with no `process` given and components in several processes: starts one child
 //     `dyad run --process P` per process whose host is this machine (or unset), forwards
-//     SIGINT/SIGTERM to them and waits; the exit code is the worst child's.
+//     SIGINT/SIGTERM to them and waits. Children run in their own process group (a terminal's
+//     Ctrl-C reaches them once, through the launcher) and get SIGTERM if the launcher dies. When
+//     one child fails, the others are stopped and the exit code is the failed child's.
 // It returns when the run ends: SIGINT/SIGTERM, `duration_s`, `steps`, a component's
 // RequestStop(), or a failed step. At exit it prints a timing table (per component: steps, step
 // duration mean/p99/max, start jitter, deadline misses) and publishes the same as
 // dyad::msg::ComponentStats on topic "dyad/stats" every `stats_period_s` while running.
 //
 // Exit codes: 0 clean end, 1 runtime failure (a component failed, DDS error, type mismatch with
-// a peer), 2 invalid graph or options. A component's failure keeps its Status code through the
+// a peer), 2 invalid graph or options, 128 + signal when SIGINT/SIGTERM stopped it (130 for
+// Ctrl-C; it still ends cleanly: components deactivated, recordings closed, timing printed, and
+// "interrupted (SIGINT)" said on stderr). A component's failure keeps its Status code through the
 // runtime (context is added, the code is not rewritten) and the exit code follows it
 // (ExitCodeOf): InvalidArgument, NotFound and DataLoss (a bad param, a missing or damaged file
 // the graph names) exit 2, every other failure 1.

@@ -6,7 +6,8 @@
 // e.g. by a replay), required inputs left unbound, topic type mismatches (between writer and
 // reader ports, and against the type declared under `topics:`), rates that are not positive, a
 // component with neither rate_hz nor trigger, processes that are not declared, stepped clock
-// across several processes.
+// across several processes; and then, with DryConfigure, whatever each component's own
+// Configure() would reject.
 #pragma once
 
 #include <map>
@@ -40,6 +41,14 @@ struct ResolvedGraph {
 
 // Appends problems to *diagnostics; the result is complete only when none were added.
 ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vector<Diagnostic>* diagnostics);
+
+// Runs every component's Configure() against a dry context (no DDS, nothing started) and adds a
+// diagnostic for each that fails, placed at the param its message names (the element inside a
+// structured param, or the --set) or at the component. Components with problems of their own in
+// *diagnostics are skipped (their params are incomplete). Relies on component.hpp's contract:
+// Configure acts on nothing. See runtime/src/dry_configure.cpp.
+void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
+                  std::vector<Diagnostic>* diagnostics);
 
 // Converts a YAML value to a param of `spec`'s type; on failure returns a message (no location).
 bool ParamFromYaml(const ParamSpec& spec, const YAML::Node& node, ParamValue* out, std::string* error);

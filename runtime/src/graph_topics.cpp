@@ -1,0 +1,60 @@
+#include "graph_topics.hpp"
+
+#include <algorithm>
+#include <set>
+
+#include <dyad/msg/types.hpp>
+
+namespace dyad {
+
+uint64_t ComponentSeed(uint64_t seed, const std::string& name) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : name) h = (h ^ c) * 1099511628211ull;
+  uint64_t z = seed + h + 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+TopicQos QosOf(const ResolvedTopic& topic) {
+  if (topic.config == nullptr) return TopicQos{};
+  return TopicQos{topic.config->reliability, topic.config->depth, topic.config->deadline_ms, false};
+}
+
+std::vector<TopicInfo> GraphTopics(const Graph& graph, const ResolvedGraph& resolved, const std::string& process) {
+  std::vector<TopicInfo> topics;
+  for (const auto& [name, rt] : resolved.topics) {
+    TopicInfo t;
+    t.name = name;
+    t.type = rt.type;
+    const TopicQos q = QosOf(rt);
+    t.reliable = q.reliability == Reliability::kReliable;
+    t.depth = q.depth;
+    t.deadline_ms = q.deadline_ms;
+    bool all_here = true;
+    for (const auto& c : graph.components)
+      for (const auto& b : c.outputs)
+        if (b.topic == name) {
+          t.writers.push_back(c.name + "." + b.port);
+          all_here = all_here && graph.ProcessOf(c) == process;
+        }
+    t.writers_local = !t.writers.empty() && all_here;
+    topics.push_back(std::move(t));
+  }
+  if (!resolved.topics.count(kStatsTopic)) {
+    TopicInfo t;
+    t.name = kStatsTopic;
+    t.type = &TypeInfoOf<msg::ComponentStats>();
+    t.reliable = true;
+    t.depth = kStatsDepth;
+    t.writers = {"runtime"};
+    std::set<std::string> processes;
+    for (const auto& c : graph.components) processes.insert(graph.ProcessOf(c));
+    t.writers_local = processes.size() == 1;  // every process's runtime writes it
+    topics.push_back(std::move(t));
+  }
+  std::sort(topics.begin(), topics.end(), [](const TopicInfo& a, const TopicInfo& b) { return a.name < b.name; });
+  return topics;
+}
+
+}  // namespace dyad
