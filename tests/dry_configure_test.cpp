@@ -62,7 +62,7 @@ std::string Humans(const std::string& dataset) {
 TEST(DryConfigure, ComponentErrorsArePlacedAtTheElementAndReportedTogether) {
   const auto diags = Validate(Humans(TinyDataset()));
   ASSERT_EQ(diags.size(), 2u);
-  EXPECT_EQ(diags[0].ToString(), "g.yaml:11:23: components.a.params.events[1].end: 5: must be > start (10)");
+  EXPECT_EQ(diags[0].ToString(), "g.yaml:11:23: components.a.params.events[1].end = 5: must be > start (10)");
   EXPECT_EQ(diags[1].key, "components.b.params.events[0].primitve");
   EXPECT_EQ(diags[1].mark.line, 19);
   EXPECT_EQ(diags[1].mark.column, 30);  // the misspelt key itself

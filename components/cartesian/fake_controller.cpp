@@ -19,6 +19,8 @@
 #include <poll.h>
 #include <signal.h>
 
+#include <CLI/CLI.hpp>
+
 #include <array>
 #include <chrono>
 #include <csignal>
@@ -48,43 +50,47 @@ struct Delayed {
   sockaddr_in to;
 };
 
-[[noreturn]] void Usage(const char* why) {
-  std::fprintf(stderr, "dyad_fake_controller: %s\nusage: dyad_fake_controller --port P [--drop N]... "
-                       "[--delay N:MS]... [--malform N]... [--initial X,Y] [--idle-exit S]\n", why);
-  std::exit(2);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   long port = -1;
   double idle_exit_s = 0;
-  std::set<uint32_t> drop, malform;
-  std::vector<std::pair<uint32_t, int>> delay;
-  dyad::cartesian::VirtualRobotOptions options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) Usage((a + " needs a value").c_str());
-      return argv[++i];
-    };
-    if (a == "--port") port = std::strtol(next(), nullptr, 10);
-    else if (a == "--drop") drop.insert(static_cast<uint32_t>(std::strtoul(next(), nullptr, 10)));
-    else if (a == "--malform") malform.insert(static_cast<uint32_t>(std::strtoul(next(), nullptr, 10)));
-    else if (a == "--delay") {
-      unsigned n = 0;
-      int ms = 0;
-      if (std::sscanf(next(), "%u:%d", &n, &ms) != 2 || ms < 0) Usage("--delay wants N:MS");
-      delay.emplace_back(n, ms);
-    } else if (a == "--initial") {
-      double x = 0, y = 0;
-      if (std::sscanf(next(), "%lf,%lf", &x, &y) != 2) Usage("--initial wants X,Y");
-      options.initial = dyad::cartesian::Vec2{x, y};
-    } else if (a == "--idle-exit") idle_exit_s = std::strtod(next(), nullptr);
-    else Usage(("unknown option " + a).c_str());
+  std::vector<uint32_t> drop_list, malform_list;
+  std::vector<std::string> delay_specs;
+  std::vector<double> initial;
+  CLI::App app{"A stand-in robot controller for udp_cartesian (protocol v1, docs/components.md): a virtual "
+               "robot behind a UDP port, with fault injection."};
+  app.add_option("--port", port, "UDP port to listen on")->required()->check(CLI::Range(1, 65535));
+  app.add_option("--drop", drop_list, "drop the reply to command N (1-based; repeatable)");
+  app.add_option("--delay", delay_specs, "delay the reply to command N by MS milliseconds: N:MS (repeatable)");
+  app.add_option("--malform", malform_list, "send a malformed reply to command N (repeatable)");
+  app.add_option("--initial", initial, "initial position X,Y")->delimiter(',')->expected(2);
+  app.add_option("--idle-exit", idle_exit_s, "exit after this many seconds without a command (0: never)")
+      ->check(CLI::NonNegativeNumber);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // --help: usage on stdout, 0
+    return code == 0 ? 0 : 2;
   }
-  if (port <= 0 || port > 65535) Usage("--port 1..65535 is required");
-  if (auto s = options.Validate(); !s.ok()) Usage(s.message().c_str());
+  std::set<uint32_t> drop(drop_list.begin(), drop_list.end()), malform(malform_list.begin(), malform_list.end());
+  std::vector<std::pair<uint32_t, int>> delay;
+  for (const auto& spec : delay_specs) {
+    unsigned n = 0;
+    int ms = 0;
+    char extra = 0;
+    if (std::sscanf(spec.c_str(), "%u:%d%c", &n, &ms, &extra) != 2 || ms < 0) {
+      std::fprintf(stderr, "dyad_fake_controller: --delay %s: wants N:MS\n", spec.c_str());
+      return 2;
+    }
+    delay.emplace_back(n, ms);
+  }
+  dyad::cartesian::VirtualRobotOptions options;
+  if (initial.size() == 2) options.initial = dyad::cartesian::Vec2{initial[0], initial[1]};
+  if (auto s = options.Validate(); !s.ok()) {
+    std::fprintf(stderr, "dyad_fake_controller: %s\n", s.message().c_str());
+    return 2;
+  }
 
   auto socket = dyad::cartesian::UdpSocket::Open(static_cast<uint16_t>(port));
   if (!socket.ok()) {

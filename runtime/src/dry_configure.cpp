@@ -152,7 +152,7 @@ bool PlaceMessage(const Graph& graph, const ComponentConfig& c, const ComponentS
   d->key = "components." + c.name + ".params." + param + tail;
   std::string msg = rest.substr(m[0].length());
   if (msg.rfind(": ", 0) == 0) msg = msg.substr(2);
-  else if (msg.rfind(" = ", 0) == 0) msg = msg.substr(3);  // "end = 300: must be ..." -> "300: must be ..."
+  else if (msg.rfind(" = ", 0) == 0) msg = msg.substr(1);  // "= 300: must be ...": Diagnostic shows "key = 300: ..."
   else if (!msg.empty() && msg[0] == ' ') msg = msg.substr(1);
   d->message = msg;
   if (auto set = c.overridden.find(param); set != c.overridden.end()) {

@@ -202,7 +202,9 @@ std::string SourceMark::ToString() const {
 }
 
 std::string Diagnostic::ToString() const {
-  return mark.ToString() + ": " + (key.empty() ? "" : key + ": ") + message;
+  // "key = value: why" when the message starts with the offending value ("= 300: must be ...").
+  const bool value_first = message.rfind("= ", 0) == 0;
+  return mark.ToString() + ": " + (key.empty() ? "" : key + (value_first ? " " : ": ")) + message;
 }
 
 const ComponentConfig* Graph::FindComponent(const std::string& n) const {

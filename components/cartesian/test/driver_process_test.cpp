@@ -326,3 +326,22 @@ TEST_F(DriverProcessTest, MixerInPiModeWithoutStateIsAConfigurationError) {
 }
 
 }  // namespace
+
+namespace dyad::cartesian {
+namespace {
+
+TEST(FakeControllerCli, HelpPrintsUsageAndBadArgumentsExitTwo) {
+  const auto dir = std::filesystem::temp_directory_path();
+  dyad::testing::ChildProcess help({DYAD_FAKE_CONTROLLER, "--help"}, dir, "fake_help");
+  ASSERT_EQ(help.Wait(10), 0) << help.err();
+  EXPECT_NE(help.out().find("--delay"), std::string::npos) << help.out();
+  dyad::testing::ChildProcess bad({DYAD_FAKE_CONTROLLER, "--port", "70000"}, dir, "fake_bad");
+  EXPECT_EQ(bad.Wait(10), 2);
+  EXPECT_NE(bad.err().find("--port"), std::string::npos) << bad.err();
+  dyad::testing::ChildProcess delay({DYAD_FAKE_CONTROLLER, "--port", "47999", "--delay", "3"}, dir, "fake_delay");
+  EXPECT_EQ(delay.Wait(10), 2);
+  EXPECT_NE(delay.err().find("--delay 3: wants N:MS"), std::string::npos) << delay.err();
+}
+
+}  // namespace
+}  // namespace dyad::cartesian

@@ -456,7 +456,8 @@ INSTANTIATE_TEST_SUITE_P(
     Table, RecorderBadParams,
     ::testing::Values(
         BadParam{"TopicMatchingNothing", "{type: recorder, rate_hz: 1, params: {file: DIR/x.mcap, topics: [ca, nope]}}",
-                 "x: configure failed: params.topics[1] = 'nope': matches no topic (topics: ca, dyad/stats)"},
+                 // caught by validation (the recorder's Configure, dry), at the element's line
+                 "g.yaml:6:142: components.x.params.topics[1] = 'nope': matches no topic (topics: ca, dyad/stats)"},
         BadParam{"TopicBadRegex", "{type: recorder, rate_hz: 1, params: {file: DIR/x.mcap, topics: ['c[a']}}",
                  "params.topics[0] = 'c[a': neither a topic nor a valid regular expression"},
         BadParam{"UnwritableFile", "{type: recorder, rate_hz: 1, params: {file: /proc/dyad/x.mcap}}",
@@ -468,7 +469,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadParam{"ChunkTooSmall", "{type: recorder, rate_hz: 1, params: {chunk_size: 10}}",
                  "components.x.params.chunk_size: must be >= 1024"},
         BadParam{"ReplayMissingFile", "{type: replay, rate_hz: 1, params: {file: DIR/missing.mcap}}",
-                 "x: configure failed: params.file = '"},
+                 "g.yaml:6:48: components.x.params.file = '"},
         BadParam{"ReplayNotMcap", "{type: replay, rate_hz: 1, params: {file: DIR/not.mcap}}", "params.file = '"},
         BadParam{"ReplayWithoutFile", "{type: replay, rate_hz: 1}", "components.x.params.file: missing required parameter"}),
     [](const ::testing::TestParamInfo<BadParam>& i) { return std::string(i.param.name); });

@@ -49,7 +49,7 @@ struct Diagnostic {
   SourceMark mark;
   std::string key;      // dotted path, e.g. "components.mixer.params.gain"
   std::string message;
-  std::string ToString() const;  // "file:line:col: key: message"
+  std::string ToString() const;  // "file:line:col: key: message" ("key = value: why" for "= value: why")
 };
 
 enum class Reliability { kReliable, kBestEffort };
