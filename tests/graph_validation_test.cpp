@@ -110,7 +110,7 @@ std::vector<BadCase> BadCases() {
       {"SteppedAcrossProcesses",
        Replace(Replace(v, "    rate_hz: 10", "    rate_hz: 10\n    process: a"), "    trigger: in", "    trigger: in\n    process: b") +
            "processes:\n  a: {}\n  b: {}\n",
-       "g.yaml:1:1", "clock", "one process"},
+       "g.yaml:2:8", "clock", "one process"},  // at the clock line
       {"RequiredInputUnbound", Replace(v, "    inputs: {in: count}\n", ""), "g.yaml:9:3", "components.sink.inputs.in",
        "required input is not bound"},
       {"BothRateAndTrigger", Replace(v, "    trigger: in", "    trigger: in\n    rate_hz: 5"), "g.yaml:11:14",
@@ -160,6 +160,36 @@ TEST(GraphValidation, OverrideSetsParamAndIsValidated) {
   ASSERT_EQ(unknown.size(), 1u);
   EXPECT_NE(unknown[0].message.find("no such component"), std::string::npos);
   EXPECT_EQ(Check(kValid, {"garbage"}).size(), 1u);
+}
+
+TEST(GraphValidation, OverrideSetsTheGraphsOwnScalars) {
+  std::vector<Diagnostic> diags;
+  Graph g = ParseGraph(kValid, "g.yaml", {{"clock=wall"}, {"seed=7"}, {"domain_id=12"}, {"graph=renamed"}}, &diags);
+  EXPECT_TRUE(diags.empty()) << diags[0].ToString();
+  EXPECT_EQ(g.clock, ClockMode::kWall);
+  EXPECT_EQ(g.seed, 7u);
+  EXPECT_EQ(g.domain_id, 12);
+  EXPECT_EQ(g.name, "renamed");
+  EXPECT_NE(g.yaml_text.find("clock: wall"), std::string::npos) << g.yaml_text;  // recorded as run
+  const std::pair<const char*, const char*> bad[] = {{"clock=sometimes", "must be wall or stepped"},
+                                                     {"seed=-1", "non-negative integer"},
+                                                     {"domain_id=999", "0..232"},
+                                                     {"nokey=1", "expected COMPONENT.PARAM=VALUE"}};
+  for (const auto& [set, why] : bad) {
+    diags.clear();
+    ParseGraph(kValid, "g.yaml", {{set}}, &diags);
+    ASSERT_EQ(diags.size(), 1u) << set;
+    EXPECT_EQ(diags[0].mark.file, std::string("--set ") + set);
+    EXPECT_NE(diags[0].message.find(why), std::string::npos) << diags[0].ToString();
+  }
+}
+
+TEST(GraphValidation, SteppedAcrossProcessesSetOnTheCommandLineIsBlamedOnTheSet) {
+  std::string y = Replace(Replace(kValid, "clock: stepped", "clock: wall"), "    rate_hz: 10", "    rate_hz: 10\n    process: a");
+  y = Replace(y, "    trigger: in", "    trigger: in\n    process: b") + "processes:\n  a: {}\n  b: {}\n";
+  const auto diags = Check(y, {"clock=stepped"});
+  ASSERT_EQ(diags.size(), 1u);
+  EXPECT_EQ(diags[0].mark.file, "--set clock=stepped");
 }
 
 // What a recorder stores: the file as read, or with --set, the graph as run.

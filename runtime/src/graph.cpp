@@ -2,6 +2,9 @@
 #include "dyad/graph.hpp"
 
 #include <filesystem>
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -159,13 +162,49 @@ void ReadComponents(Reader& r, const YAML::Node& node, Graph* g) {
   }
 }
 
-void ApplyOverrides(const std::vector<Override>& overrides, Graph* g, std::vector<Diagnostic>* out) {
+// `--set KEY=VALUE` for one of the graph's own scalars (clock, seed, domain_id, graph), checked
+// like the file's. Returns false when KEY is not one of them.
+bool ApplyGraphOverride(const std::string& key, const std::string& value, const SourceMark& cli, Graph* g,
+                        YAML::Node root, std::vector<Diagnostic>* out) {
+  if (key == "clock") {
+    g->clock_mark = cli;
+    if (value == "wall") g->clock = ClockMode::kWall;
+    else if (value == "stepped") g->clock = ClockMode::kStepped;
+    else out->push_back({cli, "clock", "must be wall or stepped, got '" + value + "'"});
+  } else if (key == "seed" || key == "domain_id") {
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long v = std::strtoull(value.c_str(), &end, 10);
+    const bool number = !value.empty() && value[0] != '-' && *end == '\0' && errno == 0;
+    if (key == "seed") {
+      if (number) g->seed = v;
+      else out->push_back({cli, "seed", "must be a non-negative integer, got '" + value + "'"});
+    } else if (number && v <= 232) {
+      g->domain_id = static_cast<int>(v);
+    } else {
+      out->push_back({cli, "domain_id", "must be in 0..232 (DDS), got '" + value + "'"});
+    }
+  } else if (key == "graph") {
+    if (value.empty()) out->push_back({cli, "graph", "must not be empty"});
+    else g->name = value;
+  } else {
+    return false;
+  }
+  if (root.IsMap()) root[key] = value;  // the recorded graph is the graph as run
+  g->graph_overrides.push_back(cli.file.substr(6));
+  return true;
+}
+
+void ApplyOverrides(const std::vector<Override>& overrides, Graph* g, YAML::Node root, std::vector<Diagnostic>* out) {
   for (const auto& o : overrides) {
     const SourceMark cli{"--set " + o.text, 0, 0};
     const auto eq = o.text.find('=');
     const auto dot = o.text.find('.');
+    if (eq != std::string::npos && (dot == std::string::npos || dot > eq) &&
+        ApplyGraphOverride(o.text.substr(0, eq), o.text.substr(eq + 1), cli, g, root, out))
+      continue;
     if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || dot + 1 == eq) {
-      out->push_back({cli, o.text, "expected COMPONENT.PARAM=VALUE"});
+      out->push_back({cli, o.text, "expected COMPONENT.PARAM=VALUE, or clock|seed|domain_id|graph=VALUE"});
       continue;
     }
     const std::string comp = o.text.substr(0, dot);
@@ -230,7 +269,7 @@ std::string Graph::ProcessOf(const ComponentConfig& c) const {
 // so analyses see what ran, not what the file said.
 void RecordOverrides(const std::vector<Override>& overrides, YAML::Node root, Graph* g) {
   if (overrides.empty() || !root.IsMap() || !root["components"].IsMap()) return;
-  bool changed = false;
+  bool changed = !g->graph_overrides.empty();  // already written into root
   for (const ComponentConfig& c : g->components) {
     if (c.overridden.empty()) continue;
     YAML::Node node = root["components"][c.name];
@@ -273,6 +312,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
       (g.domain_id < 0 || g.domain_id > 232))
     r.Error(root["domain_id"], "domain_id", "must be in 0..232 (DDS), got " + std::to_string(g.domain_id));
   if (root["clock"]) {
+    g.clock_mark = r.Mark(root["clock"]);
     std::string mode;
     if (r.String(root["clock"], "clock", &mode)) {
       if (mode == "wall") g.clock = ClockMode::kWall;
@@ -311,7 +351,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   if (const YAML::Node topics = root["topics"]) ReadTopics(r, topics, &g);
   if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, &g);
   else r.Error(SourceMark{path, 1, 1}, "components", "missing: a graph needs at least one component");
-  ApplyOverrides(overrides, &g, diagnostics);
+  ApplyOverrides(overrides, &g, root, diagnostics);
   RecordOverrides(overrides, root, &g);
   return g;
 }

@@ -265,7 +265,7 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
   }
 
   if (graph.clock == ClockMode::kStepped && processes_used.size() > 1)
-    error(file_mark, "clock", "stepped clock runs the graph in one process, but components are placed in " +
+    error(graph.clock_mark.file.empty() ? file_mark : graph.clock_mark, "clock", "stepped clock runs the graph in one process, but components are placed in " +
                                   std::to_string(processes_used.size()) + " processes");
   return out;
 }

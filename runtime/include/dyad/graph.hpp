@@ -103,6 +103,8 @@ struct Graph {
   // The file as read; with --set overrides, the graph as run (overridden params replaced,
   // re-emitted under a comment listing them). Recorders store it as metadata.
   std::string yaml_text;
+  std::vector<std::string> graph_overrides;  // "clock=wall" etc.: --set of the graph's own scalars
+  SourceMark clock_mark;                     // where `clock:` was set (file line, or the --set); empty: default
 
   const ComponentConfig* FindComponent(const std::string& name) const;
   const TopicConfig* FindTopic(const std::string& name) const;
@@ -110,7 +112,8 @@ struct Graph {
   std::string ProcessOf(const ComponentConfig& c) const;
 };
 
-// `--set NAME.PARAM=VALUE`: VALUE is parsed as YAML.
+// `--set NAME.PARAM=VALUE` (VALUE is parsed as YAML), or `--set KEY=VALUE` for the graph's own
+// clock, seed, domain_id and graph name.
 struct Override {
   std::string text;  // as given, for messages
 };
