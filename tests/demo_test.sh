@@ -38,4 +38,17 @@ cached=$(echo "$second" | grep -c "is up to date (cached)" || true)
 expected=3
 [ "$name" = macaw ] && expected=2
 [ "$cached" -eq "$expected" ] || { echo "$second"; fail "second run reused $cached of $expected cached steps"; }
+# A quick try of the graph by hand (no recorder.file) never replaces the demo's recording: the
+# graph's own recorder file is a new {time}-named one, in the folder of the run.
+# (The README's demo writes out/demo/demo.mcap of the repository; the quick try runs there too.)
+if [ "$name" = demo ]; then
+  mkdir -p "$work/out/demo"
+  cp "$rec" "$work/out/demo/demo.mcap"
+  rec="$work/out/demo/demo.mcap"
+  before=$(sha256sum "$rec" | cut -d' ' -f1)
+  (cd "$work" && "$build/bin/dyad" run "$repo/configs/demo.yaml" --steps 10 --quiet \
+     --set "human.dataset=$work/data/analytic" --set "mind.model=$work/models/demo.dpvrnn" \
+     --set "observer.model=$work/models/demo.dobs") > /dev/null 2>&1 || fail "a quick run of configs/demo.yaml failed"
+  [ "$(sha256sum "$rec" | cut -d' ' -f1)" = "$before" ] || fail "a quick run replaced the demo's recording"
+fi
 echo "PASS: $name demo (300 steps) recorded, reported, and cached on the second run"

@@ -91,7 +91,7 @@ if [ "$name" = interactive ]; then
   exit 0
 fi
 sets=(--set "human.dataset=$dataset" --set "mind.model=$model" --set "observer.model=$observer"
-      --set "recorder.file=$out/$name.mcap")
+      --set "recorder.file=$out/$name.mcap" --set recorder.overwrite=true)  # the demo replaces its own recording
 "$dyad" validate "$graph" "${sets[@]}"
 start=$(date +%s%N)
 "$dyad" run "$graph" --steps "$steps" "${sets[@]}"
