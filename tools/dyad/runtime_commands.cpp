@@ -1,6 +1,8 @@
 #include "runtime_commands.hpp"
 
+#include <charconv>
 #include <cmath>
+#include <optional>
 #include <iomanip>
 #include <sstream>
 #include <iostream>
@@ -18,6 +20,18 @@ std::vector<Override> ToOverrides(const std::vector<std::string>& sets) {
   return out;
 }
 
+// A bound exactly: integers as integers ("1073741824", not "1.07374e+09"), other numbers in the
+// shortest form that reads back to the same double.
+std::string BoundText(const ParamSpec& p, std::optional<double> v, const char* none) {
+  if (!v) return none;
+  if (p.type == ParamType::kInt && std::abs(*v) < 9.2e18) return std::to_string(static_cast<int64_t>(*v));
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, *v);
+  return std::string(buf, r.ptr);
+}
+
+std::string RangeText(const ParamSpec& p) { return BoundText(p, p.min, "-inf") + ".." + BoundText(p, p.max, "inf"); }
+
 void PrintTypes(const Catalog& catalog, std::ostream& out) {
   for (const auto& [name, e] : catalog.entries()) {
     out << name << "  (" << e.type.plugin_path << ")\n";
@@ -31,11 +45,7 @@ void PrintTypes(const Catalog& catalog, std::ostream& out) {
       out << "  param  " << p.name << ": " << ToString(p.type);
       out << (p.default_value ? " = " + ToYamlText(*p.default_value) : " (required)");
       if (!p.unit.empty()) out << " [" << p.unit << "]";
-      if (p.min || p.max) {
-        std::ostringstream range;
-        range << (p.min ? *p.min : -INFINITY) << ".." << (p.max ? *p.max : INFINITY);
-        out << " range " << range.str();
-      }
+      if (p.min || p.max) out << " range " << RangeText(p);
       if (!p.choices.empty()) {
         out << " one of";
         for (const auto& c : p.choices) out << " " << c;

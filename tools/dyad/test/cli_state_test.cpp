@@ -38,3 +38,18 @@ TEST(CliState, IntrospectionOptionsArePerInvocation) {
 
 }  // namespace
 }  // namespace dyad::cli
+
+namespace dyad::cli {
+namespace {
+
+// `dyad types` prints ranges exactly: an integer bound as an integer, not in %g notation.
+TEST(CliTypes, RangesArePrintedExactly) {
+  auto r = dyad::testing::RunCommand(AddRuntimeCommands, {"types"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("range 1024..1073741824"), std::string::npos) << r.out;  // recorder's chunk_size
+  EXPECT_EQ(r.out.find("e+"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("range 1e-06..inf"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace dyad::cli
