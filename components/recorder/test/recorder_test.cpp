@@ -457,7 +457,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadParam{"TopicMatchingNothing", "{type: recorder, rate_hz: 1, params: {file: DIR/x.mcap, topics: [ca, nope]}}",
                  // caught by validation (the recorder's Configure, dry), at the element's line
-                 "g.yaml:6:142: components.x.params.topics[1] = 'nope': matches no topic (topics: ca, dyad/stats)"},
+                 "components.x.params.topics[1] = 'nope': matches no topic (topics: ca, dyad/stats)"},
         BadParam{"TopicBadRegex", "{type: recorder, rate_hz: 1, params: {file: DIR/x.mcap, topics: ['c[a']}}",
                  "params.topics[0] = 'c[a': neither a topic nor a valid regular expression"},
         BadParam{"UnwritableFile", "{type: recorder, rate_hz: 1, params: {file: /proc/dyad/x.mcap}}",
