@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# The web component's admission (token, Origin) and steering role (components/web/test/node/
+# admission.mjs says what is checked), against a running graph.
+#   admission_test.sh BUILD_DIR WORK_DIR
+set -euo pipefail
+build=$1
+work=$2
+node_dir=$(cd "$(dirname "$0")" && pwd)/node
+if [ ! -d "$node_dir/node_modules" ]; then
+  echo "SKIP: run tools/setup.sh (npm ci in components/web/test/node)"; exit 77
+fi
+rm -rf "$work"; mkdir -p "$work"; cd "$work"
+cat > graph.yaml <<YAML
+graph: admission
+clock: wall
+domain_id: $(( 1 + $$ % 200 ))
+components:
+  web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port, token: s3cret}, outputs: {pointer: web/pointer}}
+  human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
+topics:
+  human/input: {type: HumanInput}
+YAML
+"$build/bin/dyad" run graph.yaml --duration 15 > run.out 2> run.err &
+pid=$!
+for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
+[ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
+status=0
+node "$node_dir/admission.mjs" "ws://127.0.0.1:$(cat web.port)" s3cret || status=1
+kill -INT $pid; wait $pid || true
+grep -q "?token=s3cret" run.err || { echo "FAIL: the URLs printed do not carry the token"; status=1; }
+exit $status
