@@ -42,18 +42,16 @@ std::string RangeError(const ParamSpec& spec, double v) {
 
 }  // namespace
 
-bool ParamFromYaml(const ParamSpec& spec, const YAML::Node& node, ParamValue* out, std::string* error) {
+StatusOr<ParamValue> ParamFromYaml(const ParamSpec& spec, const YAML::Node& node) {
   const std::string got = node.IsScalar() ? "'" + node.Scalar() + "'" : node.IsSequence() ? "a list" : node.IsMap() ? "a mapping" : "null";
-  auto fail = [&](const std::string& what) {
-    *error = "must be " + what + ", got " + got;
-    return false;
+  auto fail = [&](const std::string& what) -> StatusOr<ParamValue> {
+    return Status::InvalidArgument("must be " + what + ", got " + got);
   };
   switch (spec.type) {
     case ParamType::kBool: {
       if (!node.IsScalar()) return fail("true or false");
       try {
-        *out = node.as<bool>();
-        return true;
+        return ParamValue(node.as<bool>());
       } catch (const YAML::Exception&) {
         return fail("true or false");
       }
@@ -62,9 +60,8 @@ bool ParamFromYaml(const ParamSpec& spec, const YAML::Node& node, ParamValue* ou
       if (!node.IsScalar()) return fail("an integer");
       try {
         const int64_t v = node.as<int64_t>();
-        if (auto e = RangeError(spec, static_cast<double>(v)); !e.empty()) { *error = e; return false; }
-        *out = v;
-        return true;
+        if (auto e = RangeError(spec, static_cast<double>(v)); !e.empty()) return Status::InvalidArgument(e);
+        return ParamValue(v);
       } catch (const YAML::Exception&) {
         return fail("an integer");
       }
@@ -72,16 +69,14 @@ bool ParamFromYaml(const ParamSpec& spec, const YAML::Node& node, ParamValue* ou
     case ParamType::kDouble: {
       double v;
       if (!ScalarAs(node, &v) || !std::isfinite(v)) return fail("a finite number");
-      if (auto e = RangeError(spec, v); !e.empty()) { *error = e; return false; }
-      *out = v;
-      return true;
+      if (auto e = RangeError(spec, v); !e.empty()) return Status::InvalidArgument(e);
+      return ParamValue(v);
     }
     case ParamType::kString: {
       if (!node.IsScalar()) return fail("a string");
       if (!spec.choices.empty() && std::find(spec.choices.begin(), spec.choices.end(), node.Scalar()) == spec.choices.end())
         return fail("one of: " + Join(spec.choices));
-      *out = node.Scalar();
-      return true;
+      return ParamValue(node.Scalar());
     }
     case ParamType::kDoubleList: {
       if (!node.IsSequence()) return fail("a list of numbers");
@@ -89,11 +84,10 @@ bool ParamFromYaml(const ParamSpec& spec, const YAML::Node& node, ParamValue* ou
       for (const auto& e : node) {
         double x;
         if (!ScalarAs(e, &x) || !std::isfinite(x)) return fail("a list of numbers");
-        if (auto err = RangeError(spec, x); !err.empty()) { *error = "element " + err; return false; }
+        if (auto err = RangeError(spec, x); !err.empty()) return Status::InvalidArgument("element " + err);
         v.push_back(x);
       }
-      *out = v;
-      return true;
+      return ParamValue(v);
     }
     case ParamType::kStringList: {
       if (!node.IsSequence()) return fail("a list of strings");
@@ -102,14 +96,12 @@ bool ParamFromYaml(const ParamSpec& spec, const YAML::Node& node, ParamValue* ou
         if (!e.IsScalar()) return fail("a list of strings");
         v.push_back(e.Scalar());
       }
-      *out = v;
-      return true;
+      return ParamValue(v);
     }
     case ParamType::kYaml: {
       YAML::Emitter em;
       em << YAML::Flow << node;
-      *out = std::string(em.c_str());
-      return true;
+      return ParamValue(std::string(em.c_str()));
     }
   }
   return fail("a valid value");
@@ -186,10 +178,9 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
                 "unknown parameter of " + c.type + " (known: " + Names(spec.params()) + ")");
           continue;
         }
-        ParamValue v;
-        std::string msg;
-        if (!ParamFromYaml(*ps, kv.second, &v, &msg)) error(at, pkey, msg);
-        else values[pname] = v;
+        auto v = ParamFromYaml(*ps, kv.second);
+        if (!v.ok()) error(at, pkey, v.status().message());
+        else values[pname] = std::move(v.value());
       }
     }
     for (const auto& ps : spec.params()) {

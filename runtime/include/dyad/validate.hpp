@@ -50,7 +50,8 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
 void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
                   std::vector<Diagnostic>* diagnostics);
 
-// Converts a YAML value to a param of `spec`'s type; on failure returns a message (no location).
-bool ParamFromYaml(const ParamSpec& spec, const YAML::Node& node, ParamValue* out, std::string* error);
+// Converts a YAML value to a param of `spec`'s type; InvalidArgument (message without location)
+// when it is not one.
+StatusOr<ParamValue> ParamFromYaml(const ParamSpec& spec, const YAML::Node& node);
 
 }  // namespace dyad
