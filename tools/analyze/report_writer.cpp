@@ -100,8 +100,12 @@ std::string FormatMarkdown(const Report& r) {
   s << "- deliberation time per step: median " << Num(Percentile(opt_ms, 0.5)) << " ms, p99 "
     << Num(Percentile(opt_ms, 0.99)) << " ms, max " << Num(Percentile(opt_ms, 1.0)) << " ms\n";
   const double free = mean(c_free);
-  s << "- congruence P(C_t): mean " << Num(mean(c_engaged)) << " while engaged, "
-    << (std::isnan(free) ? std::string("not measured") : Num(free)) << " otherwise\n";
+  const double engaged = mean(c_engaged);
+  s << "- congruence P(C_t): "
+    << (engaged_steps == 0       ? std::string("never engaged, so not measured while engaged")
+        : std::isnan(engaged)    ? std::string("not measured while engaged (no observer labels)")
+                                 : "mean " + Num(engaged) + " while engaged")
+    << ", " << (std::isnan(free) ? std::string("not measured") : Num(free)) << " otherwise\n";
 
   if (r.plan.events.size() > r.events.size()) {
     const size_t n = r.plan.events.size() - r.events.size();
@@ -114,7 +118,12 @@ std::string FormatMarkdown(const Report& r) {
     s << "| event | steps (first-last) | primitive | mean P(C) | final P(C) | observer on human | robot follows | robot switched after |\n";
     s << "|---|---|---|---|---|---|---|---|\n";
     for (const EventSummary& e : r.events) {
-      s << "| " << e.index << " | " << e.event.start_step << "-" << e.event.end_step - 1 << " | "
+      // An event the recording ends inside is scored over its recorded steps: say so.
+      std::string cut;
+      for (const PlannedEvent& p : r.plan.events)
+        if (p.start_step == e.event.start_step && p.end_step > e.event.end_step)
+          cut = " (cut off by the end of the recording; planned to " + std::to_string(p.end_step - 1) + ")";
+      s << "| " << e.index << " | " << e.event.start_step << "-" << e.event.end_step - 1 << cut << " | "
         << (e.event.primitive < 0 ? std::string("?") : std::to_string(e.event.primitive)) << " | "
         << Num(e.mean_congruence) << " | " << Num(e.final_congruence) << " | " << Num(e.human_accuracy) << " | "
         << Num(e.robot_follows) << " | "
@@ -122,7 +131,9 @@ std::string FormatMarkdown(const Report& r) {
         << " |\n";
     }
     s << "\n\"observer on human\": fraction of the event's steps where the observer's most likely class of the "
-         "human's motion is the primitive the human traced; \"robot follows\": the same for the robot's intention.\n\n";
+         "human's motion is the primitive the human traced; \"robot follows\": the same for the robot's intention; "
+         "\"robot switched after\": steps from the event's start to the first step where the robot's intention is "
+         "classified as the human's primitive (\"never\": not within the event).\n\n";
   }
   s << "## Observer confusion on the human's traces\n\n";
   if (r.confusion.empty()) {

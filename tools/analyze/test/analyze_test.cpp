@@ -205,8 +205,17 @@ TEST(Analyze, EventsAfterTheEndOfTheRecordingAreNotScored) {
   r.events = SummariseEvents(r.timeline, events);
   const std::string md = FormatMarkdown(r);
   EXPECT_EQ(md.find("| 3 | 60-80"), std::string::npos) << md;
-  EXPECT_NE(md.find("| 2 | 36-39 | 1 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 2 | 36-39 (cut off by the end of the recording; planned to 49) | 1 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("\"robot switched after\": steps from the event's start"), std::string::npos) << md;
   EXPECT_NE(md.find("1 planned event after the end of the recording (not scored)"), std::string::npos) << md;
+}
+
+TEST(Analyze, ANeverEngagedHumanIsSaidSoNotAnEmptyNumber) {
+  Report r = Analyse(WriteExperiment(TempPath("a.mcap")));
+  for (auto& x : r.timeline.steps) x.engaged = false;
+  const std::string md = FormatMarkdown(r);
+  EXPECT_NE(md.find("- congruence P(C_t): never engaged, so not measured while engaged"), std::string::npos) << md;
+  EXPECT_EQ(md.find("mean  while"), std::string::npos) << md;
 }
 
 TEST(Analyze, WithoutObserverTheReportSaysWhatIsMissing) {
