@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <ctime>
+#include <regex>
 #include <map>
 #include <sstream>
 
@@ -18,8 +19,13 @@ std::string Bytes(std::uint64_t n) {
 
 }  // namespace
 
-std::string FormatTime(std::uint64_t ns) {
-  char text[64];
+std::string FormatTime(std::uint64_t ns, bool simulated) {
+  char text[96];
+  if (simulated) {
+    std::snprintf(text, sizeof(text), "%llu.%09llu (simulated time since start: stepped clock)",
+                  static_cast<unsigned long long>(ns / 1'000'000'000ull), static_cast<unsigned long long>(ns % 1'000'000'000ull));
+    return text;
+  }
   const std::time_t seconds = static_cast<std::time_t>(ns / 1'000'000'000ull);
   std::tm utc{};
   gmtime_r(&seconds, &utc);
@@ -46,8 +52,15 @@ std::string FormatInfo(const mcap::Reader& reader) {
     const double span = (s.message_end_time - s.message_start_time) / 1e9;
     char duration[32];
     std::snprintf(duration, sizeof(duration), "%.3f s", span);
-    out << "start:       " << FormatTime(s.message_start_time) << "\n";
-    out << "end:         " << FormatTime(s.message_end_time) << "\n";
+    // A stepped run's stamps count simulated time from 0: not dates (they read as 1970).
+    bool stepped = false;
+    for (const mcap::Metadata& m : reader.metadata()) {
+      auto it = m.entries.find("yaml");
+      if (m.name == "dyad.graph" && it != m.entries.end())
+        stepped = std::regex_search(it->second, std::regex(R"((^|\n)clock:[ \t]*stepped\b)"));
+    }
+    out << "start:       " << FormatTime(s.message_start_time, stepped) << "\n";
+    out << "end:         " << FormatTime(s.message_end_time, stepped) << "\n";
     out << "duration:    " << duration << "\n";
   }
   std::map<std::string, std::size_t> by_compression;

@@ -11,6 +11,6 @@ namespace dyad::bag {
 std::string FormatInfo(const mcap::Reader& reader);
 
 // "1700000000.123456789 (2023-11-14T22:13:20Z)": ns since the Unix epoch, exact, with its date.
-std::string FormatTime(std::uint64_t ns);
+std::string FormatTime(std::uint64_t ns, bool simulated = false);
 
 }  // namespace dyad::bag

@@ -28,7 +28,7 @@ std::string TempPath(const std::string& name) {
 
 // Two channels (/robot/pose x 4, /human/pose x 2), one Flush() per 3 messages, a graph YAML.
 // The payloads are 3 opaque bytes, not CDR: for the data_hex path (ExportCsv without a decoder).
-std::string WriteSample(const std::string& path) {
+std::string WriteSample(const std::string& path, const std::string& graph_yaml = "nodes: []\n") {
   mcap::WriterOptions options;
   options.chunk_size = 1 << 20;
   auto writer = mcap::Writer::Open(path, options);
@@ -37,7 +37,7 @@ std::string WriteSample(const std::string& path) {
                                   "module dyad { module msg { struct Pose2 { double x; }; }; };");
   auto robot = writer->AddChannel("/robot/pose", "cdr", *schema);
   auto human = writer->AddChannel("/human/pose", "cdr", *schema);
-  EXPECT_TRUE(writer->AddMetadata("dyad.graph", {{"yaml", "nodes: []\n"}}).ok());
+  EXPECT_TRUE(writer->AddMetadata("dyad.graph", {{"yaml", graph_yaml}}).ok());
   for (std::uint32_t i = 0; i < 6; ++i) {
     const std::uint8_t payload[3] = {0x00, static_cast<std::uint8_t>(i), 0xAB};
     const bool is_robot = i % 3 != 2;
@@ -76,6 +76,15 @@ TEST(BagInfo, ListsChannelsCountsChunksAndMetadata) {
   EXPECT_NE(text.find("  dyad.graph: yaml (10 bytes)"), std::string::npos) << text;
   EXPECT_NE(text.find("start:       1.000000000 (1970-01-01T00:00:01Z)"), std::string::npos) << text;
   EXPECT_NE(text.find("duration:    5.000 s"), std::string::npos) << text;
+}
+
+// A stepped run's stamps are simulated time since its start, not dates (they read as 1970).
+TEST(BagInfo, SteppedRecordingsShowSimulatedTimeNotDates) {
+  auto reader = mcap::Reader::Open(WriteSample(TempPath("s.mcap"), "graph: g\nclock: stepped\n"));
+  ASSERT_TRUE(reader.ok());
+  const std::string text = FormatInfo(*reader);
+  EXPECT_NE(text.find("start:       1.000000000 (simulated time since start: stepped clock)"), std::string::npos) << text;
+  EXPECT_EQ(text.find("1970"), std::string::npos) << text;
 }
 
 TEST(BagInfo, SaysATruncatedFileWasCutShortAndWhereItRecoveredTo) {
