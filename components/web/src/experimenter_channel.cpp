@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "json_limits.hpp"
+
 namespace dyad::web {
 namespace {
 using json = nlohmann::json;
@@ -27,6 +29,7 @@ void ExperimenterChannel::OnOpen(ClientId client) {
 }
 
 Status ExperimenterChannel::OnText(ClientId client, std::string_view text) {
+  if (!JsonDepthWithin(text)) return Status::InvalidArgument("nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   const json j = json::parse(text.begin(), text.end(), nullptr, false);
   if (j.is_discarded() || !j.is_object()) return Status::InvalidArgument("not a JSON object");
   auto op = j.find("op");

@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "json_limits.hpp"
+
 namespace dyad::web::foxglove {
 namespace {
 
@@ -78,6 +80,7 @@ std::string MessageData(uint32_t subscription_id, uint64_t timestamp_ns, std::sp
 }
 
 StatusOr<ClientText> ParseClientText(std::string_view text) {
+  if (!JsonDepthWithin(text)) return Bad("nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   const json j = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded()) return Bad("not valid JSON");
   if (!j.is_object()) return Bad("not a JSON object");

@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "json_limits.hpp"
+
 namespace dyad::web {
 namespace {
 using json = nlohmann::json;
@@ -66,6 +68,7 @@ void SubjectChannel::OnOpen(ClientId client) {
 }
 
 Status SubjectChannel::OnText(ClientId client, std::string_view text) {
+  if (!JsonDepthWithin(text)) return Status::InvalidArgument("nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   const json j = json::parse(text.begin(), text.end(), nullptr, false);
   if (j.is_discarded() || !j.is_object()) return Status::InvalidArgument("not a JSON object");
   auto op = j.find("op");

@@ -3,6 +3,8 @@
 #include <civetweb.h>
 
 #include <atomic>
+#include <condition_variable>
+#include <deque>
 #include <cstring>
 
 namespace dyad::web {
@@ -33,6 +35,52 @@ bool IsLoopback(const std::string& address) {
 
 }  // namespace
 
+// civetweb's worker threads have small stacks (an ASan build overflowed one parsing a small JSON
+// message): client messages are handled on this thread of ours, with a normal stack, one at a
+// time, while the worker waits.
+class WebServer::HandlerThread {
+ public:
+  HandlerThread() : thread_([this] { Loop(); }) {}
+  ~HandlerThread() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+  // Runs `task` on the handler thread and returns when it is done.
+  void Run(const std::function<void()>& task) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    const uint64_t ticket = ++posted_;
+    tasks_.push_back(&task);
+    cv_.notify_all();
+    cv_.wait(lock, [&] { return done_ >= ticket; });
+  }
+
+ private:
+  void Loop() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      cv_.wait(lock, [&] { return stop_ || !tasks_.empty(); });
+      if (tasks_.empty()) return;  // stop_ and nothing left
+      const std::function<void()>* task = tasks_.front();
+      tasks_.pop_front();
+      lock.unlock();
+      (*task)();
+      lock.lock();
+      ++done_;
+      cv_.notify_all();
+    }
+  }
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<const std::function<void()>*> tasks_;
+  uint64_t posted_ = 0, done_ = 0;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
 struct WebServer::EndpointState {
   WebServer* server = nullptr;
   ClientHandler* handler = nullptr;
@@ -54,6 +102,7 @@ StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
   mg_init_library(MG_FEATURES_WEBSOCKET);
   std::unique_ptr<WebServer> s(new WebServer());
   s->options_ = options;
+  s->handler_thread_ = std::make_unique<HandlerThread>();
   const std::string ports = (options.address.find(':') != std::string::npos ? "[" + options.address + "]" : options.address) +
                             ":" + std::to_string(options.port);
   const std::string threads = std::to_string(options.max_clients + 4);
@@ -107,6 +156,7 @@ int WebServer::OnPage(mg_connection* conn, void* page_ptr) {
 
 WebServer::~WebServer() {
   if (ctx_ != nullptr) mg_stop(ctx_);  // closes every connection (OnClosed joins each sender)
+  handler_thread_.reset();             // after mg_stop: no worker waits on it any more
   std::lock_guard<std::mutex> lock(mutex_);
   for (auto& [id, c] : clients_) {
     c->queue.Close();
@@ -189,10 +239,12 @@ int WebServer::OnData(mg_connection* conn, int bits, char* data, size_t len, voi
     return 0;
   }
   Status s;
-  if (opcode == MG_WEBSOCKET_OPCODE_TEXT) s = handler->OnText(id, std::string_view(data, len));
-  else if (opcode == MG_WEBSOCKET_OPCODE_BINARY)
-    s = handler->OnBinary(id, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(data), len));
-  else s = Status::InvalidArgument("unknown opcode " + std::to_string(opcode));
+  self->handler_thread_->Run([&] {
+    if (opcode == MG_WEBSOCKET_OPCODE_TEXT) s = handler->OnText(id, std::string_view(data, len));
+    else if (opcode == MG_WEBSOCKET_OPCODE_BINARY)
+      s = handler->OnBinary(id, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(data), len));
+    else s = Status::InvalidArgument("unknown opcode " + std::to_string(opcode));
+  });
   if (!s.ok()) {
     WriteClose(conn, kClosePolicy, s.message());
     return 0;

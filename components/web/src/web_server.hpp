@@ -93,6 +93,7 @@ class WebServer {
  private:
   struct Client;
   struct EndpointState;
+  class HandlerThread;
   WebServer() = default;
   static int OnPage(mg_connection* conn, void* page);
   static int OnConnect(const mg_connection* conn, void* self);
@@ -103,6 +104,7 @@ class WebServer {
   std::shared_ptr<Client> Find(ClientId id) const;
 
   Options options_;
+  std::unique_ptr<HandlerThread> handler_thread_;  // runs OnText/OnBinary (see web_server.cpp)
   mg_context* ctx_ = nullptr;
   int port_ = 0;
   std::vector<std::unique_ptr<EndpointState>> endpoints_;  // civetweb keeps pointers into these

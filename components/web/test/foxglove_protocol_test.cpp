@@ -86,6 +86,17 @@ TEST(FoxgloveProtocol, MalformedTextIsRefusedWithAReason) {
   }
 }
 
+// A frame of nested brackets is refused before parsing (nlohmann::json recurses per level: a
+// 1 MiB frame of '[' would overflow a server thread's stack).
+TEST(FoxgloveProtocol, DeepNestingIsRefusedWithoutParsing) {
+  auto r = ParseClientText(std::string(1 << 20, '['));
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("nested deeper than 32 levels"), std::string::npos) << r.status().message();
+  // Brackets inside strings do not count.
+  auto ok = ParseClientText(R"({"op":"subscribe","subscriptions":[],"note":")" + std::string(100, '[') + R"("})");
+  EXPECT_TRUE(ok.ok()) << ok.status().message();
+}
+
 TEST(FoxgloveProtocol, MalformedBinaryIsRefusedWithAReason) {
   EXPECT_FALSE(ParseClientBinary({}).ok());
   const uint8_t wrong_op[] = {2, 0, 0, 0, 0};

@@ -24,6 +24,7 @@ const bad = [
   () => Buffer.from([0x01, 1]),
   () => Buffer.alloc(2 * 1024 * 1024, 1),  // past the default 1 MiB frame cap
   () => "\u0000\u00ff\ufffe",
+  () => "[".repeat(500000),  // nesting that a recursive parser would follow into a stack overflow
 ];
 
 function once(i) {
