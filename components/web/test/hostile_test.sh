@@ -35,7 +35,10 @@ rss_kb=$(ps -o rss= -p $pid)
 wait $pid || { echo "FAIL: dyad run exited non-zero"; cat run.err; exit 1; }
 cat run.out
 echo "rss after the storm: $rss_kb KiB"
-[ "$rss_kb" -lt 300000 ] || { echo "FAIL: RSS $rss_kb KiB"; exit 1; }
+# 50 MiB here normally; under ASan its quarantine keeps up to 256 MiB of freed memory on top.
+rss_limit=300000
+[ -n "${ASAN_OPTIONS:-}" ] && rss_limit=700000
+[ "$rss_kb" -lt $rss_limit ] || { echo "FAIL: RSS $rss_kb KiB (limit $rss_limit)"; exit 1; }
 node -e '
 const c = JSON.parse(require("fs").readFileSync("clients.json", "utf8"));
 if (c.closed !== 1000) { console.error("FAIL: " + c.closed + " of 1000 bad clients closed by the server"); process.exit(1); }
