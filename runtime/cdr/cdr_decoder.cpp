@@ -407,36 +407,25 @@ class Machine {
 
 // Finds the struct and checks the encapsulation header. Sets *swap when the payload's byte order
 // differs from this machine's.
-const StructDef* Prepare(const Schema& schema, const std::string& root_type, const uint8_t* data,
-                         size_t size, bool* swap, std::string* error) {
+StatusOr<const StructDef*> Prepare(const Schema& schema, const std::string& root_type, const uint8_t* data,
+                                   size_t size, bool* swap) {
   const SchemaImpl& impl = *ImplOf(schema);
   const StructDef* def = impl.FindStruct(root_type);
   if (!def) {
     std::string known;
     for (const StructDef& s : impl.structs) known += (known.empty() ? "" : ", ") + s.name;
-    if (error) {
-      *error = "unknown type '" + root_type + "' (" +
-               (known.empty() ? "the schema defines no structs" : "the schema defines: " + known) +
-               ")";
-    }
-    return nullptr;
+    return Status::NotFound("unknown type '" + root_type + "' (" +
+                            (known.empty() ? "the schema defines no structs" : "the schema defines: " + known) + ")");
   }
   if (size < kEncapsulationSize || data == nullptr) {
-    if (error) {
-      *error = "sample of " + std::to_string(size) +
-               " bytes is shorter than the 4-byte encapsulation header";
-    }
-    return nullptr;
+    return Status::DataLoss("sample of " + std::to_string(size) + " bytes is shorter than the 4-byte encapsulation header");
   }
   if (data[0] != 0 || data[1] > 1) {
     static constexpr char kHex[] = "0123456789abcdef";
     const char id[] = {'0', 'x', kHex[data[0] >> 4], kHex[data[0] & 15], kHex[data[1] >> 4],
                        kHex[data[1] & 15], 0};
-    if (error) {
-      *error = std::string("encapsulation ") + id +
-               " is not supported (only plain CDR: 0x0000 big endian, 0x0001 little endian)";
-    }
-    return nullptr;
+    return Status::Unimplemented(std::string("encapsulation ") + id +
+                                 " is not supported (only plain CDR: 0x0000 big endian, 0x0001 little endian)");
   }
   const bool little = data[1] == 1;
   *swap = little != (std::endian::native == std::endian::little);
@@ -510,36 +499,30 @@ void SplitPath(std::string_view path, std::vector<PathToken>* tokens) {
 
 }  // namespace
 
-bool Decode(const Schema& schema, const std::string& root_type, const uint8_t* data, size_t size,
-            std::vector<Field>* out, std::string* error) {
+Status Decode(const Schema& schema, const std::string& root_type, const uint8_t* data, size_t size,
+              std::vector<Field>* out) {
   bool swap = false;
-  const StructDef* def = Prepare(schema, root_type, data, size, &swap, error);
-  if (!def) {
+  StatusOr<const StructDef*> def = Prepare(schema, root_type, data, size, &swap);
+  if (!def.ok()) {
     out->clear();
-    return false;
+    return def.status();
   }
-  Machine m(*ImplOf(schema), *def, data + kEncapsulationSize, size - kEncapsulationSize, swap);
-  if (!m.DecodeFields(out)) {
-    if (error) *error = std::move(m.error());
-    return false;
-  }
-  return true;
+  Machine m(*ImplOf(schema), **def, data + kEncapsulationSize, size - kEncapsulationSize, swap);
+  if (!m.DecodeFields(out)) return Status::DataLoss(std::move(m.error()));
+  return Status::OK();
 }
 
-bool DecodeRow(const Schema& schema, const std::string& root_type, const uint8_t* data,
-               size_t size, std::vector<std::string>* row, std::string* error) {
+Status DecodeRow(const Schema& schema, const std::string& root_type, const uint8_t* data, size_t size,
+                 std::vector<std::string>* row) {
   bool swap = false;
-  const StructDef* def = Prepare(schema, root_type, data, size, &swap, error);
-  if (!def) {
+  StatusOr<const StructDef*> def = Prepare(schema, root_type, data, size, &swap);
+  if (!def.ok()) {
     row->clear();
-    return false;
+    return def.status();
   }
-  Machine m(*ImplOf(schema), *def, data + kEncapsulationSize, size - kEncapsulationSize, swap);
-  if (!m.DecodeRow(row)) {
-    if (error) *error = std::move(m.error());
-    return false;
-  }
-  return true;
+  Machine m(*ImplOf(schema), **def, data + kEncapsulationSize, size - kEncapsulationSize, swap);
+  if (!m.DecodeRow(row)) return Status::DataLoss(std::move(m.error()));
+  return Status::OK();
 }
 
 std::vector<std::string> Columns(const Schema& schema, const std::string& root_type) {

@@ -50,6 +50,7 @@ namespace {
 struct ParseError {
   int line;
   std::string message;
+  bool unsupported = false;  // valid IDL this reader does not support (Status::Unimplemented)
 };
 
 struct Token {
@@ -121,7 +122,8 @@ std::vector<Token> Tokenize(const std::string& s) {
       if (!ignored) {
         throw ParseError{line, "preprocessor directive '#" + std::string(word) +
                                    "' is not supported (only #include, #pragma and include "
-                                   "guards, which are ignored)"};
+                                   "guards, which are ignored)",
+                         true};
       }
       i = e;
       continue;
@@ -214,6 +216,12 @@ class Parser {
   [[noreturn]] static void FailAt(int line, const std::string& message) {
     throw ParseError{line, message};
   }
+  [[noreturn]] void Unsupported(const std::string& message) const {
+    throw ParseError{Peek().line, message, true};
+  }
+  [[noreturn]] static void UnsupportedAt(int line, const std::string& message) {
+    throw ParseError{line, message, true};
+  }
   void Expect(const char* text, const char* context) {
     if (!Accept(text)) {
       Fail(std::string("expected '") + text + "' " + context + ", found " + Describe(Peek()));
@@ -248,7 +256,7 @@ class Parser {
         if (t.text == "enum") { Next(); Enum(); continue; }
         if (t.text == "typedef") { Next(); Typedef(); continue; }
         if (t.text == "const") { Next(); Const(); continue; }
-        if (IsUnsupportedKeyword(t.text)) Fail("'" + t.text + "' is not supported");
+        if (IsUnsupportedKeyword(t.text)) Unsupported("'" + t.text + "' is not supported");
       }
       Fail("expected a definition (module, struct, enum, typedef, const), found " + Describe(t));
     }
@@ -265,7 +273,7 @@ class Parser {
           "default", "verbatim", "extensibility",
       };
       if (!kIgnored.count(name)) {
-        FailAt(line, "annotation @" + name + " is not supported");
+        UnsupportedAt(line, "annotation @" + name + " is not supported");
       }
       std::string args;
       if (Accept("(")) {
@@ -279,7 +287,7 @@ class Parser {
         }
       }
       if (name == "extensibility" && args != "FINAL" && args != "APPENDABLE") {
-        FailAt(line, "@extensibility(" + args + ") is not supported (only FINAL and APPENDABLE)");
+        UnsupportedAt(line, "@extensibility(" + args + ") is not supported (only FINAL and APPENDABLE)");
       }
     }
   }
@@ -326,7 +334,7 @@ class Parser {
     StructDef def;
     def.name = Qualify(name);
     def.line = line;
-    if (Accept(";")) FailAt(line, "forward declaration of struct '" + name + "' is not supported");
+    if (Accept(";")) UnsupportedAt(line, "forward declaration of struct '" + name + "' is not supported");
     if (Accept(":")) {
       const int base_line = Peek().line;
       const std::string base = ScopedName();
@@ -357,7 +365,7 @@ class Parser {
     }
     Expect("}", "closing the struct");
     Expect(";", "after the struct's '}'");
-    if (def.members.empty()) FailAt(line, "struct '" + name + "' has no members (not supported)");
+    if (def.members.empty()) UnsupportedAt(line, "struct '" + name + "' has no members (not supported)");
     for (const Member& m : def.members) def.depth = std::max(def.depth, out_->nodes[m.node].depth + 1);
     if (def.depth > kMaxDepth) {
       FailAt(line, "types nested deeper than " + std::to_string(kMaxDepth) + " levels");
@@ -382,7 +390,7 @@ class Parser {
       Annotations();
       if (PeekIs("}")) break;  // trailing comma
       def.enumerators.push_back(Identifier("an enumerator"));
-      if (PeekIs("=")) Fail("enumerator values are not supported");
+      if (PeekIs("=")) Unsupported("enumerator values are not supported");
     } while (Accept(","));
     Expect("}", "closing the enum");
     Expect(";", "after the enum's '}'");
@@ -517,7 +525,7 @@ class Parser {
     if (w == "long") {
       Next();
       if (Accept("long")) return PrimNode(Prim::kInt64);
-      if (PeekIs("double")) FailAt(line, "'long double' is not supported");
+      if (PeekIs("double")) UnsupportedAt(line, "'long double' is not supported");
       return PrimNode(Prim::kInt32);
     }
     static const std::unordered_map<std::string, Prim> kPrims = {
@@ -553,7 +561,7 @@ class Parser {
       --depth_;
       return AddNode(n);
     }
-    if (IsUnsupportedKeyword(w)) Fail("'" + w + "' is not supported");
+    if (IsUnsupportedKeyword(w)) Unsupported("'" + w + "' is not supported");
     const std::string name = ScopedName();
     const Symbol* s = Lookup(name);
     if (!s) FailAt(line, "unknown type '" + name + "'");
@@ -695,14 +703,14 @@ Schema::Schema(std::shared_ptr<const internal::SchemaImpl> impl) : impl_(std::mo
 
 const internal::SchemaImpl* ImplOf(const Schema& schema) { return schema.impl_.get(); }
 
-Schema Schema::Parse(const std::string& idl_text, std::string* error) {
+StatusOr<Schema> Schema::Parse(const std::string& idl_text) {
   auto impl = std::make_shared<internal::SchemaImpl>();
   try {
     internal::Parser parser(internal::Tokenize(idl_text), impl.get());
     parser.ParseAll();
   } catch (const internal::ParseError& e) {
-    if (error) *error = "line " + std::to_string(e.line) + ": " + e.message;
-    return Schema();
+    std::string message = "line " + std::to_string(e.line) + ": " + e.message;
+    return e.unsupported ? Status::Unimplemented(std::move(message)) : Status::InvalidArgument(std::move(message));
   }
   for (internal::StructDef& def : impl->structs) {
     uint64_t min_size = 0;
@@ -712,15 +720,11 @@ Schema Schema::Parse(const std::string& idl_text, std::string* error) {
     try {
       for (const internal::Member& m : def.members) internal::Emit(*impl, m.node, m.name, &def.ops);
     } catch (const internal::ParseError&) {
-      if (error) {
-        *error = "line " + std::to_string(def.line) + ": struct '" + def.name +
-                 "' is too large to decode (more than " + std::to_string(internal::kMaxOps) +
-                 " steps once nested structs are expanded)";
-      }
-      return Schema();
+      return Status::Unimplemented("line " + std::to_string(def.line) + ": struct '" + def.name +
+                                   "' is too large to decode (more than " + std::to_string(internal::kMaxOps) +
+                                   " steps once nested structs are expanded)");
     }
   }
-  if (error) error->clear();
   return Schema(std::move(impl));
 }
 

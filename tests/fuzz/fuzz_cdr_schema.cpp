@@ -10,12 +10,15 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string idl(reinterpret_cast<const char*>(data), size);
-  std::string error;
-  dyad::cdr::Schema schema = dyad::cdr::Schema::Parse(idl, &error);
-  if (!error.empty()) {
-    dyad::fuzz::Require(error.rfind("line ", 0) == 0, "schema error without its line: " + error);
+  dyad::StatusOr<dyad::cdr::Schema> parsed = dyad::cdr::Schema::Parse(idl);
+  if (!parsed.ok()) {
+    const dyad::Status& s = parsed.status();
+    dyad::fuzz::Require(s.message().rfind("line ", 0) == 0, "schema error without its line: " + s.message());
+    dyad::fuzz::Require(s.code() == dyad::Status::Code::kInvalidArgument || s.code() == dyad::Status::Code::kUnimplemented,
+                        "schema error with an unexpected code: " + s.ToString());
     return 0;
   }
+  const dyad::cdr::Schema& schema = *parsed;
   // Struct names are not exposed: try the identifiers written after `struct`, with their module.
   static const uint8_t payload[] = {0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 'a', 0, 0, 0,
                                     3, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xf0, 0x3f, 1, 2, 3, 4};
@@ -31,9 +34,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (!schema.HasType(candidate)) continue;
       (void)dyad::cdr::Columns(schema, candidate);
       std::vector<dyad::cdr::Field> fields;
-      if (dyad::cdr::Decode(schema, candidate, payload, sizeof payload, &fields, &error)) (void)dyad::cdr::ToJson(fields);
+      if (dyad::cdr::Decode(schema, candidate, payload, sizeof payload, &fields).ok()) (void)dyad::cdr::ToJson(fields);
       std::vector<std::string> row;
-      (void)dyad::cdr::DecodeRow(schema, candidate, payload, sizeof payload, &row, &error);
+      (void)dyad::cdr::DecodeRow(schema, candidate, payload, sizeof payload, &row);
     }
   }
   return 0;

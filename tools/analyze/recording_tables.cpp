@@ -27,15 +27,14 @@ StatusOr<std::map<std::string, TopicTable>> ReadTables(const mcap::Reader& reade
     if (!topics.empty() && topics.count(channel.topic) == 0) continue;
     auto schema = reader.schemas().find(channel.schema_id);
     if (schema == reader.schemas().end() || schema->second.encoding != "omgidl") continue;
-    std::string error;
-    cdr::Schema parsed = cdr::Schema::Parse(schema->second.data, &error);
-    if (!error.empty() || !parsed.HasType(schema->second.name)) {
+    StatusOr<cdr::Schema> parsed = cdr::Schema::Parse(schema->second.data);
+    if (!parsed.ok() || !parsed->HasType(schema->second.name)) {
       return Status::DataLoss(reader.path() + ": topic " + channel.topic,
                               "its IDL schema \"" + schema->second.name + "\" does not parse: " +
-                                  (error.empty() ? "type not defined" : error));
+                                  (parsed.ok() ? "type not defined" : parsed.status().message()));
     }
-    tables[channel.topic].columns = cdr::Columns(parsed, schema->second.name);
-    decoders.emplace(id, Decoder{parsed, schema->second.name, channel.topic});
+    tables[channel.topic].columns = cdr::Columns(*parsed, schema->second.name);
+    decoders.emplace(id, Decoder{*parsed, schema->second.name, channel.topic});
   }
   mcap::ReadOptions options;
   for (const auto& [id, decoder] : decoders) options.topics.insert(decoder.topic);
@@ -46,11 +45,11 @@ StatusOr<std::map<std::string, TopicTable>> ReadTables(const mcap::Reader& reade
     if (it == decoders.end()) return true;
     TopicTable& table = tables[it->second.topic];
     table.rows.emplace_back();
-    std::string error;
-    if (!cdr::DecodeRow(it->second.schema, it->second.type, m.data.data(), m.data.size(), &table.rows.back(),
-                        &error)) {
-      failure = Status::DataLoss(reader.path() + ": topic " + it->second.topic,
-                                 "message " + std::to_string(table.rows.size()) + " does not decode: " + error);
+    const Status decoded =
+        cdr::DecodeRow(it->second.schema, it->second.type, m.data.data(), m.data.size(), &table.rows.back());
+    if (!decoded.ok()) {
+      failure = decoded.WithContext(reader.path() + ": topic " + it->second.topic + ": message " +
+                                    std::to_string(table.rows.size()) + " does not decode");
       return false;
     }
     return true;

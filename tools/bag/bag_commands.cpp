@@ -44,12 +44,12 @@ int RunInfo(const std::string& path, bool scan) {
 std::optional<bag::PayloadDecoder> CdrDecoder(const mcap::Schema* schema, std::string* problem) {
   if (schema == nullptr || schema->encoding != "omgidl") return std::nullopt;
   const std::string what = "schema " + std::to_string(schema->id) + " \"" + schema->name + "\" (omgidl)";
-  std::string error;
-  cdr::Schema parsed = cdr::Schema::Parse(schema->data, &error);
-  if (!error.empty()) {
-    *problem = what + ": " + error;
+  StatusOr<cdr::Schema> schema_or = cdr::Schema::Parse(schema->data);
+  if (!schema_or.ok()) {
+    *problem = what + ": " + schema_or.status().message();
     return std::nullopt;
   }
+  const cdr::Schema& parsed = *schema_or;
   if (!parsed.HasType(schema->name)) {
     *problem = what + ": its IDL defines no struct \"" + schema->name + "\"";
     return std::nullopt;
@@ -57,8 +57,8 @@ std::optional<bag::PayloadDecoder> CdrDecoder(const mcap::Schema* schema, std::s
   bag::PayloadDecoder decoder;
   decoder.columns = cdr::Columns(parsed, schema->name);
   decoder.decode = [parsed, type = schema->name](std::span<const std::uint8_t> data,
-                                                 std::vector<std::string>* cells, std::string* err) {
-    return cdr::DecodeRow(parsed, type, data.data(), data.size(), cells, err);
+                                                 std::vector<std::string>* cells) {
+    return cdr::DecodeRow(parsed, type, data.data(), data.size(), cells);
   };
   return decoder;
 }

@@ -32,7 +32,7 @@ struct ChannelOutput {
 }  // namespace
 
 PayloadDecoder HexDecoder() {
-  return {{"data_hex"}, [](std::span<const std::uint8_t> data, std::vector<std::string>* cells, std::string*) {
+  return {{"data_hex"}, [](std::span<const std::uint8_t> data, std::vector<std::string>* cells) {
             static constexpr char kDigits[] = "0123456789abcdef";
             cells->resize(1);
             std::string& hex = (*cells)[0];
@@ -41,7 +41,7 @@ PayloadDecoder HexDecoder() {
               hex[2 * i] = kDigits[data[i] >> 4];
               hex[2 * i + 1] = kDigits[data[i] & 0xF];
             }
-            return true;
+            return Status::OK();
           }};
 }
 
@@ -94,17 +94,16 @@ Status ExportCsv(const mcap::Reader& reader, const std::string& dir, const CsvEx
   read.topics = options.topics;
   read.skip_damaged = true;
   read.skipped_chunks = &summary->skipped_chunks;
-  std::string error;
   Status status = reader.ReadMessages(read, [&](const mcap::MessageView& m) {
     ChannelOutput& out = *outputs.at(m.channel->id);
     std::vector<std::string>& cells = out.cells;
     out.file << m.log_time << ',' << m.publish_time << ',' << m.sequence;
-    if (!out.decoder.decode(m.data, &cells, &error) || cells.size() != out.decoder.columns.size()) {
+    const Status decoded = out.decoder.decode(m.data, &cells);
+    if (!decoded.ok() || cells.size() != out.decoder.columns.size()) {
       if (summary->undecodable++ == 0) {
         summary->first_decode_error = m.channel->topic + " seq " + std::to_string(m.sequence) + ": " +
-                                      (error.empty() ? "decoder returned the wrong number of cells" : error);
+                                      (decoded.ok() ? "decoder returned the wrong number of cells" : decoded.message());
       }
-      error.clear();
       cells.assign(out.decoder.columns.size(), "");
     }
     for (const std::string& cell : cells) {

@@ -27,18 +27,17 @@
 #include <vector>
 
 #include "dyad/mcap/reader.hpp"
+#include "dyad/status.hpp"
 
 namespace dyad::bag {
 
 struct PayloadDecoder {
   // Header names of the payload columns (at least one).
   std::vector<std::string> columns;
-  // Replaces *cells with exactly columns.size() cells for `data`, or returns false and sets
-  // *error. *cells holds the previous row of the same channel: assign into its strings rather than
+  // Replaces *cells with exactly columns.size() cells for `data`, or returns why it cannot. *cells holds the previous row of the same channel: assign into its strings rather than
   // clearing it, so a row costs no allocation once they have grown. Cells are written as given,
   // CSV-quoted when needed.
-  std::function<bool(std::span<const std::uint8_t> data, std::vector<std::string>* cells, std::string* error)>
-      decode;
+  std::function<Status(std::span<const std::uint8_t> data, std::vector<std::string>* cells)> decode;
 };
 
 // Picks the decoder for a channel; `schema` is null when the channel has none. nullopt -> hex.

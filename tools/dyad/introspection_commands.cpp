@@ -15,19 +15,16 @@ namespace {
 // Prints samples as JSON, decoded with each type's own IDL text (parsed once per type); as hex
 // with the reason when that fails.
 SamplePrinter JsonPrinter() {
-  auto schemas = std::make_shared<std::map<std::string, std::pair<cdr::Schema, std::string>>>();
+  auto schemas = std::make_shared<std::map<std::string, StatusOr<cdr::Schema>>>();
   return [schemas](const TypeInfo& type, const uint8_t* data, size_t size) {
     auto it = schemas->find(type.name);
-    if (it == schemas->end()) {
-      std::string error;
-      cdr::Schema schema = cdr::Schema::Parse(type.idl, &error);
-      it = schemas->emplace(type.name, std::make_pair(std::move(schema), error)).first;
-    }
-    std::string error = it->second.second;
+    if (it == schemas->end()) it = schemas->emplace(type.name, cdr::Schema::Parse(type.idl)).first;
+    const StatusOr<cdr::Schema>& schema = it->second;
     std::vector<cdr::Field> fields;
-    if (error.empty() && cdr::Decode(it->second.first, type.name, data, size, &fields, &error)) return cdr::ToJson(fields);
+    const Status decoded = schema.ok() ? cdr::Decode(*schema, type.name, data, size, &fields) : schema.status();
+    if (decoded.ok()) return cdr::ToJson(fields);
     std::ostringstream os;
-    os << type.short_name() << " (" << error << ") " << size << " bytes:";
+    os << type.short_name() << " (" << decoded.message() << ") " << size << " bytes:";
     for (size_t i = 0; i < size; ++i) os << (i % 4 == 0 ? " " : "") << std::hex << std::setw(2) << std::setfill('0') << int(data[i]);
     return os.str();
   };

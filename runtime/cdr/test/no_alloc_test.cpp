@@ -30,12 +30,11 @@ namespace dyad::cdr {
 namespace {
 
 TEST(CdrCsv, DecodeRowReusesTheRowWithoutAllocating) {
-  std::string error;
-  const Schema schema = Schema::Parse(
+  const StatusOr<Schema> parsed = Schema::Parse(
       "module m { struct Inner { double a; long b; };\n"
-      "struct Sample { string name_longer_than_sso; sequence<Inner> items; double x; }; };\n",
-      &error);
-  ASSERT_EQ(error, "");
+      "struct Sample { string name_longer_than_sso; sequence<Inner> items; double x; }; };\n");
+  ASSERT_TRUE(parsed.ok()) << parsed.status().ToString();
+  const Schema& schema = *parsed;
   // Little-endian plain CDR: "a long enough name\0", 2 items, x.
   std::vector<std::uint8_t> bytes = {0x00, 0x01, 0x00, 0x00};
   auto put = [&](const void* p, std::size_t n) {
@@ -56,11 +55,11 @@ TEST(CdrCsv, DecodeRowReusesTheRowWithoutAllocating) {
   put(&x, 8);
 
   std::vector<std::string> row;
-  ASSERT_TRUE(DecodeRow(schema, "m::Sample", bytes.data(), bytes.size(), &row, &error)) << error;
+  ASSERT_TRUE(DecodeRow(schema, "m::Sample", bytes.data(), bytes.size(), &row).ok());
   EXPECT_EQ(row, (std::vector<std::string>{"a long enough name", "[{\"a\":0.25,\"b\":0},{\"a\":1.25,\"b\":1}]", "-1.5"}));
   const std::string type = "m::Sample";
   const long before = g_allocations.load();
-  for (int i = 0; i < 100; ++i) ASSERT_TRUE(DecodeRow(schema, type, bytes.data(), bytes.size(), &row, &error));
+  for (int i = 0; i < 100; ++i) ASSERT_TRUE(DecodeRow(schema, type, bytes.data(), bytes.size(), &row).ok());
   EXPECT_EQ(g_allocations.load() - before, 0);
 }
 

@@ -131,13 +131,10 @@ TEST(CsvExport, UsesTheDecoderTheFactoryPicksPerSchema) {
   options.decoder_factory = [](const mcap::Schema* schema, const mcap::Channel&) -> std::optional<PayloadDecoder> {
     if (schema == nullptr || schema->name != "dyad::msg::Pose2") return std::nullopt;
     return PayloadDecoder{{"index", "note"},
-                          [](std::span<const std::uint8_t> data, std::vector<std::string>* cells, std::string* error) {
-                            if (data[1] == 3) {
-                              *error = "index 3 is cursed";
-                              return false;
-                            }
+                          [](std::span<const std::uint8_t> data, std::vector<std::string>* cells) {
+                            if (data[1] == 3) return Status::DataLoss("index 3 is cursed");
                             *cells = {std::to_string(data[1]), "a,\"b\""};
-                            return true;
+                            return Status::OK();
                           }};
   };
   const std::string dir = TempPath("out");

@@ -59,11 +59,13 @@
 //   ("[0.25,0.75]", "[{\"x\":1,\"y\":2}]"). DecodeRow() fills a row in that column order with the
 //   same value texts as Decode(); it does no CSV quoting (that is the CSV writer's job).
 //
-// ERRORS
-//   Schema::Parse: "line N: message" (N counts from 1), e.g. "line 7: 'union' is not supported".
-//   Decode / DecodeRow: "offset N (path): message" where N is the byte offset in the payload after
-//   the encapsulation header, e.g. "offset 24 (header.stamp_ns): truncated: long long needs 8
-//   bytes, 3 left". Truncated or garbled payloads never read out of bounds; a garbled sequence
+// ERRORS (a dyad::Status; its code says what kind of problem it is)
+//   Schema::Parse: "line N: message" (N counts from 1): Unimplemented for valid IDL this reader
+//   does not support ("line 7: 'union' is not supported"), InvalidArgument for anything else.
+//   Decode / DecodeRow: NotFound for a type the schema does not define; Unimplemented for an
+//   encapsulation other than plain CDR; DataLoss for a payload that is truncated or garbled:
+//   "offset N (path): message" where N is the byte offset in the payload after the encapsulation
+//   header, e.g. "offset 24 (header.stamp_ns): truncated: long long needs 8 bytes, 3 left". Truncated or garbled payloads never read out of bounds; a garbled sequence
 //   count (or an array) larger than the remaining bytes could hold is an error, caught before
 //   any element is decoded.
 //   On failure the output holds what was decoded before the error.
@@ -75,12 +77,11 @@
 //   copy (shared); all functions are safe to call concurrently.
 //
 // EXAMPLE
-//   std::string error;
-//   dyad::cdr::Schema schema = dyad::cdr::Schema::Parse(idl_text, &error);
-//   if (!error.empty()) { std::cerr << "schema: " << error << "\n"; return; }
+//   dyad::StatusOr<dyad::cdr::Schema> schema = dyad::cdr::Schema::Parse(idl_text);
+//   if (!schema.ok()) { std::cerr << "schema: " << schema.status().message() << "\n"; return; }
 //   std::vector<dyad::cdr::Field> fields;
-//   if (!dyad::cdr::Decode(schema, "dyad::msg::HumanInput", data, size, &fields, &error)) {
-//     std::cerr << error << "\n"; return;
+//   if (dyad::Status s = dyad::cdr::Decode(*schema, "dyad::msg::HumanInput", data, size, &fields); !s.ok()) {
+//     std::cerr << s.message() << "\n"; return;
 //   }
 //   std::cout << dyad::cdr::ToJson(fields) << "\n";
 #pragma once
@@ -90,6 +91,8 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+#include <dyad/status.hpp>
 
 namespace dyad::cdr {
 
@@ -103,9 +106,8 @@ class Schema {
   // An empty schema: knows no types.
   Schema();
 
-  // Parses `idl_text`. On success returns the schema and clears *error; on failure returns an
-  // empty schema and sets *error to "line N: message". `error` may be null.
-  static Schema Parse(const std::string& idl_text, std::string* error);
+  // Parses `idl_text`: the schema, or the first problem as "line N: message" (see ERRORS).
+  static StatusOr<Schema> Parse(const std::string& idl_text);
 
   // True if `qualified_name` names a struct of this schema ("dyad::msg::HumanInput"; a leading
   // "::" is allowed). Only structs can be decoded.
@@ -132,10 +134,10 @@ struct Field {
 
 // Decodes one serialized sample (`data`, `size` bytes, starting with the 4-byte encapsulation
 // header) of the struct `root_type` (fully qualified; a "#<hash>" suffix, as in the runtime's DDS
-// type names, is ignored). Replaces *out with its fields. Returns false and sets *error (may be
-// null) if the type is unknown or the payload is truncated or garbled.
-bool Decode(const Schema& schema, const std::string& root_type, const uint8_t* data, size_t size,
-            std::vector<Field>* out, std::string* error);
+// type names, is ignored). Replaces *out with its fields. On an unknown type or a truncated or
+// garbled payload returns the error (see ERRORS) and *out holds what was decoded before it.
+Status Decode(const Schema& schema, const std::string& root_type, const uint8_t* data, size_t size,
+              std::vector<Field>* out);
 
 // Renders fields produced by Decode() as one compact nested JSON object (see OUTPUT above).
 std::string ToJson(const std::vector<Field>& fields);
@@ -145,9 +147,9 @@ std::string ToJson(const std::vector<Field>& fields);
 std::vector<std::string> Columns(const Schema& schema, const std::string& root_type);
 
 // Decodes one sample like Decode(), into *row: one value per column of Columns(), same order.
-// Reuses the row's strings (no allocation once they have grown). Returns false and sets *error
-// (may be null) on an unknown type or a truncated or garbled payload.
-bool DecodeRow(const Schema& schema, const std::string& root_type, const uint8_t* data,
-               size_t size, std::vector<std::string>* row, std::string* error);
+// Reuses the row's strings (no allocation once they have grown, and none on success: an OK
+// Status is free). Returns the error (see ERRORS) on an unknown type or a bad payload.
+Status DecodeRow(const Schema& schema, const std::string& root_type, const uint8_t* data,
+                 size_t size, std::vector<std::string>* row);
 
 }  // namespace dyad::cdr
