@@ -1,6 +1,8 @@
 // Invalid graphs are rejected before anything runs, each problem with file:line:col and key.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <dyad/catalog.hpp>
 #include <dyad/graph.hpp>
 #include <dyad/validate.hpp>
@@ -217,6 +219,35 @@ TEST(GraphValidation, FillsDefaultsAndResolvesPeriods) {
   EXPECT_DOUBLE_EQ(r.components[0].params.Double("noise"), 1.0);
   EXPECT_EQ(r.components[0].params.Int("limit"), 0);
   EXPECT_EQ(r.topics.at("count").type->short_name(), "Counter");
+}
+
+// A path param written in a graph file is relative to that file's folder; one given with --set,
+// to the working folder; absolute and empty values are kept; plain strings are not paths.
+TEST(GraphValidation, PathParamsAreRelativeToTheGraphFileOrToTheWorkingFolderForASet) {
+  const std::string graph = R"(graph: paths
+clock: stepped
+components:
+  src: {type: counter_source, rate_hz: 10, outputs: {out: count}}
+  a: {type: counter_sink, trigger: in, inputs: {in: count}, params: {file: out/a.txt}}
+  b: {type: counter_sink, trigger: in, inputs: {in: count}, params: {file: /abs/b.txt}}
+  c: {type: counter_sink, trigger: in, inputs: {in: count}, params: {file: ../c.txt}}
+  d: {type: counter_sink, trigger: in, inputs: {in: count}}
+  e: {type: counter_sink, trigger: in, inputs: {in: count}, params: {file: e.txt}}
+)";
+  std::vector<Diagnostic> diags;
+  Graph g = ParseGraph(graph, "/lab/graphs/g.yaml", {{"e.file=set/e.txt"}}, &diags);
+  ResolvedGraph r = ValidateGraph(g, ExampleCatalog(), &diags);
+  ASSERT_TRUE(diags.empty()) << diags[0].ToString();
+  ASSERT_EQ(r.components.size(), 6u);
+  EXPECT_EQ(r.components[1].params.String("file"), "/lab/graphs/out/a.txt");
+  EXPECT_EQ(r.components[2].params.String("file"), "/abs/b.txt");
+  EXPECT_EQ(r.components[3].params.String("file"), "/lab/c.txt");
+  EXPECT_EQ(r.components[4].params.String("file"), "");
+  EXPECT_EQ(r.components[5].params.String("file"), (std::filesystem::current_path() / "set/e.txt").string());
+  // A relative graph path is taken from the working folder first.
+  g = ParseGraph(graph, "graphs/g.yaml", {}, &diags);
+  r = ValidateGraph(g, ExampleCatalog(), &diags);
+  EXPECT_EQ(r.components[1].params.String("file"), (std::filesystem::current_path() / "graphs/out/a.txt").string());
 }
 
 }  // namespace

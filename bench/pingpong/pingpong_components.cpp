@@ -47,7 +47,7 @@ class Ping final : public dyad::Component {
     spec.Summary("Measures round trips through a pong (benchmark).");
     spec.Param("rounds", int64_t{10000}).Min(1).Doc("round trips to measure");
     spec.Param("payload", int64_t{0}).Min(0).Doc("payload bytes per sample");
-    spec.Param("file", "").Doc("where to write the round-trip times (ns), one per line");
+    spec.Param("file", "").Path().Doc("where to write the round-trip times (ns), one per line");
     spec.Input<dyad::msg::PingPong>("back");
     spec.Output<dyad::msg::PingPong>("out");
   }

@@ -52,7 +52,7 @@ Status ApplyMap(const std::string& param, const std::string& yaml_text,
 void Deliberator::Describe(ComponentSpec& spec) {
   spec.Summary("The robot's PV-RNN mind: online error regression over a sliding window of executed "
                "positions, publishing the next intended position each step.");
-  spec.RequiredParam("model", ParamType::kString).Doc(".dpvrnn model file (2 DOF: x, y)");
+  spec.RequiredParam("model", ParamType::kString).Path().Doc(".dpvrnn model file (2 DOF: x, y)");
   spec.Param("start_primitive", int64_t{0}).Min(0).Doc("primitive the robot starts drawing");
   spec.Param("preset", "vcbot").OneOf({"vcbot", "reference"})
       .Doc("vcbot: W 5, 15 it, Adam lr 0.3 b1 0.1 b2 0.95, w 1e-5; reference: W 15, 15 it, Adam lr 0.1; "

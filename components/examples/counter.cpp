@@ -38,7 +38,7 @@ Status CounterSource::Step(const StepInfo&) {
 
 void CounterSink::Describe(ComponentSpec& spec) {
   spec.Summary("Receives counters; writes them to a file; can end the run after N.");
-  spec.Param("file", "").Doc("one line per sample: value source sequence stamp_ns (empty: no file)");
+  spec.Param("file", "").Path().Doc("one line per sample: value source sequence stamp_ns (empty: no file)");
   spec.Param("expect", int64_t{0}).Min(0).Doc("stop the run after receiving this many samples (0: never)");
   spec.Input<msg::Counter>("in").Doc("counters to record");
 }

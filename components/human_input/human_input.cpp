@@ -4,7 +4,7 @@ namespace dyad::human_input {
 
 void HumanSynthetic::Describe(ComponentSpec& spec) {
   spec.Summary("A scripted human: during listed events engages and traces a data set primitive, else disengaged.");
-  spec.RequiredParam("dataset", ParamType::kString).Doc("NRL data set folder whose primitives are traced");
+  spec.RequiredParam("dataset", ParamType::kString).Path().Doc("NRL data set folder whose primitives are traced");
   spec.YamlParam("events", "[]")
       .Doc("list of {start, end, primitive}: steps start..end-1 engaged tracing that primitive; sorted, not overlapping");
   spec.Param("noise_std", 0.0).Min(0).Unit("workspace units").Doc("Gaussian noise per axis while engaged (seeded)");
@@ -39,7 +39,7 @@ Status HumanSynthetic::Step(const StepInfo& info) {
 
 void HumanReplay::Describe(ComponentSpec& spec) {
   spec.Summary("Plays back a human track from CSV (columns x, y, engaged by header name), one row per step.");
-  spec.RequiredParam("file", ParamType::kString).Doc("CSV as `dyad bag export --csv` writes a HumanInput topic");
+  spec.RequiredParam("file", ParamType::kString).Path().Doc("CSV as `dyad bag export --csv` writes a HumanInput topic");
   spec.Output<msg::HumanInput>("out").Doc("one CSV row per step; the run is asked to stop after the last");
 }
 

@@ -19,7 +19,7 @@ const Eigen::MatrixXd& PositionWindow::Ordered() {
 
 void Observer::Describe(ComponentSpec& spec) {
   spec.Summary("Classifies the human's and the robot's recent motion into primitives; publishes their congruence.");
-  spec.RequiredParam("model", ParamType::kString).Doc("observer file written by `dyad train-observer`");
+  spec.RequiredParam("model", ParamType::kString).Path().Doc("observer file written by `dyad train-observer`");
   spec.Param("window", int64_t{5}).Range(1, 1000).Unit("steps").Doc("steps per classified window; must match the observer file");
   spec.Param("lowpass_steps", int64_t{10}).Range(1, 100000).Unit("steps")
       .Doc("Y: P(C_t) is the moving average of the instantaneous congruence over the last Y steps");

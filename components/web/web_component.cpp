@@ -77,11 +77,11 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Param("max_clients", 8).Range(1, 64).Doc("WebSocket clients at once");
   spec.Param("client_buffer_kb", 4096).Range(16, 1 << 20).Doc("per-client send buffer; past it the busiest channel's oldest samples are dropped");
   spec.Param("max_frame_kb", 1024).Range(1, 1 << 20).Doc("a larger frame from a client closes it");
-  spec.Param("port_file", "").Doc("write the bound port to this file (tests, scripts)");
+  spec.Param("port_file", "").Path().Doc("write the bound port to this file (tests, scripts)");
   spec.Param("engage_key", "Space").Doc("subject's page: the key (KeyboardEvent.code) that engages while held, besides the mouse button");
   spec.Param("half_width", 50.0).Min(1e-6).Doc("subject's page: the workspace drawn is [-half_width, half_width]^2 (the study's 50)");
   spec.Param("show_primitives", false).Doc("subject's page: draw the data set's primitives as a faint watermark");
-  spec.Param("dataset", "").Doc("subject's page: NRL data set folder of the primitives (with show_primitives)");
+  spec.Param("dataset", "").Path().Doc("subject's page: NRL data set folder of the primitives (with show_primitives)");
   spec.Input<msg::CartesianState>("robot").Optional().Doc("robot state shown on the subject's page");
   spec.Input<msg::Intention>("intention").Optional().Doc("experimenter's page: the deliberator's N-ELBO");
   spec.Input<msg::IntentionLabel>("labels").Optional().Doc("experimenter's page: the observer's P(C_t) and labels");

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <sstream>
 
@@ -38,6 +39,18 @@ std::string RangeError(const ParamSpec& spec, double v) {
   if (spec.min && v < *spec.min) os << "must be >= " << *spec.min << ", got " << v;
   else if (spec.max && v > *spec.max) os << "must be <= " << *spec.max << ", got " << v;
   return os.str();
+}
+
+// A path param's value made absolute against `base` (the graph file's folder, or the working
+// folder for a --set); absolute and empty values are kept.
+void ResolvePaths(const std::filesystem::path& base, ParamValue* value) {
+  auto resolve = [&](std::string& p) {
+    if (p.empty() || std::filesystem::path(p).is_absolute()) return;
+    p = (base / p).lexically_normal().string();
+  };
+  if (auto* s = std::get_if<std::string>(value)) resolve(*s);
+  if (auto* list = std::get_if<std::vector<std::string>>(value))
+    for (std::string& p : *list) resolve(p);
 }
 
 }  // namespace
@@ -179,8 +192,18 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
           continue;
         }
         auto v = ParamFromYaml(*ps, kv.second);
-        if (!v.ok()) error(at, pkey, v.status().message());
-        else values[pname] = std::move(v.value());
+        if (!v.ok()) {
+          error(at, pkey, v.status().message());
+          continue;
+        }
+        if (ps->path) {
+          // Written in the file: relative to the file. Given with --set: relative to where the user is.
+          std::error_code ec;
+          const std::filesystem::path cwd = std::filesystem::current_path(ec);
+          const bool from_file = set == c.overridden.end() && !graph.file.empty();
+          ResolvePaths(from_file ? std::filesystem::absolute(graph.file, ec).parent_path() : cwd, &v.value());
+        }
+        values[pname] = std::move(v.value());
       }
     }
     for (const auto& ps : spec.params()) {

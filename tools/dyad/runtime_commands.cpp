@@ -42,7 +42,7 @@ void PrintTypes(const Catalog& catalog, std::ostream& out) {
     for (const auto& p : e.spec.outputs())
       out << "  output " << p.name << ": " << p.type->short_name() << (p.doc.empty() ? "" : "  # " + p.doc) << "\n";
     for (const auto& p : e.spec.params()) {
-      out << "  param  " << p.name << ": " << ToString(p.type);
+      out << "  param  " << p.name << ": " << ToString(p.type) << (p.path ? " path" : "");
       out << (p.default_value ? " = " + ToYamlText(*p.default_value) : " (required)");
       if (!p.unit.empty()) out << " [" << p.unit << "]";
       if (p.min || p.max) out << " range " << RangeText(p);

@@ -85,6 +85,16 @@ class Reader {
   }
   const std::vector<std::string>& errors() const { return errors_; }
 
+  // A path at `key`: written in the file, relative to the file's folder; given with --set,
+  // relative to the working folder. Absolute and empty paths are kept.
+  void ResolvePath(const std::string& key, std::string* value) const {
+    if (value->empty() || std::filesystem::path(*value).is_absolute()) return;
+    std::error_code ec;
+    const std::filesystem::path base =
+        Overridden(key) ? std::filesystem::current_path(ec) : std::filesystem::absolute(file_, ec).parent_path();
+    *value = (base / *value).lexically_normal().string();
+  }
+
  private:
   // True when --set replaced the value at `key`, at a key containing it ("adam" for
   // "adam.lr") or inside it ("adam.lr.x" for "adam.lr").
@@ -195,16 +205,12 @@ Status ApplyOverride(YAML::Node root, const std::string& spec) {
 
 namespace {
 
-TrainConfig Read(const YAML::Node& root, const std::string& path, Reader& r) {
+TrainConfig Read(const YAML::Node& root, Reader& r) {
   TrainConfig c;
   if (!r.Keys(root, "", {"dataset", "loops", "layers", "encoding", "epochs", "adam", "seed", "scalar", "noise", "log_every",
                          "checkpoint_every", "output", "checkpoint", "log_csv"}))
     return c;
-  if (r.Get(root, "dataset", "dataset", "a path", &c.dataset, true)) {
-    std::filesystem::path p(c.dataset);
-    if (p.is_relative()) p = std::filesystem::path(path).parent_path() / p;
-    c.dataset = p.lexically_normal().string();
-  }
+  if (r.Get(root, "dataset", "dataset", "a path", &c.dataset, true)) r.ResolvePath("dataset", &c.dataset);
   if (r.Get(root, "loops", "loops", "an integer", &c.loops))
     r.Check(c.loops >= 1 && c.loops <= 100, root, "loops", "loops", "must be in 1..100", c.loops);
   // Types here; value rules come from ModelSpec/AdamOptions::Problems() (one place), below.
@@ -261,9 +267,9 @@ TrainConfig Read(const YAML::Node& root, const std::string& path, Reader& r) {
     r.Check(c.log_every > 0, root, "log_every", "log_every", "must be > 0", c.log_every);
   if (r.Get(root, "checkpoint_every", "checkpoint_every", "an integer", &c.checkpoint_every))
     r.Check(c.checkpoint_every >= 0, root, "checkpoint_every", "checkpoint_every", "must be >= 0", c.checkpoint_every);
-  r.Get(root, "output", "output", "a path", &c.output, true);
-  r.Get(root, "checkpoint", "checkpoint", "a path", &c.checkpoint);
-  r.Get(root, "log_csv", "log_csv", "a path", &c.log_csv);
+  if (r.Get(root, "output", "output", "a path", &c.output, true)) r.ResolvePath("output", &c.output);
+  if (r.Get(root, "checkpoint", "checkpoint", "a path", &c.checkpoint)) r.ResolvePath("checkpoint", &c.checkpoint);
+  if (r.Get(root, "log_csv", "log_csv", "a path", &c.log_csv)) r.ResolvePath("log_csv", &c.log_csv);
   if (c.checkpoint.empty() && !c.output.empty()) c.checkpoint = c.output + ".ckpt";
   if (c.log_csv.empty() && !c.output.empty()) c.log_csv = c.output + ".csv";
   std::vector<FieldProblem> problems = c.spec.Problems();
@@ -298,7 +304,7 @@ StatusOr<TrainConfig> LoadTrainConfig(const std::string& path, const std::vector
   Reader r(path, overridden);
   TrainConfig c;
   try {
-    c = Read(root, path, r);
+    c = Read(root, r);
   } catch (const YAML::Exception& e) {  // e.g. a key that is itself a list: not our format
     return Status::InvalidArgument(path + ": " + e.msg);
   }

@@ -18,9 +18,21 @@ TEST(TrainConfig, ValidFileLoads) {
   EXPECT_EQ(c->spec, ModelSpec::MacawBot());
   EXPECT_EQ(c->epochs, 100);
   EXPECT_EQ(c->seed, 3u);
-  EXPECT_EQ(c->dataset, kDir + "/analytic_set");  // relative to the config file
-  EXPECT_EQ(c->checkpoint, "out.dpvrnn.ckpt");
-  EXPECT_EQ(c->log_csv, "out.dpvrnn.csv");
+  // Every path of a config is relative to the config file.
+  EXPECT_EQ(c->dataset, kDir + "/analytic_set");
+  EXPECT_EQ(c->output, kDir + "/out.dpvrnn");
+  EXPECT_EQ(c->checkpoint, kDir + "/out.dpvrnn.ckpt");
+  EXPECT_EQ(c->log_csv, kDir + "/out.dpvrnn.csv");
+}
+
+// A path given with --set is relative to the working folder, as a shell user expects.
+TEST(TrainConfig, PathsSetOnTheCommandLineAreRelativeToTheWorkingFolder) {
+  auto c = LoadTrainConfig(kDir + "/valid_train.yaml", {"dataset=data/set", "output=models/m.dpvrnn"});
+  ASSERT_TRUE(c.ok()) << c.status().message();
+  const std::string cwd = std::filesystem::current_path().string();
+  EXPECT_EQ(c->dataset, cwd + "/data/set");
+  EXPECT_EQ(c->output, cwd + "/models/m.dpvrnn");
+  EXPECT_EQ(c->checkpoint, cwd + "/models/m.dpvrnn.ckpt");
 }
 
 // Golden invalid files: each lists, in `# expect: <suffix>` lines, every message it must give

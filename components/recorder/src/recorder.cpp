@@ -41,7 +41,7 @@ uint64_t NonNegative(int64_t v) { return v < 0 ? 0 : static_cast<uint64_t>(v); }
 
 void Recorder::Describe(ComponentSpec& spec) {
   spec.Summary("Records graph topics (names or regexes, default all) into an MCAP file: omgidl schemas, CDR, zstd chunks.");
-  spec.Param("file", "{graph}-{time}.mcap").Doc("output path; {graph} = graph name, {time} = local start time YYYYMMDD-HHMMSS");
+  spec.Param("file", "{graph}-{time}.mcap").Path().Doc("output path; {graph} = graph name, {time} = local start time YYYYMMDD-HHMMSS");
   spec.Param("overwrite", false).Doc("replace an existing file (false: an existing file is an error, nothing is recorded over it)");
   spec.Param("topics", std::vector<std::string>{}).Doc("topic names or regexes (whole-name match); empty: every graph topic");
   spec.Param("chunk_size", int64_t{256 * 1024}).Range(1024, 1024.0 * 1024 * 1024).Unit("bytes").Doc("uncompressed bytes per chunk");

@@ -19,7 +19,7 @@ std::string Detail(const std::string& message, const std::string& path) {
 
 void Replay::Describe(ComponentSpec& spec) {
   spec.Summary("Republishes the topics of an MCAP recording with their original timing (wall) or one recorded instant per step (stepped).");
-  spec.RequiredParam("file", ParamType::kString).Doc("the MCAP recording to replay");
+  spec.RequiredParam("file", ParamType::kString).Path().Doc("the MCAP recording to replay");
   spec.Param("topics", std::vector<std::string>{}).Doc("recorded topics, names or regexes; empty: all but dyad/stats");
   spec.YamlParam("remap", "{}").Doc("recorded topic -> topic to publish on, e.g. {human/input: replay/human}");
   spec.Param("speed", 1.0).Min(1e-6).Doc("wall clock: time scale (2 = twice as fast)");

@@ -521,15 +521,21 @@ TEST_F(RecorderTest, RecordsTopicsPublishedInAnotherProcessWithoutGaps) {
 
 namespace {
 
-// The example graphs of components/recorder/examples run as their comments say.
+// The example graphs of components/recorder/examples run as their comments say. Copied to a
+// folder of their own and run from another one: their relative file names are relative to the
+// graph file, not to the working folder.
 TEST_F(RecorderTest, ExampleGraphsRecordAndReplayAsDocumented) {
-  const std::string examples = DYAD_RECORDER_EXAMPLES;
-  Child rec(Dyad({"run", examples + "/record.yaml", "--steps", "100", "--quiet"}), dir_, "record", {}, dir_);
+  const std::filesystem::path examples = dir_ / "examples";
+  std::filesystem::create_directories(examples);
+  for (const char* f : {"record.yaml", "replay.yaml"})
+    std::filesystem::copy_file(std::filesystem::path(DYAD_RECORDER_EXAMPLES) / f, examples / f);
+  Child rec(Dyad({"run", (examples / "record.yaml").string(), "--steps", "100", "--quiet"}), dir_, "record", {}, dir_);
   ASSERT_EQ(rec.Wait(60), 0) << rec.err();
-  Child play(Dyad({"run", examples + "/replay.yaml", "--quiet"}), dir_, "replay", {}, dir_);
+  Child play(Dyad({"run", (examples / "replay.yaml").string(), "--quiet"}), dir_, "replay", {}, dir_);
   ASSERT_EQ(play.Wait(60), 0) << play.err();
-  const Recording a = Read(dir_ / "counters.mcap");
-  const Recording b = Read(dir_ / "counters_replayed.mcap");
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "counters.mcap"));  // not in the working folder
+  const Recording a = Read(examples / "counters.mcap");
+  const Recording b = Read(examples / "counters_replayed.mcap");
   EXPECT_EQ(a.topics, (std::vector<std::string>{"ca", "cb", "cc", "dyad/stats"}));
   EXPECT_EQ(a.by_topic.at("cb").size(), 100u);
   EXPECT_EQ(a.by_topic.at("cc").size(), 50u);

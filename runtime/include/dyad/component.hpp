@@ -99,7 +99,8 @@ namespace dyad {
 
 // Bump when anything in this header changes layout or meaning; plugins built against another
 // version are refused at load time with a message naming both versions.
-inline constexpr uint32_t kPluginAbiVersion = 2;
+// 3: ParamSpec::path (relative paths resolved against the graph file).
+inline constexpr uint32_t kPluginAbiVersion = 3;
 
 // The runtime clock: wall time (ns since the Unix epoch) in `clock: wall` graphs, simulated time
 // (ns since start) in `clock: stepped` graphs. Thread-safe.

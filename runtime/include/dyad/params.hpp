@@ -5,9 +5,15 @@
 // validator (`dyad validate`), the listing (`dyad types`) and the component itself:
 //
 //   spec.Param("gain", 0.9).Range(0.0, 1.0).Doc("weight of the human in the blend");
-//   spec.RequiredParam("model", ParamType::kString).Doc("model file");
+//   spec.RequiredParam("model", ParamType::kString).Path().Doc("model file");
 //   ...
 //   double g = ctx.params().Double("gain");   // in Configure(): already validated
+//
+// Paths: a kString or kStringList parameter marked Path() names files or folders. A relative
+// value written in a graph file is resolved against that file's folder (so a graph runs the same
+// from any working folder); a relative value given with `--set` on the command line, against the
+// working folder (as a shell user expects); a default, as it is (the component's own choice).
+// The component always receives the resolved path; empty values stay empty.
 //
 // Values reach the component only after validation, so getters never fail on user input; asking
 // for an undeclared name or the wrong type is a programming error and aborts with a message.
@@ -45,6 +51,7 @@ struct ParamSpec {
   std::vector<std::string> choices;          // kString: allowed values, empty = any
   std::string unit;
   std::string doc;
+  bool path = false;                         // a file or folder (see the file comment)
 
   // Builder-style setters used in Describe().
   ParamSpec& Range(double lo, double hi) { min = lo; max = hi; return *this; }
@@ -53,6 +60,7 @@ struct ParamSpec {
   ParamSpec& OneOf(std::vector<std::string> values) { choices = std::move(values); return *this; }
   ParamSpec& Unit(std::string u) { unit = std::move(u); return *this; }
   ParamSpec& Doc(std::string d) { doc = std::move(d); return *this; }
+  ParamSpec& Path() { path = true; return *this; }
 };
 
 // Validated values of one component instance, defaults filled in.

@@ -13,13 +13,15 @@
 //   noise: true                                # sample eps during training
 //   log_every: 100                             # progress line + CSV row
 //   checkpoint_every: 5000                     # 0 = only at the end / on Ctrl-C
-//   output: macaw.dpvrnn                       # relative to the working directory
+//   output: macaw.dpvrnn                       # relative to this file's folder
 //   checkpoint: macaw.ckpt.dpvrnn              # default: <output>.ckpt
 //   log_csv: macaw.csv                         # default: <output>.csv
 //
 // Contract: unknown keys, wrong types and invalid values are errors, each reported as
 // "file:line:col: key: message" (1-based), all of them at once. `overrides` ("adam.lr=0.002")
 // replace values before validation and are reported as "--set key: message".
+// Paths (dataset, output, checkpoint, log_csv) come back absolute: written in the file, relative
+// to the file's folder; given as an override, relative to the working folder.
 #pragma once
 
 #include <string>
@@ -32,7 +34,7 @@
 namespace dyad::pvrnn {
 
 struct TrainConfig {
-  std::string dataset;             // resolved path
+  std::string dataset;             // absolute (see the file comment)
   // Each sequence is trained as `loops` copies of itself end to end (1..100). For closed
   // primitives: with 2 the prior learns to go round again instead of drifting after one loop.
   int64_t loops = 1;
