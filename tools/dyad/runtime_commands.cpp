@@ -1,6 +1,6 @@
 #include "runtime_commands.hpp"
 
-#include <charconv>
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <iomanip>
@@ -11,6 +11,8 @@
 #include <dyad/catalog.hpp>
 #include <dyad/run.hpp>
 
+#include "reference_markdown.hpp"
+
 namespace dyad::cli {
 namespace {
 
@@ -20,20 +22,8 @@ std::vector<Override> ToOverrides(const std::vector<std::string>& sets) {
   return out;
 }
 
-// A bound exactly: integers as integers ("1073741824", not "1.07374e+09"), other numbers in the
-// shortest form that reads back to the same double.
-std::string BoundText(const ParamSpec& p, std::optional<double> v, const char* none) {
-  if (!v) return none;
-  if (p.type == ParamType::kInt && std::abs(*v) < 9.2e18) return std::to_string(static_cast<int64_t>(*v));
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, *v);
-  return std::string(buf, r.ptr);
-}
-
-std::string RangeText(const ParamSpec& p) { return BoundText(p, p.min, "-inf") + ".." + BoundText(p, p.max, "inf"); }
-
-void PrintTypes(const Catalog& catalog, std::ostream& out) {
-  for (const auto& [name, e] : catalog.entries()) {
+void PrintType(const std::string& name, const CatalogEntry& e, std::ostream& out) {
+  {
     out << name << "  (" << e.type.plugin_path << ")\n";
     if (!e.spec.summary().empty()) out << "  " << e.spec.summary() << "\n";
     for (const auto& p : e.spec.inputs())
@@ -45,7 +35,7 @@ void PrintTypes(const Catalog& catalog, std::ostream& out) {
       out << "  param  " << p.name << ": " << ToString(p.type) << (p.path ? " path" : "");
       out << (p.default_value ? " = " + ToYamlText(*p.default_value) : " (required)");
       if (!p.unit.empty()) out << " [" << p.unit << "]";
-      if (p.min || p.max) out << " range " << RangeText(p);
+      if (p.min || p.max) out << " range " << ParamRangeText(p);
       if (!p.choices.empty()) {
         out << " one of";
         for (const auto& c : p.choices) out << " " << c;
@@ -63,7 +53,8 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
   // the same process (tests, embedding programs) starts from the defaults again.
   struct State {
     RunOptions run;
-    std::vector<std::string> sets, plugins;
+    std::vector<std::string> sets, plugins, type_names;
+    bool markdown = false, messages = false;
   };
   auto st = std::make_shared<State>();
   RunOptions& run = st->run;
@@ -96,11 +87,37 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
 
   auto* types = app.add_subcommand("types", "List every component type found, with its ports and parameters");
   types->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
+  types->add_option("names", st->type_names, "Only these component types");
+  types->add_flag("--markdown", st->markdown, "Reference tables in Markdown (what docs/components.md embeds)");
+  types->add_flag("--messages", st->messages, "The message types and their fields instead (with --markdown: docs/messages.md)");
   types->callback([st, &exit_code] {
     Catalog catalog;
     Status s = catalog.LoadDefault(st->plugins);
     if (!s.ok()) std::cerr << "warning: " << s.message() << "\n";
-    PrintTypes(catalog, std::cout);
+    exit_code = 0;
+    if (st->messages) {
+      if (st->markdown) {
+        std::cout << MessageReferenceMarkdown(catalog);
+      } else {
+        for (const TypeInfo* t : catalog.MessageTypes()) std::cout << t->short_name() << "  (" << t->dds_name() << ")\n";
+      }
+      return;
+    }
+    for (const std::string& n : st->type_names) {
+      if (catalog.Find(n) == nullptr) {
+        std::cerr << "dyad types: no component type '" << n << "' (dyad types lists them)\n";
+        exit_code = 2;
+      }
+    }
+    if (exit_code != 0) return;
+    std::ostringstream listed;
+    for (const auto& [name, e] : catalog.entries()) {
+      if (!st->type_names.empty() && std::find(st->type_names.begin(), st->type_names.end(), name) == st->type_names.end())
+        continue;
+      if (st->markdown) listed << ComponentReferenceMarkdown(name, e) << "\n";
+      else PrintType(name, e, listed);
+    }
+    std::cout << listed.str();
     exit_code = catalog.entries().empty() ? 1 : 0;
   });
 }

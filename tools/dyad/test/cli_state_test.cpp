@@ -53,3 +53,33 @@ TEST(CliTypes, RangesArePrintedExactly) {
 
 }  // namespace
 }  // namespace dyad::cli
+
+namespace dyad::cli {
+namespace {
+
+// `dyad types --markdown NAME` is the block docs/components.md embeds (tools/docs.py); an unknown
+// name is an error, not an empty block.
+TEST(CliTypes, MarkdownReferenceOfOneTypeAndOfTheMessages) {
+  auto r = dyad::testing::RunCommand(AddRuntimeCommands, {"types", "--markdown", "counter_sink"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("<!-- BEGIN dyad types --markdown counter_sink ", 0), 0u) << r.out;
+  EXPECT_NE(r.out.find("| input `in` | Counter |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("| `file` | string (path) | `\"\"` |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("<!-- END dyad types --markdown counter_sink -->"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("counter_source"), std::string::npos) << r.out;
+
+  auto unknown = dyad::testing::RunCommand(AddRuntimeCommands, {"types", "--markdown", "no_such_type"});
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_NE(unknown.err.find("no component type 'no_such_type'"), std::string::npos) << unknown.err;
+
+  auto messages = dyad::testing::RunCommand(AddRuntimeCommands, {"types", "--messages", "--markdown"});
+  ASSERT_EQ(messages.code, 0) << messages.err;
+  // Fields with their IDL type and the comment of their line, from idl/human.idl.
+  EXPECT_NE(messages.out.find("| `engaged` | `boolean` | true while the human holds the robot (intervenes) |"),
+            std::string::npos) << messages.out;
+  EXPECT_NE(messages.out.find("| `stamp_ns` | `long long` |"), std::string::npos) << messages.out;
+  EXPECT_NE(messages.out.find("| `human` | `sequence<double>` |"), std::string::npos) << messages.out;
+}
+
+}  // namespace
+}  // namespace dyad::cli
