@@ -54,7 +54,9 @@ const TypeInfo* ResolveType(const Catalog& catalog, const std::string& dds_type,
           << " (same IDL name, different definition): rebuild from the same idl/\n";
       return nullptr;
     }
-  err << "topic '" << topic << "' carries " << dds_type << ", a type this dyad does not know\n";
+  err << "topic '" << topic << "' carries " << dds_type
+      << ", a type this dyad does not know: name the plugin that defines it (--graph GRAPH.yaml, --plugins FILE,"
+         " or DYAD_PLUGIN_PATH)\n";
   return nullptr;
 }
 

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include <dyad/cdr_decoder.hpp>
+#include <dyad/graph.hpp>
 #include <dyad/introspect.hpp>
 
 namespace dyad::cli {
@@ -30,6 +31,21 @@ SamplePrinter JsonPrinter() {
   };
 }
 
+// The catalog a watcher decodes with: the built-in types, DYAD_PLUGIN_PATH, --plugins, and the
+// `plugins:` of --graph (so a plugin's own message types are known as the graph knows them).
+// Returns false, having said why, when the graph file cannot be read.
+bool LoadWatcherCatalog(const std::string& graph_path, std::vector<std::string> plugins, Catalog* catalog) {
+  if (!graph_path.empty()) {
+    std::vector<Diagnostic> diagnostics;
+    const Graph graph = LoadGraph(graph_path, {}, &diagnostics);
+    for (const Diagnostic& d : diagnostics) std::cerr << d.ToString() << "\n";
+    if (!diagnostics.empty()) return false;
+    plugins.insert(plugins.end(), graph.plugins.begin(), graph.plugins.end());
+  }
+  if (Status s = catalog->LoadDefault(plugins); !s.ok()) std::cerr << "warning: " << s.message() << "\n";
+  return true;
+}
+
 }  // namespace
 
 void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
@@ -40,6 +56,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
     uint64_t count = 0;
     double duration = 0;
     std::vector<std::string> plugins;
+    std::string graph;
   };
   auto st = std::make_shared<State>();
   auto add_common = [st](CLI::App* c) {
@@ -57,9 +74,13 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   echo->add_option("-n,--count", st->count, "Stop after this many samples (0: until Ctrl-C)");
   echo->add_option("--duration", st->duration, "Stop after this many seconds");
   echo->add_option("--plugins", st->plugins, "Plugin file or folder whose message types to know (repeatable)");
+  echo->add_option("--graph", st->graph, "Know the message types of this graph's plugins");
   echo->callback([st, &exit_code] {
     Catalog catalog;
-    catalog.LoadDefault(st->plugins);
+    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog)) {
+      exit_code = 2;
+      return;
+    }
     exit_code = EchoTopic(st->opts, catalog, st->topic, st->count, st->duration, JsonPrinter(), std::cout, std::cerr);
   });
 
@@ -68,9 +89,13 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   hz->add_option("topic", st->topic, "Topic name")->required();
   hz->add_option("--duration", st->duration, "Stop after this many seconds (0: until Ctrl-C)");
   hz->add_option("--plugins", st->plugins, "Plugin file or folder whose message types to know (repeatable)");
+  hz->add_option("--graph", st->graph, "Know the message types of this graph's plugins");
   hz->callback([st, &exit_code] {
     Catalog catalog;
-    catalog.LoadDefault(st->plugins);
+    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog)) {
+      exit_code = 2;
+      return;
+    }
     exit_code = TopicHz(st->opts, catalog, st->topic, st->duration, std::cout, std::cerr);
   });
 }

@@ -1,0 +1,142 @@
+# Message types from OMG IDL, for dyad itself and for plugins that bring their own.
+#
+# dyad_add_messages(<target> NAMESPACE <ns> FILES <a.idl>... [IDL_DIR <dir>] [INCLUDE_PREFIX <dir>])
+#
+#   Compiles the IDL files (IDL_DIR, default the calling folder) into <target>: runs fastddsgen at
+#   build time with dyad's IDL folder on the include path, so `#include "header.idl"` and a member
+#   `dyad::msg::Header header;` reuse dyad's Header (its code lives in dyad::msgs; the copy
+#   fastddsgen writes for included files is discarded), generates the type traits (below) into
+#   <INCLUDE_PREFIX>/types.hpp (default <target>/msg/types.hpp), and links <target> to dyad::msgs.
+#   In the plugin: `#include <<target>/msg/types.hpp>` and use `ns::Struct` as a port type; the
+#   runtime, `dyad echo/hz` (with --graph or --plugins), the recorder and `dyad bag export` then
+#   know the type, its IDL travelling with it. Example: tests/out_of_tree/messages/.
+#
+#   Each struct must start with `dyad::msg::Header header;` (the runtime stamps it).
+#
+# Needs DYAD_IDL_DIR (dyad's IDL files) and DYAD_MSG_INCLUDE_DIR (the folder holding dyad's
+# generated header.h): find_package(dyad) sets both; dyad's own build sets them in idl/.
+
+find_program(FASTDDSGEN fastddsgen)
+
+function(dyad_add_messages target)
+  cmake_parse_arguments(A "" "NAMESPACE;IDL_DIR;INCLUDE_PREFIX" "FILES" ${ARGN})
+  if(NOT A_NAMESPACE OR NOT A_FILES)
+    message(FATAL_ERROR "dyad_add_messages(${target}): NAMESPACE and FILES are required")
+  endif()
+  if(NOT FASTDDSGEN)
+    message(FATAL_ERROR "dyad_add_messages(${target}): fastddsgen not found (Debian package fastddsgen, with a Java runtime)")
+  endif()
+  if(NOT A_IDL_DIR)
+    set(A_IDL_DIR ${CMAKE_CURRENT_SOURCE_DIR})
+  endif()
+  if(NOT A_INCLUDE_PREFIX)
+    set(A_INCLUDE_PREFIX ${target}/msg)
+  endif()
+  set(_root ${CMAKE_CURRENT_BINARY_DIR}/dyad_messages/${target})
+  set(_out ${_root}/include/${A_INCLUDE_PREFIX})
+  set(_scratch ${_root}/fastddsgen)
+  set(_idl_paths "")
+  set(_outputs "")
+  set(_own_files "")
+  foreach(_idl IN LISTS A_FILES)
+    get_filename_component(_stem ${_idl} NAME_WE)
+    list(APPEND _idl_paths ${A_IDL_DIR}/${_idl})
+    foreach(_suffix .h .cxx PubSubTypes.h PubSubTypes.cxx)
+      list(APPEND _own_files ${_scratch}/${_stem}${_suffix})
+      list(APPEND _outputs ${_out}/${_stem}${_suffix})
+    endforeach()
+  endforeach()
+  # fastddsgen also writes C++ for every included file (a second dyad::msg::Header): it goes to a
+  # scratch folder, and only the files of FILES are kept.
+  add_custom_command(
+    OUTPUT ${_outputs}
+    COMMAND ${CMAKE_COMMAND} -E rm -rf ${_scratch}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${_scratch} ${_out}
+    COMMAND ${FASTDDSGEN} -cs -replace -d ${_scratch} -I ${A_IDL_DIR} -I ${DYAD_IDL_DIR} ${_idl_paths}
+    COMMAND ${CMAKE_COMMAND} -E copy ${_own_files} ${_out}
+    DEPENDS ${_idl_paths}
+    WORKING_DIRECTORY ${A_IDL_DIR}
+    COMMENT "fastddsgen: C++ for ${A_FILES} (${target})"
+    VERBATIM)
+  dyad_generate_type_traits(
+    OUTPUT ${_out}/types.hpp
+    NAMESPACE ${A_NAMESPACE}
+    INCLUDE_PREFIX ${A_INCLUDE_PREFIX}
+    IDL_DIR ${A_IDL_DIR}
+    IDL_PATH ${DYAD_IDL_DIR}
+    FILES ${A_FILES})
+  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${_idl_paths})
+  set(_sources ${_outputs})
+  list(FILTER _sources INCLUDE REGEX "\\.cxx$")
+  target_sources(${target} PRIVATE ${_sources})
+  set_source_files_properties(${_sources} PROPERTIES COMPILE_OPTIONS -w)  # fastddsgen's code is not ours to fix
+  # ${_out}: our generated "x.h" includes; DYAD_MSG_INCLUDE_DIR: their "header.h"
+  target_include_directories(${target} PRIVATE ${_root}/include ${_out} ${DYAD_MSG_INCLUDE_DIR})
+  if(TARGET dyad::msgs)
+    target_link_libraries(${target} PRIVATE dyad::msgs)
+  else()
+    target_link_libraries(${target} PRIVATE dyad_msgs)
+  endif()
+endfunction()
+
+# dyad_generate_type_traits(OUTPUT file NAMESPACE ns INCLUDE_PREFIX dir IDL_DIR dir [IDL_PATH dir...] FILES a.idl ...)
+#
+# Writes a header that includes fastddsgen's output for FILES and declares, for every struct,
+# dyad::MessageTraits<ns::Struct> (see dyad/message_traits.hpp): the DDS type name
+# "<ns>::<Struct>#<hash>", where hash covers the definition text of the file and of the files it
+# includes with comments and whitespace removed, and the IDL text itself (includes inlined) as
+# the schema a recording carries. `#include "x.idl"` is looked up in IDL_DIR, then IDL_PATH.
+# dyad_add_messages calls it; use it directly only with fastddsgen output of your own.
+function(dyad_generate_type_traits)
+  cmake_parse_arguments(A "" "OUTPUT;NAMESPACE;INCLUDE_PREFIX;IDL_DIR" "FILES;IDL_PATH" ${ARGN})
+  set(_body "")
+  set(_list "")
+  set(_includes "")
+  foreach(_idl IN LISTS A_FILES)
+    get_filename_component(_stem ${_idl} NAME_WE)
+    _dyad_idl_inline("${A_IDL_DIR};${A_IDL_PATH}" ${_idl} _text)
+    string(REGEX REPLACE "//[^\n]*" "" _normal "${_text}")
+    string(REGEX REPLACE "/\\*([^*]|\\*[^/])*\\*/" "" _normal "${_normal}")
+    string(REGEX REPLACE "[ \t\r\n]+" " " _normal "${_normal}")
+    string(SHA256 _sha "${_normal}")
+    string(SUBSTRING ${_sha} 0 16 _hash)
+    string(APPEND _includes "#include <${A_INCLUDE_PREFIX}/${_stem}.h>\n#include <${A_INCLUDE_PREFIX}/${_stem}PubSubTypes.h>\n")
+    # Only structs defined in this file itself get traits (not those of included files).
+    file(READ ${A_IDL_DIR}/${_idl} _own)
+    string(REGEX MATCHALL "struct[ \t\n]+[A-Za-z_][A-Za-z0-9_]*[ \t\n]*{" _structs "${_own}")
+    foreach(_s IN LISTS _structs)
+      string(REGEX REPLACE "struct[ \t\n]+([A-Za-z_][A-Za-z0-9_]*).*" "\\1" _name "${_s}")
+      string(APPEND _body "DYAD_MESSAGE_TYPE(${A_NAMESPACE}, ${_name}, \"${_hash}\", R\"dyadidl(${_text})dyadidl\");\n")
+      string(APPEND _list "      &::dyad::TypeInfoOf<${A_NAMESPACE}::${_name}>(),\n")
+    endforeach()
+  endforeach()
+  set(_content "// Generated by dyad_generate_type_traits from ${A_FILES}. Do not edit.\n#pragma once\n#include <vector>\n#include <dyad/message_traits.hpp>\n${_includes}\n${_body}\nnamespace ${A_NAMESPACE} {\n// Every message type of these IDL files.\ninline std::vector<const ::dyad::TypeInfo*> AllTypes() {\n  return {\n${_list}  };\n}\n}  // namespace ${A_NAMESPACE}\n")
+  if(EXISTS ${A_OUTPUT})
+    file(READ ${A_OUTPUT} _old)
+  endif()
+  if(NOT "${_old}" STREQUAL "${_content}")
+    file(WRITE ${A_OUTPUT} "${_content}")
+  endif()
+endfunction()
+
+# The IDL text of `file` (found in the first of `dirs` that has it) with its #include "x.idl"
+# lines replaced by x.idl's text.
+function(_dyad_idl_inline dirs file out)
+  set(_path "")
+  foreach(_dir IN LISTS dirs)
+    if(_dir AND EXISTS ${_dir}/${file} AND NOT _path)
+      set(_path ${_dir}/${file})
+    endif()
+  endforeach()
+  if(NOT _path)
+    message(FATAL_ERROR "IDL file ${file} not found in: ${dirs}")
+  endif()
+  file(READ ${_path} _text)
+  string(REGEX MATCHALL "#include[ \t]+\"[^\"]+\"" _incs "${_text}")
+  foreach(_inc IN LISTS _incs)
+    string(REGEX REPLACE "#include[ \t]+\"([^\"]+)\"" "\\1" _inc_file "${_inc}")
+    _dyad_idl_inline("${dirs}" ${_inc_file} _inc_text)
+    string(REPLACE "${_inc}" "${_inc_text}" _text "${_text}")
+  endforeach()
+  set(${out} "${_text}" PARENT_SCOPE)
+endfunction()
