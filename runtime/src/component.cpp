@@ -19,6 +19,10 @@ const std::string& Context::graph_yaml() const {
   static const std::string empty;
   return empty;
 }
+const std::string& Context::graph_folder() const {
+  static const std::string empty;
+  return empty;
+}
 const std::vector<TopicInfo>& Context::graph_topics() const {
   static const std::vector<TopicInfo> none;
   return none;

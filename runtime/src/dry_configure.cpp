@@ -84,6 +84,7 @@ class DryContext final : public Context {
   void RequestStop(std::string) override {}
   const std::string& graph_name() const override { return graph_.name; }
   const std::string& graph_yaml() const override { return graph_.yaml_text; }
+  const std::string& graph_folder() const override { return graph_.folder; }
   bool stepped() const override { return graph_.clock == ClockMode::kStepped; }
   const std::vector<TopicInfo>& graph_topics() const override { return topics_; }
   const TypeInfo* FindMessageType(std::string_view name) const override {

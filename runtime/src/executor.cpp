@@ -113,6 +113,7 @@ class Executor::ContextImpl final : public Context {
 
   const std::string& graph_name() const override { return ex_->graph_.name; }
   const std::string& graph_yaml() const override { return ex_->graph_.yaml_text; }
+  const std::string& graph_folder() const override { return ex_->graph_.folder; }
   bool stepped() const override { return ex_->clock_->stepped(); }
   const std::vector<TopicInfo>& graph_topics() const override { return ex_->topics_; }
   const TypeInfo* FindMessageType(std::string_view name) const override {

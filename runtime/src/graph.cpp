@@ -289,6 +289,11 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
                  std::vector<Diagnostic>* diagnostics) {
   Graph g;
   g.file = path;
+  {
+    std::error_code ec;
+    const std::filesystem::path cwd = std::filesystem::current_path(ec);
+    g.folder = (path.empty() ? cwd : std::filesystem::absolute(path, ec).parent_path()).lexically_normal().string();
+  }
   g.yaml_text = yaml_text;
   Reader r(path, diagnostics);
   YAML::Node root;

@@ -200,8 +200,7 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
           // Written in the file: relative to the file. Given with --set: relative to where the user is.
           std::error_code ec;
           const std::filesystem::path cwd = std::filesystem::current_path(ec);
-          const bool from_file = set == c.overridden.end() && !graph.file.empty();
-          ResolvePaths(from_file ? std::filesystem::absolute(graph.file, ec).parent_path() : cwd, &v.value());
+          ResolvePaths(set == c.overridden.end() ? std::filesystem::path(graph.folder) : cwd, &v.value());
         }
         values[pname] = std::move(v.value());
       }

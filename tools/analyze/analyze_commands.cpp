@@ -61,13 +61,17 @@ int RunAnalyze(const Options& o) {
   if (reader->recovery().truncated) std::cerr << "dyad analyze: " << o.recording << ": " << reader->recovery().Describe() << "\n";
   analyze::Report report;
   report.recording = o.recording;
-  report.graph_yaml = analyze::GraphYaml(*reader);
+  report.graph_yaml = analyze::GraphMetadata(*reader, "yaml");
   auto plan = analyze::PlanFromGraphYaml(report.graph_yaml);
   if (!plan.ok()) {
     std::cerr << "dyad analyze: " << o.recording << ": " << plan.status().message() << "\n";
     return kBadInput;
   }
   report.plan = *plan;
+  // The graph's data set path is relative to the graph file's folder (recorded with it).
+  if (const std::string folder = analyze::GraphMetadata(*reader, "folder");
+      !folder.empty() && !report.plan.dataset.empty() && std::filesystem::path(report.plan.dataset).is_relative())
+    report.plan.dataset = (std::filesystem::path(folder) / report.plan.dataset).lexically_normal().string();
   auto tables = analyze::ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels"});
   if (!tables.ok()) {
     std::cerr << "dyad analyze: " << tables.status().message() << "\n";

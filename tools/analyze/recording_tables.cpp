@@ -59,10 +59,10 @@ StatusOr<std::map<std::string, TopicTable>> ReadTables(const mcap::Reader& reade
   return tables;
 }
 
-std::string GraphYaml(const mcap::Reader& reader) {
+std::string GraphMetadata(const mcap::Reader& reader, const std::string& key) {
   for (const mcap::Metadata& m : reader.metadata()) {
     if (m.name != "dyad.graph") continue;
-    auto it = m.entries.find("yaml");
+    auto it = m.entries.find(key);
     if (it != m.entries.end()) return it->second;
   }
   return {};

@@ -34,8 +34,9 @@ struct TopicTable {
 StatusOr<std::map<std::string, TopicTable>> ReadTables(const mcap::Reader& reader,
                                                        const std::set<std::string>& topics);
 
-// The graph YAML the recorder stored (metadata "dyad.graph", key "yaml"); empty when absent.
-std::string GraphYaml(const mcap::Reader& reader);
+// A value the recorder stored about the graph (metadata "dyad.graph"): "yaml" (the graph as
+// run), "folder" (what its relative paths are relative to), "name", "clock"; empty when absent.
+std::string GraphMetadata(const mcap::Reader& reader, const std::string& key);
 
 // Cell parsers: a number ("nan" allowed), a bool ("true"/"false"), a JSON array of numbers.
 // They return false on text that is not one.

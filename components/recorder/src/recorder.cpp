@@ -131,7 +131,8 @@ Status Recorder::OpenFile() {
   }
   if (Status s = writer_->AddMetadata("dyad.graph", {{"name", ctx_->graph_name()},
                                                      {"clock", ctx_->stepped() ? "stepped" : "wall"},
-                                                     {"yaml", ctx_->graph_yaml()}});
+                                                     {"yaml", ctx_->graph_yaml()},
+                                                     {"folder", ctx_->graph_folder()}});
       !s.ok())
     return s;
   thread_ = std::thread([this] { WriterLoop(); });

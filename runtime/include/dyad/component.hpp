@@ -63,7 +63,8 @@
 // compile time. In Configure() they may ask the Context for:
 //   - graph_topics(): every topic of the graph (port-bound, declared under `topics:` with a type,
 //     and the runtime's `dyad/stats`), with its TypeInfo (IDL text, hash) and QoS;
-//     graph_yaml() / graph_name(): the graph file as run (--set overrides applied); stepped(): the clock mode;
+//     graph_yaml() / graph_name(): the graph file as run (--set overrides applied); graph_folder():
+//     what its relative paths are relative to; stepped(): the clock mode;
 //     FindMessageType(name): any message type this process knows (IDL or short name).
 //   - SubscribeSerialized(topic, callback): the callback receives every sample of the topic as CDR
 //     bytes with its source stamp, receive time and sequence number. It runs on the delivering
@@ -99,7 +100,7 @@ namespace dyad {
 
 // Bump when anything in this header changes layout or meaning; plugins built against another
 // version are refused at load time with a message naming both versions.
-// 3: ParamSpec::path (relative paths resolved against the graph file).
+// 3: ParamSpec::path (relative paths resolved against the graph file), Context::graph_folder().
 inline constexpr uint32_t kPluginAbiVersion = 3;
 
 // The runtime clock: wall time (ns since the Unix epoch) in `clock: wall` graphs, simulated time
@@ -352,6 +353,8 @@ class Context {
   // them all; the defaults (empty graph, Unimplemented) serve test fakes of Context.
   virtual const std::string& graph_name() const;
   virtual const std::string& graph_yaml() const;  // the graph file as run (Graph::yaml_text)
+  // The absolute folder the graph's relative paths are relative to (its file's; ABI 3).
+  virtual const std::string& graph_folder() const;
   virtual bool stepped() const { return false; }  // `clock: stepped`
   // Every topic of the graph, sorted by name, `dyad/stats` included.
   virtual const std::vector<TopicInfo>& graph_topics() const;

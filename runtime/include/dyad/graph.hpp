@@ -91,6 +91,9 @@ struct ComponentConfig {
 
 struct Graph {
   std::string file;  // path as given
+  // The folder relative paths of the file are relative to: the file's, made absolute (the
+  // working folder for a graph without a file name).
+  std::string folder;
   std::string name = "dyad";
   int domain_id = 0;
   ClockMode clock = ClockMode::kWall;

@@ -116,7 +116,7 @@ Report Analyse(const std::string& path) {
   EXPECT_TRUE(reader.ok());
   Report r;
   r.recording = path;
-  r.graph_yaml = GraphYaml(*reader);
+  r.graph_yaml = GraphMetadata(*reader, "yaml");
   auto plan = PlanFromGraphYaml(r.graph_yaml);
   EXPECT_TRUE(plan.ok()) << plan.status().ToString();
   r.plan = *plan;
