@@ -96,9 +96,11 @@ std::string FormatMarkdown(const Report& r) {
     return v.empty() ? std::nan("") : t / static_cast<double>(v.size());
   };
   s << "- engaged steps: " << engaged_steps << "\n";
-  s << "- N-ELBO: mean " << Num(mean(nelbo)) << ", median " << Num(Percentile(nelbo, 0.5)) << "\n";
-  s << "- deliberation time per step: median " << Num(Percentile(opt_ms, 0.5)) << " ms, p99 "
-    << Num(Percentile(opt_ms, 0.99)) << " ms, max " << Num(Percentile(opt_ms, 1.0)) << " ms\n";
+  if (nelbo.empty()) s << "- N-ELBO: not recorded (no robot/intention samples)\n";
+  else s << "- N-ELBO: mean " << Num(mean(nelbo)) << ", median " << Num(Percentile(nelbo, 0.5)) << "\n";
+  if (opt_ms.empty()) s << "- deliberation time per step: not recorded\n";
+  else s << "- deliberation time per step: median " << Num(Percentile(opt_ms, 0.5)) << " ms, p99 "
+         << Num(Percentile(opt_ms, 0.99)) << " ms, max " << Num(Percentile(opt_ms, 1.0)) << " ms\n";
   const double free = mean(c_free);
   const double engaged = mean(c_engaged);
   s << "- congruence P(C_t): "

@@ -218,6 +218,30 @@ TEST(Analyze, ANeverEngagedHumanIsSaidSoNotAnEmptyNumber) {
   EXPECT_EQ(md.find("mean  while"), std::string::npos) << md;
 }
 
+// A person steering (web_human: no planned events) and no deliberator: the engaged runs are the
+// events, and what was not recorded is said, not printed as empty numbers.
+TEST(Analyze, AnInteractiveRunHasItsEngagedRunsAsEventsAndSaysWhatWasNotRecorded) {
+  Report r = Analyse(WriteExperiment(TempPath("a.mcap")));
+  r.plan.events.clear();
+  for (auto& x : r.timeline.steps) {
+    x.engaged = (x.step >= 5 && x.step < 12) || (x.step >= 20 && x.step < 23);
+    x.nelbo = x.optimisation_s = std::nan("");
+  }
+  const auto events = Events(r.timeline, r.plan);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].start_step, 5);
+  EXPECT_EQ(events[0].end_step, 12);
+  EXPECT_EQ(events[1].start_step, 20);
+  EXPECT_EQ(events[1].end_step, 23);
+  EXPECT_EQ(events[1].primitive, -1);
+  r.events = SummariseEvents(r.timeline, events);
+  const std::string md = FormatMarkdown(r);
+  EXPECT_NE(md.find("| 1 | 20-22 | ? |"), std::string::npos) << md;
+  EXPECT_NE(md.find("- N-ELBO: not recorded"), std::string::npos) << md;
+  EXPECT_NE(md.find("- deliberation time per step: not recorded"), std::string::npos) << md;
+  EXPECT_EQ(md.find("mean , median"), std::string::npos) << md;
+}
+
 TEST(Analyze, WithoutObserverTheReportSaysWhatIsMissing) {
   Report r = Analyse(WriteExperiment(TempPath("a.mcap"), /*with_observer=*/false));
   ASSERT_EQ(r.timeline.missing_topics.size(), 1u);
