@@ -74,8 +74,13 @@ echo "alone:   steps > 20 ms: $alone_gaps, longest gap $alone_max ms"
 rm -f /dev/shm/fastrtps_* /dev/shm/fast_datasharing_* 2> /dev/null  # leftovers of SIGKILLed processes
 [ $hz_fail = 0 ] || { echo "FAIL: an hz after a killed watcher did not find the writer"; fail=1; }
 [ $watcher_fail = 0 ] || { echo "FAIL: a watcher did not exit cleanly"; fail=1; }
-[ "$watched_gaps" -le $((alone_gaps + 2)) ] || { echo "FAIL: watchers caused $watched_gaps stalled steps (alone: $alone_gaps)"; fail=1; }
-awk -v w="$watched_max" -v a="$alone_max" 'BEGIN { exit !(w <= a + 20) }' ||
-  { echo "FAIL: longest gap $watched_max ms with watchers, $alone_max ms alone"; fail=1; }
+# Under sanitizers (third argument "functional") each watcher is an instrumented process several
+# times as costly to start, competing with the graph for this machine's 2 cores: the timing
+# comparison is printed but only the functional checks above decide.
+if [ "${3:-}" != functional ]; then
+  [ "$watched_gaps" -le $((alone_gaps + 2)) ] || { echo "FAIL: watchers caused $watched_gaps stalled steps (alone: $alone_gaps)"; fail=1; }
+  awk -v w="$watched_max" -v a="$alone_max" 'BEGIN { exit !(w <= a + 20) }' ||
+    { echo "FAIL: longest gap $watched_max ms with watchers, $alone_max ms alone"; fail=1; }
+fi
 [ $fail = 0 ] && echo PASS
 exit $fail
