@@ -91,5 +91,33 @@ TEST(Catalog, DyadPluginPathComesBeforeBuiltinsAndConflictsAreReported) {
   fs::remove_all(dir);
 }
 
+// Path() only means something on strings: a plugin marking a number as a path is refused at
+// load time, naming the plugin, the type and the param; its other types still register.
+class NumberMarkedAsPath : public Component {
+ public:
+  static void Describe(ComponentSpec& spec) { spec.Param("gain", 0.5).Path(); }
+  Status Configure(Context&) override { return Status::OK(); }
+  Status Step(const StepInfo&) override { return Status::OK(); }
+};
+class FileParam : public Component {
+ public:
+  static void Describe(ComponentSpec& spec) { spec.Param("file", "").Path(); }
+  Status Configure(Context&) override { return Status::OK(); }
+  Status Step(const StepInfo&) override { return Status::OK(); }
+};
+
+TEST(Catalog, PathOnANonStringParamIsRefused) {
+  Catalog catalog;
+  const Status s = catalog.Register("test-plugin", [](PluginRegistry& r) {
+    r.Add<NumberMarkedAsPath>("bad_path");
+    r.Add<FileParam>("good_path");
+  });
+  EXPECT_EQ(s.code(), Status::Code::kInvalidArgument);
+  EXPECT_EQ(s.message(), "test-plugin: component type 'bad_path': param 'gain' is marked Path() but is double "
+                         "(only string and list of strings can be paths)");
+  EXPECT_EQ(catalog.Find("bad_path"), nullptr);
+  EXPECT_NE(catalog.Find("good_path"), nullptr);
+}
+
 }  // namespace
 }  // namespace dyad

@@ -77,6 +77,15 @@ Status Catalog::Register(const std::string& origin, void (*register_types)(Plugi
     CatalogEntry e;
     e.type = t;
     t.describe(e.spec);
+    bool bad_spec = false;
+    for (const ParamSpec& p : e.spec.params()) {
+      if (p.path && p.type != ParamType::kString && p.type != ParamType::kStringList) {
+        conflicts << file << ": component type '" << t.name << "': param '" << p.name << "' is marked Path() but is "
+                  << ToString(p.type) << " (only string and list of strings can be paths)\n";
+        bad_spec = true;
+      }
+    }
+    if (bad_spec) continue;
     for (const auto& p : e.spec.inputs()) AddMessageType(p.type);
     for (const auto& p : e.spec.outputs()) AddMessageType(p.type);
     entries_.emplace(t.name, std::move(e));

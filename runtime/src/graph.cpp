@@ -326,7 +326,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
     }
   }
   if (root["seed"]) r.Number(root["seed"], "seed", &g.seed, "a non-negative integer");
-  const std::filesystem::path base = std::filesystem::path(path).parent_path();
+  const std::filesystem::path base = g.folder;  // plugins: like every path of the file
   if (const YAML::Node plugins = root["plugins"]) {
     if (!plugins.IsSequence()) {
       r.Error(plugins, "plugins", "must be a list of paths");

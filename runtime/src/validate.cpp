@@ -199,8 +199,8 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
         if (ps->path) {
           // Written in the file: relative to the file. Given with --set: relative to where the user is.
           std::error_code ec;
-          const std::filesystem::path cwd = std::filesystem::current_path(ec);
-          ResolvePaths(set == c.overridden.end() ? std::filesystem::path(graph.folder) : cwd, &v.value());
+          ResolvePaths(set == c.overridden.end() ? std::filesystem::path(graph.folder) : std::filesystem::current_path(ec),
+                       &v.value());
         }
         values[pname] = std::move(v.value());
       }

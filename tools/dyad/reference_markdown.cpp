@@ -29,6 +29,13 @@ std::string Trim(const std::string& s) {
   return s.substr(b, s.find_last_not_of(" \t\r") - b + 1);
 }
 
+// The anchor a Markdown renderer gives the heading "## Name" of a message type: lower case.
+std::string Anchor(const std::string& name) {
+  std::string anchor;
+  for (char c : name) anchor += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return anchor;
+}
+
 struct Member {
   std::string name, type, doc;
 };
@@ -147,11 +154,7 @@ std::string MessageReferenceMarkdown(const Catalog& catalog) {
          "OMG IDL (`idl/*.idl`), compiled by fastddsgen at build time; on the wire a type is named\n"
          "`<IDL name>#<hash of its definition>` (docs/runtime.md). Graphs name them by their short name\n"
          "(`topics: {robot/state: {type: CartesianState}}`).\n\n";
-  for (const TypeInfo* t : catalog.MessageTypes()) out << "- [" << t->short_name() << "](#" << [&] {
-      std::string anchor;
-      for (char c : t->short_name()) anchor += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-      return anchor;
-    }() << ")\n";
+  for (const TypeInfo* t : catalog.MessageTypes()) out << "- [" << t->short_name() << "](#" << Anchor(t->short_name()) << ")\n";
   for (const TypeInfo* t : catalog.MessageTypes()) {
     const StructText s = FindStruct(t->idl, t->short_name());
     out << "\n## " << t->short_name() << "\n\n`" << t->name << "`";

@@ -23,26 +23,24 @@ std::vector<Override> ToOverrides(const std::vector<std::string>& sets) {
 }
 
 void PrintType(const std::string& name, const CatalogEntry& e, std::ostream& out) {
-  {
-    out << name << "  (" << e.type.plugin_path << ")\n";
-    if (!e.spec.summary().empty()) out << "  " << e.spec.summary() << "\n";
-    for (const auto& p : e.spec.inputs())
-      out << "  input  " << p.name << ": " << p.type->short_name() << (p.optional ? " (optional)" : "")
-          << (p.doc.empty() ? "" : "  # " + p.doc) << "\n";
-    for (const auto& p : e.spec.outputs())
-      out << "  output " << p.name << ": " << p.type->short_name() << (p.doc.empty() ? "" : "  # " + p.doc) << "\n";
-    for (const auto& p : e.spec.params()) {
-      out << "  param  " << p.name << ": " << ToString(p.type) << (p.path ? " path" : "");
-      out << (p.default_value ? " = " + ToYamlText(*p.default_value) : " (required)");
-      if (!p.unit.empty()) out << " [" << p.unit << "]";
-      if (p.min || p.max) out << " range " << ParamRangeText(p);
-      if (!p.choices.empty()) {
-        out << " one of";
-        for (const auto& c : p.choices) out << " " << c;
-      }
-      if (!p.doc.empty()) out << "  # " << p.doc;
-      out << "\n";
+  out << name << "  (" << e.type.plugin_path << ")\n";
+  if (!e.spec.summary().empty()) out << "  " << e.spec.summary() << "\n";
+  for (const auto& p : e.spec.inputs())
+    out << "  input  " << p.name << ": " << p.type->short_name() << (p.optional ? " (optional)" : "")
+        << (p.doc.empty() ? "" : "  # " + p.doc) << "\n";
+  for (const auto& p : e.spec.outputs())
+    out << "  output " << p.name << ": " << p.type->short_name() << (p.doc.empty() ? "" : "  # " + p.doc) << "\n";
+  for (const auto& p : e.spec.params()) {
+    out << "  param  " << p.name << ": " << ToString(p.type) << (p.path ? " path" : "");
+    out << (p.default_value ? " = " + ToYamlText(*p.default_value) : " (required)");
+    if (!p.unit.empty()) out << " [" << p.unit << "]";
+    if (p.min || p.max) out << " range " << ParamRangeText(p);
+    if (!p.choices.empty()) {
+      out << " one of";
+      for (const auto& c : p.choices) out << " " << c;
     }
+    if (!p.doc.empty()) out << "  # " << p.doc;
+    out << "\n";
   }
 }
 

@@ -271,6 +271,8 @@ TEST_F(RecorderTest, SteppedGraphRecordsEverySampleOfThreePublishersReadBackByMc
       has_graph = true;
       EXPECT_EQ(md.entries.at("yaml"), ReadFile(graph));
       EXPECT_EQ(md.entries.at("clock"), "stepped");
+      // What the graph's relative paths are relative to: its file's folder, absolute.
+      EXPECT_EQ(md.entries.at("folder"), std::filesystem::absolute(graph).parent_path().lexically_normal().string());
     }
   EXPECT_TRUE(has_graph);
   EXPECT_EQ(CheckWithNode(file, r, false), "");

@@ -9,7 +9,8 @@
 //   ...
 //   double g = ctx.params().Double("gain");   // in Configure(): already validated
 //
-// Paths: a kString or kStringList parameter marked Path() names files or folders. A relative
+// Paths: a kString or kStringList parameter marked Path() names files or folders (Path() on any
+// other type is refused when the plugin is loaded). A relative
 // value written in a graph file is resolved against that file's folder (so a graph runs the same
 // from any working folder); a relative value given with `--set` on the command line, against the
 // working folder (as a shell user expects); a default, as it is (the component's own choice).

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <fastdds/rtps/common/SerializedPayload.h>
@@ -81,10 +82,11 @@ std::vector<double> OneHot(int k, int n = 7) {
 // 40 steps. Human engaged during the graph's two events. Observer: the human's class is right
 // except at steps 12 and 13 (says 3); the robot's class is 1 until step 15, then 2 until 25,
 // then 1. Congruence = step / 100.
-std::string WriteExperiment(const std::string& path, bool with_observer = true) {
+std::string WriteExperiment(const std::string& path, bool with_observer = true,
+                            const std::map<std::string, std::string>& graph = {{"yaml", kGraph}}) {
   auto writer = mcap::Writer::Open(path);
   EXPECT_TRUE(writer.ok());
-  EXPECT_TRUE(writer->AddMetadata("dyad.graph", {{"yaml", kGraph}}).ok());
+  EXPECT_TRUE(writer->AddMetadata("dyad.graph", graph).ok());
   Channel<msg::HumanInput> human(*writer, "human/input");
   Channel<msg::Intention> robot(*writer, "robot/intention");
   Channel<msg::CartesianState> state(*writer, "robot/state");
@@ -279,6 +281,16 @@ std::string Head(const std::string& path, size_t n) {
   std::string s(n, '\0');
   in.read(s.data(), static_cast<std::streamsize>(n));
   return s.substr(0, static_cast<size_t>(in.gcount()));
+}
+
+// The graph's data set path is relative to the graph file's folder, which the recording keeps.
+TEST(AnalyzeCli, TheGraphsRelativeDatasetIsFoundFromTheRecordedFolder) {
+  std::string yaml = kGraph;
+  yaml.replace(yaml.find("/nonexistent/dataset"), 20, "data/set");
+  const std::string rec = WriteExperiment(TempPath("rel.mcap"), true, {{"yaml", yaml}, {"folder", "/lab/graphs"}});
+  std::string err;
+  EXPECT_EQ(RunCli({"analyze", rec, "-o", TempPath("rel_report")}, &err), 0) << err;
+  EXPECT_NE(err.find("the graph's dataset /lab/graphs/data/set is not a folder from here"), std::string::npos) << err;
 }
 
 // The CLI end to end through the `dyad` executable (it finds share/dyad/plot_report.py).

@@ -83,3 +83,16 @@ TEST(CliTypes, MarkdownReferenceOfOneTypeAndOfTheMessages) {
 
 }  // namespace
 }  // namespace dyad::cli
+
+namespace dyad::cli {
+namespace {
+
+// `dyad echo --graph` with a graph that cannot be read says where and exits 2 (no discovery wait).
+TEST(CliIntrospection, EchoWithAnUnreadableGraphNamesItAndExits2) {
+  auto r = dyad::testing::RunCommand(AddIntrospectionCommands, {"echo", "t", "--graph", "/nonexistent/g.yaml"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("/nonexistent/g.yaml"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace dyad::cli

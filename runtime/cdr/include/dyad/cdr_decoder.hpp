@@ -65,9 +65,10 @@
 //   Decode / DecodeRow: NotFound for a type the schema does not define; Unimplemented for an
 //   encapsulation other than plain CDR; DataLoss for a payload that is truncated or garbled:
 //   "offset N (path): message" where N is the byte offset in the payload after the encapsulation
-//   header, e.g. "offset 24 (header.stamp_ns): truncated: long long needs 8 bytes, 3 left". Truncated or garbled payloads never read out of bounds; a garbled sequence
-//   count (or an array) larger than the remaining bytes could hold is an error, caught before
-//   any element is decoded.
+//   header, e.g. "offset 24 (header.stamp_ns): truncated: long long needs 8 bytes, 3 left".
+//   Truncated or garbled payloads never read out of bounds; a garbled sequence count (or an
+//   array) larger than the remaining bytes could hold is an error, caught before any element is
+//   decoded.
 //   On failure the output holds what was decoded before the error.
 //
 // PERFORMANCE / THREADS
