@@ -80,6 +80,26 @@ TEST(DryConfigure, AFileSetOnTheCommandLineIsBlamedOnTheSet) {
   EXPECT_NE(diags[0].message.find("/nonexistent.dpvrnn"), std::string::npos) << diags[0].ToString();
 }
 
+// A process started on its own checks only its own components: another process's files live on
+// its machine or are already open there (a launcher's child saw the recorder's file, just created
+// by the recorder's process, as "exists" and refused to start).
+TEST(DryConfigure, OnlyTheComponentsOfTheGivenProcessAreConfigured) {
+  std::string y = Humans(TinyDataset());
+  y.replace(y.find("clock: stepped"), 14, "clock: wall\nprocesses: {pa: {}, pb: {}}");
+  y.replace(y.find("  a:\n    type: human_synthetic\n"), 31, "  a:\n    type: human_synthetic\n    process: pa\n");
+  y.replace(y.find("  b:\n    type: human_synthetic\n"), 31, "  b:\n    type: human_synthetic\n    process: pb\n");
+  std::vector<Diagnostic> diags;
+  Graph g = ParseGraph(y, "g.yaml", {}, &diags);
+  ResolvedGraph r = ValidateGraph(g, Builtins(), &diags);
+  ASSERT_TRUE(diags.empty()) << diags[0].ToString();
+  DryConfigure(g, r, Builtins(), &diags, "pb");
+  ASSERT_EQ(diags.size(), 1u);
+  EXPECT_EQ(diags[0].key, "components.b.params.events[0].primitve");
+  diags.clear();
+  DryConfigure(g, r, Builtins(), &diags);  // the launcher: every component
+  EXPECT_EQ(diags.size(), 2u);
+}
+
 TEST(DryConfigure, AComponentWithStructuralProblemsIsNotConfigured) {
   // A mistyped param is a structural problem: reported once, Configure not attempted.
   std::string y = Humans(TinyDataset());

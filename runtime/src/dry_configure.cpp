@@ -192,9 +192,10 @@ bool PlaceMessage(const Graph& graph, const ComponentConfig& c, const ComponentS
 }  // namespace
 
 void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
-                  std::vector<Diagnostic>* diagnostics) {
+                  std::vector<Diagnostic>* diagnostics, const std::string& only_process) {
   for (const auto& rc : resolved.components) {
     if (rc.entry == nullptr) continue;
+    if (!only_process.empty() && graph.ProcessOf(*rc.config) != only_process) continue;
     const std::string key = "components." + rc.config->name;
     bool has_problem = false;  // a component with problems of its own has no complete params
     for (const auto& d : *diagnostics)

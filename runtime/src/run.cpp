@@ -31,8 +31,10 @@ struct Loaded {
 };
 
 // Returns false (after printing every problem) when the graph is invalid.
+// `process`: dry-configure only the components of that process (see DryConfigure); empty: all.
 bool LoadAndValidate(const std::string& path, const std::vector<Override>& overrides,
-                     const std::vector<std::string>& plugin_paths, Loaded* l, std::ostream& err) {
+                     const std::vector<std::string>& plugin_paths, Loaded* l, std::ostream& err,
+                     const std::string& process = "") {
   std::vector<Diagnostic> diags;
   l->graph = LoadGraph(path, overrides, &diags);
   // Plugins the graph or the command line names must load: their problems are the graph's.
@@ -44,7 +46,7 @@ bool LoadAndValidate(const std::string& path, const std::vector<Override>& overr
   if (Status s = l->catalog.LoadDefault({}); !s.ok()) err << "warning: " << s.message() << "\n";
   if (!l->graph.components.empty()) {
     l->resolved = ValidateGraph(l->graph, l->catalog, &diags);
-    DryConfigure(l->graph, l->resolved, l->catalog, &diags);
+    DryConfigure(l->graph, l->resolved, l->catalog, &diags, process);
   }
   for (const auto& d : diags) err << d.ToString() << "\n";
   if (!diags.empty()) err << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", nothing was started\n";
@@ -192,7 +194,9 @@ int ValidateGraphFile(const std::string& path, const std::vector<Override>& over
 
 int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   Loaded l;
-  if (!LoadAndValidate(options.graph_path, options.overrides, options.plugin_paths, &l, err)) return 2;
+  // The launcher (no --process) checks every component before starting any child; a child checks
+  // its own (the others' files may already be open in their processes).
+  if (!LoadAndValidate(options.graph_path, options.overrides, options.plugin_paths, &l, err, options.process)) return 2;
   const std::set<std::string> procs = ProcessesOf(l.graph);
   std::string process = options.process;
   if (process.empty()) {

@@ -47,8 +47,12 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
 // structured param, or the --set) or at the component. Components with problems of their own in
 // *diagnostics are skipped (their params are incomplete). Relies on component.hpp's contract:
 // Configure acts on nothing. See runtime/src/dry_configure.cpp.
+// With `only_process`, only the components placed in that process are configured: a process
+// started on its own (a launcher's child, or `--process` on another host) checks what it will
+// run, not the files of other processes, which live elsewhere or are already in use (a
+// recorder's file, created by its own process, "exists").
 void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
-                  std::vector<Diagnostic>* diagnostics);
+                  std::vector<Diagnostic>* diagnostics, const std::string& only_process = "");
 
 // Converts a YAML value to a param of `spec`'s type; InvalidArgument (message without location)
 // when it is not one.
