@@ -1,5 +1,7 @@
 #include "dds_participant.hpp"
 
+#include "network_qos.hpp"
+
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
@@ -288,7 +290,8 @@ int DdsWriter::matched() const {
 }
 
 StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, const std::string& name,
-                                                                  ProblemHandler on_problem, Scope scope) {
+                                                                  ProblemHandler on_problem, Scope scope,
+                                                                  const NetworkConfig& network) {
   std::unique_ptr<DdsParticipant> p(new DdsParticipant());
   p->name_ = name;
   p->listener_ = std::make_unique<DiscoveryListener>(p.get(), std::move(on_problem));
@@ -297,9 +300,10 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
   fdds::DomainParticipantQos qos = factory->get_default_participant_qos();
   qos.name(name);
   p->scope_ = scope;
+  // A stepped run stays inside its process: the network section does not concern it.
+  if (scope != Scope::kProcessOnly)
+    if (Status s = ApplyNetwork(network, scope == Scope::kWatcher, &qos); !s.ok()) return s;
   if (scope == Scope::kWatcher) {
-    qos.transport().use_builtin_transports = false;
-    qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
     // A watcher lives seconds: announce often, so a first discovery exchange that got lost is
     // repeated within half a second rather than the default 3 s.
     qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0.5);
@@ -320,6 +324,29 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
   if (p->publisher_ == nullptr || p->subscriber_ == nullptr)
     return Status::Internal("cannot create DDS publisher/subscriber for '" + name + "'");
   return p;
+}
+
+std::vector<EndpointMatch> DdsParticipant::Matches() const {
+  std::vector<EndpointMatch> out;
+  fdds::PublicationMatchedStatus pub;
+  fdds::SubscriptionMatchedStatus sub;
+  for (const auto& w : writers_) {
+    w->writer_->get_publication_matched_status(pub);
+    out.push_back({w->topic_, true, false, pub.current_count});
+  }
+  for (const auto& w : serialized_writers_) {
+    w->writer_->get_publication_matched_status(pub);
+    out.push_back({w->topic_, true, true, pub.current_count});
+  }
+  for (const auto& r : readers_) {
+    r->reader_->get_subscription_matched_status(sub);
+    out.push_back({r->topic_, false, false, sub.current_count});
+  }
+  for (const auto& r : serialized_readers_) {
+    r->reader_->get_subscription_matched_status(sub);
+    out.push_back({r->topic_, false, true, sub.current_count});
+  }
+  return out;
 }
 
 DdsParticipant::~DdsParticipant() {
@@ -363,7 +390,7 @@ namespace {
 template <class Q>
 void ApplyQos(Q& q, const TopicQos& qos) {
   q.reliability().kind = qos.reliability == Reliability::kReliable ? fdds::RELIABLE_RELIABILITY_QOS : fdds::BEST_EFFORT_RELIABILITY_QOS;
-  q.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+  q.durability().kind = qos.transient_local ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS : fdds::VOLATILE_DURABILITY_QOS;
   if (qos.keep_all) {
     q.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
   } else {

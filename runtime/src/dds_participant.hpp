@@ -149,8 +149,12 @@ class DdsParticipant final : public Transport {
   // writing component's step: steps of 0.3 to 2 s measured), and the next watcher reusing that
   // port could not be reached for seconds. Over UDP a dead peer costs a lost datagram.
   enum class Scope { kNetwork, kProcessOnly, kWatcher };
+  //
+  // `network`: the graph's network section (discovery, transports, lease; see network_qos.hpp),
+  // for kNetwork and kWatcher (a watcher keeps to UDP whatever it says).
   static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, ProblemHandler on_problem,
-                                                          Scope scope = Scope::kNetwork);
+                                                          Scope scope = Scope::kNetwork,
+                                                          const NetworkConfig& network = NetworkConfig{});
   // Stops every callback, deletes every endpoint created here, then the participant.
   ~DdsParticipant() override;
   DdsParticipant(const DdsParticipant&) = delete;
@@ -165,6 +169,9 @@ class DdsParticipant final : public Transport {
                                                            SerializedCallback callback) override;
   StatusOr<SerializedWriter*> CreateSerializedWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
                                                      const Clock* clock) override;
+
+  // Endpoints are created and destroyed on the executor's thread only: call it there.
+  std::vector<EndpointMatch> Matches() const override;
 
   const std::string& name() const { return name_; }
   // Every remote (or local) endpoint discovered so far that is still alive.

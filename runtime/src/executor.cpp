@@ -234,7 +234,8 @@ Status Executor::Setup() {
                                       ++problems_;
                                       StderrLogger("dds").Error(msg);
                                     },
-                                    stepped ? DdsParticipant::Scope::kProcessOnly : DdsParticipant::Scope::kNetwork);
+                                    stepped ? DdsParticipant::Scope::kProcessOnly : DdsParticipant::Scope::kNetwork,
+                                    graph_.network);
     if (!p.ok()) return p.status();
     transport_ = std::move(p.value());
   }
@@ -284,6 +285,11 @@ Status Executor::Setup() {
   if (!w.ok()) return w.status().WithContext(kStatsTopic);
   stats_output_ = std::make_unique<Output<msg::ComponentStats>>();
   stats_output_->Bind("stats", kStatsTopic, "dyad/" + options_.process, w.value(), clock_.get());
+
+  if (!stepped && ProcessCount() > 1) {
+    barrier_ = std::make_unique<StartBarrier>(graph_, options_.process, options_.host);
+    if (Status s = barrier_->Open(transport_.get()); !s.ok()) return s;
+  }
 
   BuildTopicList();
   for (auto& inst : instances_) {
@@ -341,7 +347,7 @@ void Executor::TriggerStep(Instance& inst) {
 
 void Executor::PeriodicLoop(Instance& inst) {
   const int64_t period = inst.rc->period_ns;
-  int64_t next = SteadyNs();
+  int64_t next = start_steady_ns_;
   std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
   while (!stopping()) {
     lock.lock();
@@ -420,24 +426,38 @@ Status Executor::RunStepped() {
 }
 
 Status Executor::RunWall() {
+  if (barrier_) {
+    auto start = barrier_->Wait([this] { return stopping(); });
+    if (!start.ok()) return start.status();
+    if (start.value() == 0) return Status::OK();  // stopped while waiting
+    start_steady_ns_ = SteadyNs() + (start.value() - WallNowNs());
+    barrier_->Announce("running");
+  } else {
+    start_steady_ns_ = SteadyNs();
+  }
   for (auto& inst : instances_)
     if (inst->rc->period_ns > 0) inst->thread = std::thread([this, i = inst.get()] { PeriodicLoop(*i); });
   // A triggered component may have missed samples delivered before it was active.
   for (auto& inst : instances_)
     if (inst->trigger != nullptr && inst->trigger->Unread() > 0) TriggerStep(*inst);
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = std::chrono::steady_clock::time_point(std::chrono::nanoseconds(start_steady_ns_));
+  int64_t duration_ns = options_.duration_s > 0 ? static_cast<int64_t>(options_.duration_s * 1e9) : 0;
+  if (barrier_ && options_.steps > 0 && !HoldsFastestComponent()) {
+    const int64_t by_steps = static_cast<int64_t>(options_.steps) * FastestPeriodNs() + 1'000'000'000;
+    duration_ns = duration_ns > 0 ? std::min(duration_ns, by_steps) : by_steps;
+  }
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stopping()) {
     auto wake = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<int64_t>(options_.stats_period_s * 1000));
-    if (options_.duration_s > 0) {
-      const auto end = start + std::chrono::nanoseconds(static_cast<int64_t>(options_.duration_s * 1e9));
+    if (duration_ns > 0) {
+      const auto end = start + std::chrono::nanoseconds(duration_ns);
       if (end < wake) wake = end;
     }
     cv_.wait_until(lock, wake, [&] { return stopping(); });
     if (stopping()) break;
-    if (options_.duration_s > 0 && std::chrono::steady_clock::now() - start >= std::chrono::nanoseconds(static_cast<int64_t>(options_.duration_s * 1e9))) {
+    if (duration_ns > 0 && std::chrono::steady_clock::now() - start >= std::chrono::nanoseconds(duration_ns)) {
       lock.unlock();
-      RequestStop("duration reached");
+      RequestStop(options_.duration_s > 0 ? "duration reached" : "the graph's fastest component reached its steps");
       lock.lock();
       break;
     }
@@ -468,6 +488,7 @@ Status Executor::Run() {
     Status r = clock_->stepped() ? RunStepped() : RunWall();
     if (!r.ok()) Fail(r);
   }
+  if (barrier_) barrier_->Announce("stopping");
   // Stop: no more triggered steps, wait for any in flight, then deactivate in reverse order.
   stop_.store(true, std::memory_order_release);
   cv_.notify_all();
@@ -492,7 +513,27 @@ Status Executor::Run() {
   return failure_;
 }
 
+int Executor::ProcessCount() const {
+  std::set<std::string> processes;
+  for (const auto& c : graph_.components) processes.insert(graph_.ProcessOf(c));
+  return static_cast<int>(processes.size());
+}
+
+int64_t Executor::FastestPeriodNs() const {
+  int64_t fastest = 0;
+  for (const auto& rc : resolved_.components)
+    if (rc.period_ns > 0 && (fastest == 0 || rc.period_ns < fastest)) fastest = rc.period_ns;
+  return fastest;
+}
+
+bool Executor::HoldsFastestComponent() const {
+  for (const auto& inst : instances_)
+    if (inst->rc->period_ns > 0 && inst->rc->period_ns == FastestPeriodNs()) return true;
+  return false;
+}
+
 void Executor::PublishStats() {
+  if (barrier_ && !stopping()) barrier_->Announce("running");
   if (!stats_output_) return;
   auto* out = static_cast<Output<msg::ComponentStats>*>(stats_output_.get());
   for (const auto& inst : instances_) {

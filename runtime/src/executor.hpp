@@ -25,6 +25,11 @@
 // upstream's Publish()) is measured on its own and subtracted from the enclosing step; a
 // periodic step misses its deadline when its late start plus its own time exceed the period.
 //
+// Several processes (wall clock): after Activate, each process waits at a StartBarrier for the
+// others and starts its periodic components at the agreed instant (start_barrier.hpp). With
+// `steps`, a process without the graph's fastest periodic component stops once that many of its
+// periods have passed since the start, plus a second for the last samples to arrive.
+//
 // Serialized subscriptions (Context::SubscribeSerialized) call back on the delivering thread; each
 // is closed (unread samples delivered first) just before its component's Deactivate(). The last
 // stats are published before any component is deactivated, so a recorder sees them.
@@ -46,6 +51,7 @@
 #include <dyad/graph.hpp>
 #include <dyad/validate.hpp>
 
+#include "start_barrier.hpp"
 #include "step_stats.hpp"
 #include "transport.hpp"
 
@@ -55,6 +61,7 @@ class Executor {
  public:
   struct Options {
     std::string process;
+    std::string host;       // this machine's name (announced to the other processes)
     double duration_s = 0;  // > 0: stop after this long (wall time, or simulated time when stepped)
     uint64_t steps = 0;     // > 0: stop after the fastest periodic component ran this many steps
     double stats_period_s = 1.0;
@@ -93,6 +100,9 @@ class Executor {
   Status RunStepped();
   Status RunWall();
   void PublishStats();
+  int ProcessCount() const;            // processes of the whole graph
+  int64_t FastestPeriodNs() const;     // of the whole graph's periodic components; 0: none
+  bool HoldsFastestComponent() const;  // this process runs one of them
   void Fail(const Status& status);
   bool stopping() const { return stop_.load(std::memory_order_acquire); }
 
@@ -104,6 +114,9 @@ class Executor {
   std::unique_ptr<ClockImpl> clock_;
   std::vector<std::unique_ptr<Instance>> instances_;
   std::unique_ptr<OutputBase> stats_output_;
+  // Graphs of several processes, wall clock: all start together (start_barrier.hpp).
+  std::unique_ptr<StartBarrier> barrier_;
+  int64_t start_steady_ns_ = 0;  // when periodic components take their first step
 
   std::atomic<bool> stop_{false};
   std::atomic<int> problems_{0};

@@ -20,12 +20,19 @@ class Reader {
   Reader(std::string file, std::vector<Diagnostic>* out) : file_(std::move(file)), out_(out) {}
 
   void Error(const YAML::Node& node, const std::string& key, const std::string& message) {
-    out_->push_back(Diagnostic{SourceMark::Of(file_, node), key, message});
+    out_->push_back(Diagnostic{Mark(node, key), key, message});
   }
   void Error(const SourceMark& mark, const std::string& key, const std::string& message) {
     out_->push_back(Diagnostic{mark, key, message});
   }
   SourceMark Mark(const YAML::Node& node) const { return SourceMark::Of(file_, node); }
+  // A node a `--set` put in: its problems are the command line's, not the file's.
+  SourceMark Mark(const YAML::Node& node, const std::string& key) const {
+    for (const auto& [set_key, mark] : cli_marks_)
+      if (key == set_key || key.rfind(set_key + ".", 0) == 0) return mark;
+    return Mark(node);
+  }
+  void SetFromCommandLine(const std::string& key, SourceMark mark) { cli_marks_[key] = std::move(mark); }
 
   // Checks `node` is a map, reports keys outside `allowed` and duplicate keys.
   bool Map(const YAML::Node& node, const std::string& key, const std::set<std::string>& allowed) {
@@ -74,7 +81,95 @@ class Reader {
  private:
   std::string file_;
   std::vector<Diagnostic>* out_;
+  std::map<std::string, SourceMark> cli_marks_;
 };
+
+// "host:port" -> host and port (1..65535); false when malformed.
+bool SplitHostPort(const std::string& text, std::string* host, int* port, bool port_required) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos) {
+    *host = text;
+    *port = 0;
+    return !port_required && !text.empty();
+  }
+  *host = text.substr(0, colon);
+  const std::string p = text.substr(colon + 1);
+  if (host->empty() || p.empty() || p.size() > 5 || p.find_first_not_of("0123456789") != std::string::npos) return false;
+  *port = std::stoi(p);
+  return *port >= 1 && *port <= 65535;
+}
+
+std::string Names(const std::map<std::string, std::string>& m) {
+  std::string list;
+  for (const auto& [k, _] : m) list += (list.empty() ? "" : ", ") + k;
+  return list;
+}
+
+void ReadStringList(Reader& r, const YAML::Node& node, const std::string& key, std::vector<std::string>* out) {
+  if (!node.IsSequence()) {
+    r.Error(node, key, "must be a list");
+    return;
+  }
+  for (const auto& item : node) {
+    std::string s;
+    if (r.String(item, key, &s)) out->push_back(s);
+  }
+}
+
+void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
+  n->mark = r.Mark(node);
+  if (node.IsNull()) return;
+  if (!r.Map(node, "network", {"discovery", "hosts", "peers", "server", "transport", "interfaces", "lease_s", "start_timeout_s"}))
+    return;
+  std::string s;
+  if (node["discovery"] && r.String(node["discovery"], "network.discovery", &s)) {
+    if (s == "multicast") n->discovery = Discovery::kMulticast;
+    else if (s == "peers") n->discovery = Discovery::kPeers;
+    else if (s == "server") n->discovery = Discovery::kServer;
+    else r.Error(node["discovery"], "network.discovery", "must be multicast, peers or server, got '" + s + "'");
+  }
+  if (const YAML::Node hosts = node["hosts"]; hosts && r.Map(hosts, "network.hosts", {})) {
+    for (const auto& kv : hosts) {
+      std::string address;
+      if (r.String(kv.second, "network.hosts." + kv.first.Scalar(), &address)) n->hosts[kv.first.Scalar()] = address;
+    }
+  }
+  if (node["peers"]) {
+    ReadStringList(r, node["peers"], "network.peers", &n->peers);
+    for (const auto& p : n->peers) {
+      std::string host;
+      int port = 0;
+      if (!SplitHostPort(p, &host, &port, false))
+        r.Error(node["peers"], "network.peers", "'" + p + "' is not address or address:port (port 1..65535)");
+    }
+  }
+  if (node["server"] && r.String(node["server"], "network.server", &n->server)) {
+    std::string host;
+    if (!SplitHostPort(n->server, &host, &n->server_port, true)) {
+      r.Error(node["server"], "network.server", "must be HOST:PORT (HOST a name of network.hosts or an address), got '" + n->server + "'");
+    } else if (auto it = n->hosts.find(host); it != n->hosts.end()) {
+      n->server_host = host;
+      n->server_address = it->second;
+    } else {
+      n->server_address = host;
+    }
+  }
+  if (node["transport"] && r.String(node["transport"], "network.transport", &s)) {
+    if (s == "shm+udp") n->transport = NetTransport::kShmUdp;
+    else if (s == "udp") n->transport = NetTransport::kUdp;
+    else r.Error(node["transport"], "network.transport", "must be shm+udp or udp, got '" + s + "'");
+  }
+  if (node["interfaces"]) ReadStringList(r, node["interfaces"], "network.interfaces", &n->interfaces);
+  if (node["lease_s"] && r.Number(node["lease_s"], "network.lease_s", &n->lease_s, "a number") && !(n->lease_s >= 1))
+    r.Error(node["lease_s"], "network.lease_s", "must be >= 1 (a shorter lease declares live processes gone)");
+  if (node["start_timeout_s"] && r.Number(node["start_timeout_s"], "network.start_timeout_s", &n->start_timeout_s, "a number") &&
+      !(n->start_timeout_s > 0))
+    r.Error(node["start_timeout_s"], "network.start_timeout_s", "must be > 0");
+  if (n->discovery == Discovery::kPeers && n->peers.empty() && n->hosts.empty())
+    r.Error(node["discovery"], "network.discovery", "peers: needs network.peers or network.hosts (the addresses to announce to)");
+  if (n->discovery == Discovery::kServer && n->server.empty())
+    r.Error(node["discovery"], "network.discovery", "server: needs network.server (HOST:PORT of the discovery server)");
+}
 
 void ReadTopics(Reader& r, const YAML::Node& node, Graph* g) {
   if (!r.Map(node, "topics", {})) return;
@@ -200,11 +295,12 @@ void ApplyOverrides(const std::vector<Override>& overrides, Graph* g, YAML::Node
     const SourceMark cli{"--set " + o.text, 0, 0};
     const auto eq = o.text.find('=');
     const auto dot = o.text.find('.');
+    if (o.text.rfind("network.", 0) == 0) continue;  // read with the network section
     if (eq != std::string::npos && (dot == std::string::npos || dot > eq) &&
         ApplyGraphOverride(o.text.substr(0, eq), o.text.substr(eq + 1), cli, g, root, out))
       continue;
     if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || dot + 1 == eq) {
-      out->push_back({cli, o.text, "expected COMPONENT.PARAM=VALUE, or clock|seed|domain_id|graph=VALUE"});
+      out->push_back({cli, o.text, "expected COMPONENT.PARAM=VALUE, clock|seed|domain_id|graph=VALUE or network.KEY=VALUE"});
       continue;
     }
     const std::string comp = o.text.substr(0, dot);
@@ -311,7 +407,27 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
     diagnostics->push_back({SourceMark{path, 1, 1}, "", "a graph file must be a YAML mapping"});
     return g;
   }
-  r.Map(root, "", {"graph", "domain_id", "clock", "seed", "plugins", "processes", "topics", "components"});
+  // `--set network.KEY=VALUE` goes into the document before it is read, so it is checked (and
+  // recorded) like the file's own; its problems name the --set.
+  for (const Override& o : overrides) {
+    const auto eq = o.text.find('=');
+    if (o.text.rfind("network.", 0) != 0 || eq == std::string::npos) continue;
+    const std::string key = o.text.substr(8, eq - 8);
+    const SourceMark cli{"--set " + o.text, 0, 0};
+    if (key.empty() || key.find('.') != std::string::npos) {
+      diagnostics->push_back({cli, "network", "expected network.KEY=VALUE"});
+      continue;
+    }
+    try {
+      if (!root["network"] || root["network"].IsNull()) root["network"] = YAML::Node(YAML::NodeType::Map);
+      root["network"][key] = YAML::Load(o.text.substr(eq + 1));
+      r.SetFromCommandLine("network." + key, cli);
+      g.graph_overrides.push_back(o.text);
+    } catch (const YAML::Exception& e) {
+      diagnostics->push_back({cli, "network." + key, "value is not valid YAML: " + e.msg});
+    }
+  }
+  r.Map(root, "", {"graph", "domain_id", "clock", "seed", "plugins", "network", "processes", "topics", "components"});
   if (root["graph"]) r.String(root["graph"], "graph", &g.name);
   if (root["domain_id"] && r.Number(root["domain_id"], "domain_id", &g.domain_id, "an integer") &&
       (g.domain_id < 0 || g.domain_id > 232))
@@ -340,6 +456,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
       }
     }
   }
+  if (const YAML::Node network = root["network"]) ReadNetwork(r, network, &g.network);
   if (const YAML::Node procs = root["processes"]) {
     if (r.Map(procs, "processes", {})) {
       for (const auto& kv : procs) {
@@ -347,10 +464,19 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
         p.name = kv.first.Scalar();
         p.mark = r.Mark(kv.first);
         const std::string key = "processes." + p.name;
-        if (!kv.second.IsNull() && r.Map(kv.second, key, {"host"}) && kv.second["host"])
+        if (!kv.second.IsNull() && r.Map(kv.second, key, {"host"}) && kv.second["host"]) {
           r.String(kv.second["host"], key + ".host", &p.host);
+          if (!p.host.empty() && !g.network.hosts.empty() && !g.network.hosts.count(p.host))
+            r.Error(kv.second["host"], key + ".host", "'" + p.host + "' is not one of network.hosts (" + Names(g.network.hosts) + ")");
+        }
         g.processes.push_back(p);
       }
+      // A process without a host would start on every host's launcher: a second copy of it.
+      bool any_host = false;
+      for (const auto& p : g.processes) any_host |= !p.host.empty();
+      for (const auto& p : g.processes)
+        if (any_host && p.host.empty())
+          r.Error(p.mark, "processes." + p.name + ".host", "missing: when one process names its host, every process must");
     }
   }
   if (const YAML::Node topics = root["topics"]) ReadTopics(r, topics, &g);

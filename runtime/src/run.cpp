@@ -77,21 +77,79 @@ void PrintReport(const std::vector<Executor::Row>& rows, const std::string& proc
   out.unsetf(std::ios::fixed);
 }
 
-int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err) {
+std::string ThisHost(const RunOptions& options) {
+  if (!options.host.empty()) return options.host;
   char host[256] = {0};
   gethostname(host, sizeof(host) - 1);
+  return host;
+}
+
+std::string HostOf(const Graph& g, const std::string& process) {
+  for (const auto& pc : g.processes)
+    if (pc.name == process) return pc.host;
+  return "";
+}
+
+// Whether the launcher (not a single in-process run) handles this graph here.
+bool NeedsLauncher(const Graph& g, const std::string& this_host) {
+  if (ProcessesOf(g).size() > 1) return true;
+  for (const auto& pc : g.processes)
+    if (!pc.host.empty()) return true;
+  return !g.network.server_host.empty() && g.network.server_host == this_host;
+}
+
+// Starts `args` as a child of the launcher (see LaunchChildren).
+pid_t StartChild(std::vector<std::string> args) {
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    // Its own process group: a terminal's Ctrl-C reaches the launcher only, which forwards it
+    // once (a child hit by both would take the second as "exit now" and skip its clean
+    // shutdown). And it ends if the launcher dies (SIGKILL) instead of running on unwatched.
+    setpgid(0, 0);
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(1);
+    sigset_t none;
+    sigemptyset(&none);
+    pthread_sigmask(SIG_SETMASK, &none, nullptr);
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv("/proc/self/exe", argv.data());
+    std::perror("dyad: exec");
+    _exit(127);
+  }
+  return pid;
+}
+
+int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err) {
+  const std::string host = ThisHost(options);
   std::map<pid_t, std::string> children;
   std::vector<std::string> names;
   for (const auto& p : ProcessesOf(l.graph)) {
-    std::string where;
-    for (const auto& pc : l.graph.processes)
-      if (pc.name == p) where = pc.host;
-    if (!where.empty() && where != host && where != "localhost") {
+    const std::string where = HostOf(l.graph, p);
+    if (!where.empty() && where != host && !(options.host.empty() && where == "localhost")) {
       err << "process '" << p << "' runs on host '" << where << "': start it there with `dyad run " << options.graph_path
-          << " --process " << p << "`\n";
+          << " --host " << where << "`\n";
       continue;
     }
     names.push_back(p);
+  }
+  // The discovery server this host is named to run: up before the processes (they retry until
+  // it answers anyway), down after the last.
+  pid_t server = 0;
+  const NetworkConfig& net = l.graph.network;
+  if (net.discovery == Discovery::kServer && !net.server_host.empty() && net.server_host == host) {
+    server = StartChild({"dyad", "discovery-server", "--listen", net.server_address + ":" + std::to_string(net.server_port)});
+    if (server < 0) {
+      err << "cannot start the discovery server\n";
+      return 1;
+    }
+    children[server] = "discovery-server";
+  }
+  if (names.empty() && server == 0) {
+    err << options.graph_path << ": no process of the graph is placed on host '" << host << "'\n";
+    return 2;
   }
   // The signal thread and this one both touch `children`: under `mutex`. A signal that arrives
   // while children are being started stops the starting too.
@@ -111,25 +169,8 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
     if (options.duration_s > 0) args.insert(args.end(), {"--duration", std::to_string(options.duration_s)});
     if (options.steps > 0) args.insert(args.end(), {"--steps", std::to_string(options.steps)});
     if (options.quiet) args.push_back("--quiet");
-    const pid_t parent = getpid();
-    const pid_t pid = fork();
-    if (pid == 0) {
-      // Its own process group: a terminal's Ctrl-C reaches the launcher only, which forwards it
-      // once (a child hit by both would take the second as "exit now" and skip its clean
-      // shutdown). And it ends if the launcher dies (SIGKILL) instead of running on unwatched.
-      setpgid(0, 0);
-      prctl(PR_SET_PDEATHSIG, SIGTERM);
-      if (getppid() != parent) _exit(1);
-      sigset_t none;
-      sigemptyset(&none);
-      pthread_sigmask(SIG_SETMASK, &none, nullptr);
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv("/proc/self/exe", argv.data());
-      std::perror("dyad: exec");
-      _exit(127);
-    }
+    if (!options.host.empty()) args.insert(args.end(), {"--host", options.host});
+    const pid_t pid = StartChild(std::move(args));
     if (pid < 0) {
       err << "cannot start process '" << p << "'\n";
       continue;
@@ -138,10 +179,16 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
   }
   int first_failure = 0;  // the exit code of the first child that failed on its own
   bool stopped_others = false;
+  bool server_stopped = false;
   for (;;) {
     {
       std::lock_guard<std::mutex> lock(mutex);
       if (children.empty()) break;
+      // The graph's processes here are done: the discovery server's work too.
+      if (server != 0 && !server_stopped && children.size() == 1 && children.count(server) && !names.empty()) {
+        server_stopped = true;
+        kill(server, SIGTERM);
+      }
     }
     int status = 0;
     const pid_t pid = waitpid(-1, &status, 0);
@@ -150,7 +197,7 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
     std::lock_guard<std::mutex> lock(mutex);
     // Stopped by us (the user's signal forwarded, or SIGTERM after another child failed): not a failure.
     const bool stopped = (interrupt.signal() != 0 && code == ExitCodeForSignal(interrupt.signal())) ||
-                         (stopped_others && code == ExitCodeForSignal(SIGTERM));
+                         ((stopped_others || (pid == server && server_stopped)) && code == ExitCodeForSignal(SIGTERM));
     if (code != 0 && !stopped) {
       err << "process '" << children[pid] << "' exited with " << code << "\n";
       if (first_failure == 0) first_failure = code;
@@ -200,7 +247,7 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   const std::set<std::string> procs = ProcessesOf(l.graph);
   std::string process = options.process;
   if (process.empty()) {
-    if (procs.size() > 1) return LaunchChildren(options, l, err);
+    if (NeedsLauncher(l.graph, ThisHost(options))) return LaunchChildren(options, l, err);
     process = *procs.begin();
   } else if (!procs.count(process)) {
     std::string list;
@@ -210,6 +257,7 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   }
   Executor::Options eo;
   eo.process = process;
+  eo.host = ThisHost(options);
   eo.duration_s = options.duration_s;
   eo.steps = options.steps;
   eo.stats_period_s = options.stats_period_s;

@@ -31,6 +31,15 @@ struct TopicQos {
   int depth = 1;
   double deadline_ms = 0;
   bool keep_all = false;  // KEEP_ALL history (recorders); depth then sizes resource limits only
+  bool transient_local = false;  // a late-joining reader gets the writer's history (dyad/processes)
+};
+
+// One endpoint of this transport and how many remote-or-local endpoints it is matched with.
+struct EndpointMatch {
+  std::string topic;
+  bool writer = false;
+  bool serialized = false;  // a Context::SubscribeSerialized/AdvertiseSerialized endpoint
+  int matched = 0;
 };
 
 // A typed reader the executor polls (the port's endpoint).
@@ -57,6 +66,9 @@ class SerializedSubscription {
 class Transport {
  public:
   virtual ~Transport() = default;
+  // Every endpoint created here with its current match count (the start barrier). A transport
+  // that cannot tell returns none (every endpoint counts as matched).
+  virtual std::vector<EndpointMatch> Matches() const { return {}; }
 
   // `on_data` (may be empty) is called on the delivering thread whenever samples arrive.
   virtual StatusOr<TypedReader*> CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include <dyad/catalog.hpp>
+#include <dyad/discovery_server.hpp>
 #include <dyad/run.hpp>
 
 #include "reference_markdown.hpp"
@@ -53,6 +54,7 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
     RunOptions run;
     std::vector<std::string> sets, plugins, type_names;
     bool markdown = false, messages = false;
+    std::string listen;  // discovery-server --listen
   };
   auto st = std::make_shared<State>();
   RunOptions& run = st->run;
@@ -70,6 +72,7 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
   auto* r = app.add_subcommand("run", "Run a graph (the components of one process, or launch every process)");
   r->add_option("graph", run.graph_path, "Graph YAML file")->required();
   r->add_option("--process", run.process, "Run only the components placed in this process");
+  r->add_option("--host", run.host, "This machine's name in the graph (processes: NAME: {host: ...}); default: its host name");
   r->add_option("--set", sets, "Override a parameter: COMPONENT.PARAM=VALUE (repeatable)");
   r->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
   r->add_option("--duration", run.duration_s, "Stop after this many seconds of wall time")->check(CLI::NonNegativeNumber);
@@ -82,6 +85,10 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
     st->run.plugin_paths = st->plugins;
     exit_code = RunGraph(st->run, std::cout, std::cerr);
   });
+
+  auto* ds = app.add_subcommand("discovery-server", "Run a Fast DDS discovery server for graphs with network.discovery: server");
+  ds->add_option("--listen", st->listen, "ADDRESS:PORT to listen on (UDP)")->required();
+  ds->callback([st, &exit_code] { exit_code = RunDiscoveryServer(st->listen, std::cout, std::cerr); });
 
   auto* types = app.add_subcommand("types", "List every component type found, with its ports and parameters");
   types->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");

@@ -7,9 +7,20 @@
 //   clock: wall                 # wall | stepped
 //   seed: 1                     # stepped-mode determinism and component seeds
 //   plugins: [build/plugins]    # extra plugin files or folders, relative to this file
+//   network:                    # optional: how processes find each other (docs/distributed.md)
+//     discovery: multicast      # multicast (default) | peers | server
+//     hosts: {lab: 10.0.0.1, robot-pc: 10.0.0.2}   # host name -> address
+//     peers: [10.0.0.9:7412]    # discovery: peers (default: every address in hosts)
+//     server: lab:11811         # discovery: server; a host of `hosts` (its launcher starts the
+//                               # server) or an address (started by you: `dyad discovery-server`)
+//     transport: shm+udp        # shm+udp (default) | udp
+//     interfaces: [eth0]        # only these interfaces (names or addresses); default: all
+//     lease_s: 5                # a silent process is declared gone after this long
+//     start_timeout_s: 30       # how long a process waits for the others to start together
 //   processes:                  # optional; default: one process "main"
 //     main: {}
-//     robot: {host: robot-pc}   # host: where `dyad run` without --process starts it (default: here)
+//     robot: {host: robot-pc}   # host: where `dyad run` without --process starts it (default: here;
+//                               # when one process names its host, every process must)
 //   topics:                     # optional per topic: type and QoS
 //     human/input: {type: HumanInput, reliability: reliable, depth: 1, deadline_ms: 200}
 //   components:
@@ -65,6 +76,25 @@ struct TopicConfig {
   SourceMark type_mark;
 };
 
+enum class Discovery { kMulticast, kPeers, kServer };
+enum class NetTransport { kShmUdp, kUdp };
+
+// The `network:` section, mapped onto Fast DDS participant QoS by the runtime.
+struct NetworkConfig {
+  Discovery discovery = Discovery::kMulticast;
+  std::map<std::string, std::string> hosts;  // host name -> address (IPv4 or DNS name)
+  std::vector<std::string> peers;            // "address" or "address:port" (port 0: well-known ports)
+  std::string server;                        // "host-or-address:port" as written
+  std::string server_address;                // resolved through `hosts`
+  int server_port = 0;
+  std::string server_host;                   // the host of `hosts` that runs the server; empty: external
+  NetTransport transport = NetTransport::kShmUdp;
+  std::vector<std::string> interfaces;
+  double lease_s = 5;
+  double start_timeout_s = 30;
+  SourceMark mark;
+};
+
 struct ProcessConfig {
   std::string name;
   std::string host;  // empty: this machine
@@ -100,6 +130,7 @@ struct Graph {
   uint64_t seed = 1;
   std::vector<std::string> plugins;  // resolved against the file's folder
   std::vector<SourceMark> plugin_marks;  // where each of `plugins` is written
+  NetworkConfig network;
   std::vector<ProcessConfig> processes;
   std::vector<TopicConfig> topics;
   std::vector<ComponentConfig> components;
@@ -115,8 +146,8 @@ struct Graph {
   std::string ProcessOf(const ComponentConfig& c) const;
 };
 
-// `--set NAME.PARAM=VALUE` (VALUE is parsed as YAML), or `--set KEY=VALUE` for the graph's own
-// clock, seed, domain_id and graph name.
+// `--set NAME.PARAM=VALUE` (VALUE is parsed as YAML), `--set KEY=VALUE` for the graph's own
+// clock, seed, domain_id and graph name, or `--set network.KEY=VALUE` for the network section.
 struct Override {
   std::string text;  // as given, for messages
 };

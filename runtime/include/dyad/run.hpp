@@ -4,11 +4,14 @@
 // against a dry context: see validate.hpp's DryConfigure; printing every problem and returning 2
 // if there is any: nothing is started), then either
 //   - runs the components placed in `process` (one DDS participant for them), or
-//   - with no `process` given and components in several processes: starts one child
-//     `dyad run --process P` per process whose host is this machine (or unset), forwards
+//   - with no `process` given and components in several processes (or processes placed on
+//     hosts): starts one child `dyad run --process P` per process whose host is this machine
+//     (`host`, else the machine's host name; a graph naming no host runs all here), forwards
 //     SIGINT/SIGTERM to them and waits. Children run in their own process group (a terminal's
 //     Ctrl-C reaches them once, through the launcher) and get SIGTERM if the launcher dies. When
-//     one child fails, the others are stopped and the exit code is the failed child's.
+//     one child fails, the others are stopped and the exit code is the failed child's. When the
+//     graph's `network.server` names this host, it first starts `dyad discovery-server` there
+//     and stops it after the last child.
 // It returns when the run ends: SIGINT/SIGTERM, `duration_s`, `steps`, a component's
 // RequestStop(), or a failed step. At exit it prints a timing table (per component: steps, step
 // duration mean/p99/max, start jitter, deadline misses) and publishes the same as
@@ -37,6 +40,7 @@ struct RunOptions {
   std::string graph_path;
   std::vector<Override> overrides;
   std::string process;             // empty: every process of the graph (see above)
+  std::string host;                // this machine's name in the graph; empty: gethostname()
   double duration_s = 0;           // > 0: stop after this much wall time
   uint64_t steps = 0;              // > 0: stop after the fastest periodic component ran this many steps
   double stats_period_s = 1.0;     // ComponentStats publication period (wall time)

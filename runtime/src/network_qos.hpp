@@ -1,0 +1,39 @@
+// The graph's `network:` section as Fast DDS participant QoS (internal to the runtime).
+//
+//   discovery multicast: Fast DDS's default SPDP (multicast 239.255.0.1 plus unicast).
+//   discovery peers:     no multicast at all: a unicast metatraffic locator (all interfaces, the
+//                        well-known port) and the initial peers list: every address of
+//                        `network.hosts` and `network.peers` (a peer without a port is tried on
+//                        the well-known ports of participant ids 0..kPeerParticipants-1).
+//   discovery server:    a Fast DDS discovery-server client of `network.server`.
+//   transport:           shared memory + UDPv4, or UDPv4 only; `interfaces` is the UDP allow-list.
+//   lease_s:             the participant lease; announcements every lease/4.
+#pragma once
+
+#include <string>
+
+#include <dyad/graph.hpp>
+#include <dyad/status.hpp>
+
+namespace eprosima::fastdds::dds {
+class DomainParticipantQos;
+}
+
+namespace dyad {
+
+// Participant ids a peer address is tried on (Fast DDS's default is 4): each process and each
+// watcher (`dyad echo`, `dyad status`) on a host takes one.
+inline constexpr int kPeerParticipants = 12;
+
+// The discovery server's GUID prefix (Fast DDS's convention for server id 0, the one
+// `fast-discovery-server -i 0` uses too).
+inline constexpr const char* kDiscoveryServerPrefix = "44.53.00.5f.45.50.52.4f.53.49.4d.41";
+
+// `udp_only`: no shared memory whatever the section says (watchers: see DdsParticipant).
+// InvalidArgument when an address does not resolve (naming the key).
+Status ApplyNetwork(const NetworkConfig& network, bool udp_only, eprosima::fastdds::dds::DomainParticipantQos* qos);
+
+// An IPv4 address in dotted form for `name` (an address or a DNS name).
+StatusOr<std::string> ResolveIPv4(const std::string& name);
+
+}  // namespace dyad

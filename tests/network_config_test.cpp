@@ -1,0 +1,209 @@
+// The graph's `network:` section: read, checked (each problem at its line, or at the --set that
+// caused it) and mapped onto Fast DDS participant QoS.
+#include <gtest/gtest.h>
+
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+
+#include <dyad/graph.hpp>
+
+#include "network_qos.hpp"
+
+namespace dyad {
+namespace {
+
+const char* kSplit =
+    "graph: split\n"                              // 1
+    "network:\n"                                  // 2
+    "  discovery: peers\n"                        // 3
+    "  hosts: {lab: 10.77.0.1, mind: 10.77.0.2}\n"  // 4
+    "  peers: [10.77.0.9:7412]\n"                 // 5
+    "  server: lab:11811\n"                       // 6
+    "  transport: udp\n"                          // 7
+    "  interfaces: [veth0]\n"                     // 8
+    "  lease_s: 3\n"                              // 9
+    "  start_timeout_s: 12\n"                     // 10
+    "processes:\n"                                // 11
+    "  a: {host: lab}\n"                          // 12
+    "  b: {host: mind}\n"                         // 13
+    "components:\n"                               // 14
+    "  src: {type: counter_source, rate_hz: 10, process: a, outputs: {out: c}}\n"
+    "  sink: {type: counter_sink, trigger: in, process: b, inputs: {in: c}}\n";
+
+Graph Parse(const std::string& yaml, std::vector<Diagnostic>* diags, const std::vector<std::string>& sets = {}) {
+  std::vector<Override> overrides;
+  for (const auto& s : sets) overrides.push_back({s});
+  return ParseGraph(yaml, "g.yaml", overrides, diags);
+}
+
+std::string Replace(std::string s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) s.replace(at, from.size(), to);
+  return s;
+}
+
+TEST(NetworkConfig, ReadsEveryKey) {
+  std::vector<Diagnostic> diags;
+  const Graph g = Parse(kSplit, &diags);
+  ASSERT_TRUE(diags.empty()) << diags[0].ToString();
+  const NetworkConfig& n = g.network;
+  EXPECT_EQ(n.discovery, Discovery::kPeers);
+  EXPECT_EQ(n.hosts.at("mind"), "10.77.0.2");
+  EXPECT_EQ(n.peers, std::vector<std::string>{"10.77.0.9:7412"});
+  EXPECT_EQ(n.server_host, "lab");
+  EXPECT_EQ(n.server_address, "10.77.0.1");
+  EXPECT_EQ(n.server_port, 11811);
+  EXPECT_EQ(n.transport, NetTransport::kUdp);
+  EXPECT_EQ(n.interfaces, std::vector<std::string>{"veth0"});
+  EXPECT_EQ(n.lease_s, 3);
+  EXPECT_EQ(n.start_timeout_s, 12);
+}
+
+TEST(NetworkConfig, DefaultsToMulticastOverSharedMemoryAndUdp) {
+  std::vector<Diagnostic> diags;
+  const Graph g = Parse("components:\n  src: {type: counter_source, rate_hz: 10}\n", &diags);
+  ASSERT_TRUE(diags.empty());
+  EXPECT_EQ(g.network.discovery, Discovery::kMulticast);
+  EXPECT_EQ(g.network.transport, NetTransport::kShmUdp);
+}
+
+struct Bad {
+  const char* name;
+  std::string yaml;
+  const char* mark;
+  const char* key;
+  const char* why;
+};
+
+class BadNetwork : public ::testing::TestWithParam<Bad> {};
+
+TEST_P(BadNetwork, IsRejectedAtItsLine) {
+  std::vector<Diagnostic> diags;
+  Parse(GetParam().yaml, &diags);
+  std::string all;
+  for (const auto& d : diags) all += d.ToString() + "\n";
+  ASSERT_EQ(diags.size(), 1u) << all;
+  EXPECT_EQ(diags[0].mark.ToString().rfind(GetParam().mark, 0), 0u) << diags[0].ToString();
+  EXPECT_EQ(diags[0].key, GetParam().key) << diags[0].ToString();
+  EXPECT_NE(diags[0].message.find(GetParam().why), std::string::npos) << diags[0].ToString();
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Table, BadNetwork,
+    ::testing::Values(
+        Bad{"UnknownKey", Replace(kSplit, "  lease_s: 3\n", "  lease: 3\n"), "g.yaml:9:3", "network.lease", "unknown key"},
+        Bad{"BadDiscovery", Replace(kSplit, "discovery: peers", "discovery: gossip"), "g.yaml:3:14", "network.discovery",
+            "multicast, peers or server"},
+        Bad{"BadTransport", Replace(kSplit, "transport: udp", "transport: tcp"), "g.yaml:7:14", "network.transport",
+            "shm+udp or udp"},
+        Bad{"ServerWithoutPort", Replace(kSplit, "server: lab:11811", "server: lab"), "g.yaml:6:11", "network.server",
+            "HOST:PORT"},
+        Bad{"ServerPortTooBig", Replace(kSplit, "server: lab:11811", "server: lab:70000"), "g.yaml:6:11", "network.server",
+            "HOST:PORT"},
+        Bad{"PeerWithBadPort", Replace(kSplit, "10.77.0.9:7412", "10.77.0.9:x"), "g.yaml:5:10", "network.peers",
+            "address:port"},
+        Bad{"PeersWithNowhereToAnnounce",
+            Replace(Replace(Replace(Replace(kSplit, "  hosts: {lab: 10.77.0.1, mind: 10.77.0.2}\n", ""), "  peers: [10.77.0.9:7412]\n", ""),
+                            "  server: lab:11811\n", ""),
+                    "processes:\n  a: {host: lab}\n  b: {host: mind}\n", "processes:\n  a: {}\n  b: {}\n"),
+            "g.yaml:3:14", "network.discovery", "needs network.peers or network.hosts"},
+        Bad{"ShortLease", Replace(kSplit, "lease_s: 3", "lease_s: 0.2"), "g.yaml:9:12", "network.lease_s", ">= 1"},
+        Bad{"HostNotInHosts", Replace(kSplit, "b: {host: mind}", "b: {host: mnid}"), "g.yaml:13:13", "processes.b.host",
+            "'mnid' is not one of network.hosts (lab, mind)"},
+        Bad{"ProcessWithoutHostBesideOneWithHost", Replace(kSplit, "b: {host: mind}", "b: {}"), "g.yaml:13:3",
+            "processes.b.host", "every process must"}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+TEST(NetworkConfig, ASetOverridesAKeyAndItsProblemNamesTheSet) {
+  std::vector<Diagnostic> diags;
+  Graph g = Parse(kSplit, &diags, {"network.discovery=server", "network.start_timeout_s=5"});
+  ASSERT_TRUE(diags.empty()) << diags[0].ToString();
+  EXPECT_EQ(g.network.discovery, Discovery::kServer);
+  EXPECT_EQ(g.network.start_timeout_s, 5);
+  EXPECT_NE(g.yaml_text.find("--set network.discovery=server"), std::string::npos) << g.yaml_text;  // recorded as run
+
+  diags.clear();
+  Parse(kSplit, &diags, {"network.discovery=gossip"});
+  ASSERT_EQ(diags.size(), 1u);
+  EXPECT_EQ(diags[0].mark.ToString(), "--set network.discovery=gossip");
+  EXPECT_EQ(diags[0].key, "network.discovery");
+
+  diags.clear();
+  Parse(kSplit, &diags, {"network.hosts.lab=1.2.3.4"});
+  ASSERT_EQ(diags.size(), 1u);
+  EXPECT_NE(diags[0].message.find("expected network.KEY=VALUE"), std::string::npos);
+}
+
+// The QoS a participant gets from each discovery mode.
+eprosima::fastdds::dds::DomainParticipantQos QosOf(const std::string& sets) {
+  std::vector<Diagnostic> diags;
+  const Graph g = Parse(kSplit, &diags, {sets});
+  EXPECT_TRUE(diags.empty());
+  eprosima::fastdds::dds::DomainParticipantQos qos;
+  Status s = ApplyNetwork(g.network, false, &qos);
+  EXPECT_TRUE(s.ok()) << s.ToString();
+  return qos;
+}
+
+TEST(NetworkQos, PeersTurnMulticastOffAndListEveryHostAndPeer) {
+  const auto qos = QosOf("network.discovery=peers");
+  const auto& b = qos.wire_protocol().builtin;
+  ASSERT_EQ(b.metatrafficUnicastLocatorList.size(), 1u);  // its presence keeps multicast off
+  EXPECT_TRUE(b.metatrafficMulticastLocatorList.empty());
+  std::vector<std::string> peers;
+  for (const auto& l : b.initialPeersList) peers.push_back(eprosima::fastrtps::rtps::IPLocator::ip_to_string(l) + ":" + std::to_string(l.port));
+  EXPECT_EQ(peers, (std::vector<std::string>{"10.77.0.1:0", "10.77.0.2:0", "10.77.0.9:7412"}));
+  EXPECT_EQ(b.discovery_config.leaseDuration, eprosima::fastrtps::Duration_t(3.0));
+  EXPECT_EQ(b.discovery_config.leaseDuration_announcementperiod, eprosima::fastrtps::Duration_t(0.75));
+  // transport: udp: no shared memory; the allow-list and the wider peer range reach UDP.
+  ASSERT_EQ(qos.transport().user_transports.size(), 1u);
+  EXPECT_FALSE(qos.transport().use_builtin_transports);
+  auto udp = std::dynamic_pointer_cast<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(qos.transport().user_transports[0]);
+  ASSERT_NE(udp, nullptr);
+  EXPECT_EQ(udp->interfaceWhiteList, std::vector<std::string>{"veth0"});
+  EXPECT_EQ(udp->maxInitialPeersRange, static_cast<uint32_t>(kPeerParticipants));
+}
+
+TEST(NetworkQos, ServerMakesAClientOfTheNamedHostsAddress) {
+  const auto qos = QosOf("network.discovery=server");
+  const auto& d = qos.wire_protocol().builtin.discovery_config;
+  EXPECT_EQ(d.discoveryProtocol, eprosima::fastrtps::rtps::DiscoveryProtocol_t::CLIENT);
+  ASSERT_EQ(d.m_DiscoveryServers.size(), 1u);
+  const auto& server = d.m_DiscoveryServers.front();
+  ASSERT_EQ(server.metatrafficUnicastLocatorList.size(), 1u);
+  const auto& l = *server.metatrafficUnicastLocatorList.begin();
+  EXPECT_EQ(eprosima::fastrtps::rtps::IPLocator::ip_to_string(l), "10.77.0.1");
+  EXPECT_EQ(l.port, 11811u);
+  std::ostringstream prefix;
+  prefix << server.guidPrefix;
+  EXPECT_EQ(prefix.str(), "44.53.00.5f.45.50.52.4f.53.49.4d.41");
+}
+
+TEST(NetworkQos, SharedMemoryComesFirstUnlessAWatcherAsksForUdpOnly) {
+  std::vector<Diagnostic> diags;
+  const Graph g = Parse(kSplit, &diags, {"network.transport=shm+udp"});
+  ASSERT_TRUE(diags.empty());
+  eprosima::fastdds::dds::DomainParticipantQos qos, watcher;
+  ASSERT_TRUE(ApplyNetwork(g.network, false, &qos).ok());
+  ASSERT_TRUE(ApplyNetwork(g.network, true, &watcher).ok());
+  ASSERT_EQ(qos.transport().user_transports.size(), 2u);
+  EXPECT_NE(std::dynamic_pointer_cast<eprosima::fastdds::rtps::SharedMemTransportDescriptor>(qos.transport().user_transports[0]), nullptr);
+  EXPECT_EQ(watcher.transport().user_transports.size(), 1u);
+}
+
+TEST(NetworkQos, AnAddressThatDoesNotResolveNamesItsKey) {
+  std::vector<Diagnostic> diags;
+  const Graph g = Parse(Replace(kSplit, "mind: 10.77.0.2", "mind: no-such-host.invalid"), &diags);
+  ASSERT_TRUE(diags.empty());
+  eprosima::fastdds::dds::DomainParticipantQos qos;
+  const Status s = ApplyNetwork(g.network, false, &qos);
+  EXPECT_EQ(s.code(), Status::Code::kInvalidArgument);
+  EXPECT_NE(s.message().find("network.hosts.mind"), std::string::npos) << s.ToString();
+  EXPECT_NE(s.message().find("no-such-host.invalid"), std::string::npos) << s.ToString();
+}
+
+}  // namespace
+}  // namespace dyad
