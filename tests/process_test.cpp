@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -331,6 +332,78 @@ TEST_P(DiscoveryModeTest, ProcessesStartedApartStartTogetherAndLoseNothing) {
 
 INSTANTIATE_TEST_SUITE_P(Modes, DiscoveryModeTest, ::testing::Values("multicast", "peers", "server"),
                          [](const auto& info) { return std::string(info.param); });
+
+// The pid of the `dyad run ... --process P` child whose command line holds `graph`, or 0.
+pid_t ChildPid(const fs::path& graph, const std::string& process) {
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    const std::string name = entry.path().filename();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream in(entry.path() / "cmdline");
+    std::string cmdline((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+    if (cmdline.find(graph.string()) != std::string::npos && cmdline.find("--process " + process + " ") != std::string::npos)
+      return static_cast<pid_t>(std::stoi(name));
+  }
+  return 0;
+}
+
+TEST_F(ProcessTest, SupervisorRestartsAKilledProcessAndItRejoinsTheRunningGraph) {
+  const fs::path out = dir_ / "sink.txt";
+  const fs::path g = Write("g.yaml", "graph: restart\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\nprocesses: {a: {}, b: {restart: on-failure, backoff_s: 0.2}}\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 20, process: a, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " +
+                                         out.string() + "}, inputs: {in: count}}\n");
+  Child c(Dyad({"run", g.string(), "--steps", "200"}), dir_, "restart");  // 10 s
+  pid_t b = 0;
+  for (int i = 0; i < 100 && (b = ChildPid(g, "b")) == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_NE(b, 0);
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  ASSERT_EQ(kill(b, SIGKILL), 0);
+  ASSERT_EQ(c.Wait(60), 0) << c.err();
+  EXPECT_NE(c.err().find("process 'b' exited with 137 (SIGKILL); restarting in 0.2 s"), std::string::npos) << c.err();
+  EXPECT_NE(c.err().find("process 'b': restarting (restart 1 of 3)"), std::string::npos) << c.err();
+  // The restarted sink joined the running graph at once and received what the source sent then:
+  // the source's run was not restarted (its numbers go on), the sink's file is its new one.
+  const auto received = ReadSink(out);
+  ASSERT_GT(received.size(), 20u) << c.err() << c.out();
+  EXPECT_GT(received.front().sequence, 40u);
+  for (size_t i = 1; i < received.size(); ++i) EXPECT_EQ(received[i].sequence, received[i - 1].sequence + 1);
+  EXPECT_EQ(received.back().sequence, 200u);  // and it ended with the graph, not 120 steps after its restart
+}
+
+TEST_F(ProcessTest, ARequiredProcessThatKeepsFailingEndsTheRunAndIsNamed) {
+  const fs::path g = Write("g.yaml", "graph: crashy\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\nprocesses: {a: {}, b: {restart: on-failure, max_restarts: 2, backoff_s: 0.1}}\n"
+                                         "components:\n"
+                                         "  src: {type: counter_source, rate_hz: 20, process: a, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " +
+                                         (dir_ / "no/such/dir/sink.txt").string() + "}, inputs: {in: count}}\n");
+  Child c(Dyad({"run", g.string()}), dir_, "crashy");  // a alone would run forever
+  ASSERT_EQ(c.Wait(60), 1) << c.err();
+  EXPECT_NE(c.err().find("process 'b': restarting (restart 2 of 2)"), std::string::npos) << c.err();
+  EXPECT_NE(c.err().find("process 'b' exited with 1 (after 2 restarts)"), std::string::npos) << c.err();
+}
+
+TEST_F(ProcessTest, AProcessThatIsNotRequiredMayFailWithoutEndingTheRun) {
+  const fs::path out = dir_ / "sink.txt";
+  const fs::path g = Write("g.yaml", "graph: optional\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\nnetwork: {start_timeout_s: 3}\nprocesses: {a: {}, b: {}, c: {required: false}}\n"
+                                         "components:\n"
+                                         "  src: {type: counter_source, rate_hz: 20, process: a, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " + out.string() +
+                                         "}, inputs: {in: count}}\n"
+                                         "  bad: {type: counter_sink, trigger: in, process: c, params: {file: " +
+                                         (dir_ / "no/such/dir/sink.txt").string() + "}, inputs: {in: count}}\n");
+  Child c(Dyad({"run", g.string(), "--steps", "20"}), dir_, "optional");
+  // Nobody waits for a process that is not required: a and b start together without c.
+  ASSERT_EQ(c.Wait(60), 0) << c.err();
+  EXPECT_NE(c.err().find("process 'c' exited with 1; it is not required: the experiment goes on without it"), std::string::npos)
+      << c.err();
+  const auto received = ReadSink(out);
+  ASSERT_EQ(received.size(), 20u) << c.err();
+  EXPECT_EQ(received.front().sequence, 1u);
+}
 
 TEST_F(ProcessTest, OneFailingProcessEndsTheWholeExperiment) {
   const fs::path g = Write("g.yaml", "graph: fail\ndomain_id: " + std::to_string(domain_) +

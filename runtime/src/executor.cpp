@@ -426,11 +426,13 @@ Status Executor::RunStepped() {
 }
 
 Status Executor::RunWall() {
+  int64_t start_wall_ns = 0;
   if (barrier_) {
     auto start = barrier_->Wait([this] { return stopping(); });
     if (!start.ok()) return start.status();
     if (start.value() == 0) return Status::OK();  // stopped while waiting
-    start_steady_ns_ = SteadyNs() + (start.value() - WallNowNs());
+    start_wall_ns = start.value();
+    start_steady_ns_ = SteadyNs() + (start_wall_ns - WallNowNs());
     barrier_->Announce("running");
   } else {
     start_steady_ns_ = SteadyNs();
@@ -442,8 +444,13 @@ Status Executor::RunWall() {
     if (inst->trigger != nullptr && inst->trigger->Unread() > 0) TriggerStep(*inst);
   const auto start = std::chrono::steady_clock::time_point(std::chrono::nanoseconds(start_steady_ns_));
   int64_t duration_ns = options_.duration_s > 0 ? static_cast<int64_t>(options_.duration_s * 1e9) : 0;
-  if (barrier_ && options_.steps > 0 && !HoldsFastestComponent()) {
-    const int64_t by_steps = static_cast<int64_t>(options_.steps) * FastestPeriodNs() + 1'000'000'000;
+  if (barrier_ && options_.steps > 0) {
+    // The graph's steps, counted from the graph's start: a process that joined late (restarted)
+    // ends with the others, and one without the fastest component a second after its last step.
+    const int64_t period = FastestPeriodNs();
+    const int64_t end_wall = barrier_->graph_start_ns() + static_cast<int64_t>(options_.steps) * period +
+                             (HoldsFastestComponent() ? period / 2 : 1'000'000'000);
+    const int64_t by_steps = std::max<int64_t>(end_wall - start_wall_ns, 0);
     duration_ns = duration_ns > 0 ? std::min(duration_ns, by_steps) : by_steps;
   }
   std::unique_lock<std::mutex> lock(mutex_);

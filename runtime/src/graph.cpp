@@ -464,10 +464,25 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
         p.name = kv.first.Scalar();
         p.mark = r.Mark(kv.first);
         const std::string key = "processes." + p.name;
-        if (!kv.second.IsNull() && r.Map(kv.second, key, {"host"}) && kv.second["host"]) {
-          r.String(kv.second["host"], key + ".host", &p.host);
-          if (!p.host.empty() && !g.network.hosts.empty() && !g.network.hosts.count(p.host))
-            r.Error(kv.second["host"], key + ".host", "'" + p.host + "' is not one of network.hosts (" + Names(g.network.hosts) + ")");
+        const YAML::Node spec = kv.second;
+        if (!spec.IsNull() && r.Map(spec, key, {"host", "restart", "max_restarts", "backoff_s", "required"})) {
+          if (spec["host"] && r.String(spec["host"], key + ".host", &p.host) && !g.network.hosts.empty() &&
+              !g.network.hosts.count(p.host))
+            r.Error(spec["host"], key + ".host", "'" + p.host + "' is not one of network.hosts (" + Names(g.network.hosts) + ")");
+          std::string policy;
+          if (spec["restart"] && r.String(spec["restart"], key + ".restart", &policy)) {
+            if (policy == "never") p.restart = RestartPolicy::kNever;
+            else if (policy == "on-failure") p.restart = RestartPolicy::kOnFailure;
+            else if (policy == "always") p.restart = RestartPolicy::kAlways;
+            else r.Error(spec["restart"], key + ".restart", "must be never, on-failure or always, got '" + policy + "'");
+          }
+          if (spec["max_restarts"] && r.Number(spec["max_restarts"], key + ".max_restarts", &p.max_restarts, "an integer") &&
+              p.max_restarts < 0)
+            r.Error(spec["max_restarts"], key + ".max_restarts", "must be >= 0");
+          if (spec["backoff_s"] && r.Number(spec["backoff_s"], key + ".backoff_s", &p.backoff_s, "a number") &&
+              !(p.backoff_s >= 0 && p.backoff_s <= 60))
+            r.Error(spec["backoff_s"], key + ".backoff_s", "must be in 0..60");
+          if (spec["required"]) r.Number(spec["required"], key + ".required", &p.required, "true or false");
         }
         g.processes.push_back(p);
       }

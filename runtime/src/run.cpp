@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
@@ -122,9 +124,20 @@ pid_t StartChild(std::vector<std::string> args) {
   return pid;
 }
 
+const ProcessConfig& ConfigOf(const Graph& g, const std::string& process) {
+  static const ProcessConfig kDefault;
+  for (const auto& pc : g.processes)
+    if (pc.name == process) return pc;
+  return kDefault;
+}
+
+std::string DescribeExit(int code) {
+  if (code > 128 && code < 128 + 32) return std::to_string(code) + " (" + SignalName(code - 128) + ")";
+  return std::to_string(code);
+}
+
 int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err) {
   const std::string host = ThisHost(options);
-  std::map<pid_t, std::string> children;
   std::vector<std::string> names;
   for (const auto& p : ProcessesOf(l.graph)) {
     const std::string where = HostOf(l.graph, p);
@@ -135,34 +148,13 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
     }
     names.push_back(p);
   }
-  // The discovery server this host is named to run: up before the processes (they retry until
-  // it answers anyway), down after the last.
-  pid_t server = 0;
   const NetworkConfig& net = l.graph.network;
-  if (net.discovery == Discovery::kServer && !net.server_host.empty() && net.server_host == host) {
-    server = StartChild({"dyad", "discovery-server", "--listen", net.server_address + ":" + std::to_string(net.server_port)});
-    if (server < 0) {
-      err << "cannot start the discovery server\n";
-      return 1;
-    }
-    children[server] = "discovery-server";
-  }
-  if (names.empty() && server == 0) {
+  const bool runs_server = net.discovery == Discovery::kServer && !net.server_host.empty() && net.server_host == host;
+  if (names.empty() && !runs_server) {
     err << options.graph_path << ": no process of the graph is placed on host '" << host << "'\n";
     return 2;
   }
-  // The signal thread and this one both touch `children`: under `mutex`. A signal that arrives
-  // while children are being started stops the starting too.
-  std::mutex mutex;
-  bool stopping = false;
-  InterruptWatcher interrupt([&](int sig) {
-    std::lock_guard<std::mutex> lock(mutex);
-    stopping = true;
-    for (const auto& [pid, _] : children) kill(pid, sig);
-  });
-  for (const auto& p : names) {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (stopping) break;
+  auto child_args = [&](const std::string& p) {
     std::vector<std::string> args = {"dyad", "run", options.graph_path, "--process", p};
     for (const auto& o : options.overrides) args.insert(args.end(), {"--set", o.text});
     for (const auto& pp : options.plugin_paths) args.insert(args.end(), {"--plugins", pp});
@@ -170,45 +162,113 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
     if (options.steps > 0) args.insert(args.end(), {"--steps", std::to_string(options.steps)});
     if (options.quiet) args.push_back("--quiet");
     if (!options.host.empty()) args.insert(args.end(), {"--host", options.host});
+    return args;
+  };
+
+  // One child per process of this host (and the discovery server, first: the processes retry
+  // until it answers anyway). The signal thread and this one share `children` and `stopping`.
+  struct Supervised {
+    std::string name;
+    int restarts = 0;
+  };
+  std::map<pid_t, Supervised> children;
+  struct Pending {
+    std::string name;
+    int restarts;
+    std::chrono::steady_clock::time_point due;
+  };
+  std::vector<Pending> pending;  // restarts waiting for their back-off
+  std::mutex mutex;
+  bool stopping = false;
+  pid_t server = 0;
+  InterruptWatcher interrupt([&](int sig) {
+    std::lock_guard<std::mutex> lock(mutex);
+    stopping = true;
+    for (const auto& [pid, _] : children) kill(pid, sig);
+  });
+  auto start = [&](const std::string& name, std::vector<std::string> args, int restarts) {
     const pid_t pid = StartChild(std::move(args));
     if (pid < 0) {
-      err << "cannot start process '" << p << "'\n";
-      continue;
+      err << "cannot start process '" << name << "'\n";
+      return false;
     }
-    children[pid] = p;
+    children[pid] = {name, restarts};
+    return true;
+  };
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (runs_server) {
+      const std::string listen = net.server_address + ":" + std::to_string(net.server_port);
+      if (!start("discovery-server", {"dyad", "discovery-server", "--listen", listen}, 0)) return 1;
+      server = children.begin()->first;
+    }
+    for (const auto& p : names)
+      if (!stopping) start(p, child_args(p), 0);
   }
-  int first_failure = 0;  // the exit code of the first child that failed on its own
-  bool stopped_others = false;
-  bool server_stopped = false;
+
+  int first_failure = 0;  // the exit code of the first required process that failed for good
+  bool stopped_others = false, server_stopped = false;
+  auto stop_all = [&](pid_t except) {  // REQUIRES: mutex held
+    stopping = stopped_others = true;
+    pending.clear();
+    for (const auto& [other, _] : children)
+      if (other != except) kill(other, SIGTERM);
+  };
   for (;;) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (children.empty()) break;
-      // The graph's processes here are done: the discovery server's work too.
-      if (server != 0 && !server_stopped && children.size() == 1 && children.count(server) && !names.empty()) {
+    int status = 0;
+    const pid_t pid = waitpid(-1, &status, WNOHANG);
+    std::lock_guard<std::mutex> lock(mutex);
+    if (pid <= 0) {
+      // Restarts that are due; the discovery server once the graph's processes here are done.
+      const auto now = std::chrono::steady_clock::now();
+      if (stopping) pending.clear();
+      for (auto it = pending.begin(); it != pending.end();) {
+        if (it->due > now) {
+          ++it;
+          continue;
+        }
+        err << "process '" << it->name << "': restarting (restart " << it->restarts << " of "
+            << ConfigOf(l.graph, it->name).max_restarts << ")\n";
+        start(it->name, child_args(it->name), it->restarts);
+        it = pending.erase(it);
+      }
+      if (server != 0 && !server_stopped && pending.empty() && children.size() == 1 && children.count(server) &&
+          !names.empty()) {
         server_stopped = true;
         kill(server, SIGTERM);
       }
+      if (children.empty() && pending.empty()) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      continue;
     }
-    int status = 0;
-    const pid_t pid = waitpid(-1, &status, 0);
-    if (pid < 0) break;
+    const Supervised child = children[pid];
+    children.erase(pid);
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    std::lock_guard<std::mutex> lock(mutex);
     // Stopped by us (the user's signal forwarded, or SIGTERM after another child failed): not a failure.
     const bool stopped = (interrupt.signal() != 0 && code == ExitCodeForSignal(interrupt.signal())) ||
                          ((stopped_others || (pid == server && server_stopped)) && code == ExitCodeForSignal(SIGTERM));
-    if (code != 0 && !stopped) {
-      err << "process '" << children[pid] << "' exited with " << code << "\n";
-      if (first_failure == 0) first_failure = code;
-      // One process failing ends the experiment.
-      if (!stopping) {
-        stopping = stopped_others = true;
-        for (const auto& [other, _] : children)
-          if (other != pid) kill(other, SIGTERM);
-      }
+    if (stopped || stopping) continue;
+    const ProcessConfig& pc = ConfigOf(l.graph, child.name);
+    const bool restart = pid != server && (pc.restart == RestartPolicy::kAlways ||
+                                           (pc.restart == RestartPolicy::kOnFailure && code != 0));
+    if (restart && child.restarts < pc.max_restarts) {
+      const double backoff = std::min(10.0, pc.backoff_s * std::pow(2.0, child.restarts));
+      err << "process '" << child.name << "' exited with " << DescribeExit(code) << "; restarting in " << backoff << " s\n";
+      pending.push_back({child.name, child.restarts + 1,
+                         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                                std::chrono::duration<double>(backoff))});
+      continue;
     }
-    children.erase(pid);
+    if (code == 0) continue;
+    const std::string given_up = restart ? " (after " + std::to_string(child.restarts) + " restarts)" : "";
+    if (pid != server && !pc.required) {
+      err << "process '" << child.name << "' exited with " << DescribeExit(code) << given_up
+          << "; it is not required: the experiment goes on without it\n";
+      continue;
+    }
+    err << "process '" << child.name << "' exited with " << DescribeExit(code) << given_up << "\n";
+    if (first_failure == 0) first_failure = code;
+    stop_all(pid);  // one required process failing ends the experiment
   }
   if (first_failure != 0) return first_failure;
   if (interrupt.signal() != 0) {

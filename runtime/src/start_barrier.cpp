@@ -15,9 +15,17 @@ int64_t WallNowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
+bool StartBarrier::Awaited(const std::string& process) const {
+  if (process == process_) return true;
+  for (const auto& pc : graph_.processes)
+    if (pc.name == process) return pc.required;
+  return true;
+}
+
 StartBarrier::StartBarrier(const Graph& graph, std::string process, std::string host)
     : graph_(graph), process_(std::move(process)), host_(std::move(host)) {
   for (const auto& c : graph.components) {
+    if (!Awaited(graph.ProcessOf(c))) continue;
     for (const auto& b : c.outputs) ++writers_of_[b.topic];
     for (const auto& b : c.inputs) ++readers_of_[b.topic];
   }
@@ -74,7 +82,8 @@ std::string StartBarrier::MissingEndpoints(const std::vector<EndpointMatch>& mat
 
 StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
   std::set<std::string> processes;
-  for (const auto& c : graph_.components) processes.insert(graph_.ProcessOf(c));
+  for (const auto& c : graph_.components)
+    if (Awaited(graph_.ProcessOf(c))) processes.insert(graph_.ProcessOf(c));
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(graph_.network.start_timeout_s);
   Announce("waiting");
   for (;;) {
@@ -86,11 +95,13 @@ StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
       Announce("waiting");
     }
     // Joining a graph that already runs (restarted, or started late): no one waits for us.
-    int64_t running_since = 0;
+    int64_t running_since = 0;  // the graph's start, as the running processes agreed it
     for (const auto& [name, s] : heard_)
-      if (name != process_ && s.state() == "running" && s.start_ns() > 0) running_since = std::max(running_since, s.start_ns());
+      if (name != process_ && s.state() == "running" && s.start_ns() > 0 && (running_since == 0 || s.start_ns() < running_since))
+        running_since = s.start_ns();
     if (ready_ns_ != 0 && running_since != 0) {
       start_ns_ = std::max(running_since, WallNowNs());  // an agreed start still ahead is kept
+      graph_start_ns_ = running_since;
       return start_ns_;
     }
     std::string not_heard;
@@ -104,7 +115,7 @@ StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
       last_ready = std::max(last_ready, ready);
     }
     if (ready_ns_ != 0 && not_heard.empty()) {
-      start_ns_ = last_ready + kStartMarginNs;
+      start_ns_ = graph_start_ns_ = last_ready + kStartMarginNs;
       return start_ns_;
     }
     if (std::chrono::steady_clock::now() >= deadline) {

@@ -10,7 +10,7 @@
 //   2. waits until it has heard every process of the graph announce itself ready;
 //   3. starts its clocks at max(ready_ns) + kStartMargin, an instant every process computes
 //      alike from the same announcements (as exact as the hosts' clock sync, docs/distributed.md).
-// A process that hears another already "running" (it was restarted, or started late) joins at
+// Processes with `required: false` are not waited for. A process that hears another already "running" (it was restarted, or started late) joins at
 // once instead. After `network.start_timeout_s` it gives up with a message naming every process
 // not heard from and every endpoint of its own still short of matches.
 //
@@ -52,10 +52,17 @@ class StartBarrier {
   // is missing).
   StatusOr<int64_t> Wait(const std::function<bool()>& stopping);
 
+  // When the graph started: the agreed instant, or for a process that joined a running graph,
+  // the others' (valid after Wait()).
+  int64_t graph_start_ns() const { return graph_start_ns_; }
+
   // Publishes this process's state ("running" with the start instant, "stopping").
   void Announce(const std::string& state);
 
  private:
+  // Whether the barrier waits for `process`: itself and every required process (one that is not
+  // required joins when it comes; its endpoints are not counted).
+  bool Awaited(const std::string& process) const;
   std::string MissingEndpoints(const std::vector<EndpointMatch>& matches) const;
   void TakeAnnouncements();
 
@@ -67,7 +74,7 @@ class StartBarrier {
   TypedWriter* writer_ = nullptr;
   TypedReader* reader_ = nullptr;
   uint64_t sequence_ = 0;
-  int64_t ready_ns_ = 0, start_ns_ = 0;
+  int64_t ready_ns_ = 0, start_ns_ = 0, graph_start_ns_ = 0;
 };
 
 }  // namespace dyad

@@ -21,6 +21,8 @@
 //     main: {}
 //     robot: {host: robot-pc}   # host: where `dyad run` without --process starts it (default: here;
 //                               # when one process names its host, every process must)
+//     mind: {restart: on-failure, max_restarts: 3, backoff_s: 0.5, required: true}
+//                               # supervision: never (default) | on-failure | always
 //   topics:                     # optional per topic: type and QoS
 //     human/input: {type: HumanInput, reliability: reliable, depth: 1, deadline_ms: 200}
 //   components:
@@ -95,9 +97,18 @@ struct NetworkConfig {
   SourceMark mark;
 };
 
+enum class RestartPolicy { kNever, kOnFailure, kAlways };
+
 struct ProcessConfig {
   std::string name;
   std::string host;  // empty: this machine
+  // Supervision by the launcher (run.hpp): restart after an exit (on-failure: a non-zero one),
+  // up to max_restarts times, waiting backoff_s, doubled after each restart (at most 10 s).
+  RestartPolicy restart = RestartPolicy::kNever;
+  int max_restarts = 3;
+  double backoff_s = 0.5;
+  // A required process that fails for good ends the experiment; another one is left out.
+  bool required = true;
   SourceMark mark;
 };
 

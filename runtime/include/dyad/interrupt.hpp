@@ -46,7 +46,7 @@ class InterruptWatcher {
   std::thread thread_;
 };
 
-// "SIGINT", "SIGTERM", or "signal N".
+// "SIGINT", "SIGTERM", "SIGKILL" and the other signals that end a process, or "signal".
 const char* SignalName(int signal);
 // 128 + signal.
 inline int ExitCodeForSignal(int signal) { return 128 + signal; }
