@@ -347,6 +347,39 @@ pid_t ChildPid(const fs::path& graph, const std::string& process) {
   return 0;
 }
 
+// `dyad status` on a split graph whose second process's clock is 25 ms ahead (the test-only
+// DYAD_TEST_CLOCK_OFFSET_MS): both processes listed with their hosts and pids, the offset
+// measured within 1 ms both ways, and the warning said by the process that measured it.
+TEST_F(ProcessTest, StatusListsTheProcessesAndTheMeasuredClockOffsets) {
+  const fs::path g = Write("g.yaml", "graph: clocks\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\nnetwork: {discovery: peers, hosts: {h1: 127.0.0.1, h2: 127.0.0.1}}\n"
+                                         "processes: {a: {host: h1}, b: {host: h2}}\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 20, process: a, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: b, inputs: {in: count}}\n");
+  Child a(Dyad({"run", g.string(), "--host", "h1", "--steps", "200"}), dir_, "a");
+  Child b(Dyad({"run", g.string(), "--host", "h2", "--steps", "200"}), dir_, "b", {"DYAD_TEST_CLOCK_OFFSET_MS=25"});
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  Child status(Dyad({"status", "--graph", g.string(), "--wait", "4"}), dir_, "status");
+  ASSERT_EQ(status.Wait(30), 0) << status.err();
+  const pid_t pid_a = ChildPid(g, "a"), pid_b = ChildPid(g, "b");
+  ASSERT_EQ(a.Wait(60), 0) << a.err();
+  ASSERT_EQ(b.Wait(60), 0) << b.err();
+  const std::string out = status.out();
+  EXPECT_NE(out.find("clocks/a                h1              " + std::to_string(pid_a) + " "), std::string::npos) << out;
+  EXPECT_NE(out.find("clocks/b                h2              " + std::to_string(pid_b) + " "), std::string::npos) << out;
+  EXPECT_NE(out.find("running"), std::string::npos) << out;
+  auto offset_ms = [&](const std::string& from, const std::string& to) {
+    const std::string key = "  " + from + std::string(16 - from.size(), ' ') + "-> " + to;
+    const auto at = out.find(key);
+    EXPECT_NE(at, std::string::npos) << key << "\n" << out;
+    return at == std::string::npos ? 0.0 : std::stod(out.substr(at + key.size(), 40));
+  };
+  EXPECT_NEAR(offset_ms("a", "b"), 25.0, 1.0) << out;
+  EXPECT_NEAR(offset_ms("b", "a"), -25.0, 1.0) << out;
+  EXPECT_NE(a.err().find("[warn] clock: the clock of process 'b' is +2"), std::string::npos) << a.err();
+  EXPECT_NE(out.find("src                 a"), std::string::npos) << out;  // step stats
+}
+
 TEST_F(ProcessTest, SupervisorRestartsAKilledProcessAndItRejoinsTheRunningGraph) {
   const fs::path out = dir_ / "sink.txt";
   const fs::path g = Write("g.yaml", "graph: restart\nclock: wall\ndomain_id: " + std::to_string(domain_) +

@@ -69,7 +69,7 @@ class Executor::ClockImpl final : public Clock {
   explicit ClockImpl(bool stepped) : stepped_(stepped) {}
   int64_t now_ns() const override {
     if (stepped_) return sim_ns_.load(std::memory_order_acquire);
-    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+    return WallNowNs();
   }
   void Set(int64_t t) { sim_ns_.store(t, std::memory_order_release); }
   bool stepped() const { return stepped_; }
@@ -201,6 +201,7 @@ Executor::~Executor() {
     if (inst->thread.joinable()) inst->thread.join();
   }
   // The transport first (no callback after it), then components and ports (member order).
+  if (clock_sync_) clock_sync_->Stop();  // its thread writes on the transport's endpoints
   transport_.reset();
 }
 
@@ -289,6 +290,9 @@ Status Executor::Setup() {
   if (!stepped && ProcessCount() > 1) {
     barrier_ = std::make_unique<StartBarrier>(graph_, options_.process, options_.host);
     if (Status s = barrier_->Open(transport_.get()); !s.ok()) return s;
+    clock_sync_ = std::make_unique<ClockSync>(graph_, options_.process, options_.host,
+                                              [](const std::string& m) { StderrLogger("clock").Warn(m); });
+    if (Status s = clock_sync_->Open(transport_.get()); !s.ok()) return s;
   }
 
   BuildTopicList();
@@ -432,6 +436,7 @@ Status Executor::RunWall() {
     if (!start.ok()) return start.status();
     if (start.value() == 0) return Status::OK();  // stopped while waiting
     start_wall_ns = start.value();
+    clock_sync_->Start(kClockSyncPeriodS);
     start_steady_ns_ = SteadyNs() + (start_wall_ns - WallNowNs());
     barrier_->Announce("running");
   } else {

@@ -30,6 +30,8 @@
 // `steps`, a process without the graph's fastest periodic component stops once that many of its
 // periods have passed since the start, plus a second for the last samples to arrive.
 //
+// They also measure each other's clocks every 2 s (clock_sync.hpp).
+//
 // Serialized subscriptions (Context::SubscribeSerialized) call back on the delivering thread; each
 // is closed (unread samples delivered first) just before its component's Deactivate(). The last
 // stats are published before any component is deactivated, so a recorder sees them.
@@ -51,6 +53,7 @@
 #include <dyad/graph.hpp>
 #include <dyad/validate.hpp>
 
+#include "clock_sync.hpp"
 #include "start_barrier.hpp"
 #include "step_stats.hpp"
 #include "transport.hpp"
@@ -116,6 +119,8 @@ class Executor {
   std::unique_ptr<OutputBase> stats_output_;
   // Graphs of several processes, wall clock: all start together (start_barrier.hpp).
   std::unique_ptr<StartBarrier> barrier_;
+  std::unique_ptr<ClockSync> clock_sync_;  // stopped before the transport goes
+  static constexpr double kClockSyncPeriodS = 2;
   int64_t start_steady_ns_ = 0;  // when periodic components take their first step
 
   std::atomic<bool> stop_{false};

@@ -119,7 +119,8 @@ void ReadStringList(Reader& r, const YAML::Node& node, const std::string& key, s
 void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
   n->mark = r.Mark(node);
   if (node.IsNull()) return;
-  if (!r.Map(node, "network", {"discovery", "hosts", "peers", "server", "transport", "interfaces", "lease_s", "start_timeout_s"}))
+  if (!r.Map(node, "network", {"discovery", "hosts", "peers", "server", "transport", "interfaces", "lease_s", "start_timeout_s",
+                            "max_clock_offset_ms"}))
     return;
   std::string s;
   if (node["discovery"] && r.String(node["discovery"], "network.discovery", &s)) {
@@ -165,6 +166,10 @@ void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
   if (node["start_timeout_s"] && r.Number(node["start_timeout_s"], "network.start_timeout_s", &n->start_timeout_s, "a number") &&
       !(n->start_timeout_s > 0))
     r.Error(node["start_timeout_s"], "network.start_timeout_s", "must be > 0");
+  if (node["max_clock_offset_ms"] &&
+      r.Number(node["max_clock_offset_ms"], "network.max_clock_offset_ms", &n->max_clock_offset_ms, "a number") &&
+      !(n->max_clock_offset_ms > 0))
+    r.Error(node["max_clock_offset_ms"], "network.max_clock_offset_ms", "must be > 0");
   if (n->discovery == Discovery::kPeers && n->peers.empty() && n->hosts.empty())
     r.Error(node["discovery"], "network.discovery", "peers: needs network.peers or network.hosts (the addresses to announce to)");
   if (n->discovery == Discovery::kServer && n->server.empty())

@@ -5,6 +5,9 @@
 
 #include <dyad/msg/types.hpp>
 
+#include "clock_sync.hpp"
+#include "start_barrier.hpp"
+
 namespace dyad {
 
 uint64_t ComponentSeed(uint64_t seed, const std::string& name) {
@@ -52,6 +55,23 @@ std::vector<TopicInfo> GraphTopics(const Graph& graph, const ResolvedGraph& reso
     for (const auto& c : graph.components) processes.insert(graph.ProcessOf(c));
     t.writers_local = processes.size() == 1;  // every process's runtime writes it
     topics.push_back(std::move(t));
+  }
+  // A graph of several processes: their announcements and clock offsets (start_barrier.hpp,
+  // clock_sync.hpp), so a recorder keeps them with the rest.
+  std::set<std::string> processes;
+  for (const auto& c : graph.components) processes.insert(graph.ProcessOf(c));
+  if (processes.size() > 1 && graph.clock == ClockMode::kWall) {
+    for (const auto& [name, type] : {std::pair{kProcessesTopic, &TypeInfoOf<msg::ProcessState>()},
+                                     std::pair{kClockOffsetsTopic, &TypeInfoOf<msg::ClockOffset>()}}) {
+      if (resolved.topics.count(name)) continue;
+      TopicInfo t;
+      t.name = name;
+      t.type = type;
+      t.reliable = true;
+      t.depth = 16;
+      t.writers = {"runtime"};
+      topics.push_back(std::move(t));
+    }
   }
   std::sort(topics.begin(), topics.end(), [](const TopicInfo& a, const TopicInfo& b) { return a.name < b.name; });
   return topics;

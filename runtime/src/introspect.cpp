@@ -12,10 +12,17 @@
 #include <optional>
 #include <ostream>
 #include <set>
+#include <sstream>
 #include <thread>
 
 
+#include <dyad/message_traits.hpp>
+#include <dyad/msg/types.hpp>
+
+#include "clock_sync.hpp"
 #include "dds_participant.hpp"
+#include "graph_topics.hpp"
+#include "start_barrier.hpp"
 #include "dyad/interrupt.hpp"
 
 namespace dyad {
@@ -24,7 +31,7 @@ namespace {
 using Steady = std::chrono::steady_clock;
 
 std::unique_ptr<DdsParticipant> Join(const IntrospectOptions& o, std::ostream& err) {
-  auto p = DdsParticipant::Create(o.domain_id, "dyad/introspect", nullptr, DdsParticipant::Scope::kWatcher);
+  auto p = DdsParticipant::Create(o.domain_id, "dyad/introspect", nullptr, DdsParticipant::Scope::kWatcher, o.network);
   if (!p.ok()) {
     err << p.status().message() << "\n";
     return nullptr;
@@ -240,6 +247,72 @@ int TopicHz(const IntrospectOptions& o, const Catalog& catalog, const std::strin
     }
   }
   return total == 0 ? 1 : 0;
+}
+
+int ShowStatus(const IntrospectOptions& o, const std::string& graph_name, std::ostream& out, std::ostream& err) {
+  InterruptWatcher interrupt;  // before the participant: its threads inherit the blocked signals
+  auto p = Join(o, err);
+  if (!p) return 1;
+  // dyad/processes is RELIABLE + TRANSIENT_LOCAL with one sample per writer: a reliable reader
+  // gets each process's last state at once and can never make a writer wait (its history is 1).
+  auto processes = p->CreateReader(kProcessesTopic, TypeInfoOf<msg::ProcessState>(),
+                                   TopicQos{Reliability::kReliable, 64, 0, false, true}, nullptr);
+  auto stats = p->CreateReader(kStatsTopic, TypeInfoOf<msg::ComponentStats>(), TopicQos{Reliability::kBestEffort, 256, 0, false}, nullptr);
+  auto offsets = p->CreateReader(kClockOffsetsTopic, TypeInfoOf<msg::ClockOffset>(), TopicQos{Reliability::kBestEffort, 256, 0, false}, nullptr);
+  if (!processes.ok() || !stats.ok() || !offsets.ok()) {
+    err << "dyad status: cannot create its readers\n";
+    return 1;
+  }
+  std::map<std::string, msg::ProcessState> procs;             // "graph/process" -> newest
+  std::map<std::string, msg::ComponentStats> components;      // component -> newest
+  std::map<std::pair<std::string, std::string>, msg::ClockOffset> clock;  // (measurer, peer) -> newest
+  const auto end = Steady::now() + std::chrono::duration<double>(o.wait_s);
+  while (Steady::now() < end && !interrupt.interrupted()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    msg::ProcessState ps;
+    while (processes.value()->TakeNext(&ps))
+      if (graph_name.empty() || ps.graph_name() == graph_name) procs[ps.graph_name() + "/" + ps.process_name()] = ps;
+    msg::ComponentStats cs;
+    while (stats.value()->TakeNext(&cs)) components[cs.process_name() + "/" + cs.component_name()] = cs;
+    msg::ClockOffset co;
+    while (offsets.value()->TakeNext(&co))
+      if (graph_name.empty() || co.graph_name() == graph_name) clock[{co.process_name(), co.peer_process()}] = co;
+  }
+  if (procs.empty()) {
+    err << "dyad status: no process" << (graph_name.empty() ? "" : " of graph '" + graph_name + "'") << " heard on domain "
+        << o.domain_id << " within " << o.wait_s << " s\n";
+    return 1;
+  }
+  std::set<std::string> process_names;
+  out << std::left << std::setw(24) << "process" << std::setw(16) << "host" << std::setw(9) << "pid" << std::setw(10) << "state"
+      << std::setw(10) << "restarts" << "running for\n";
+  const int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  for (const auto& [key, ps] : procs) {
+    process_names.insert(ps.process_name());
+    std::ostringstream running;
+    if (ps.start_ns() > 0 && ps.state() == "running")
+      running << std::fixed << std::setprecision(1) << (now_ns - ps.start_ns()) * 1e-9 << " s";
+    out << std::left << std::setw(24) << key << std::setw(16) << ps.host() << std::setw(9) << ps.pid() << std::setw(10) << ps.state()
+        << std::setw(10) << ps.restarts() << running.str() << "\n";
+  }
+  out << "\nclock offsets (the peer's clock minus the measuring process's, from the exchange with the least round trip):\n";
+  if (clock.empty()) out << "  none measured yet (every 2 s once the graph runs)\n";
+  for (const auto& [key, co] : clock)
+    out << "  " << std::left << std::setw(16) << co.process_name() << "-> " << std::setw(16) << co.peer_process() << std::right
+        << std::fixed << std::setprecision(3) << std::showpos << std::setw(10) << co.offset_ns() * 1e-6 << std::noshowpos
+        << " ms  round trip " << co.round_trip_ns() * 1e-6 << " ms\n";
+  out.unsetf(std::ios::fixed);
+  out << "\n" << std::left << std::setw(20) << "component" << std::setw(16) << "process" << std::right << std::setw(9) << "steps"
+      << std::setw(11) << "mean_ms" << std::setw(11) << "p99_ms" << std::setw(11) << "max_ms" << std::setw(8) << "misses\n";
+  out << std::fixed << std::setprecision(3);
+  for (const auto& [key, cs] : components) {
+    if (!process_names.count(cs.process_name())) continue;
+    out << std::left << std::setw(20) << cs.component_name() << std::setw(16) << cs.process_name() << std::right << std::setw(9)
+        << cs.steps() << std::setw(11) << cs.step_mean_s() * 1e3 << std::setw(11) << cs.step_p99_s() * 1e3 << std::setw(11)
+        << cs.step_max_s() * 1e3 << std::setw(7) << cs.deadline_misses() << "\n";
+  }
+  out.unsetf(std::ios::fixed);
+  return 0;
 }
 
 }  // namespace dyad

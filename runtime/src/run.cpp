@@ -100,8 +100,20 @@ bool NeedsLauncher(const Graph& g, const std::string& this_host) {
   return !g.network.server_host.empty() && g.network.server_host == this_host;
 }
 
-// Starts `args` as a child of the launcher (see LaunchChildren).
-pid_t StartChild(std::vector<std::string> args) {
+// Starts `args` as a child of the launcher (see LaunchChildren), with `restarts` in its
+// environment (DYAD_RESTARTS: it announces the count on dyad/processes).
+pid_t StartChild(std::vector<std::string> args, int restarts = 0) {
+  // Everything the child needs is built before fork: after it, only exec.
+  std::vector<std::string> env;
+  for (char** e = environ; *e != nullptr; ++e)
+    if (std::string(*e).rfind("DYAD_RESTARTS=", 0) != 0) env.emplace_back(*e);
+  env.push_back("DYAD_RESTARTS=" + std::to_string(restarts));
+  std::vector<char*> envp;
+  for (auto& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
   const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid == 0) {
@@ -114,10 +126,7 @@ pid_t StartChild(std::vector<std::string> args) {
     sigset_t none;
     sigemptyset(&none);
     pthread_sigmask(SIG_SETMASK, &none, nullptr);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv("/proc/self/exe", argv.data());
+    execve("/proc/self/exe", argv.data(), envp.data());
     std::perror("dyad: exec");
     _exit(127);
   }
@@ -187,7 +196,7 @@ int LaunchChildren(const RunOptions& options, const Loaded& l, std::ostream& err
     for (const auto& [pid, _] : children) kill(pid, sig);
   });
   auto start = [&](const std::string& name, std::vector<std::string> args, int restarts) {
-    const pid_t pid = StartChild(std::move(args));
+    const pid_t pid = StartChild(std::move(args), restarts);
     if (pid < 0) {
       err << "cannot start process '" << name << "'\n";
       return false;

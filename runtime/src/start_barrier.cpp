@@ -4,16 +4,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <set>
 #include <thread>
 
 #include <dyad/message_traits.hpp>
 
 namespace dyad {
-
-int64_t WallNowNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
 
 bool StartBarrier::Awaited(const std::string& process) const {
   if (process == process_) return true;
@@ -24,6 +21,7 @@ bool StartBarrier::Awaited(const std::string& process) const {
 
 StartBarrier::StartBarrier(const Graph& graph, std::string process, std::string host)
     : graph_(graph), process_(std::move(process)), host_(std::move(host)) {
+  if (const char* r = std::getenv("DYAD_RESTARTS")) restarts_ = static_cast<uint32_t>(std::strtoul(r, nullptr, 10));
   for (const auto& c : graph.components) {
     if (!Awaited(graph.ProcessOf(c))) continue;
     for (const auto& b : c.outputs) ++writers_of_[b.topic];
@@ -57,6 +55,7 @@ void StartBarrier::Announce(const std::string& state) {
   m.state(state);
   m.ready_ns(ready_ns_);
   m.start_ns(start_ns_);
+  m.restarts(restarts_);
   (void)writer_->Write(&m);  // best effort: a lost announcement is repeated with the next change
 }
 

@@ -29,6 +29,7 @@
 #include <dyad/status.hpp>
 
 #include "transport.hpp"
+#include "wall_clock.hpp"
 
 namespace dyad {
 
@@ -36,8 +37,6 @@ inline constexpr const char* kProcessesTopic = "dyad/processes";
 // Time between the last process becoming ready and the common start: enough for its
 // announcement to reach every other process.
 inline constexpr int64_t kStartMarginNs = 500'000'000;
-
-int64_t WallNowNs();
 
 class StartBarrier {
  public:
@@ -74,6 +73,7 @@ class StartBarrier {
   TypedWriter* writer_ = nullptr;
   TypedReader* reader_ = nullptr;
   uint64_t sequence_ = 0;
+  uint32_t restarts_ = 0;  // DYAD_RESTARTS, set by the launcher
   int64_t ready_ns_ = 0, start_ns_ = 0, graph_start_ns_ = 0;
 };
 

@@ -34,13 +34,20 @@ SamplePrinter JsonPrinter() {
 // The catalog a watcher decodes with: the built-in types, DYAD_PLUGIN_PATH, --plugins, and the
 // `plugins:` of --graph (so a plugin's own message types are known as the graph knows them).
 // Returns false, having said why, when the graph file cannot be read.
-bool LoadWatcherCatalog(const std::string& graph_path, std::vector<std::string> plugins, Catalog* catalog) {
+// With a graph, the watcher also joins the way the graph's processes do: its domain (unless
+// --domain was given) and its network section (static peers, discovery server).
+bool LoadWatcherCatalog(const std::string& graph_path, std::vector<std::string> plugins, Catalog* catalog,
+                        IntrospectOptions* options = nullptr, bool domain_given = false) {
   if (!graph_path.empty()) {
     std::vector<Diagnostic> diagnostics;
     const Graph graph = LoadGraph(graph_path, {}, &diagnostics);
     for (const Diagnostic& d : diagnostics) std::cerr << d.ToString() << "\n";
     if (!diagnostics.empty()) return false;
     plugins.insert(plugins.end(), graph.plugins.begin(), graph.plugins.end());
+    if (options != nullptr) {
+      options->network = graph.network;
+      if (!domain_given) options->domain_id = graph.domain_id;
+    }
   }
   if (Status s = catalog->LoadDefault(plugins); !s.ok()) std::cerr << "warning: " << s.message() << "\n";
   return true;
@@ -57,16 +64,39 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
     double duration = 0;
     std::vector<std::string> plugins;
     std::string graph;
+    std::vector<CLI::Option*> domain_options;
+    bool domain_given() const {
+      for (auto* o : domain_options)
+        if (o->count() > 0) return true;
+      return false;
+    }
   };
   auto st = std::make_shared<State>();
   auto add_common = [st](CLI::App* c) {
-    c->add_option("--domain", st->opts.domain_id, "DDS domain id")->check(CLI::Range(0, 232));
+    st->domain_options.push_back(c->add_option("--domain", st->opts.domain_id, "DDS domain id (default: the --graph's, else 0)")->check(CLI::Range(0, 232)));
     c->add_option("--wait", st->opts.wait_s, "Seconds of discovery before answering (topics) or giving up on a topic (echo, hz); default 5")->check(CLI::NonNegativeNumber);
   };
 
   auto* topics = app.add_subcommand("topics", "List the topics on the DDS domain with their types and endpoints");
   add_common(topics);
   topics->callback([st, &exit_code] { exit_code = ListTopics(st->opts, std::cout); });
+
+  auto* status = app.add_subcommand("status", "Every process of a running graph: host, pid, state, restarts, clock offsets, step stats");
+  add_common(status);
+  status->add_option("--graph", st->graph, "The graph (its name, domain and network); default: every graph on the domain");
+  status->callback([st, &exit_code] {
+    Catalog catalog;
+    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given())) {
+      exit_code = 2;
+      return;
+    }
+    std::string name;
+    if (!st->graph.empty()) {
+      std::vector<Diagnostic> ignored;
+      name = LoadGraph(st->graph, {}, &ignored).name;
+    }
+    exit_code = ShowStatus(st->opts, name, std::cout, std::cerr);
+  });
 
   auto* echo = app.add_subcommand("echo", "Print the samples published on a topic");
   add_common(echo);
@@ -77,7 +107,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   echo->add_option("--graph", st->graph, "Know the message types of this graph's plugins");
   echo->callback([st, &exit_code] {
     Catalog catalog;
-    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog)) {
+    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given())) {
       exit_code = 2;
       return;
     }
@@ -92,7 +122,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   hz->add_option("--graph", st->graph, "Know the message types of this graph's plugins");
   hz->callback([st, &exit_code] {
     Catalog catalog;
-    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog)) {
+    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given())) {
       exit_code = 2;
       return;
     }

@@ -17,6 +17,7 @@
 //     interfaces: [eth0]        # only these interfaces (names or addresses); default: all
 //     lease_s: 5                # a silent process is declared gone after this long
 //     start_timeout_s: 30       # how long a process waits for the others to start together
+//     max_clock_offset_ms: 5    # warn when another process's clock is further off than this
 //   processes:                  # optional; default: one process "main"
 //     main: {}
 //     robot: {host: robot-pc}   # host: where `dyad run` without --process starts it (default: here;
@@ -94,6 +95,7 @@ struct NetworkConfig {
   std::vector<std::string> interfaces;
   double lease_s = 5;
   double start_timeout_s = 30;
+  double max_clock_offset_ms = 5;  // a peer's measured clock offset beyond it is warned about
   SourceMark mark;
 };
 

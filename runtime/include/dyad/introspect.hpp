@@ -1,5 +1,5 @@
 // dyad/introspect.hpp — looking at a running experiment from outside: `dyad topics`,
-// `dyad echo`, `dyad hz`. Each joins the DDS domain as a guest participant (UDP only, BEST_EFFORT
+// `dyad echo`, `dyad hz`, `dyad status`. Each joins the DDS domain as a guest participant (UDP only, BEST_EFFORT
 // readers, no shared memory): whatever a watcher does or however it dies (SIGKILL, `| head`),
 // the graph's writers never wait for it.
 //
@@ -20,6 +20,7 @@
 #include <vector>
 
 #include <dyad/catalog.hpp>
+#include <dyad/graph.hpp>
 
 namespace dyad {
 
@@ -29,6 +30,8 @@ struct IntrospectOptions {
   // soon as a writer is found, typically after ~0.2 s). Fast DDS occasionally loses its first
   // discovery exchange and repeats it only at the next announcement (up to 3 s): 5 s covers it.
   double wait_s = 5.0;
+  // How to find the graph's processes: its network section (`--graph`; default: multicast).
+  NetworkConfig network;
 };
 
 // Prints one line per topic: name, type, writers, readers, participants. Returns 0, or 1 when
@@ -46,5 +49,11 @@ int EchoTopic(const IntrospectOptions& options, const Catalog& catalog, const st
 // (0: until SIGINT); returns 1 if no sample arrived.
 int TopicHz(const IntrospectOptions& options, const Catalog& catalog, const std::string& topic, double duration_s,
             std::ostream& out, std::ostream& err);
+
+// `dyad status`: listens `wait_s` to dyad/processes, dyad/stats and dyad/clock_offsets, then
+// prints every process of the graph named `graph_name` (empty: every graph on the domain) with
+// its host, pid, state and restarts, the clock offsets the processes measured of each other, and
+// each component's step statistics. Returns 0, or 1 when no process was heard.
+int ShowStatus(const IntrospectOptions& options, const std::string& graph_name, std::ostream& out, std::ostream& err);
 
 }  // namespace dyad

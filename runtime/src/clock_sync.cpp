@@ -1,0 +1,154 @@
+#include "clock_sync.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <dyad/message_traits.hpp>
+
+#include "wall_clock.hpp"
+
+namespace dyad {
+
+ClockSync::ClockSync(const Graph& graph, std::string process, std::string host, std::function<void(const std::string&)> warn)
+    : graph_(graph), process_(std::move(process)), host_(std::move(host)), warn_(std::move(warn)) {}
+
+ClockSync::~ClockSync() { Stop(); }
+
+Status ClockSync::Open(Transport* transport) {
+  // Probes: best effort (a lost one is simply not an exchange), deep enough for every peer's answer.
+  const TopicQos probes{Reliability::kBestEffort, 32, 0, false, false};
+  auto w = transport->CreateWriter(kClockTopic, TypeInfoOf<msg::ClockProbe>(), probes);
+  if (!w.ok()) return w.status().WithContext(kClockTopic);
+  probe_writer_ = w.value();
+  auto r = transport->CreateReader(kClockTopic, TypeInfoOf<msg::ClockProbe>(), probes, [this] { OnProbes(); });
+  if (!r.ok()) return r.status().WithContext(kClockTopic);
+  probe_reader_ = r.value();
+  auto o = transport->CreateWriter(kClockOffsetsTopic, TypeInfoOf<msg::ClockOffset>(), TopicQos{Reliability::kReliable, 16, 0, false, false});
+  if (!o.ok()) return o.status().WithContext(kClockOffsetsTopic);
+  offset_writer_ = o.value();
+  return Status::OK();
+}
+
+void ClockSync::Start(double period_s) {
+  thread_ = std::thread([this, period_s] {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!stop_) {
+      lock.unlock();
+      Ask();
+      lock.lock();
+      // Half a period later, the answers are in: publish what this round measured.
+      if (cv_.wait_for(lock, std::chrono::duration<double>(period_s / 2), [&] { return stop_; })) break;
+      lock.unlock();
+      Publish();
+      lock.lock();
+      cv_.wait_for(lock, std::chrono::duration<double>(period_s / 2), [&] { return stop_; });
+    }
+  });
+}
+
+void ClockSync::Stop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+// Writes happen outside mutex_: a reader in this process gets the sample inside Write(), in
+// OnProbes, which takes mutex_.
+void ClockSync::Ask() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  msg::ClockProbe p;
+  p.graph_name(graph_.name);
+  p.asker(process_);
+  p.id(next_id_);
+  // Requests older than the window are not waited for any more.
+  while (!asked_.empty() && asked_.begin()->first + kWindow < next_id_) asked_.erase(asked_.begin());
+  p.header().source("dyad/" + process_);
+  p.header().sequence_number(++probe_sequence_);
+  const int64_t t1 = WallNowNs();
+  p.header().stamp_ns(t1);
+  p.t1_ns(t1);
+  asked_[next_id_++] = t1;
+  lock.unlock();
+  (void)probe_writer_->Write(&p);
+}
+
+void ClockSync::OnProbes() {
+  const int64_t received = WallNowNs();  // t2 or t4: before anything else
+  std::vector<msg::ClockProbe> answers;
+  std::unique_lock<std::mutex> lock(mutex_);
+  msg::ClockProbe p;
+  while (probe_reader_->TakeNext(&p)) {
+    if (p.graph_name() != graph_.name) continue;
+    if (p.answerer().empty() && p.asker() != process_) {  // a request: answer it
+      p.answerer(process_);
+      p.t2_ns(received);
+      p.header().source("dyad/" + process_);
+      p.header().sequence_number(++probe_sequence_);
+      answers.push_back(p);
+    } else if (p.asker() == process_ && !p.answerer().empty() && p.answerer() != process_) {  // an answer to us
+      auto it = asked_.find(p.id());
+      if (it == asked_.end() || it->second != p.t1_ns()) continue;
+      const int64_t t1 = p.t1_ns(), t2 = p.t2_ns(), t3 = p.t3_ns(), t4 = received;
+      Peer& peer = peers_[p.answerer()];
+      peer.window.push_back({((t2 - t1) + (t3 - t4)) / 2, (t4 - t1) - (t3 - t2)});
+      if (peer.window.size() > kWindow) peer.window.pop_front();
+    }
+  }
+  lock.unlock();
+  for (auto& a : answers) {
+    a.t3_ns(WallNowNs());
+    a.header().stamp_ns(a.t3_ns());
+    (void)probe_writer_->Write(&a);
+  }
+}
+
+std::vector<msg::ClockOffset> ClockSync::Offsets() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<msg::ClockOffset> out;
+  for (const auto& [name, peer] : peers_) {
+    if (peer.window.empty()) continue;
+    const Exchange best = *std::min_element(peer.window.begin(), peer.window.end(),
+                                            [](const Exchange& a, const Exchange& b) { return a.round_trip_ns < b.round_trip_ns; });
+    msg::ClockOffset o;
+    o.graph_name(graph_.name);
+    o.process_name(process_);
+    o.host(host_);
+    o.peer_process(name);
+    for (const auto& pc : graph_.processes)
+      if (pc.name == name) o.peer_host(pc.host);
+    o.offset_ns(best.offset_ns);
+    o.round_trip_ns(best.round_trip_ns);
+    out.push_back(o);
+  }
+  return out;
+}
+
+void ClockSync::Publish() {
+  const double bound_ms = graph_.network.max_clock_offset_ms;
+  for (msg::ClockOffset o : Offsets()) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    o.header().source("dyad/" + process_);
+    o.header().sequence_number(++offset_sequence_);
+    o.header().stamp_ns(WallNowNs());
+    Peer& peer = peers_[o.peer_process()];
+    const double offset_ms = o.offset_ns() * 1e-6;
+    if (std::abs(offset_ms) > bound_ms && !peer.warned && warn_) {
+      char text[512];
+      std::snprintf(text, sizeof(text),
+                    "the clock of process '%s' is %+.3f ms off this one's (round trip %.3f ms; bound: "
+                    "network.max_clock_offset_ms = %g): stamps across them disagree by that much; sync the hosts' "
+                    "clocks (chrony, docs/distributed.md)",
+                    o.peer_process().c_str(), offset_ms, o.round_trip_ns() * 1e-6, bound_ms);
+      warn_(text);
+    }
+    peer.warned = std::abs(offset_ms) > bound_ms;
+    lock.unlock();
+    (void)offset_writer_->Write(&o);
+  }
+}
+
+}  // namespace dyad
