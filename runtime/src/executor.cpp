@@ -525,11 +525,7 @@ Status Executor::Run() {
   return failure_;
 }
 
-int Executor::ProcessCount() const {
-  std::set<std::string> processes;
-  for (const auto& c : graph_.components) processes.insert(graph_.ProcessOf(c));
-  return static_cast<int>(processes.size());
-}
+int Executor::ProcessCount() const { return static_cast<int>(graph_.ProcessNames().size()); }
 
 int64_t Executor::FastestPeriodNs() const {
   int64_t fastest = 0;

@@ -359,6 +359,12 @@ const TopicConfig* Graph::FindTopic(const std::string& n) const {
   return nullptr;
 }
 
+std::set<std::string> Graph::ProcessNames() const {
+  std::set<std::string> out;
+  for (const auto& c : components) out.insert(ProcessOf(c));
+  return out;
+}
+
 std::string Graph::ProcessOf(const ComponentConfig& c) const {
   if (!c.process.empty()) return c.process;
   if (processes.size() == 1) return processes.front().name;
@@ -432,7 +438,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
       diagnostics->push_back({cli, "network." + key, "value is not valid YAML: " + e.msg});
     }
   }
-  r.Map(root, "", {"graph", "domain_id", "clock", "seed", "plugins", "network", "processes", "topics", "components"});
+  r.Map(root, "", {"graph", "domain_id", "clock", "seed", "plugins", "logs", "network", "processes", "topics", "components"});
   if (root["graph"]) r.String(root["graph"], "graph", &g.name);
   if (root["domain_id"] && r.Number(root["domain_id"], "domain_id", &g.domain_id, "an integer") &&
       (g.domain_id < 0 || g.domain_id > 232))
@@ -460,6 +466,11 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
         g.plugin_marks.push_back(r.Mark(p));
       }
     }
+  }
+  if (root["logs"]) {
+    std::string logs;
+    if (r.String(root["logs"], "logs", &logs))
+      g.logs = std::filesystem::path(logs).is_absolute() ? logs : (base / logs).lexically_normal().string();
   }
   if (const YAML::Node network = root["network"]) ReadNetwork(r, network, &g.network);
   if (const YAML::Node procs = root["processes"]) {

@@ -51,16 +51,12 @@ std::vector<TopicInfo> GraphTopics(const Graph& graph, const ResolvedGraph& reso
     t.reliable = true;
     t.depth = kStatsDepth;
     t.writers = {"runtime"};
-    std::set<std::string> processes;
-    for (const auto& c : graph.components) processes.insert(graph.ProcessOf(c));
-    t.writers_local = processes.size() == 1;  // every process's runtime writes it
+    t.writers_local = graph.ProcessNames().size() == 1;  // every process's runtime writes it
     topics.push_back(std::move(t));
   }
   // A graph of several processes: their announcements and clock offsets (start_barrier.hpp,
   // clock_sync.hpp), so a recorder keeps them with the rest.
-  std::set<std::string> processes;
-  for (const auto& c : graph.components) processes.insert(graph.ProcessOf(c));
-  if (processes.size() > 1 && graph.clock == ClockMode::kWall) {
+  if (graph.ProcessNames().size() > 1 && graph.clock == ClockMode::kWall) {
     for (const auto& [name, type] : {std::pair{kProcessesTopic, &TypeInfoOf<msg::ProcessState>()},
                                      std::pair{kClockOffsetsTopic, &TypeInfoOf<msg::ClockOffset>()}}) {
       if (resolved.topics.count(name)) continue;

@@ -72,6 +72,7 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
   auto* r = app.add_subcommand("run", "Run a graph (the components of one process, or launch every process)");
   r->add_option("graph", run.graph_path, "Graph YAML file")->required();
   r->add_option("--process", run.process, "Run only the components placed in this process");
+  r->add_option("--logs", run.logs_dir, "Folder for each process's log (<process>.log); default: the graph's logs:");
   r->add_option("--host", run.host, "This machine's name in the graph (processes: NAME: {host: ...}); default: its host name");
   r->add_option("--set", sets, "Override a parameter: COMPONENT.PARAM=VALUE (repeatable)");
   r->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");

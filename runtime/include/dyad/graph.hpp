@@ -7,6 +7,7 @@
 //   clock: wall                 # wall | stepped
 //   seed: 1                     # stepped-mode determinism and component seeds
 //   plugins: [build/plugins]    # extra plugin files or folders, relative to this file
+//   logs: ../out/logs           # the launcher writes each process's output to <logs>/<process>.log
 //   network:                    # optional: how processes find each other (docs/distributed.md)
 //     discovery: multicast      # multicast (default) | peers | server
 //     hosts: {lab: 10.0.0.1, robot-pc: 10.0.0.2}   # host name -> address
@@ -42,6 +43,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -142,6 +144,7 @@ struct Graph {
   ClockMode clock = ClockMode::kWall;
   uint64_t seed = 1;
   std::vector<std::string> plugins;  // resolved against the file's folder
+  std::string logs;                  // the launcher's per-process log folder, resolved; "": none
   std::vector<SourceMark> plugin_marks;  // where each of `plugins` is written
   NetworkConfig network;
   std::vector<ProcessConfig> processes;
@@ -157,6 +160,8 @@ struct Graph {
   const TopicConfig* FindTopic(const std::string& name) const;
   // The process a component runs in ("main" when the graph lists none).
   std::string ProcessOf(const ComponentConfig& c) const;
+  // Every process that runs a component.
+  std::set<std::string> ProcessNames() const;
 };
 
 // `--set NAME.PARAM=VALUE` (VALUE is parsed as YAML), `--set KEY=VALUE` for the graph's own

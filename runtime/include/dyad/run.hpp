@@ -11,7 +11,11 @@
 //     Ctrl-C reaches them once, through the launcher) and get SIGTERM if the launcher dies. When
 //     one child fails, the others are stopped and the exit code is the failed child's. When the
 //     graph's `network.server` names this host, it first starts `dyad discovery-server` there
-//     and stops it after the last child.
+//     and stops it after the last child. Each child's output is relayed with a "[process] "
+//     prefix and appended to <logs>/<process>.log (`logs:` of the graph or --logs). Processes
+//     are supervised: `restart` (never | on-failure | always, max_restarts, backoff_s doubling
+//     up to 10 s) and `required` (a required process that fails for good stops the others and
+//     ends the run with its exit code; another one is reported and left out).
 // It returns when the run ends: SIGINT/SIGTERM, `duration_s`, `steps`, a component's
 // RequestStop(), or a failed step. At exit it prints a timing table (per component: steps, step
 // duration mean/p99/max, start jitter, deadline misses) and publishes the same as
@@ -41,6 +45,7 @@ struct RunOptions {
   std::vector<Override> overrides;
   std::string process;             // empty: every process of the graph (see above)
   std::string host;                // this machine's name in the graph; empty: gethostname()
+  std::string logs_dir;            // the launcher's per-process logs (default: the graph's `logs:`)
   double duration_s = 0;           // > 0: stop after this much wall time
   uint64_t steps = 0;              // > 0: stop after the fastest periodic component ran this many steps
   double stats_period_s = 1.0;     // ComponentStats publication period (wall time)

@@ -1,0 +1,63 @@
+// OutputRelay — the launcher's view of its children's output (internal to the runtime).
+//
+// Each child's stdout and stderr arrive on pipes; a thread of the relay reads them all (poll)
+// and passes every line on to the launcher's own stdout or stderr prefixed with the process's
+// name ("[mind] ..."), and appends it, unprefixed, to the process's log file when there is one
+// (a restarted process appends to the same file after a header line). The launcher's own
+// messages go through Say() so lines never interleave mid-line. A partial last line is passed
+// on when its pipe closes.
+#pragma once
+
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <ostream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <dyad/status.hpp>
+
+namespace dyad {
+
+class OutputRelay {
+ public:
+  OutputRelay(std::ostream& out, std::ostream& err);
+  // Reads until every pipe added so far has closed (every child exited), then stops.
+  ~OutputRelay();
+  OutputRelay(const OutputRelay&) = delete;
+  OutputRelay& operator=(const OutputRelay&) = delete;
+
+  // Pipes for one child's stdout and stderr: the child dup2()s the write ends onto 1 and 2;
+  // the caller closes them in the parent after fork (CloseWriteEnds). `log_path` empty: no file.
+  struct Pipes {
+    int out_write = -1, err_write = -1;
+  };
+  StatusOr<Pipes> Add(const std::string& name, const std::string& log_path, const std::string& header);
+  static void CloseWriteEnds(const Pipes& pipes);
+
+  // A line of the launcher's own, to its stderr.
+  void Say(const std::string& line);
+
+ private:
+  struct Source {
+    std::string name;
+    bool is_err = false;
+    std::string partial;
+    std::shared_ptr<std::ofstream> log;
+  };
+  void Run();
+  void Emit(const Source& s, const std::string& line);  // REQUIRES: mutex_ held
+
+  std::ostream& out_;
+  std::ostream& err_;
+  std::mutex mutex_;  // guards sources_, logs_, the streams
+  std::map<int, Source> sources_;                          // read end -> its child
+  std::map<std::string, std::shared_ptr<std::ofstream>> logs_;  // log path -> open file
+  int wake_[2] = {-1, -1};  // a byte here makes the thread re-read sources_
+  bool closing_ = false;
+  std::thread thread_;
+};
+
+}  // namespace dyad
