@@ -387,7 +387,7 @@ TEST_F(ProcessTest, SupervisorRestartsAKilledProcessAndItRejoinsTheRunningGraph)
                                          "  src: {type: counter_source, rate_hz: 20, process: a, outputs: {out: count}}\n"
                                          "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " +
                                          out.string() + "}, inputs: {in: count}}\n");
-  Child c(Dyad({"run", g.string(), "--steps", "200"}), dir_, "restart");  // 10 s
+  Child c(Dyad({"run", g.string(), "--steps", "200", "--logs", (dir_ / "logs").string()}), dir_, "restart");  // 10 s
   pid_t b = 0;
   for (int i = 0; i < 100 && (b = ChildPid(g, "b")) == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   ASSERT_NE(b, 0);
@@ -402,7 +402,14 @@ TEST_F(ProcessTest, SupervisorRestartsAKilledProcessAndItRejoinsTheRunningGraph)
   ASSERT_GT(received.size(), 20u) << c.err() << c.out();
   EXPECT_GT(received.front().sequence, 40u);
   for (size_t i = 1; i < received.size(); ++i) EXPECT_EQ(received[i].sequence, received[i - 1].sequence + 1);
-  EXPECT_EQ(received.back().sequence, 200u);  // and it ended with the graph, not 120 steps after its restart
+  EXPECT_EQ(received.back().sequence, 200u);  // and it ended with the graph, not 200 steps after its restart
+  // Each process's output: relayed with its name, and in its own log, one header per start.
+  EXPECT_NE(c.out().find("[a] timing (process a):"), std::string::npos) << c.out();
+  const std::string log_b = dyad::testing::ReadFile(dir_ / "logs" / "b.log");
+  EXPECT_NE(log_b.find("=== b started at "), std::string::npos) << log_b;
+  EXPECT_NE(log_b.find("=== b started (restart 1) at "), std::string::npos) << log_b;
+  EXPECT_NE(log_b.find("timing (process b):"), std::string::npos) << log_b;
+  EXPECT_EQ(dyad::testing::ReadFile(dir_ / "logs" / "a.log").find("[a]"), std::string::npos);  // unprefixed
 }
 
 TEST_F(ProcessTest, ARequiredProcessThatKeepsFailingEndsTheRunAndIsNamed) {

@@ -32,17 +32,31 @@ Status ClockSync::Open(Transport* transport) {
 
 void ClockSync::Start(double period_s) {
   thread_ = std::thread([this, period_s] {
+    const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(period_s));
+    auto next_ask = std::chrono::steady_clock::now();
+    auto next_publish = next_ask + period / 2;  // half a period after asking, the answers are in
     std::unique_lock<std::mutex> lock(mutex_);
     while (!stop_) {
+      cv_.wait_until(lock, std::min(next_ask, next_publish), [&] { return stop_ || !to_answer_.empty(); });
+      if (stop_) break;
+      std::vector<msg::ClockProbe> answers;
+      answers.swap(to_answer_);
       lock.unlock();
-      Ask();
+      for (auto& a : answers) {
+        a.t3_ns(WallNowNs());
+        a.header().stamp_ns(a.t3_ns());
+        (void)probe_writer_->Write(&a);
+      }
+      const auto now = std::chrono::steady_clock::now();
+      if (now >= next_ask) {
+        Ask();
+        next_ask += period;
+      }
+      if (now >= next_publish) {
+        Publish();
+        next_publish += period;
+      }
       lock.lock();
-      // Half a period later, the answers are in: publish what this round measured.
-      if (cv_.wait_for(lock, std::chrono::duration<double>(period_s / 2), [&] { return stop_; })) break;
-      lock.unlock();
-      Publish();
-      lock.lock();
-      cv_.wait_for(lock, std::chrono::duration<double>(period_s / 2), [&] { return stop_; });
     }
   });
 }
@@ -56,8 +70,10 @@ void ClockSync::Stop() {
   if (thread_.joinable()) thread_.join();
 }
 
-// Writes happen outside mutex_: a reader in this process gets the sample inside Write(), in
-// OnProbes, which takes mutex_.
+// Writes happen outside mutex_ (a reader in this process gets the sample inside Write(), in
+// OnProbes, which takes mutex_) and never from OnProbes: Fast DDS 2.9 holds the reader's lock
+// during the callback, and a write there delivering to this process's own reader while another
+// thread writes deadlocks the two (seen: a best-effort writer and reader, lock order inverted).
 void ClockSync::Ask() {
   std::unique_lock<std::mutex> lock(mutex_);
   msg::ClockProbe p;
@@ -78,8 +94,8 @@ void ClockSync::Ask() {
 
 void ClockSync::OnProbes() {
   const int64_t received = WallNowNs();  // t2 or t4: before anything else
-  std::vector<msg::ClockProbe> answers;
   std::unique_lock<std::mutex> lock(mutex_);
+  const size_t answers_before = to_answer_.size();
   msg::ClockProbe p;
   while (probe_reader_->TakeNext(&p)) {
     if (p.graph_name() != graph_.name) continue;
@@ -88,7 +104,7 @@ void ClockSync::OnProbes() {
       p.t2_ns(received);
       p.header().source("dyad/" + process_);
       p.header().sequence_number(++probe_sequence_);
-      answers.push_back(p);
+      to_answer_.push_back(p);
     } else if (p.asker() == process_ && !p.answerer().empty() && p.answerer() != process_) {  // an answer to us
       auto it = asked_.find(p.id());
       if (it == asked_.end() || it->second != p.t1_ns()) continue;
@@ -98,12 +114,9 @@ void ClockSync::OnProbes() {
       if (peer.window.size() > kWindow) peer.window.pop_front();
     }
   }
+  const bool wake = to_answer_.size() > answers_before;
   lock.unlock();
-  for (auto& a : answers) {
-    a.t3_ns(WallNowNs());
-    a.header().stamp_ns(a.t3_ns());
-    (void)probe_writer_->Write(&a);
-  }
+  if (wake) cv_.notify_all();
 }
 
 std::vector<msg::ClockOffset> ClockSync::Offsets() const {

@@ -3,8 +3,9 @@
 //
 // Samples carry their writer's wall-clock stamp; across hosts a stamp is only as good as the
 // hosts' clock sync. So every `period` each process asks on dyad/clock (t1, its clock); every
-// other process answers at once from the delivering thread with its receive and send times (t2,
-// t3, its clock); the asker notes t4 and computes, as NTP does,
+// other process notes the receive time on the delivering thread (t2) and answers from its
+// clock-sync thread with it and the send time (t3); the asker notes t4 on receipt and computes,
+// as NTP does,
 //   offset = ((t2 - t1) + (t3 - t4)) / 2      (the peer's clock minus ours)
 //   round trip = (t4 - t1) - (t3 - t2)
 // and keeps, per peer, the offset of the exchange with the least round trip among the last
@@ -63,7 +64,7 @@ class ClockSync {
     std::deque<Exchange> window;
     bool warned = false;
   };
-  void OnProbes();  // the dyad/clock reader's callback
+  void OnProbes();  // the dyad/clock reader's callback: takes, notes t2/t4, never writes
   void Ask();
   void Publish();
 
@@ -77,6 +78,7 @@ class ClockSync {
   uint64_t next_id_ = 1, probe_sequence_ = 0, offset_sequence_ = 0;
   std::map<uint64_t, int64_t> asked_;  // request id -> t1
   std::map<std::string, Peer> peers_;  // process -> what we measured
+  std::vector<msg::ClockProbe> to_answer_;  // requests received, answered by the thread
   std::condition_variable cv_;
   bool stop_ = false;
   std::thread thread_;
