@@ -430,18 +430,15 @@ Status Executor::RunStepped() {
 }
 
 Status Executor::RunWall() {
-  int64_t start_wall_ns = 0;
   if (barrier_) {
-    auto start = barrier_->Wait([this] { return stopping(); });
-    if (!start.ok()) return start.status();
-    if (start.value() == 0) return Status::OK();  // stopped while waiting
-    start_wall_ns = start.value();
+    if (start_wall_ns_ == 0) return Status::OK();  // stopped while waiting at the barrier
     clock_sync_->Start(kClockSyncPeriodS);
-    start_steady_ns_ = SteadyNs() + (start_wall_ns - WallNowNs());
+    start_steady_ns_ = SteadyNs() + (start_wall_ns_ - WallNowNs());
     barrier_->Announce("running");
   } else {
     start_steady_ns_ = SteadyNs();
   }
+  const int64_t start_wall_ns = start_wall_ns_;
   for (auto& inst : instances_)
     if (inst->rc->period_ns > 0) inst->thread = std::thread([this, i = inst.get()] { PeriodicLoop(*i); });
   // A triggered component may have missed samples delivered before it was active.
@@ -485,7 +482,13 @@ Status Executor::RunWall() {
 
 Status Executor::Run() {
   Status s = Setup();
-  if (s.ok()) {
+  // Several processes: nobody activates (and may publish) before every endpoint has matched.
+  if (s.ok() && barrier_) {
+    auto start = barrier_->Wait([this] { return stopping(); });
+    if (start.ok()) start_wall_ns_ = start.value();
+    else s = start.status();
+  }
+  if (s.ok() && !(barrier_ && start_wall_ns_ == 0)) {
     for (auto& inst : instances_) {
       s = inst->component->Activate();
       if (!s.ok()) {

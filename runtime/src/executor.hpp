@@ -25,8 +25,9 @@
 // upstream's Publish()) is measured on its own and subtracted from the enclosing step; a
 // periodic step misses its deadline when its late start plus its own time exceed the period.
 //
-// Several processes (wall clock): after Activate, each process waits at a StartBarrier for the
-// others and starts its periodic components at the agreed instant (start_barrier.hpp). With
+// Several processes (wall clock): after Configure and before Activate (so nothing is published
+// before every endpoint has matched), each process waits at a StartBarrier for the others and
+// starts its periodic components at the agreed instant (start_barrier.hpp). With
 // `steps`, a process without the graph's fastest periodic component stops once that many of its
 // periods have passed since the start, plus a second for the last samples to arrive.
 //
@@ -122,6 +123,7 @@ class Executor {
   std::unique_ptr<ClockSync> clock_sync_;  // stopped before the transport goes
   static constexpr double kClockSyncPeriodS = 2;
   int64_t start_steady_ns_ = 0;  // when periodic components take their first step
+  int64_t start_wall_ns_ = 0;    // the agreed start (barrier); 0: stopped while waiting
 
   std::atomic<bool> stop_{false};
   std::atomic<int> problems_{0};

@@ -4,6 +4,10 @@
 
 
 #include <atomic>
+#include <thread>
+#include <cstdlib>
+#include <cstdio>
+#include <chrono>
 #include <iomanip>
 #include <iostream>
 #include <set>
@@ -16,6 +20,9 @@
 
 namespace dyad {
 namespace {
+
+// How long a stopping process may take to end cleanly after SIGINT/SIGTERM.
+constexpr double kStopGraceS = 20;
 
 struct Loaded {
   Graph graph;
@@ -114,6 +121,14 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   {
     InterruptWatcher interrupt([&](int sig) {
       if (Executor* ex = current.load()) ex->RequestStop(SignalName(sig));
+      // A process that cannot stop (a component or the DDS stack stuck) must not outlive its
+      // launcher unseen: after kStopGraceS it exits anyway, saying so.
+      std::thread([sig] {
+        std::this_thread::sleep_for(std::chrono::duration<double>(kStopGraceS));
+        std::fprintf(stderr, "dyad run: did not stop within %g s of %s: exiting without a clean shutdown\n", kStopGraceS,
+                     SignalName(sig));
+        std::_Exit(ExitCodeForSignal(sig));
+      }).detach();
     });
     Executor ex(l.graph, l.resolved, &l.catalog, eo);
     current.store(&ex);

@@ -3,7 +3,8 @@
 //
 // A process started apart from the others used to run without them: a robot started 3 s before
 // the human ran 30 steps with no input, and those samples were missing from the recording. Now
-// every process of a graph with several processes, its components configured and activated:
+// every process of a graph with several processes, its components configured (not yet activated:
+// nothing is published before every endpoint has matched):
 //   1. waits until each endpoint of its own has matched as many peers as the graph binds to its
 //      topic (a reader: every writer of the topic; a writer: every reader; the runtime's own
 //      dyad/ topics excepted), and then announces its wall-clock `ready_ns` on dyad/processes;

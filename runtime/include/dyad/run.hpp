@@ -24,7 +24,8 @@
 // Exit codes: 0 clean end, 1 runtime failure (a component failed, DDS error, type mismatch with
 // a peer), 2 invalid graph or options, 128 + signal when SIGINT/SIGTERM stopped it (130 for
 // Ctrl-C; it still ends cleanly: components deactivated, recordings closed, timing printed, and
-// "interrupted (SIGINT)" said on stderr). A component's failure keeps its Status code through the
+// "interrupted (SIGINT)" said on stderr; a process that has not ended 20 s after the signal
+// exits anyway, saying so, rather than hang). A component's failure keeps its Status code through the
 // runtime (context is added, the code is not rewritten) and the exit code follows it
 // (ExitCodeOf): InvalidArgument, NotFound and DataLoss (a bad param, a missing or damaged file
 // the graph names) exit 2, every other failure 1.
