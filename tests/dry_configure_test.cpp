@@ -92,7 +92,7 @@ TEST(DryConfigure, OnlyTheComponentsOfTheGivenProcessAreConfigured) {
   Graph g = ParseGraph(y, "g.yaml", {}, &diags);
   ResolvedGraph r = ValidateGraph(g, Builtins(), &diags);
   ASSERT_TRUE(diags.empty()) << diags[0].ToString();
-  DryConfigure(g, r, Builtins(), &diags, "pb");
+  DryConfigure(g, r, Builtins(), &diags, {"pb"});
   ASSERT_EQ(diags.size(), 1u);
   EXPECT_EQ(diags[0].key, "components.b.params.events[0].primitve");
   diags.clear();

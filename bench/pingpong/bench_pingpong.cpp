@@ -1,8 +1,14 @@
 // Round-trip latency of a sample through two dyad components (bench_ping -> bench_pong -> back)
-// versus two bare Fast DDS endpoints doing the same (same type, QoS, transport and process),
-// alternating in one run. Prints median and p99 of each and their ratio.
+// versus two bare Fast DDS endpoints doing the same (same type, QoS, transport), alternating in
+// one run. Prints median and p99 of each and their ratio.
 //
 //   build/bin/bench_pingpong [--rounds N] [--repeats R] [--payload BYTES]
+//                            [--processes [--pong-prefix "ip netns exec NS"]]
+//
+// --processes puts pong in a second OS process (bare: this binary with --bare-pong; dyad: a
+// `dyad run --process pong` child of a two-process graph), started with the words of
+// --pong-prefix in front: run the whole benchmark in one network namespace with the pong side in
+// another (bench/pingpong/bench_netns.sh) and the round trip crosses a veth pair.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -15,7 +21,12 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <mutex>
+#include <thread>
 #include <vector>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -27,6 +38,8 @@
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 
 #include <dyad/msg/types.hpp>
 #include <dyad/run.hpp>
@@ -47,9 +60,16 @@ int64_t SteadyNs() {
 // inside the nested listener instead would stop the clock before either write() has finished.)
 class BarePingPong {
  public:
-  BarePingPong(int domain, size_t payload) {
+  enum class Role { kBoth, kPing, kPong };
+  BarePingPong(int domain, size_t payload, Role role = Role::kBoth) : role_(role) {
     auto* f = fdds::DomainParticipantFactory::get_instance();
-    participant_ = f->create_participant(domain, fdds::PARTICIPANT_QOS_DEFAULT);
+    // The transports dyad's participants use (runtime/src/network_qos.cpp, the default network
+    // section): shared memory first, then UDPv4, declared explicitly.
+    fdds::DomainParticipantQos pq = f->get_default_participant_qos();
+    pq.transport().use_builtin_transports = false;
+    pq.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+    pq.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+    participant_ = f->create_participant(domain, pq);
     const auto& info = dyad::TypeInfoOf<dyad::msg::PingPong>();
     fdds::TypeSupport ts(info.make_type_support());
     ts.register_type(participant_, info.dds_name());
@@ -67,13 +87,30 @@ class BarePingPong {
     rq.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
     rq.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
     rq.history().depth = 1;
-    ping_writer_ = pub->create_datawriter(ping_topic, wq);
-    pong_writer_ = pub->create_datawriter(pong_topic, wq);
     pong_listener_.owner = this;
     ping_listener_.owner = this;
-    sub->create_datareader(ping_topic, rq, &pong_listener_, fdds::StatusMask::data_available());
-    back_reader_ = sub->create_datareader(pong_topic, rq, &ping_listener_, fdds::StatusMask::data_available());
+    if (role != Role::kPong) {
+      ping_writer_ = pub->create_datawriter(ping_topic, wq);
+      back_reader_ = sub->create_datareader(pong_topic, rq, &ping_listener_, fdds::StatusMask::data_available());
+    }
+    if (role != Role::kPing) {
+      pong_writer_ = pub->create_datawriter(pong_topic, wq);
+      sub->create_datareader(ping_topic, rq, &pong_listener_, fdds::StatusMask::data_available());
+    }
     sample_.payload().resize(payload);
+  }
+  // The ping side of a split run: until the pong process's endpoints have matched.
+  bool WaitForPong(double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    fdds::PublicationMatchedStatus pub;
+    fdds::SubscriptionMatchedStatus sub;
+    while (std::chrono::steady_clock::now() < end) {
+      ping_writer_->get_publication_matched_status(pub);
+      back_reader_->get_subscription_matched_status(sub);
+      if (pub.current_count > 0 && sub.current_count > 0) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return false;
   }
   ~BarePingPong() {
     participant_->delete_contained_entities();
@@ -83,6 +120,7 @@ class BarePingPong {
   std::vector<int64_t> Run(int rounds) {
     rtt_.clear();
     rtt_.reserve(rounds);
+    if (role_ == Role::kPing) return RunFromListener(rounds);
     fdds::SampleInfo info;
     while (static_cast<int>(rtt_.size()) < rounds) {
       pending_.store(false);
@@ -101,6 +139,40 @@ class BarePingPong {
   }
 
  private:
+  // Split run: the reply arrives on a Fast DDS receive thread, and ping answers it there (takes
+  // it, notes the round trip, writes the next ping), as a dyad component triggered by it does.
+  // Waking another thread for each reply instead would add a thread switch to bare Fast DDS only.
+  std::vector<int64_t> RunFromListener(int rounds) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      rounds_ = rounds;
+      done_ = false;
+      sample_.id(sample_.id() + 1);
+      sample_.t0_ns(SteadyNs());
+    }
+    ping_writer_->write(&sample_);
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [&] { return done_; });
+    return rtt_;
+  }
+  void OnReply() {  // the ping listener, split run
+    fdds::SampleInfo info;
+    std::unique_lock<std::mutex> lock(mutex_);
+    bool again = false;
+    while (back_reader_->take_next_sample(&reply_, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || reply_.id() != sample_.id()) continue;
+      rtt_.push_back(SteadyNs() - reply_.t0_ns());
+      again = static_cast<int>(rtt_.size()) < rounds_;
+      done_ = !again;
+    }
+    if (done_) cv_.notify_one();
+    if (!again) return;
+    sample_.id(sample_.id() + 1);
+    sample_.t0_ns(SteadyNs());
+    lock.unlock();
+    ping_writer_->write(&sample_);
+  }
+
   struct PongListener : fdds::DataReaderListener {
     BarePingPong* owner;
     dyad::msg::PingPong s;
@@ -113,6 +185,10 @@ class BarePingPong {
   struct PingListener : fdds::DataReaderListener {
     BarePingPong* owner;
     void on_data_available(fdds::DataReader*) override {
+      if (owner->role_ == Role::kPing) {
+        owner->OnReply();
+        return;
+      }
       std::lock_guard<std::mutex> lock(owner->mutex_);
       owner->pending_.store(true);
       owner->cv_.notify_one();
@@ -129,24 +205,60 @@ class BarePingPong {
   std::atomic<bool> pending_{false};
   std::mutex mutex_;
   std::condition_variable cv_;
+  Role role_ = Role::kBoth;
+  int rounds_ = 0;     // split run
+  bool done_ = false;  // split run: rounds_ replies taken
 };
 
-std::vector<int64_t> RunDyad(int domain, int rounds, size_t payload, const std::string& dir) {
+// Starts `args` (with `prefix` in front) as a child; its pid.
+pid_t Spawn(const std::vector<std::string>& prefix, std::vector<std::string> args) {
+  args.insert(args.begin(), prefix.begin(), prefix.end());
+  const pid_t pid = fork();
+  if (pid == 0) {
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execvp(argv[0], argv.data());
+    std::perror("bench_pingpong: exec");
+    _exit(127);
+  }
+  return pid;
+}
+
+void Stop(pid_t pid) {
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+}
+
+std::vector<int64_t> RunDyad(int domain, int rounds, size_t payload, const std::string& dir, bool processes,
+                             const std::vector<std::string>& pong_prefix) {
   const std::string graph = dir + "/pingpong.yaml";
   const std::string out = dir + "/rtt.txt";
   std::ofstream(graph) << "graph: pingpong\nclock: wall\ndomain_id: " << domain
+                       << (processes ? "\nprocesses: {ping: {}, pong: {}}" : "")
                        << "\ncomponents:\n"
-                          "  pong: {type: bench_pong, trigger: in, inputs: {in: ping}, outputs: {out: pong}}\n"
+                          "  pong: {type: bench_pong, trigger: in, inputs: {in: ping}, outputs: {out: pong}"
+                       << (processes ? ", process: pong" : "")
+                       << "}\n"
                           "  ping: {type: bench_ping, trigger: back, params: {rounds: "
-                       << rounds << ", payload: " << payload << ", file: " << out
-                       << "}, inputs: {back: pong}, outputs: {out: ping}}\n"
+                       << rounds << ", payload: " << payload << ", file: " << out << "}, inputs: {back: pong}, outputs: {out: ping}"
+                       << (processes ? ", process: ping" : "")
+                       << "}\n"
                           "topics:\n  ping: {reliability: reliable, depth: 1}\n  pong: {reliability: reliable, depth: 1}\n";
   dyad::RunOptions o;
   o.graph_path = graph;
   o.quiet = true;
   o.plugin_paths = {DYAD_BENCH_PLUGIN};
+  pid_t pong = 0;
+  if (processes) {
+    o.process = "ping";
+    pong = Spawn(pong_prefix, {DYAD_EXE, "run", graph, "--process", "pong", "--quiet", "--plugins", DYAD_BENCH_PLUGIN});
+  }
   std::ostringstream sink;
-  if (dyad::RunGraph(o, sink, std::cerr) != 0) {
+  const int code = dyad::RunGraph(o, sink, std::cerr);
+  if (pong != 0) Stop(pong);
+  if (code != 0) {
     std::cerr << "dyad run failed\n";
     std::exit(1);
   }
@@ -168,32 +280,71 @@ double Mean(const std::vector<int64_t>& v) {
   return v.empty() ? 0 : sum / static_cast<double>(v.size()) * 1e-3;
 }
 
+// --bare-pong DOMAIN PAYLOAD: the pong side of the bare split run, until SIGTERM.
+int BarePongMain(int domain, size_t payload) {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);  // before Fast DDS's threads: they inherit it
+  BarePingPong pong(domain, payload, BarePingPong::Role::kPong);
+  int sig = 0;
+  sigwait(&set, &sig);
+  return 0;
+}
+
+std::vector<std::string> Words(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<std::string> out;
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int rounds = 20000, repeats = 5;
   size_t payload = 0;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--rounds")) rounds = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--repeats")) repeats = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--payload")) payload = static_cast<size_t>(std::atoi(argv[i + 1]));
+  bool processes = false;
+  std::vector<std::string> pong_prefix;
+  for (int i = 1; i < argc; ++i) {
+    const bool has_value = i + 1 < argc;
+    if (!std::strcmp(argv[i], "--processes")) processes = true;
+    else if (!std::strcmp(argv[i], "--bare-pong") && i + 2 < argc) return BarePongMain(std::atoi(argv[i + 1]), static_cast<size_t>(std::atoi(argv[i + 2])));
+    else if (!has_value) break;
+    else if (!std::strcmp(argv[i], "--rounds")) rounds = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--repeats")) repeats = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--payload")) payload = static_cast<size_t>(std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--pong-prefix")) pong_prefix = Words(argv[++i]);
   }
   const int domain = 1 + static_cast<int>(getpid() % 200);
   const std::string dir = std::filesystem::temp_directory_path() / ("dyad_pingpong_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   std::vector<int64_t> bare_all, dyad_all;
-  BarePingPong bare(domain, payload);
+  pid_t bare_pong = 0;
+  if (processes) {
+    const std::string self = std::filesystem::read_symlink("/proc/self/exe");
+    bare_pong = Spawn(pong_prefix, {self, "--bare-pong", std::to_string(domain), std::to_string(payload)});
+  }
+  BarePingPong bare(domain, payload, processes ? BarePingPong::Role::kPing : BarePingPong::Role::kBoth);
+  if (processes && !bare.WaitForPong(30)) {
+    std::cerr << "bench_pingpong: the bare pong process did not match within 30 s\n";
+    Stop(bare_pong);
+    return 1;
+  }
   bare.Run(1000);  // warm-up
   for (int r = 0; r < repeats; ++r) {  // alternate, so drift on a shared machine hits both alike
     auto b = bare.Run(rounds);
     bare_all.insert(bare_all.end(), b.begin() + b.size() / 10, b.end());
-    auto d = RunDyad(domain + 1, rounds, payload, dir);
+    auto d = RunDyad(domain + 1, rounds, payload, dir, processes, pong_prefix);
     dyad_all.insert(dyad_all.end(), d.begin() + d.size() / 10, d.end());
   }
+  if (bare_pong != 0) Stop(bare_pong);
   std::filesystem::remove_all(dir);
   const double bm = Percentile(bare_all, 0.5), bp = Percentile(bare_all, 0.99);
   const double dm = Percentile(dyad_all, 0.5), dp = Percentile(dyad_all, 0.99);
-  std::printf("round trip, one process, RELIABLE KEEP_LAST 1, PingPong with %zu-byte payload, %d x %d rounds (first 10%% of each dropped)\n",
+  std::printf("round trip, %s, RELIABLE KEEP_LAST 1, PingPong with %zu-byte payload, %d x %d rounds (first 10%% of each dropped)\n",
+              processes ? (pong_prefix.empty() ? "two processes" : "two processes, pong behind the prefix") : "one process",
               payload, repeats, rounds);
   const double ba = Mean(bare_all), da = Mean(dyad_all);
   std::printf("%-22s %12s %12s %12s\n", "", "median_us", "p99_us", "mean_us");

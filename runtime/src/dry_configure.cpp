@@ -192,10 +192,10 @@ bool PlaceMessage(const Graph& graph, const ComponentConfig& c, const ComponentS
 }  // namespace
 
 void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
-                  std::vector<Diagnostic>* diagnostics, const std::string& only_process) {
+                  std::vector<Diagnostic>* diagnostics, const std::set<std::string>& only_processes) {
   for (const auto& rc : resolved.components) {
     if (rc.entry == nullptr) continue;
-    if (!only_process.empty() && graph.ProcessOf(*rc.config) != only_process) continue;
+    if (!only_processes.empty() && !only_processes.count(graph.ProcessOf(*rc.config))) continue;
     const std::string key = "components." + rc.config->name;
     bool has_problem = false;  // a component with problems of its own has no complete params
     for (const auto& d : *diagnostics)

@@ -30,11 +30,26 @@ struct Loaded {
   ResolvedGraph resolved;
 };
 
-// Returns false (after printing every problem) when the graph is invalid.
-// `process`: dry-configure only the components of that process (see DryConfigure); empty: all.
+// The processes whose components a run here dry-configures (DryConfigure; empty: all): --process
+// P: P; a launcher of a graph placed on hosts: the processes of this host; else all.
+std::set<std::string> ProcessesToCheck(const Graph& g, const RunOptions* run) {
+  if (run == nullptr) return {};
+  if (!run->process.empty()) return {run->process};
+  bool placed = false;
+  for (const auto& pc : g.processes) placed |= !pc.host.empty();
+  if (!placed) return {};
+  std::set<std::string> here;
+  for (const auto& p : g.ProcessNames())
+    for (const auto& pc : g.processes)
+      if (pc.name == p && pc.host == ThisHost(*run)) here.insert(p);
+  return here.empty() ? std::set<std::string>{""} : here;  // {""}: none (only the discovery server)
+}
+
+// Returns false (after printing every problem) when the graph is invalid. `run`: what runs here
+// (see ProcessesToCheck); null: everything is checked (`dyad validate`).
 bool LoadAndValidate(const std::string& path, const std::vector<Override>& overrides,
                      const std::vector<std::string>& plugin_paths, Loaded* l, std::ostream& err,
-                     const std::string& process = "") {
+                     const RunOptions* run = nullptr) {
   std::vector<Diagnostic> diags;
   l->graph = LoadGraph(path, overrides, &diags);
   // Plugins the graph or the command line names must load: their problems are the graph's.
@@ -46,7 +61,7 @@ bool LoadAndValidate(const std::string& path, const std::vector<Override>& overr
   if (Status s = l->catalog.LoadDefault({}); !s.ok()) err << "warning: " << s.message() << "\n";
   if (!l->graph.components.empty()) {
     l->resolved = ValidateGraph(l->graph, l->catalog, &diags);
-    DryConfigure(l->graph, l->resolved, l->catalog, &diags, process);
+    DryConfigure(l->graph, l->resolved, l->catalog, &diags, ProcessesToCheck(l->graph, run));
   }
   for (const auto& d : diags) err << d.ToString() << "\n";
   if (!diags.empty()) err << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", nothing was started\n";
@@ -94,9 +109,10 @@ int ValidateGraphFile(const std::string& path, const std::vector<Override>& over
 
 int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   Loaded l;
-  // The launcher (no --process) checks every component before starting any child; a child checks
-  // its own (the others' files may already be open in their processes).
-  if (!LoadAndValidate(options.graph_path, options.overrides, options.plugin_paths, &l, err, options.process)) return 2;
+  // The launcher (no --process) checks the components of every process it starts before starting
+  // any (all of them, unless the graph places processes on hosts); a child checks its own (the
+  // others' files may already be open in their processes).
+  if (!LoadAndValidate(options.graph_path, options.overrides, options.plugin_paths, &l, err, &options)) return 2;
   const std::set<std::string> procs = l.graph.ProcessNames();
   std::string process = options.process;
   if (process.empty()) {

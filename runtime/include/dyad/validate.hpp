@@ -11,6 +11,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -47,12 +48,13 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
 // structured param, or the --set) or at the component. Components with problems of their own in
 // *diagnostics are skipped (their params are incomplete). Relies on component.hpp's contract:
 // Configure acts on nothing. See runtime/src/dry_configure.cpp.
-// With `only_process`, only the components placed in that process are configured: a process
-// started on its own (a launcher's child, or `--process` on another host) checks what it will
-// run, not the files of other processes, which live elsewhere or are already in use (a
-// recorder's file, created by its own process, "exists").
+// With `only_processes` (empty: all), only the components placed in those processes are
+// configured: a process started on its own (a launcher's child, or `--process` on another host)
+// and a launcher of one host (`--host`) check what they will run, not the files of processes on
+// other machines, which live there or are already in use (a recorder's file, created by its own
+// process on a shared folder, "exists").
 void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
-                  std::vector<Diagnostic>* diagnostics, const std::string& only_process = "");
+                  std::vector<Diagnostic>* diagnostics, const std::set<std::string>& only_processes = {});
 
 // Converts a YAML value to a param of `spec`'s type; InvalidArgument (message without location)
 // when it is not one.

@@ -1,0 +1,377 @@
+#!/usr/bin/env bash
+# configs/split.yaml on three "machines": network namespaces lab, mind and rec (10.77.0.1-3/24),
+# each joined by a veth pair to a Linux bridge in a fourth namespace. The three launchers
+# (`dyad run configs/split.yaml --host H --steps 300`, the same --set everywhere) start one per
+# namespace, rec first and lab last, 2 s apart; each must exit 0 within the time limit, and the
+# recording made on rec must be complete, with every topic's sequence numbers contiguous from 1
+# per writer (nothing lost between the hosts) and at least 300 human/input samples. Once per
+# discovery MODE (a failed mode does not stop the next; the exit status is 1 if any failed):
+#   multicast  the default: SPDP over multicast (the probe first proves multicast crosses the bridge)
+#   peers      static peers from network.hosts; an nftables rule in every host drops all IPv4
+#              multicast (224.0.0.0/4, in and out), so only unicast can work
+#   server     a discovery server on lab:11811 (started by lab's launcher); multicast dropped too
+#   net        (for debugging) only the namespaces and the UDP probe, no dyad run
+# Needs root, `ip netns` and `nft` (skipped, exit 77, otherwise). Leaves nothing behind: the EXIT
+# trap kills every process in its namespaces and deletes them (each host has a /dev/shm of its
+# own, so killed Fast DDS processes leave no files in this machine's).
+#   multihost_test.sh REPO BUILD_DIR WORK_DIR [MODE...]      (default: multicast peers server)
+# MULTIHOST_TIMEOUT=S: how long the three launchers of one mode may take (default 120 s);
+# MULTIHOST_STAGGER=S: the time between the starts of rec, mind and lab (default 2 s, 0: at once);
+# MULTIHOST_SHARED_SHM=1: the hosts share this machine's /dev/shm (default: one tmpfs each).
+set -euo pipefail
+[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|net...]" >&2; exit 2; }
+repo=$(cd "$1" && pwd) build=$(cd "$2" && pwd) work=$3
+shift 3
+modes=("$@")
+[ ${#modes[@]} -gt 0 ] || modes=(multicast peers server)
+for mode in "${modes[@]}"; do
+  case $mode in multicast | peers | server | net) ;; *) echo "unknown mode '$mode'" >&2; exit 2 ;; esac
+done
+dyad=$build/bin/dyad
+timeout_s=${MULTIHOST_TIMEOUT:-120}
+stagger=${MULTIHOST_STAGGER:-2}
+skip() { echo "SKIP: multihost: $*"; exit 77; }
+fail() { echo "FAIL: multihost: $*" >&2; exit 1; }
+
+[ "$(id -u)" = 0 ] || skip "needs root (it creates network namespaces)"
+command -v ip > /dev/null && ip netns list > /dev/null 2>&1 || skip "no 'ip netns' (iproute2)"
+command -v nft > /dev/null || skip "no 'nft' (nftables)"
+command -v python3 > /dev/null || skip "no python3"
+[ "${modes[*]}" = net ] || [ -x "$dyad" ] || fail "no dyad at $dyad"
+
+hosts=(lab mind rec)
+declare -A ns addr
+addr=([lab]=10.77.0.1 [mind]=10.77.0.2 [rec]=10.77.0.3)
+prefix=dyadmh
+sw=${prefix}_sw_$$
+for h in "${hosts[@]}"; do ns[$h]=${prefix}_${h}_$$; done
+
+# Namespaces of an earlier run of this test that was killed before its trap ran (its pid is gone).
+for old in $(ip netns list | awk '{print $1}' | grep -E "^${prefix}_(sw|lab|mind|rec)_[0-9]+$" || true); do
+  if ! kill -0 "${old##*_}" 2> /dev/null; then
+    ip netns pids "$old" 2> /dev/null | xargs -r kill -KILL 2> /dev/null || true
+    ip netns del "$old" 2> /dev/null || true
+  fi
+done
+
+rm -rf "$work"
+mkdir -p "$work"
+work=$(cd "$work" && pwd)
+stamp=$work/.start
+touch "$stamp"
+made=() started=()
+
+# Kills what runs in our namespaces and deletes them. With MULTIHOST_SHARED_SHM=1 also removes
+# the new Fast DDS shared-memory files that no live process maps (a killed participant leaves its
+# segments and locks behind); otherwise each host's own tmpfs went with its last process.
+cleanup() {
+  local code=$? n p f base i
+  set +e
+  trap - EXIT INT TERM
+  for p in "${started[@]}"; do kill -KILL "$p" 2> /dev/null; done
+  for i in 1 2 3 4 5 6 7 8 9 10; do
+    p=""
+    for n in "${made[@]}"; do p+=$(ip netns pids "$n" 2> /dev/null); done
+    [ -z "$p" ] && break
+    echo "$p" | xargs -r kill -KILL 2> /dev/null
+    sleep 0.3
+  done
+  for p in "${started[@]}"; do wait "$p" 2> /dev/null; done
+  for n in "${made[@]}"; do ip netns del "$n" 2> /dev/null || echo "multihost: could not delete namespace $n" >&2; done
+  if [ -f "$stamp" ] && [ "${MULTIHOST_SHARED_SHM:-0}" = 1 ]; then
+    local mapped
+    mapped=$(cat /proc/[0-9]*/maps 2> /dev/null | grep -o '/dev/shm/[^ ]*' | sort -u)
+    while IFS= read -r f; do
+      [ -n "$f" ] || continue
+      base=${f%_el}; base=${base%_sl}; base=${base%_mutex}
+      grep -qxF "$base" <<< "$mapped" || rm -f "$f"
+    done < <(find /dev/shm -maxdepth 1 \( -name 'fastrtps_*' -o -name 'sem.fastrtps_*' -o -name 'fast_datasharing_*' \) \
+               -newer "$stamp" 2> /dev/null)
+  fi
+  exit "$code"
+}
+trap cleanup EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM
+
+# --- the network: a bridge in $sw, one veth pair per host -----------------------------------------
+# A step that fails here is a limit of this machine (no CAP_NET_ADMIN, no bridge or veth driver):
+# skipped, with the reason.
+setup() { "$@" 2> "$work/netns.err" || skip "cannot set up the network: '$*': $(cat "$work/netns.err")"; }
+setup ip netns add "$sw"
+made+=("$sw")
+setup ip -n "$sw" link set lo up
+setup ip -n "$sw" link add br0 type bridge
+# IGMP snooping off: with no querier on this bridge a group's membership could age out (260 s)
+# and a long run would lose multicast discovery halfway; a plain flooding switch is what we want.
+setup ip -n "$sw" link set br0 type bridge mcast_snooping 0
+setup ip -n "$sw" link set br0 up
+setup ip netns exec "$sw" nft add table ip dyad_multihost_probe  # nf_tables works here
+setup ip netns exec "$sw" nft delete table ip dyad_multihost_probe
+for h in "${hosts[@]}"; do
+  n=${ns[$h]}
+  setup ip netns add "$n"
+  made+=("$n")
+  setup ip -n "$sw" link add "v$h" type veth peer name eth0 netns "$n"
+  setup ip -n "$sw" link set "v$h" master br0 up
+  setup ip -n "$n" link set lo up
+  setup ip -n "$n" addr add "${addr[$h]}/24" dev eth0
+  setup ip -n "$n" link set eth0 up
+  # No default route in the namespace: without this one, a send to a multicast group fails
+  # (ENETUNREACH) unless the socket names its interface.
+  setup ip -n "$n" route add 224.0.0.0/4 dev eth0
+done
+echo "multihost: namespaces ${made[*]}: ${addr[lab]} lab, ${addr[mind]} mind, ${addr[rec]} rec on a bridge"
+
+# --- the probe: UDP unicast and multicast between every pair of hosts -----------------------------
+# (ping is not installed everywhere; UDP is what Fast DDS uses anyway.) Each host listens on
+# 17400 and on the group 239.255.0.77; each sends to the two others and to the group, a few times.
+cat > "$work/probe.py" <<'PY'
+import socket, struct, sys, time
+role, me = sys.argv[1], sys.argv[2]
+others = sys.argv[3].split(',')
+group, port = '239.255.0.77', 17400
+if role == 'recv':
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    s.bind(('', port))
+    s.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
+                 struct.pack('4s4s', socket.inet_aton(group), socket.inet_aton(me)))
+    want = {f'{kind} {o}' for o in others for kind in ('unicast', 'multicast')}
+    got, end = set(), time.time() + 6
+    s.settimeout(0.2)
+    print('ready', flush=True)
+    while time.time() < end and not want <= got:
+        try:
+            got.add(s.recv(100).decode())
+        except socket.timeout:
+            pass
+    for w in sorted(want):
+        print(('ok      ' if w in got else 'MISSING ') + w + ' -> ' + me)
+    sys.exit(0 if want <= got else 1)
+else:
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 1)
+    for _ in range(10):
+        for o in others:
+            s.sendto(f'unicast {me}'.encode(), (o, port))
+        try:
+            s.sendto(f'multicast {me}'.encode(), (group, port))
+        except OSError as e:
+            print(f'multicast send from {me}: {e}', file=sys.stderr)
+        time.sleep(0.3)
+PY
+probe() {
+  local h o others p rc=0
+  declare -A rpid
+  for h in "${hosts[@]}"; do
+    others=""
+    for o in "${hosts[@]}"; do [ "$o" = "$h" ] || others+=${others:+,}${addr[$o]}; done
+    ip netns exec "${ns[$h]}" python3 "$work/probe.py" recv "${addr[$h]}" "$others" > "$work/probe_$h.out" 2>&1 &
+    rpid[$h]=$!; started+=($!)
+  done
+  for h in "${hosts[@]}"; do
+    for _ in $(seq 50); do grep -q ready "$work/probe_$h.out" 2> /dev/null && break; sleep 0.1; done
+  done
+  for h in "${hosts[@]}"; do
+    others=""
+    for o in "${hosts[@]}"; do [ "$o" = "$h" ] || others+=${others:+,}${addr[$o]}; done
+    ip netns exec "${ns[$h]}" python3 "$work/probe.py" send "${addr[$h]}" "$others" &
+    started+=($!)
+  done
+  for h in "${hosts[@]}"; do wait "${rpid[$h]}" || rc=1; done
+  wait
+  for h in "${hosts[@]}"; do grep -v '^ready' "$work/probe_$h.out" | sed "s/^/multihost: probe: /"; done
+  return $rc
+}
+if probe; then
+  echo "multihost: UDP unicast and multicast reach every host from every other"
+elif grep -q 'MISSING unicast' "$work"/probe_*.out; then
+  fail "UDP unicast between the namespaces does not work (see above)"
+elif [[ " ${modes[*]} " == *" multicast "* ]]; then
+  fail "multicast does not cross the bridge between the namespaces (unicast does; see above)"
+else
+  echo "multihost: multicast does not cross the bridge (not needed by the modes asked for)"
+fi
+
+# --- no multicast: an nftables table in each host namespace ---------------------------------------
+# Its counters, printed after the run: UDP to a group is what Fast DDS would send (SPDP on
+# 239.255.0.1); the other rule counts the rest, the kernel's own IGMP membership reports.
+# A dropped send fails with EPERM in the sender.
+block_multicast() {
+  local h
+  for h in "${hosts[@]}"; do
+    ip netns exec "${ns[$h]}" nft -f - <<'NFT'
+table ip dyad_multihost {
+  chain input {
+    type filter hook input priority 0; policy accept;
+    ip daddr 224.0.0.0/4 meta l4proto udp counter drop
+    ip daddr 224.0.0.0/4 counter drop
+  }
+  chain output {
+    type filter hook output priority 0; policy accept;
+    ip daddr 224.0.0.0/4 meta l4proto udp counter drop
+    ip daddr 224.0.0.0/4 counter drop
+  }
+}
+NFT
+  done
+}
+unblock_multicast() {
+  local h
+  for h in "${hosts[@]}"; do ip netns exec "${ns[$h]}" nft delete table ip dyad_multihost; done
+}
+print_drops() {
+  local h
+  for h in "${hosts[@]}"; do
+    ip netns exec "${ns[$h]}" nft list table ip dyad_multihost |
+      awk -v h="$h" '/chain/ { c = $2 }
+        /counter/ { for (i = 1; i < NF; i++) if ($i == "packets") n = $(i + 1)
+                    if (/udp/) u = n; else printf "multihost: %s %-6s multicast dropped: %s UDP, %s other (IGMP)\n", h, c, u, n }'
+  done
+}
+
+# --- the models (quality does not matter: 20 epochs) -------------------------------------------------
+dataset=$work/data/analytic model=$work/models/demo.dpvrnn observer=$work/models/demo.dobs
+make_models() {
+  [ -f "$observer" ] && return
+  mkdir -p "$work/data" "$work/models"
+  local t0=$SECONDS
+  { "$dyad" generate dataset --out "$dataset" &&
+    "$dyad" train "$repo/configs/train/demo.yaml" --set "dataset=$dataset" --set "output=$model" \
+      --set epochs=20 --set log_every=20 &&
+    "$dyad" train-observer "$model" -o "$observer" --epochs 20; } > "$work/models.log" 2>&1 ||
+    { cat "$work/models.log"; fail "could not make the data set and models"; }
+  echo "multihost: data set, model and observer made in $((SECONDS - t0)) s"
+}
+
+# --- the recording's check ---------------------------------------------------------------------------
+cat > "$work/check.py" <<'PY'
+# Per topic and writer (header.source): sequence numbers contiguous from 1, no gap, no repeat;
+# human/input has at least MIN samples. Reads the CSVs of `dyad bag export --csv DIR`.
+import csv, os, sys
+folder, minimum = sys.argv[1], int(sys.argv[2])
+topics = ['human/input', 'robot/intention', 'robot/command', 'robot/state', 'observer/labels']
+ok = True
+for topic in topics:
+    path = os.path.join(folder, topic.replace('/', '_') + '.csv')
+    if not os.path.exists(path):
+        print(f'{topic}: no {os.path.basename(path)} (files: {sorted(os.listdir(folder))})'); ok = False; continue
+    with open(path, newline='') as f:
+        reader = csv.DictReader(f)
+        columns = reader.fieldnames or []
+        def column(name):
+            hits = [c for c in columns if c == 'header.' + name] or [c for c in columns if c.split('.')[-1] == name]
+            return hits[0] if hits else None
+        src, seq = column('source'), column('sequence_number')
+        if not src or not seq:
+            print(f'{topic}: no header source / sequence_number column in {columns}'); ok = False; continue
+        writers = {}
+        for row in reader:
+            writers.setdefault(row[src], []).append(int(row[seq]))
+    count = sum(len(v) for v in writers.values())
+    parts = []
+    for writer, seqs in sorted(writers.items()):
+        parts.append(f'{writer or "(empty)"} {seqs[0]}..{seqs[-1]}')
+        expected = list(range(1, len(seqs) + 1))
+        if sorted(seqs) != expected:
+            have = set(seqs)
+            missing = [n for n in range(1, max(seqs) + 1) if n not in have]
+            repeated = len(seqs) - len(have)
+            print(f'{topic}: writer {writer!r}: {len(seqs)} samples, sequence numbers {min(seqs)}..{max(seqs)}, '
+                  f'{len(missing)} missing (first: {missing[:10]}), {repeated} repeated')
+            ok = False
+        elif seqs != expected:
+            print(f'{topic}: writer {writer!r}: complete, but recorded out of order')
+    print(f'{topic}: {count} samples, {len(writers)} writer(s): {", ".join(parts)}')
+    if count == 0:
+        print(f'{topic}: no samples'); ok = False
+    if topic == 'human/input' and count < minimum:
+        print(f'{topic}: {count} samples, fewer than {minimum}'); ok = False
+sys.exit(0 if ok else 1)
+PY
+# check_recording FILE.mcap OUT_DIR MIN_HUMAN_SAMPLES: prints the check; non-zero on a failure.
+check_recording() {
+  local rec=$1 out=$2 info
+  [ -f "$rec" ] || { echo "no recording at $rec"; return 1; }
+  info=$("$dyad" bag info "$rec" 2>&1) || { echo "$info"; echo "dyad bag info failed"; return 1; }
+  echo "$info" | grep -q "state:       complete" || { echo "$info"; echo "the recording is not complete"; return 1; }
+  rm -rf "$out"
+  "$dyad" bag export "$rec" --csv "$out" > "$out.log" 2>&1 || { cat "$out.log"; echo "dyad bag export failed"; return 1; }
+  python3 "$work/check.py" "$out" "$3"
+}
+
+# --- one run of configs/split.yaml per mode --------------------------------------------------------
+run_mode() {
+  local mode=$1 out=$work/$1 h code failed="" t0=$SECONDS
+  declare -A lpid
+  mkdir -p "$out"
+  if [ "$mode" != multicast ]; then block_multicast; fi
+  local sets=(--set "network.discovery=$mode" --set "human.dataset=$dataset" --set "mind.model=$model"
+              --set "observer.model=$observer" --set "recorder.file=$out/split.mcap")
+  # Each host gets its own /dev/shm (a tmpfs in the mount namespace of `ip netns exec`), as on
+  # separate machines: nothing can pass through shared memory between hosts, and Fast DDS's
+  # port files cannot collide with another host's or another test's. MULTIHOST_SHARED_SHM=1: no.
+  local wrap=()
+  [ "${MULTIHOST_SHARED_SHM:-0}" = 1 ] ||
+    wrap=(sh -c 'mount -t tmpfs -o mode=1777,size=256m dyad_multihost /dev/shm && exec "$@"' sh)
+  # rec first, lab last, $stagger s apart: the start barrier must hold the early ones, and the
+  # later launchers find the recording rec has already opened (one file system here, as with a
+  # shared home folder).
+  local first=1
+  for h in rec mind lab; do
+    [ $first = 1 ] || sleep "$stagger"
+    first=0
+    (cd "$out" && exec ip netns exec "${ns[$h]}" "${wrap[@]}" "$dyad" run "$repo/configs/split.yaml" \
+       --host "$h" --steps 300 --quiet --logs "$out/logs" "${sets[@]}") > "$out/$h.log" 2>&1 &
+    lpid[$h]=$!; started+=($!)
+  done
+  local deadline=$((SECONDS + timeout_s)) alive
+  while :; do
+    alive=""
+    for h in "${hosts[@]}"; do kill -0 "${lpid[$h]}" 2> /dev/null && alive+=" $h"; done
+    [ -z "$alive" ] && break
+    if [ $SECONDS -ge $deadline ]; then
+      echo "multihost: $mode: still running after $timeout_s s:$alive (killed)"
+      for h in $alive; do
+        ip netns pids "${ns[$h]}" | xargs -r kill -KILL 2> /dev/null || true
+      done
+      failed+=" timeout"
+      break
+    fi
+    sleep 1
+  done
+  for h in "${hosts[@]}"; do
+    code=0
+    wait "${lpid[$h]}" || code=$?
+    if [ $code != 0 ]; then
+      echo "----- $mode: $h exited $code; its launcher's output ($out/$h.log; each process's: $out/logs):"
+      cat "$out/$h.log"
+      failed+=" $h"
+    fi
+  done
+  echo "multihost: $mode: the launchers ended after $((SECONDS - t0)) s"
+  if [ "$mode" != multicast ]; then
+    print_drops
+    unblock_multicast
+  fi
+  if [ -n "$failed" ]; then
+    echo "FAIL: multihost $mode: launcher(s) failed:$failed" >&2
+    failures+=("$mode"); return 0
+  fi
+  if ! check_recording "$out/split.mcap" "$out/csv" 300 | sed "s/^/multihost: $mode: /"; then
+    echo "FAIL: multihost $mode: the recording $out/split.mcap does not pass (see above)" >&2
+    failures+=("$mode"); return 0
+  fi
+  echo "PASS: multihost $mode: 3 hosts, 300 steps, recording complete, no sample lost"
+}
+
+# run_mode reports a failure in `failures` (not by its status: under `||` or `if`, set -e would
+# stop applying inside it).
+failures=()
+for mode in "${modes[@]}"; do
+  [ "$mode" = net ] && { echo "PASS: multihost net: namespaces and probe"; continue; }
+  make_models
+  run_mode "$mode"
+done
+[ ${#failures[@]} = 0 ] || fail "failed mode(s): ${failures[*]}"
