@@ -10,6 +10,12 @@
 #   peers      static peers from network.hosts; an nftables rule in every host drops all IPv4
 #              multicast (224.0.0.0/4, in and out), so only unicast can work
 #   server     a discovery server on lab:11811 (started by lab's launcher); multicast dropped too
+#   faults     multicast, and two faults: `kill -9` of mind's process about step 100 (its
+#              launcher restarts it: restart: on-failure) and mind's link down for 5 s about step
+#              200. Checked: every launcher exits 0; lab's and rec's topics lose nothing; the
+#              intentions resume after the restart (first one within 2.5 s of the kill) and after
+#              the link is back, the gap on mind's topic only; no command moves further than
+#              the mixer's max_step (5) from the one before.
 #   net        (for debugging) only the namespaces and the UDP probe, no dyad run
 # Needs root, `ip netns` and `nft` (skipped, exit 77, otherwise). Leaves nothing behind: the EXIT
 # trap kills every process in its namespaces and deletes them (each host has a /dev/shm of its
@@ -19,13 +25,13 @@
 # MULTIHOST_STAGGER=S: the time between the starts of rec, mind and lab (default 2 s, 0: at once);
 # MULTIHOST_SHARED_SHM=1: the hosts share this machine's /dev/shm (default: one tmpfs each).
 set -euo pipefail
-[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|net...]" >&2; exit 2; }
+[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|faults|net...]" >&2; exit 2; }
 repo=$(cd "$1" && pwd) build=$(cd "$2" && pwd) work=$3
 shift 3
 modes=("$@")
-[ ${#modes[@]} -gt 0 ] || modes=(multicast peers server)
+[ ${#modes[@]} -gt 0 ] || modes=(multicast peers server faults)
 for mode in "${modes[@]}"; do
-  case $mode in multicast | peers | server | net) ;; *) echo "unknown mode '$mode'" >&2; exit 2 ;; esac
+  case $mode in multicast | peers | server | faults | net) ;; *) echo "unknown mode '$mode'" >&2; exit 2 ;; esac
 done
 dyad=$build/bin/dyad
 timeout_s=${MULTIHOST_TIMEOUT:-120}
@@ -251,7 +257,7 @@ cat > "$work/check.py" <<'PY'
 # human/input has at least MIN samples. Reads the CSVs of `dyad bag export --csv DIR`.
 import csv, os, sys
 folder, minimum = sys.argv[1], int(sys.argv[2])
-topics = ['human/input', 'robot/intention', 'robot/command', 'robot/state', 'observer/labels']
+topics = sys.argv[3:] or ['human/input', 'robot/intention', 'robot/command', 'robot/state', 'observer/labels']
 ok = True
 for topic in topics:
     path = os.path.join(folder, topic.replace('/', '_') + '.csv')
@@ -290,15 +296,92 @@ for topic in topics:
         print(f'{topic}: {count} samples, fewer than {minimum}'); ok = False
 sys.exit(0 if ok else 1)
 PY
-# check_recording FILE.mcap OUT_DIR MIN_HUMAN_SAMPLES: prints the check; non-zero on a failure.
+# check_recording FILE.mcap OUT_DIR MIN_HUMAN_SAMPLES [TOPIC...]: prints the check; non-zero on a failure.
 check_recording() {
-  local rec=$1 out=$2 info
+  local rec=$1 out=$2 min=$3 info
+  shift 3
   [ -f "$rec" ] || { echo "no recording at $rec"; return 1; }
   info=$("$dyad" bag info "$rec" 2>&1) || { echo "$info"; echo "dyad bag info failed"; return 1; }
   echo "$info" | grep -q "state:       complete" || { echo "$info"; echo "the recording is not complete"; return 1; }
   rm -rf "$out"
   "$dyad" bag export "$rec" --csv "$out" > "$out.log" 2>&1 || { cat "$out.log"; echo "dyad bag export failed"; return 1; }
-  python3 "$work/check.py" "$out" "$3"
+  python3 "$work/check.py" "$out" "$min" "$@"
+}
+
+# --- faults: what happened to mind, and what the recording must show ------------------------------
+cat > "$work/check_faults.py" <<'PY'
+# The recording of the faults run: lab's and rec's topics contiguous per writer (the one check of
+# check.py); robot/intention (mind's): runs of sequence numbers, one per start of mind's process,
+# a gap only while mind's link was down; the restart's first intention soon after the kill; no
+# command further than MAX_STEP from the previous one.
+import csv, math, os, sys
+folder, kill_ns, down_ns, up_ns, max_step = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), float(sys.argv[5])
+def rows(topic):
+    with open(os.path.join(folder, topic.replace('/', '_') + '.csv'), newline='') as f:
+        return list(csv.DictReader(f))
+ok = True
+intent = rows('robot/intention')
+runs, run = [], []
+for r in intent:
+    seq, stamp = int(r['header.sequence_number']), int(r['header.stamp_ns'])
+    if run and seq <= run[-1][0]:
+        runs.append(run); run = []
+    run.append((seq, stamp))
+runs.append(run)
+print(f'robot/intention: {len(intent)} samples in {len(runs)} run(s) of sequence numbers: ' +
+      ', '.join(f'{r[0][0]}..{r[-1][0]}' for r in runs))
+if len(runs) != 2:
+    print('robot/intention: expected 2 runs (before the kill, after the restart)'); ok = False
+else:
+    before, after = runs
+    restart_s = (after[0][1] - kill_ns) * 1e-9
+    print(f'robot/intention: last before the kill {(before[-1][1] - kill_ns) * 1e-9:+.2f} s, '
+          f'first after the restart {restart_s:+.2f} s from the kill')
+    if not 0 < restart_s <= 2.5:
+        print('robot/intention: the restarted mind took longer than 2.5 s to publish'); ok = False
+    if after[0][0] != 1:
+        print('robot/intention: the restarted writer does not start at 1'); ok = False
+    gaps = [(a, b) for a, b in zip(after, after[1:]) if b[0] != a[0] + 1]
+    for a, b in gaps:
+        print(f'robot/intention: gap {a[0]}..{b[0]} ({b[0] - a[0] - 1} samples), '
+              f'{(a[1] - down_ns) * 1e-9:+.2f} s to {(b[1] - down_ns) * 1e-9:+.2f} s from the link going down '
+              f'(up after {(up_ns - down_ns) * 1e-9:.1f} s)')
+        if not (down_ns - 1e9 <= a[1] and b[1] <= up_ns + 15e9):
+            print('robot/intention: a gap outside the link outage'); ok = False
+    if not gaps:
+        print('robot/intention: no gap while the link was down'); ok = False
+    if after[-1][1] < up_ns:
+        print('robot/intention: nothing after the link came back'); ok = False
+cmd = rows('robot/command')
+worst = 0.0
+for a, b in zip(cmd, cmd[1:]):
+    worst = max(worst, math.hypot(float(b['x']) - float(a['x']), float(b['y']) - float(a['y'])))
+print(f'robot/command: {len(cmd)} commands, largest step {worst:.3f} (max_step {max_step})')
+if worst > max_step + 1e-6:
+    print('robot/command: a commanded jump larger than max_step'); ok = False
+sys.exit(0 if ok else 1)
+PY
+
+# inject_faults OUT: waits for the graph to run, kills mind's process (kill -9) about step 100,
+# then takes mind's link down for 5 s about step 200; writes the instants (wall ns) to OUT/faults.
+inject_faults() {
+  local out=$1 p pid="" t_kill t_down t_up
+  sleep 12  # after the last launcher: the start barrier (~2 s) and ~100 steps of 100 ms
+  for p in $(ip netns pids "${ns[mind]}"); do
+    tr '\0' ' ' < "/proc/$p/cmdline" 2> /dev/null | grep -q -- "--process mind " && pid=$p
+  done
+  [ -n "$pid" ] || { echo "multihost: faults: mind's process not found"; return; }
+  t_kill=$(date +%s%N)
+  kill -KILL "$pid"
+  echo "multihost: faults: killed mind's process ($pid)"
+  sleep 10
+  t_down=$(date +%s%N)
+  ip -n "$sw" link set vmind down
+  sleep 5
+  ip -n "$sw" link set vmind up
+  t_up=$(date +%s%N)
+  echo "multihost: faults: mind's link was down for 5 s"
+  echo "$t_kill $t_down $t_up" > "$out/faults"
 }
 
 # --- one run of configs/split.yaml per mode --------------------------------------------------------
@@ -306,8 +389,10 @@ run_mode() {
   local mode=$1 out=$work/$1 h code failed="" t0=$SECONDS
   declare -A lpid
   mkdir -p "$out"
-  if [ "$mode" != multicast ]; then block_multicast; fi
-  local sets=(--set "network.discovery=$mode" --set "human.dataset=$dataset" --set "mind.model=$model"
+  if [ "$mode" = peers ] || [ "$mode" = server ]; then block_multicast; fi
+  local discovery=$mode
+  [ "$mode" = faults ] && discovery=multicast
+  local sets=(--set "network.discovery=$discovery" --set "human.dataset=$dataset" --set "mind.model=$model"
               --set "observer.model=$observer" --set "recorder.file=$out/split.mcap")
   # Each host gets its own /dev/shm (a tmpfs in the mount namespace of `ip netns exec`), as on
   # separate machines: nothing can pass through shared memory between hosts, and Fast DDS's
@@ -326,6 +411,11 @@ run_mode() {
        --host "$h" --steps 300 --quiet --logs "$out/logs" "${sets[@]}") > "$out/$h.log" 2>&1 &
     lpid[$h]=$!; started+=($!)
   done
+  local injector=""
+  if [ "$mode" = faults ]; then
+    inject_faults "$out" &
+    injector=$!
+  fi
   local deadline=$((SECONDS + timeout_s)) alive
   while :; do
     alive=""
@@ -350,14 +440,30 @@ run_mode() {
       failed+=" $h"
     fi
   done
+  [ -z "$injector" ] || wait "$injector" || true
   echo "multihost: $mode: the launchers ended after $((SECONDS - t0)) s"
-  if [ "$mode" != multicast ]; then
+  if [ "$mode" = peers ] || [ "$mode" = server ]; then
     print_drops
     unblock_multicast
   fi
   if [ -n "$failed" ]; then
     echo "FAIL: multihost $mode: launcher(s) failed:$failed" >&2
     failures+=("$mode"); return 0
+  fi
+  if [ "$mode" = faults ]; then
+    local f
+    f=$(cat "$out/faults" 2> /dev/null) || { echo "FAIL: multihost faults: the faults were not injected" >&2; failures+=("$mode"); return 0; }
+    grep -q "process 'mind' exited with 137 (SIGKILL); restarting" "$out/mind.log" ||
+      { cat "$out/mind.log"; echo "FAIL: multihost faults: mind's launcher did not restart it" >&2; failures+=("$mode"); return 0; }
+    # lab's and rec's topics must lose nothing; mind's are checked for their runs and gap.
+    if ! check_recording "$out/split.mcap" "$out/csv" 300 human/input robot/command robot/state observer/labels |
+         sed "s/^/multihost: $mode: /" ||
+       ! python3 "$work/check_faults.py" "$out/csv" $f 5 | sed "s/^/multihost: $mode: /"; then
+      echo "FAIL: multihost $mode: the recording $out/split.mcap does not pass (see above)" >&2
+      failures+=("$mode"); return 0
+    fi
+    echo "PASS: multihost faults: mind killed and restarted, its link cut for 5 s: the others lost nothing, intentions resumed"
+    return 0
   fi
   if ! check_recording "$out/split.mcap" "$out/csv" 300 | sed "s/^/multihost: $mode: /"; then
     echo "FAIL: multihost $mode: the recording $out/split.mcap does not pass (see above)" >&2
