@@ -6,7 +6,10 @@
 # recording made on rec must be complete, with every topic's sequence numbers contiguous from 1
 # per writer (nothing lost between the hosts) and at least 300 human/input samples. Once per
 # discovery MODE (a failed mode does not stop the next; the exit status is 1 if any failed):
-#   multicast  the default: SPDP over multicast (the probe first proves multicast crosses the bridge)
+#   multicast  the default: SPDP over multicast (the probe first proves multicast crosses the bridge);
+#              mind's clock lies by +20 ms (DYAD_TEST_CLOCK_OFFSET_MS): `dyad status` run from rec
+#              mid-run must list the three processes (host, pid, running) and measure the lie
+#              within 1 ms both ways, and lab and rec must warn about it
 #   peers      static peers from network.hosts; an nftables rule in every host drops all IPv4
 #              multicast (224.0.0.0/4, in and out), so only unicast can work
 #   server     a discovery server on lab:11811 (started by lab's launcher); multicast dropped too
@@ -407,13 +410,20 @@ run_mode() {
   for h in rec mind lab; do
     [ $first = 1 ] || sleep "$stagger"
     first=0
-    (cd "$out" && exec ip netns exec "${ns[$h]}" "${wrap[@]}" "$dyad" run "$repo/configs/split.yaml" \
+    # multicast: mind's clock lies by 20 ms (test only), for `dyad status` and the warning.
+    local lie=""
+    [ "$mode" = multicast ] && [ "$h" = mind ] && lie=20
+    (cd "$out" && DYAD_TEST_CLOCK_OFFSET_MS=$lie exec ip netns exec "${ns[$h]}" "${wrap[@]}" "$dyad" run "$repo/configs/split.yaml" \
        --host "$h" --steps 300 --quiet --logs "$out/logs" "${sets[@]}") > "$out/$h.log" 2>&1 &
     lpid[$h]=$!; started+=($!)
   done
   local injector=""
   if [ "$mode" = faults ]; then
     inject_faults "$out" &
+    injector=$!
+  elif [ "$mode" = multicast ]; then
+    # Mid-run, from rec: every process with its host and pid, and mind's lie measured.
+    (sleep 10 && ip netns exec "${ns[rec]}" "$dyad" status --graph "$repo/configs/split.yaml" --wait 5 > "$out/status.txt" 2>&1) &
     injector=$!
   fi
   local deadline=$((SECONDS + timeout_s)) alive
@@ -448,6 +458,34 @@ run_mode() {
   fi
   if [ -n "$failed" ]; then
     echo "FAIL: multihost $mode: launcher(s) failed:$failed" >&2
+    failures+=("$mode"); return 0
+  fi
+  if [ "$mode" = multicast ] && ! python3 - "$out/status.txt" "$out/logs" <<'PY' | sed "s/^/multihost: status: /"; then
+# `dyad status` lists lab, mind and rec with their hosts, pids and state; the offsets measured of
+# mind (whose clock lies by +20 ms) are within 1 ms of it; the processes that measured it warned.
+import os, re, sys
+text = open(sys.argv[1]).read()
+print(text.rstrip().replace('\n', '\nstatus| '))
+ok = True
+for p in ['lab', 'mind', 'rec']:
+    if not re.search(rf'^split/{p}\s+{p}\s+\d+\s+running', text, re.M):
+        print(f'{p}: not listed as running on host {p} with a pid'); ok = False
+offsets = {(a, b): float(v) for a, b, v in re.findall(r'^\s+(\w+)\s+-> (\w+)\s+([+-][0-9.]+) ms', text, re.M)}
+for (a, b), v in sorted(offsets.items()):
+    want = 20.0 if b == 'mind' else -20.0 if a == 'mind' else 0.0
+    good = abs(v - want) <= 1.0
+    print(f'offset {a} -> {b}: {v:+.3f} ms (expected {want:+.0f} within 1 ms): {"ok" if good else "WRONG"}')
+    ok &= good
+if len(offsets) != 6:
+    print(f'{len(offsets)} offsets listed, expected 6 (every ordered pair of 3 processes)'); ok = False
+logs = sys.argv[2]
+for p in ['lab', 'rec']:
+    log = open(os.path.join(logs, p + '.log')).read()
+    if "[warn] clock: the clock of process 'mind' is +" not in log:
+        print(f'{p}.log: no warning about mind\'s clock'); ok = False
+sys.exit(0 if ok else 1)
+PY
+    echo "FAIL: multihost $mode: dyad status (see above)" >&2
     failures+=("$mode"); return 0
   fi
   if [ "$mode" = faults ]; then
