@@ -412,6 +412,26 @@ TEST_F(ProcessTest, SupervisorRestartsAKilledProcessAndItRejoinsTheRunningGraph)
   EXPECT_EQ(dyad::testing::ReadFile(dir_ / "logs" / "a.log").find("[a]"), std::string::npos);  // unprefixed
 }
 
+// Input health across processes: the sink's input counts the source's writer alive while its
+// process runs, and not once it is killed (liveliness_ms: 300), without the sink's own timeout.
+TEST_F(ProcessTest, AnInputSeesItsWriterGoWhenTheWritersProcessIsKilled) {
+  const fs::path g = Write("g.yaml", "graph: health\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\nprocesses: {a: {required: false}, b: {}}\n"
+                                         "topics: {count: {liveliness_ms: 300}}\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 20, process: a, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, rate_hz: 20, process: b, inputs: {in: count}}\n");
+  Child c(Dyad({"run", g.string(), "--duration", "6"}), dir_, "health");
+  pid_t a = 0;
+  for (int i = 0; i < 100 && (a = ChildPid(g, "a")) == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_NE(a, 0);
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  ASSERT_EQ(kill(a, SIGKILL), 0);
+  ASSERT_EQ(c.Wait(60), 0) << c.err();
+  EXPECT_NE(c.err().find("[b] [info] sink: writers of 'count' alive: 0 -> 1"), std::string::npos) << c.err();
+  EXPECT_NE(c.err().find("[b] [info] sink: writers of 'count' alive: 1 -> 0"), std::string::npos) << c.err();
+  EXPECT_NE(c.err().find("process 'a' exited with 137 (SIGKILL); it is not required"), std::string::npos) << c.err();
+}
+
 TEST_F(ProcessTest, ARequiredProcessThatKeepsFailingEndsTheRunAndIsNamed) {
   const fs::path g = Write("g.yaml", "graph: crashy\nclock: wall\ndomain_id: " + std::to_string(domain_) +
                                          "\nprocesses: {a: {}, b: {restart: on-failure, max_restarts: 2, backoff_s: 0.1}}\n"

@@ -2,6 +2,7 @@
 
 #include <cinttypes>
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace dyad::mixer {
@@ -19,7 +20,8 @@ void ComplianceMixer::Describe(ComponentSpec& spec) {
   spec.Param("integral_limit", 10.0).Min(0).Unit("workspace units * s").Doc(
       "mode pi: anti-windup clamp of the integral per axis (also frozen while the command saturates)");
   spec.Param("stale_timeout_s", 0.5).Min(1e-6).Unit("s").Doc(
-      "an input without a sample for longer is stale (runtime clock): hold the last command");
+      "an input without a sample for longer is stale (runtime clock): hold the last command; one whose "
+      "writers are gone (DDS liveliness, across processes) is stale at once");
   spec.Param("z", 0.0).Unit("workspace units").Doc("z of every command (planar robot)");
   spec.Input<msg::HumanInput>("human").Doc("the human's hand position and engaged flag");
   spec.Input<msg::Intention>("robot").Doc("the robot's intended position");
@@ -53,12 +55,17 @@ Status ComplianceMixer::Configure(Context& ctx) {
 
 Status ComplianceMixer::Step(const StepInfo& info) {
   MixerCore::Inputs in;
-  if (const msg::Intention* r = robot_->latest()) in.robot = {{r->x(), r->y()}, robot_->last_receive_ns()};
+  // An input whose writers are gone (DDS liveliness: their process died, their link is down) is
+  // stale at once, not only after stale_timeout_s without a sample.
+  auto received_at = [](const InputBase* input) {
+    return input->writers_gone() ? std::numeric_limits<int64_t>::min() / 2 : input->last_receive_ns();
+  };
+  if (const msg::Intention* r = robot_->latest()) in.robot = {{r->x(), r->y()}, received_at(robot_)};
   if (const msg::HumanInput* h = human_->latest()) {
-    in.human = {{h->x(), h->y()}, human_->last_receive_ns()};
+    in.human = {{h->x(), h->y()}, received_at(human_)};
     in.engaged = h->engaged();
   }
-  if (const msg::CartesianState* s = state_->latest()) in.state = {{s->x(), s->y()}, state_->last_receive_ns()};
+  if (const msg::CartesianState* s = state_->latest()) in.state = {{s->x(), s->y()}, received_at(state_)};
 
   const MixerCore::Result r = core_->Update(in, info.now_ns);
   if (first_step_ns_ < 0) first_step_ns_ = info.now_ns;
@@ -73,9 +80,10 @@ Status ComplianceMixer::Step(const StepInfo& info) {
   if (r.hold && !holding_ && !starting) {
     holding_ = true;
     const std::string ms = std::to_string(timeout / 1'000'000);
-    const std::string why = r.non_finite       ? "' not finite (NaN or infinite position)"
-                            : never_received ? "' has sent nothing in the " + ms + " ms since start"
-                                             : "' stale (no sample for more than " + ms + " ms)";
+    const std::string why = r.non_finite               ? "' not finite (NaN or infinite position)"
+                            : never_received         ? "' has sent nothing in the " + ms + " ms since start"
+                            : input->writers_gone() ? "': its writer is gone (DDS liveliness)"
+                                                     : "' stale (no sample for more than " + ms + " ms)";
     ctx_->log().Warn(std::string("input '") + ToString(r.stale) + why + ": " +
                      (r.has_command ? "holding the last command" : "no command yet"));
   } else if (!r.hold && holding_) {

@@ -52,6 +52,7 @@ class CounterSink final : public Component {
   Context* ctx_ = nullptr;
   Input<msg::Counter>* in_ = nullptr;  // owned by the runtime
   std::string path_;
+  int writers_alive_ = -1;  // as last said
   std::FILE* file_ = nullptr;
   int64_t expect_ = 0, received_ = 0;
 };

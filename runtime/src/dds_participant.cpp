@@ -18,6 +18,7 @@
 #include <fastdds/rtps/builtin/data/WriterProxyData.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 
+#include <algorithm>
 #include <sstream>
 
 namespace fdds = eprosima::fastdds::dds;
@@ -130,16 +131,40 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
 
 std::vector<DiscoveredEndpoint> DdsParticipant::Discovered() const { return listener_->Snapshot(); }
 
+// Health counters are kept from Fast DDS's status callbacks (its threads) and read by the
+// component's poll: atomics.
 class DdsReader::Listener final : public fdds::DataReaderListener {
  public:
-  explicit Listener(std::function<void()> on_data) : on_data_(std::move(on_data)) {}
+  Listener(std::function<void()> on_data, bool liveliness) : on_data_(std::move(on_data)), liveliness_(liveliness) {}
   void on_data_available(fdds::DataReader*) override {
     if (on_data_) on_data_();
   }
+  void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& s) override {
+    matched_.store(s.current_count, std::memory_order_relaxed);
+  }
+  void on_liveliness_changed(fdds::DataReader*, const fdds::LivelinessChangedStatus& s) override {
+    alive_.store(s.alive_count, std::memory_order_relaxed);
+  }
+  void on_requested_deadline_missed(fdds::DataReader*, const fdds::RequestedDeadlineMissedStatus& s) override {
+    deadline_misses_.store(static_cast<uint64_t>(s.total_count), std::memory_order_relaxed);
+  }
+  // With a liveliness lease the alive count is the truth; without, a writer counts while matched
+  // (the participant lease ends the match of a writer whose process died).
+  int alive_writers() const {
+    const int matched = matched_.load(std::memory_order_relaxed);
+    return liveliness_ ? std::min(matched, alive_.load(std::memory_order_relaxed)) : matched;
+  }
+  uint64_t deadline_misses() const { return deadline_misses_.load(std::memory_order_relaxed); }
 
  private:
   std::function<void()> on_data_;
+  bool liveliness_;
+  std::atomic<int> matched_{0}, alive_{0};
+  std::atomic<uint64_t> deadline_misses_{0};
 };
+
+int DdsReader::AliveWriters() const { return listener_->alive_writers(); }
+uint64_t DdsReader::DeadlineMisses() const { return listener_->deadline_misses(); }
 
 DdsReader::~DdsReader() {
   if (on_delete_) on_delete_();
@@ -398,6 +423,11 @@ void ApplyQos(Q& q, const TopicQos& qos) {
     q.history().depth = qos.depth;
   }
   if (qos.deadline_ms > 0) q.deadline().period = eprosima::fastrtps::Duration_t(qos.deadline_ms * 1e-3);
+  if (qos.liveliness_ms > 0) {
+    q.liveliness().kind = fdds::AUTOMATIC_LIVELINESS_QOS;
+    q.liveliness().lease_duration = eprosima::fastrtps::Duration_t(qos.liveliness_ms * 1e-3);
+    q.liveliness().announcement_period = eprosima::fastrtps::Duration_t(qos.liveliness_ms * 1e-3 / 3);
+  }
 }
 }  // namespace
 
@@ -410,8 +440,11 @@ StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, co
   std::unique_ptr<DdsReader> r(new DdsReader());
   r->topic_ = topic;
   if (scope_ == Scope::kWatcher) rq.data_sharing().off();
-  r->listener_ = std::make_unique<DdsReader::Listener>(std::move(on_data));
-  r->reader_ = subscriber_->create_datareader(*t, rq, r->listener_.get(), fdds::StatusMask::data_available());
+  r->listener_ = std::make_unique<DdsReader::Listener>(std::move(on_data), qos.liveliness_ms > 0);
+  fdds::StatusMask mask = fdds::StatusMask::data_available();
+  mask << fdds::StatusMask::subscription_matched() << fdds::StatusMask::liveliness_changed()
+       << fdds::StatusMask::requested_deadline_missed();
+  r->reader_ = subscriber_->create_datareader(*t, rq, r->listener_.get(), mask);
   if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
   auto* sub = subscriber_;
   auto* raw = r->reader_;

@@ -41,6 +41,8 @@ class DdsReader final : public TypedReader {
   ~DdsReader() override;
   bool TakeNext(void* sample) override;
   uint64_t Unread() const override;
+  int AliveWriters() const override;
+  uint64_t DeadlineMisses() const override;
   const std::string& topic() const { return topic_; }
 
  private:

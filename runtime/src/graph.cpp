@@ -188,7 +188,7 @@ void ReadTopics(Reader& r, const YAML::Node& node, Graph* g) {
       g->topics.push_back(t);
       continue;
     }
-    if (!r.Map(spec, key, {"type", "reliability", "depth", "deadline_ms"})) continue;
+    if (!r.Map(spec, key, {"type", "reliability", "depth", "deadline_ms", "liveliness_ms"})) continue;
     if (spec["type"]) {
       r.String(spec["type"], key + ".type", &t.type);
       t.type_mark = r.Mark(spec["type"]);
@@ -206,6 +206,9 @@ void ReadTopics(Reader& r, const YAML::Node& node, Graph* g) {
     if (spec["deadline_ms"] && r.Number(spec["deadline_ms"], key + ".deadline_ms", &t.deadline_ms, "a number") &&
         t.deadline_ms < 0)
       r.Error(spec["deadline_ms"], key + ".deadline_ms", "must be >= 0");
+    if (spec["liveliness_ms"] && r.Number(spec["liveliness_ms"], key + ".liveliness_ms", &t.liveliness_ms, "a number") &&
+        t.liveliness_ms < 0)
+      r.Error(spec["liveliness_ms"], key + ".liveliness_ms", "must be >= 0");
     g->topics.push_back(t);
   }
 }

@@ -21,7 +21,9 @@ uint64_t ComponentSeed(uint64_t seed, const std::string& name) {
 
 TopicQos QosOf(const ResolvedTopic& topic) {
   if (topic.config == nullptr) return TopicQos{};
-  return TopicQos{topic.config->reliability, topic.config->depth, topic.config->deadline_ms, false};
+  TopicQos q{topic.config->reliability, topic.config->depth, topic.config->deadline_ms, false};
+  q.liveliness_ms = topic.config->liveliness_ms;
+  return q;
 }
 
 std::vector<TopicInfo> GraphTopics(const Graph& graph, const ResolvedGraph& resolved, const std::string& process) {

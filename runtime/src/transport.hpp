@@ -32,6 +32,7 @@ struct TopicQos {
   double deadline_ms = 0;
   bool keep_all = false;  // KEEP_ALL history (recorders); depth then sizes resource limits only
   bool transient_local = false;  // a late-joining reader gets the writer's history (dyad/processes)
+  double liveliness_ms = 0;      // > 0: AUTOMATIC liveliness with this lease
 };
 
 // One endpoint of this transport and how many remote-or-local endpoints it is matched with.

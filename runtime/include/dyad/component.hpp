@@ -101,7 +101,8 @@ namespace dyad {
 // Bump when anything in this header changes layout or meaning; plugins built against another
 // version are refused at load time with a message naming both versions.
 // 3: ParamSpec::path (relative paths resolved against the graph file), Context::graph_folder().
-inline constexpr uint32_t kPluginAbiVersion = 3;
+// 4: input health (InputBase::writers_alive, writers_gone, deadline_misses).
+inline constexpr uint32_t kPluginAbiVersion = 4;
 
 // The runtime clock: wall time (ns since the Unix epoch) in `clock: wall` graphs, simulated time
 // (ns since start) in `clock: stepped` graphs. Thread-safe.
@@ -130,6 +131,10 @@ class ReaderEndpoint {
   virtual ~ReaderEndpoint() = default;
   // Deserialises the next unread sample into *sample (a T); false when none is left.
   virtual bool TakeNext(void* sample) = 0;
+  // Writers matched with this reader whose liveliness holds; -1 when the transport cannot tell.
+  virtual int AliveWriters() const { return -1; }
+  // Deadline periods (the topic's deadline_ms) that passed without a sample, so far.
+  virtual uint64_t DeadlineMisses() const { return 0; }
 };
 class WriterEndpoint {
  public:
@@ -151,6 +156,16 @@ class InputBase {
   int64_t last_receive_ns() const { return last_receive_ns_; }
   // Samples received in the last poll.
   size_t new_count() const { return new_count_; }
+  // Health of the writers on this input's topic, as of the last poll (docs/runtime.md, "Input
+  // health"). writers_alive(): writers matched and alive; a writer whose process died, or whose
+  // link is down, stops counting once the topic's `liveliness_ms` (else the network's `lease_s`)
+  // has passed without word from it. -1: the transport cannot tell (in-memory tests). A
+  // component can hold as soon as it drops to 0 instead of waiting out its own stale timeout;
+  // writers_gone() says exactly that (there was a writer, and none is alive now).
+  int writers_alive() const { return writers_alive_; }
+  bool writers_gone() const { return had_writer_ && writers_alive_ == 0; }
+  // Deadline misses so far: periods of the topic's `deadline_ms` that passed without a sample.
+  uint64_t deadline_misses() const { return deadline_misses_; }
 
   // Runtime use only.
   void Bind(std::string name, std::string topic, detail::ReaderEndpoint* endpoint) {
@@ -163,6 +178,14 @@ class InputBase {
   detail::ReaderEndpoint* endpoint_ = nullptr;  // owned by the runtime; null when unbound
   int64_t last_receive_ns_ = -1;
   size_t new_count_ = 0;
+  int writers_alive_ = -1;
+  bool had_writer_ = false;
+  uint64_t deadline_misses_ = 0;
+  void PollHealth() {
+    writers_alive_ = endpoint_->AliveWriters();
+    had_writer_ = had_writer_ || writers_alive_ > 0;
+    deadline_misses_ = endpoint_->DeadlineMisses();
+  }
 };
 
 template <class T>
@@ -185,6 +208,7 @@ class Input final : public InputBase {
     received_.clear();
     new_count_ = 0;
     if (endpoint_ == nullptr) return 0;
+    PollHealth();
     while (endpoint_->TakeNext(&scratch_)) received_.push_back(std::move(scratch_));
     new_count_ = received_.size();
     if (new_count_ > 0) last_receive_ns_ = now_ns;

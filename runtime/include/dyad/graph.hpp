@@ -26,7 +26,7 @@
 //     mind: {restart: on-failure, max_restarts: 3, backoff_s: 0.5, required: true}
 //                               # supervision: never (default) | on-failure | always
 //   topics:                     # optional per topic: type and QoS
-//     human/input: {type: HumanInput, reliability: reliable, depth: 1, deadline_ms: 200}
+//     human/input: {type: HumanInput, reliability: reliable, depth: 1, deadline_ms: 200, liveliness_ms: 500}
 //   components:
 //     human:
 //       type: synthetic_human   # a registered component type (`dyad types`)
@@ -77,6 +77,7 @@ struct TopicConfig {
   Reliability reliability = Reliability::kReliable;
   int depth = 1;             // KEEP_LAST history depth
   double deadline_ms = 0;    // 0: none
+  double liveliness_ms = 0;  // 0: the network's lease_s; else a writer silent this long is not alive
   SourceMark mark;
   SourceMark type_mark;
 };
