@@ -72,12 +72,18 @@ int RunAnalyze(const Options& o) {
   if (const std::string folder = analyze::GraphMetadata(*reader, "folder");
       !folder.empty() && !report.plan.dataset.empty() && std::filesystem::path(report.plan.dataset).is_relative())
     report.plan.dataset = (std::filesystem::path(folder) / report.plan.dataset).lexically_normal().string();
-  auto tables = analyze::ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels"});
+  auto tables = analyze::ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels",
+                                              "dyad/clock_offsets"});
   if (!tables.ok()) {
     std::cerr << "dyad analyze: " << tables.status().message() << "\n";
     return kBadInput;
   }
-  auto timeline = analyze::BuildTimeline(*tables, report.plan);
+  auto corrections = analyze::ClockCorrections(*tables, report.plan);
+  if (!corrections.ok()) {
+    std::cerr << "dyad analyze: " << o.recording << ": " << corrections.status().message() << "\n";
+    return kBadInput;
+  }
+  auto timeline = analyze::BuildTimeline(*tables, report.plan, *corrections);
   if (!timeline.ok()) {
     std::cerr << "dyad analyze: " << o.recording << ": " << timeline.status().message() << "\n";
     return kBadInput;

@@ -44,6 +44,7 @@ class Cells {
     if (!ParseBool(cell, &v)) return Bad(row, name, cell);
     return v;
   }
+  const std::string& Text(size_t row, const std::string& name) const { return table_.rows[row][index_.at(name)]; }
   Status List(size_t row, const std::string& name, std::vector<double>* out) const {
     const std::string& cell = table_.rows[row][index_.at(name)];
     if (!ParseNumberList(cell, out)) return Bad(row, name, cell);
@@ -75,6 +76,12 @@ StatusOr<ExperimentPlan> PlanFromGraphYaml(const std::string& yaml) {
     if (root["graph"]) plan.graph_name = root["graph"].as<std::string>();
     const YAML::Node components = root["components"];
     if (!components || !components.IsMap()) return plan;
+    for (const auto& entry : components) {  // where each component runs
+      const YAML::Node c = entry.second;
+      const std::string process = c["process"] ? c["process"].as<std::string>() : "";
+      plan.process_of[entry.first.as<std::string>()] = process;
+      if (c["type"] && c["type"].as<std::string>() == "recorder") plan.recorder_process = process;
+    }
     for (const auto& entry : components) {
       const YAML::Node c = entry.second;
       const std::string type = c["type"] ? c["type"].as<std::string>() : "";
@@ -100,8 +107,43 @@ StatusOr<ExperimentPlan> PlanFromGraphYaml(const std::string& yaml) {
   return plan;
 }
 
-StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan) {
+StatusOr<std::map<std::string, int64_t>> ClockCorrections(const std::map<std::string, TopicTable>& tables,
+                                                          const ExperimentPlan& plan) {
+  std::map<std::string, int64_t> out;
+  auto it = tables.find("dyad/clock_offsets");
+  if (it == tables.end() || plan.recorder_process.empty()) return out;
+  Cells cells("dyad/clock_offsets", it->second);
+  if (Status s = cells.Need({"process_name", "peer_process", "offset_ns", "round_trip_ns"}); !s.ok()) return s;
+  std::map<std::string, double> best_round_trip;
+  for (size_t r = 0; r < it->second.size(); ++r) {
+    if (cells.Text(r, "process_name") != plan.recorder_process) continue;
+    const std::string peer = cells.Text(r, "peer_process");
+    auto offset = cells.Number(r, "offset_ns");
+    auto rtt = cells.Number(r, "round_trip_ns");
+    if (!offset.ok()) return offset.status();
+    if (!rtt.ok()) return rtt.status();
+    auto b = best_round_trip.find(peer);
+    if (b != best_round_trip.end() && b->second <= *rtt) continue;
+    best_round_trip[peer] = *rtt;
+    out[peer] = static_cast<int64_t>(std::llround(*offset));
+  }
+  return out;
+}
+
+StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
+                                 const std::map<std::string, int64_t>& corrections) {
   Timeline timeline;
+  timeline.clock_corrections_ns = corrections;
+  // A row's stamp on the recorder's process's clock.
+  auto corrected = [&](const Cells& cells, size_t row, double stamp) {
+    if (corrections.empty()) return stamp;
+    auto p = plan.process_of.find(cells.Text(row, "header.source"));
+    if (p == plan.process_of.end()) return stamp;
+    auto c = corrections.find(p->second);
+    return c == corrections.end() ? stamp : stamp - static_cast<double>(c->second);
+  };
+  const std::vector<std::string> stamp_columns =
+      corrections.empty() ? std::vector<std::string>{"header.stamp_ns"} : std::vector<std::string>{"header.stamp_ns", "header.source"};
   const char* const kTopics[] = {"human/input", "robot/intention", "robot/state", "observer/labels"};
   for (const char* t : kTopics) {
     auto it = tables.find(t);
@@ -113,11 +155,12 @@ StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables
     auto it = tables.find(t);
     if (it == tables.end() || it->second.size() == 0) continue;
     Cells cells(t, it->second);
-    if (Status s = cells.Need({"header.stamp_ns"}); !s.ok()) return s;
+    if (Status s = cells.Need(stamp_columns); !s.ok()) return s;
     auto stamp = cells.Number(0, "header.stamp_ns");
     if (!stamp.ok()) return stamp.status();
-    if (std::string(t) == "human/input") { t0 = static_cast<int64_t>(*stamp); break; }
-    t0 = std::min(t0, static_cast<int64_t>(*stamp));
+    const auto first = static_cast<int64_t>(corrected(cells, 0, *stamp));
+    if (std::string(t) == "human/input") { t0 = first; break; }
+    t0 = std::min(t0, first);
   }
   if (t0 == std::numeric_limits<int64_t>::max()) return timeline;
 
@@ -136,12 +179,12 @@ StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables
     if (it == tables.end()) return Status::OK();
     Cells cells(topic, it->second);
     std::vector<std::string> need = fields;
-    need.push_back("header.stamp_ns");
+    need.insert(need.end(), stamp_columns.begin(), stamp_columns.end());
     if (Status s = cells.Need(need); !s.ok()) return s;
     for (size_t r = 0; r < it->second.size(); ++r) {
       auto stamp = cells.Number(r, "header.stamp_ns");
       if (!stamp.ok()) return stamp.status();
-      StepSample* s = at(*stamp);
+      StepSample* s = at(corrected(cells, r, *stamp));
       if (s == nullptr) continue;
       if (Status st = fill(cells, r, *s); !st.ok()) return st;
     }

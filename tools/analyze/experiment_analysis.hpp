@@ -10,6 +10,11 @@
 // sample's stamp, period from the graph (the human source's rate_hz; 100 ms if unknown). A topic
 // missing from the recording leaves its fields NaN; the report says which topics were missing.
 //
+// Clocks: in a graph split over processes (hosts), each sample is stamped by its writer's clock.
+// When the recording holds dyad/clock_offsets (docs/distributed.md), each stamp is first moved
+// onto the recorder's process's clock: stamp - offset(writer's process), the offset being the
+// one the recorder's process measured of that process with the least round trip.
+//
 // Events are the human's interventions: taken from the graph's human_synthetic `events` (with the
 // primitive the human traced, so confusion and "robot follows" can be scored), else from runs of
 // engaged steps (primitive unknown: -1).
@@ -37,7 +42,14 @@ struct ExperimentPlan {
   int64_t period_ns = 100'000'000;
   std::vector<PlannedEvent> events;  // empty when the human is not human_synthetic
   std::string dataset;               // the human's dataset param, "" if none
+  std::map<std::string, std::string> process_of;  // component -> its process ("" when one process)
+  std::string recorder_process;                   // the process of the recorder, "" if none
 };
+
+// Per process, what to subtract from its stamps to put them on the recorder's process's clock
+// (ns), from the dyad/clock_offsets table; empty when the recording has none (one process).
+StatusOr<std::map<std::string, int64_t>> ClockCorrections(const std::map<std::string, TopicTable>& tables,
+                                                          const ExperimentPlan& plan);
 
 // Tolerant: a recording without graph metadata, or a graph without a synthetic human, gives the
 // defaults. Fails (InvalidArgument) only on YAML that does not parse.
@@ -57,9 +69,12 @@ struct Timeline {
   std::vector<StepSample> steps;  // steps[i].step == i
   std::vector<std::string> missing_topics;
   int classes = 0;  // length of the observer's probability vectors (0: no observer)
+  std::map<std::string, int64_t> clock_corrections_ns;  // applied, per process (see above)
 };
 
-StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan);
+// `corrections`: ClockCorrections(); stamps of components of other processes are used as they are.
+StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
+                                 const std::map<std::string, int64_t>& corrections = {});
 
 // Events of the plan, or engaged runs of the timeline when the plan has none. Planned events are
 // limited to the recorded steps: one starting after the last recorded step is left out (the run

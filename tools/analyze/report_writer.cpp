@@ -77,6 +77,13 @@ std::string FormatMarkdown(const Report& r) {
   if (!r.plan.graph_name.empty()) s << "- graph: `" << r.plan.graph_name << "`\n";
   s << "- steps: " << r.timeline.steps.size() << " of " << Num(static_cast<double>(r.plan.period_ns) * 1e-6, 1)
     << " ms\n";
+  if (!r.timeline.clock_corrections_ns.empty()) {
+    s << "- stamps moved onto the clock of the recorder's process `" << r.plan.recorder_process
+      << "` (offsets it measured, dyad/clock_offsets):";
+    for (const auto& [process, ns] : r.timeline.clock_corrections_ns)
+      s << " `" << process << "` " << (ns >= 0 ? "+" : "") << Num(static_cast<double>(ns) * 1e-6, 3) << " ms";
+    s << "\n";
+  }
   if (!r.timeline.missing_topics.empty()) {
     s << "- missing topics (their columns are empty):";
     for (const std::string& t : r.timeline.missing_topics) s << " `" << t << "`";

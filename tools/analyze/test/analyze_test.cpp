@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 #include <fastdds/rtps/common/SerializedPayload.h>
 
@@ -57,8 +58,9 @@ class Channel {
     EXPECT_TRUE(channel.ok());
     id_ = *channel;
   }
-  void Write(T& m, int64_t step) {
-    m.header().stamp_ns(1'000'000'000 + step * kPeriod);  // t0 != 0: alignment subtracts it
+  // `clock_offset_ns`: the writer's clock is that far ahead (a process on another host).
+  void Write(T& m, int64_t step, int64_t clock_offset_ns = 0) {
+    m.header().stamp_ns(1'000'000'000 + step * kPeriod + clock_offset_ns);  // t0 != 0: alignment subtracts it
     m.header().sequence_number(++seq_);
     eprosima::fastrtps::rtps::SerializedPayload_t payload(type_.getSerializedSizeProvider(&m)());
     ASSERT_TRUE(type_.serialize(&m, &payload));
@@ -162,6 +164,62 @@ TEST(Analyze, TimelineAlignsEveryTopicOnTheStepGrid) {
   EXPECT_DOUBLE_EQ(s.executed_x, 51);
   EXPECT_DOUBLE_EQ(s.congruence, 0.17);
   EXPECT_FALSE(r.timeline.steps[20].engaged);
+}
+
+// A graph split over processes, the deliberator's clock 250 ms (2.5 steps) ahead of the
+// recorder's: its stamps are moved back by what the recorder's process measured (the exchange
+// with the least round trip), so its intentions land on their own steps again.
+TEST(Analyze, StampsOfAnotherProcessAreCorrectedByTheMeasuredClockOffset) {
+  const char* graph = R"(graph: split
+clock: wall
+components:
+  human: {type: human_synthetic, rate_hz: 10, process: lab}
+  mind: {type: deliberator, rate_hz: 10, process: mind}
+  recorder: {type: recorder, rate_hz: 1, process: rec}
+)";
+  const std::string path = TempPath("split.mcap");
+  {
+    auto writer = mcap::Writer::Open(path);
+    ASSERT_TRUE(writer.ok());
+    ASSERT_TRUE(writer->AddMetadata("dyad.graph", {{"yaml", graph}}).ok());
+    Channel<msg::HumanInput> human(*writer, "human/input");
+    Channel<msg::Intention> robot(*writer, "robot/intention");
+    Channel<msg::ClockOffset> offsets(*writer, "dyad/clock_offsets");
+    for (int t = 0; t < 20; ++t) {
+      msg::HumanInput h; h.header().source("human"); h.x(t);
+      human.Write(h, t);
+      msg::Intention i; i.header().source("mind"); i.x(2 * t);
+      robot.Write(i, t, 250'000'000);
+    }
+    // rec's measurements of mind: a noisy one (long round trip) and the good one; and what
+    // mind measured of rec (not the recorder's view: ignored).
+    for (auto [measurer, offset, rtt] : {std::tuple{"rec", 262'000'000, 9'000'000}, std::tuple{"rec", 250'000'000, 200'000},
+                                         std::tuple{"mind", -250'000'000, 100'000}}) {
+      msg::ClockOffset o; o.process_name(measurer); o.peer_process(measurer == std::string("rec") ? "mind" : "rec");
+      o.offset_ns(offset); o.round_trip_ns(rtt);
+      offsets.Write(o, 0);
+    }
+    ASSERT_TRUE(writer->Close().ok());
+  }
+  auto reader = mcap::Reader::Open(path);
+  ASSERT_TRUE(reader.ok());
+  auto plan = PlanFromGraphYaml(GraphMetadata(*reader, "yaml"));
+  ASSERT_TRUE(plan.ok());
+  EXPECT_EQ(plan->recorder_process, "rec");
+  EXPECT_EQ(plan->process_of.at("mind"), "mind");
+  auto tables = ReadTables(*reader, {});
+  ASSERT_TRUE(tables.ok());
+  auto corrections = ClockCorrections(*tables, *plan);
+  ASSERT_TRUE(corrections.ok()) << corrections.status().ToString();
+  ASSERT_EQ(corrections->size(), 1u);
+  EXPECT_EQ(corrections->at("mind"), 250'000'000);
+  auto uncorrected = BuildTimeline(*tables, *plan);
+  auto timeline = BuildTimeline(*tables, *plan, *corrections);
+  ASSERT_TRUE(uncorrected.ok() && timeline.ok());
+  EXPECT_TRUE(std::isnan(uncorrected->steps[5].robot_x) || uncorrected->steps[5].robot_x != 10);  // 2.5 steps late
+  EXPECT_DOUBLE_EQ(timeline->steps[5].human_x, 5);
+  EXPECT_DOUBLE_EQ(timeline->steps[5].robot_x, 10);
+  EXPECT_EQ(timeline->steps.size(), 20u);
 }
 
 TEST(Analyze, EventScoresMatchHandComputedValues) {
