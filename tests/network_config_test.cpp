@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/rtps/transport/TCPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
@@ -97,8 +98,8 @@ INSTANTIATE_TEST_SUITE_P(
         Bad{"UnknownKey", Replace(kSplit, "  lease_s: 3\n", "  lease: 3\n"), "g.yaml:9:3", "network.lease", "unknown key"},
         Bad{"BadDiscovery", Replace(kSplit, "discovery: peers", "discovery: gossip"), "g.yaml:3:14", "network.discovery",
             "multicast, peers or server"},
-        Bad{"BadTransport", Replace(kSplit, "transport: udp", "transport: tcp"), "g.yaml:7:14", "network.transport",
-            "shm+udp or udp"},
+        Bad{"BadTransport", Replace(kSplit, "transport: udp", "transport: quic"), "g.yaml:7:14", "network.transport",
+            "shm+udp, udp or tcp"},
         Bad{"ServerWithoutPort", Replace(kSplit, "server: lab:11811", "server: lab"), "g.yaml:6:11", "network.server",
             "HOST:PORT"},
         Bad{"ServerPortTooBig", Replace(kSplit, "server: lab:11811", "server: lab:70000"), "g.yaml:6:11", "network.server",
@@ -114,7 +115,18 @@ INSTANTIATE_TEST_SUITE_P(
         Bad{"HostNotInHosts", Replace(kSplit, "b: {host: mind}", "b: {host: mnid}"), "g.yaml:13:13", "processes.b.host",
             "'mnid' is not one of network.hosts (lab, mind)"},
         Bad{"ProcessWithoutHostBesideOneWithHost", Replace(kSplit, "b: {host: mind}", "b: {}"), "g.yaml:13:3",
-            "processes.b.host", "every process must"}),
+            "processes.b.host", "every process must"},
+        Bad{"ComponentWithoutProcessInAGraphOnHosts", Replace(kSplit, "process: b, ", ""), "g.yaml:16:3",
+            "components.sink.process", "each component names its process"},
+        Bad{"TcpWithoutPeers",
+            Replace(Replace(Replace(Replace(kSplit, "transport: udp", "transport: tcp"), "discovery: peers", "discovery: multicast"),
+                            "a: {host: lab}", "a: {host: lab, tcp_port: 7601}"),
+                    "b: {host: mind}", "b: {host: mind, tcp_port: 7602}"),
+            "g.yaml:7:14", "network.transport", "tcp: needs discovery: peers"},
+        Bad{"TcpWithoutAPort", Replace(Replace(kSplit, "transport: udp", "transport: tcp"), "a: {host: lab}", "a: {host: lab, tcp_port: 7601}"),
+            "g.yaml:13:3", "processes.b.tcp_port", "needs each process's tcp_port"},
+        Bad{"BackoffTooShort", Replace(kSplit, "a: {host: lab}", "a: {host: lab, restart: always, backoff_s: 0}"), "g.yaml:12:46",
+            "processes.a.backoff_s", "0.05..60"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(NetworkConfig, ASetOverridesAKeyAndItsProblemNamesTheSet) {
@@ -131,10 +143,43 @@ TEST(NetworkConfig, ASetOverridesAKeyAndItsProblemNamesTheSet) {
   EXPECT_EQ(diags[0].mark.ToString(), "--set network.discovery=gossip");
   EXPECT_EQ(diags[0].key, "network.discovery");
 
-  diags.clear();
-  Parse(kSplit, &diags, {"network.hosts.lab=1.2.3.4"});
-  ASSERT_EQ(diags.size(), 1u);
-  EXPECT_NE(diags[0].message.find("expected network.KEY=VALUE"), std::string::npos);
+  for (const char* bad : {"network.hosts.lab=1.2.3.4", "network.lease_s"}) {
+    diags.clear();
+    Parse(kSplit, &diags, {bad});
+    ASSERT_EQ(diags.size(), 1u) << bad;
+    EXPECT_NE(diags[0].message.find("expected network.KEY=VALUE"), std::string::npos) << bad;
+  }
+}
+
+// TCP: each process listens on its port at its host's address, and connects only to the
+// processes named before it (one connection per pair); a watcher connects to all.
+TEST(NetworkQos, TcpListensOnTheProcesssPortAndConnectsToTheEarlierProcesses) {
+  std::vector<Diagnostic> diags;
+  const std::string yaml = Replace(Replace(Replace(kSplit, "transport: udp", "transport: tcp"), "a: {host: lab}",
+                                           "a: {host: lab, tcp_port: 7601}"),
+                                   "b: {host: mind}", "b: {host: mind, tcp_port: 7602}");
+  const Graph g = Parse(yaml, &diags);
+  ASSERT_TRUE(diags.empty()) << diags[0].ToString();
+  EXPECT_EQ(g.network.tcp_listeners.at("b"), "10.77.0.2:7602");
+  auto peers_of = [&](const std::string& process, std::vector<uint16_t>* listening) {
+    eprosima::fastdds::dds::DomainParticipantQos qos;
+    EXPECT_TRUE(ApplyNetwork(g.network, process.empty(), &qos, process).ok());
+    auto tcp = std::dynamic_pointer_cast<eprosima::fastdds::rtps::TCPv4TransportDescriptor>(qos.transport().user_transports.at(0));
+    EXPECT_NE(tcp, nullptr);
+    if (tcp) *listening = tcp->listening_ports;
+    std::vector<std::string> peers;
+    for (const auto& l : qos.wire_protocol().builtin.initialPeersList)
+      peers.push_back(eprosima::fastrtps::rtps::IPLocator::ip_to_string(l) + ":" +
+                      std::to_string(eprosima::fastrtps::rtps::IPLocator::getPhysicalPort(l)));
+    return peers;
+  };
+  std::vector<uint16_t> listening;
+  EXPECT_TRUE(peers_of("a", &listening).empty());
+  EXPECT_EQ(listening, std::vector<uint16_t>{7601});
+  EXPECT_EQ(peers_of("b", &listening), std::vector<std::string>{"10.77.0.1:7601"});
+  EXPECT_EQ(listening, std::vector<uint16_t>{7602});
+  EXPECT_EQ(peers_of("", &listening), (std::vector<std::string>{"10.77.0.1:7601", "10.77.0.2:7602"}));
+  EXPECT_TRUE(listening.empty());
 }
 
 // The QoS a participant gets from each discovery mode.

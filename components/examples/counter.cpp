@@ -62,8 +62,9 @@ Status CounterSink::Activate() {
 Status CounterSink::Step(const StepInfo&) {
   // The input's health, said when it changes (tests read it from the log).
   if (in_->writers_alive() != writers_alive_ && in_->writers_alive() >= 0) {
-    ctx_->log().Info("writers of '" + in_->topic() + "' alive: " + std::to_string(std::max(writers_alive_, 0)) + " -> " +
-                     std::to_string(in_->writers_alive()));
+    if (writers_alive_ >= 0 || in_->writers_alive() > 0)  // not "0 -> 0" at the first step
+      ctx_->log().Info("writers of '" + in_->topic() + "' alive: " + std::to_string(std::max(writers_alive_, 0)) + " -> " +
+                       std::to_string(in_->writers_alive()));
     writers_alive_ = in_->writers_alive();
   }
   for (const auto& c : in_->received()) {

@@ -110,6 +110,7 @@ void ClockSync::OnProbes() {
       if (it == asked_.end() || it->second != p.t1_ns()) continue;
       const int64_t t1 = p.t1_ns(), t2 = p.t2_ns(), t3 = p.t3_ns(), t4 = received;
       Peer& peer = peers_[p.answerer()];
+      peer.last_answered = p.id();
       peer.window.push_back({((t2 - t1) + (t3 - t4)) / 2, (t4 - t1) - (t3 - t2)});
       if (peer.window.size() > kWindow) peer.window.pop_front();
     }
@@ -123,7 +124,8 @@ std::vector<msg::ClockOffset> ClockSync::Offsets() const {
   std::lock_guard<std::mutex> lock(mutex_);
   std::vector<msg::ClockOffset> out;
   for (const auto& [name, peer] : peers_) {
-    if (peer.window.empty()) continue;
+    // A peer that has not answered the last kWindow requests is gone: its offset is stale.
+    if (peer.window.empty() || peer.last_answered + kWindow < next_id_) continue;
     const Exchange best = *std::min_element(peer.window.begin(), peer.window.end(),
                                             [](const Exchange& a, const Exchange& b) { return a.round_trip_ns < b.round_trip_ns; });
     msg::ClockOffset o;

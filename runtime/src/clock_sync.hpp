@@ -62,6 +62,7 @@ class ClockSync {
   struct Peer {
     std::string host;
     std::deque<Exchange> window;
+    uint64_t last_answered = 0;  // id of the newest request it answered
     bool warned = false;
   };
   void OnProbes();  // the dyad/clock reader's callback: takes, notes t2/t4, never writes

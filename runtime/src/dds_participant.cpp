@@ -316,7 +316,7 @@ int DdsWriter::matched() const {
 
 StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, const std::string& name,
                                                                   ProblemHandler on_problem, Scope scope,
-                                                                  const NetworkConfig& network) {
+                                                                  const NetworkConfig& network, const std::string& process) {
   std::unique_ptr<DdsParticipant> p(new DdsParticipant());
   p->name_ = name;
   p->listener_ = std::make_unique<DiscoveryListener>(p.get(), std::move(on_problem));
@@ -327,7 +327,7 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
   p->scope_ = scope;
   // A stepped run stays inside its process: the network section does not concern it.
   if (scope != Scope::kProcessOnly)
-    if (Status s = ApplyNetwork(network, scope == Scope::kWatcher, &qos); !s.ok()) return s;
+    if (Status s = ApplyNetwork(network, scope == Scope::kWatcher, &qos, process); !s.ok()) return s;
   if (scope == Scope::kWatcher) {
     // A watcher lives seconds: announce often, so a first discovery exchange that got lost is
     // repeated within half a second rather than the default 3 s.

@@ -153,10 +153,12 @@ class DdsParticipant final : public Transport {
   enum class Scope { kNetwork, kProcessOnly, kWatcher };
   //
   // `network`: the graph's network section (discovery, transports, lease; see network_qos.hpp),
-  // for kNetwork and kWatcher (a watcher keeps to UDP whatever it says).
+  // for kNetwork and kWatcher (a watcher keeps to UDP whatever it says, or connects as a TCP
+  // client when the transport is tcp); `process` names the graph's process (its TCP listener).
   static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, ProblemHandler on_problem,
                                                           Scope scope = Scope::kNetwork,
-                                                          const NetworkConfig& network = NetworkConfig{});
+                                                          const NetworkConfig& network = NetworkConfig{},
+                                                          const std::string& process = "");
   // Stops every callback, deletes every endpoint created here, then the participant.
   ~DdsParticipant() override;
   DdsParticipant(const DdsParticipant&) = delete;

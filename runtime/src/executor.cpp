@@ -149,7 +149,12 @@ class Executor::ContextImpl final : public Context {
       if (info->type->name != type.name)
         return Status::InvalidArgument("topic '" + topic + "' carries " + info->type->name + " in graph '" + ex_->graph_.name +
                                        "', not " + type.name);
-      qos = TopicQos{info->reliable ? Reliability::kReliable : Reliability::kBestEffort, info->depth, info->deadline_ms, false};
+      // The graph's QoS for the topic, all of it (a writer offering less liveliness than the
+      // graph's readers request would never match them).
+      auto rt = ex_->resolved_.topics.find(topic);
+      qos = rt != ex_->resolved_.topics.end()
+                ? QosOf(rt->second)
+                : TopicQos{info->reliable ? Reliability::kReliable : Reliability::kBestEffort, info->depth, info->deadline_ms, false};
     }
     auto w = ex_->transport_->CreateSerializedWriter(topic, type, qos, ex_->clock_.get());
     if (!w.ok()) return w.status().WithContext(inst_->name() + ": AdvertiseSerialized('" + topic + "')");
@@ -236,7 +241,7 @@ Status Executor::Setup() {
                                       StderrLogger("dds").Error(msg);
                                     },
                                     stepped ? DdsParticipant::Scope::kProcessOnly : DdsParticipant::Scope::kNetwork,
-                                    graph_.network);
+                                    graph_.network, options_.process);
     if (!p.ok()) return p.status();
     transport_ = std::move(p.value());
   }
@@ -445,15 +450,20 @@ Status Executor::RunWall() {
   for (auto& inst : instances_)
     if (inst->trigger != nullptr && inst->trigger->Unread() > 0) TriggerStep(*inst);
   const auto start = std::chrono::steady_clock::time_point(std::chrono::nanoseconds(start_steady_ns_));
-  int64_t duration_ns = options_.duration_s > 0 ? static_cast<int64_t>(options_.duration_s * 1e9) : 0;
-  if (barrier_ && options_.steps > 0) {
-    // The graph's steps, counted from the graph's start: a process that joined late (restarted)
-    // ends with the others, and one without the fastest component a second after its last step.
-    const int64_t period = FastestPeriodNs();
-    const int64_t end_wall = barrier_->graph_start_ns() + static_cast<int64_t>(options_.steps) * period +
-                             (HoldsFastestComponent() ? period / 2 : 1'000'000'000);
-    const int64_t by_steps = std::max<int64_t>(end_wall - start_wall_ns, 0);
-    duration_ns = duration_ns > 0 ? std::min(duration_ns, by_steps) : by_steps;
+  // 0: no end. With several processes both limits count from the graph's start, so a process
+  // that joined late (restarted) ends with the others (at once when that end has passed), and one
+  // without the fastest component a second after the last step.
+  int64_t duration_ns = options_.duration_s > 0 ? static_cast<int64_t>(std::min(options_.duration_s, 1e9) * 1e9) : 0;
+  if (barrier_) {
+    const int64_t late = start_wall_ns - barrier_->graph_start_ns();
+    if (duration_ns > 0) duration_ns = std::max<int64_t>(duration_ns - late, 1);
+    if (options_.steps > 0) {
+      const int64_t period = FastestPeriodNs();
+      const int64_t steps = static_cast<int64_t>(std::min<uint64_t>(options_.steps, INT64_MAX / 4 / std::max<int64_t>(period, 1)));
+      const int64_t by_steps =
+          std::max<int64_t>(steps * period + (HoldsFastestComponent() ? period / 2 : 1'000'000'000) - late, 1);
+      duration_ns = duration_ns > 0 ? std::min(duration_ns, by_steps) : by_steps;
+    }
   }
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stopping()) {

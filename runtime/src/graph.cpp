@@ -158,7 +158,8 @@ void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
   if (node["transport"] && r.String(node["transport"], "network.transport", &s)) {
     if (s == "shm+udp") n->transport = NetTransport::kShmUdp;
     else if (s == "udp") n->transport = NetTransport::kUdp;
-    else r.Error(node["transport"], "network.transport", "must be shm+udp or udp, got '" + s + "'");
+    else if (s == "tcp") n->transport = NetTransport::kTcp;
+    else r.Error(node["transport"], "network.transport", "must be shm+udp, udp or tcp, got '" + s + "'");
   }
   if (node["interfaces"]) ReadStringList(r, node["interfaces"], "network.interfaces", &n->interfaces);
   if (node["lease_s"] && r.Number(node["lease_s"], "network.lease_s", &n->lease_s, "a number") && !(n->lease_s >= 1))
@@ -172,6 +173,9 @@ void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
     r.Error(node["max_clock_offset_ms"], "network.max_clock_offset_ms", "must be > 0");
   if (n->discovery == Discovery::kPeers && n->peers.empty() && n->hosts.empty())
     r.Error(node["discovery"], "network.discovery", "peers: needs network.peers or network.hosts (the addresses to announce to)");
+  if (n->transport == NetTransport::kTcp && n->discovery != Discovery::kPeers)
+    r.Error(node["transport"], "network.transport", "tcp: needs discovery: peers (TCP carries no multicast; each process "
+                                                    "connects to the others' tcp_port)");
   if (n->discovery == Discovery::kServer && n->server.empty())
     r.Error(node["discovery"], "network.discovery", "server: needs network.server (HOST:PORT of the discovery server)");
 }
@@ -425,8 +429,8 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   // recorded) like the file's own; its problems name the --set.
   for (const Override& o : overrides) {
     const auto eq = o.text.find('=');
-    if (o.text.rfind("network.", 0) != 0 || eq == std::string::npos) continue;
-    const std::string key = o.text.substr(8, eq - 8);
+    if (o.text.rfind("network.", 0) != 0) continue;
+    const std::string key = eq == std::string::npos ? "" : o.text.substr(8, eq - 8);
     const SourceMark cli{"--set " + o.text, 0, 0};
     if (key.empty() || key.find('.') != std::string::npos) {
       diagnostics->push_back({cli, "network", "expected network.KEY=VALUE"});
@@ -484,7 +488,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
         p.mark = r.Mark(kv.first);
         const std::string key = "processes." + p.name;
         const YAML::Node spec = kv.second;
-        if (!spec.IsNull() && r.Map(spec, key, {"host", "restart", "max_restarts", "backoff_s", "required"})) {
+        if (!spec.IsNull() && r.Map(spec, key, {"host", "restart", "max_restarts", "backoff_s", "required", "tcp_port"})) {
           if (spec["host"] && r.String(spec["host"], key + ".host", &p.host) && !g.network.hosts.empty() &&
               !g.network.hosts.count(p.host))
             r.Error(spec["host"], key + ".host", "'" + p.host + "' is not one of network.hosts (" + Names(g.network.hosts) + ")");
@@ -499,11 +503,25 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
               p.max_restarts < 0)
             r.Error(spec["max_restarts"], key + ".max_restarts", "must be >= 0");
           if (spec["backoff_s"] && r.Number(spec["backoff_s"], key + ".backoff_s", &p.backoff_s, "a number") &&
-              !(p.backoff_s >= 0 && p.backoff_s <= 60))
-            r.Error(spec["backoff_s"], key + ".backoff_s", "must be in 0..60");
+              !(p.backoff_s >= 0.05 && p.backoff_s <= 60))
+            r.Error(spec["backoff_s"], key + ".backoff_s", "must be in 0.05..60 (a shorter one restarts a crashing process in a tight loop)");
           if (spec["required"]) r.Number(spec["required"], key + ".required", &p.required, "true or false");
+          if (spec["tcp_port"] && r.Number(spec["tcp_port"], key + ".tcp_port", &p.tcp_port, "an integer") &&
+              (p.tcp_port < 1 || p.tcp_port > 65535))
+            r.Error(spec["tcp_port"], key + ".tcp_port", "must be in 1..65535");
         }
         g.processes.push_back(p);
+      }
+      // transport: tcp: each process listens on its port, at its host's address.
+      if (g.network.transport == NetTransport::kTcp) {
+        for (const auto& p : g.processes) {
+          auto address = g.network.hosts.find(p.host);
+          if (p.tcp_port == 0 || address == g.network.hosts.end())
+            r.Error(p.mark, "processes." + p.name + ".tcp_port",
+                    "network.transport tcp needs each process's tcp_port and a host listed in network.hosts");
+          else
+            g.network.tcp_listeners[p.name] = address->second + ":" + std::to_string(p.tcp_port);
+        }
       }
       // A process without a host would start on every host's launcher: a second copy of it.
       bool any_host = false;
@@ -516,6 +534,17 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   if (const YAML::Node topics = root["topics"]) ReadTopics(r, topics, &g);
   if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, &g);
   else r.Error(SourceMark{path, 1, 1}, "components", "missing: a graph needs at least one component");
+  // A component left in the implicit process "main" of a graph placed on hosts would start on
+  // every host's launcher.
+  bool placed = false;
+  for (const auto& p : g.processes) placed |= !p.host.empty();
+  if (placed && g.processes.size() > 1) {
+    for (const auto& c : g.components) {
+      if (c.process.empty())
+        r.Error(c.mark, "components." + c.name + ".process",
+                "missing: the graph places its processes on hosts, so each component names its process");
+    }
+  }
   ApplyOverrides(overrides, &g, root, diagnostics);
   RecordOverrides(overrides, root, &g);
   return g;

@@ -75,9 +75,11 @@ pid_t StartChild(std::vector<std::string> args, int restarts, const OutputRelay:
     sigemptyset(&none);
     pthread_sigmask(SIG_SETMASK, &none, nullptr);
     execve("/proc/self/exe", argv.data(), envp.data());
-    std::perror("dyad: exec");
+    const char message[] = "dyad: exec of /proc/self/exe failed\n";  // no stdio after fork: its lock may be held
+    (void)!write(STDERR_FILENO, message, sizeof(message) - 1);
     _exit(127);
   }
+  if (pid > 0) setpgid(pid, pid);  // also here: no window in which a Ctrl-C reaches the child directly
   return pid;
 }
 
@@ -103,11 +105,15 @@ std::string ThisHost(const RunOptions& options) {
 }
 
 // Whether the launcher (not a single in-process run) handles this graph here.
-bool NeedsLauncher(const Graph& g, const std::string& this_host) {
+bool NeedsLauncher(const Graph& g, const RunOptions& options) {
   if (g.ProcessNames().size() > 1) return true;
   for (const auto& pc : g.processes)
     if (!pc.host.empty()) return true;
-  return !g.network.server_host.empty() && g.network.server_host == this_host;
+  return g.network.discovery == Discovery::kServer && !g.network.server_host.empty() && RunsHere(g.network.server_host, options);
+}
+
+bool RunsHere(const std::string& host, const RunOptions& options) {
+  return host.empty() || host == ThisHost(options) || (options.host.empty() && host == "localhost");
 }
 
 int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& out, std::ostream& err) {
@@ -115,7 +121,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
   std::vector<std::string> names;
   for (const auto& p : graph.ProcessNames()) {
     const std::string where = HostOf(graph, p);
-    if (!where.empty() && where != host && !(options.host.empty() && where == "localhost")) {
+    if (!RunsHere(where, options)) {
       err << "process '" << p << "' runs on host '" << where << "': start it there with `dyad run " << options.graph_path
           << " --host " << where << "`\n";
       continue;
@@ -123,7 +129,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
     names.push_back(p);
   }
   const NetworkConfig& net = graph.network;
-  const bool runs_server = net.discovery == Discovery::kServer && !net.server_host.empty() && net.server_host == host;
+  const bool runs_server = net.discovery == Discovery::kServer && !net.server_host.empty() && RunsHere(net.server_host, options);
   if (names.empty() && !runs_server) {
     err << options.graph_path << ": no process of the graph is placed on host '" << host << "'\n";
     return 2;
@@ -132,7 +138,16 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
     std::vector<std::string> args = {"dyad", "run", options.graph_path, "--process", p};
     for (const auto& o : options.overrides) args.insert(args.end(), {"--set", o.text});
     for (const auto& pp : options.plugin_paths) args.insert(args.end(), {"--plugins", pp});
-    if (options.duration_s > 0) args.insert(args.end(), {"--duration", std::to_string(options.duration_s)});
+    if (options.duration_s > 0) {
+      char text[40];
+      std::snprintf(text, sizeof(text), "%.17g", options.duration_s);  // to_string would round 1e-7 to 0
+      args.insert(args.end(), {"--duration", text});
+    }
+    if (options.stats_period_s != RunOptions{}.stats_period_s) {
+      char text[40];
+      std::snprintf(text, sizeof(text), "%.17g", options.stats_period_s);
+      args.insert(args.end(), {"--stats-period", text});
+    }
     if (options.steps > 0) args.insert(args.end(), {"--steps", std::to_string(options.steps)});
     if (options.quiet) args.push_back("--quiet");
     if (!options.host.empty()) args.insert(args.end(), {"--host", options.host});
@@ -203,8 +218,9 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
   };
   for (;;) {
     int status = 0;
+    // Reaped under the lock: the signal thread never kill()s a pid already reaped (and reused).
+    std::unique_lock<std::mutex> lock(mutex);
     const pid_t pid = waitpid(-1, &status, WNOHANG);
-    std::lock_guard<std::mutex> lock(mutex);
     if (pid <= 0) {
       // Restarts that are due; the discovery server once the graph's processes here are done.
       const auto now = std::chrono::steady_clock::now();
@@ -225,18 +241,24 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
         kill(server, SIGTERM);
       }
       if (children.empty() && pending.empty()) break;
+      lock.unlock();
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
       continue;
     }
-    const Supervised child = children[pid];
-    children.erase(pid);
+    const auto found = children.find(pid);
+    if (found == children.end()) continue;  // not ours (a process a plugin started, reparented to us)
+    const Supervised child = found->second;
+    children.erase(found);
     const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     // Stopped by us (the user's signal forwarded, or SIGTERM after another child failed): not a failure.
     const bool stopped = (interrupt.signal() != 0 && code == ExitCodeForSignal(interrupt.signal())) ||
                          ((stopped_others || (pid == server && server_stopped)) && code == ExitCodeForSignal(SIGTERM));
     if (stopped || stopping) continue;
     const ProcessConfig& pc = ConfigOf(graph, child.name);
-    const bool restart = pid != server && (pc.restart == RestartPolicy::kAlways ||
+    // A clean exit of a run with an end (--steps, --duration) is that end, whatever the policy:
+    // `always` restarts clean exits only in runs that go on until Ctrl-C.
+    const bool run_has_end = options.steps > 0 || options.duration_s > 0;
+    const bool restart = pid != server && ((pc.restart == RestartPolicy::kAlways && (code != 0 || !run_has_end)) ||
                                            (pc.restart == RestartPolicy::kOnFailure && code != 0));
     if (restart && child.restarts < pc.max_restarts) {
       const double backoff = std::min(10.0, pc.backoff_s * std::pow(2.0, child.restarts));

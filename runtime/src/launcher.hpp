@@ -14,9 +14,12 @@ namespace dyad {
 
 // This machine's name in the graph: --host, else gethostname().
 std::string ThisHost(const RunOptions& options);
+// Whether a process (or the discovery server) placed on `host` runs on this machine: no host,
+// this machine's name (ThisHost), or "localhost" when no --host was given.
+bool RunsHere(const std::string& host, const RunOptions& options);
 // Whether `dyad run` without --process launches children here (several processes, processes
 // placed on hosts, or the discovery server to run) rather than running the graph in-process.
-bool NeedsLauncher(const Graph& graph, const std::string& this_host);
+bool NeedsLauncher(const Graph& graph, const RunOptions& options);
 // Runs the children to the end; the exit code of the run (run.hpp).
 int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& out, std::ostream& err);
 

@@ -7,6 +7,7 @@
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/rtps/attributes/ServerAttributes.h>
+#include <fastdds/rtps/transport/TCPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
@@ -49,20 +50,41 @@ StatusOr<rtps::Locator_t> UdpLocator(const std::string& text, const std::string&
 
 }  // namespace
 
-Status ApplyNetwork(const NetworkConfig& net, bool udp_only, eprosima::fastdds::dds::DomainParticipantQos* qos) {
+Status ApplyNetwork(const NetworkConfig& net, bool udp_only, eprosima::fastdds::dds::DomainParticipantQos* qos,
+                    const std::string& process) {
   auto& transport = qos->transport();
   transport.use_builtin_transports = false;
   transport.user_transports.clear();
+  auto& builtin = qos->wire_protocol().builtin;
+  builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(net.lease_s);
+  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(net.lease_s / 4);
+  if (net.transport == NetTransport::kTcp) {
+    auto tcp = std::make_shared<eprosima::fastdds::rtps::TCPv4TransportDescriptor>();
+    tcp->interfaceWhiteList = net.interfaces;
+    if (auto own = net.tcp_listeners.find(process); own != net.tcp_listeners.end())
+      tcp->add_listener_port(static_cast<uint16_t>(std::stoul(own->second.substr(own->second.rfind(':') + 1))));
+    transport.user_transports.push_back(tcp);
+    // One connection per pair: a process connects to the listeners of the processes named before
+    // it (they connect to none of its own); a watcher, with no listener, to all. When both sides
+    // of a pair connected at once, Fast DDS 2.9 dropped both connections and the pair never met.
+    for (const auto& [other, listener] : net.tcp_listeners) {
+      if (!process.empty() && other >= process) continue;
+      auto l = UdpLocator(listener, "processes." + other + ".tcp_port");
+      if (!l.ok()) return l.status();
+      rtps::Locator_t peer = l.value();
+      peer.kind = LOCATOR_KIND_TCPv4;
+      rtps::IPLocator::setPhysicalPort(peer, static_cast<uint16_t>(peer.port));
+      rtps::IPLocator::setLogicalPort(peer, 0);
+      builtin.initialPeersList.push_back(peer);
+    }
+    return Status::OK();
+  }
   if (!udp_only && net.transport == NetTransport::kShmUdp)
     transport.user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
   auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
   udp->interfaceWhiteList = net.interfaces;
   udp->maxInitialPeersRange = kPeerParticipants;
   transport.user_transports.push_back(udp);
-
-  auto& builtin = qos->wire_protocol().builtin;
-  builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(net.lease_s);
-  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(net.lease_s / 4);
 
   if (net.discovery == Discovery::kPeers) {
     // A unicast metatraffic locator (address and port left to Fast DDS: every allowed interface,

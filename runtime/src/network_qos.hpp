@@ -6,7 +6,10 @@
 //                        `network.hosts` and `network.peers` (a peer without a port is tried on
 //                        the well-known ports of participant ids 0..kPeerParticipants-1).
 //   discovery server:    a Fast DDS discovery-server client of `network.server`.
-//   transport:           shared memory + UDPv4, or UDPv4 only; `interfaces` is the UDP allow-list.
+//   transport:           shared memory + UDPv4, UDPv4 only, or TCPv4: each process listens on its
+//                        tcp_port and connects to the listeners of the processes named before it
+//                        (one connection per pair); a watcher only connects, to all.
+//                        `interfaces` is the allow-list.
 //   lease_s:             the participant lease; announcements every lease/4.
 #pragma once
 
@@ -30,8 +33,10 @@ inline constexpr int kPeerParticipants = 12;
 inline constexpr const char* kDiscoveryServerPrefix = "44.53.00.5f.45.50.52.4f.53.49.4d.41";
 
 // `udp_only`: no shared memory whatever the section says (watchers: see DdsParticipant).
+// `process`: whose participant this is (its TCP listener); empty for a watcher.
 // InvalidArgument when an address does not resolve (naming the key).
-Status ApplyNetwork(const NetworkConfig& network, bool udp_only, eprosima::fastdds::dds::DomainParticipantQos* qos);
+Status ApplyNetwork(const NetworkConfig& network, bool udp_only, eprosima::fastdds::dds::DomainParticipantQos* qos,
+                    const std::string& process = "");
 
 // An IPv4 address in dotted form for `name` (an address or a DNS name).
 StatusOr<std::string> ResolveIPv4(const std::string& name);

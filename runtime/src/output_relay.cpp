@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 
@@ -77,15 +78,34 @@ void OutputRelay::Emit(const Source& s, const std::string& line) {
 void OutputRelay::Run() {
   std::vector<pollfd> fds;
   char buf[4096];
+  std::chrono::steady_clock::time_point give_up{};
   for (;;) {
     fds.clear();
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (closing_ && sources_.empty()) return;
+      // Every child has exited; a pipe still open is held by something a child left behind
+      // (a process a component started): what it says after kCloseGraceMs is not waited for.
+      if (closing_ && give_up == std::chrono::steady_clock::time_point{})
+        give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(kCloseGraceMs);
+      if (closing_ && std::chrono::steady_clock::now() >= give_up) {
+        for (auto& [fd, source] : sources_) {
+          if (!source.partial.empty()) Emit(source, source.partial);
+          close(fd);
+        }
+        sources_.clear();
+        return;
+      }
       fds.push_back({wake_[0], POLLIN, 0});
       for (const auto& [fd, _] : sources_) fds.push_back({fd, POLLIN, 0});
     }
-    if (poll(fds.data(), fds.size(), 200) < 0 && errno != EINTR) return;
+    if (poll(fds.data(), fds.size(), 200) < 0 && errno != EINTR) {
+      // Cannot happen with valid descriptors; say so rather than let the children block on
+      // full pipes unnoticed.
+      std::lock_guard<std::mutex> lock(mutex_);
+      err_ << "dyad run: the output relay failed (poll: " << std::strerror(errno) << "); children's output is lost\n";
+      return;
+    }
     if (fds[0].revents & POLLIN) (void)!read(wake_[0], buf, sizeof(buf));
     for (size_t i = 1; i < fds.size(); ++i) {
       if (fds[i].revents == 0) continue;

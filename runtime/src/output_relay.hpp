@@ -24,7 +24,9 @@ namespace dyad {
 class OutputRelay {
  public:
   OutputRelay(std::ostream& out, std::ostream& err);
-  // Reads until every pipe added so far has closed (every child exited), then stops.
+  // Reads until every pipe added so far has closed (every child exited), then stops; a pipe
+  // still open kCloseGraceMs after that (held by a grandchild) is closed unread.
+  static constexpr int kCloseGraceMs = 2000;
   ~OutputRelay();
   OutputRelay(const OutputRelay&) = delete;
   OutputRelay& operator=(const OutputRelay&) = delete;

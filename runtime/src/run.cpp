@@ -4,12 +4,14 @@
 
 
 #include <atomic>
+#include <condition_variable>
 #include <thread>
 #include <cstdlib>
 #include <cstdio>
 #include <chrono>
 #include <iomanip>
 #include <iostream>
+#include <mutex>
 #include <set>
 
 #include "dyad/catalog.hpp"
@@ -41,7 +43,7 @@ std::set<std::string> ProcessesToCheck(const Graph& g, const RunOptions* run) {
   std::set<std::string> here;
   for (const auto& p : g.ProcessNames())
     for (const auto& pc : g.processes)
-      if (pc.name == p && pc.host == ThisHost(*run)) here.insert(p);
+      if (pc.name == p && RunsHere(pc.host, *run)) here.insert(p);
   return here.empty() ? std::set<std::string>{""} : here;  // {""}: none (only the discovery server)
 }
 
@@ -116,7 +118,7 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   const std::set<std::string> procs = l.graph.ProcessNames();
   std::string process = options.process;
   if (process.empty()) {
-    if (NeedsLauncher(l.graph, ThisHost(options))) return LaunchChildren(options, l.graph, out, err);
+    if (NeedsLauncher(l.graph, options)) return LaunchChildren(options, l.graph, out, err);
     process = *procs.begin();
   } else if (!procs.count(process)) {
     std::string list;
@@ -134,17 +136,25 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   Status result;
   std::vector<Executor::Row> rows;
   int mismatches = 0, signal = 0;
+  // A process that cannot stop (a component or the DDS stack stuck) must not outlive its
+  // launcher unseen: kStopGraceS after a signal it exits anyway, saying so, unless the run has
+  // ended by then (the guard is cancelled when RunGraph returns).
+  std::mutex guard_mutex;
+  std::condition_variable guard_cv;
+  bool run_over = false;
+  std::thread guard;
   {
     InterruptWatcher interrupt([&](int sig) {
       if (Executor* ex = current.load()) ex->RequestStop(SignalName(sig));
-      // A process that cannot stop (a component or the DDS stack stuck) must not outlive its
-      // launcher unseen: after kStopGraceS it exits anyway, saying so.
-      std::thread([sig] {
-        std::this_thread::sleep_for(std::chrono::duration<double>(kStopGraceS));
+      std::lock_guard<std::mutex> lock(guard_mutex);
+      if (guard.joinable() || run_over) return;
+      guard = std::thread([&, sig] {
+        std::unique_lock<std::mutex> lock(guard_mutex);
+        if (guard_cv.wait_for(lock, std::chrono::duration<double>(kStopGraceS), [&] { return run_over; })) return;
         std::fprintf(stderr, "dyad run: did not stop within %g s of %s: exiting without a clean shutdown\n", kStopGraceS,
                      SignalName(sig));
         std::_Exit(ExitCodeForSignal(sig));
-      }).detach();
+      });
     });
     Executor ex(l.graph, l.resolved, &l.catalog, eo);
     current.store(&ex);
@@ -154,7 +164,13 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
     mismatches = ex.type_mismatches();
     current.store(nullptr);
     signal = interrupt.signal();
-  }
+    {
+      std::lock_guard<std::mutex> lock(guard_mutex);
+      run_over = true;
+    }
+    guard_cv.notify_all();
+  }  // the signal thread has ended: `guard` is no longer written
+  if (guard.joinable()) guard.join();
   if (!options.quiet) PrintReport(rows, process, out);
   if (signal != 0) {
     // A person stopped it: the run ended cleanly (recordings closed), but it did not finish.

@@ -12,12 +12,13 @@
 
 namespace dyad {
 
-bool StartBarrier::Awaited(const std::string& process) const {
-  if (process == process_) return true;
+bool StartBarrier::Required(const std::string& process) const {
   for (const auto& pc : graph_.processes)
     if (pc.name == process) return pc.required;
   return true;
 }
+
+bool StartBarrier::Awaited(const std::string& process) const { return process == process_ || Required(process); }
 
 StartBarrier::StartBarrier(const Graph& graph, std::string process, std::string host)
     : graph_(graph), process_(std::move(process)), host_(std::move(host)) {
@@ -104,11 +105,14 @@ StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
       return start_ns_;
     }
     std::string not_heard;
-    int64_t last_ready = ready_ns_;
+    // The start every process computes alike: from the required processes' ready times only (a
+    // process that is not required must not move it by being ready last).
+    int64_t last_ready = Required(process_) ? ready_ns_ : 0;
     for (const auto& p : processes) {
       const auto it = heard_.find(p);
-      const int64_t ready = p == process_ ? ready_ns_ : (it == heard_.end() ? 0 : it->second.ready_ns());
-      if (ready == 0 && p != process_)
+      if (p == process_) continue;
+      const int64_t ready = it == heard_.end() ? 0 : it->second.ready_ns();
+      if (ready == 0)
         not_heard += std::string(not_heard.empty() ? "" : ", ") + "'" + p + "'" +
                      (it == heard_.end() ? " (not seen)" : " (seen, its endpoints not all matched)");
       last_ready = std::max(last_ready, ready);

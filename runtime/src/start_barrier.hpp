@@ -63,6 +63,7 @@ class StartBarrier {
   // Whether the barrier waits for `process`: itself and every required process (one that is not
   // required joins when it comes; its endpoints are not counted).
   bool Awaited(const std::string& process) const;
+  bool Required(const std::string& process) const;  // `required:` of the process (default true)
   std::string MissingEndpoints(const std::vector<EndpointMatch>& matches) const;
   void TakeAnnouncements();
 

@@ -14,7 +14,7 @@
 //     peers: [10.0.0.9:7412]    # discovery: peers (default: every address in hosts)
 //     server: lab:11811         # discovery: server; a host of `hosts` (its launcher starts the
 //                               # server) or an address (started by you: `dyad discovery-server`)
-//     transport: shm+udp        # shm+udp (default) | udp
+//     transport: shm+udp        # shm+udp (default) | udp | tcp (each process: tcp_port)
 //     interfaces: [eth0]        # only these interfaces (names or addresses); default: all
 //     lease_s: 5                # a silent process is declared gone after this long
 //     start_timeout_s: 30       # how long a process waits for the others to start together
@@ -23,7 +23,7 @@
 //     main: {}
 //     robot: {host: robot-pc}   # host: where `dyad run` without --process starts it (default: here;
 //                               # when one process names its host, every process must)
-//     mind: {restart: on-failure, max_restarts: 3, backoff_s: 0.5, required: true}
+//     mind: {restart: on-failure, max_restarts: 3, backoff_s: 0.5, required: true, tcp_port: 7600}
 //                               # supervision: never (default) | on-failure | always
 //   topics:                     # optional per topic: type and QoS
 //     human/input: {type: HumanInput, reliability: reliable, depth: 1, deadline_ms: 200, liveliness_ms: 500}
@@ -83,7 +83,7 @@ struct TopicConfig {
 };
 
 enum class Discovery { kMulticast, kPeers, kServer };
-enum class NetTransport { kShmUdp, kUdp };
+enum class NetTransport { kShmUdp, kUdp, kTcp };
 
 // The `network:` section, mapped onto Fast DDS participant QoS by the runtime.
 struct NetworkConfig {
@@ -95,6 +95,8 @@ struct NetworkConfig {
   int server_port = 0;
   std::string server_host;                   // the host of `hosts` that runs the server; empty: external
   NetTransport transport = NetTransport::kShmUdp;
+  // transport: tcp: every process's listener, "address:port" (network.hosts[host]:tcp_port).
+  std::map<std::string, std::string> tcp_listeners;  // process -> address:port
   std::vector<std::string> interfaces;
   double lease_s = 5;
   double start_timeout_s = 30;
@@ -114,6 +116,7 @@ struct ProcessConfig {
   double backoff_s = 0.5;
   // A required process that fails for good ends the experiment; another one is left out.
   bool required = true;
+  int tcp_port = 0;  // network.transport: tcp: the port this process listens on
   SourceMark mark;
 };
 
