@@ -209,45 +209,26 @@ fi
 # Its counters, printed after the run: UDP to a group is what Fast DDS would send (SPDP on
 # 239.255.0.1); the other rule counts the rest, the kernel's own IGMP membership reports.
 # A dropped send fails with EPERM in the sender.
+# block_multicast [udp]: with `udp` (tcp mode) also every UDP datagram not on loopback, as on a
+# network that passes TCP only.
 block_multicast() {
-  local h
+  local h extra=""
+  [ "${1:-}" = udp ] && extra=1
   for h in "${hosts[@]}"; do
-    ip netns exec "${ns[$h]}" nft -f - <<'NFT'
-table ip dyad_multihost {
-  chain input {
-    type filter hook input priority 0; policy accept;
-    ip daddr 224.0.0.0/4 meta l4proto udp counter drop
-    ip daddr 224.0.0.0/4 counter drop
-  }
-  chain output {
-    type filter hook output priority 0; policy accept;
-    ip daddr 224.0.0.0/4 meta l4proto udp counter drop
-    ip daddr 224.0.0.0/4 counter drop
-  }
-}
-NFT
-  done
-}
-# tcp mode: no UDP at all between the hosts (nor multicast), as on a network that passes TCP only.
-block_udp() {
-  local h
-  for h in "${hosts[@]}"; do
-    ip netns exec "${ns[$h]}" nft -f - <<'NFT'
-table ip dyad_multihost {
-  chain input {
-    type filter hook input priority 0; policy accept;
-    ip daddr 224.0.0.0/4 meta l4proto udp counter drop
-    ip daddr 224.0.0.0/4 counter drop
-    iifname != "lo" meta l4proto udp counter drop
-  }
-  chain output {
-    type filter hook output priority 0; policy accept;
-    ip daddr 224.0.0.0/4 meta l4proto udp counter drop
-    ip daddr 224.0.0.0/4 counter drop
-    oifname != "lo" meta l4proto udp counter drop
-  }
-}
-NFT
+    {
+      echo 'table ip dyad_multihost {'
+      for chain in input output; do
+        local dev=iifname
+        [ $chain = output ] && dev=oifname
+        echo "  chain $chain {"
+        echo "    type filter hook $chain priority 0; policy accept;"
+        echo '    ip daddr 224.0.0.0/4 meta l4proto udp counter drop'
+        echo '    ip daddr 224.0.0.0/4 counter drop'
+        [ -n "$extra" ] && echo "    $dev != \"lo\" meta l4proto udp counter drop"
+        echo '  }'
+      done
+      echo '}'
+    } | ip netns exec "${ns[$h]}" nft -f -
   done
 }
 unblock_multicast() {
@@ -417,7 +398,7 @@ run_mode() {
   declare -A lpid
   mkdir -p "$out"
   if [ "$mode" = peers ] || [ "$mode" = server ]; then block_multicast; fi
-  [ "$mode" = tcp ] && block_udp
+  [ "$mode" = tcp ] && block_multicast udp
   local discovery=$mode
   [ "$mode" = faults ] && discovery=multicast
   [ "$mode" = tcp ] && discovery=peers

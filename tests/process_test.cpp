@@ -347,6 +347,15 @@ pid_t ChildPid(const fs::path& graph, const std::string& process) {
   return 0;
 }
 
+// ChildPid, waiting up to 5 s for the launcher to start that child; 0 if it did not.
+pid_t AwaitChildPid(const fs::path& graph, const std::string& process) {
+  for (int i = 0; i < 100; ++i) {
+    if (const pid_t pid = ChildPid(graph, process)) return pid;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return 0;
+}
+
 // `dyad status` on a split graph whose second process's clock is 25 ms ahead (the test-only
 // DYAD_TEST_CLOCK_OFFSET_MS): both processes listed with their hosts and pids, the offset
 // measured within 1 ms both ways, and the warning said by the process that measured it.
@@ -394,8 +403,7 @@ TEST_F(ProcessTest, SupervisorRestartsAKilledProcessAndItRejoinsTheRunningGraph)
                                          "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " +
                                          out.string() + "}, inputs: {in: count}}\n");
   Child c(Dyad({"run", g.string(), "--steps", "200", "--logs", (dir_ / "logs").string()}), dir_, "restart");  // 10 s
-  pid_t b = 0;
-  for (int i = 0; i < 100 && (b = ChildPid(g, "b")) == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const pid_t b = AwaitChildPid(g, "b");
   ASSERT_NE(b, 0);
   std::this_thread::sleep_for(std::chrono::seconds(3));
   ASSERT_EQ(kill(b, SIGKILL), 0);
@@ -427,8 +435,7 @@ TEST_F(ProcessTest, AnInputSeesItsWriterGoWhenTheWritersProcessIsKilled) {
                                          "  src: {type: counter_source, rate_hz: 20, process: a, outputs: {out: count}}\n"
                                          "  sink: {type: counter_sink, rate_hz: 20, process: b, inputs: {in: count}}\n");
   Child c(Dyad({"run", g.string(), "--duration", "6"}), dir_, "health");
-  pid_t a = 0;
-  for (int i = 0; i < 100 && (a = ChildPid(g, "a")) == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const pid_t a = AwaitChildPid(g, "a");
   ASSERT_NE(a, 0);
   std::this_thread::sleep_for(std::chrono::seconds(3));
   ASSERT_EQ(kill(a, SIGKILL), 0);
@@ -436,6 +443,18 @@ TEST_F(ProcessTest, AnInputSeesItsWriterGoWhenTheWritersProcessIsKilled) {
   EXPECT_NE(c.err().find("[b] [info] sink: writers of 'count' alive: 0 -> 1"), std::string::npos) << c.err();
   EXPECT_NE(c.err().find("[b] [info] sink: writers of 'count' alive: 1 -> 0"), std::string::npos) << c.err();
   EXPECT_NE(c.err().find("process 'a' exited with 137 (SIGKILL); it is not required"), std::string::npos) << c.err();
+}
+
+// restart: always restarts a clean exit only in a run without an end: with --steps, the clean
+// exit is the end of the run.
+TEST_F(ProcessTest, AlwaysDoesNotRestartTheCleanEndOfARunWithSteps) {
+  const fs::path g = Write("g.yaml", "graph: always\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\nprocesses: {a: {restart: always}, b: {restart: always}}\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 20, process: a, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: b, inputs: {in: count}}\n");
+  Child c(Dyad({"run", g.string(), "--steps", "20"}), dir_, "always");
+  ASSERT_EQ(c.Wait(60), 0) << c.err();
+  EXPECT_EQ(c.err().find("restarting"), std::string::npos) << c.err();
 }
 
 TEST_F(ProcessTest, ARequiredProcessThatKeepsFailingEndsTheRunAndIsNamed) {
