@@ -41,17 +41,21 @@ int main(int argc, char** argv) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  uint64_t fed = 0;
+  uint64_t fed = 0, dropped = 0;
+  auto take_drops = [&] {  // while the client is connected: its counts go with it
+    for (auto c : (*server)->clients())
+      for (const auto& [ch, n] : (*server)->TakeDrops(c)) dropped += n;
+  };
   while (std::chrono::steady_clock::now() < end) {
-    for (int i = 0; i < 64; ++i, ++fed) {
+    for (int i = 0; i < 4096; ++i, ++fed) {
       s.source_stamp_ns = static_cast<int64_t>(fed);
       bridge.OnSample(1, s);
     }
+    take_drops();
   }
-  uint64_t dropped = 0;
-  for (auto c : (*server)->clients())
-    for (const auto& [ch, n] : (*server)->TakeDrops(c)) dropped += n;
-  std::fprintf(stderr, "fed %llu samples in %.1f s (%.0f/s), dropped %llu in the client's buffer\n",
-               static_cast<unsigned long long>(fed), seconds, fed / seconds, static_cast<unsigned long long>(dropped));
+  take_drops();
+  std::fprintf(stderr, "fed %llu samples in %.1f s (%.0f/s), %llu while the client was subscribed, %llu of them dropped in its buffer\n",
+               static_cast<unsigned long long>(fed), seconds, fed / seconds,
+               static_cast<unsigned long long>(bridge.samples_sent()), static_cast<unsigned long long>(dropped));
   return 0;
 }

@@ -5,7 +5,7 @@
 #   2. Foxglove bridge throughput to one client: bench_bridge feeds the bridge 100-byte samples as
 #      fast as one thread can (no graph in the way); samples/s the client receives;
 #   3. the experiment's step time p99 at 100 Hz (wall) with 0 and with 4 Foxglove clients
-#      subscribed to every topic: 3 alternating pairs of 15 s runs, median p99 of each.
+#      subscribed to every topic: 5 alternating pairs of 15 s runs, median p99 of each.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
 build=${1:-$here/build}
@@ -50,11 +50,11 @@ throughput=$(node "$node_dir/bench_clients.mjs" foxglove "ws://127.0.0.1:$port" 
 wait $BRIDGE_PID || true
 throughput="$throughput; bridge: $(cat bridge.err)"
 
-# Three alternating pairs of runs; the median p99 of each condition (one run's p99 of a 0.1 ms
+# Five alternating pairs of runs; the median p99 of each condition (one run's p99 of a 0.1 ms
 # step on a shared 2-core machine moves by 2x from run to run).
 median() { sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 : > base_p.txt; : > base_d.txt; : > four_p.txt; : > four_d.txt
-for _ in 1 2 3; do
+for _ in 1 2 3 4 5; do
   start wall.yaml --duration 15
   wait $pid
   p99 pattern >> base_p.txt; p99 driver >> base_d.txt
@@ -71,7 +71,9 @@ echo "| --- | --- |"
 echo "| pointer event (page's wall stamp) -> published on the graph | $arrival |"
 echo "| pointer round trip page -> component -> page (500 moves) | $pointer |"
 echo "| bridge to one client, 100-byte samples | $throughput |"
-echo "| step p99 at 100 Hz, 0 clients (median of 3 runs): pattern / driver | $base_pattern / $base_driver ms |"
-echo "| step p99 at 100 Hz, 4 clients (median of 3 runs): pattern / driver | $four_pattern / $four_driver ms |"
+echo "| step p99 at 100 Hz, 0 clients (median of 5 runs): pattern / driver | $base_pattern / $base_driver ms |"
+echo "| step p99 at 100 Hz, 4 clients (median of 5 runs): pattern / driver | $four_pattern / $four_driver ms |"
+echo "| each run's p99, 0 clients: pattern / driver | $(paste -sd' ' base_p.txt) / $(paste -sd' ' base_d.txt) ms |"
+echo "| each run's p99, 4 clients: pattern / driver | $(paste -sd' ' four_p.txt) / $(paste -sd' ' four_d.txt) ms |"
 awk -v a="$base_pattern" -v b="$four_pattern" -v c="$base_driver" -v d="$four_driver" \
   'BEGIN { printf "| p99 ratio 4 clients / 0: pattern %.2f, driver %.2f |  |\n", b / a, d / c }'

@@ -174,9 +174,9 @@ Status WebComponent::Configure(Context& ctx) {
   options_.pages["/subject"] = WebServer::Page{"text/html; charset=utf-8", kSubjectHtml, ""};
   options_.pages["/experimenter"] = WebServer::Page{"text/html; charset=utf-8", kExperimenterHtml, ""};
   options_.endpoints = {
-      WebServer::Endpoint{"/", {foxglove::kSubprotocol, foxglove::kSubprotocolSdk}, bridge_.get()},
+      WebServer::Endpoint{"/", {foxglove::kSubprotocol, foxglove::kSubprotocolSdk}, bridge_.get(), /*background=*/true},
       WebServer::Endpoint{"/subject/ws", {}, subject_.get()},
-      WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get()},
+      WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get(), /*background=*/true},
   };
   FoxgloveBridge* bridge = bridge_.get();
   for (const auto& c : channels) {

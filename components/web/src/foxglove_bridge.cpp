@@ -20,7 +20,9 @@ void FoxgloveBridge::OnSample(uint32_t channel_id, const SerializedSample& sampl
   WebServer* server = server_.load();
   if (server == nullptr) return;
   const uint64_t stamp = sample.source_stamp_ns > 0 ? static_cast<uint64_t>(sample.source_stamp_ns) : 0;
-  for (const auto& [client, sub] : to) server->SendData(client, channel_id, foxglove::MessageData(sub, stamp, sample.cdr));
+  // One copy of the sample, shared by every client's frame (a 13-byte head each, no allocation).
+  auto payload = std::make_shared<const std::string>(reinterpret_cast<const char*>(sample.cdr.data()), sample.cdr.size());
+  for (const auto& [client, sub] : to) server->SendShared(client, channel_id, foxglove::MessageDataHead(sub, stamp), payload);
 }
 
 void FoxgloveBridge::ReportDrops() {

@@ -69,12 +69,16 @@ std::string StatusMessage(Level level, const std::string& message) {
       -1, ' ', false, json::error_handler_t::replace);
 }
 
-std::string MessageData(uint32_t subscription_id, uint64_t timestamp_ns, std::span<const uint8_t> payload) {
+std::string MessageDataHead(uint32_t subscription_id, uint64_t timestamp_ns) {
   std::string out;
-  out.reserve(1 + 4 + 8 + payload.size());
   out.push_back(0x01);
   PutLe(&out, subscription_id, 4);
   PutLe(&out, timestamp_ns, 8);
+  return out;
+}
+
+std::string MessageData(uint32_t subscription_id, uint64_t timestamp_ns, std::span<const uint8_t> payload) {
+  std::string out = MessageDataHead(subscription_id, timestamp_ns);
   out.append(reinterpret_cast<const char*>(payload.data()), payload.size());
   return out;
 }

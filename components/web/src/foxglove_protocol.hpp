@@ -39,6 +39,8 @@ std::string Advertise(const std::vector<Channel>& channels);
 std::string StatusMessage(Level level, const std::string& message);
 // The binary Message Data frame for one sample: its CDR bytes with encapsulation, as is.
 std::string MessageData(uint32_t subscription_id, uint64_t timestamp_ns, std::span<const uint8_t> payload);
+// Its 13-byte head (opcode, subscription id, stamp): the bridge sends head + one shared payload.
+std::string MessageDataHead(uint32_t subscription_id, uint64_t timestamp_ns);
 
 struct Subscribe {
   std::vector<std::pair<uint32_t, uint32_t>> subscriptions;  // (subscription id, channel id)

@@ -7,9 +7,18 @@
 /// new frame fits (a big, busy topic cannot starve the small ones, foxglove_bridge's lesson).
 /// Drops are counted per channel for the status message the sender reports.
 ///
+/// Waking the consumer. A producer is a graph thread in the middle of a step: waking a sender
+/// thread per sample made the sender preempt the graph on a two-core machine. So data is handed
+/// out in batches, at most once per `flush_interval`: a stream faster than that is collected by
+/// the consumer's own timer and its producers never wake anyone; the first sample after a quiet
+/// spell (a sparse stream, a page's 30 Hz robot state) wakes the consumer at once. An idle
+/// client's consumer sleeps until there is something to send (no polling). Control frames and
+/// Close() always wake it at once.
+///
+/// Memory: at most `limit_bytes` queued, plus the batch the consumer is writing.
+///
 /// Thread-safe: any number of producers, one consumer (the client's sender thread) blocking in
-/// Pop(). Control frames and Close() wake the consumer at once; data frames are picked up within
-/// kBatch (a producer never pays for waking the consumer).
+/// PopAll().
 #pragma once
 
 #include <chrono>
@@ -17,6 +26,7 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -25,25 +35,34 @@ namespace dyad::web {
 
 struct Frame {
   bool binary = false;
-  std::string bytes;
-  uint32_t channel = 0;  // data frames: their channel; 0 for control frames
-  uint64_t order = 0;    // push order (data frames leave in push order)
+  std::string bytes;                        // the frame, or its head when `tail` is set
+  std::shared_ptr<const std::string> tail;  // appended to `bytes`: one sample shared by every client's frame
+  uint32_t channel = 0;                     // data frames: their channel; 0 for control frames
+  uint64_t order = 0;                       // push order (data frames leave in push order)
+  size_t size() const { return bytes.size() + (tail ? tail->size() : 0); }
 };
 
 class SendQueue {
  public:
-  explicit SendQueue(size_t limit_bytes) : limit_(limit_bytes) {}
+  // One 60 Hz display frame: what a viewer cannot tell from "at once".
+  static constexpr std::chrono::milliseconds kDefaultFlushInterval{16};
+
+  explicit SendQueue(size_t limit_bytes, std::chrono::steady_clock::duration flush_interval = kDefaultFlushInterval)
+      : limit_(limit_bytes), flush_interval_(flush_interval) {}
 
   // Queues a control frame (never dropped).
   void PushControl(std::string json);
-  // Queues a data frame of `channel`; drops the busiest channel's oldest frames to stay within
-  // the limit. A frame larger than the whole limit is dropped itself. Returns false if dropped.
-  bool PushData(uint32_t channel, std::string bytes, bool binary = true);
+  // Queues a data frame of `channel` (`bytes` followed by `tail`, when given); drops the busiest
+  // channel's oldest frames to stay within the limit. A frame larger than the whole limit is
+  // dropped itself. Returns false if dropped.
+  bool PushData(uint32_t channel, std::string bytes, bool binary = true, std::shared_ptr<const std::string> tail = nullptr);
   // Queues a data frame that replaces any frame of `channel` still queued (newest only: a slow
   // page gets the latest robot state, never a backlog).
   void PushLatest(uint32_t channel, std::string bytes, bool binary = true);
-  // Waits for the next frame; false once closed (frames still queued are discarded).
-  bool Pop(Frame* out);
+  // Waits until there is something to send (see "Waking the consumer"), then moves every queued
+  // frame to `out` (replacing its contents): control frames first, then data in push order.
+  // False once closed (frames still queued are discarded).
+  bool PopAll(std::vector<Frame>* out);
   void Close();
 
   // Drops per channel since the last call (and resets them).
@@ -51,12 +70,14 @@ class SendQueue {
   size_t queued_bytes() const;
 
  private:
-  static constexpr std::chrono::milliseconds kBatch{2};
   bool HasData() const;  // REQUIRES: mutex_ held
   const size_t limit_;
+  const std::chrono::steady_clock::duration flush_interval_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
   bool closed_ = false;
+  bool consumer_idle_ = false;  // the consumer waits with nothing queued: the next push wakes it
+  std::chrono::steady_clock::time_point last_flush_{};
   uint64_t next_order_ = 0;
   size_t bytes_ = 0;  // data frames only
   std::deque<std::string> control_;

@@ -1,6 +1,8 @@
 #include "web_server.hpp"
 
 #include <civetweb.h>
+#include <pthread.h>
+#include <sched.h>
 
 #include <atomic>
 #include <condition_variable>
@@ -84,6 +86,7 @@ class WebServer::HandlerThread {
 struct WebServer::EndpointState {
   WebServer* server = nullptr;
   ClientHandler* handler = nullptr;
+  bool background = false;
   std::vector<const char*> protocol_ptrs;
   mg_websocket_subprotocols protocols{};
 };
@@ -126,6 +129,7 @@ StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
     auto st = std::make_unique<EndpointState>();
     st->server = s.get();
     st->handler = e.handler;
+    st->background = e.background;
     for (const auto& p : e.subprotocols) st->protocol_ptrs.push_back(p.c_str());
     st->protocols.nb_subprotocols = static_cast<int>(st->protocol_ptrs.size());
     st->protocols.subprotocols = st->protocol_ptrs.data();
@@ -199,13 +203,28 @@ void WebServer::OnReady(mg_connection* conn, void* endpoint) {
     self->by_conn_[conn] = {c->id, handler};
   }
   Client* raw = c.get();
-  c->sender = std::thread([raw] {
-    Frame f;
-    while (raw->queue.Pop(&f)) {
-      std::lock_guard<std::mutex> lock(raw->write_mutex);
-      if (raw->closed) break;
-      const int op = f.binary ? MG_WEBSOCKET_OPCODE_BINARY : MG_WEBSOCKET_OPCODE_TEXT;
-      if (mg_websocket_write(raw->conn, op, f.bytes.data(), f.bytes.size()) <= 0) break;
+  const bool background = static_cast<EndpointState*>(endpoint)->background;
+  c->sender = std::thread([raw, background] {
+    if (background) {
+      // A viewer's frames wait for idle CPU: the graph's threads are never preempted for them
+      // (a slow viewer loses samples instead, see SendQueue).
+      sched_param idle{};
+      pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle);  // may fail (seccomp): then it runs as before
+    }
+    std::vector<Frame> batch;
+    std::string joined;  // a head and its shared tail, written as one frame
+    while (raw->queue.PopAll(&batch)) {
+      for (const Frame& f : batch) {
+        const std::string* bytes = &f.bytes;
+        if (f.tail) {
+          joined.assign(f.bytes).append(*f.tail);
+          bytes = &joined;
+        }
+        std::lock_guard<std::mutex> lock(raw->write_mutex);
+        if (raw->closed) return;
+        const int op = f.binary ? MG_WEBSOCKET_OPCODE_BINARY : MG_WEBSOCKET_OPCODE_TEXT;
+        if (mg_websocket_write(raw->conn, op, bytes->data(), bytes->size()) <= 0) return;
+      }
     }
   });
   handler->OnOpen(c->id);
@@ -286,6 +305,10 @@ void WebServer::SendText(ClientId client, std::string json) {
 
 void WebServer::SendData(ClientId client, uint32_t channel, std::string frame) {
   if (auto c = Find(client)) c->queue.PushData(channel, std::move(frame));
+}
+
+void WebServer::SendShared(ClientId client, uint32_t channel, std::string head, std::shared_ptr<const std::string> tail) {
+  if (auto c = Find(client)) c->queue.PushData(channel, std::move(head), /*binary=*/true, std::move(tail));
 }
 
 void WebServer::SendLatest(ClientId client, uint32_t channel, std::string frame, bool binary) {

@@ -61,6 +61,9 @@ class WebServer {
     std::string uri;                        // e.g. "/"
     std::vector<std::string> subprotocols;  // empty: any
     ClientHandler* handler = nullptr;
+    // Its clients are viewers (the Foxglove bridge): their sender threads run at SCHED_IDLE, so
+    // they never take a core from the graph; under full load they fall behind and drop samples.
+    bool background = false;
   };
   struct Options {
     std::string address = "127.0.0.1";
@@ -84,6 +87,8 @@ class WebServer {
   // Queue frames for a client (dropped silently if it is gone).
   void SendText(ClientId client, std::string json);
   void SendData(ClientId client, uint32_t channel, std::string frame);
+  // A binary data frame `head` + `*tail`: one copy of a sample shared by every client's frame.
+  void SendShared(ClientId client, uint32_t channel, std::string head, std::shared_ptr<const std::string> tail);
   // Newest only (see SendQueue::PushLatest); a text frame unless `binary`.
   void SendLatest(ClientId client, uint32_t channel, std::string frame, bool binary);
   // Per-channel drops of a client since the last call.

@@ -1,13 +1,24 @@
 // SendQueue: bounded, never blocks producers, drops the busiest channel's oldest frames first,
-// never drops control frames, keeps data in push order.
+// never drops control frames, keeps data in push order; hands a stream out in batches at most
+// once per flush interval, and wakes an idle consumer at once.
 #include "send_queue.hpp"
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <thread>
 
 namespace dyad::web {
 namespace {
+
+using std::chrono::milliseconds;
+using Clock = std::chrono::steady_clock;
+
+std::vector<std::string> Texts(const std::vector<Frame>& frames) {
+  std::vector<std::string> out;
+  for (const auto& f : frames) out.push_back(f.bytes + (f.tail ? *f.tail : ""));
+  return out;
+}
 
 TEST(SendQueue, KeepsPushOrderAcrossChannelsAndControlFirst) {
   SendQueue q(1000);
@@ -15,13 +26,9 @@ TEST(SendQueue, KeepsPushOrderAcrossChannelsAndControlFirst) {
   q.PushData(2, "b1");
   q.PushData(1, "a2");
   q.PushControl("{c}");
-  Frame f;
-  std::vector<std::string> out;
-  for (int i = 0; i < 4; ++i) {
-    ASSERT_TRUE(q.Pop(&f));
-    out.push_back(f.bytes);
-  }
-  EXPECT_EQ(out, (std::vector<std::string>{"{c}", "a1", "b1", "a2"}));
+  std::vector<Frame> batch;
+  ASSERT_TRUE(q.PopAll(&batch));
+  EXPECT_EQ(Texts(batch), (std::vector<std::string>{"{c}", "a1", "b1", "a2"}));
   EXPECT_EQ(q.queued_bytes(), 0u);
 }
 
@@ -34,10 +41,9 @@ TEST(SendQueue, DropsTheBusiestChannelsOldestFramesWhenFull) {
   auto drops = q.TakeDrops();
   EXPECT_EQ(drops, (std::map<uint32_t, uint64_t>{{2, 1}}));
   EXPECT_TRUE(q.TakeDrops().empty());
-  Frame f;
-  std::vector<std::string> out;
-  while (q.queued_bytes() > 0 && q.Pop(&f)) out.push_back(f.bytes);
-  EXPECT_EQ(out, (std::vector<std::string>{small, big + "1", big + "2", small}));
+  std::vector<Frame> batch;
+  ASSERT_TRUE(q.PopAll(&batch));
+  EXPECT_EQ(Texts(batch), (std::vector<std::string>{small, big + "1", big + "2", small}));
 }
 
 TEST(SendQueue, NeverExceedsTheLimitAndNeverBlocksAProducer) {
@@ -58,12 +64,88 @@ TEST(SendQueue, AFrameLargerThanTheLimitIsDroppedItself) {
 TEST(SendQueue, CloseWakesTheConsumer) {
   SendQueue q(10);
   std::thread t([&] {
-    Frame f;
-    EXPECT_FALSE(q.Pop(&f));
+    std::vector<Frame> batch;
+    EXPECT_FALSE(q.PopAll(&batch));
   });
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
   q.Close();
   t.join();
+}
+
+TEST(SendQueue, ASharedTailCountsAndIsSentAfterItsHead) {
+  SendQueue q(30);
+  auto sample = std::make_shared<const std::string>("0123456789");
+  EXPECT_TRUE(q.PushData(1, "h1", true, sample));  // 2 + 10 bytes
+  EXPECT_TRUE(q.PushData(2, "h2", true, sample));
+  EXPECT_EQ(q.queued_bytes(), 24u);
+  EXPECT_TRUE(q.PushData(3, "h3", true, sample));  // 36 > 30: channel 1 (tied busiest, first) loses its frame
+  EXPECT_EQ(q.queued_bytes(), 24u);
+  EXPECT_EQ(q.TakeDrops(), (std::map<uint32_t, uint64_t>{{1, 1}}));
+  std::vector<Frame> batch;
+  ASSERT_TRUE(q.PopAll(&batch));
+  EXPECT_EQ(Texts(batch), (std::vector<std::string>{"h20123456789", "h30123456789"}));
+}
+
+// The first sample after a quiet spell is handed out at once, even with a long interval.
+TEST(SendQueue, AnIdleConsumerIsWokenByTheFirstSample) {
+  SendQueue q(1000, std::chrono::hours(1));
+  std::atomic<int> batches{0};
+  std::thread consumer([&] {
+    std::vector<Frame> batch;
+    while (q.PopAll(&batch)) ++batches;
+  });
+  q.PushData(1, "first");  // the consumer may not wait yet: then it finds the frame
+  while (batches.load() < 1) std::this_thread::sleep_for(milliseconds(1));
+  q.Close();
+  consumer.join();
+  EXPECT_EQ(batches.load(), 1);
+}
+
+// After a batch, data waits for the interval (no wake-up per sample); a control frame does not.
+TEST(SendQueue, DataRightAfterABatchWaitsForTheIntervalButControlDoesNot) {
+  SendQueue q(1000, std::chrono::hours(1));
+  std::vector<Frame> batch;
+  q.PushData(1, "a");
+  ASSERT_TRUE(q.PopAll(&batch));  // the first batch: at once
+  q.PushData(1, "b");
+  std::atomic<bool> returned{false};
+  std::thread consumer([&] {
+    std::vector<Frame> second;
+    EXPECT_TRUE(q.PopAll(&second));
+    EXPECT_EQ(Texts(second), (std::vector<std::string>{"{c}", "b"}));
+    returned = true;
+  });
+  std::this_thread::sleep_for(milliseconds(200));
+  EXPECT_FALSE(returned.load()) << "data woke the consumer inside the interval";
+  q.PushControl("{c}");
+  consumer.join();
+  EXPECT_TRUE(returned.load());
+}
+
+// A fast stream is collected in batches: at most one per interval (plus the first).
+TEST(SendQueue, AFastStreamIsHandedOutAtMostOncePerInterval) {
+  const auto interval = milliseconds(20);
+  SendQueue q(1 << 20, interval);
+  std::atomic<int> batches{0}, frames{0};
+  std::thread consumer([&] {
+    std::vector<Frame> batch;
+    while (q.PopAll(&batch)) {
+      ++batches;
+      frames += static_cast<int>(batch.size());
+    }
+  });
+  const auto start = Clock::now();
+  for (int i = 0; i < 2000; ++i) {  // about 5 kHz for about 0.4 s
+    q.PushData(1, std::string(100, 'x'));
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  while (frames.load() < 2000) std::this_thread::sleep_for(milliseconds(1));
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  q.Close();
+  consumer.join();
+  EXPECT_EQ(frames.load(), 2000);
+  EXPECT_LE(batches.load(), elapsed / 0.020 + 2) << "over " << elapsed << " s";
+  EXPECT_GE(batches.load(), 2);
 }
 
 }  // namespace
