@@ -3,7 +3,7 @@
 # (4 connections at a time) and a client that subscribes to everything and never reads, while a
 # wall-clock graph runs at 100 Hz. Each bad client is closed with a reason, the server still
 # answers afterwards, the process stays small, and the graph keeps its rate and exits 0.
-# (Step-time p99 with and without clients is compared in bench/web, not here: timing.)
+# (Step-time p99 with and without these clients is compared in bench/web, not here: timing.)
 #   hostile_test.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 build=$1
