@@ -333,6 +333,31 @@ TEST_P(DiscoveryModeTest, ProcessesStartedApartStartTogetherAndLoseNothing) {
 INSTANTIATE_TEST_SUITE_P(Modes, DiscoveryModeTest, ::testing::Values("multicast", "peers", "server"),
                          [](const auto& info) { return std::string(info.param); });
 
+// `dyad discovery-server` refuses what it cannot listen on, naming --listen, with a non-zero exit;
+// a second server on a taken port fails and says so, and the first keeps running.
+TEST_F(ProcessTest, DiscoveryServerRefusesABadListenAddress) {
+  struct Case {
+    const char* listen;
+    const char* says;
+  };
+  for (const Case& c : {Case{"11811", "expected ADDRESS:PORT"}, Case{"127.0.0.1:0", "expected ADDRESS:PORT"},
+                        Case{"127.0.0.1:70000", "expected ADDRESS:PORT"}, Case{"127.0.0.1:x", "expected ADDRESS:PORT"},
+                        Case{"no-such-host.invalid:11811", "--listen no-such-host.invalid:11811"},
+                        Case{"192.0.2.1:11811", "cannot listen on 192.0.2.1:11811"}}) {
+    Child d(Dyad({"discovery-server", "--listen", c.listen}), dir_, "bad");
+    EXPECT_NE(d.Wait(30), 0) << c.listen;
+    EXPECT_NE(d.err().find(c.says), std::string::npos) << c.listen << ": " << d.err();
+  }
+  const std::string listen = "127.0.0.1:" + std::to_string(22000 + domain_);
+  Child first(Dyad({"discovery-server", "--listen", listen}), dir_, "first");
+  ASSERT_TRUE(first.WaitForOutput("listening on " + listen, 10)) << first.err();
+  Child second(Dyad({"discovery-server", "--listen", listen}), dir_, "second");
+  EXPECT_EQ(second.Wait(30), 1) << second.out() << second.err();
+  EXPECT_NE(second.err().find("cannot listen on " + listen), std::string::npos) << second.err();
+  first.Signal(SIGINT);
+  EXPECT_EQ(first.Wait(30), 128 + SIGINT) << first.err();  // dyad's exit code for a signal
+}
+
 // The pid of the `dyad run ... --process P` child whose command line holds `graph`, or 0.
 pid_t ChildPid(const fs::path& graph, const std::string& process) {
   for (const auto& entry : fs::directory_iterator("/proc")) {

@@ -1,6 +1,13 @@
 #include "dyad/discovery_server.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <condition_variable>
+#include <cstring>
 #include <mutex>
 #include <ostream>
 #include <sstream>
@@ -17,6 +24,27 @@ namespace fdds = eprosima::fastdds::dds;
 namespace rtps = eprosima::fastrtps::rtps;
 
 namespace dyad {
+namespace {
+
+// OK when a UDP socket can be bound to address:port on this machine now.
+Status CanBindUdp(const std::string& address, int port) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  if (fd < 0) return Status::IOError(std::string("socket: ") + std::strerror(errno));
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<uint16_t>(port));
+  ::inet_pton(AF_INET, address.c_str(), &a.sin_addr);
+  const int rc = ::bind(fd, reinterpret_cast<const sockaddr*>(&a), sizeof(a));
+  const int error = errno;
+  ::close(fd);
+  if (rc == 0) return Status::OK();
+  const std::string where = "cannot listen on " + address + ":" + std::to_string(port);
+  if (error == EADDRNOTAVAIL) return Status::InvalidArgument(where + ": " + address + " is not an address of this machine");
+  if (error == EADDRINUSE) return Status::IOError(where + ": the port is taken");
+  return Status::IOError(where + ": " + std::strerror(error));
+}
+
+}  // namespace
 
 int RunDiscoveryServer(const std::string& listen, std::ostream& out, std::ostream& err) {
   const auto colon = listen.rfind(':');
@@ -32,6 +60,12 @@ int RunDiscoveryServer(const std::string& listen, std::ostream& out, std::ostrea
   if (!address.ok()) {
     err << "dyad discovery-server: --listen " << listen << ": " << address.status().message() << "\n";
     return 2;
+  }
+  // Fast DDS opens its socket on every interface and would announce any address given, so a
+  // wrong one (not this machine's) would run and never be reached: bind it ourselves first.
+  if (Status here = CanBindUdp(address.value(), port); !here.ok()) {
+    err << "dyad discovery-server: --listen " << listen << ": " << here.message() << "\n";
+    return 1;
   }
   std::mutex mutex;
   std::condition_variable cv;

@@ -8,8 +8,9 @@
 // graph's processes; run it by hand for a server on a machine that runs no process of the graph.
 //
 // It runs until a signal, and returns 128 + signal then (the launcher's SIGTERM is its normal
-// end); 2 for a bad address, 1 when Fast DDS cannot create the server (the port is taken, the
-// address is not this machine's).
+// end); 2 for a malformed or unresolvable --listen, 1 when it cannot listen there (the port is
+// taken, the address is not this machine's: checked by binding it first, since Fast DDS would
+// open every interface, announce the wrong address and never be reached).
 #pragma once
 
 #include <iosfwd>
