@@ -381,6 +381,35 @@ pid_t AwaitChildPid(const fs::path& graph, const std::string& process) {
   return 0;
 }
 
+// A required process killed on one host, with no restart left, ends the run on every host: its
+// launcher announces the failure on dyad/processes, the other host's launcher stops its own
+// processes (cleanly: SIGTERM) and exits 1 naming the process and its host. In each discovery
+// mode; with a server, the failing host runs it (it must outlive the announcement).
+TEST_P(DiscoveryModeTest, ARequiredProcessFailingOnOneHostEndsTheRunOnEveryHost) {
+  const int server_port = 21000 + domain_;
+  const fs::path out = dir_ / "sink.txt";
+  const fs::path g = Write("g.yaml", "graph: hosts\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\nnetwork:\n  discovery: " + GetParam() + "\n  hosts: {h1: 127.0.0.1, h2: 127.0.0.1}\n  server: h2:" +
+                                         std::to_string(server_port) + "\n  start_timeout_s: 20\n"
+                                         "processes: {a: {host: h1}, b: {host: h2}}\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 50, process: a, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " + out.string() +
+                                         "}, inputs: {in: count}}\n");
+  Child h1(Dyad({"run", g.string(), "--host", "h1"}), dir_, "h1");  // runs until told otherwise
+  Child h2(Dyad({"run", g.string(), "--host", "h2"}), dir_, "h2");
+  for (int i = 0; i < 400 && ReadSink(out).size() < 10; ++i) usleep(50'000);
+  ASSERT_GE(ReadSink(out).size(), 10u) << h1.err() << h2.err();
+  const pid_t b = AwaitChildPid(g, "b");
+  ASSERT_GT(b, 0);
+  ASSERT_EQ(kill(b, SIGKILL), 0);
+  EXPECT_EQ(h2.Wait(30), 137) << h2.err();
+  EXPECT_NE(h2.err().find("process 'b' exited with 137 (SIGKILL)"), std::string::npos) << h2.err();
+  EXPECT_EQ(h1.Wait(30), 1) << h1.err();
+  EXPECT_NE(h1.err().find("process 'b' on host 'h2' failed for good: stopping the processes of host 'h1'"), std::string::npos)
+      << h1.err();
+  EXPECT_EQ(h1.err().find("process 'a' exited"), std::string::npos) << "a was stopped, not failed: " << h1.err();
+}
+
 // `dyad status` on a split graph whose second process's clock is 25 ms ahead (the test-only
 // DYAD_TEST_CLOCK_OFFSET_MS): both processes listed with their hosts and pids, the offset
 // measured within 1 ms both ways, and the warning said by the process that measured it.

@@ -189,6 +189,10 @@ void AwaitAcks(fdds::DataWriter* w) {
 }
 }  // namespace
 
+bool DdsWriter::AwaitAcknowledged(double timeout_s) {
+  return writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(timeout_s)) == ReturnCode_t::RETCODE_OK;
+}
+
 DdsWriter::~DdsWriter() {
   AwaitAcks(writer_);
   if (on_delete_) on_delete_();

@@ -63,6 +63,8 @@ class DdsWriter final : public TypedWriter {
   // runtime clock (simulated time under the stepped clock) rather than the wall clock.
   Status WriteStamped(const void* sample, int64_t stamp_ns) override;
   int matched() const override;
+  // Waits until every matched reliable reader acknowledged what was written; false on timeout.
+  bool AwaitAcknowledged(double timeout_s);
 
  private:
   friend class DdsParticipant;

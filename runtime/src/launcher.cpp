@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include <thread>
 
 #include "dyad/interrupt.hpp"
+#include "launcher_link.hpp"
 #include "output_relay.hpp"
 
 namespace dyad {
@@ -71,6 +73,8 @@ pid_t StartChild(std::vector<std::string> args, int restarts, const OutputRelay:
     if (getppid() != parent) _exit(1);
     if (pipes.out_write >= 0) dup2(pipes.out_write, STDOUT_FILENO);
     if (pipes.err_write >= 0) dup2(pipes.err_write, STDERR_FILENO);
+    // Nothing else of the launcher's: its DDS sockets (LauncherLink), other children's pipes.
+    close_range(3, ~0U, 0);
     sigset_t none;
     sigemptyset(&none);
     pthread_sigmask(SIG_SETMASK, &none, nullptr);
@@ -179,6 +183,13 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
   // child has exited (it reads their pipes to the end).
   OutputRelay relay(out, err);
   auto say = [&](const std::string& line) { relay.Say(line); };
+  // Graphs on several hosts: the launchers tell each other of a required process's failure.
+  std::unique_ptr<LauncherLink> link;
+  if (std::any_of(graph.processes.begin(), graph.processes.end(), [](const ProcessConfig& pc) { return !pc.host.empty(); })) {
+    auto l = LauncherLink::Open(graph, host);
+    if (l.ok()) link = std::move(l.value());
+    else say("warning: " + l.status().message() + ": a failure on another host will not end this host's run");
+  }
   auto start = [&](const std::string& name, std::vector<std::string> args, int restarts) {
     const std::string log = LogPathOf(options, graph, name);
     auto pipes = relay.Add(name, log,
@@ -241,6 +252,13 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
         kill(server, SIGTERM);
       }
       if (children.empty() && pending.empty()) break;
+      if (link != nullptr && !stopping) {
+        if (auto failure = link->TakeRemoteFailure()) {
+          say(*failure + ": stopping the processes of host '" + host + "'");
+          if (first_failure == 0) first_failure = 1;
+          stop_all(0);
+        }
+      }
       lock.unlock();
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
       continue;
@@ -279,7 +297,15 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
     }
     say("process '" + child.name + "' exited with " + DescribeExit(code) + given_up);
     if (first_failure == 0) first_failure = code;
-    stop_all(pid);  // one required process failing ends the experiment
+    // One required process failing ends the experiment: on the other hosts (told first, while
+    // this host's discovery server, if any, still runs), then here.
+    if (link != nullptr && pid != server) {
+      lock.unlock();
+      link->AnnounceFailure(child.name, child.restarts);  // milliseconds; at most 2 s
+      lock.lock();
+      if (stopping) continue;  // a signal came meanwhile and was forwarded: no second one
+    }
+    stop_all(pid);
   }
   if (first_failure != 0) return first_failure;
   if (interrupt.signal() != 0) {
