@@ -174,9 +174,10 @@ Status WebComponent::Configure(Context& ctx) {
   options_.pages["/subject"] = WebServer::Page{"text/html; charset=utf-8", kSubjectHtml, ""};
   options_.pages["/experimenter"] = WebServer::Page{"text/html; charset=utf-8", kExperimenterHtml, ""};
   options_.endpoints = {
-      WebServer::Endpoint{"/", {foxglove::kSubprotocol, foxglove::kSubprotocolSdk}, bridge_.get(), /*background=*/true},
-      WebServer::Endpoint{"/subject/ws", {}, subject_.get()},
-      WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get(), /*background=*/true},
+      WebServer::Endpoint{"/", {foxglove::kSubprotocol, foxglove::kSubprotocolSdk}, bridge_.get()},
+      // The subject steers by the robot state on this page: no batching delay.
+      WebServer::Endpoint{"/subject/ws", {}, subject_.get(), std::chrono::milliseconds(0)},
+      WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get()},
   };
   FoxgloveBridge* bridge = bridge_.get();
   for (const auto& c : channels) {

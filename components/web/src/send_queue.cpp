@@ -42,6 +42,7 @@ bool SendQueue::PushData(uint32_t channel, std::string bytes, bool binary, std::
     data_[channel].push_back(std::move(frame));
     wake = consumer_idle_;
     consumer_idle_ = false;  // one wake-up is enough
+    if (wake) ++wakeups_by_producers_;
   }
   if (wake) cv_.notify_one();
   return true;
@@ -61,35 +62,50 @@ void SendQueue::PushLatest(uint32_t channel, std::string bytes, bool binary) {
 
 bool SendQueue::PopAll(std::vector<Frame>* out) {
   out->clear();
-  std::unique_lock<std::mutex> lock(mutex_);
-  for (;;) {
-    if (closed_) return false;
-    if (!control_.empty()) break;
-    const auto due = last_flush_ + flush_interval_;
-    if (std::chrono::steady_clock::now() < due) {
-      // The quiet time after a flush: data collects without waking anyone.
-      cv_.wait_until(lock, due);
-      continue;
+  std::deque<std::string> control;
+  std::map<uint32_t, std::deque<Frame>> data;
+  {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      if (closed_) return false;
+      if (!control_.empty()) break;
+      const auto due = last_flush_ + flush_interval_;
+      if (std::chrono::steady_clock::now() < due) {
+        // The quiet time after a flush: data collects without waking anyone.
+        cv_.wait_until(lock, due);
+        continue;
+      }
+      if (HasData()) break;
+      consumer_idle_ = true;  // the next push wakes us
+      ++idle_waits_;
+      cv_.wait(lock);
+      consumer_idle_ = false;
     }
-    if (HasData()) break;
-    consumer_idle_ = true;  // the next push wakes us
-    cv_.wait(lock);
-    consumer_idle_ = false;
+    last_flush_ = std::chrono::steady_clock::now();
+    // O(1) under the lock: producers (graph threads) wait for it.
+    control.swap(control_);
+    data.swap(data_);
+    channel_bytes_.clear();
+    bytes_ = 0;
   }
-  last_flush_ = std::chrono::steady_clock::now();
-  for (auto& c : control_) out->push_back(Frame{false, std::move(c), nullptr, 0, 0});
-  control_.clear();
-  // Data in push order across channels: a merge of the per-channel queues by `order`.
+  for (auto& c : control) out->push_back(Frame{false, std::move(c), nullptr, 0, 0});
+  // Data in push order across channels: the per-channel queues merged by `order`.
   const size_t first_data = out->size();
-  for (auto& [c, q] : data_) {
+  for (auto& [c, q] : data)
     for (auto& f : q) out->push_back(std::move(f));
-    q.clear();
-    channel_bytes_[c] = 0;
-  }
   std::sort(out->begin() + static_cast<std::ptrdiff_t>(first_data), out->end(),
             [](const Frame& a, const Frame& b) { return a.order < b.order; });
-  bytes_ = 0;
   return true;
+}
+
+uint64_t SendQueue::wakeups_by_producers() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return wakeups_by_producers_;
+}
+
+uint64_t SendQueue::idle_waits() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return idle_waits_;
 }
 
 bool SendQueue::HasData() const {

@@ -15,7 +15,8 @@
 /// client's consumer sleeps until there is something to send (no polling). Control frames and
 /// Close() always wake it at once.
 ///
-/// Memory: at most `limit_bytes` queued, plus the batch the consumer is writing.
+/// Memory: at most `limit_bytes` queued, plus the batch the consumer is writing. A producer holds
+/// the queue's mutex for O(1) work, and so does the consumer (it takes a batch by swapping).
 ///
 /// Thread-safe: any number of producers, one consumer (the client's sender thread) blocking in
 /// PopAll().
@@ -44,7 +45,8 @@ struct Frame {
 
 class SendQueue {
  public:
-  // One 60 Hz display frame: what a viewer cannot tell from "at once".
+  // One 60 Hz display frame: what a viewer cannot tell from "at once". Zero: every sample that
+  // finds the consumer idle wakes it (the subject's page, whose robot state is a person's feedback).
   static constexpr std::chrono::milliseconds kDefaultFlushInterval{16};
 
   explicit SendQueue(size_t limit_bytes, std::chrono::steady_clock::duration flush_interval = kDefaultFlushInterval)
@@ -68,6 +70,10 @@ class SendQueue {
   // Drops per channel since the last call (and resets them).
   std::map<uint32_t, uint64_t> TakeDrops();
   size_t queued_bytes() const;
+  // How often a data push woke the consumer, and how often the consumer went idle (waiting for
+  // a push): what the wake-up policy promises, made visible (tests).
+  uint64_t wakeups_by_producers() const;
+  uint64_t idle_waits() const;
 
  private:
   bool HasData() const;  // REQUIRES: mutex_ held
@@ -77,7 +83,10 @@ class SendQueue {
   std::condition_variable cv_;
   bool closed_ = false;
   bool consumer_idle_ = false;  // the consumer waits with nothing queued: the next push wakes it
-  std::chrono::steady_clock::time_point last_flush_{};
+  uint64_t wakeups_by_producers_ = 0, idle_waits_ = 0;
+  // min(), not the epoch: steady_clock's zero is boot time, and a machine up for less than one
+  // interval would hold the first batch back.
+  std::chrono::steady_clock::time_point last_flush_ = std::chrono::steady_clock::time_point::min();
   uint64_t next_order_ = 0;
   size_t bytes_ = 0;  // data frames only
   std::deque<std::string> control_;

@@ -1,8 +1,6 @@
 #include "web_server.hpp"
 
 #include <civetweb.h>
-#include <pthread.h>
-#include <sched.h>
 
 #include <atomic>
 #include <condition_variable>
@@ -86,7 +84,7 @@ class WebServer::HandlerThread {
 struct WebServer::EndpointState {
   WebServer* server = nullptr;
   ClientHandler* handler = nullptr;
-  bool background = false;
+  std::chrono::steady_clock::duration flush_interval{};
   std::vector<const char*> protocol_ptrs;
   mg_websocket_subprotocols protocols{};
 };
@@ -98,7 +96,7 @@ struct WebServer::Client {
   std::mutex write_mutex;  // held while writing; closing takes it, so no write outlives the connection
   bool closed = false;
   std::thread sender;
-  explicit Client(size_t limit) : queue(limit) {}
+  Client(size_t limit, std::chrono::steady_clock::duration flush_interval) : queue(limit, flush_interval) {}
 };
 
 StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
@@ -129,7 +127,7 @@ StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
     auto st = std::make_unique<EndpointState>();
     st->server = s.get();
     st->handler = e.handler;
-    st->background = e.background;
+    st->flush_interval = e.flush_interval;
     for (const auto& p : e.subprotocols) st->protocol_ptrs.push_back(p.c_str());
     st->protocols.nb_subprotocols = static_cast<int>(st->protocol_ptrs.size());
     st->protocols.subprotocols = st->protocol_ptrs.data();
@@ -164,6 +162,10 @@ WebServer::~WebServer() {
   std::lock_guard<std::mutex> lock(mutex_);
   for (auto& [id, c] : clients_) {
     c->queue.Close();
+    {
+      std::lock_guard<std::mutex> write(c->write_mutex);  // a sender in the middle of a batch stops
+      c->closed = true;
+    }
     if (c->sender.joinable()) c->sender.join();
   }
 }
@@ -194,7 +196,7 @@ int WebServer::OnConnect(const mg_connection* conn, void* endpoint) {
 void WebServer::OnReady(mg_connection* conn, void* endpoint) {
   auto* self = static_cast<EndpointState*>(endpoint)->server;
   ClientHandler* handler = static_cast<EndpointState*>(endpoint)->handler;
-  auto c = std::make_shared<Client>(self->options_.client_buffer_bytes);
+  auto c = std::make_shared<Client>(self->options_.client_buffer_bytes, static_cast<EndpointState*>(endpoint)->flush_interval);
   c->conn = conn;
   {
     std::lock_guard<std::mutex> lock(self->mutex_);
@@ -203,14 +205,7 @@ void WebServer::OnReady(mg_connection* conn, void* endpoint) {
     self->by_conn_[conn] = {c->id, handler};
   }
   Client* raw = c.get();
-  const bool background = static_cast<EndpointState*>(endpoint)->background;
-  c->sender = std::thread([raw, background] {
-    if (background) {
-      // A viewer's frames wait for idle CPU: the graph's threads are never preempted for them
-      // (a slow viewer loses samples instead, see SendQueue).
-      sched_param idle{};
-      pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle);  // may fail (seccomp): then it runs as before
-    }
+  c->sender = std::thread([raw] {
     std::vector<Frame> batch;
     std::string joined;  // a head and its shared tail, written as one frame
     while (raw->queue.PopAll(&batch)) {

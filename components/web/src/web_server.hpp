@@ -14,6 +14,7 @@
 /// allowed when the server binds a loopback address).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -61,9 +62,9 @@ class WebServer {
     std::string uri;                        // e.g. "/"
     std::vector<std::string> subprotocols;  // empty: any
     ClientHandler* handler = nullptr;
-    // Its clients are viewers (the Foxglove bridge): their sender threads run at SCHED_IDLE, so
-    // they never take a core from the graph; under full load they fall behind and drop samples.
-    bool background = false;
+    // How often a stream is handed to a client's sender (SendQueue): viewers (Foxglove, the
+    // experimenter's page) are batched per display frame; zero sends a sample at once.
+    std::chrono::steady_clock::duration flush_interval = SendQueue::kDefaultFlushInterval;
   };
   struct Options {
     std::string address = "127.0.0.1";
