@@ -176,7 +176,7 @@ Status WebComponent::Configure(Context& ctx) {
   options_.endpoints = {
       WebServer::Endpoint{"/", {foxglove::kSubprotocol, foxglove::kSubprotocolSdk}, bridge_.get()},
       // The subject steers by the robot state on this page: no batching delay.
-      WebServer::Endpoint{"/subject/ws", {}, subject_.get(), std::chrono::milliseconds(0)},
+      WebServer::Endpoint{"/subject/ws", {}, subject_.get(), /*viewers=*/false},
       WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get()},
   };
   FoxgloveBridge* bridge = bridge_.get();

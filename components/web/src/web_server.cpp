@@ -1,6 +1,8 @@
 #include "web_server.hpp"
 
 #include <civetweb.h>
+#include <pthread.h>
+#include <sched.h>
 
 #include <atomic>
 #include <condition_variable>
@@ -84,7 +86,7 @@ class WebServer::HandlerThread {
 struct WebServer::EndpointState {
   WebServer* server = nullptr;
   ClientHandler* handler = nullptr;
-  std::chrono::steady_clock::duration flush_interval{};
+  bool viewers = true;
   std::vector<const char*> protocol_ptrs;
   mg_websocket_subprotocols protocols{};
 };
@@ -127,7 +129,7 @@ StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
     auto st = std::make_unique<EndpointState>();
     st->server = s.get();
     st->handler = e.handler;
-    st->flush_interval = e.flush_interval;
+    st->viewers = e.viewers;
     for (const auto& p : e.subprotocols) st->protocol_ptrs.push_back(p.c_str());
     st->protocols.nb_subprotocols = static_cast<int>(st->protocol_ptrs.size());
     st->protocols.subprotocols = st->protocol_ptrs.data();
@@ -196,7 +198,9 @@ int WebServer::OnConnect(const mg_connection* conn, void* endpoint) {
 void WebServer::OnReady(mg_connection* conn, void* endpoint) {
   auto* self = static_cast<EndpointState*>(endpoint)->server;
   ClientHandler* handler = static_cast<EndpointState*>(endpoint)->handler;
-  auto c = std::make_shared<Client>(self->options_.client_buffer_bytes, static_cast<EndpointState*>(endpoint)->flush_interval);
+  const bool viewers = static_cast<EndpointState*>(endpoint)->viewers;
+  auto c = std::make_shared<Client>(self->options_.client_buffer_bytes,
+                                    viewers ? SendQueue::kDefaultFlushInterval : std::chrono::steady_clock::duration::zero());
   c->conn = conn;
   {
     std::lock_guard<std::mutex> lock(self->mutex_);
@@ -205,7 +209,13 @@ void WebServer::OnReady(mg_connection* conn, void* endpoint) {
     self->by_conn_[conn] = {c->id, handler};
   }
   Client* raw = c.get();
-  c->sender = std::thread([raw] {
+  c->sender = std::thread([raw, viewers] {
+    if (viewers) {
+      // Not SCHED_IDLE: a graph thread waiting for the queue's lock held by an idle-class sender
+      // that was preempted waited up to 1.4 s on a loaded machine (no priority inheritance).
+      sched_param none{};
+      pthread_setschedparam(pthread_self(), SCHED_BATCH, &none);  // if refused, it runs as before
+    }
     std::vector<Frame> batch;
     std::string joined;  // a head and its shared tail, written as one frame
     while (raw->queue.PopAll(&batch)) {

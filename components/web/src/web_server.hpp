@@ -14,7 +14,6 @@
 /// allowed when the server binds a loopback address).
 #pragma once
 
-#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -62,9 +61,12 @@ class WebServer {
     std::string uri;                        // e.g. "/"
     std::vector<std::string> subprotocols;  // empty: any
     ClientHandler* handler = nullptr;
-    // How often a stream is handed to a client's sender (SendQueue): viewers (Foxglove, the
-    // experimenter's page) are batched per display frame; zero sends a sample at once.
-    std::chrono::steady_clock::duration flush_interval = SendQueue::kDefaultFlushInterval;
+    // Its clients are viewers (Foxglove, the experimenter's page): their frames are batched per
+    // display frame (SendQueue::kDefaultFlushInterval) and their sender threads are SCHED_BATCH,
+    // which never preempt a running thread when they wake (a graph thread finishes its step
+    // first) yet get a fair share of the CPU. False: every sample at once, normal scheduling
+    // (the subject's page, whose robot state is what the subject steers by).
+    bool viewers = true;
   };
   struct Options {
     std::string address = "127.0.0.1";
