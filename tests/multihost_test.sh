@@ -21,6 +21,11 @@
 #              intentions resume after the restart (first one within 2.5 s of the kill) and after
 #              the link is back, the gap on mind's topic only; no command moves further than
 #              the mixer's max_step (5) from the one before.
+#   failure    multicast, mind without restarts (--set processes.mind.restart=never) and
+#              `kill -9` of mind's process about step 100: mind's launcher exits 137 naming it;
+#              lab's and rec's launchers hear of it (their launchers' link, dyad/processes) and
+#              exit 1 within 10 s of the kill, naming mind and its host, their processes stopped
+#              cleanly: rec's recording is complete and holds mind's "failed" announcement.
 #   net        (for debugging) only the namespaces and the UDP probe, no dyad run
 # Needs root, `ip netns` and `nft` (skipped, exit 77, otherwise). Leaves nothing behind: the EXIT
 # trap kills every process in its namespaces and deletes them (each host has a /dev/shm of its
@@ -30,13 +35,13 @@
 # MULTIHOST_STAGGER=S: the time between the starts of rec, mind and lab (default 2 s, 0: at once);
 # MULTIHOST_SHARED_SHM=1: the hosts share this machine's /dev/shm (default: one tmpfs each).
 set -euo pipefail
-[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|tcp|faults|net...]" >&2; exit 2; }
+[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|tcp|faults|failure|net...]" >&2; exit 2; }
 repo=$(cd "$1" && pwd) build=$(cd "$2" && pwd) work=$3
 shift 3
 modes=("$@")
-[ ${#modes[@]} -gt 0 ] || modes=(multicast peers server tcp faults)
+[ ${#modes[@]} -gt 0 ] || modes=(multicast peers server tcp faults failure)
 for mode in "${modes[@]}"; do
-  case $mode in multicast | peers | server | tcp | faults | net) ;; *) echo "unknown mode '$mode'" >&2; exit 2 ;; esac
+  case $mode in multicast | peers | server | tcp | faults | failure | net) ;; *) echo "unknown mode '$mode'" >&2; exit 2 ;; esac
 done
 dyad=$build/bin/dyad
 timeout_s=${MULTIHOST_TIMEOUT:-120}
@@ -392,6 +397,20 @@ inject_faults() {
   echo "$t_kill $t_down $t_up" > "$out/faults"
 }
 
+# kill_mind OUT: waits for the graph to run, kills mind's process (kill -9) about step 100; writes
+# the instant (wall ns) to OUT/killed.
+kill_mind() {
+  local out=$1 p pid=""
+  sleep 12
+  for p in $(ip netns pids "${ns[mind]}"); do
+    tr '\0' ' ' < "/proc/$p/cmdline" 2> /dev/null | grep -q -- "--process mind " && pid=$p
+  done
+  [ -n "$pid" ] || { echo "multihost: failure: mind's process not found"; return; }
+  date +%s%N > "$out/killed"
+  kill -KILL "$pid"
+  echo "multihost: failure: killed mind's process ($pid)"
+}
+
 # --- one run of configs/split.yaml per mode --------------------------------------------------------
 run_mode() {
   local mode=$1 out=$work/$1 h code failed="" t0=$SECONDS
@@ -401,11 +420,13 @@ run_mode() {
   [ "$mode" = tcp ] && block_multicast udp
   local discovery=$mode
   [ "$mode" = faults ] && discovery=multicast
+  [ "$mode" = failure ] && discovery=multicast
   [ "$mode" = tcp ] && discovery=peers
   local transport=shm+udp
   [ "$mode" = tcp ] && transport=tcp
   local sets=(--set "network.discovery=$discovery" --set "network.transport=$transport" --set "human.dataset=$dataset" --set "mind.model=$model"
               --set "observer.model=$observer" --set "recorder.file=$out/split.mcap")
+  [ "$mode" = failure ] && sets+=(--set processes.mind.restart=never)
   # Each host gets its own /dev/shm (a tmpfs in the mount namespace of `ip netns exec`), as on
   # separate machines: nothing can pass through shared memory between hosts, and Fast DDS's
   # port files cannot collide with another host's or another test's. MULTIHOST_SHARED_SHM=1: no.
@@ -430,6 +451,9 @@ run_mode() {
   if [ "$mode" = faults ]; then
     inject_faults "$out" &
     injector=$!
+  elif [ "$mode" = failure ]; then
+    kill_mind "$out" &
+    injector=$!
   elif [ "$mode" = multicast ]; then
     # Mid-run, from rec: every process with its host and pid, and mind's lie measured.
     (sleep 10 && ip netns exec "${ns[rec]}" "$dyad" status --graph "$repo/configs/split.yaml" --wait 5 > "$out/status.txt" 2>&1) &
@@ -453,6 +477,17 @@ run_mode() {
   for h in "${hosts[@]}"; do
     code=0
     wait "${lpid[$h]}" || code=$?
+    if [ "$mode" = failure ]; then
+      local want=1
+      [ "$h" = mind ] && want=137
+      if [ $code != $want ]; then
+        echo "----- $mode: $h exited $code, expected $want; its launcher's output:"
+        cat "$out/$h.log"
+        failed+=" $h"
+      fi
+      echo "$code" > "$out/$h.code"
+      continue
+    fi
     if [ $code != 0 ]; then
       echo "----- $mode: $h exited $code; its launcher's output ($out/$h.log; each process's: $out/logs):"
       cat "$out/$h.log"
@@ -497,6 +532,30 @@ sys.exit(0 if ok else 1)
 PY
     echo "FAIL: multihost $mode: dyad status (see above)" >&2
     failures+=("$mode"); return 0
+  fi
+  if [ "$mode" = failure ]; then
+    local t_kill t_end ok=1
+    t_kill=$(cat "$out/killed" 2> /dev/null) || { echo "FAIL: multihost failure: mind was not killed" >&2; failures+=("$mode"); return 0; }
+    grep -q "process 'mind' exited with 137 (SIGKILL)$" "$out/mind.log" || { echo "mind's launcher did not name mind's end"; ok=0; }
+    for h in lab rec; do
+      grep -q "process 'mind' on host 'mind' failed for good: stopping the processes of host '$h'" "$out/$h.log" ||
+        { echo "$h's launcher did not say mind failed:"; cat "$out/$h.log"; ok=0; }
+      t_end=$(stat -c %Y "$out/$h.code")
+      echo "multihost: failure: $h's launcher ended $((t_end - t_kill / 1000000000)) s after the kill"
+      [ $((t_end - t_kill / 1000000000)) -le 10 ] || { echo "$h's launcher took longer than 10 s"; ok=0; }
+    done
+    local info
+    info=$("$dyad" bag info "$out/split.mcap" 2>&1) || { echo "$info"; ok=0; }
+    echo "$info" | grep -q "state:       complete" || { echo "$info"; echo "rec's recording is not complete"; ok=0; }
+    "$dyad" bag export "$out/split.mcap" --csv "$out/csv" > "$out/csv.log" 2>&1 || { cat "$out/csv.log"; ok=0; }
+    grep -q ",mind,mind,.*,failed," "$out/csv/dyad_processes.csv" 2> /dev/null ||
+      { echo "no 'failed' state of mind in the recording's dyad/processes:"; head -3 "$out/csv/dyad_processes.csv" 2>&1; ok=0; }
+    if [ $ok = 0 ]; then
+      echo "FAIL: multihost failure: see above" >&2
+      failures+=("$mode"); return 0
+    fi
+    echo "PASS: multihost failure: mind killed with no restart left: every host's launcher ended the run within 10 s, naming it; the recording is complete and holds the failure"
+    return 0
   fi
   if [ "$mode" = faults ]; then
     local f

@@ -151,6 +151,43 @@ TEST(NetworkConfig, ASetOverridesAKeyAndItsProblemNamesTheSet) {
   }
 }
 
+// `--set processes.NAME.KEY=VALUE` changes one process's supervision (a run without restarts, say),
+// checked like the file's own; its problems name the --set.
+TEST(NetworkConfig, ASetOverridesAProcesssKeyAndItsProblemNamesTheSet) {
+  std::vector<Diagnostic> diags;
+  Graph g = Parse(Replace(kSplit, "a: {host: lab}", "a: {host: lab, restart: on-failure}"), &diags,
+                  {"processes.a.restart=never", "processes.b.max_restarts=7"});
+  ASSERT_TRUE(diags.empty()) << diags[0].ToString();
+  for (const auto& pc : g.processes) {
+    if (pc.name == "a") {
+      EXPECT_EQ(pc.restart, RestartPolicy::kNever);
+    } else {
+      EXPECT_EQ(pc.max_restarts, 7);
+    }
+  }
+  EXPECT_NE(g.yaml_text.find("--set processes.a.restart=never"), std::string::npos) << g.yaml_text;
+
+  diags.clear();
+  Parse(kSplit, &diags, {"processes.a.restart=sometimes"});
+  ASSERT_EQ(diags.size(), 1u);
+  EXPECT_EQ(diags[0].mark.ToString(), "--set processes.a.restart=sometimes");
+  EXPECT_EQ(diags[0].key, "processes.a.restart");
+
+  struct Case {
+    const char* set;
+    const char* says;
+  };
+  for (const Case& c : {Case{"processes.a=never", "expected processes.NAME.KEY=VALUE"},
+                        Case{"processes.a.restart.x=1", "expected processes.NAME.KEY=VALUE"},
+                        Case{"processes.zz.restart=never", "no such process"}}) {
+    diags.clear();
+    Parse(kSplit, &diags, {c.set});
+    ASSERT_EQ(diags.size(), 1u) << c.set;
+    EXPECT_NE(diags[0].message.find(c.says), std::string::npos) << c.set << ": " << diags[0].ToString();
+    EXPECT_EQ(diags[0].mark.ToString(), std::string("--set ") + c.set);
+  }
+}
+
 // TCP: each process listens on its port at its host's address, and connects only to the
 // processes named before it (one connection per pair); a watcher connects to all.
 TEST(NetworkQos, TcpListensOnTheProcesssPortAndConnectsToTheEarlierProcesses) {

@@ -307,12 +307,12 @@ void ApplyOverrides(const std::vector<Override>& overrides, Graph* g, YAML::Node
     const SourceMark cli{"--set " + o.text, 0, 0};
     const auto eq = o.text.find('=');
     const auto dot = o.text.find('.');
-    if (o.text.rfind("network.", 0) == 0) continue;  // read with the network section
+    if (o.text.rfind("network.", 0) == 0 || o.text.rfind("processes.", 0) == 0) continue;  // read with their sections
     if (eq != std::string::npos && (dot == std::string::npos || dot > eq) &&
         ApplyGraphOverride(o.text.substr(0, eq), o.text.substr(eq + 1), cli, g, root, out))
       continue;
     if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || dot + 1 == eq) {
-      out->push_back({cli, o.text, "expected COMPONENT.PARAM=VALUE, clock|seed|domain_id|graph=VALUE or network.KEY=VALUE"});
+      out->push_back({cli, o.text, "expected COMPONENT.PARAM=VALUE, clock|seed|domain_id|graph=VALUE, network.KEY=VALUE or processes.NAME.KEY=VALUE"});
       continue;
     }
     const std::string comp = o.text.substr(0, dot);
@@ -425,24 +425,39 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
     diagnostics->push_back({SourceMark{path, 1, 1}, "", "a graph file must be a YAML mapping"});
     return g;
   }
-  // `--set network.KEY=VALUE` goes into the document before it is read, so it is checked (and
-  // recorded) like the file's own; its problems name the --set.
+  // `--set network.KEY=VALUE` and `--set processes.NAME.KEY=VALUE` go into the document before
+  // it is read, so they are checked (and recorded) like the file's own; their problems name the --set.
   for (const Override& o : overrides) {
     const auto eq = o.text.find('=');
-    if (o.text.rfind("network.", 0) != 0) continue;
-    const std::string key = eq == std::string::npos ? "" : o.text.substr(8, eq - 8);
+    const bool network = o.text.rfind("network.", 0) == 0, process = o.text.rfind("processes.", 0) == 0;
+    if (!network && !process) continue;
+    const std::string section = network ? "network" : "processes";
+    const std::string path = eq == std::string::npos ? "" : o.text.substr(section.size() + 1, eq - section.size() - 1);
     const SourceMark cli{"--set " + o.text, 0, 0};
-    if (key.empty() || key.find('.') != std::string::npos) {
-      diagnostics->push_back({cli, "network", "expected network.KEY=VALUE"});
+    const auto dot = path.find('.');
+    const std::string name = network ? "" : path.substr(0, dot == std::string::npos ? 0 : dot);
+    const std::string key = network ? path : dot == std::string::npos ? "" : path.substr(dot + 1);
+    if (key.empty() || key.find('.') != std::string::npos || (process && name.empty())) {
+      diagnostics->push_back({cli, section, network ? "expected network.KEY=VALUE" : "expected processes.NAME.KEY=VALUE"});
       continue;
     }
     try {
-      if (!root["network"] || root["network"].IsNull()) root["network"] = YAML::Node(YAML::NodeType::Map);
-      root["network"][key] = YAML::Load(o.text.substr(eq + 1));
-      r.SetFromCommandLine("network." + key, cli);
+      // (No `YAML::Node n = ...; n = n[...]`: assigning to a yaml-cpp node overwrites what it refers to.)
+      if (!root[section] || root[section].IsNull()) root[section] = YAML::Node(YAML::NodeType::Map);
+      if (network) {
+        root[section][key] = YAML::Load(o.text.substr(eq + 1));
+      } else {
+        if (!root[section].IsMap() || !root[section][name]) {
+          diagnostics->push_back({cli, "processes." + name, "no such process in the graph's `processes:`"});
+          continue;
+        }
+        if (root[section][name].IsNull()) root[section][name] = YAML::Node(YAML::NodeType::Map);
+        root[section][name][key] = YAML::Load(o.text.substr(eq + 1));
+      }
+      r.SetFromCommandLine(section + "." + path, cli);
       g.graph_overrides.push_back(o.text);
     } catch (const YAML::Exception& e) {
-      diagnostics->push_back({cli, "network." + key, "value is not valid YAML: " + e.msg});
+      diagnostics->push_back({cli, section + "." + path, "value is not valid YAML: " + e.msg});
     }
   }
   r.Map(root, "", {"graph", "domain_id", "clock", "seed", "plugins", "logs", "network", "processes", "topics", "components"});
