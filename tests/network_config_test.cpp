@@ -158,6 +158,7 @@ TEST(NetworkConfig, ASetOverridesAProcesssKeyAndItsProblemNamesTheSet) {
   Graph g = Parse(Replace(kSplit, "a: {host: lab}", "a: {host: lab, restart: on-failure}"), &diags,
                   {"processes.a.restart=never", "processes.b.max_restarts=7"});
   ASSERT_TRUE(diags.empty()) << diags[0].ToString();
+  ASSERT_EQ(g.processes.size(), 2u);
   for (const auto& pc : g.processes) {
     if (pc.name == "a") {
       EXPECT_EQ(pc.restart, RestartPolicy::kNever);
@@ -186,6 +187,11 @@ TEST(NetworkConfig, ASetOverridesAProcesssKeyAndItsProblemNamesTheSet) {
     EXPECT_NE(diags[0].message.find(c.says), std::string::npos) << c.set << ": " << diags[0].ToString();
     EXPECT_EQ(diags[0].mark.ToString(), std::string("--set ") + c.set);
   }
+  diags.clear();  // a process that is not a mapping: the file's error, not a YAML exception
+  Parse(Replace(kSplit, "a: {host: lab}", "a: 3"), &diags, {"processes.a.restart=never"});
+  ASSERT_FALSE(diags.empty());
+  EXPECT_EQ(diags[0].key, "processes.a") << diags[0].ToString();
+  EXPECT_NE(diags[0].message.find("must be a mapping"), std::string::npos) << diags[0].ToString();
 }
 
 // TCP: each process listens on its port at its host's address, and connects only to the

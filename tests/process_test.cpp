@@ -5,8 +5,11 @@
 
 #include "dyad/testing/child_process.hpp"
 
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -348,7 +351,20 @@ TEST_F(ProcessTest, DiscoveryServerRefusesABadListenAddress) {
     EXPECT_NE(d.Wait(30), 0) << c.listen;
     EXPECT_NE(d.err().find(c.says), std::string::npos) << c.listen << ": " << d.err();
   }
-  const std::string listen = "127.0.0.1:" + std::to_string(22000 + domain_);
+  // A port the kernel says is free now (a fixed one could be a Fast DDS port of a parallel test).
+  int port = 0;
+  {
+    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t length = sizeof(a);
+    ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
+    ASSERT_EQ(getsockname(fd, reinterpret_cast<sockaddr*>(&a), &length), 0);
+    port = ntohs(a.sin_port);
+    close(fd);
+  }
+  const std::string listen = "127.0.0.1:" + std::to_string(port);
   Child first(Dyad({"discovery-server", "--listen", listen}), dir_, "first");
   ASSERT_TRUE(first.WaitForOutput("listening on " + listen, 10)) << first.err();
   Child second(Dyad({"discovery-server", "--listen", listen}), dir_, "second");

@@ -452,6 +452,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
           continue;
         }
         if (root[section][name].IsNull()) root[section][name] = YAML::Node(YAML::NodeType::Map);
+        if (!root[section][name].IsMap()) continue;  // the file's own error ("must be a mapping") says it
         root[section][name][key] = YAML::Load(o.text.substr(eq + 1));
       }
       r.SetFromCommandLine(section + "." + path, cli);

@@ -176,6 +176,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
   pid_t server = 0;
   InterruptWatcher interrupt([&](int sig) {
     std::lock_guard<std::mutex> lock(mutex);
+    if (stopping) return;  // already told to stop (SIGTERM): a second signal would mean "exit now"
     stopping = true;
     for (const auto& [pid, _] : children) kill(pid, sig);
   });
@@ -226,6 +227,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
     pending.clear();
     for (const auto& [other, _] : children)
       if (other != except) kill(other, SIGTERM);
+    if (server != 0 && server != except) server_stopped = true;  // signalled once, here
   };
   for (;;) {
     int status = 0;
@@ -289,7 +291,8 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
       continue;
     }
     if (code == 0) continue;
-    const std::string given_up = restart ? " (after " + std::to_string(child.restarts) + " restarts)" : "";
+    const std::string given_up =
+        restart ? " (after " + std::to_string(child.restarts) + (child.restarts == 1 ? " restart)" : " restarts)") : "";
     if (pid != server && !pc.required) {
       say("process '" + child.name + "' exited with " + DescribeExit(code) + given_up +
           "; it is not required: the experiment goes on without it");

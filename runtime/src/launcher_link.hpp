@@ -3,19 +3,23 @@
 // not only its own (internal to the runtime; docs/distributed.md, "Supervision").
 //
 // The failed process cannot say so itself (a `kill -9` leaves no last word); its launcher can.
-// Each launcher of a graph with hosts joins the graph's domain as a watcher (UDP, the graph's
+// Each launcher of a graph with hosts joins the graph's domain as a watcher (the graph's
 // network section) and:
 //   - on a required process of its host failing for good, publishes that process's state as
-//     "failed" on dyad/processes (RELIABLE, TRANSIENT_LOCAL, like the processes' own
-//     announcements: a launcher that starts later hears it too, `dyad status` shows it and a
-//     recorder keeps it) and waits up to 2 s for the other launchers to acknowledge it;
-//   - reads dyad/processes for a "failed" state of a required process of the graph on another
-//     host: its launcher then stops its own processes (SIGTERM: they deactivate cleanly) and
-//     exits 1, naming the process and its host.
-// A whole machine that disappears (power, cable) says nothing: the others see its writers gone
-// ("Health") and go on.
+//     "failed" on dyad/launchers, which only launchers read (RELIABLE, TRANSIENT_LOCAL: a
+//     launcher that matches late still gets it), and waits up to 2 s until a launcher of every
+//     other host of the graph has matched and acknowledged it; and on dyad/processes too, for
+//     `dyad status` and the recorder;
+//   - reads dyad/launchers for a "failed" required process of the graph on another host, stamped
+//     after this launcher started (an older one belongs to an earlier run of the same graph): its
+//     launcher then stops its own processes (SIGTERM: they deactivate cleanly) and exits 1,
+//     naming the process and its host.
+// Not with `transport: tcp`: a watcher there only connects to the processes' listeners, so two
+// launchers never meet (the launcher warns). A whole machine that disappears (power, cable)
+// says nothing: the others see its writers gone ("Health") and go on.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -29,17 +33,19 @@ class DdsParticipant;
 class TypedReader;
 class TypedWriter;
 
+inline constexpr const char* kLaunchersTopic = "dyad/launchers";
+
 class LauncherLink {
  public:
-  // Joins the graph's domain as the launcher of `host`.
+  // Joins the graph's domain as the launcher of `host`. Unimplemented with `transport: tcp`.
   static StatusOr<std::unique_ptr<LauncherLink>> Open(const Graph& graph, const std::string& host);
   ~LauncherLink();
   LauncherLink(const LauncherLink&) = delete;
   LauncherLink& operator=(const LauncherLink&) = delete;
 
   // Announces that `process` (of this host) failed for good after `restarts` restarts; returns
-  // once every matched launcher acknowledged it, or after 2 s.
-  void AnnounceFailure(const std::string& process, int restarts);
+  // once a launcher of every other host acknowledged it, or after 2 s (false then).
+  bool AnnounceFailure(const std::string& process, int restarts);
 
   // The first failure of a required process announced from another host, once:
   // "process 'mind' on host 'h2' failed for good (after 1 restart)".
@@ -49,9 +55,12 @@ class LauncherLink {
   LauncherLink(const Graph& graph, std::string host);
   const Graph& graph_;
   std::string host_;
+  int other_hosts_ = 0;     // hosts of the graph's processes besides this one
+  int64_t started_ns_ = 0;  // wall clock at Open()
   bool reported_ = false;
   std::unique_ptr<DdsParticipant> participant_;
-  TypedWriter* writer_ = nullptr;  // owned by participant_
+  TypedWriter* launchers_writer_ = nullptr;  // owned by participant_
+  TypedWriter* processes_writer_ = nullptr;
   TypedReader* reader_ = nullptr;
 };
 
