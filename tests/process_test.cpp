@@ -306,19 +306,42 @@ TEST_F(ProcessTest, LauncherStartsOnlyThisHostsProcessesAndNamesTheOnesItWaitedF
 
 // Two launchers started 3 s apart, as on two machines, in each discovery mode (on loopback):
 // nothing runs before both are up, so the sink has every sample from the first.
-class DiscoveryModeTest : public ProcessTest, public ::testing::WithParamInterface<const char*> {};
+// A loopback UDP port the kernel says is free now (a fixed one could be a Fast DDS port of a test
+// running in parallel on another domain).
+int FreeUdpPort() {
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof(a);
+  int port = 0;
+  if (fd >= 0 && bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0 &&
+      getsockname(fd, reinterpret_cast<sockaddr*>(&a), &length) == 0)
+    port = ntohs(a.sin_port);
+  if (fd >= 0) close(fd);
+  return port;
+}
+
+class DiscoveryModeTest : public ProcessTest, public ::testing::WithParamInterface<const char*> {
+ protected:
+  // Two "hosts" on loopback, in this test's discovery mode: a (h1) counts at 50 Hz into b's (h2)
+  // sink, which writes `out`; the discovery server, used in mode "server", on `server_host` at
+  // `server_port`.
+  fs::path TwoHostGraph(const std::string& name, const std::string& server_host, int server_port, const fs::path& out) {
+    return Write("g.yaml", "graph: " + name + "\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                               "\nnetwork:\n  discovery: " + GetParam() + "\n  hosts: {h1: 127.0.0.1, h2: 127.0.0.1}\n  server: " +
+                               server_host + ":" + std::to_string(server_port) + "\n  start_timeout_s: 20\n"
+                               "processes: {a: {host: h1}, b: {host: h2}}\ncomponents:\n"
+                               "  src: {type: counter_source, rate_hz: 50, process: a, outputs: {out: count}}\n"
+                               "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " + out.string() +
+                               "}, inputs: {in: count}}\n");
+  }
+};
 
 TEST_P(DiscoveryModeTest, ProcessesStartedApartStartTogetherAndLoseNothing) {
   const fs::path out = dir_ / "sink.txt";
-  const int server_port = 21000 + domain_;  // one per test process, like the domain
-  const fs::path g = Write(
-      "g.yaml", "graph: apart\nclock: wall\ndomain_id: " + std::to_string(domain_) +
-                    "\nnetwork:\n  discovery: " + GetParam() + "\n  hosts: {h1: 127.0.0.1, h2: 127.0.0.1}\n  server: h1:" +
-                    std::to_string(server_port) + "\n  start_timeout_s: 20\n"
-                    "processes: {a: {host: h1}, b: {host: h2}}\ncomponents:\n"
-                    "  src: {type: counter_source, rate_hz: 50, process: a, outputs: {out: count}}\n"
-                    "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " + out.string() +
-                    "}, inputs: {in: count}}\n");
+  const int server_port = FreeUdpPort();
+  const fs::path g = TwoHostGraph("apart", "h1", server_port, out);
   Child a(Dyad({"run", g.string(), "--host", "h1", "--steps", "40"}), dir_, "a");
   std::this_thread::sleep_for(std::chrono::seconds(3));
   Child b(Dyad({"run", g.string(), "--host", "h2", "--steps", "40"}), dir_, "b");
@@ -351,19 +374,8 @@ TEST_F(ProcessTest, DiscoveryServerRefusesABadListenAddress) {
     EXPECT_NE(d.Wait(30), 0) << c.listen;
     EXPECT_NE(d.err().find(c.says), std::string::npos) << c.listen << ": " << d.err();
   }
-  // A port the kernel says is free now (a fixed one could be a Fast DDS port of a parallel test).
-  int port = 0;
-  {
-    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t length = sizeof(a);
-    ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
-    ASSERT_EQ(getsockname(fd, reinterpret_cast<sockaddr*>(&a), &length), 0);
-    port = ntohs(a.sin_port);
-    close(fd);
-  }
+  const int port = FreeUdpPort();
+  ASSERT_GT(port, 0);
   const std::string listen = "127.0.0.1:" + std::to_string(port);
   Child first(Dyad({"discovery-server", "--listen", listen}), dir_, "first");
   ASSERT_TRUE(first.WaitForOutput("listening on " + listen, 10)) << first.err();
@@ -398,19 +410,12 @@ pid_t AwaitChildPid(const fs::path& graph, const std::string& process) {
 }
 
 // A required process killed on one host, with no restart left, ends the run on every host: its
-// launcher announces the failure on dyad/processes, the other host's launcher stops its own
+// launcher announces the failure on dyad/launchers, the other host's launcher stops its own
 // processes (cleanly: SIGTERM) and exits 1 naming the process and its host. In each discovery
 // mode; with a server, the failing host runs it (it must outlive the announcement).
 TEST_P(DiscoveryModeTest, ARequiredProcessFailingOnOneHostEndsTheRunOnEveryHost) {
-  const int server_port = 21000 + domain_;
   const fs::path out = dir_ / "sink.txt";
-  const fs::path g = Write("g.yaml", "graph: hosts\nclock: wall\ndomain_id: " + std::to_string(domain_) +
-                                         "\nnetwork:\n  discovery: " + GetParam() + "\n  hosts: {h1: 127.0.0.1, h2: 127.0.0.1}\n  server: h2:" +
-                                         std::to_string(server_port) + "\n  start_timeout_s: 20\n"
-                                         "processes: {a: {host: h1}, b: {host: h2}}\ncomponents:\n"
-                                         "  src: {type: counter_source, rate_hz: 50, process: a, outputs: {out: count}}\n"
-                                         "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " + out.string() +
-                                         "}, inputs: {in: count}}\n");
+  const fs::path g = TwoHostGraph("hosts", "h2", FreeUdpPort(), out);
   Child h1(Dyad({"run", g.string(), "--host", "h1"}), dir_, "h1");  // runs until told otherwise
   Child h2(Dyad({"run", g.string(), "--host", "h2"}), dir_, "h2");
   for (int i = 0; i < 400 && ReadSink(out).size() < 10; ++i) usleep(50'000);

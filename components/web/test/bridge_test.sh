@@ -32,7 +32,14 @@ pid=$!
 for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
 [ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
 port=$(cat web.port)
-node "$node_dir/foxglove_client.mjs" watch "ws://127.0.0.1:$port" robot/state 3 client.json
+node "$node_dir/foxglove_client.mjs" watch "ws://127.0.0.1:$port" robot/state 3 client.json &
+watcher=$!
+# While the client is connected its sender thread is SCHED_BATCH (policy 3, field 41 of the
+# thread's stat): it never preempts a graph thread when it wakes.
+sleep 1.5
+batch_threads=$(for t in /proc/$pid/task/*; do awk '{print $41}' "$t/stat" 2> /dev/null; done | grep -c '^3$' || true)
+wait $watcher
+[ "$batch_threads" -ge 1 ] || { echo "FAIL: no SCHED_BATCH sender thread while a Foxglove client was connected"; kill $pid; exit 1; }
 wait $pid || { echo "dyad run failed"; cat run.err; exit 1; }
 node -e '
 const r = JSON.parse(require("fs").readFileSync("client.json", "utf8"));
