@@ -1,7 +1,7 @@
 // The executor on an in-memory transport (memory_transport.hpp), as rclcpp tests its executors:
 // trigger delivery, lifecycle order and threads, the cap on triggered cycles, a failure in each
 // phase (its Status code kept), teardown order, and timing charged to the component that spent it.
-#include "executor.hpp"
+#include "exec/executor.hpp"
 
 #include <gtest/gtest.h>
 

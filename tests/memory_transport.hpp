@@ -1,4 +1,4 @@
-// MemoryTransport — an in-memory Transport (runtime/src/transport.hpp) for the executor's unit
+// MemoryTransport — an in-memory Transport (runtime/dds/transport.hpp) for the executor's unit
 // tests: no DDS, no threads of its own. A write is delivered synchronously, inside Write(), to
 // every reader of the topic, as Fast DDS does within a process; samples travel as CDR made by
 // the type's own TypeSupport. KEEP_LAST keeps `depth` samples per reader (the oldest dropped),
@@ -19,7 +19,7 @@
 #include <fastdds/dds/topic/TopicDataType.hpp>
 #include <fastdds/rtps/common/SerializedPayload.h>
 
-#include "transport.hpp"
+#include "dds/transport.hpp"
 
 namespace dyad::testing {
 

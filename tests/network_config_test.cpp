@@ -10,7 +10,7 @@
 
 #include <dyad/graph.hpp>
 
-#include "network_qos.hpp"
+#include "dds/network_qos.hpp"
 
 namespace dyad {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <random>
 
-#include "step_stats.hpp"
+#include "exec/step_stats.hpp"
 
 namespace dyad {
 namespace {

@@ -7,7 +7,7 @@
 
 #include <dyad/msg/types.hpp>
 
-#include "dds_participant.hpp"
+#include "dds/dds_participant.hpp"
 
 int main(int argc, char** argv) {
   if (argc != 4) {

@@ -63,7 +63,7 @@ class BarePingPong {
   enum class Role { kBoth, kPing, kPong };
   BarePingPong(int domain, size_t payload, Role role = Role::kBoth) : role_(role) {
     auto* f = fdds::DomainParticipantFactory::get_instance();
-    // The transports dyad's participants use (runtime/src/network_qos.cpp, the default network
+    // The transports dyad's participants use (runtime/dds/network_qos.cpp, the default network
     // section): shared memory first, then UDPv4, declared explicitly.
     fdds::DomainParticipantQos pq = f->get_default_participant_qos();
     pq.transport().use_builtin_transports = false;

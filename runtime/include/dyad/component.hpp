@@ -79,7 +79,7 @@
 //   - AdvertiseSerialized(topic, type): a writer that publishes CDR bytes of `type` on `topic`.
 //   Both endpoints are owned by the runtime and live until Shutdown() returns.
 //
-// ABI history: 1 = typed ports only; 2 = generic topics (above), DDS source timestamp = header stamp.
+// The plugin ABI's version and its history: kPluginAbiVersion below (the one place that says it).
 #pragma once
 
 #include <cstdint>
@@ -100,6 +100,8 @@ namespace dyad {
 
 // Bump when anything in this header changes layout or meaning; plugins built against another
 // version are refused at load time with a message naming both versions.
+// 1: typed ports only.
+// 2: generic topics (above); the DDS source timestamp is the header's stamp.
 // 3: ParamSpec::path (relative paths resolved against the graph file), Context::graph_folder().
 // 4: input health (InputBase::writers_alive, writers_gone, deadline_misses).
 inline constexpr uint32_t kPluginAbiVersion = 4;

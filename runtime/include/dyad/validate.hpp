@@ -47,7 +47,7 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
 // diagnostic for each that fails, placed at the param its message names (the element inside a
 // structured param, or the --set) or at the component. Components with problems of their own in
 // *diagnostics are skipped (their params are incomplete). Relies on component.hpp's contract:
-// Configure acts on nothing. See runtime/src/dry_configure.cpp.
+// Configure acts on nothing. See runtime/graph/dry_configure.cpp.
 // With `only_processes` (empty: all), only the components placed in those processes are
 // configured: a process started on its own (a launcher's child, or `--process` on another host)
 // and a launcher of one host (`--host`) check what they will run, not the files of processes on

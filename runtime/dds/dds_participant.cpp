@@ -1,0 +1,542 @@
+#include "dds/dds_participant.hpp"
+
+#include "dds/network_qos.hpp"
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/builtin/data/ParticipantProxyData.h>
+#include <fastdds/rtps/builtin/data/ReaderProxyData.h>
+#include <fastdds/rtps/builtin/data/WriterProxyData.h>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+
+#include <algorithm>
+#include <sstream>
+
+namespace fdds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+
+namespace dyad {
+namespace {
+
+std::string GuidPrefixString(const rtps::GuidPrefix_t& p) {
+  std::ostringstream os;
+  os << p;
+  return os.str();
+}
+
+std::string QosPolicyName(fdds::QosPolicyId_t id) {
+  switch (id) {
+    case fdds::RELIABILITY_QOS_POLICY_ID: return "reliability";
+    case fdds::DURABILITY_QOS_POLICY_ID: return "durability";
+    case fdds::DEADLINE_QOS_POLICY_ID: return "deadline";
+    case fdds::HISTORY_QOS_POLICY_ID: return "history";
+    default: return "policy " + std::to_string(static_cast<int>(id));
+  }
+}
+
+}  // namespace
+
+class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantListener {
+ public:
+  DiscoveryListener(DdsParticipant* owner, ProblemHandler on_problem) : owner_(owner), on_problem_(std::move(on_problem)) {}
+
+  void on_participant_discovery(fdds::DomainParticipant*, rtps::ParticipantDiscoveryInfo&& info) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    names_[GuidPrefixString(info.info.m_guid.guidPrefix)] = info.info.m_participantName.to_string();
+  }
+  void on_publisher_discovery(fdds::DomainParticipant*, rtps::WriterDiscoveryInfo&& info) override {
+    const bool gone = info.status == rtps::WriterDiscoveryInfo::REMOVED_WRITER;
+    Track(true, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid());
+    if (info.status != rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) return;
+    Check("writer", info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid().guidPrefix);
+  }
+  void on_subscriber_discovery(fdds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override {
+    const bool gone = info.status == rtps::ReaderDiscoveryInfo::REMOVED_READER;
+    Track(false, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid());
+    if (info.status != rtps::ReaderDiscoveryInfo::DISCOVERED_READER) return;
+    Check("reader", info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid().guidPrefix);
+  }
+
+  std::vector<DiscoveredEndpoint> Snapshot() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<DiscoveredEndpoint> out;
+    for (auto [guid, e] : endpoints_) {
+      auto it = names_.find(e.participant);
+      if (it != names_.end()) e.participant = it->second;
+      out.push_back(e);
+    }
+    return out;
+  }
+  void on_requested_incompatible_qos(fdds::DataReader* reader, const fdds::RequestedIncompatibleQosStatus& status) override {
+    if (on_problem_)
+      on_problem_("topic '" + reader->get_topicdescription()->get_name() + "': a writer offers an incompatible " +
+                  QosPolicyName(status.last_policy_id) + " QoS; no data will flow to this reader");
+  }
+  void on_offered_incompatible_qos(fdds::DataWriter* writer, const fdds::OfferedIncompatibleQosStatus& status) override {
+    if (on_problem_)
+      on_problem_("topic '" + writer->get_topic()->get_name() + "': a reader requests an incompatible " +
+                  QosPolicyName(status.last_policy_id) + " QoS; this writer's data will not reach it");
+  }
+
+ private:
+  void Check(const char* kind, const std::string& topic, const std::string& type, const rtps::GuidPrefix_t& prefix) {
+    std::string ours;
+    {
+      std::lock_guard<std::mutex> lock(owner_->mutex_);
+      auto it = owner_->topic_types_.find(topic);
+      if (it == owner_->topic_types_.end()) return;
+      ours = it->second;
+    }
+    if (ours == type || !on_problem_) return;
+    std::string remote;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      auto it = names_.find(GuidPrefixString(prefix));
+      remote = it != names_.end() ? it->second : "participant " + GuidPrefixString(prefix);
+    }
+    const bool same_idl_name = ours.substr(0, ours.find('#')) == type.substr(0, type.find('#'));
+    on_problem_("type mismatch on topic '" + topic + "': '" + owner_->name_ + "' uses " + ours + ", a " + kind + " of '" +
+                remote + "' uses " + type +
+                (same_idl_name ? " (same IDL name, different definition: rebuild both from the same idl/)"
+                               : " (different types)") +
+                "; no samples will flow between them");
+  }
+
+  void Track(bool writer, bool gone, const std::string& topic, const std::string& type, const rtps::GUID_t& guid) {
+    std::ostringstream os;
+    os << guid;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (gone) {
+      endpoints_.erase(os.str());
+      return;
+    }
+    endpoints_[os.str()] = DiscoveredEndpoint{writer, topic, type, GuidPrefixString(guid.guidPrefix), os.str()};
+  }
+
+  DdsParticipant* owner_;
+  ProblemHandler on_problem_;
+  std::mutex mutex_;
+  std::map<std::string, std::string> names_;  // guid prefix -> participant name
+  std::map<std::string, DiscoveredEndpoint> endpoints_;  // by guid; participant holds the prefix
+};
+
+std::vector<DiscoveredEndpoint> DdsParticipant::Discovered() const { return listener_->Snapshot(); }
+
+// Health counters are kept from Fast DDS's status callbacks (its threads) and read by the
+// component's poll: atomics.
+class DdsReader::Listener final : public fdds::DataReaderListener {
+ public:
+  Listener(std::function<void()> on_data, bool liveliness) : on_data_(std::move(on_data)), liveliness_(liveliness) {}
+  void on_data_available(fdds::DataReader*) override {
+    if (on_data_) on_data_();
+  }
+  void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& s) override {
+    matched_.store(s.current_count, std::memory_order_relaxed);
+  }
+  void on_liveliness_changed(fdds::DataReader*, const fdds::LivelinessChangedStatus& s) override {
+    alive_.store(s.alive_count, std::memory_order_relaxed);
+  }
+  void on_requested_deadline_missed(fdds::DataReader*, const fdds::RequestedDeadlineMissedStatus& s) override {
+    deadline_misses_.store(static_cast<uint64_t>(s.total_count), std::memory_order_relaxed);
+  }
+  // With a liveliness lease the alive count is the truth; without, a writer counts while matched
+  // (the participant lease ends the match of a writer whose process died).
+  int alive_writers() const {
+    const int matched = matched_.load(std::memory_order_relaxed);
+    return liveliness_ ? std::min(matched, alive_.load(std::memory_order_relaxed)) : matched;
+  }
+  uint64_t deadline_misses() const { return deadline_misses_.load(std::memory_order_relaxed); }
+
+ private:
+  std::function<void()> on_data_;
+  bool liveliness_;
+  std::atomic<int> matched_{0}, alive_{0};
+  std::atomic<uint64_t> deadline_misses_{0};
+};
+
+int DdsReader::AliveWriters() const { return listener_->alive_writers(); }
+uint64_t DdsReader::DeadlineMisses() const { return listener_->deadline_misses(); }
+
+DdsReader::~DdsReader() {
+  if (on_delete_) on_delete_();
+}
+
+bool DdsReader::TakeNext(void* sample) {
+  fdds::SampleInfo info;
+  while (reader_->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
+    if (info.valid_data) return true;
+  }
+  return false;
+}
+
+uint64_t DdsReader::Unread() const { return reader_->get_unread_count(); }
+
+namespace {
+// A reliable writer deleted with samples in flight loses them for remote readers (a recorder in
+// another process): give acknowledgments a moment first. Returns at once when all are acked,
+// when nothing matched, or for best-effort writers.
+void AwaitAcks(fdds::DataWriter* w) {
+  if (w != nullptr) w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(0.5));
+}
+}  // namespace
+
+bool DdsWriter::AwaitAcknowledged(double timeout_s) {
+  return writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(timeout_s)) == ReturnCode_t::RETCODE_OK;
+}
+
+DdsWriter::~DdsWriter() {
+  AwaitAcks(writer_);
+  if (on_delete_) on_delete_();
+}
+
+Status DdsWriter::Write(const void* sample) {
+  if (!writer_->write(const_cast<void*>(sample)))
+    return Status::IOError("topic '" + topic_ + "': DDS write failed");
+  return Status::OK();
+}
+
+namespace {
+eprosima::fastrtps::Time_t TimeOfNs(int64_t ns) {
+  if (ns < 0) ns = 0;
+  return eprosima::fastrtps::Time_t(static_cast<int32_t>(ns / 1'000'000'000), static_cast<uint32_t>(ns % 1'000'000'000));
+}
+}  // namespace
+
+Status DdsWriter::WriteStamped(const void* sample, int64_t stamp_ns) {
+  if (writer_->write_w_timestamp(const_cast<void*>(sample), fdds::HANDLE_NIL, TimeOfNs(stamp_ns)) != ReturnCode_t::RETCODE_OK)
+    return Status::IOError("topic '" + topic_ + "': DDS write failed");
+  return Status::OK();
+}
+
+// What a serialized endpoint reuses for every sample: its own (unregistered) type support for
+// (de)serialising, one sample object and one payload buffer.
+struct SerializedScratch {
+  explicit SerializedScratch(const TypeInfo& type) : support(type.make_type_support()) {
+    sample = support->createData();
+    payload.reserve(support->m_typeSize + 64);
+  }
+  ~SerializedScratch() {
+    if (sample) support->deleteData(sample);
+  }
+  fdds::TypeSupport support;
+  void* sample = nullptr;
+  eprosima::fastrtps::rtps::SerializedPayload_t payload;
+};
+struct DdsSerializedReader::Scratch : SerializedScratch {
+  using SerializedScratch::SerializedScratch;
+};
+struct DdsSerializedWriter::Scratch : SerializedScratch {
+  using SerializedScratch::SerializedScratch;
+};
+
+class DdsSerializedReader::Listener final : public fdds::DataReaderListener {
+ public:
+  explicit Listener(DdsSerializedReader* owner) : owner_(owner) {}
+  void on_data_available(fdds::DataReader*) override {
+    std::lock_guard<std::mutex> lock(owner_->mutex_);
+    if (!owner_->closed_) owner_->Drain();
+  }
+
+ private:
+  DdsSerializedReader* owner_;
+};
+
+DdsSerializedReader::DdsSerializedReader() = default;
+DdsSerializedReader::~DdsSerializedReader() {
+  Close();
+  if (on_delete_) on_delete_();
+}
+
+void DdsSerializedReader::Close() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (closed_) return;
+  if (reader_ != nullptr) Drain();
+  closed_ = true;
+}
+
+void DdsSerializedReader::Drain() {
+  Scratch& s = *scratch_;
+  fdds::SampleInfo info;
+  while (reader_->take_next_sample(s.sample, &info) == ReturnCode_t::RETCODE_OK) {
+    if (!info.valid_data) continue;
+    const uint32_t need = s.support->getSerializedSizeProvider(s.sample)();
+    if (s.payload.max_size < need) s.payload.reserve(need);
+    s.payload.length = 0;
+    s.payload.pos = 0;
+    if (!s.support->serialize(s.sample, &s.payload)) continue;  // cannot happen for a sample we just decoded
+    SerializedSample out;
+    out.cdr = std::span<const uint8_t>(s.payload.data, s.payload.length);
+    out.source_stamp_ns = info.source_timestamp.to_ns();
+    out.receive_ns = clock_->now_ns();
+    out.sequence = info.sample_identity.sequence_number().to64long();
+    callback_(out);
+    delivered_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+DdsSerializedWriter::DdsSerializedWriter() = default;
+DdsSerializedWriter::~DdsSerializedWriter() {
+  AwaitAcks(writer_);
+  if (on_delete_) on_delete_();
+}
+
+Status DdsSerializedWriter::Write(std::span<const uint8_t> cdr, int64_t source_stamp_ns) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Scratch& s = *scratch_;
+  if (cdr.size() > UINT32_MAX) return Status::InvalidArgument("topic '" + topic_ + "': sample of " + std::to_string(cdr.size()) + " bytes is too large");
+  if (s.payload.max_size < cdr.size()) s.payload.reserve(static_cast<uint32_t>(cdr.size()));
+  std::copy(cdr.begin(), cdr.end(), s.payload.data);
+  s.payload.length = static_cast<uint32_t>(cdr.size());
+  s.payload.pos = 0;
+  bool decoded = false;
+  try {  // fastcdr throws on short input; nothing may escape to the component
+    decoded = s.support->deserialize(&s.payload, s.sample);
+  } catch (...) {
+    decoded = false;
+  }
+  if (!decoded)
+    return Status::InvalidArgument("topic '" + topic_ + "': " + std::to_string(cdr.size()) + " bytes do not decode as " + type_->name);
+  const int64_t stamp = source_stamp_ns >= 0 ? source_stamp_ns : clock_->now_ns();
+  if (writer_->write_w_timestamp(s.sample, fdds::HANDLE_NIL, TimeOfNs(stamp)) != ReturnCode_t::RETCODE_OK)
+    return Status::IOError("topic '" + topic_ + "': DDS write failed");
+  ++written_;
+  return Status::OK();
+}
+
+int DdsWriter::matched() const {
+  fdds::PublicationMatchedStatus st;
+  writer_->get_publication_matched_status(st);
+  return st.current_count;
+}
+
+StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, const std::string& name,
+                                                                  ProblemHandler on_problem, Scope scope,
+                                                                  const NetworkConfig& network, const std::string& process) {
+  std::unique_ptr<DdsParticipant> p(new DdsParticipant());
+  p->name_ = name;
+  p->listener_ = std::make_unique<DiscoveryListener>(p.get(), std::move(on_problem));
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  factory->load_profiles();  // profiles load lazily; load them before reading defaults
+  fdds::DomainParticipantQos qos = factory->get_default_participant_qos();
+  qos.name(name);
+  p->scope_ = scope;
+  // A stepped run stays inside its process: the network section does not concern it.
+  if (scope != Scope::kProcessOnly)
+    if (Status s = ApplyNetwork(network, scope == Scope::kWatcher, &qos, process); !s.ok()) return s;
+  if (scope == Scope::kWatcher) {
+    // A watcher lives seconds: announce often, so a first discovery exchange that got lost is
+    // repeated within half a second rather than the default 3 s.
+    qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(0.5);
+  }
+  if (scope == Scope::kProcessOnly) {
+    // Discovery ignores participants of other processes: nothing matches across the process
+    // boundary, while this participant's own endpoints match and deliver intra-process.
+    qos.wire_protocol().builtin.discovery_config.ignoreParticipantFlags =
+        eprosima::fastrtps::rtps::ParticipantFilteringFlags_t::FILTER_DIFFERENT_PROCESS;
+  }
+  fdds::StatusMask mask = fdds::StatusMask::none();
+  mask << fdds::StatusMask::requested_incompatible_qos() << fdds::StatusMask::offered_incompatible_qos();
+  p->participant_ = factory->create_participant(domain_id, qos, p->listener_.get(), mask);
+  if (p->participant_ == nullptr)
+    return Status::Internal("cannot create DDS participant '" + name + "' on domain " + std::to_string(domain_id));
+  p->publisher_ = p->participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+  p->subscriber_ = p->participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  if (p->publisher_ == nullptr || p->subscriber_ == nullptr)
+    return Status::Internal("cannot create DDS publisher/subscriber for '" + name + "'");
+  return p;
+}
+
+std::vector<EndpointMatch> DdsParticipant::Matches() const {
+  std::vector<EndpointMatch> out;
+  fdds::PublicationMatchedStatus pub;
+  fdds::SubscriptionMatchedStatus sub;
+  for (const auto& w : writers_) {
+    w->writer_->get_publication_matched_status(pub);
+    out.push_back({w->topic_, true, false, pub.current_count});
+  }
+  for (const auto& w : serialized_writers_) {
+    w->writer_->get_publication_matched_status(pub);
+    out.push_back({w->topic_, true, true, pub.current_count});
+  }
+  for (const auto& r : readers_) {
+    r->reader_->get_subscription_matched_status(sub);
+    out.push_back({r->topic_, false, false, sub.current_count});
+  }
+  for (const auto& r : serialized_readers_) {
+    r->reader_->get_subscription_matched_status(sub);
+    out.push_back({r->topic_, false, true, sub.current_count});
+  }
+  return out;
+}
+
+DdsParticipant::~DdsParticipant() {
+  // No callback after this block: serialized subscriptions closed (their last samples delivered),
+  // typed readers' listeners detached. Then endpoints, then the participant.
+  for (auto& r : serialized_readers_) r->Close();
+  for (auto& r : readers_)
+    if (r->reader_ != nullptr) r->reader_->set_listener(nullptr);
+  serialized_readers_.clear();
+  readers_.clear();
+  serialized_writers_.clear();
+  writers_.clear();
+  if (participant_ == nullptr) return;
+  participant_->set_listener(nullptr);
+  participant_->delete_contained_entities();
+  fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+StatusOr<fdds::Topic*> DdsParticipant::GetTopic(const std::string& topic, const TypeInfo& type) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const std::string dds_type = type.dds_name();
+  auto it = topics_.find(topic);
+  if (it != topics_.end()) {
+    if (topic_types_[topic] != dds_type)
+      return Status::InvalidArgument("topic '" + topic + "' already carries " + topic_types_[topic] + ", not " + dds_type);
+    return it->second;
+  }
+  if (participant_->find_type(dds_type).empty()) {
+    fdds::TypeSupport support(type.make_type_support());
+    if (support.register_type(participant_, dds_type) != ReturnCode_t::RETCODE_OK)
+      return Status::Internal("cannot register type " + dds_type);
+  }
+  fdds::Topic* t = participant_->create_topic(topic, dds_type, fdds::TOPIC_QOS_DEFAULT);
+  if (t == nullptr) return Status::Internal("cannot create topic '" + topic + "' of type " + dds_type);
+  topics_[topic] = t;
+  topic_types_[topic] = dds_type;
+  return t;
+}
+
+namespace {
+template <class Q>
+void ApplyQos(Q& q, const TopicQos& qos) {
+  q.reliability().kind = qos.reliability == Reliability::kReliable ? fdds::RELIABLE_RELIABILITY_QOS : fdds::BEST_EFFORT_RELIABILITY_QOS;
+  q.durability().kind = qos.transient_local ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS : fdds::VOLATILE_DURABILITY_QOS;
+  if (qos.keep_all) {
+    q.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
+  } else {
+    q.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    q.history().depth = qos.depth;
+  }
+  if (qos.deadline_ms > 0) q.deadline().period = eprosima::fastrtps::Duration_t(qos.deadline_ms * 1e-3);
+  if (qos.liveliness_ms > 0) {
+    q.liveliness().kind = fdds::AUTOMATIC_LIVELINESS_QOS;
+    q.liveliness().lease_duration = eprosima::fastrtps::Duration_t(qos.liveliness_ms * 1e-3);
+    q.liveliness().announcement_period = eprosima::fastrtps::Duration_t(qos.liveliness_ms * 1e-3 / 3);
+  }
+}
+}  // namespace
+
+StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
+                                                    std::function<void()> on_data) {
+  auto t = GetTopic(topic, type);
+  if (!t.ok()) return t.status();
+  fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
+  ApplyQos(rq, qos);
+  std::unique_ptr<DdsReader> r(new DdsReader());
+  r->topic_ = topic;
+  if (scope_ == Scope::kWatcher) rq.data_sharing().off();
+  r->listener_ = std::make_unique<DdsReader::Listener>(std::move(on_data), qos.liveliness_ms > 0);
+  fdds::StatusMask mask = fdds::StatusMask::data_available();
+  mask << fdds::StatusMask::subscription_matched() << fdds::StatusMask::liveliness_changed()
+       << fdds::StatusMask::requested_deadline_missed();
+  r->reader_ = subscriber_->create_datareader(*t, rq, r->listener_.get(), mask);
+  if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
+  auto* sub = subscriber_;
+  auto* raw = r->reader_;
+  r->on_delete_ = [sub, raw] {
+    raw->set_listener(nullptr);
+    sub->delete_datareader(raw);
+  };
+  readers_.push_back(std::move(r));
+  return readers_.back().get();
+}
+
+StatusOr<TypedWriter*> DdsParticipant::CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos) {
+  auto t = GetTopic(topic, type);
+  if (!t.ok()) return t.status();
+  fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
+  ApplyQos(wq, qos);
+  std::unique_ptr<DdsWriter> w(new DdsWriter());
+  w->topic_ = topic;
+  w->writer_ = publisher_->create_datawriter(*t, wq);
+  if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'");
+  auto* pub = publisher_;
+  auto* raw = w->writer_;
+  w->on_delete_ = [pub, raw] { pub->delete_datawriter(raw); };
+  writers_.push_back(std::move(w));
+  return writers_.back().get();
+}
+
+StatusOr<SerializedSubscription*> DdsParticipant::CreateSerializedReader(const std::string& topic,
+                                                                                      const TypeInfo& type,
+                                                                                      const TopicQos& qos,
+                                                                                      const Clock* clock,
+                                                                                      SerializedCallback callback) {
+  auto t = GetTopic(topic, type);
+  if (!t.ok()) return t.status();
+  fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
+  ApplyQos(rq, qos);
+  if (qos.keep_all) {
+    // KEEP_ALL alone still caps the history (5000 samples, 400 per instance by default): samples
+    // that pile up while the callback waits (a full recorder queue) must not be refused.
+    rq.resource_limits().max_samples = fdds::LENGTH_UNLIMITED;
+    rq.resource_limits().max_samples_per_instance = fdds::LENGTH_UNLIMITED;
+    rq.resource_limits().max_instances = fdds::LENGTH_UNLIMITED;
+  }
+  if (scope_ == Scope::kWatcher) rq.data_sharing().off();
+  std::unique_ptr<DdsSerializedReader> r(new DdsSerializedReader());
+  r->topic_ = topic;
+  r->clock_ = clock;
+  r->callback_ = std::move(callback);
+  r->scratch_ = std::make_unique<DdsSerializedReader::Scratch>(type);
+  r->listener_ = std::make_unique<DdsSerializedReader::Listener>(r.get());
+  r->reader_ = subscriber_->create_datareader(*t, rq, nullptr, fdds::StatusMask::none());
+  if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
+  auto* sub = subscriber_;
+  auto* raw = r->reader_;
+  r->on_delete_ = [sub, raw] {
+    raw->set_listener(nullptr);
+    sub->delete_datareader(raw);
+  };
+  // The listener is attached once reader_ is set; samples that came in between are drained here.
+  r->reader_->set_listener(r->listener_.get(), fdds::StatusMask::data_available());
+  {
+    std::lock_guard<std::mutex> lock(r->mutex_);
+    r->Drain();
+  }
+  serialized_readers_.push_back(std::move(r));
+  return serialized_readers_.back().get();
+}
+
+StatusOr<SerializedWriter*> DdsParticipant::CreateSerializedWriter(const std::string& topic,
+                                                                                      const TypeInfo& type,
+                                                                                      const TopicQos& qos,
+                                                                                      const Clock* clock) {
+  auto t = GetTopic(topic, type);
+  if (!t.ok()) return t.status();
+  fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
+  ApplyQos(wq, qos);
+  std::unique_ptr<DdsSerializedWriter> w(new DdsSerializedWriter());
+  w->topic_ = topic;
+  w->type_ = &type;
+  w->clock_ = clock;
+  w->scratch_ = std::make_unique<DdsSerializedWriter::Scratch>(type);
+  w->writer_ = publisher_->create_datawriter(*t, wq);
+  if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'");
+  auto* pub = publisher_;
+  auto* raw = w->writer_;
+  w->on_delete_ = [pub, raw] { pub->delete_datawriter(raw); };
+  serialized_writers_.push_back(std::move(w));
+  return serialized_writers_.back().get();
+}
+
+}  // namespace dyad

@@ -1,0 +1,206 @@
+// DdsParticipant — RAII owner of one Fast DDS DomainParticipant and of every topic, writer and
+// reader created on it (the Transport of the runtime, see transport.hpp for the ownership and
+// delivery contract). Internal to the runtime.
+//
+// Every type is registered under TypeInfo::dds_name() ("name#hash"). Discovery callbacks compare
+// remote endpoints' type names with ours per topic; a remote endpoint on one of our topics with
+// another type (same IDL name, other hash: a layout change) is reported through `on_mismatch`
+// naming both participants, because Fast DDS would otherwise match them silently (same name)
+// or never match them and say nothing (other name).
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <dyad/component.hpp>
+#include <dyad/graph.hpp>
+#include <dyad/status.hpp>
+
+#include "dds/transport.hpp"
+
+namespace eprosima::fastdds::dds {
+class DomainParticipant;
+class Publisher;
+class Subscriber;
+class Topic;
+class DataReader;
+class DataWriter;
+}  // namespace eprosima::fastdds::dds
+
+namespace dyad {
+
+// A reader the runtime polls; `on_data` (may be empty) is called from Fast DDS's delivery thread
+// whenever samples arrive. Created and destroyed by DdsParticipant only.
+class DdsReader final : public TypedReader {
+ public:
+  ~DdsReader() override;
+  bool TakeNext(void* sample) override;
+  uint64_t Unread() const override;
+  int AliveWriters() const override;
+  uint64_t DeadlineMisses() const override;
+  const std::string& topic() const { return topic_; }
+
+ private:
+  friend class DdsParticipant;
+  class Listener;
+  DdsReader() = default;
+  std::string topic_;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;  // owned by the participant's subscriber
+  std::unique_ptr<Listener> listener_;
+  std::function<void()> on_delete_;
+};
+
+class DdsWriter final : public TypedWriter {
+ public:
+  ~DdsWriter() override;
+  Status Write(const void* sample) override;
+  // Sets the DDS source timestamp to stamp_ns (the header's stamp), so readers see the writer's
+  // runtime clock (simulated time under the stepped clock) rather than the wall clock.
+  Status WriteStamped(const void* sample, int64_t stamp_ns) override;
+  int matched() const override;
+  bool AwaitAcknowledged(double timeout_s) override;
+
+ private:
+  friend class DdsParticipant;
+  DdsWriter() = default;
+  std::string topic_;
+  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;  // owned by the participant's publisher
+  std::function<void()> on_delete_;
+};
+
+// A reader that hands every sample to a callback as CDR bytes (Context::SubscribeSerialized).
+// The sample is taken as the type's C++ object and serialised again (Fast DDS 2.9 offers no
+// public access to the received payload); the callback runs on the delivering thread under a
+// per-reader mutex, so never concurrently with itself.
+class DdsSerializedReader final : public SerializedSubscription {
+ public:
+  ~DdsSerializedReader() override;
+  void Close() override;
+  const std::string& topic() const { return topic_; }
+  uint64_t delivered() const override { return delivered_.load(std::memory_order_relaxed); }
+
+ private:
+  friend class DdsParticipant;
+  class Listener;
+  DdsSerializedReader();
+  void Drain();  // REQUIRES: mutex_ held
+  std::string topic_;
+  const Clock* clock_ = nullptr;  // owned by the executor
+  SerializedCallback callback_;
+  std::mutex mutex_;
+  bool closed_ = false;
+  std::atomic<uint64_t> delivered_{0};
+  struct Scratch;
+  std::unique_ptr<Scratch> scratch_;  // type support, sample, payload: reused for every sample
+  std::unique_ptr<Listener> listener_;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;  // owned by the participant's subscriber
+  std::function<void()> on_delete_;
+};
+
+// Publishes CDR bytes (Context::AdvertiseSerialized): decodes them into the type's C++ object
+// and writes that, with the given source timestamp.
+class DdsSerializedWriter final : public SerializedWriter {
+ public:
+  ~DdsSerializedWriter() override;
+  const std::string& topic() const override { return topic_; }
+  const TypeInfo& type() const override { return *type_; }
+  Status Write(std::span<const uint8_t> cdr, int64_t source_stamp_ns) override;
+  uint64_t written() const override { return written_; }
+
+ private:
+  friend class DdsParticipant;
+  DdsSerializedWriter();
+  std::string topic_;
+  const TypeInfo* type_ = nullptr;
+  const Clock* clock_ = nullptr;
+  std::mutex mutex_;
+  uint64_t written_ = 0;
+  struct Scratch;
+  std::unique_ptr<Scratch> scratch_;
+  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;  // owned by the participant's publisher
+  std::function<void()> on_delete_;
+};
+
+// An endpoint seen through discovery.
+struct DiscoveredEndpoint {
+  bool writer = false;
+  std::string topic;
+  std::string type;         // DDS type name ("name#hash" for dyad types)
+  std::string participant;  // its participant's name
+  std::string guid;
+};
+
+class DdsParticipant final : public Transport {
+ public:
+  // Reports type mismatches and incompatible QoS; called from Fast DDS threads.
+  using ProblemHandler = std::function<void(const std::string& message)>;
+
+  // kNetwork: a normal participant of the domain. kProcessOnly: discovery ignores participants
+  // of other processes (ignoreParticipantFlags = FILTER_DIFFERENT_PROCESS; the transports stay
+  // up), so its endpoints match only endpoints in this process: a stepped (deterministic) run
+  // that no other process on the domain can disturb, and that disturbs no one.
+  //
+  // kWatcher: a guest that watches a running graph (`dyad echo/hz/topics`): UDPv4 only, no
+  // shared-memory transport and no data sharing. A watcher may die at any moment (SIGKILL,
+  // SIGPIPE of `| head`): with shared memory, the graph's writers would keep pushing into the
+  // dead watcher's shared-memory port until Fast DDS's port health check gave up (blocking the
+  // writing component's step: steps of 0.3 to 2 s measured), and the next watcher reusing that
+  // port could not be reached for seconds. Over UDP a dead peer costs a lost datagram.
+  enum class Scope { kNetwork, kProcessOnly, kWatcher };
+  //
+  // `network`: the graph's network section (discovery, transports, lease; see network_qos.hpp),
+  // for kNetwork and kWatcher (a watcher keeps to UDP whatever it says, or connects as a TCP
+  // client when the transport is tcp); `process` names the graph's process (its TCP listener).
+  static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, ProblemHandler on_problem,
+                                                          Scope scope = Scope::kNetwork,
+                                                          const NetworkConfig& network = NetworkConfig{},
+                                                          const std::string& process = "");
+  // Stops every callback, deletes every endpoint created here, then the participant.
+  ~DdsParticipant() override;
+  DdsParticipant(const DdsParticipant&) = delete;
+  DdsParticipant& operator=(const DdsParticipant&) = delete;
+
+  // Transport. Endpoints are owned by the participant (see transport.hpp).
+  StatusOr<TypedReader*> CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
+                                      std::function<void()> on_data) override;
+  StatusOr<TypedWriter*> CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos) override;
+  StatusOr<SerializedSubscription*> CreateSerializedReader(const std::string& topic, const TypeInfo& type,
+                                                           const TopicQos& qos, const Clock* clock,
+                                                           SerializedCallback callback) override;
+  StatusOr<SerializedWriter*> CreateSerializedWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
+                                                     const Clock* clock) override;
+
+  // Endpoints are created and destroyed on the executor's thread only: call it there.
+  std::vector<EndpointMatch> Matches() const override;
+
+  const std::string& name() const { return name_; }
+  // Every remote (or local) endpoint discovered so far that is still alive.
+  std::vector<DiscoveredEndpoint> Discovered() const;
+
+ private:
+  class DiscoveryListener;
+  DdsParticipant() = default;
+  StatusOr<eprosima::fastdds::dds::Topic*> GetTopic(const std::string& topic, const TypeInfo& type);
+
+  std::string name_;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::unique_ptr<DiscoveryListener> listener_;
+  std::mutex mutex_;  // guards the maps below (discovery reads them from Fast DDS threads)
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+  std::map<std::string, std::string> topic_types_;  // topic -> dds type name
+  Scope scope_ = Scope::kNetwork;
+  // Every endpoint created here; destroyed (in this order) by the destructor only.
+  std::vector<std::unique_ptr<DdsSerializedReader>> serialized_readers_;
+  std::vector<std::unique_ptr<DdsReader>> readers_;
+  std::vector<std::unique_ptr<DdsSerializedWriter>> serialized_writers_;
+  std::vector<std::unique_ptr<DdsWriter>> writers_;
+};
+
+}  // namespace dyad

@@ -1,0 +1,117 @@
+#include "dds/network_qos.hpp"
+
+#include <arpa/inet.h>
+#include <netdb.h>
+
+#include <memory>
+
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/rtps/attributes/ServerAttributes.h>
+#include <fastdds/rtps/transport/TCPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+
+namespace rtps = eprosima::fastrtps::rtps;
+
+namespace dyad {
+
+StatusOr<std::string> ResolveIPv4(const std::string& name) {
+  in_addr a{};
+  if (inet_pton(AF_INET, name.c_str(), &a) == 1) return name;
+  addrinfo hints{};
+  hints.ai_family = AF_INET;
+  addrinfo* res = nullptr;
+  if (getaddrinfo(name.c_str(), nullptr, &hints, &res) != 0 || res == nullptr)
+    return Status::InvalidArgument("'" + name + "' is neither an IPv4 address nor a host name this machine resolves");
+  char buf[INET_ADDRSTRLEN] = {0};
+  inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(res->ai_addr)->sin_addr, buf, sizeof(buf));
+  freeaddrinfo(res);
+  return std::string(buf);
+}
+
+namespace {
+
+StatusOr<rtps::Locator_t> UdpLocator(const std::string& text, const std::string& key) {
+  std::string host = text;
+  uint32_t port = 0;
+  if (const auto colon = text.rfind(':'); colon != std::string::npos) {
+    host = text.substr(0, colon);
+    port = static_cast<uint32_t>(std::stoul(text.substr(colon + 1)));  // checked when the graph was read
+  }
+  auto address = ResolveIPv4(host);
+  if (!address.ok()) return address.status().WithContext(key);
+  rtps::Locator_t l;
+  l.kind = LOCATOR_KIND_UDPv4;
+  rtps::IPLocator::setIPv4(l, address.value());
+  l.port = port;
+  return l;
+}
+
+}  // namespace
+
+Status ApplyNetwork(const NetworkConfig& net, bool udp_only, eprosima::fastdds::dds::DomainParticipantQos* qos,
+                    const std::string& process) {
+  auto& transport = qos->transport();
+  transport.use_builtin_transports = false;
+  transport.user_transports.clear();
+  auto& builtin = qos->wire_protocol().builtin;
+  builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(net.lease_s);
+  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(net.lease_s / 4);
+  if (net.transport == NetTransport::kTcp) {
+    auto tcp = std::make_shared<eprosima::fastdds::rtps::TCPv4TransportDescriptor>();
+    tcp->interfaceWhiteList = net.interfaces;
+    if (auto own = net.tcp_listeners.find(process); own != net.tcp_listeners.end())
+      tcp->add_listener_port(static_cast<uint16_t>(std::stoul(own->second.substr(own->second.rfind(':') + 1))));
+    transport.user_transports.push_back(tcp);
+    // One connection per pair: a process connects to the listeners of the processes named before
+    // it (they connect to none of its own); a watcher, with no listener, to all. When both sides
+    // of a pair connected at once, Fast DDS 2.9 dropped both connections and the pair never met.
+    for (const auto& [other, listener] : net.tcp_listeners) {
+      if (!process.empty() && other >= process) continue;
+      auto l = UdpLocator(listener, "processes." + other + ".tcp_port");
+      if (!l.ok()) return l.status();
+      rtps::Locator_t peer = l.value();
+      peer.kind = LOCATOR_KIND_TCPv4;
+      rtps::IPLocator::setPhysicalPort(peer, static_cast<uint16_t>(peer.port));
+      rtps::IPLocator::setLogicalPort(peer, 0);
+      builtin.initialPeersList.push_back(peer);
+    }
+    return Status::OK();
+  }
+  if (!udp_only && net.transport == NetTransport::kShmUdp)
+    transport.user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+  auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  udp->interfaceWhiteList = net.interfaces;
+  udp->maxInitialPeersRange = kPeerParticipants;
+  transport.user_transports.push_back(udp);
+
+  if (net.discovery == Discovery::kPeers) {
+    // A unicast metatraffic locator (address and port left to Fast DDS: every allowed interface,
+    // the well-known port) keeps Fast DDS from creating the multicast one.
+    rtps::Locator_t any;
+    any.kind = LOCATOR_KIND_UDPv4;
+    builtin.metatrafficUnicastLocatorList.push_back(any);
+    for (const auto& [host, address] : net.hosts) {
+      auto l = UdpLocator(address, "network.hosts." + host);
+      if (!l.ok()) return l.status();
+      builtin.initialPeersList.push_back(l.value());
+    }
+    for (const auto& p : net.peers) {
+      auto l = UdpLocator(p, "network.peers");
+      if (!l.ok()) return l.status();
+      builtin.initialPeersList.push_back(l.value());
+    }
+  } else if (net.discovery == Discovery::kServer) {
+    auto l = UdpLocator(net.server_address + ":" + std::to_string(net.server_port), "network.server");
+    if (!l.ok()) return l.status();
+    builtin.discovery_config.discoveryProtocol = rtps::DiscoveryProtocol_t::CLIENT;
+    eprosima::fastdds::rtps::RemoteServerAttributes server;
+    server.ReadguidPrefix(kDiscoveryServerPrefix);
+    server.metatrafficUnicastLocatorList.push_back(l.value());
+    builtin.discovery_config.m_DiscoveryServers.push_back(server);
+  }
+  return Status::OK();
+}
+
+}  // namespace dyad

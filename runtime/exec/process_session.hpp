@@ -1,0 +1,39 @@
+// ProcessSession — what the executor of one process needs from the other processes of its graph,
+// behind a small interface so that the executor stays about one process. The hosts layer
+// implements it (hosts/graph_session.hpp: start barrier, clock sync, state announcements); a
+// graph of one process, or a stepped one, runs without a session.
+//
+// Calls, all from the executor's Run() thread except Close():
+//   Open(transport)       after the components' ports exist, before Activate
+//   AwaitStart(stopping)  blocks until the agreed start (wall-clock ns; 0: stopped while waiting)
+//   Started()             the clocks start: background work begins, "running" is announced
+//   Heartbeat()           once per stats period while running
+//   Stopping()            the run ends (before any component is deactivated)
+//   Close()               stops every thread that writes on the transport; idempotent, also
+//                         from the executor's destructor, before the transport goes
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include <dyad/status.hpp>
+
+#include "dds/transport.hpp"
+
+namespace dyad {
+
+class ProcessSession {
+ public:
+  virtual ~ProcessSession() = default;
+  virtual Status Open(Transport* transport) = 0;
+  virtual StatusOr<int64_t> AwaitStart(const std::function<bool()>& stopping) = 0;
+  // When the graph started (valid after AwaitStart): the agreed instant, or for a process that
+  // joined a running graph (restarted), the others' start, so it ends with them.
+  virtual int64_t graph_start_ns() const = 0;
+  virtual void Started() = 0;
+  virtual void Heartbeat() = 0;
+  virtual void Stopping() = 0;
+  virtual void Close() = 0;
+};
+
+}  // namespace dyad

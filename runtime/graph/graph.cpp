@@ -1,0 +1,603 @@
+// Reads an experiment graph from YAML, keeping every node's position for error messages.
+#include "dyad/graph.hpp"
+
+#include <filesystem>
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/depthguard.h>
+
+namespace dyad {
+namespace {
+
+// Collects diagnostics for one file.
+class Reader {
+ public:
+  Reader(std::string file, std::vector<Diagnostic>* out) : file_(std::move(file)), out_(out) {}
+
+  void Error(const YAML::Node& node, const std::string& key, const std::string& message) {
+    out_->push_back(Diagnostic{Mark(node, key), key, message});
+  }
+  void Error(const SourceMark& mark, const std::string& key, const std::string& message) {
+    out_->push_back(Diagnostic{mark, key, message});
+  }
+  SourceMark Mark(const YAML::Node& node) const { return SourceMark::Of(file_, node); }
+  // A node a `--set` put in: its problems are the command line's, not the file's.
+  SourceMark Mark(const YAML::Node& node, const std::string& key) const {
+    for (const auto& [set_key, mark] : cli_marks_)
+      if (key == set_key || key.rfind(set_key + ".", 0) == 0) return mark;
+    return Mark(node);
+  }
+  void SetFromCommandLine(const std::string& key, SourceMark mark) { cli_marks_[key] = std::move(mark); }
+
+  // Checks `node` is a map, reports keys outside `allowed` and duplicate keys.
+  bool Map(const YAML::Node& node, const std::string& key, const std::set<std::string>& allowed) {
+    if (!node.IsMap()) {
+      Error(node, key, "must be a mapping");
+      return false;
+    }
+    std::set<std::string> seen;
+    for (const auto& kv : node) {
+      const std::string k = kv.first.Scalar();
+      const std::string path = key.empty() ? k : key + "." + k;
+      if (!seen.insert(k).second) Error(kv.first, path, "duplicate key");
+      if (!allowed.empty() && !allowed.count(k)) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        Error(kv.first, path, "unknown key (expected one of: " + list + ")");
+      }
+    }
+    return true;
+  }
+
+  bool String(const YAML::Node& node, const std::string& key, std::string* out) {
+    if (!node.IsScalar() || node.Scalar().empty()) {
+      Error(node, key, "must be a non-empty string");
+      return false;
+    }
+    *out = node.Scalar();
+    return true;
+  }
+
+  template <class T>
+  bool Number(const YAML::Node& node, const std::string& key, T* out, const char* what) {
+    if (node.IsScalar()) {
+      try {
+        *out = node.as<T>();
+        return true;
+      } catch (const YAML::Exception&) {
+      }
+    }
+    Error(node, key, std::string("must be ") + what + (node.IsScalar() ? ", got '" + node.Scalar() + "'" : ""));
+    return false;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+  std::vector<Diagnostic>* out_;
+  std::map<std::string, SourceMark> cli_marks_;
+};
+
+// "host:port" -> host and port (1..65535); false when malformed.
+bool SplitHostPort(const std::string& text, std::string* host, int* port, bool port_required) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos) {
+    *host = text;
+    *port = 0;
+    return !port_required && !text.empty();
+  }
+  *host = text.substr(0, colon);
+  const std::string p = text.substr(colon + 1);
+  if (host->empty() || p.empty() || p.size() > 5 || p.find_first_not_of("0123456789") != std::string::npos) return false;
+  *port = std::stoi(p);
+  return *port >= 1 && *port <= 65535;
+}
+
+std::string Names(const std::map<std::string, std::string>& m) {
+  std::string list;
+  for (const auto& [k, _] : m) list += (list.empty() ? "" : ", ") + k;
+  return list;
+}
+
+void ReadStringList(Reader& r, const YAML::Node& node, const std::string& key, std::vector<std::string>* out) {
+  if (!node.IsSequence()) {
+    r.Error(node, key, "must be a list");
+    return;
+  }
+  for (const auto& item : node) {
+    std::string s;
+    if (r.String(item, key, &s)) out->push_back(s);
+  }
+}
+
+void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
+  n->mark = r.Mark(node);
+  if (node.IsNull()) return;
+  if (!r.Map(node, "network", {"discovery", "hosts", "peers", "server", "transport", "interfaces", "lease_s", "start_timeout_s",
+                            "max_clock_offset_ms"}))
+    return;
+  std::string s;
+  if (node["discovery"] && r.String(node["discovery"], "network.discovery", &s)) {
+    if (s == "multicast") n->discovery = Discovery::kMulticast;
+    else if (s == "peers") n->discovery = Discovery::kPeers;
+    else if (s == "server") n->discovery = Discovery::kServer;
+    else r.Error(node["discovery"], "network.discovery", "must be multicast, peers or server, got '" + s + "'");
+  }
+  if (const YAML::Node hosts = node["hosts"]; hosts && r.Map(hosts, "network.hosts", {})) {
+    for (const auto& kv : hosts) {
+      std::string address;
+      if (r.String(kv.second, "network.hosts." + kv.first.Scalar(), &address)) n->hosts[kv.first.Scalar()] = address;
+    }
+  }
+  if (node["peers"]) {
+    ReadStringList(r, node["peers"], "network.peers", &n->peers);
+    for (const auto& p : n->peers) {
+      std::string host;
+      int port = 0;
+      if (!SplitHostPort(p, &host, &port, false))
+        r.Error(node["peers"], "network.peers", "'" + p + "' is not address or address:port (port 1..65535)");
+    }
+  }
+  if (node["server"] && r.String(node["server"], "network.server", &n->server)) {
+    std::string host;
+    if (!SplitHostPort(n->server, &host, &n->server_port, true)) {
+      r.Error(node["server"], "network.server", "must be HOST:PORT (HOST a name of network.hosts or an address), got '" + n->server + "'");
+    } else if (auto it = n->hosts.find(host); it != n->hosts.end()) {
+      n->server_host = host;
+      n->server_address = it->second;
+    } else {
+      n->server_address = host;
+    }
+  }
+  if (node["transport"] && r.String(node["transport"], "network.transport", &s)) {
+    if (s == "shm+udp") n->transport = NetTransport::kShmUdp;
+    else if (s == "udp") n->transport = NetTransport::kUdp;
+    else if (s == "tcp") n->transport = NetTransport::kTcp;
+    else r.Error(node["transport"], "network.transport", "must be shm+udp, udp or tcp, got '" + s + "'");
+  }
+  if (node["interfaces"]) ReadStringList(r, node["interfaces"], "network.interfaces", &n->interfaces);
+  if (node["lease_s"] && r.Number(node["lease_s"], "network.lease_s", &n->lease_s, "a number") && !(n->lease_s >= 1))
+    r.Error(node["lease_s"], "network.lease_s", "must be >= 1 (a shorter lease declares live processes gone)");
+  if (node["start_timeout_s"] && r.Number(node["start_timeout_s"], "network.start_timeout_s", &n->start_timeout_s, "a number") &&
+      !(n->start_timeout_s > 0))
+    r.Error(node["start_timeout_s"], "network.start_timeout_s", "must be > 0");
+  if (node["max_clock_offset_ms"] &&
+      r.Number(node["max_clock_offset_ms"], "network.max_clock_offset_ms", &n->max_clock_offset_ms, "a number") &&
+      !(n->max_clock_offset_ms > 0))
+    r.Error(node["max_clock_offset_ms"], "network.max_clock_offset_ms", "must be > 0");
+  if (n->discovery == Discovery::kPeers && n->peers.empty() && n->hosts.empty())
+    r.Error(node["discovery"], "network.discovery", "peers: needs network.peers or network.hosts (the addresses to announce to)");
+  if (n->transport == NetTransport::kTcp && n->discovery != Discovery::kPeers)
+    r.Error(node["transport"], "network.transport", "tcp: needs discovery: peers (TCP carries no multicast; each process "
+                                                    "connects to the others' tcp_port)");
+  if (n->discovery == Discovery::kServer && n->server.empty())
+    r.Error(node["discovery"], "network.discovery", "server: needs network.server (HOST:PORT of the discovery server)");
+}
+
+void ReadTopics(Reader& r, const YAML::Node& node, Graph* g) {
+  if (!r.Map(node, "topics", {})) return;
+  for (const auto& kv : node) {
+    TopicConfig t;
+    t.name = kv.first.Scalar();
+    t.mark = r.Mark(kv.first);
+    const std::string key = "topics." + t.name;
+    const YAML::Node spec = kv.second;
+    if (spec.IsNull()) {
+      g->topics.push_back(t);
+      continue;
+    }
+    if (!r.Map(spec, key, {"type", "reliability", "depth", "deadline_ms", "liveliness_ms"})) continue;
+    if (spec["type"]) {
+      r.String(spec["type"], key + ".type", &t.type);
+      t.type_mark = r.Mark(spec["type"]);
+    }
+    if (spec["reliability"]) {
+      std::string rel;
+      if (r.String(spec["reliability"], key + ".reliability", &rel)) {
+        if (rel == "reliable") t.reliability = Reliability::kReliable;
+        else if (rel == "best_effort") t.reliability = Reliability::kBestEffort;
+        else r.Error(spec["reliability"], key + ".reliability", "must be reliable or best_effort, got '" + rel + "'");
+      }
+    }
+    if (spec["depth"] && r.Number(spec["depth"], key + ".depth", &t.depth, "an integer") && t.depth < 1)
+      r.Error(spec["depth"], key + ".depth", "must be >= 1, got " + std::to_string(t.depth));
+    if (spec["deadline_ms"] && r.Number(spec["deadline_ms"], key + ".deadline_ms", &t.deadline_ms, "a number") &&
+        t.deadline_ms < 0)
+      r.Error(spec["deadline_ms"], key + ".deadline_ms", "must be >= 0");
+    if (spec["liveliness_ms"] && r.Number(spec["liveliness_ms"], key + ".liveliness_ms", &t.liveliness_ms, "a number") &&
+        t.liveliness_ms < 0)
+      r.Error(spec["liveliness_ms"], key + ".liveliness_ms", "must be >= 0");
+    g->topics.push_back(t);
+  }
+}
+
+void ReadBindings(Reader& r, const YAML::Node& node, const std::string& key, std::vector<PortBinding>* out) {
+  if (!r.Map(node, key, {})) return;
+  for (const auto& kv : node) {
+    PortBinding b;
+    b.port = kv.first.Scalar();
+    b.mark = r.Mark(kv.second);
+    if (r.String(kv.second, key + "." + b.port, &b.topic)) out->push_back(b);
+  }
+}
+
+void ReadComponents(Reader& r, const YAML::Node& node, Graph* g) {
+  if (!r.Map(node, "components", {})) return;
+  for (const auto& kv : node) {
+    ComponentConfig c;
+    c.name = kv.first.Scalar();
+    c.mark = r.Mark(kv.first);
+    const std::string key = "components." + c.name;
+    const YAML::Node spec = kv.second;
+    if (!r.Map(spec, key, {"type", "rate_hz", "trigger", "process", "params", "inputs", "outputs"})) continue;
+    if (spec["type"]) {
+      r.String(spec["type"], key + ".type", &c.type);
+      c.type_mark = r.Mark(spec["type"]);
+    } else {
+      r.Error(kv.first, key + ".type", "missing (every component names its type)");
+    }
+    if (spec["rate_hz"]) {
+      c.rate_mark = r.Mark(spec["rate_hz"]);
+      if (r.Number(spec["rate_hz"], key + ".rate_hz", &c.rate_hz, "a number") && !(c.rate_hz > 0))
+        r.Error(spec["rate_hz"], key + ".rate_hz", "must be > 0, got " + spec["rate_hz"].Scalar());
+    }
+    if (spec["trigger"]) {
+      c.trigger_mark = r.Mark(spec["trigger"]);
+      r.String(spec["trigger"], key + ".trigger", &c.trigger);
+    }
+    if (spec["process"]) {
+      c.process_mark = r.Mark(spec["process"]);
+      r.String(spec["process"], key + ".process", &c.process);
+    }
+    if (spec["params"]) {
+      c.params_mark = r.Mark(spec["params"]);
+      if (spec["params"].IsNull()) c.params = YAML::Node(YAML::NodeType::Map);
+      else if (r.Map(spec["params"], key + ".params", {})) c.params = spec["params"];
+    } else {
+      c.params = YAML::Node(YAML::NodeType::Map);
+      c.params_mark = c.mark;
+    }
+    if (spec["inputs"] && !spec["inputs"].IsNull()) ReadBindings(r, spec["inputs"], key + ".inputs", &c.inputs);
+    if (spec["outputs"] && !spec["outputs"].IsNull()) ReadBindings(r, spec["outputs"], key + ".outputs", &c.outputs);
+    g->components.push_back(std::move(c));
+  }
+}
+
+// `--set KEY=VALUE` for one of the graph's own scalars (clock, seed, domain_id, graph), checked
+// like the file's. Returns false when KEY is not one of them.
+bool ApplyGraphOverride(const std::string& key, const std::string& value, const SourceMark& cli, Graph* g,
+                        YAML::Node root, std::vector<Diagnostic>* out) {
+  if (key == "clock") {
+    g->clock_mark = cli;
+    if (value == "wall") g->clock = ClockMode::kWall;
+    else if (value == "stepped") g->clock = ClockMode::kStepped;
+    else out->push_back({cli, "clock", "must be wall or stepped, got '" + value + "'"});
+  } else if (key == "seed" || key == "domain_id") {
+    char* end = nullptr;
+    errno = 0;
+    const unsigned long long v = std::strtoull(value.c_str(), &end, 10);
+    const bool number = !value.empty() && value[0] != '-' && *end == '\0' && errno == 0;
+    if (key == "seed") {
+      if (number) g->seed = v;
+      else out->push_back({cli, "seed", "must be a non-negative integer, got '" + value + "'"});
+    } else if (number && v <= 232) {
+      g->domain_id = static_cast<int>(v);
+    } else {
+      out->push_back({cli, "domain_id", "must be in 0..232 (DDS), got '" + value + "'"});
+    }
+  } else if (key == "graph") {
+    if (value.empty()) out->push_back({cli, "graph", "must not be empty"});
+    else g->name = value;
+  } else {
+    return false;
+  }
+  if (root.IsMap()) root[key] = value;  // the recorded graph is the graph as run
+  g->graph_overrides.push_back(cli.file.substr(6));
+  return true;
+}
+
+void ApplyOverrides(const std::vector<Override>& overrides, Graph* g, YAML::Node root, std::vector<Diagnostic>* out) {
+  for (const auto& o : overrides) {
+    const SourceMark cli{"--set " + o.text, 0, 0};
+    const auto eq = o.text.find('=');
+    const auto dot = o.text.find('.');
+    if (o.text.rfind("network.", 0) == 0 || o.text.rfind("processes.", 0) == 0) continue;  // read with their sections
+    if (eq != std::string::npos && (dot == std::string::npos || dot > eq) &&
+        ApplyGraphOverride(o.text.substr(0, eq), o.text.substr(eq + 1), cli, g, root, out))
+      continue;
+    if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || dot + 1 == eq) {
+      out->push_back({cli, o.text, "expected COMPONENT.PARAM=VALUE, clock|seed|domain_id|graph=VALUE, network.KEY=VALUE or processes.NAME.KEY=VALUE"});
+      continue;
+    }
+    const std::string comp = o.text.substr(0, dot);
+    std::string param = o.text.substr(dot + 1, eq - dot - 1);
+    if (param.rfind("params.", 0) == 0) param = param.substr(7);
+    const std::string value = o.text.substr(eq + 1);
+    ComponentConfig* c = nullptr;
+    for (auto& cc : g->components)
+      if (cc.name == comp) c = &cc;
+    if (c == nullptr) {
+      out->push_back({cli, "components." + comp, "no such component in the graph"});
+      continue;
+    }
+    try {
+      c->params[param] = YAML::Load(value);
+      c->overridden[param] = o.text;
+    } catch (const YAML::Exception& e) {
+      out->push_back({cli, "components." + comp + ".params." + param, "value is not valid YAML: " + e.msg});
+    }
+  }
+}
+
+}  // namespace
+
+SourceMark SourceMark::Of(const std::string& file, const YAML::Node& node) {
+  const YAML::Mark m = node.Mark();
+  if (m.is_null()) return SourceMark{file, 0, 0};
+  return SourceMark{file, m.line + 1, m.column + 1};
+}
+
+std::string SourceMark::ToString() const {
+  if (line <= 0) return file;
+  return file + ":" + std::to_string(line) + ":" + std::to_string(column);
+}
+
+std::string Diagnostic::ToString() const {
+  // "key = value: why" when the message starts with the offending value ("= 300: must be ...").
+  const bool value_first = message.rfind("= ", 0) == 0;
+  return mark.ToString() + ": " + (key.empty() ? "" : key + (value_first ? " " : ": ")) + message;
+}
+
+const ComponentConfig* Graph::FindComponent(const std::string& n) const {
+  for (const auto& c : components)
+    if (c.name == n) return &c;
+  return nullptr;
+}
+
+const TopicConfig* Graph::FindTopic(const std::string& n) const {
+  for (const auto& t : topics)
+    if (t.name == n) return &t;
+  return nullptr;
+}
+
+std::set<std::string> Graph::ProcessNames() const {
+  std::set<std::string> out;
+  for (const auto& c : components) out.insert(ProcessOf(c));
+  return out;
+}
+
+std::string Graph::ProcessOf(const ComponentConfig& c) const {
+  if (!c.process.empty()) return c.process;
+  if (processes.size() == 1) return processes.front().name;
+  return "main";
+}
+
+namespace {
+
+// With overrides, yaml_text becomes the graph as run: the file's document with the overridden
+// params replaced, re-emitted (comments are lost), headed by the --set list. Recordings store it,
+// so analyses see what ran, not what the file said.
+void RecordOverrides(const std::vector<Override>& overrides, YAML::Node root, Graph* g) {
+  if (overrides.empty() || !root.IsMap() || !root["components"].IsMap()) return;
+  bool changed = !g->graph_overrides.empty();  // already written into root
+  for (const ComponentConfig& c : g->components) {
+    if (c.overridden.empty()) continue;
+    YAML::Node node = root["components"][c.name];
+    if (!node.IsMap()) continue;
+    for (const auto& [param, text] : c.overridden) node["params"][param] = YAML::Clone(c.params[param]);
+    changed = true;
+  }
+  if (!changed) return;
+  YAML::Emitter out;
+  out << root;
+  std::string header = "# the graph as run: " + g->file + " with";
+  for (const Override& o : overrides) header += " --set " + o.text;
+  g->yaml_text = header + "\n" + out.c_str() + "\n";
+}
+
+// `--set network.KEY=VALUE` and `--set processes.NAME.KEY=VALUE` go into the document before it
+// is read, so they are checked (and recorded) like the file's own; their problems name the --set.
+void InjectSectionOverrides(const std::vector<Override>& overrides, YAML::Node root, Reader& r, Graph* g,
+                            std::vector<Diagnostic>* diagnostics) {
+  for (const Override& o : overrides) {
+    const auto eq = o.text.find('=');
+    const bool network = o.text.rfind("network.", 0) == 0, process = o.text.rfind("processes.", 0) == 0;
+    if (!network && !process) continue;
+    const std::string section = network ? "network" : "processes";
+    const std::string path = eq == std::string::npos ? "" : o.text.substr(section.size() + 1, eq - section.size() - 1);
+    const SourceMark cli{"--set " + o.text, 0, 0};
+    const auto dot = path.find('.');
+    const std::string name = network ? "" : path.substr(0, dot == std::string::npos ? 0 : dot);
+    const std::string key = network ? path : dot == std::string::npos ? "" : path.substr(dot + 1);
+    if (key.empty() || key.find('.') != std::string::npos || (process && name.empty())) {
+      diagnostics->push_back({cli, section, network ? "expected network.KEY=VALUE" : "expected processes.NAME.KEY=VALUE"});
+      continue;
+    }
+    try {
+      // (No `YAML::Node n = ...; n = n[...]`: assigning to a yaml-cpp node overwrites what it refers to.)
+      if (!root[section] || root[section].IsNull()) root[section] = YAML::Node(YAML::NodeType::Map);
+      if (network) {
+        root[section][key] = YAML::Load(o.text.substr(eq + 1));
+      } else {
+        if (!root[section].IsMap() || !root[section][name]) {
+          diagnostics->push_back({cli, "processes." + name, "no such process in the graph's `processes:`"});
+          continue;
+        }
+        if (root[section][name].IsNull()) root[section][name] = YAML::Node(YAML::NodeType::Map);
+        if (!root[section][name].IsMap()) continue;  // the file's own error ("must be a mapping") says it
+        root[section][name][key] = YAML::Load(o.text.substr(eq + 1));
+      }
+      r.SetFromCommandLine(section + "." + path, cli);
+      g->graph_overrides.push_back(o.text);
+    } catch (const YAML::Exception& e) {
+      diagnostics->push_back({cli, section + "." + path, "value is not valid YAML: " + e.msg});
+    }
+  }
+}
+
+// The graph's own scalars: graph, domain_id, clock, seed, plugins, logs.
+void ReadGraphScalars(Reader& r, const YAML::Node& root, Graph* g) {
+  if (root["graph"]) r.String(root["graph"], "graph", &g->name);
+  if (root["domain_id"] && r.Number(root["domain_id"], "domain_id", &g->domain_id, "an integer") &&
+      (g->domain_id < 0 || g->domain_id > 232))
+    r.Error(root["domain_id"], "domain_id", "must be in 0..232 (DDS), got " + std::to_string(g->domain_id));
+  if (root["clock"]) {
+    g->clock_mark = r.Mark(root["clock"]);
+    std::string mode;
+    if (r.String(root["clock"], "clock", &mode)) {
+      if (mode == "wall") g->clock = ClockMode::kWall;
+      else if (mode == "stepped") g->clock = ClockMode::kStepped;
+      else r.Error(root["clock"], "clock", "must be wall or stepped, got '" + mode + "'");
+    }
+  }
+  if (root["seed"]) r.Number(root["seed"], "seed", &g->seed, "a non-negative integer");
+  const std::filesystem::path base = g->folder;  // plugins: like every path of the file
+  if (const YAML::Node plugins = root["plugins"]) {
+    if (!plugins.IsSequence()) {
+      r.Error(plugins, "plugins", "must be a list of paths");
+    } else {
+      for (const auto& p : plugins) {
+        std::string s;
+        if (!r.String(p, "plugins", &s)) continue;
+        std::filesystem::path fp(s);
+        g->plugins.push_back(fp.is_absolute() ? s : (base / fp).lexically_normal().string());
+        g->plugin_marks.push_back(r.Mark(p));
+      }
+    }
+  }
+  if (root["logs"]) {
+    std::string logs;
+    if (r.String(root["logs"], "logs", &logs))
+      g->logs = std::filesystem::path(logs).is_absolute() ? logs : (base / logs).lexically_normal().string();
+  }
+}
+
+// `processes:`: each process's host, restart policy and port; then the rules across them.
+void ReadProcesses(Reader& r, const YAML::Node& procs, Graph* g) {
+  if (!r.Map(procs, "processes", {})) return;
+  for (const auto& kv : procs) {
+    ProcessConfig p;
+    p.name = kv.first.Scalar();
+    p.mark = r.Mark(kv.first);
+    const std::string key = "processes." + p.name;
+    const YAML::Node spec = kv.second;
+    if (!spec.IsNull() && r.Map(spec, key, {"host", "restart", "max_restarts", "backoff_s", "required", "tcp_port"})) {
+      if (spec["host"] && r.String(spec["host"], key + ".host", &p.host) && !g->network.hosts.empty() &&
+          !g->network.hosts.count(p.host))
+        r.Error(spec["host"], key + ".host", "'" + p.host + "' is not one of network.hosts (" + Names(g->network.hosts) + ")");
+      std::string policy;
+      if (spec["restart"] && r.String(spec["restart"], key + ".restart", &policy)) {
+        if (policy == "never") p.restart = RestartPolicy::kNever;
+        else if (policy == "on-failure") p.restart = RestartPolicy::kOnFailure;
+        else if (policy == "always") p.restart = RestartPolicy::kAlways;
+        else r.Error(spec["restart"], key + ".restart", "must be never, on-failure or always, got '" + policy + "'");
+      }
+      if (spec["max_restarts"] && r.Number(spec["max_restarts"], key + ".max_restarts", &p.max_restarts, "an integer") &&
+          p.max_restarts < 0)
+        r.Error(spec["max_restarts"], key + ".max_restarts", "must be >= 0");
+      if (spec["backoff_s"] && r.Number(spec["backoff_s"], key + ".backoff_s", &p.backoff_s, "a number") &&
+          !(p.backoff_s >= 0.05 && p.backoff_s <= 60))
+        r.Error(spec["backoff_s"], key + ".backoff_s", "must be in 0.05..60 (a shorter one restarts a crashing process in a tight loop)");
+      if (spec["required"]) r.Number(spec["required"], key + ".required", &p.required, "true or false");
+      if (spec["tcp_port"] && r.Number(spec["tcp_port"], key + ".tcp_port", &p.tcp_port, "an integer") &&
+          (p.tcp_port < 1 || p.tcp_port > 65535))
+        r.Error(spec["tcp_port"], key + ".tcp_port", "must be in 1..65535");
+    }
+    g->processes.push_back(p);
+  }
+  // transport: tcp: each process listens on its port, at its host's address.
+  if (g->network.transport == NetTransport::kTcp) {
+    for (const auto& p : g->processes) {
+      auto address = g->network.hosts.find(p.host);
+      if (p.tcp_port == 0 || address == g->network.hosts.end())
+        r.Error(p.mark, "processes." + p.name + ".tcp_port",
+                "network.transport tcp needs each process's tcp_port and a host listed in network.hosts");
+      else
+        g->network.tcp_listeners[p.name] = address->second + ":" + std::to_string(p.tcp_port);
+    }
+  }
+  // A process without a host would start on every host's launcher: a second copy of it.
+  bool any_host = false;
+  for (const auto& p : g->processes) any_host |= !p.host.empty();
+  for (const auto& p : g->processes)
+    if (any_host && p.host.empty())
+      r.Error(p.mark, "processes." + p.name + ".host", "missing: when one process names its host, every process must");
+}
+
+
+// A component left in the implicit process "main" of a graph placed on hosts would start on
+// every host's launcher.
+void CheckPlacement(Reader& r, const Graph& g) {
+  bool placed = false;
+  for (const auto& p : g.processes) placed |= !p.host.empty();
+  if (placed && g.processes.size() > 1) {
+    for (const auto& c : g.components) {
+      if (c.process.empty())
+        r.Error(c.mark, "components." + c.name + ".process",
+                "missing: the graph places its processes on hosts, so each component names its process");
+    }
+  }
+}
+
+}  // namespace
+
+Graph ParseGraph(const std::string& yaml_text, const std::string& path, const std::vector<Override>& overrides,
+                 std::vector<Diagnostic>* diagnostics) {
+  Graph g;
+  g.file = path;
+  {
+    std::error_code ec;
+    const std::filesystem::path cwd = std::filesystem::current_path(ec);
+    g.folder = (path.empty() ? cwd : std::filesystem::absolute(path, ec).parent_path()).lexically_normal().string();
+  }
+  g.yaml_text = yaml_text;
+  Reader r(path, diagnostics);
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::DeepRecursion& e) {  // yaml-cpp says only "bad file"
+    diagnostics->push_back({SourceMark{path, e.mark.line + 1, e.mark.column + 1}, "",
+                            "YAML syntax error: nested too deeply (" + std::to_string(e.depth()) + " levels)"});
+    return g;
+  } catch (const YAML::ParserException& e) {
+    diagnostics->push_back({SourceMark{path, e.mark.line + 1, e.mark.column + 1}, "", "YAML syntax error: " + e.msg});
+    return g;
+  }
+  if (!root.IsMap()) {
+    diagnostics->push_back({SourceMark{path, 1, 1}, "", "a graph file must be a YAML mapping"});
+    return g;
+  }
+  InjectSectionOverrides(overrides, root, r, &g, diagnostics);
+  r.Map(root, "", {"graph", "domain_id", "clock", "seed", "plugins", "logs", "network", "processes", "topics", "components"});
+  ReadGraphScalars(r, root, &g);
+  if (const YAML::Node network = root["network"]) ReadNetwork(r, network, &g.network);
+  if (const YAML::Node procs = root["processes"]) ReadProcesses(r, procs, &g);
+  if (const YAML::Node topics = root["topics"]) ReadTopics(r, topics, &g);
+  if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, &g);
+  else r.Error(SourceMark{path, 1, 1}, "components", "missing: a graph needs at least one component");
+  CheckPlacement(r, g);
+  ApplyOverrides(overrides, &g, root, diagnostics);
+  RecordOverrides(overrides, root, &g);
+  return g;
+}
+
+Graph LoadGraph(const std::string& path, const std::vector<Override>& overrides, std::vector<Diagnostic>* diagnostics) {
+  std::ifstream in(path);
+  if (!in) {
+    diagnostics->push_back({SourceMark{path, 0, 0}, "", "cannot open graph file"});
+    Graph g;
+    g.file = path;
+    return g;
+  }
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ParseGraph(ss.str(), path, overrides, diagnostics);
+}
+
+}  // namespace dyad

@@ -1,0 +1,75 @@
+// The runtime's own topics: one table of {name, type, writer QoS, reader QoS, watcher QoS}.
+// Every reader and writer of these topics takes its QoS from here, so the two sides cannot drift
+// apart (a reader asking for more than its writer offers, e.g. TRANSIENT_LOCAL from a VOLATILE
+// writer, silently never matches).
+//
+//   dyad/processes      each process's state (ready, running, stopping, failed): start barrier,
+//                       launchers, `dyad status`; TRANSIENT_LOCAL so a late joiner hears it
+//   dyad/launchers      the launchers' link: a required process failed for good
+//   dyad/clock          clock-sync probes and answers between processes (best effort)
+//   dyad/clock_offsets  each process's measured offsets to the others
+//   dyad/stats          every component's timing, once per stats period
+//
+// `reader` is for the runtime's and the recorder's readers, which must not lose a sample;
+// `watcher` for guests (`dyad status`, `hz`), which may drop samples but never slow a writer.
+#pragma once
+
+#include <dyad/component.hpp>
+#include <dyad/msg/types.hpp>
+
+#include "graph/topic_qos.hpp"
+
+namespace dyad {
+
+struct RuntimeTopic {
+  const char* name;
+  const TypeInfo& (*type)();
+  TopicQos writer;
+  TopicQos reader;
+  TopicQos watcher;
+};
+
+namespace runtime_topics {
+
+inline const RuntimeTopic kProcesses{
+    .name = "dyad/processes",
+    .type = &TypeInfoOf<msg::ProcessState>,
+    .writer = {.reliability = Reliability::kReliable, .depth = 1, .transient_local = true},
+    .reader = {.reliability = Reliability::kReliable, .depth = 64, .transient_local = true},
+    .watcher = {.reliability = Reliability::kReliable, .depth = 64, .transient_local = true},
+};
+
+inline const RuntimeTopic kLaunchers{
+    .name = "dyad/launchers",
+    .type = &TypeInfoOf<msg::ProcessState>,
+    .writer = {.reliability = Reliability::kReliable, .depth = 1, .transient_local = true},
+    .reader = {.reliability = Reliability::kReliable, .depth = 64, .transient_local = true},
+    .watcher = {.reliability = Reliability::kReliable, .depth = 64, .transient_local = true},
+};
+
+inline const RuntimeTopic kClock{
+    .name = "dyad/clock",
+    .type = &TypeInfoOf<msg::ClockProbe>,
+    .writer = {.reliability = Reliability::kBestEffort, .depth = 32},
+    .reader = {.reliability = Reliability::kBestEffort, .depth = 32},
+    .watcher = {.reliability = Reliability::kBestEffort, .depth = 32},
+};
+
+inline const RuntimeTopic kClockOffsets{
+    .name = "dyad/clock_offsets",
+    .type = &TypeInfoOf<msg::ClockOffset>,
+    .writer = {.reliability = Reliability::kReliable, .depth = 16},
+    .reader = {.reliability = Reliability::kReliable, .depth = 16},
+    .watcher = {.reliability = Reliability::kBestEffort, .depth = 256},
+};
+
+inline const RuntimeTopic kStats{
+    .name = "dyad/stats",
+    .type = &TypeInfoOf<msg::ComponentStats>,
+    .writer = {.reliability = Reliability::kReliable, .depth = 16},
+    .reader = {.reliability = Reliability::kReliable, .depth = 16},
+    .watcher = {.reliability = Reliability::kBestEffort, .depth = 256},
+};
+
+}  // namespace runtime_topics
+}  // namespace dyad

@@ -1,0 +1,196 @@
+// `dyad run` and `dyad validate`: load, validate, then run in this process or launch one child
+// per process of the graph.
+#include "dyad/run.hpp"
+
+
+#include <atomic>
+#include <condition_variable>
+#include <thread>
+#include <cstdlib>
+#include <cstdio>
+#include <chrono>
+#include <iomanip>
+#include <iostream>
+#include <mutex>
+#include <set>
+
+#include "dyad/catalog.hpp"
+#include "dyad/interrupt.hpp"
+#include "dyad/validate.hpp"
+#include "exec/executor.hpp"
+#include "hosts/graph_session.hpp"
+#include "hosts/launcher.hpp"
+
+namespace dyad {
+namespace {
+
+// How long a stopping process may take to end cleanly after SIGINT/SIGTERM.
+constexpr double kStopGraceS = 20;
+
+struct Loaded {
+  Graph graph;
+  Catalog catalog;
+  ResolvedGraph resolved;
+};
+
+// The processes whose components a run here dry-configures (DryConfigure; empty: all): --process
+// P: P; a launcher of a graph placed on hosts: the processes of this host; else all.
+std::set<std::string> ProcessesToCheck(const Graph& g, const RunOptions* run) {
+  if (run == nullptr) return {};
+  if (!run->process.empty()) return {run->process};
+  bool placed = false;
+  for (const auto& pc : g.processes) placed |= !pc.host.empty();
+  if (!placed) return {};
+  std::set<std::string> here;
+  for (const auto& p : g.ProcessNames())
+    for (const auto& pc : g.processes)
+      if (pc.name == p && RunsHere(pc.host, *run)) here.insert(p);
+  return here.empty() ? std::set<std::string>{""} : here;  // {""}: none (only the discovery server)
+}
+
+// Returns false (after printing every problem) when the graph is invalid. `run`: what runs here
+// (see ProcessesToCheck); null: everything is checked (`dyad validate`).
+bool LoadAndValidate(const std::string& path, const std::vector<Override>& overrides,
+                     const std::vector<std::string>& plugin_paths, Loaded* l, std::ostream& err,
+                     const RunOptions* run = nullptr) {
+  std::vector<Diagnostic> diags;
+  l->graph = LoadGraph(path, overrides, &diags);
+  // Plugins the graph or the command line names must load: their problems are the graph's.
+  for (size_t i = 0; i < l->graph.plugins.size(); ++i)
+    if (Status s = l->catalog.Load(l->graph.plugins[i]); !s.ok()) diags.push_back({l->graph.plugin_marks[i], "plugins", s.message()});
+  for (const auto& p : plugin_paths)
+    if (Status s = l->catalog.Load(p); !s.ok()) diags.push_back({SourceMark{"--plugins " + p, 0, 0}, "", s.message()});
+  // DYAD_PLUGIN_PATH and the built-in folder: a stray file there is worth a warning only.
+  if (Status s = l->catalog.LoadDefault({}); !s.ok()) err << "warning: " << s.message() << "\n";
+  if (!l->graph.components.empty()) {
+    l->resolved = ValidateGraph(l->graph, l->catalog, &diags);
+    DryConfigure(l->graph, l->resolved, l->catalog, &diags, ProcessesToCheck(l->graph, run));
+  }
+  for (const auto& d : diags) err << d.ToString() << "\n";
+  if (!diags.empty()) err << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", nothing was started\n";
+  return diags.empty();
+}
+
+void PrintReport(const std::vector<Executor::Row>& rows, const std::string& process, std::ostream& out) {
+  out << "timing (process " << process << "):\n";
+  out << std::left << std::setw(20) << "component" << std::right << std::setw(9) << "steps" << std::setw(12) << "mean_ms"
+      << std::setw(12) << "p99_ms" << std::setw(12) << "max_ms" << std::setw(13) << "jitter_ms" << std::setw(15)
+      << "jitter_max_ms" << std::setw(8) << "misses" << "\n";
+  out << std::fixed << std::setprecision(3);
+  for (const auto& r : rows)
+    out << std::left << std::setw(20) << r.component << std::right << std::setw(9) << r.stats.steps << std::setw(12)
+        << r.stats.mean_s * 1e3 << std::setw(12) << r.stats.p99_s * 1e3 << std::setw(12) << r.stats.max_s * 1e3
+        << std::setw(13) << r.stats.jitter_mean_s * 1e3 << std::setw(15) << r.stats.jitter_max_s * 1e3 << std::setw(8)
+        << r.stats.deadline_misses << "\n";
+  for (const auto& r : rows)
+    if (r.stats.deliveries > 0)
+      out << "callbacks " << r.component << ": " << r.stats.deliveries << ", mean " << r.stats.delivery_mean_s * 1e3
+          << " ms, max " << r.stats.delivery_max_s * 1e3 << " ms\n";
+  out.unsetf(std::ios::fixed);
+}
+
+}  // namespace
+
+int ExitCodeOf(const Status& status) {
+  switch (status.code()) {
+    case Status::Code::kOk: return 0;
+    case Status::Code::kInvalidArgument:
+    case Status::Code::kNotFound:
+    case Status::Code::kDataLoss: return 2;
+    default: return 1;
+  }
+}
+
+int ValidateGraphFile(const std::string& path, const std::vector<Override>& overrides,
+                      const std::vector<std::string>& plugin_paths, std::ostream& out, std::ostream& err) {
+  Loaded l;
+  if (!LoadAndValidate(path, overrides, plugin_paths, &l, err)) return 2;
+  out << path << ": OK (" << l.graph.components.size() << " components, " << l.resolved.topics.size() << " topics, "
+      << l.graph.ProcessNames().size() << " process" << (l.graph.ProcessNames().size() == 1 ? "" : "es") << ")\n";
+  return 0;
+}
+
+int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
+  Loaded l;
+  // The launcher (no --process) checks the components of every process it starts before starting
+  // any (all of them, unless the graph places processes on hosts); a child checks its own (the
+  // others' files may already be open in their processes).
+  if (!LoadAndValidate(options.graph_path, options.overrides, options.plugin_paths, &l, err, &options)) return 2;
+  const std::set<std::string> procs = l.graph.ProcessNames();
+  std::string process = options.process;
+  if (process.empty()) {
+    if (NeedsLauncher(l.graph, options)) return LaunchChildren(options, l.graph, out, err);
+    process = *procs.begin();
+  } else if (!procs.count(process)) {
+    std::string list;
+    for (const auto& p : procs) list += (list.empty() ? "" : ", ") + p;
+    err << options.graph_path << ": --process " << process << ": no component is placed there (processes: " << list << ")\n";
+    return 2;
+  }
+  Executor::Options eo;
+  eo.process = process;
+  eo.host = ThisHost(options);
+  eo.duration_s = options.duration_s;
+  eo.steps = options.steps;
+  eo.stats_period_s = options.stats_period_s;
+  // The launcher tells a child how often it restarted it (announced on dyad/processes).
+  uint32_t restarts = 0;
+  if (const char* r = std::getenv("DYAD_RESTARTS")) restarts = static_cast<uint32_t>(std::strtoul(r, nullptr, 10));
+  eo.session = [&graph = l.graph, process, host = eo.host, restarts] { return MakeGraphSession(graph, process, host, restarts); };
+  std::atomic<Executor*> current{nullptr};
+  Status result;
+  std::vector<Executor::Row> rows;
+  int mismatches = 0, signal = 0;
+  // A process that cannot stop (a component or the DDS stack stuck) must not outlive its
+  // launcher unseen: kStopGraceS after a signal it exits anyway, saying so, unless the run has
+  // ended by then (the guard is cancelled when RunGraph returns).
+  std::mutex guard_mutex;
+  std::condition_variable guard_cv;
+  bool run_over = false;
+  std::thread guard;
+  {
+    InterruptWatcher interrupt([&](int sig) {
+      if (Executor* ex = current.load()) ex->RequestStop(SignalName(sig));
+      std::lock_guard<std::mutex> lock(guard_mutex);
+      if (guard.joinable() || run_over) return;
+      guard = std::thread([&, sig] {
+        std::unique_lock<std::mutex> lock(guard_mutex);
+        if (guard_cv.wait_for(lock, std::chrono::duration<double>(kStopGraceS), [&] { return run_over; })) return;
+        std::fprintf(stderr, "dyad run: did not stop within %g s of %s: exiting without a clean shutdown\n", kStopGraceS,
+                     SignalName(sig));
+        std::_Exit(ExitCodeForSignal(sig));
+      });
+    });
+    Executor ex(l.graph, l.resolved, &l.catalog, eo);
+    current.store(&ex);
+    if (interrupt.signal() != 0) ex.RequestStop(SignalName(interrupt.signal()));  // before `current` was set
+    result = ex.Run();
+    rows = ex.Report();
+    mismatches = ex.type_mismatches();
+    current.store(nullptr);
+    signal = interrupt.signal();
+    {
+      std::lock_guard<std::mutex> lock(guard_mutex);
+      run_over = true;
+    }
+    guard_cv.notify_all();
+  }  // the signal thread has ended: `guard` is no longer written
+  if (guard.joinable()) guard.join();
+  if (!options.quiet) PrintReport(rows, process, out);
+  if (signal != 0) {
+    // A person stopped it: the run ended cleanly (recordings closed), but it did not finish.
+    err << "dyad run: interrupted (" << SignalName(signal) << ")" << (result.ok() ? "" : ": " + result.message()) << "\n";
+    return ExitCodeForSignal(signal);
+  }
+  if (!result.ok()) {
+    err << "dyad run: " << result.message() << "\n";
+    return ExitCodeOf(result);
+  }
+  if (mismatches > 0) {
+    err << "dyad run: " << mismatches << " type/QoS mismatch(es) with peers (see above)\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace dyad

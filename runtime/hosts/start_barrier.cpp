@@ -1,0 +1,134 @@
+#include "hosts/start_barrier.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <set>
+#include <thread>
+
+#include <dyad/message_traits.hpp>
+
+namespace dyad {
+
+bool StartBarrier::Required(const std::string& process) const {
+  for (const auto& pc : graph_.processes)
+    if (pc.name == process) return pc.required;
+  return true;
+}
+
+bool StartBarrier::Awaited(const std::string& process) const { return process == process_ || Required(process); }
+
+StartBarrier::StartBarrier(const Graph& graph, std::string process, std::string host, uint32_t restarts)
+    : graph_(graph), process_(std::move(process)), host_(std::move(host)), restarts_(restarts) {
+  for (const auto& c : graph.components) {
+    if (!Awaited(graph.ProcessOf(c))) continue;
+    for (const auto& b : c.outputs) ++writers_of_[b.topic];
+    for (const auto& b : c.inputs) ++readers_of_[b.topic];
+  }
+}
+
+Status StartBarrier::Open(Transport* transport) {
+  transport_ = transport;
+  // Depth: the newest announcement of each writer is what counts; a few more absorb a burst.
+  auto w = CreateRuntimeWriter(transport, runtime_topics::kProcesses);
+  if (!w.ok()) return w.status();
+  writer_ = w.value();
+  auto r = CreateRuntimeReader(transport, runtime_topics::kProcesses);
+  if (!r.ok()) return r.status();
+  reader_ = r.value();
+  return Status::OK();
+}
+
+void StartBarrier::Announce(const std::string& state) {
+  if (writer_ == nullptr) return;
+  msg::ProcessState m;
+  m.header().source("dyad/" + process_);
+  m.header().sequence_number(++sequence_);
+  m.header().stamp_ns(WallNowNs());
+  m.graph_name(graph_.name);
+  m.process_name(process_);
+  m.host(host_);
+  m.pid(static_cast<int32_t>(getpid()));
+  m.state(state);
+  m.ready_ns(ready_ns_);
+  m.start_ns(start_ns_);
+  m.restarts(restarts_);
+  (void)writer_->Write(&m);  // best effort: a lost announcement is repeated with the next change
+}
+
+void StartBarrier::TakeAnnouncements() {
+  msg::ProcessState m;
+  while (reader_->TakeNext(&m))
+    if (m.graph_name() == graph_.name) heard_[m.process_name()] = m;
+}
+
+std::string StartBarrier::MissingEndpoints(const std::vector<EndpointMatch>& matches) const {
+  std::string out;
+  for (const auto& e : matches) {
+    if (e.topic.rfind("dyad/", 0) == 0 || (e.writer && e.serialized)) continue;
+    const auto& expected_of = e.writer ? readers_of_ : writers_of_;
+    const auto it = expected_of.find(e.topic);
+    const int expected = it == expected_of.end() ? 0 : it->second;
+    if (e.matched < expected)
+      out += std::string(out.empty() ? "" : "; ") + "the " + (e.writer ? "writer" : "reader") + " of '" + e.topic +
+             "' matched " + std::to_string(e.matched) + " of " + std::to_string(expected) + (e.writer ? " readers" : " writers");
+  }
+  return out;
+}
+
+StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
+  std::set<std::string> processes;
+  for (const auto& c : graph_.components)
+    if (Awaited(graph_.ProcessOf(c))) processes.insert(graph_.ProcessOf(c));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(graph_.network.start_timeout_s);
+  Announce("waiting");
+  for (;;) {
+    if (stopping()) return int64_t{0};
+    TakeAnnouncements();
+    const std::string missing_endpoints = MissingEndpoints(transport_->Matches());
+    if (ready_ns_ == 0 && missing_endpoints.empty()) {
+      ready_ns_ = WallNowNs();
+      Announce("waiting");
+    }
+    // Joining a graph that already runs (restarted, or started late): no one waits for us.
+    int64_t running_since = 0;  // the graph's start, as the running processes agreed it
+    for (const auto& [name, s] : heard_)
+      if (name != process_ && s.state() == "running" && s.start_ns() > 0 && (running_since == 0 || s.start_ns() < running_since))
+        running_since = s.start_ns();
+    if (ready_ns_ != 0 && running_since != 0) {
+      start_ns_ = std::max(running_since, WallNowNs());  // an agreed start still ahead is kept
+      graph_start_ns_ = running_since;
+      return start_ns_;
+    }
+    std::string not_heard;
+    // The start every process computes alike: from the required processes' ready times only (a
+    // process that is not required must not move it by being ready last).
+    int64_t last_ready = Required(process_) ? ready_ns_ : 0;
+    for (const auto& p : processes) {
+      const auto it = heard_.find(p);
+      if (p == process_) continue;
+      const int64_t ready = it == heard_.end() ? 0 : it->second.ready_ns();
+      if (ready == 0)
+        not_heard += std::string(not_heard.empty() ? "" : ", ") + "'" + p + "'" +
+                     (it == heard_.end() ? " (not seen)" : " (seen, its endpoints not all matched)");
+      last_ready = std::max(last_ready, ready);
+    }
+    if (ready_ns_ != 0 && not_heard.empty()) {
+      start_ns_ = graph_start_ns_ = last_ready + kStartMarginNs;
+      return start_ns_;
+    }
+    if (std::chrono::steady_clock::now() >= deadline) {
+      std::string what;
+      if (!not_heard.empty()) what = "processes not ready: " + not_heard;
+      if (!missing_endpoints.empty()) what += std::string(what.empty() ? "" : "; ") + "here: " + missing_endpoints;
+      return Status::FailedPrecondition("process '" + process_ + "' waited " +
+                                        std::to_string(static_cast<int>(graph_.network.start_timeout_s)) +
+                                        " s (network.start_timeout_s) for the graph to start together: " + what);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+}  // namespace dyad
