@@ -17,6 +17,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <thread>
 
@@ -162,6 +163,61 @@ TEST_F(ProcessTest, TwoComponentsExchangeSamplesAcrossTwoOsProcesses) {
   EXPECT_NE(a.out().find("timing (process a)"), std::string::npos);
 }
 
+// Two copies of one wall-clock graph (the same name) side by side on one domain, as two rigs in
+// a lab: each run is its own DDS partition, so each sink and each recording holds exactly its
+// own source's samples, and each run says that the other's writer was seen and ignored.
+TEST_F(ProcessTest, TwoRunsOfOneGraphOnOneDomainNeverMix) {
+  auto graph = [&](const std::string& copy, int start) {
+    return Write(copy + ".yaml", "graph: twin\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                     "\ncomponents:\n"
+                                     "  src: {type: counter_source, rate_hz: 20, params: {start: " + std::to_string(start) +
+                                     "}, outputs: {out: count}}\n"
+                                     "  sink: {type: counter_sink, trigger: in, params: {file: " + (dir_ / (copy + ".txt")).string() +
+                                     "}, inputs: {in: count}}\n"
+                                     "  rec: {type: recorder, rate_hz: 1, params: {file: " + (dir_ / (copy + ".mcap")).string() + "}}\n");
+  };
+  const fs::path a = graph("a", 0), b = graph("b", 100000);
+  Child ca(Dyad({"run", a.string(), "--duration", "5", "--quiet"}), dir_, "a");
+  Child cb(Dyad({"run", b.string(), "--duration", "5", "--quiet"}), dir_, "b");
+  ASSERT_EQ(ca.Wait(30), 0) << ca.err();
+  ASSERT_EQ(cb.Wait(30), 0) << cb.err();
+  for (const auto& [copy, lo] : {std::pair<std::string, int64_t>{"a", 0}, {"b", 100000}}) {
+    const auto received = ReadSink(dir_ / (copy + ".txt"));
+    ASSERT_GE(received.size(), 60u) << copy;  // 20 Hz for 5 s: ~100
+    ASSERT_LE(received.size(), 110u) << copy << ": more samples than its own source wrote";
+    for (size_t i = 0; i < received.size(); ++i) {
+      EXPECT_GE(received[i].value, lo) << copy << " received another run's sample";
+      EXPECT_LT(received[i].value, lo + 1000) << copy << " received another run's sample";
+      if (i > 0) {
+        EXPECT_EQ(received[i].sequence, received[i - 1].sequence + 1) << copy;
+      }
+    }
+    // The recording, read by `dyad bag info`: one channel of `count` with as many samples as the
+    // sink saw (give or take the first and last, which a later-matched or earlier-closed
+    // endpoint may miss), never the two runs' together.
+    Child info(Dyad({"bag", "info", (dir_ / (copy + ".mcap")).string()}), dir_, "info_" + copy);
+    ASSERT_EQ(info.Wait(30), 0) << info.err();
+    std::smatch m;
+    const std::string text = info.out();
+    ASSERT_TRUE(std::regex_search(text, m, std::regex(R"(  count  (\d+) msgs)"))) << text;
+    const long recorded = std::stol(m[1]);
+    EXPECT_LE(recorded, static_cast<long>(received.size()) + 3) << copy << ": " << text;
+    EXPECT_GE(recorded, static_cast<long>(received.size()) - 3) << copy << ": " << text;
+  }
+  // Each saw the other's writer of `count` and said it ignored it.
+  EXPECT_NE(ca.err().find("topic 'count' is also written by 'dyad/twin/main'"), std::string::npos) << ca.err();
+  EXPECT_NE(ca.err().find("another run on this domain: ignored"), std::string::npos) << ca.err();
+  EXPECT_NE(cb.err().find("another run on this domain: ignored"), std::string::npos) << cb.err();
+}
+
+// A run's id may not be a partition pattern.
+TEST_F(ProcessTest, ARunIdThatIsNotAWordIsRefused) {
+  const fs::path g = Write("g.yaml", "graph: t\ncomponents:\n  src: {type: counter_source, rate_hz: 10, outputs: {out: count}}\n");
+  Child c(Dyad({"run", g.string(), "--run-id", "a*", "--steps", "2"}), dir_, "bad");
+  EXPECT_EQ(c.Wait(30), 2);
+  EXPECT_NE(c.err().find("--run-id 'a*'"), std::string::npos) << c.err();
+}
+
 TEST_F(ProcessTest, SigintStopsEveryProcessCleanly) {
   const fs::path out = dir_ / "sink.txt";
   const fs::path g = Write("g.yaml", "graph: sig\ndomain_id: " + std::to_string(domain_) +
@@ -201,8 +257,8 @@ TEST_F(ProcessTest, TypeMismatchWithAPeerIsReportedNamingBoth) {
                                          "\ncomponents:\n"
                                          "  src: {type: counter_source, rate_hz: 10, outputs: {out: count}}\n"
                                          "  sink: {type: counter_sink, trigger: in, inputs: {in: count}}\n");
-  Child peer({DYAD_TYPE_PEER, std::to_string(domain_), "count", "8"}, dir_, "peer");
-  Child c(Dyad({"run", g.string(), "--duration", "4"}), dir_, "mm");
+  Child peer({DYAD_TYPE_PEER, std::to_string(domain_), "count", "8", "dyad/mm/r1"}, dir_, "peer");
+  Child c(Dyad({"run", g.string(), "--duration", "4", "--run-id", "r1"}), dir_, "mm");
   EXPECT_EQ(c.Wait(30), 1) << c.err();
   const std::string e = c.err();
   EXPECT_NE(e.find("type mismatch on topic 'count'"), std::string::npos) << e;

@@ -1,5 +1,5 @@
 // Test peer: publishes dyad::msg::Counter under a different definition hash, as a process built
-// from another version of the IDL would. Usage: dyad_type_peer DOMAIN TOPIC SECONDS
+// from another version of the IDL would. Usage: dyad_type_peer DOMAIN TOPIC SECONDS [PARTITION]
 #include <chrono>
 #include <cstdlib>
 #include <iostream>
@@ -10,8 +10,8 @@
 #include "dds/dds_participant.hpp"
 
 int main(int argc, char** argv) {
-  if (argc != 4) {
-    std::cerr << "usage: dyad_type_peer DOMAIN TOPIC SECONDS\n";
+  if (argc != 4 && argc != 5) {
+    std::cerr << "usage: dyad_type_peer DOMAIN TOPIC SECONDS [PARTITION]\n";
     return 2;
   }
   dyad::TypeInfo other = dyad::TypeInfoOf<dyad::msg::Counter>();
@@ -22,7 +22,9 @@ int main(int argc, char** argv) {
     t->setName(dds_name.c_str());
     return static_cast<eprosima::fastdds::dds::TopicDataType*>(t);
   };
-  auto p = dyad::DdsParticipant::Create(std::atoi(argv[1]), "type-peer", nullptr);
+  dyad::DdsParticipant::Options po;
+  if (argc == 5) po.partitions = {argv[4]};
+  auto p = dyad::DdsParticipant::Create(std::atoi(argv[1]), "type-peer", std::move(po));
   if (!p.ok()) return 1;
   auto w = p.value()->CreateWriter(argv[2], other, dyad::TopicQos{});
   if (!w.ok()) return 1;

@@ -18,7 +18,10 @@
 #include <fastdds/rtps/builtin/data/WriterProxyData.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 
+#include <fnmatch.h>
+
 #include <algorithm>
+#include <set>
 #include <sstream>
 
 namespace fdds = eprosima::fastdds::dds;
@@ -43,11 +46,32 @@ std::string QosPolicyName(fdds::QosPolicyId_t id) {
   }
 }
 
+// DDS partition matching (DDS 1.4, 2.2.3.13): two endpoints share a partition when a name of
+// one equals, or is matched by a pattern of, a name of the other; no names is the default
+// partition "". Fast DDS matches the same way (fnmatch).
+bool PartitionsMatch(const std::vector<std::string>& a, const std::vector<std::string>& b) {
+  const std::vector<std::string> none{""};
+  const auto& x = a.empty() ? none : a;
+  const auto& y = b.empty() ? none : b;
+  for (const auto& m : x)
+    for (const auto& n : y)
+      if (m == n || fnmatch(m.c_str(), n.c_str(), 0) == 0 || fnmatch(n.c_str(), m.c_str(), 0) == 0) return true;
+  return false;
+}
+
+std::string PartitionText(const std::vector<std::string>& names) {
+  if (names.empty()) return "the default partition";
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "'" : ", '") + n + "'";
+  return "partition " + out;
+}
+
 }  // namespace
 
 class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantListener {
  public:
-  DiscoveryListener(DdsParticipant* owner, ProblemHandler on_problem) : owner_(owner), on_problem_(std::move(on_problem)) {}
+  DiscoveryListener(DdsParticipant* owner, ProblemHandler on_problem, ProblemHandler on_foreign)
+      : owner_(owner), on_problem_(std::move(on_problem)), on_foreign_(std::move(on_foreign)) {}
 
   void on_participant_discovery(fdds::DomainParticipant*, rtps::ParticipantDiscoveryInfo&& info) override {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -57,12 +81,18 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
     const bool gone = info.status == rtps::WriterDiscoveryInfo::REMOVED_WRITER;
     Track(true, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid());
     if (info.status != rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) return;
-    Check("writer", info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid().guidPrefix);
+    const std::string topic = info.info.topicName().to_string();
+    if (!PartitionsMatch(owner_->partitions_, info.info.m_qos.m_partition.names())) {
+      Foreign(topic, info.info.m_qos.m_partition.names(), info.info.guid());
+      return;  // another run's: its type is not ours to check
+    }
+    Check("writer", topic, info.info.typeName().to_string(), info.info.guid().guidPrefix);
   }
   void on_subscriber_discovery(fdds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override {
     const bool gone = info.status == rtps::ReaderDiscoveryInfo::REMOVED_READER;
     Track(false, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid());
     if (info.status != rtps::ReaderDiscoveryInfo::DISCOVERED_READER) return;
+    if (!PartitionsMatch(owner_->partitions_, info.info.m_qos.m_partition.names())) return;
     Check("reader", info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid().guidPrefix);
   }
 
@@ -111,6 +141,27 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
                 "; no samples will flow between them");
   }
 
+  // A writer of a topic this participant uses, in another run's partition: DDS does not match
+  // them, so nothing of it is delivered (or recorded) here; say so once per writer.
+  void Foreign(const std::string& topic, const std::vector<std::string>& partitions, const rtps::GUID_t& guid) {
+    {
+      std::lock_guard<std::mutex> lock(owner_->mutex_);
+      if (!owner_->topic_types_.count(topic)) return;
+    }
+    std::ostringstream os;
+    os << guid;
+    std::string remote;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!foreign_reported_.insert(os.str()).second || !on_foreign_) return;
+      auto it = names_.find(GuidPrefixString(guid.guidPrefix));
+      remote = it != names_.end() ? it->second : "participant " + GuidPrefixString(guid.guidPrefix);
+    }
+    on_foreign_("topic '" + topic + "' is also written by '" + remote + "' in " + PartitionText(partitions) +
+                ", another run on this domain: ignored (not delivered, not recorded); this run is in " +
+                PartitionText(owner_->partitions_));
+  }
+
   void Track(bool writer, bool gone, const std::string& topic, const std::string& type, const rtps::GUID_t& guid) {
     std::ostringstream os;
     os << guid;
@@ -123,8 +174,9 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
   }
 
   DdsParticipant* owner_;
-  ProblemHandler on_problem_;
+  ProblemHandler on_problem_, on_foreign_;
   std::mutex mutex_;
+  std::set<std::string> foreign_reported_;  // writer guids
   std::map<std::string, std::string> names_;  // guid prefix -> participant name
   std::map<std::string, DiscoveredEndpoint> endpoints_;  // by guid; participant holds the prefix
 };
@@ -318,12 +370,14 @@ int DdsWriter::matched() const {
   return st.current_count;
 }
 
-StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, const std::string& name,
-                                                                  ProblemHandler on_problem, Scope scope,
-                                                                  const NetworkConfig& network, const std::string& process) {
+StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, const std::string& name, Options options) {
+  const Scope scope = options.scope;
+  const NetworkConfig& network = options.network;
+  const std::string& process = options.process;
   std::unique_ptr<DdsParticipant> p(new DdsParticipant());
   p->name_ = name;
-  p->listener_ = std::make_unique<DiscoveryListener>(p.get(), std::move(on_problem));
+  p->partitions_ = options.partitions;
+  p->listener_ = std::make_unique<DiscoveryListener>(p.get(), std::move(options.on_problem), std::move(options.on_foreign_writer));
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   factory->load_profiles();  // profiles load lazily; load them before reading defaults
   fdds::DomainParticipantQos qos = factory->get_default_participant_qos();
@@ -348,8 +402,14 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
   p->participant_ = factory->create_participant(domain_id, qos, p->listener_.get(), mask);
   if (p->participant_ == nullptr)
     return Status::Internal("cannot create DDS participant '" + name + "' on domain " + std::to_string(domain_id));
-  p->publisher_ = p->participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
-  p->subscriber_ = p->participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  fdds::PublisherQos pub_qos = fdds::PUBLISHER_QOS_DEFAULT;
+  fdds::SubscriberQos sub_qos = fdds::SUBSCRIBER_QOS_DEFAULT;
+  for (const auto& partition : p->partitions_) {
+    pub_qos.partition().push_back(partition.c_str());
+    sub_qos.partition().push_back(partition.c_str());
+  }
+  p->publisher_ = p->participant_->create_publisher(pub_qos);
+  p->subscriber_ = p->participant_->create_subscriber(sub_qos);
   if (p->publisher_ == nullptr || p->subscriber_ == nullptr)
     return Status::Internal("cannot create DDS publisher/subscriber for '" + name + "'");
   return p;

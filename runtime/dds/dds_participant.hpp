@@ -137,7 +137,6 @@ struct DiscoveredEndpoint {
 
 class DdsParticipant final : public Transport {
  public:
-  // Reports type mismatches and incompatible QoS; called from Fast DDS threads.
   using ProblemHandler = std::function<void(const std::string& message)>;
 
   // kNetwork: a normal participant of the domain. kProcessOnly: discovery ignores participants
@@ -152,14 +151,25 @@ class DdsParticipant final : public Transport {
   // writing component's step: steps of 0.3 to 2 s measured), and the next watcher reusing that
   // port could not be reached for seconds. Over UDP a dead peer costs a lost datagram.
   enum class Scope { kNetwork, kProcessOnly, kWatcher };
-  //
-  // `network`: the graph's network section (discovery, transports, lease; see network_qos.hpp),
-  // for kNetwork and kWatcher (a watcher keeps to UDP whatever it says, or connects as a TCP
-  // client when the transport is tcp); `process` names the graph's process (its TCP listener).
-  static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, ProblemHandler on_problem,
-                                                          Scope scope = Scope::kNetwork,
-                                                          const NetworkConfig& network = NetworkConfig{},
-                                                          const std::string& process = "");
+
+  struct Options {
+    Scope scope = Scope::kNetwork;
+    // The graph's network section (discovery, transports, lease; see network_qos.hpp), for
+    // kNetwork and kWatcher (a watcher keeps to UDP whatever it says, or connects as a TCP
+    // client when the transport is tcp); `process` names the graph's process (its TCP listener).
+    NetworkConfig network;
+    std::string process;
+    // The DDS partitions of every endpoint (empty: the default partition). A run's processes use
+    // its one partition (RunPartition, graph/runtime_topics.hpp): endpoints of another run of a
+    // graph on the same domain do not match them. Watchers may use patterns ("dyad/demo/*").
+    std::vector<std::string> partitions;
+    // Type mismatches and incompatible QoS (data cannot flow where it should); Fast DDS threads.
+    ProblemHandler on_problem;
+    // A writer of one of this participant's topics in partitions none of ours matches: another
+    // run's, never delivered here. Reported once per writer; Fast DDS threads.
+    ProblemHandler on_foreign_writer;
+  };
+  static StatusOr<std::unique_ptr<DdsParticipant>> Create(int domain_id, const std::string& name, Options options);
   // Stops every callback, deletes every endpoint created here, then the participant.
   ~DdsParticipant() override;
   DdsParticipant(const DdsParticipant&) = delete;
@@ -196,6 +206,7 @@ class DdsParticipant final : public Transport {
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
   std::map<std::string, std::string> topic_types_;  // topic -> dds type name
   Scope scope_ = Scope::kNetwork;
+  std::vector<std::string> partitions_;
   // Every endpoint created here; destroyed (in this order) by the destructor only.
   std::vector<std::unique_ptr<DdsSerializedReader>> serialized_readers_;
   std::vector<std::unique_ptr<DdsReader>> readers_;

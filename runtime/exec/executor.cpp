@@ -12,6 +12,7 @@
 #include "graph/graph_topics.hpp"
 #include "exec/logger.hpp"
 #include "exec/wall_clock.hpp"
+#include "graph/run_partition.hpp"
 
 namespace dyad {
 namespace {
@@ -236,13 +237,20 @@ Status Executor::Setup() {
     if (!t.ok()) return t.status();
     transport_ = std::move(t.value());
   } else {
-    auto p = DdsParticipant::Create(graph_.domain_id, participant_name,
-                                    [this](const std::string& msg) {
-                                      ++problems_;
-                                      StderrLogger("dds").Error(msg);
-                                    },
-                                    stepped ? DdsParticipant::Scope::kProcessOnly : DdsParticipant::Scope::kNetwork,
-                                    graph_.network, options_.process);
+    DdsParticipant::Options po;
+    po.scope = stepped ? DdsParticipant::Scope::kProcessOnly : DdsParticipant::Scope::kNetwork;
+    po.network = graph_.network;
+    po.process = options_.process;
+    po.partitions = {RunPartition(graph_)};
+    po.on_problem = [this](const std::string& msg) {
+      ++problems_;
+      StderrLogger("dds").Error(msg);
+    };
+    po.on_foreign_writer = [this](const std::string& msg) {
+      ++foreign_writers_;
+      StderrLogger("dds").Warn(msg);
+    };
+    auto p = DdsParticipant::Create(graph_.domain_id, participant_name, std::move(po));
     if (!p.ok()) return p.status();
     transport_ = std::move(p.value());
   }

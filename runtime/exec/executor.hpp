@@ -89,6 +89,8 @@ class Executor {
   };
   std::vector<Row> Report() const;
   int type_mismatches() const { return problems_.load(); }
+  // Writers of this process's topics seen in another run's partition (ignored; warned about).
+  int foreign_writers() const { return foreign_writers_.load(); }
 
  private:
   struct Instance;
@@ -124,6 +126,7 @@ class Executor {
 
   std::atomic<bool> stop_{false};
   std::atomic<int> problems_{0};
+  std::atomic<int> foreign_writers_{0};
   mutable std::mutex mutex_;  // guards stop_reason_, failure_; with cv_ wakes sleepers on stop
   std::condition_variable cv_;
   std::string stop_reason_;

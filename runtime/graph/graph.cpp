@@ -11,8 +11,14 @@
 
 #include <yaml-cpp/depthguard.h>
 
+#include "graph/run_partition.hpp"
+
 namespace dyad {
 namespace {
+
+// Graph names become part of DDS partition names (graph/run_partition.hpp).
+const std::string kGraphNameRule = "must be 1 to 64 of the characters A-Z a-z 0-9 _ . - (it names the run's DDS partition)";
+
 
 // Collects diagnostics for one file.
 class Reader {
@@ -292,7 +298,7 @@ bool ApplyGraphOverride(const std::string& key, const std::string& value, const 
       out->push_back({cli, "domain_id", "must be in 0..232 (DDS), got '" + value + "'"});
     }
   } else if (key == "graph") {
-    if (value.empty()) out->push_back({cli, "graph", "must not be empty"});
+    if (!IsPartitionWord(value)) out->push_back({cli, "graph", kGraphNameRule + (", got '" + value + "'")});
     else g->name = value;
   } else {
     return false;
@@ -443,7 +449,8 @@ void InjectSectionOverrides(const std::vector<Override>& overrides, YAML::Node r
 
 // The graph's own scalars: graph, domain_id, clock, seed, plugins, logs.
 void ReadGraphScalars(Reader& r, const YAML::Node& root, Graph* g) {
-  if (root["graph"]) r.String(root["graph"], "graph", &g->name);
+  if (root["graph"] && r.String(root["graph"], "graph", &g->name) && !IsPartitionWord(g->name))
+    r.Error(root["graph"], "graph", kGraphNameRule + (", got '" + g->name + "'"));
   if (root["domain_id"] && r.Number(root["domain_id"], "domain_id", &g->domain_id, "an integer") &&
       (g->domain_id < 0 || g->domain_id > 232))
     r.Error(root["domain_id"], "domain_id", "must be in 0..232 (DDS), got " + std::to_string(g->domain_id));

@@ -21,6 +21,7 @@
 
 #include "hosts/clock_sync.hpp"
 #include "dds/dds_participant.hpp"
+#include "graph/run_partition.hpp"
 #include "graph/graph_topics.hpp"
 #include "hosts/start_barrier.hpp"
 #include "dyad/interrupt.hpp"
@@ -31,7 +32,11 @@ namespace {
 using Steady = std::chrono::steady_clock;
 
 std::unique_ptr<DdsParticipant> Join(const IntrospectOptions& o, std::ostream& err) {
-  auto p = DdsParticipant::Create(o.domain_id, "dyad/introspect", nullptr, DdsParticipant::Scope::kWatcher, o.network);
+  DdsParticipant::Options po;
+  po.scope = DdsParticipant::Scope::kWatcher;
+  po.network = o.network;
+  po.partitions = {o.run_id.empty() || o.graph_name.empty() ? WatchPartition(o.graph_name) : RunPartition(o.graph_name, o.run_id)};
+  auto p = DdsParticipant::Create(o.domain_id, "dyad/introspect", std::move(po));
   if (!p.ok()) {
     err << p.status().message() << "\n";
     return nullptr;

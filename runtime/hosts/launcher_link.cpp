@@ -10,6 +10,7 @@
 #include <dyad/message_traits.hpp>
 #include <dyad/msg/types.hpp>
 
+#include "graph/run_partition.hpp"
 #include "dds/dds_participant.hpp"
 #include "hosts/start_barrier.hpp"
 #include "exec/wall_clock.hpp"
@@ -28,8 +29,11 @@ StatusOr<std::unique_ptr<LauncherLink>> LauncherLink::Open(const Graph& graph, c
   for (const auto& pc : graph.processes)
     if (!pc.host.empty() && pc.host != host) others.insert(pc.host);
   link->other_hosts_ = static_cast<int>(others.size());
-  auto p = DdsParticipant::Create(graph.domain_id, "dyad/launcher/" + host, nullptr, DdsParticipant::Scope::kWatcher,
-                                  graph.network);
+  DdsParticipant::Options po;
+  po.scope = DdsParticipant::Scope::kWatcher;
+  po.network = graph.network;
+  po.partitions = {RunPartition(graph)};  // another run's launchers are not ours to hear
+  auto p = DdsParticipant::Create(graph.domain_id, "dyad/launcher/" + host, std::move(po));
   if (!p.ok()) return p.status();
   link->participant_ = std::move(p.value());
   auto lw = CreateRuntimeWriter(link->participant_.get(), runtime_topics::kLaunchers);

@@ -12,12 +12,14 @@
 #include <iomanip>
 #include <iostream>
 #include <mutex>
+#include <random>
 #include <set>
 
 #include "dyad/catalog.hpp"
 #include "dyad/interrupt.hpp"
 #include "dyad/validate.hpp"
 #include "exec/executor.hpp"
+#include "graph/run_partition.hpp"
 #include "hosts/graph_session.hpp"
 #include "hosts/launcher.hpp"
 
@@ -71,6 +73,18 @@ bool LoadAndValidate(const std::string& path, const std::vector<Override>& overr
   return diags.empty();
 }
 
+// A graph on one host gets a run of its own (two copies side by side do not mix); the launchers
+// of a graph on several hosts cannot agree on a drawn id, so they share kSharedRun.
+std::string DefaultRunId(const Graph& g) {
+  std::set<std::string> hosts;
+  for (const auto& p : g.processes) hosts.insert(p.host);
+  if (hosts.size() > 1) return kSharedRun;
+  std::random_device random;
+  char id[16];
+  std::snprintf(id, sizeof(id), "%08x", static_cast<unsigned>(random()));
+  return id;
+}
+
 void PrintReport(const std::vector<Executor::Row>& rows, const std::string& process, std::ostream& out) {
   out << "timing (process " << process << "):\n";
   out << std::left << std::setw(20) << "component" << std::right << std::setw(9) << "steps" << std::setw(12) << "mean_ms"
@@ -118,8 +132,17 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   if (!LoadAndValidate(options.graph_path, options.overrides, options.plugin_paths, &l, err, &options)) return 2;
   const std::set<std::string> procs = l.graph.ProcessNames();
   std::string process = options.process;
+  if (!options.run_id.empty() && !IsPartitionWord(options.run_id)) {
+    err << "dyad run: --run-id '" << options.run_id << "': must be 1 to 64 of the characters A-Z a-z 0-9 _ . -\n";
+    return 2;
+  }
+  l.graph.run = options.run_id.empty() && process.empty() ? DefaultRunId(l.graph) : options.run_id;
   if (process.empty()) {
-    if (NeedsLauncher(l.graph, options)) return LaunchChildren(options, l.graph, out, err);
+    if (NeedsLauncher(l.graph, options)) {
+      RunOptions launched = options;
+      launched.run_id = l.graph.run;  // every child joins the launcher's run
+      return LaunchChildren(launched, l.graph, out, err);
+    }
     process = *procs.begin();
   } else if (!procs.count(process)) {
     std::string list;

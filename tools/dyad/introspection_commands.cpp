@@ -46,6 +46,7 @@ bool LoadWatcherCatalog(const std::string& graph_path, std::vector<std::string> 
     plugins.insert(plugins.end(), graph.plugins.begin(), graph.plugins.end());
     if (options != nullptr) {
       options->network = graph.network;
+      options->graph_name = graph.name;
       if (!domain_given) options->domain_id = graph.domain_id;
     }
   }
@@ -74,6 +75,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   auto st = std::make_shared<State>();
   auto add_common = [st](CLI::App* c) {
     st->domain_options.push_back(c->add_option("--domain", st->opts.domain_id, "DDS domain id (default: the --graph's, else 0)")->check(CLI::Range(0, 232)));
+    c->add_option("--run-id", st->opts.run_id, "Watch only this run of the --graph (its `dyad run --run-id`); default: every run");
     c->add_option("--wait", st->opts.wait_s, "Seconds of discovery before answering (topics) or giving up on a topic (echo, hz); default 5")->check(CLI::NonNegativeNumber);
   };
 

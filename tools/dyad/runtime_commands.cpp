@@ -80,6 +80,9 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
   r->add_option("--steps", run.steps, "Stop after the fastest periodic component ran this many steps");
   r->add_option("--stats-period", run.stats_period_s, "Seconds between ComponentStats samples on dyad/stats")
       ->check(CLI::PositiveNumber);
+  r->add_option("--run-id", run.run_id,
+                "This run's id: with the graph's name, the DDS partition that keeps it apart from other runs on the domain "
+                "(default: a fresh one for a graph on one host, 'shared' for a graph on several; give the same one on every host)");
   r->add_flag("--quiet", run.quiet, "Do not print the timing table at exit");
   r->callback([st, &exit_code] {
     st->run.overrides = ToOverrides(st->sets);

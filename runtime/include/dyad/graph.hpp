@@ -144,6 +144,9 @@ struct Graph {
   // working folder for a graph without a file name).
   std::string folder;
   std::string name = "dyad";
+  // This run's id (`dyad run --run-id`, or the launcher's choice; not in the file): with the
+  // name, the DDS partition that isolates the run from others on the domain.
+  std::string run;
   int domain_id = 0;
   ClockMode clock = ClockMode::kWall;
   uint64_t seed = 1;

@@ -32,6 +32,10 @@ struct IntrospectOptions {
   double wait_s = 5.0;
   // How to find the graph's processes: its network section (`--graph`; default: multicast).
   NetworkConfig network;
+  // Which runs to watch (each run is a DDS partition, see docs/runtime.md): empty graph_name:
+  // every dyad run on the domain; a name: that graph's runs; with run_id: that run only.
+  std::string graph_name;
+  std::string run_id;
 };
 
 // Prints one line per topic: name, type, writers, readers, participants. Returns 0, or 1 when

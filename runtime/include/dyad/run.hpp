@@ -52,6 +52,10 @@ struct RunOptions {
   double stats_period_s = 1.0;     // ComponentStats publication period (wall time)
   std::vector<std::string> plugin_paths;  // in addition to the graph's plugins:
   bool quiet = false;              // no timing table
+  // With the graph's name, the run's DDS partition (graph/run_partition.hpp). Empty: the
+  // launcher of a graph on one host draws a fresh one (8 hex digits) and gives it to its
+  // children; a graph on several hosts, or a process started by hand, uses "shared".
+  std::string run_id;
 };
 
 int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err);
