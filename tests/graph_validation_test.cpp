@@ -176,6 +176,7 @@ TEST(GraphValidation, OverrideSetsTheGraphsOwnScalars) {
   const std::pair<const char*, const char*> bad[] = {{"clock=sometimes", "must be wall or stepped"},
                                                      {"seed=-1", "non-negative integer"},
                                                      {"domain_id=999", "0..232"},
+                                                     {"graph=two words", "A-Z a-z 0-9 _ . -"},
                                                      {"nokey=1", "expected COMPONENT.PARAM=VALUE"}};
   for (const auto& [set, why] : bad) {
     diags.clear();
@@ -183,6 +184,17 @@ TEST(GraphValidation, OverrideSetsTheGraphsOwnScalars) {
     ASSERT_EQ(diags.size(), 1u) << set;
     EXPECT_EQ(diags[0].mark.file, std::string("--set ") + set);
     EXPECT_NE(diags[0].message.find(why), std::string::npos) << diags[0].ToString();
+  }
+}
+
+// A graph's name is part of its runs' DDS partition: no pattern characters, no spaces.
+TEST(GraphValidation, AGraphNameThatCannotNameAPartitionIsAnErrorAtItsLine) {
+  for (const char* name : {"demo*", "my graph", "a/b"}) {
+    const auto diags = Check(Replace(kValid, "graph: ok", std::string("graph: \"") + name + "\""));
+    ASSERT_EQ(diags.size(), 1u) << name;
+    EXPECT_EQ(diags[0].key, "graph");
+    EXPECT_EQ(diags[0].mark.line, 1);
+    EXPECT_NE(diags[0].message.find(std::string("got '") + name + "'"), std::string::npos) << diags[0].ToString();
   }
 }
 
