@@ -187,6 +187,23 @@ TEST(GraphValidation, OverrideSetsTheGraphsOwnScalars) {
   }
 }
 
+// Legal holes in the wiring are warnings, at their lines; the graph stays valid.
+TEST(GraphValidation, AnUnboundOutputAndADeclaredTopicNoComponentWritesAreWarnings) {
+  std::vector<Diagnostic> diags;
+  const std::string y = Replace(kValid, "    outputs: {out: count}\n", "") + "topics:\n  count: {type: Counter}\n";
+  Graph g = ParseGraph(y, "g.yaml", {}, &diags);
+  const ResolvedGraph r = ValidateGraph(g, ExampleCatalog(), &diags);
+  EXPECT_TRUE(diags.empty()) << diags[0].ToString();
+  ASSERT_EQ(r.warnings.size(), 2u);
+  EXPECT_EQ(r.warnings[0].key, "components.src.outputs.out");
+  EXPECT_EQ(r.warnings[0].mark.line, 4);
+  EXPECT_NE(r.warnings[0].message.find("bound to no topic"), std::string::npos);
+  EXPECT_EQ(r.warnings[1].key, "topics.count");
+  EXPECT_EQ(r.warnings[1].mark.line, 13);
+  EXPECT_NE(r.warnings[1].message.find("no component of the graph writes"), std::string::npos);
+  EXPECT_TRUE(ValidateGraph(ParseGraph(kValid, "g.yaml", {}, &diags), ExampleCatalog(), &diags).warnings.empty());
+}
+
 // A graph's name is part of its runs' DDS partition: no pattern characters, no spaces.
 TEST(GraphValidation, AGraphNameThatCannotNameAPartitionIsAnErrorAtItsLine) {
   for (const char* name : {"demo*", "my graph", "a/b"}) {

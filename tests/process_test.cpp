@@ -210,6 +210,23 @@ TEST_F(ProcessTest, TwoRunsOfOneGraphOnOneDomainNeverMix) {
   EXPECT_NE(cb.err().find("another run on this domain: ignored"), std::string::npos) << cb.err();
 }
 
+// A component that never stepped is named at exit; --strict makes it an error.
+TEST_F(ProcessTest, AComponentThatNeverSteppedIsNamedAndStrictMakesItAnError) {
+  const fs::path g = Write("g.yaml", "graph: idle\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\ncomponents:\n  src: {type: counter_source, rate_hz: 10, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, inputs: {in: ext}}\n"
+                                         "topics:\n  ext: {type: Counter}\n");
+  Child lax(Dyad({"run", g.string(), "--duration", "1", "--quiet"}), dir_, "lax");
+  EXPECT_EQ(lax.Wait(30), 0) << lax.err();
+  EXPECT_NE(lax.err().find("warning: process main: component 'sink' never stepped (triggered by input 'in': nothing arrived on 'ext')"),
+            std::string::npos) << lax.err();
+  EXPECT_EQ(lax.err().find("component 'src' never stepped"), std::string::npos) << lax.err();
+  EXPECT_NE(lax.err().find("topics.ext: no component of the graph writes this topic"), std::string::npos) << lax.err();
+  Child strict(Dyad({"run", g.string(), "--duration", "1", "--quiet", "--strict"}), dir_, "strict");
+  EXPECT_EQ(strict.Wait(30), 1) << strict.err();
+  EXPECT_NE(strict.err().find("error: process main: component 'sink' never stepped"), std::string::npos) << strict.err();
+}
+
 // A run's id may not be a partition pattern.
 TEST_F(ProcessTest, ARunIdThatIsNotAWordIsRefused) {
   const fs::path g = Write("g.yaml", "graph: t\ncomponents:\n  src: {type: counter_source, rate_hz: 10, outputs: {out: count}}\n");

@@ -154,6 +154,8 @@ class Validation {
   };
 
   void error(const SourceMark& m, const std::string& key, const std::string& msg) { diags_->push_back(Diagnostic{m, key, msg}); }
+  // Legal but likely a hole in the wiring: said, never refused.
+  void warn(const SourceMark& m, const std::string& key, const std::string& msg) { out_.warnings.push_back(Diagnostic{m, key, msg}); }
 
   // Rate or trigger, type, params and ports of one component.
   void ResolveComponent(const ComponentConfig& c, const std::string& key) {
@@ -246,14 +248,19 @@ class Validation {
     for (const auto& ps : spec.inputs())
       if (!ps.optional && !bound_inputs.count(ps.name))
         error(c.mark, key + ".inputs." + ps.name, "required input is not bound to a topic (" + ps.type->short_name() + ")");
+    std::set<std::string> bound_outputs;
     for (const auto& b : c.outputs) {
       const PortSpec* ps = spec.FindOutput(b.port);
       if (ps == nullptr) {
         error(b.mark, key + ".outputs." + b.port, "no output '" + b.port + "' on type " + c.type + " (outputs: " + Names(spec.outputs()) + ")");
         continue;
       }
+      bound_outputs.insert(b.port);
       writers_[b.topic].push_back({ps->type, key + ".outputs." + b.port, b.mark});
     }
+    for (const auto& ps : spec.outputs())
+      if (!bound_outputs.count(ps.name))
+        warn(c.mark, key + ".outputs." + ps.name, "output is bound to no topic: what it writes goes nowhere (and is not recorded)");
   }
 
   // Declared topic types must exist.
@@ -295,6 +302,8 @@ class Validation {
       if (writers_[name].empty() && declared == nullptr)
         for (const auto& u : readers_[name])
           error(u.mark, u.who, "nothing publishes topic '" + name + "' (no component output is bound to it)");
+      if (writers_[name].empty() && declared != nullptr)
+        warn(rt.config->mark, "topics." + name, "no component of the graph writes this topic: it must come from outside (a replay, another program)");
       out_.topics[name] = rt;
     }
   }

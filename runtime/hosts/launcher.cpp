@@ -154,6 +154,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
     }
     if (options.steps > 0) args.insert(args.end(), {"--steps", std::to_string(options.steps)});
     if (options.quiet) args.push_back("--quiet");
+    if (options.strict) args.push_back("--strict");
     if (!options.run_id.empty()) args.insert(args.end(), {"--run-id", options.run_id});
     if (!options.host.empty()) args.insert(args.end(), {"--host", options.host});
     return args;

@@ -14,6 +14,7 @@
 #include <mutex>
 #include <random>
 #include <set>
+#include <sstream>
 
 #include "dyad/catalog.hpp"
 #include "dyad/interrupt.hpp"
@@ -68,6 +69,9 @@ bool LoadAndValidate(const std::string& path, const std::vector<Override>& overr
     l->resolved = ValidateGraph(l->graph, l->catalog, &diags);
     DryConfigure(l->graph, l->resolved, l->catalog, &diags, ProcessesToCheck(l->graph, run));
   }
+  // A launcher's children validate again: the warnings are said once, by the command a person ran.
+  if (diags.empty() && (run == nullptr || run->process.empty()))
+    for (const auto& w : l->resolved.warnings) err << "warning: " << w.ToString() << "\n";
   for (const auto& d : diags) err << d.ToString() << "\n";
   if (!diags.empty()) err << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", nothing was started\n";
   return diags.empty();
@@ -83,6 +87,31 @@ std::string DefaultRunId(const Graph& g) {
   char id[16];
   std::snprintf(id, sizeof(id), "%08x", static_cast<unsigned>(random()));
   return id;
+}
+
+// A component that never stepped in a run that went to its end is a hole in the wiring (a trigger
+// whose topic nobody wrote, a rate slower than the run): named, as a warning or (--strict) an
+// error. Returns how many.
+int ReportIdleComponents(const std::vector<Executor::Row>& rows, const Graph& g, const std::string& process, bool strict,
+                         std::ostream& err) {
+  int idle = 0;
+  for (const auto& row : rows) {
+    if (row.stats.steps > 0) continue;
+    ++idle;
+    const ComponentConfig* c = g.FindComponent(row.component);
+    std::string why;
+    if (c != nullptr && !c->trigger.empty()) {
+      for (const auto& b : c->inputs)
+        if (b.port == c->trigger) why = " (triggered by input '" + c->trigger + "': nothing arrived on '" + b.topic + "')";
+    } else if (c != nullptr) {
+      std::ostringstream rate;
+      rate << c->rate_hz;
+      why = " (rate_hz " + rate.str() + ": the run ended before its first step)";
+    }
+    err << (strict ? "error" : "warning") << ": process " << process << ": component '" << row.component << "' never stepped"
+        << why << "\n";
+  }
+  return idle;
 }
 
 void PrintReport(const std::vector<Executor::Row>& rows, const std::string& process, std::ostream& out) {
@@ -208,6 +237,10 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   if (!result.ok()) {
     err << "dyad run: " << result.message() << "\n";
     return ExitCodeOf(result);
+  }
+  if (int idle = ReportIdleComponents(rows, l.graph, process, options.strict, err); idle > 0 && options.strict) {
+    err << "dyad run: " << idle << " component" << (idle == 1 ? "" : "s") << " never stepped (--strict)\n";
+    return 1;
   }
   if (mismatches > 0) {
     err << "dyad run: " << mismatches << " type/QoS mismatch(es) with peers (see above)\n";

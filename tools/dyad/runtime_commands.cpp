@@ -84,6 +84,7 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
                 "This run's id: with the graph's name, the DDS partition that keeps it apart from other runs on the domain "
                 "(default: a fresh one for a graph on one host, 'shared' for a graph on several; give the same one on every host)");
   r->add_flag("--quiet", run.quiet, "Do not print the timing table at exit");
+  r->add_flag("--strict", run.strict, "A component that never stepped is an error (exit 1), not only a warning");
   r->callback([st, &exit_code] {
     st->run.overrides = ToOverrides(st->sets);
     st->run.plugin_paths = st->plugins;

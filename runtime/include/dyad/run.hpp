@@ -56,6 +56,9 @@ struct RunOptions {
   // launcher of a graph on one host draws a fresh one (8 hex digits) and gives it to its
   // children; a graph on several hosts, or a process started by hand, uses "shared".
   std::string run_id;
+  // A component that never stepped during a run that went to its end is an error (exit 1), not
+  // only a warning.
+  bool strict = false;
 };
 
 int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err);

@@ -6,7 +6,8 @@
 // e.g. by a replay), required inputs left unbound, topic type mismatches (between writer and
 // reader ports, and against the type declared under `topics:`), rates that are not positive, a
 // component with neither rate_hz nor trigger, processes that are not declared, stepped clock
-// across several processes; and then, with DryConfigure, whatever each component's own
+// across several processes; warns (ResolvedGraph::warnings) about outputs bound to no topic and
+// declared topics that no component writes; and then, with DryConfigure, whatever each component's own
 // Configure() would reject.
 #pragma once
 
@@ -38,6 +39,10 @@ struct ResolvedGraph {
   std::vector<ResolvedComponent> components;   // graph order
   // Every topic some port binds, and every topic declared under `topics:` with a known type.
   std::map<std::string, ResolvedTopic> topics;
+  // Legal wiring that is likely a hole: an output bound to no topic, a topic declared under
+  // `topics:` that no component writes. `dyad validate` and a launcher print them, prefixed
+  // "warning: "; they never stop a run.
+  std::vector<Diagnostic> warnings;
 };
 
 // Appends problems to *diagnostics; the result is complete only when none were added.
