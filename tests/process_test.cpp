@@ -504,6 +504,29 @@ TEST_P(DiscoveryModeTest, ARequiredProcessFailingOnOneHostEndsTheRunOnEveryHost)
   EXPECT_EQ(h1.err().find("process 'a' exited"), std::string::npos) << "a was stopped, not failed: " << h1.err();
 }
 
+// A restart is never silent: the restarting launcher and the other host's say which process
+// restarted and what that reset.
+TEST_F(ProcessTest, EveryLauncherSaysWhenAProcessOfAnotherHostRestarted) {
+  const fs::path g = Write("g.yaml", "graph: restarts\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\nnetwork: {discovery: peers, hosts: {h1: 127.0.0.1, h2: 127.0.0.1}}\n"
+                                         "processes: {a: {host: h1}, b: {host: h2, restart: on-failure, backoff_s: 0.2}}\n"
+                                         "components:\n"
+                                         "  src: {type: counter_source, rate_hz: 20, process: a, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: b, inputs: {in: count}}\n");
+  Child h1(Dyad({"run", g.string(), "--host", "h1", "--steps", "140"}), dir_, "h1");  // 7 s
+  Child h2(Dyad({"run", g.string(), "--host", "h2", "--steps", "140"}), dir_, "h2");
+  const pid_t b = AwaitChildPid(g, "b");
+  ASSERT_GT(b, 0);
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  ASSERT_EQ(kill(b, SIGKILL), 0);
+  EXPECT_EQ(h2.Wait(60), 0) << h2.err();
+  EXPECT_EQ(h1.Wait(60), 0) << h1.err();
+  EXPECT_NE(h2.err().find("process 'b': restarting (restart 1 of 3): its components' state is reset (sink: counter_sink)"),
+            std::string::npos) << h2.err();
+  EXPECT_NE(h1.err().find("process 'b' on host 'h2' restarted (restart 1): its components' state is reset (sink: counter_sink)"),
+            std::string::npos) << h1.err();
+}
+
 // `dyad status` on a split graph whose second process's clock is 25 ms ahead (the test-only
 // DYAD_TEST_CLOCK_OFFSET_MS): both processes listed with their hosts and pids, the offset
 // measured within 1 ms both ways, and the warning said by the process that measured it.
@@ -557,7 +580,8 @@ TEST_F(ProcessTest, SupervisorRestartsAKilledProcessAndItRejoinsTheRunningGraph)
   ASSERT_EQ(kill(b, SIGKILL), 0);
   ASSERT_EQ(c.Wait(60), 0) << c.err();
   EXPECT_NE(c.err().find("process 'b' exited with 137 (SIGKILL); restarting in 0.2 s"), std::string::npos) << c.err();
-  EXPECT_NE(c.err().find("process 'b': restarting (restart 1 of 3)"), std::string::npos) << c.err();
+  EXPECT_NE(c.err().find("process 'b': restarting (restart 1 of 3): its components' state is reset (sink: counter_sink)"),
+            std::string::npos) << c.err();
   // The restarted sink joined the running graph at once and received what the source sent then:
   // the source's run was not restarted (its numbers go on), the sink's file is its new one.
   const auto received = ReadSink(out);

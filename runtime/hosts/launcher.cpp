@@ -246,7 +246,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
           continue;
         }
         say("process '" + it->name + "': restarting (restart " + std::to_string(it->restarts) + " of " +
-            std::to_string(ConfigOf(graph, it->name).max_restarts) + ")");
+            std::to_string(ConfigOf(graph, it->name).max_restarts) + "): " + ResetClause(graph, it->name));
         start(it->name, child_args(it->name), it->restarts);
         it = pending.erase(it);
       }
@@ -257,6 +257,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
       }
       if (children.empty() && pending.empty()) break;
       if (link != nullptr && !stopping) {
+        for (const auto& notice : link->TakeRemoteRestarts()) say(notice);
         if (auto failure = link->TakeRemoteFailure()) {
           say(*failure + ": stopping the processes of host '" + host + "'");
           if (first_failure == 0) first_failure = 1;

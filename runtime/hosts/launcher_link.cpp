@@ -45,6 +45,9 @@ StatusOr<std::unique_ptr<LauncherLink>> LauncherLink::Open(const Graph& graph, c
   auto r = CreateRuntimeReader(link->participant_.get(), runtime_topics::kLaunchers);
   if (!r.ok()) return r.status();
   link->reader_ = r.value();
+  auto pr = CreateRuntimeReader(link->participant_.get(), runtime_topics::kProcesses);
+  if (!pr.ok()) return pr.status();
+  link->processes_reader_ = pr.value();
   return link;
 }
 
@@ -85,6 +88,32 @@ std::optional<std::string> LauncherLink::TakeRemoteFailure() {
     return text;
   }
   return std::nullopt;
+}
+
+std::vector<std::string> LauncherLink::TakeRemoteRestarts() {
+  std::vector<std::string> out;
+  msg::ProcessState m;
+  while (processes_reader_->TakeNext(&m)) {
+    if (m.graph_name() != graph_.name || m.host() == host_ || m.state() == "failed") continue;
+    uint32_t& seen = restarts_seen_[m.process_name()];
+    if (m.restarts() <= seen) continue;
+    seen = m.restarts();
+    if (m.header().stamp_ns() < started_ns_) continue;  // said before this launcher started
+    out.push_back(RestartNotice(graph_, m.process_name(), m.host(), m.restarts()));
+  }
+  return out;
+}
+
+std::string ResetClause(const Graph& graph, const std::string& process) {
+  std::string components;
+  for (const auto& c : graph.components)
+    if (graph.ProcessOf(c) == process) components += (components.empty() ? "" : ", ") + c.name + ": " + c.type;
+  return "its components' state is reset (" + components + ")";
+}
+
+std::string RestartNotice(const Graph& graph, const std::string& process, const std::string& host, uint32_t restarts) {
+  return "process '" + process + "' on host '" + host + "' restarted (restart " + std::to_string(restarts) +
+         "): " + ResetClause(graph, process);
 }
 
 }  // namespace dyad

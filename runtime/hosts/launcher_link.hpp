@@ -19,6 +19,8 @@
 // says nothing: the others see its writers gone ("Health") and go on.
 #pragma once
 
+#include <map>
+
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -50,6 +52,11 @@ class LauncherLink {
   // "process 'mind' on host 'h2' failed for good (after 1 restart)".
   std::optional<std::string> TakeRemoteFailure();
 
+  // Processes of other hosts that restarted since the last call (their dyad/processes
+  // announcements carry a higher restart count than before), one line each:
+  // "process 'mind' on host 'h2' restarted (restart 1): ..." (RestartNotice).
+  std::vector<std::string> TakeRemoteRestarts();
+
  private:
   LauncherLink(const Graph& graph, std::string host);
   const Graph& graph_;
@@ -61,6 +68,14 @@ class LauncherLink {
   TypedWriter* launchers_writer_ = nullptr;  // owned by participant_
   TypedWriter* processes_writer_ = nullptr;
   TypedReader* reader_ = nullptr;
+  TypedReader* processes_reader_ = nullptr;
+  std::map<std::string, uint32_t> restarts_seen_;  // process -> highest restart count announced
 };
+
+// What a restart means for the experiment: "its components' state is reset (mind: deliberator)"
+// (a PV-RNN's context, a mixer's last command: a restarted process starts from its Configure).
+std::string ResetClause(const Graph& graph, const std::string& process);
+// "process 'mind' on host 'h2' restarted (restart 1): " + ResetClause.
+std::string RestartNotice(const Graph& graph, const std::string& process, const std::string& host, uint32_t restarts);
 
 }  // namespace dyad
