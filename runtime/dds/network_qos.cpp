@@ -1,8 +1,11 @@
 #include "dds/network_qos.hpp"
 
 #include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <net/if.h>
 #include <netdb.h>
 
+#include <algorithm>
 #include <memory>
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
@@ -28,6 +31,36 @@ StatusOr<std::string> ResolveIPv4(const std::string& name) {
   inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(res->ai_addr)->sin_addr, buf, sizeof(buf));
   freeaddrinfo(res);
   return std::string(buf);
+}
+
+double AnnouncementPeriodS(const NetworkConfig& net) {
+  // With a discovery server, the server alone watches each client's lease and tells the others
+  // when it ends (clients never lease each other). The silence it sees after a pulled cable is
+  // the outage plus up to two announcement periods; if that ends the lease just as the client
+  // comes back, Fast DDS 2.9's server database discards the client's return and orphans its
+  // endpoints (docs/distributed.md, "A pulled cable"). Announcing every lease/10 keeps any
+  // outage shorter than 0.8 lease from ending the lease at all.
+  return net.discovery == Discovery::kServer ? net.lease_s / 10 : net.lease_s / 4;
+}
+
+bool NetworkUp(const NetworkConfig& net) {
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) != 0) return true;  // cannot tell: do not hold anything back
+  bool any = false, up = false;
+  for (ifaddrs* i = list; i != nullptr; i = i->ifa_next) {
+    if (i->ifa_addr == nullptr || i->ifa_addr->sa_family != AF_INET || (i->ifa_flags & IFF_LOOPBACK)) continue;
+    char address[INET_ADDRSTRLEN] = {0};
+    inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(i->ifa_addr)->sin_addr, address, sizeof(address));
+    const bool allowed = net.interfaces.empty() ||
+                         std::find_if(net.interfaces.begin(), net.interfaces.end(), [&](const std::string& n) {
+                           return n == i->ifa_name || n == address;
+                         }) != net.interfaces.end();
+    if (!allowed) continue;
+    any = true;
+    up |= (i->ifa_flags & IFF_UP) && (i->ifa_flags & IFF_RUNNING);
+  }
+  freeifaddrs(list);
+  return !any || up;
 }
 
 namespace {
@@ -57,7 +90,7 @@ Status ApplyNetwork(const NetworkConfig& net, bool udp_only, eprosima::fastdds::
   transport.user_transports.clear();
   auto& builtin = qos->wire_protocol().builtin;
   builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(net.lease_s);
-  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(net.lease_s / 4);
+  builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(AnnouncementPeriodS(net));
   if (net.transport == NetTransport::kTcp) {
     auto tcp = std::make_shared<eprosima::fastdds::rtps::TCPv4TransportDescriptor>();
     tcp->interfaceWhiteList = net.interfaces;

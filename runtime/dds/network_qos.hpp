@@ -10,7 +10,7 @@
 //                        tcp_port and connects to the listeners of the processes named before it
 //                        (one connection per pair); a watcher only connects, to all.
 //                        `interfaces` is the allow-list.
-//   lease_s:             the participant lease; announcements every lease/4.
+//   lease_s:             the participant lease; announcements every lease/4 (lease/10 with a discovery server).
 #pragma once
 
 #include <string>
@@ -37,6 +37,16 @@ inline constexpr const char* kDiscoveryServerPrefix = "44.53.00.5f.45.50.52.4f.5
 // InvalidArgument when an address does not resolve (naming the key).
 Status ApplyNetwork(const NetworkConfig& network, bool udp_only, eprosima::fastdds::dds::DomainParticipantQos* qos,
                     const std::string& process = "");
+
+// How often a participant announces itself: lease/4, or lease/10 with a discovery server (see
+// network_qos.cpp for why).
+double AnnouncementPeriodS(const NetworkConfig& network);
+
+// Whether this machine can talk on the network now: a non-loopback IPv4 interface (of the
+// `interfaces` allow-list, when there is one) is up and running (has carrier). True when the
+// machine has no such interface at all (a one-machine graph over loopback). A participant made
+// while it is false announces loopback locators only and is never reached once the cable is back.
+bool NetworkUp(const NetworkConfig& network);
 
 // An IPv4 address in dotted form for `name` (an address or a DNS name).
 StatusOr<std::string> ResolveIPv4(const std::string& name);
