@@ -22,6 +22,8 @@
 
 #include <algorithm>
 #include <set>
+#include <shared_mutex>
+#include <thread>
 #include <sstream>
 
 namespace fdds = eprosima::fastdds::dds;
@@ -183,22 +185,74 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
 
 std::vector<DiscoveredEndpoint> DdsParticipant::Discovered() const { return listener_->Snapshot(); }
 
+// Data callbacks of a renewed reader: only its current DDS entity's go through. Fast DDS holds an
+// entity's lock while it calls back, and a callback takes from both entities of a renewed reader
+// (the retired one first): if the retired one's callbacks ran too, two delivery threads could each
+// hold one entity's lock and wait for the other's. So a retired entity's callbacks are dropped
+// (its samples are taken with the current one's), and a renewal waits out the ones already
+// running before it hands out the second entity (two epochs of in-flight counts, as RCU does).
+class CallbackGate {
+ public:
+  // True: the callback may run; call Leave(ticket) after it.
+  bool Enter(const fdds::DataReader* entity, uint64_t* ticket) {
+    if (entity != current_.load()) return false;
+    const uint64_t epoch = epoch_.load();
+    in_flight_[epoch & 1].fetch_add(1);
+    if (epoch_.load() != epoch || entity != current_.load()) {  // renewed meanwhile
+      in_flight_[epoch & 1].fetch_sub(1);
+      return false;
+    }
+    *ticket = epoch;
+    return true;
+  }
+  void Leave(uint64_t ticket) { in_flight_[ticket & 1].fetch_sub(1); }
+  bool IsCurrent(const fdds::DataReader* entity) const { return entity == current_.load(); }
+  // From now on only `entity` calls back; waits (2 s at most) for the callbacks that entered
+  // before. The thread calling it must not hold anything a callback waits for.
+  void SetCurrent(const fdds::DataReader* entity) {
+    current_.store(entity);
+    const uint64_t old = epoch_.fetch_add(1);
+    for (int i = 0; i < 2000 && in_flight_[old & 1].load() > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+
+ private:
+  std::atomic<const fdds::DataReader*> current_{nullptr};
+  std::atomic<uint64_t> epoch_{0};
+  std::atomic<int> in_flight_[2] = {0, 0};
+};
+
 // Health counters are kept from Fast DDS's status callbacks (its threads) and read by the
 // component's poll: atomics.
 class DdsReader::Listener final : public fdds::DataReaderListener {
  public:
   Listener(std::function<void()> on_data, bool liveliness) : on_data_(std::move(on_data)), liveliness_(liveliness) {}
-  void on_data_available(fdds::DataReader*) override {
-    if (on_data_) on_data_();
+  void on_data_available(fdds::DataReader* r) override {
+    uint64_t ticket = 0;
+    if (!on_data_ || !gate_.Enter(r, &ticket)) return;
+    on_data_();
+    gate_.Leave(ticket);
   }
-  void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& s) override {
-    matched_.store(s.current_count, std::memory_order_relaxed);
+  // Status callbacks count for the current DDS reader only (a retired one is going away).
+  void on_subscription_matched(fdds::DataReader* r, const fdds::SubscriptionMatchedStatus& s) override {
+    if (gate_.IsCurrent(r)) matched_.store(s.current_count, std::memory_order_relaxed);
   }
-  void on_liveliness_changed(fdds::DataReader*, const fdds::LivelinessChangedStatus& s) override {
-    alive_.store(s.alive_count, std::memory_order_relaxed);
+  void on_liveliness_changed(fdds::DataReader* r, const fdds::LivelinessChangedStatus& s) override {
+    if (gate_.IsCurrent(r)) alive_.store(s.alive_count, std::memory_order_relaxed);
   }
-  void on_requested_deadline_missed(fdds::DataReader*, const fdds::RequestedDeadlineMissedStatus& s) override {
-    deadline_misses_.store(static_cast<uint64_t>(s.total_count), std::memory_order_relaxed);
+  void on_requested_deadline_missed(fdds::DataReader*, const fdds::RequestedDeadlineMissedStatus&) override {
+    deadline_misses_.fetch_add(1, std::memory_order_relaxed);
+  }
+  // The DDS reader whose callbacks and status count (set before it can call back, and on
+  // renewal: see CallbackGate, whose wait this includes).
+  void SetCurrent(fdds::DataReader* r) {
+    gate_.SetCurrent(r);
+    if (r == nullptr) return;
+    fdds::SubscriptionMatchedStatus m;
+    r->get_subscription_matched_status(m);
+    matched_.store(m.current_count, std::memory_order_relaxed);
+    fdds::LivelinessChangedStatus l;
+    r->get_liveliness_changed_status(l);
+    alive_.store(l.alive_count, std::memory_order_relaxed);
   }
   // With a liveliness lease the alive count is the truth; without, a writer counts while matched
   // (the participant lease ends the match of a writer whose process died).
@@ -207,30 +261,116 @@ class DdsReader::Listener final : public fdds::DataReaderListener {
     return liveliness_ ? std::min(matched, alive_.load(std::memory_order_relaxed)) : matched;
   }
   uint64_t deadline_misses() const { return deadline_misses_.load(std::memory_order_relaxed); }
+  int matched() const { return matched_.load(std::memory_order_relaxed); }
 
  private:
   std::function<void()> on_data_;
   bool liveliness_;
+  CallbackGate gate_;
   std::atomic<int> matched_{0}, alive_{0};
   std::atomic<uint64_t> deadline_misses_{0};
 };
+
+bool SeenWriters::Fresh(const Guid& writer, int64_t sequence) {
+  for (auto& [guid, newest] : seen_) {
+    if (guid != writer) continue;
+    if (sequence <= newest) return false;
+    newest = sequence;
+    return true;
+  }
+  seen_.emplace_back(writer, sequence);
+  return true;
+}
+
+namespace {
+// The sample's writer and number, for SeenWriters; a sample with no known writer is always fresh.
+bool FreshSample(SeenWriters& seen, const fdds::SampleInfo& info) {
+  const rtps::GUID_t& g = info.sample_identity.writer_guid();
+  if (g == rtps::GUID_t::unknown()) return true;
+  SeenWriters::Guid key;
+  std::copy(g.guidPrefix.value, g.guidPrefix.value + 12, key.begin());
+  std::copy(g.entityId.value, g.entityId.value + 4, key.begin() + 12);
+  return seen.Fresh(key, info.sample_identity.sequence_number().to64long());
+}
+
+int ReaderMatched(fdds::DataReader* r) {
+  if (r == nullptr) return 0;
+  fdds::SubscriptionMatchedStatus st;
+  r->get_subscription_matched_status(st);
+  return st.current_count;
+}
+
+int WriterMatched(fdds::DataWriter* w) {
+  fdds::PublicationMatchedStatus st;
+  w->get_publication_matched_status(st);
+  return st.current_count;
+}
+
+// A retired reader is kept kRetireS, not just until its successor has matched: the reader side
+// matching a writer does not mean the writer has matched the new reader yet (each side learns the
+// other on its own), and until it has, the retired reader is the only one receiving its samples.
+bool RetiredDone(fdds::DataReader* retired, std::chrono::steady_clock::time_point since) {
+  const auto age = std::chrono::steady_clock::now() - since;
+  if (age > std::chrono::duration<double>(2 * kRetireS)) return true;  // unread samples nobody takes
+  return age > std::chrono::duration<double>(kRetireS) && retired->get_unread_count() == 0;
+}
+}  // namespace
 
 int DdsReader::AliveWriters() const { return listener_->alive_writers(); }
 uint64_t DdsReader::DeadlineMisses() const { return listener_->deadline_misses(); }
 
 DdsReader::~DdsReader() {
-  if (on_delete_) on_delete_();
+  if (!destroy_) return;
+  for (fdds::DataReader* d : graveyard_) destroy_(d);
+  destroy_(retired_);
+  destroy_(reader_);
 }
 
 bool DdsReader::TakeNext(void* sample) {
+  std::shared_lock<std::shared_mutex> lock(entities_);
   fdds::SampleInfo info;
-  while (reader_->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
-    if (info.valid_data) return true;
+  for (fdds::DataReader* r : {retired_, reader_}) {  // the retired one's samples are older
+    if (r == nullptr) continue;
+    while (r->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      std::lock_guard<std::mutex> seen(seen_mutex_);
+      if (FreshSample(seen_, info)) return true;
+    }
   }
   return false;
 }
 
-uint64_t DdsReader::Unread() const { return reader_->get_unread_count(); }
+uint64_t DdsReader::Unread() const {
+  std::shared_lock<std::shared_mutex> lock(entities_);
+  return reader_->get_unread_count() + (retired_ != nullptr ? retired_->get_unread_count() : 0);
+}
+
+int DdsReader::Matched() const { return listener_->matched(); }
+
+bool DdsReader::Renew() {
+  {
+    std::shared_lock<std::shared_mutex> lock(entities_);
+    if (retired_ != nullptr) return false;  // one renewal at a time: its retired reader may hold samples
+  }
+  fdds::DataReader* fresh = make_();  // counted by the listener from now on
+  if (fresh == nullptr) return false;
+  std::unique_lock<std::shared_mutex> lock(entities_);
+  retired_ = reader_;
+  reader_ = fresh;
+  retired_at_ = std::chrono::steady_clock::now();
+  return true;
+}
+
+bool DdsReader::Reap(bool force) {
+  {
+    std::shared_lock<std::shared_mutex> lock(entities_);
+    if (retired_ == nullptr) return true;
+    if (!force && !RetiredDone(retired_, retired_at_)) return false;
+  }
+  std::unique_lock<std::shared_mutex> lock(entities_);
+  graveyard_.push_back(std::exchange(retired_, nullptr));  // deleted with this reader (kRetireS)
+  return true;
+}
 
 namespace {
 // A reliable writer deleted with samples in flight loses them for remote readers (a recorder in
@@ -242,15 +382,29 @@ void AwaitAcks(fdds::DataWriter* w) {
 }  // namespace
 
 bool DdsWriter::AwaitAcknowledged(double timeout_s) {
+  std::shared_lock<std::shared_mutex> lock(entities_);
   return writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(timeout_s)) == ReturnCode_t::RETCODE_OK;
 }
 
 DdsWriter::~DdsWriter() {
   AwaitAcks(writer_);
-  if (on_delete_) on_delete_();
+  if (destroy_) destroy_(writer_);
+}
+
+bool DdsWriter::Renew() {
+  fdds::DataWriter* fresh = make_();
+  if (fresh == nullptr) return false;
+  fdds::DataWriter* old = nullptr;
+  {
+    std::unique_lock<std::shared_mutex> lock(entities_);
+    old = std::exchange(writer_, fresh);
+  }
+  destroy_(old);
+  return true;
 }
 
 Status DdsWriter::Write(const void* sample) {
+  std::shared_lock<std::shared_mutex> lock(entities_);
   if (!writer_->write(const_cast<void*>(sample)))
     return Status::IOError("topic '" + topic_ + "': DDS write failed");
   return Status::OK();
@@ -264,10 +418,14 @@ eprosima::fastrtps::Time_t TimeOfNs(int64_t ns) {
 }  // namespace
 
 Status DdsWriter::WriteStamped(const void* sample, int64_t stamp_ns) {
+  std::shared_lock<std::shared_mutex> lock(entities_);
   if (writer_->write_w_timestamp(const_cast<void*>(sample), fdds::HANDLE_NIL, TimeOfNs(stamp_ns)) != ReturnCode_t::RETCODE_OK)
     return Status::IOError("topic '" + topic_ + "': DDS write failed");
   return Status::OK();
 }
+
+// A serialized reader's listener: its samples, and its matches (EndpointHealth).
+const fdds::StatusMask kSerializedMask = fdds::StatusMask::data_available() << fdds::StatusMask::subscription_matched();
 
 // What a serialized endpoint reuses for every sample: its own (unregistered) type support for
 // (de)serialising, one sample object and one payload buffer.
@@ -293,19 +451,39 @@ struct DdsSerializedWriter::Scratch : SerializedScratch {
 class DdsSerializedReader::Listener final : public fdds::DataReaderListener {
  public:
   explicit Listener(DdsSerializedReader* owner) : owner_(owner) {}
-  void on_data_available(fdds::DataReader*) override {
-    std::lock_guard<std::mutex> lock(owner_->mutex_);
-    if (!owner_->closed_) owner_->Drain();
+  void on_data_available(fdds::DataReader* r) override {
+    uint64_t ticket = 0;
+    if (!gate_.Enter(r, &ticket)) return;
+    {
+      std::lock_guard<std::mutex> lock(owner_->mutex_);
+      if (!owner_->closed_) owner_->Drain();
+    }
+    gate_.Leave(ticket);
   }
+  void on_subscription_matched(fdds::DataReader* r, const fdds::SubscriptionMatchedStatus& s) override {
+    if (gate_.IsCurrent(r)) matched_.store(s.current_count, std::memory_order_relaxed);
+  }
+  // The DDS reader whose callbacks and matches count (before its listener is attached, and on
+  // renewal: see CallbackGate, whose wait this includes).
+  void SetCurrent(fdds::DataReader* r) {
+    gate_.SetCurrent(r);
+    matched_.store(ReaderMatched(r), std::memory_order_relaxed);
+  }
+  int matched() const { return matched_.load(std::memory_order_relaxed); }
 
  private:
   DdsSerializedReader* owner_;
+  CallbackGate gate_;
+  std::atomic<int> matched_{0};
 };
 
 DdsSerializedReader::DdsSerializedReader() = default;
 DdsSerializedReader::~DdsSerializedReader() {
   Close();
-  if (on_delete_) on_delete_();
+  if (!destroy_) return;
+  for (fdds::DataReader* d : graveyard_) destroy_(d);
+  destroy_(retired_);
+  destroy_(reader_);
 }
 
 void DdsSerializedReader::Close() {
@@ -315,11 +493,51 @@ void DdsSerializedReader::Close() {
   closed_ = true;
 }
 
+int DdsSerializedReader::Matched() const { return listener_->matched(); }
+
+bool DdsSerializedReader::Renew() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (retired_ != nullptr || closed_) return false;  // one renewal at a time
+  }
+  fdds::DataReader* fresh = make_();
+  if (fresh == nullptr) return false;
+  listener_->SetCurrent(fresh);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Drain();
+    retired_ = reader_;
+    reader_ = fresh;
+    retired_at_ = std::chrono::steady_clock::now();
+  }
+  fresh->set_listener(listener_.get(), kSerializedMask);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!closed_) Drain();
+  return true;
+}
+
+bool DdsSerializedReader::Reap(bool force) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (retired_ == nullptr) return true;
+    if (!force && !RetiredDone(retired_, retired_at_)) return false;
+    if (!closed_) Drain(retired_);
+    graveyard_.push_back(std::exchange(retired_, nullptr));  // drained, deleted with this reader (kRetireS)
+  }
+  return true;
+}
+
 void DdsSerializedReader::Drain() {
+  for (fdds::DataReader* d : graveyard_) Drain(d);  // KEEP_ALL: what still reaches them must not pile up
+  if (retired_ != nullptr) Drain(retired_);  // its samples are older
+  Drain(reader_);
+}
+
+void DdsSerializedReader::Drain(fdds::DataReader* reader) {
   Scratch& s = *scratch_;
   fdds::SampleInfo info;
-  while (reader_->take_next_sample(s.sample, &info) == ReturnCode_t::RETCODE_OK) {
-    if (!info.valid_data) continue;
+  while (reader->take_next_sample(s.sample, &info) == ReturnCode_t::RETCODE_OK) {
+    if (!info.valid_data || !FreshSample(seen_, info)) continue;
     const uint32_t need = s.support->getSerializedSizeProvider(s.sample)();
     if (s.payload.max_size < need) s.payload.reserve(need);
     s.payload.length = 0;
@@ -338,7 +556,19 @@ void DdsSerializedReader::Drain() {
 DdsSerializedWriter::DdsSerializedWriter() = default;
 DdsSerializedWriter::~DdsSerializedWriter() {
   AwaitAcks(writer_);
-  if (on_delete_) on_delete_();
+  if (destroy_) destroy_(writer_);
+}
+
+bool DdsSerializedWriter::Renew() {
+  fdds::DataWriter* fresh = make_();
+  if (fresh == nullptr) return false;
+  fdds::DataWriter* old = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    old = std::exchange(writer_, fresh);
+  }
+  destroy_(old);
+  return true;
 }
 
 Status DdsSerializedWriter::Write(std::span<const uint8_t> cdr, int64_t source_stamp_ns) {
@@ -365,9 +595,8 @@ Status DdsSerializedWriter::Write(std::span<const uint8_t> cdr, int64_t source_s
 }
 
 int DdsWriter::matched() const {
-  fdds::PublicationMatchedStatus st;
-  writer_->get_publication_matched_status(st);
-  return st.current_count;
+  std::shared_lock<std::shared_mutex> lock(entities_);
+  return WriterMatched(writer_);
 }
 
 StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, const std::string& name, Options options) {
@@ -397,82 +626,198 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
     qos.wire_protocol().builtin.discovery_config.ignoreParticipantFlags =
         eprosima::fastrtps::rtps::ParticipantFilteringFlags_t::FILTER_DIFFERENT_PROCESS;
   }
+  p->domain_id_ = domain_id;
+  p->network_ = network;
+  p->qos_ = std::make_unique<fdds::DomainParticipantQos>(qos);
+  auto g = p->MakeGeneration();
+  if (!g.ok()) return g.status();
+  p->gen_ = g.value();
+  return p;
+}
+
+StatusOr<DdsParticipant::Generation> DdsParticipant::MakeGeneration() {
   fdds::StatusMask mask = fdds::StatusMask::none();
   mask << fdds::StatusMask::requested_incompatible_qos() << fdds::StatusMask::offered_incompatible_qos();
-  p->participant_ = factory->create_participant(domain_id, qos, p->listener_.get(), mask);
-  if (p->participant_ == nullptr)
-    return Status::Internal("cannot create DDS participant '" + name + "' on domain " + std::to_string(domain_id));
+  Generation g;
+  g.participant = fdds::DomainParticipantFactory::get_instance()->create_participant(domain_id_, *qos_, listener_.get(), mask);
+  if (g.participant == nullptr)
+    return Status::Internal("cannot create DDS participant '" + name_ + "' on domain " + std::to_string(domain_id_));
   fdds::PublisherQos pub_qos = fdds::PUBLISHER_QOS_DEFAULT;
   fdds::SubscriberQos sub_qos = fdds::SUBSCRIBER_QOS_DEFAULT;
-  for (const auto& partition : p->partitions_) {
+  for (const auto& partition : partitions_) {
     pub_qos.partition().push_back(partition.c_str());
     sub_qos.partition().push_back(partition.c_str());
   }
-  p->publisher_ = p->participant_->create_publisher(pub_qos);
-  p->subscriber_ = p->participant_->create_subscriber(sub_qos);
-  if (p->publisher_ == nullptr || p->subscriber_ == nullptr)
-    return Status::Internal("cannot create DDS publisher/subscriber for '" + name + "'");
-  return p;
+  g.publisher = g.participant->create_publisher(pub_qos);
+  g.subscriber = g.participant->create_subscriber(sub_qos);
+  Status st = g.publisher != nullptr && g.subscriber != nullptr
+                  ? Status::OK()
+                  : Status::Internal("cannot create DDS publisher/subscriber for '" + name_ + "'");
+  // The topics of the generation it replaces (a renewal), with their types.
+  for (const auto& [topic, type] : topic_infos_) {
+    if (!st.ok()) break;
+    st = AddTopic(g, topic, *type);
+  }
+  if (!st.ok()) {
+    DeleteGeneration(g);
+    return st;
+  }
+  return g;
+}
+
+Status DdsParticipant::AddTopic(Generation& g, const std::string& topic, const TypeInfo& type) {
+  const std::string dds_type = type.dds_name();
+  if (g.participant->find_type(dds_type).empty()) {
+    fdds::TypeSupport support(type.make_type_support());
+    if (support.register_type(g.participant, dds_type) != ReturnCode_t::RETCODE_OK)
+      return Status::Internal("cannot register type " + dds_type);
+  }
+  fdds::Topic* t = g.participant->create_topic(topic, dds_type, fdds::TOPIC_QOS_DEFAULT);
+  if (t == nullptr) return Status::Internal("cannot create topic '" + topic + "' of type " + dds_type);
+  g.topics[topic] = t;
+  return Status::OK();
+}
+
+void DdsParticipant::DeleteGeneration(Generation& g) {
+  if (g.participant == nullptr) return;
+  g.participant->set_listener(nullptr);
+  g.participant->delete_contained_entities();
+  fdds::DomainParticipantFactory::get_instance()->delete_participant(g.participant);
+  g = Generation{};
+}
+
+// Not under mutex_: creating an endpoint calls the discovery listener back, which takes it.
+// (Generations are swapped and deleted on the executor's thread, which is the one calling.)
+fdds::DataReader* DdsParticipant::NewReader(const std::string& topic, const fdds::DataReaderQos& qos) {
+  fdds::Subscriber* sub = nullptr;
+  fdds::Topic* t = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    sub = gen_.subscriber;
+    t = gen_.topics.at(topic);
+  }
+  return sub->create_datareader(t, qos, nullptr, fdds::StatusMask::none());
+}
+
+fdds::DataWriter* DdsParticipant::NewWriter(const std::string& topic, const fdds::DataWriterQos& qos) {
+  fdds::Publisher* pub = nullptr;
+  fdds::Topic* t = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pub = gen_.publisher;
+    t = gen_.topics.at(topic);
+  }
+  return pub->create_datawriter(t, qos);
+}
+
+namespace {
+// An entity goes with the publisher or subscriber (of whichever generation) that made it.
+void DeleteReader(fdds::DataReader* d) {
+  if (d == nullptr) return;
+  d->set_listener(nullptr);
+  const_cast<fdds::Subscriber*>(d->get_subscriber())->delete_datareader(d);
+}
+void DeleteWriter(fdds::DataWriter* d) {
+  if (d != nullptr) const_cast<fdds::Publisher*>(d->get_publisher())->delete_datawriter(d);
+}
+}  // namespace
+
+bool DdsParticipant::RenewParticipant() {
+  if (scope_ != Scope::kProcessOnly && !NetworkUp(network_)) return false;  // it would announce loopback only
+  auto g = MakeGeneration();
+  if (!g.ok()) return false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    retired_gens_.push_back(gen_);
+    gen_ = g.value();
+  }
+  // Every endpoint onto the new participant; a reader's renewal in flight ends first.
+  for (auto& r : readers_) {
+    r->Reap(true);
+    r->Renew();
+  }
+  for (auto& r : serialized_readers_) {
+    r->Reap(true);
+    r->Renew();
+  }
+  for (auto& w : writers_) w->Renew();
+  for (auto& w : serialized_writers_) w->Renew();
+  return true;
 }
 
 std::vector<EndpointMatch> DdsParticipant::Matches() const {
   std::vector<EndpointMatch> out;
-  fdds::PublicationMatchedStatus pub;
-  fdds::SubscriptionMatchedStatus sub;
-  for (const auto& w : writers_) {
-    w->writer_->get_publication_matched_status(pub);
-    out.push_back({w->topic_, true, false, pub.current_count});
-  }
+  for (const auto& w : writers_) out.push_back({w->topic_, true, false, w->matched()});
   for (const auto& w : serialized_writers_) {
-    w->writer_->get_publication_matched_status(pub);
-    out.push_back({w->topic_, true, true, pub.current_count});
+    std::lock_guard<std::mutex> lock(w->mutex_);
+    out.push_back({w->topic_, true, true, WriterMatched(w->writer_)});
   }
-  for (const auto& r : readers_) {
-    r->reader_->get_subscription_matched_status(sub);
-    out.push_back({r->topic_, false, false, sub.current_count});
-  }
-  for (const auto& r : serialized_readers_) {
-    r->reader_->get_subscription_matched_status(sub);
-    out.push_back({r->topic_, false, true, sub.current_count});
-  }
+  for (const auto& r : readers_) out.push_back({r->topic_, false, false, r->Matched()});
+  for (const auto& r : serialized_readers_) out.push_back({r->topic_, false, true, r->Matched()});
   return out;
 }
+
+int DdsParticipant::Renew(const std::string& topic, bool writers, int expected) {
+  int renewed = 0;
+  if (writers) {
+    for (auto& w : writers_)
+      if (w->topic_ == topic && w->matched() < expected) renewed += w->Renew();
+    for (auto& w : serialized_writers_) {
+      if (w->topic_ != topic) continue;
+      int matched = 0;
+      {
+        std::lock_guard<std::mutex> lock(w->mutex_);
+        matched = WriterMatched(w->writer_);
+      }
+      if (matched < expected) renewed += w->Renew();
+    }
+  } else {
+    for (auto& r : readers_)
+      if (r->topic_ == topic && r->Matched() < expected) renewed += r->Renew();
+    for (auto& r : serialized_readers_)
+      if (r->topic_ == topic && r->Matched() < expected) renewed += r->Renew();
+  }
+  return renewed;
+}
+
+void DdsParticipant::Reap() {
+  // Retired generations stay until the participant goes: their readers are kept (kRetireS).
+  for (auto& r : readers_) r->Reap(false);
+  for (auto& r : serialized_readers_) r->Reap(false);
+}
+
+DdsParticipant::DdsParticipant() = default;
 
 DdsParticipant::~DdsParticipant() {
   // No callback after this block: serialized subscriptions closed (their last samples delivered),
   // typed readers' listeners detached. Then endpoints, then the participant.
   for (auto& r : serialized_readers_) r->Close();
-  for (auto& r : readers_)
-    if (r->reader_ != nullptr) r->reader_->set_listener(nullptr);
+  for (auto& r : readers_) {
+    std::unique_lock<std::shared_mutex> lock(r->entities_);
+    for (fdds::DataReader* d : r->graveyard_) d->set_listener(nullptr);
+    for (fdds::DataReader* d : {r->reader_, r->retired_})
+      if (d != nullptr) d->set_listener(nullptr);
+  }
   serialized_readers_.clear();
   readers_.clear();
   serialized_writers_.clear();
   writers_.clear();
-  if (participant_ == nullptr) return;
-  participant_->set_listener(nullptr);
-  participant_->delete_contained_entities();
-  fdds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  for (auto& g : retired_gens_) DeleteGeneration(g);
+  DeleteGeneration(gen_);
 }
 
-StatusOr<fdds::Topic*> DdsParticipant::GetTopic(const std::string& topic, const TypeInfo& type) {
+Status DdsParticipant::GetTopic(const std::string& topic, const TypeInfo& type) {
   std::lock_guard<std::mutex> lock(mutex_);
   const std::string dds_type = type.dds_name();
-  auto it = topics_.find(topic);
-  if (it != topics_.end()) {
-    if (topic_types_[topic] != dds_type)
-      return Status::InvalidArgument("topic '" + topic + "' already carries " + topic_types_[topic] + ", not " + dds_type);
-    return it->second;
+  if (auto it = topic_types_.find(topic); it != topic_types_.end()) {
+    if (it->second != dds_type)
+      return Status::InvalidArgument("topic '" + topic + "' already carries " + it->second + ", not " + dds_type);
+    return Status::OK();
   }
-  if (participant_->find_type(dds_type).empty()) {
-    fdds::TypeSupport support(type.make_type_support());
-    if (support.register_type(participant_, dds_type) != ReturnCode_t::RETCODE_OK)
-      return Status::Internal("cannot register type " + dds_type);
-  }
-  fdds::Topic* t = participant_->create_topic(topic, dds_type, fdds::TOPIC_QOS_DEFAULT);
-  if (t == nullptr) return Status::Internal("cannot create topic '" + topic + "' of type " + dds_type);
-  topics_[topic] = t;
+  if (Status s = AddTopic(gen_, topic, type); !s.ok()) return s;
   topic_types_[topic] = dds_type;
-  return t;
+  topic_infos_[topic] = &type;
+  return Status::OK();
 }
 
 namespace {
@@ -497,8 +842,7 @@ void ApplyQos(Q& q, const TopicQos& qos) {
 
 StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
                                                     std::function<void()> on_data) {
-  auto t = GetTopic(topic, type);
-  if (!t.ok()) return t.status();
+  if (Status st = GetTopic(topic, type); !st.ok()) return st;
   fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
   ApplyQos(rq, qos);
   std::unique_ptr<DdsReader> r(new DdsReader());
@@ -508,30 +852,32 @@ StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, co
   fdds::StatusMask mask = fdds::StatusMask::data_available();
   mask << fdds::StatusMask::subscription_matched() << fdds::StatusMask::liveliness_changed()
        << fdds::StatusMask::requested_deadline_missed();
-  r->reader_ = subscriber_->create_datareader(*t, rq, r->listener_.get(), mask);
-  if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
-  auto* sub = subscriber_;
-  auto* raw = r->reader_;
-  r->on_delete_ = [sub, raw] {
-    raw->set_listener(nullptr);
-    sub->delete_datareader(raw);
+  auto* listener = r->listener_.get();
+  r->make_ = [this, topic, rq, listener, mask] {
+    // Created without a listener, which is attached once it counts (no callback before).
+    fdds::DataReader* d = NewReader(topic, rq);
+    if (d == nullptr) return d;
+    listener->SetCurrent(d);
+    d->set_listener(listener, mask);
+    return d;
   };
+  r->destroy_ = DeleteReader;
+  r->reader_ = r->make_();
+  if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
   readers_.push_back(std::move(r));
   return readers_.back().get();
 }
 
 StatusOr<TypedWriter*> DdsParticipant::CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos) {
-  auto t = GetTopic(topic, type);
-  if (!t.ok()) return t.status();
+  if (Status st = GetTopic(topic, type); !st.ok()) return st;
   fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
   ApplyQos(wq, qos);
   std::unique_ptr<DdsWriter> w(new DdsWriter());
   w->topic_ = topic;
-  w->writer_ = publisher_->create_datawriter(*t, wq);
+  w->make_ = [this, topic, wq] { return NewWriter(topic, wq); };
+  w->destroy_ = DeleteWriter;
+  w->writer_ = w->make_();
   if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'");
-  auto* pub = publisher_;
-  auto* raw = w->writer_;
-  w->on_delete_ = [pub, raw] { pub->delete_datawriter(raw); };
   writers_.push_back(std::move(w));
   return writers_.back().get();
 }
@@ -541,8 +887,7 @@ StatusOr<SerializedSubscription*> DdsParticipant::CreateSerializedReader(const s
                                                                                       const TopicQos& qos,
                                                                                       const Clock* clock,
                                                                                       SerializedCallback callback) {
-  auto t = GetTopic(topic, type);
-  if (!t.ok()) return t.status();
+  if (Status st = GetTopic(topic, type); !st.ok()) return st;
   fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
   ApplyQos(rq, qos);
   if (qos.keep_all) {
@@ -559,16 +904,14 @@ StatusOr<SerializedSubscription*> DdsParticipant::CreateSerializedReader(const s
   r->callback_ = std::move(callback);
   r->scratch_ = std::make_unique<DdsSerializedReader::Scratch>(type);
   r->listener_ = std::make_unique<DdsSerializedReader::Listener>(r.get());
-  r->reader_ = subscriber_->create_datareader(*t, rq, nullptr, fdds::StatusMask::none());
+  // The listener is attached once the reader is in place (its callback drains reader_); samples
+  // that came in between are drained right after. A renewal's new reader is made the same way.
+  r->make_ = [this, topic, rq] { return NewReader(topic, rq); };
+  r->destroy_ = DeleteReader;
+  r->reader_ = r->make_();
   if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
-  auto* sub = subscriber_;
-  auto* raw = r->reader_;
-  r->on_delete_ = [sub, raw] {
-    raw->set_listener(nullptr);
-    sub->delete_datareader(raw);
-  };
-  // The listener is attached once reader_ is set; samples that came in between are drained here.
-  r->reader_->set_listener(r->listener_.get(), fdds::StatusMask::data_available());
+  r->listener_->SetCurrent(r->reader_);
+  r->reader_->set_listener(r->listener_.get(), kSerializedMask);
   {
     std::lock_guard<std::mutex> lock(r->mutex_);
     r->Drain();
@@ -581,8 +924,7 @@ StatusOr<SerializedWriter*> DdsParticipant::CreateSerializedWriter(const std::st
                                                                                       const TypeInfo& type,
                                                                                       const TopicQos& qos,
                                                                                       const Clock* clock) {
-  auto t = GetTopic(topic, type);
-  if (!t.ok()) return t.status();
+  if (Status st = GetTopic(topic, type); !st.ok()) return st;
   fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
   ApplyQos(wq, qos);
   std::unique_ptr<DdsSerializedWriter> w(new DdsSerializedWriter());
@@ -590,11 +932,10 @@ StatusOr<SerializedWriter*> DdsParticipant::CreateSerializedWriter(const std::st
   w->type_ = &type;
   w->clock_ = clock;
   w->scratch_ = std::make_unique<DdsSerializedWriter::Scratch>(type);
-  w->writer_ = publisher_->create_datawriter(*t, wq);
+  w->make_ = [this, topic, wq] { return NewWriter(topic, wq); };
+  w->destroy_ = DeleteWriter;
+  w->writer_ = w->make_();
   if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'");
-  auto* pub = publisher_;
-  auto* raw = w->writer_;
-  w->on_delete_ = [pub, raw] { pub->delete_datawriter(raw); };
   serialized_writers_.push_back(std::move(w));
   return serialized_writers_.back().get();
 }

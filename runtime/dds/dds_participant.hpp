@@ -9,11 +9,14 @@
 // or never match them and say nothing (other name).
 #pragma once
 
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <shared_mutex>
 #include <string>
 #include <vector>
 
@@ -25,6 +28,9 @@
 
 namespace eprosima::fastdds::dds {
 class DomainParticipant;
+class DomainParticipantQos;
+class DataReaderQos;
+class DataWriterQos;
 class Publisher;
 class Subscriber;
 class Topic;
@@ -33,6 +39,34 @@ class DataWriter;
 }  // namespace eprosima::fastdds::dds
 
 namespace dyad {
+
+// The newest sequence number taken from each writer, so that a renewed reader (below) delivers
+// a sample once although its retired and its new DDS reader may both hold it.
+class SeenWriters {
+ public:
+  using Guid = std::array<uint8_t, 16>;
+  SeenWriters() { seen_.reserve(8); }
+  // False for a sample of `writer` numbered at or below the newest taken from it.
+  bool Fresh(const Guid& writer, int64_t sequence);
+
+ private:
+  std::vector<std::pair<Guid, int64_t>> seen_;
+};
+
+// Renewal (DdsParticipant::Renew, the runtime's healing of endpoints that discovery lost): an
+// endpoint object keeps its identity for its port while the DDS entity behind it is replaced by
+// a new one (a new GUID, which discovery learns afresh). A reader keeps its old entity as
+// `retired_` for kRetireS (until every writer has matched the new one: each side learns the
+// other on its own) and takes from it first, each sample once (SeenWriters); it is not renewed
+// again before Reap() lets the old one go. A writer switches at once.
+// Each endpoint's mutex guards its entity pointers against the threads that use them.
+//
+// A retired entity is not deleted during the run but kept, unused (its callbacks dropped), until
+// the endpoint goes: Fast DDS 2.9 crashes (a best-effort writer's intra-process delivery to a
+// deleted reader, seen with dyad/clock) when a reader is deleted while a writer of the same
+// process writes to it, and its retired participant stays with them. Renewals are rare (a
+// handful per outage); a retired KEEP_ALL reader is still drained, so nothing piles up.
+inline constexpr double kRetireS = 5;
 
 // A reader the runtime polls; `on_data` (may be empty) is called from Fast DDS's delivery thread
 // whenever samples arrive. Created and destroyed by DdsParticipant only.
@@ -49,10 +83,23 @@ class DdsReader final : public TypedReader {
   friend class DdsParticipant;
   class Listener;
   DdsReader() = default;
+  int Matched() const;
+  bool Renew();
+  bool Reap(bool force);  // true: nothing retired is left
   std::string topic_;
-  eprosima::fastdds::dds::DataReader* reader_ = nullptr;  // owned by the participant's subscriber
+  // Shared by every use of the entities below, exclusive only to swap them (never while calling
+  // Fast DDS: a delivery holds its reader's lock while our on_data steps a component that takes
+  // from this reader; glibc's rwlock lets that shared lock through while a swap waits).
+  mutable std::shared_mutex entities_;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;   // owned by the participant's subscriber
+  eprosima::fastdds::dds::DataReader* retired_ = nullptr;  // renewed away, still taken from
+  std::chrono::steady_clock::time_point retired_at_;
+  std::vector<eprosima::fastdds::dds::DataReader*> graveyard_;  // retired for good, deleted with this
+  std::mutex seen_mutex_;
+  SeenWriters seen_;
   std::unique_ptr<Listener> listener_;
-  std::function<void()> on_delete_;
+  std::function<eprosima::fastdds::dds::DataReader*()> make_;
+  std::function<void(eprosima::fastdds::dds::DataReader*)> destroy_;
 };
 
 class DdsWriter final : public TypedWriter {
@@ -68,9 +115,12 @@ class DdsWriter final : public TypedWriter {
  private:
   friend class DdsParticipant;
   DdsWriter() = default;
+  bool Renew();
   std::string topic_;
+  mutable std::shared_mutex entities_;  // as DdsReader's: shared to use writer_, exclusive to swap it
   eprosima::fastdds::dds::DataWriter* writer_ = nullptr;  // owned by the participant's publisher
-  std::function<void()> on_delete_;
+  std::function<eprosima::fastdds::dds::DataWriter*()> make_;
+  std::function<void(eprosima::fastdds::dds::DataWriter*)> destroy_;
 };
 
 // A reader that hands every sample to a callback as CDR bytes (Context::SubscribeSerialized).
@@ -89,17 +139,26 @@ class DdsSerializedReader final : public SerializedSubscription {
   class Listener;
   DdsSerializedReader();
   void Drain();  // REQUIRES: mutex_ held
+  void Drain(eprosima::fastdds::dds::DataReader* reader);  // REQUIRES: mutex_ held
+  int Matched() const;
+  bool Renew();
+  bool Reap(bool force);  // true: nothing retired is left
   std::string topic_;
   const Clock* clock_ = nullptr;  // owned by the executor
   SerializedCallback callback_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;  // serializes Drain (and the callback); reader_/retired_ change under it
   bool closed_ = false;
   std::atomic<uint64_t> delivered_{0};
   struct Scratch;
   std::unique_ptr<Scratch> scratch_;  // type support, sample, payload: reused for every sample
   std::unique_ptr<Listener> listener_;
-  eprosima::fastdds::dds::DataReader* reader_ = nullptr;  // owned by the participant's subscriber
-  std::function<void()> on_delete_;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;   // owned by the participant's subscriber
+  eprosima::fastdds::dds::DataReader* retired_ = nullptr;  // renewed away, still drained
+  std::chrono::steady_clock::time_point retired_at_;
+  std::vector<eprosima::fastdds::dds::DataReader*> graveyard_;  // retired for good, drained, deleted with this
+  SeenWriters seen_;
+  std::function<eprosima::fastdds::dds::DataReader*()> make_;
+  std::function<void(eprosima::fastdds::dds::DataReader*)> destroy_;
 };
 
 // Publishes CDR bytes (Context::AdvertiseSerialized): decodes them into the type's C++ object
@@ -115,15 +174,17 @@ class DdsSerializedWriter final : public SerializedWriter {
  private:
   friend class DdsParticipant;
   DdsSerializedWriter();
+  bool Renew();
   std::string topic_;
   const TypeInfo* type_ = nullptr;
   const Clock* clock_ = nullptr;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   uint64_t written_ = 0;
   struct Scratch;
   std::unique_ptr<Scratch> scratch_;
   eprosima::fastdds::dds::DataWriter* writer_ = nullptr;  // owned by the participant's publisher
-  std::function<void()> on_delete_;
+  std::function<eprosima::fastdds::dds::DataWriter*()> make_;
+  std::function<void(eprosima::fastdds::dds::DataWriter*)> destroy_;
 };
 
 // An endpoint seen through discovery.
@@ -187,6 +248,16 @@ class DdsParticipant final : public Transport {
 
   // Endpoints are created and destroyed on the executor's thread only: call it there.
   std::vector<EndpointMatch> Matches() const override;
+  // Renews (see kRetireS above) each endpoint of this kind on `topic` matched with fewer than
+  // `expected` endpoints; returns how many. Reap() stops using retired readers that are done.
+  // Both on the executor's thread, like Matches().
+  int Renew(const std::string& topic, bool writers, int expected) override;
+  // Replaces the DDS participant itself (a new GUID prefix, which discovery learns as a new
+  // participant) and moves every endpoint onto it, readers losslessly as above; the old one is
+  // kept, unused, until this participant goes (see kRetireS). False if the new one cannot be made, or
+  // not now: while no network interface is up (NetworkUp), it would announce loopback only.
+  bool RenewParticipant() override;
+  void Reap() override;
 
   const std::string& name() const { return name_; }
   // Every remote (or local) endpoint discovered so far that is still alive.
@@ -194,17 +265,32 @@ class DdsParticipant final : public Transport {
 
  private:
   class DiscoveryListener;
-  DdsParticipant() = default;
-  StatusOr<eprosima::fastdds::dds::Topic*> GetTopic(const std::string& topic, const TypeInfo& type);
+  // A DDS participant with its publisher, subscriber and topics (one per name). A renewal makes
+  // a new one and retires the old until its endpoints are gone.
+  struct Generation {
+    eprosima::fastdds::dds::DomainParticipant* participant = nullptr;
+    eprosima::fastdds::dds::Publisher* publisher = nullptr;
+    eprosima::fastdds::dds::Subscriber* subscriber = nullptr;
+    std::map<std::string, eprosima::fastdds::dds::Topic*> topics;
+  };
+  DdsParticipant();
+  StatusOr<Generation> MakeGeneration();
+  static Status AddTopic(Generation& g, const std::string& topic, const TypeInfo& type);
+  static void DeleteGeneration(Generation& g);
+  Status GetTopic(const std::string& topic, const TypeInfo& type);  // on the current generation
+  eprosima::fastdds::dds::DataReader* NewReader(const std::string& topic, const eprosima::fastdds::dds::DataReaderQos& qos);
+  eprosima::fastdds::dds::DataWriter* NewWriter(const std::string& topic, const eprosima::fastdds::dds::DataWriterQos& qos);
 
   std::string name_;
-  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
-  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
-  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  int domain_id_ = 0;
+  NetworkConfig network_;
+  std::unique_ptr<eprosima::fastdds::dds::DomainParticipantQos> qos_;
   std::unique_ptr<DiscoveryListener> listener_;
-  std::mutex mutex_;  // guards the maps below (discovery reads them from Fast DDS threads)
-  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
-  std::map<std::string, std::string> topic_types_;  // topic -> dds type name
+  std::mutex mutex_;  // guards the members below (discovery reads the maps from Fast DDS threads)
+  Generation gen_;
+  std::vector<Generation> retired_gens_;
+  std::map<std::string, std::string> topic_types_;     // topic -> dds type name
+  std::map<std::string, const TypeInfo*> topic_infos_;  // topic -> its type
   Scope scope_ = Scope::kNetwork;
   std::vector<std::string> partitions_;
   // Every endpoint created here; destroyed (in this order) by the destructor only.

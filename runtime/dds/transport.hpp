@@ -67,6 +67,14 @@ class Transport {
   // Every endpoint created here with its current match count (the start barrier). A transport
   // that cannot tell returns none (every endpoint counts as matched).
   virtual std::vector<EndpointMatch> Matches() const { return {}; }
+  // Healing (hosts/endpoint_health.hpp): replaces the middleware entity behind each endpoint of
+  // this kind on `topic` matched with fewer than `expected` endpoints by a new one that
+  // discovery learns afresh, keeping the endpoint objects; returns how many. Reap() finishes
+  // earlier renewals. A transport that cannot lose a match (the tests' in-memory one) has none.
+  virtual int Renew(const std::string& /*topic*/, bool /*writers*/, int /*expected*/) { return 0; }
+  // The same for every endpoint at once, with a new participant (a new identity in discovery).
+  virtual bool RenewParticipant() { return false; }
+  virtual void Reap() {}
 
   // `on_data` (may be empty) is called on the delivering thread whenever samples arrive.
   virtual StatusOr<TypedReader*> CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
