@@ -557,7 +557,8 @@ bool Executor::HoldsFastestComponent() const {
 }
 
 void Executor::PublishStats() {
-  if (session_ && !stopping()) session_->Heartbeat();
+  if (session_ && !stopping())
+    if (Status s = session_->Heartbeat(); !s.ok()) Fail(s);
   if (!stats_output_) return;
   auto* out = static_cast<Output<msg::ComponentStats>*>(stats_output_.get());
   for (const auto& inst : instances_) {

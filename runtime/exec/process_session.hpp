@@ -7,7 +7,7 @@
 //   Open(transport)       after the components' ports exist, before Activate
 //   AwaitStart(stopping)  blocks until the agreed start (wall-clock ns; 0: stopped while waiting)
 //   Started()             the clocks start: background work begins, "running" is announced
-//   Heartbeat()           once per stats period while running
+//   Heartbeat()           once per stats period while running; an error fails the process
 //   Stopping()            the run ends (before any component is deactivated)
 //   Close()               stops every thread that writes on the transport; idempotent, also
 //                         from the executor's destructor, before the transport goes
@@ -31,7 +31,7 @@ class ProcessSession {
   // joined a running graph (restarted), the others' start, so it ends with them.
   virtual int64_t graph_start_ns() const = 0;
   virtual void Started() = 0;
-  virtual void Heartbeat() = 0;
+  virtual Status Heartbeat() = 0;
   virtual void Stopping() = 0;
   virtual void Close() = 0;
 };

@@ -63,6 +63,7 @@ std::vector<TopicInfo> GraphTopics(const Graph& graph, const ResolvedGraph& reso
   if (!one_process && graph.clock == ClockMode::kWall) {
     add_runtime_topic(runtime_topics::kProcesses, false);
     add_runtime_topic(runtime_topics::kClockOffsets, false);
+    add_runtime_topic(runtime_topics::kHealth, false);
   }
   std::sort(topics.begin(), topics.end(), [](const TopicInfo& a, const TopicInfo& b) { return a.name < b.name; });
   return topics;

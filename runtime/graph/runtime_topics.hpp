@@ -9,6 +9,7 @@
 //   dyad/clock          clock-sync probes and answers between processes (best effort)
 //   dyad/clock_offsets  each process's measured offsets to the others
 //   dyad/stats          every component's timing, once per stats period
+//   dyad/health         what a process did about endpoints discovery lost (hosts/endpoint_health)
 //
 // `reader` is for the runtime's and the recorder's readers, which must not lose a sample;
 // `watcher` for guests (`dyad status`, `hz`), which may drop samples but never slow a writer.
@@ -68,6 +69,14 @@ inline const RuntimeTopic kStats{
     .type = &TypeInfoOf<msg::ComponentStats>,
     .writer = {.reliability = Reliability::kReliable, .depth = 16},
     .reader = {.reliability = Reliability::kReliable, .depth = 16},
+    .watcher = {.reliability = Reliability::kBestEffort, .depth = 256},
+};
+
+inline const RuntimeTopic kHealth{
+    .name = "dyad/health",
+    .type = &TypeInfoOf<msg::HealthEvent>,
+    .writer = {.reliability = Reliability::kReliable, .depth = 32},
+    .reader = {.reliability = Reliability::kReliable, .depth = 32},
     .watcher = {.reliability = Reliability::kBestEffort, .depth = 256},
 };
 

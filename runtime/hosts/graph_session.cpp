@@ -1,7 +1,12 @@
 #include "hosts/graph_session.hpp"
 
+#include <vector>
+
 #include "exec/logger.hpp"
+#include "exec/wall_clock.hpp"
+#include "graph/runtime_topics.hpp"
 #include "hosts/clock_sync.hpp"
+#include "hosts/endpoint_health.hpp"
 #include "hosts/start_barrier.hpp"
 
 namespace dyad {
@@ -12,10 +17,18 @@ class GraphSession final : public ProcessSession {
  public:
   GraphSession(const Graph& graph, const std::string& process, const std::string& host, uint32_t restarts)
       : barrier_(graph, process, host, restarts),
-        clock_sync_(graph, process, host, [](const std::string& m) { StderrLogger("clock").Warn(m); }) {}
+        clock_sync_(graph, process, host, [](const std::string& m) { StderrLogger("clock").Warn(m); }),
+        health_(graph, process, EndpointHealth::kLostS, [this](msg::HealthEvent e) { Publish(std::move(e)); }),
+        graph_name_(graph.name),
+        process_(process),
+        host_(host) {}
   ~GraphSession() override { Close(); }
 
   Status Open(Transport* transport) override {
+    transport_ = transport;
+    auto w = CreateRuntimeWriter(transport, runtime_topics::kHealth);
+    if (!w.ok()) return w.status();
+    health_writer_ = w.value();
     if (Status s = barrier_.Open(transport); !s.ok()) return s;
     return clock_sync_.Open(transport);
   }
@@ -25,14 +38,41 @@ class GraphSession final : public ProcessSession {
     clock_sync_.Start(kClockSyncPeriodS);
     barrier_.Announce("running");
   }
-  void Heartbeat() override { barrier_.Announce("running"); }
-  void Stopping() override { barrier_.Announce("stopping"); }
+  Status Heartbeat() override {
+    barrier_.Announce("running");
+    // Last check's events go out now: after a renewal, the new writer has had a period to match.
+    for (auto& e : pending_) (void)health_writer_->Write(&e);  // the log has said them too
+    pending_.clear();
+    const StartBarrier::Peers peers = barrier_.Hear(EndpointHealth::kFreshS);
+    return health_.Check(transport_, peers.running, peers.silence_s);
+  }
+  void Stopping() override {
+    for (auto& e : pending_) (void)health_writer_->Write(&e);
+    pending_.clear();
+    barrier_.Announce("stopping");
+  }
   void Close() override { clock_sync_.Stop(); }
 
  private:
   static constexpr double kClockSyncPeriodS = 2;
   StartBarrier barrier_;
   ClockSync clock_sync_;
+  void Publish(msg::HealthEvent e) {
+    e.header().source("dyad/" + process_);
+    e.header().sequence_number(++health_sequence_);
+    e.header().stamp_ns(WallNowNs());
+    e.graph_name(graph_name_);
+    e.process_name(process_);
+    e.host(host_);
+    pending_.push_back(std::move(e));
+  }
+
+  EndpointHealth health_;
+  std::string graph_name_, process_, host_;
+  Transport* transport_ = nullptr;
+  TypedWriter* health_writer_ = nullptr;
+  uint64_t health_sequence_ = 0;
+  std::vector<msg::HealthEvent> pending_;  // published with the next heartbeat
 };
 
 }  // namespace

@@ -61,7 +61,10 @@ void StartBarrier::Announce(const std::string& state) {
 void StartBarrier::TakeAnnouncements() {
   msg::ProcessState m;
   while (reader_->TakeNext(&m))
-    if (m.graph_name() == graph_.name) heard_[m.process_name()] = m;
+    if (m.graph_name() == graph_.name) {
+      heard_[m.process_name()] = m;
+      heard_at_[m.process_name()] = std::chrono::steady_clock::now();
+    }
 }
 
 std::string StartBarrier::MissingEndpoints(const std::vector<EndpointMatch>& matches) const {
@@ -129,6 +132,24 @@ StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
+}
+
+StartBarrier::Peers StartBarrier::Hear(double fresh_s) {
+  TakeAnnouncements();
+  const auto now = std::chrono::steady_clock::now();
+  Peers out;
+  bool owed = false;
+  std::chrono::steady_clock::time_point last{};
+  for (const auto& [name, s] : heard_) {
+    if (name == process_) continue;
+    const auto at = heard_at_[name];
+    if (s.state() == "running" && std::chrono::duration<double>(now - at).count() <= fresh_s) out.running.insert(name);
+    if (!Required(name)) continue;
+    owed |= s.state() == "running";
+    last = std::max(last, at);
+  }
+  if (owed) out.silence_s = std::chrono::duration<double>(now - last).count();
+  return out;
 }
 
 }  // namespace dyad

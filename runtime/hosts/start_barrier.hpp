@@ -20,6 +20,9 @@
 // "stopping") go out through Announce() too; `dyad status` reads them.
 #pragma once
 
+#include <chrono>
+#include <set>
+
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -59,6 +62,16 @@ class StartBarrier {
   // Publishes this process's state ("running" with the start instant, "stopping").
   void Announce(const std::string& state);
 
+  // What this process hears of the others (takes what arrived first). On the thread that calls
+  // Wait, after it.
+  struct Peers {
+    std::set<std::string> running;  // newest announcement "running", heard within `fresh_s`
+    // Seconds since any other required process was last heard, when the newest word of one of
+    // them is "running" (it should be talking); else 0.
+    double silence_s = 0;
+  };
+  Peers Hear(double fresh_s);
+
  private:
   // Whether the barrier waits for `process`: itself and every required process (one that is not
   // required joins when it comes; its endpoints are not counted).
@@ -71,6 +84,7 @@ class StartBarrier {
   std::string process_, host_;
   std::map<std::string, int> writers_of_, readers_of_;  // topic -> endpoints the graph binds
   std::map<std::string, msg::ProcessState> heard_;      // process -> its newest announcement
+  std::map<std::string, std::chrono::steady_clock::time_point> heard_at_;  // process -> when
   Transport* transport_ = nullptr;
   TypedWriter* writer_ = nullptr;
   TypedReader* reader_ = nullptr;
