@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bag_info.hpp"
+#include "losses.hpp"
 #include "csv_export.hpp"
 #include "dyad/mcap/reader.hpp"
 
@@ -35,6 +36,12 @@ int RunInfo(const std::string& path, bool scan) {
   auto reader = OpenRecording(path, scan);
   if (!reader) return kBadInput;
   std::cout << bag::FormatInfo(*reader);
+  auto losses = bag::FindLosses(*reader);
+  if (!losses.ok()) {
+    std::cerr << "dyad bag: " << path << ": " << losses.status().message() << "\n";
+    return kFailure;
+  }
+  std::cout << bag::FormatLosses(*losses);
   return reader->recovery().damaged_chunks.empty() ? kOk : kFailure;
 }
 

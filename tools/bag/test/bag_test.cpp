@@ -14,6 +14,7 @@
 #include "dyad/testing/cli.hpp"
 #include "bag_info.hpp"
 #include "csv_export.hpp"
+#include "losses.hpp"
 #include "dyad/mcap/writer.hpp"
 
 namespace dyad::bag {
@@ -277,6 +278,53 @@ TEST(BagCommands, ExportNamesAnOmgidlSchemaWithoutItsType) {
   EXPECT_EQ(err, "dyad bag: " + path +
                      ": /counter: schema 1 \"dyad::msg::Counter\" (omgidl): its IDL defines no struct "
                      "\"dyad::msg::Counter\"; exported as data_hex\n");
+}
+
+// Two writers on one channel: "a" loses 4..6 and falls silent 5 s before the end; "b" is complete.
+TEST(BagLosses, SaysPerWriterWhatWasLostAndWhen) {
+  const std::string path = TempPath("losses.mcap");
+  {
+    auto writer = mcap::Writer::Open(path);
+    ASSERT_TRUE(writer.ok());
+    auto schema = writer->AddSchema(MessageTraits<msg::Counter>::kName, "omgidl", MessageTraits<msg::Counter>::kIdl);
+    auto channel = writer->AddChannel("c", "cdr", *schema);
+    MessageTraits<msg::Counter>::PubSubType type;
+    std::uint32_t n = 0;
+    auto put = [&](const std::string& source, std::uint64_t seq, std::int64_t stamp_ms) {
+      msg::Counter m;
+      m.header().source(source);
+      m.header().sequence_number(seq);
+      m.header().stamp_ns(stamp_ms * 1'000'000);
+      eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(&m)());
+      ASSERT_TRUE(type.serialize(&m, &payload));
+      ASSERT_TRUE(writer->Write(*channel, n++, stamp_ms, stamp_ms, {payload.data, payload.length}).ok());
+    };
+    for (std::uint64_t i = 1; i <= 100; ++i) {
+      if ((i < 4 || i > 6) && i <= 50) put("a", i, 100 * static_cast<std::int64_t>(i));  // 10 Hz, stops at 5 s
+      put("b", i, 100 * static_cast<std::int64_t>(i));
+    }
+    ASSERT_TRUE(writer->Close().ok());
+  }
+  auto reader = mcap::Reader::Open(path);
+  ASSERT_TRUE(reader.ok());
+  auto losses = FindLosses(*reader);
+  ASSERT_TRUE(losses.ok()) << losses.status().message();
+  ASSERT_EQ(losses->writers.size(), 2u);
+  const WriterLosses& a = losses->writers[0];
+  EXPECT_EQ(a.writer, "a");
+  EXPECT_EQ(a.samples, 47u);
+  ASSERT_EQ(a.gaps.size(), 1u);
+  EXPECT_EQ(a.gaps[0].missing, 3u);
+  EXPECT_EQ(a.gaps[0].from_ns, 300'000'000);
+  EXPECT_EQ(a.gaps[0].to_ns, 700'000'000);
+  EXPECT_NEAR(a.silent_at_end_s, 5.0, 1e-9);
+  const WriterLosses& b = losses->writers[1];
+  EXPECT_TRUE(b.gaps.empty());
+  EXPECT_EQ(b.silent_at_end_s, 0);
+  const std::string text = FormatLosses(*losses);
+  EXPECT_NE(text.find("  c  a  47 samples, 1..50: 3 missing\n    3 lost from +0.2 s to +0.6 s\n"
+                      "    silent for the last 5.0 s of the recording\n"), std::string::npos) << text;
+  EXPECT_EQ(text.find("  c  b "), std::string::npos) << "a complete writer is not listed\n" << text;
 }
 
 }  // namespace
