@@ -26,22 +26,50 @@
 #              lab's and rec's launchers hear of it (their launchers' link, dyad/processes) and
 #              exit 1 within 10 s of the kill, naming mind and its host, their processes stopped
 #              cleanly: rec's recording is complete and holds mind's "failed" announcement.
+#   cut:D:H:S  discovery mode D (multicast, peers, server or tcp, as above), and host H's cable
+#              pulled (its eth0 down) for S seconds about step 100. Checked: every launcher
+#              exits 0; in the recording (on rec), every writer's samples are contiguous before
+#              the cut and again from 2 s after the cable's return to the end of the run (none
+#              stops), and no gap ends later than 2.2 s after the return; what was lost is
+#              printed per writer. `matrix` expands to every D x H x (1, 3, 7 s) and the
+#              server's race (4.5 s); MODE*N repeats a mode (e.g. cut:server:rec:3*10).
 #   net        (for debugging) only the namespaces and the UDP probe, no dyad run
 # Needs root, `ip netns` and `nft` (skipped, exit 77, otherwise). Leaves nothing behind: the EXIT
 # trap kills every process in its namespaces and deletes them (each host has a /dev/shm of its
 # own, so killed Fast DDS processes leave no files in this machine's).
-#   multihost_test.sh REPO BUILD_DIR WORK_DIR [MODE...]      (default: multicast peers server)
+#   multihost_test.sh REPO BUILD_DIR WORK_DIR [MODE...]   (default: multicast peers server tcp faults failure)
 # MULTIHOST_TIMEOUT=S: how long the three launchers of one mode may take (default 120 s);
 # MULTIHOST_STAGGER=S: the time between the starts of rec, mind and lab (default 2 s, 0: at once);
 # MULTIHOST_SHARED_SHM=1: the hosts share this machine's /dev/shm (default: one tmpfs each).
 set -euo pipefail
-[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|tcp|faults|failure|net...]" >&2; exit 2; }
+[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|tcp|faults|failure|cut:D:H:S|matrix|net|MODE*N...]" >&2; exit 2; }
 repo=$(cd "$1" && pwd) build=$(cd "$2" && pwd) work=$3
 shift 3
-modes=("$@")
+modes=()
+# matrix: every discovery mode x whose cable x 1 s, 3 s, past the lease (7 s), and the server's
+# race (4.5 s: the lease ends as the cable returns); MODE*N: MODE N times.
+for mode in "$@"; do
+  if [ "$mode" = matrix ]; then
+    for d in multicast peers server tcp; do
+      for h in lab mind rec; do
+        for s in 1 3 7; do modes+=("cut:$d:$h:$s"); done
+        [ $d = server ] && modes+=("cut:$d:$h:4.5")
+      done
+    done
+  elif [[ $mode =~ ^(.+)\*([0-9]+)$ ]]; then
+    for ((i = 0; i < BASH_REMATCH[2]; i++)); do modes+=("${BASH_REMATCH[1]}"); done
+  else
+    modes+=("$mode")
+  fi
+done
 [ ${#modes[@]} -gt 0 ] || modes=(multicast peers server tcp faults failure)
 for mode in "${modes[@]}"; do
-  case $mode in multicast | peers | server | tcp | faults | failure | net) ;; *) echo "unknown mode '$mode'" >&2; exit 2 ;; esac
+  case $mode in
+    multicast | peers | server | tcp | faults | failure | net) ;;
+    cut:*) [[ $mode =~ ^cut:(multicast|peers|server|tcp):(lab|mind|rec):[0-9]+(\.[0-9]+)?$ ]] ||
+             { echo "bad mode '$mode': cut:DISCOVERY:HOST:SECONDS (DISCOVERY multicast|peers|server|tcp, HOST lab|mind|rec)" >&2; exit 2; } ;;
+    *) echo "unknown mode '$mode'" >&2; exit 2 ;;
+  esac
 done
 dyad=$build/bin/dyad
 timeout_s=${MULTIHOST_TIMEOUT:-120}
@@ -309,16 +337,102 @@ for topic in topics:
         print(f'{topic}: {count} samples, fewer than {minimum}'); ok = False
 sys.exit(0 if ok else 1)
 PY
-# check_recording FILE.mcap OUT_DIR MIN_HUMAN_SAMPLES [TOPIC...]: prints the check; non-zero on a failure.
-check_recording() {
-  local rec=$1 out=$2 min=$3 info
-  shift 3
+# export_recording FILE.mcap OUT_DIR: the recording must be complete; its topics as CSVs in OUT_DIR.
+export_recording() {
+  local rec=$1 out=$2 info
   [ -f "$rec" ] || { echo "no recording at $rec"; return 1; }
   info=$("$dyad" bag info "$rec" 2>&1) || { echo "$info"; echo "dyad bag info failed"; return 1; }
   echo "$info" | grep -q "state:       complete" || { echo "$info"; echo "the recording is not complete"; return 1; }
   rm -rf "$out"
   "$dyad" bag export "$rec" --csv "$out" > "$out.log" 2>&1 || { cat "$out.log"; echo "dyad bag export failed"; return 1; }
+}
+# check_recording FILE.mcap OUT_DIR MIN_HUMAN_SAMPLES [TOPIC...]: prints the check; non-zero on a failure.
+check_recording() {
+  local rec=$1 out=$2 min=$3
+  shift 3
+  export_recording "$rec" "$out" || return 1
   python3 "$work/check.py" "$out" "$min" "$@"
+}
+
+# --- cut: a host's cable pulled mid-run -------------------------------------------------------------
+cat > "$work/check_cut.py" <<'PY'
+# The recording of a run in which a host's cable was out from DOWN to UP (wall ns). Per topic and
+# writer (header.source, stamps on the writer's clock: the hosts share one here):
+#   before the cut   sequence numbers contiguous from 1 (nothing lost while the network was whole)
+#   after UP + 2 s   samples again, contiguous, to the end of the run (within 1 s of the last
+#                    sample of any topic), and no gap that ends later than UP + 2.2 s (one
+#                    sample period of slack): data flows again within 2 s of the cable's return;
+#                    5 s when a process renewed its participant (dyad/health): discovery had
+#                    forgotten it, and it waits 2.5 s of silence before it renews
+# and prints what was lost around the cut (samples and seconds), per writer.
+import csv, os, sys
+folder, down, up = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+topics = ['human/input', 'robot/intention', 'robot/command', 'robot/state', 'observer/labels']
+writers = {}
+for topic in topics:
+    with open(os.path.join(folder, topic.replace('/', '_') + '.csv'), newline='') as f:
+        for r in csv.DictReader(f):
+            writers.setdefault((topic, r['header.source']), []).append(
+                (int(r['header.sequence_number']), int(r['header.stamp_ns'])))
+if not writers:
+    print('no samples at all'); sys.exit(1)
+end = max(s for samples in writers.values() for _, s in samples)
+# A process forgotten by discovery as a whole heals by renewing its participant once it has heard
+# no one for 2.5 s (docs/distributed.md): then the flow may resume up to 5 s after the return.
+bound_ns, renewed = 2_200_000_000, []
+health = os.path.join(folder, 'dyad_health.csv')
+if os.path.exists(health):
+    with open(health, newline='') as f:
+        for r in csv.DictReader(f):
+            print(f"health: {r['process_name']} {r['endpoint']} {r['topic']} {r['action']} "
+                  f"(matched {r['matched']} of {r['expected']}, {float(r['starved_s']):.1f} s) "
+                  f"at {(int(r['header.stamp_ns']) - up) * 1e-9:+.1f} s from the return")
+            renewed += [r['process_name']] if r['endpoint'] == 'participant' and r['action'] == 'renewed' else []
+if renewed:
+    bound_ns = 5_000_000_000
+print(f'every writer must flow again within {bound_ns * 1e-9:.1f} s of the return'
+      + (f' (participant renewed by {", ".join(renewed)})' if renewed else ''))
+ok = True
+for (topic, writer), samples in sorted(writers.items()):
+    samples.sort()
+    name = f'{topic} ({writer})'
+    before = [q for q, s in samples if s < down - 500_000_000]
+    after = [(q, s) for q, s in samples if s >= up + 2_000_000_000]
+    lost = [(a, b) for a, b in zip(samples, samples[1:]) if b[0] != a[0] + 1]
+    for a, b in lost:
+        if a[1] < up + 2_000_000_000 and b[1] > up + bound_ns:
+            print(f'{name}: flowed again only {(b[1] - up) * 1e-9:.1f} s after the cable came back '
+                  f'(more than {bound_ns * 1e-9:.1f} s)'); ok = False
+    gaps = ', '.join(f'{b[0] - a[0] - 1} samples {(a[1] - down) * 1e-9:+.1f} s..{(b[1] - down) * 1e-9:+.1f} s' for a, b in lost)
+    print(f'{name}: {len(samples)} samples {samples[0][0]}..{samples[-1][0]}; lost around the cut: {gaps or "none"}')
+    if before != list(range(1, len(before) + 1)):
+        print(f'{name}: samples lost before the cable was pulled'); ok = False
+    if not after:
+        print(f'{name}: NOTHING after the cable came back (+2 s); last sample {(samples[-1][1] - up) * 1e-9:+.1f} s from its return'); ok = False
+        continue
+    seqs = [q for q, _ in after]
+    if seqs != list(range(seqs[0], seqs[0] + len(seqs))):
+        print(f'{name}: samples lost after the cable came back (+2 s)'); ok = False
+    if after[-1][1] < end - 1_000_000_000:
+        print(f'{name}: stopped {(after[-1][1] - up) * 1e-9:.1f} s after the cable came back, '
+              f'{(end - after[-1][1]) * 1e-9:.1f} s before the end of the run'); ok = False
+sys.exit(0 if ok else 1)
+PY
+
+# cut_cable HOST SECONDS OUT: about step 100, HOST's cable is pulled (its eth0 set down inside the
+# host, as `ip link set eth0 down` on a machine) for SECONDS, then put back, with the multicast
+# route the kernel dropped with the link; writes the instants (wall ns) to OUT/cut.
+cut_cable() {
+  local host=$1 secs=$2 out=$3 t_down t_up
+  sleep 12
+  t_down=$(date +%s%N)
+  ip -n "${ns[$host]}" link set eth0 down
+  sleep "$secs"
+  ip -n "${ns[$host]}" link set eth0 up
+  ip -n "${ns[$host]}" route replace 224.0.0.0/4 dev eth0
+  t_up=$(date +%s%N)
+  echo "multihost: cut: $host's cable was out for $secs s"
+  echo "$t_down $t_up" > "$out/cut"
 }
 
 # --- faults: what happened to mind, and what the recording must show ------------------------------
@@ -413,17 +527,20 @@ kill_mind() {
 
 # --- one run of configs/split.yaml per mode --------------------------------------------------------
 run_mode() {
-  local mode=$1 out=$work/$1 h code failed="" t0=$SECONDS
+  local mode=$1 out=$work/${2:-}${1//:/_} h code failed="" t0=$SECONDS
   declare -A lpid
   mkdir -p "$out"
-  if [ "$mode" = peers ] || [ "$mode" = server ]; then block_multicast; fi
-  [ "$mode" = tcp ] && block_multicast udp
-  local discovery=$mode
-  [ "$mode" = faults ] && discovery=multicast
-  [ "$mode" = failure ] && discovery=multicast
-  [ "$mode" = tcp ] && discovery=peers
+  # net: the network's mode (what is blocked, which discovery); cut:NET:HOST:SECONDS names it.
+  local net=$mode cut_host="" cut_s=""
+  [[ $mode == cut:* ]] && IFS=: read -r _ net cut_host cut_s <<< "$mode"
+  [ "$mode" = faults ] && net=multicast
+  [ "$mode" = failure ] && net=multicast
+  if [ "$net" = peers ] || [ "$net" = server ]; then block_multicast; fi
+  [ "$net" = tcp ] && block_multicast udp
+  local discovery=$net
+  [ "$net" = tcp ] && discovery=peers
   local transport=shm+udp
-  [ "$mode" = tcp ] && transport=tcp
+  [ "$net" = tcp ] && transport=tcp
   local sets=(--set "network.discovery=$discovery" --set "network.transport=$transport" --set "human.dataset=$dataset" --set "mind.model=$model"
               --set "observer.model=$observer" --set "recorder.file=$out/split.mcap")
   [ "$mode" = failure ] && sets+=(--set processes.mind.restart=never)
@@ -454,6 +571,9 @@ run_mode() {
   elif [ "$mode" = failure ]; then
     kill_mind "$out" &
     injector=$!
+  elif [ -n "$cut_host" ]; then
+    cut_cable "$cut_host" "$cut_s" "$out" &
+    injector=$!
   elif [ "$mode" = multicast ]; then
     # Mid-run, from rec: every process with its host and pid, and mind's lie measured.
     (sleep 10 && ip netns exec "${ns[rec]}" "$dyad" status --graph "$repo/configs/split.yaml" --wait 5 > "$out/status.txt" 2>&1) &
@@ -465,8 +585,14 @@ run_mode() {
     for h in "${hosts[@]}"; do kill -0 "${lpid[$h]}" 2> /dev/null && alive+=" $h"; done
     [ -z "$alive" ] && break
     if [ $SECONDS -ge $deadline ]; then
-      echo "multihost: $mode: still running after $timeout_s s:$alive (killed)"
+      echo "multihost: $mode: still running after $timeout_s s:$alive (killed; their threads' stacks, if gdb is here: $out/stacks-HOST.txt)"
       for h in $alive; do
+        if command -v gdb > /dev/null; then
+          for p in $(ip netns pids "${ns[$h]}"); do
+            echo "=== pid $p: $(tr '\0' ' ' < "/proc/$p/cmdline" 2> /dev/null)"
+            timeout 60 gdb -p "$p" -batch -ex "thread apply all bt 25" 2>&1 | grep -E '^Thread|^#'
+          done > "$out/stacks-$h.txt" 2>&1
+        fi
         ip netns pids "${ns[$h]}" | xargs -r kill -KILL 2> /dev/null || true
       done
       failed+=" timeout"
@@ -496,7 +622,7 @@ run_mode() {
   done
   [ -z "$injector" ] || wait "$injector" || true
   echo "multihost: $mode: the launchers ended after $((SECONDS - t0)) s"
-  if [ "$mode" = peers ] || [ "$mode" = server ] || [ "$mode" = tcp ]; then
+  if [ "$net" = peers ] || [ "$net" = server ] || [ "$net" = tcp ]; then
     print_drops
     unblock_multicast
   fi
@@ -572,6 +698,17 @@ PY
     echo "PASS: multihost faults: mind killed and restarted, its link cut for 5 s: the others lost nothing, intentions resumed"
     return 0
   fi
+  if [ -n "$cut_host" ]; then
+    local c
+    c=$(cat "$out/cut" 2> /dev/null) || { echo "FAIL: multihost $mode: the cable was not pulled" >&2; failures+=("$mode"); return 0; }
+    if ! export_recording "$out/split.mcap" "$out/csv" | sed "s/^/multihost: $mode: /" ||
+       ! python3 "$work/check_cut.py" "$out/csv" $c | sed "s/^/multihost: $mode: /"; then
+      echo "FAIL: multihost $mode: the recording $out/split.mcap does not pass (see above)" >&2
+      failures+=("$mode"); return 0
+    fi
+    echo "PASS: multihost $mode: $cut_host's cable out for $cut_s s ($net): every topic flowed again in time (above), to the end"
+    return 0
+  fi
   if ! check_recording "$out/split.mcap" "$out/csv" 300 | sed "s/^/multihost: $mode: /"; then
     echo "FAIL: multihost $mode: the recording $out/split.mcap does not pass (see above)" >&2
     failures+=("$mode"); return 0
@@ -582,9 +719,12 @@ PY
 # run_mode reports a failure in `failures` (not by its status: under `||` or `if`, set -e would
 # stop applying inside it).
 failures=()
+n=0
 for mode in "${modes[@]}"; do
   [ "$mode" = net ] && { echo "PASS: multihost net: namespaces and probe"; continue; }
   make_models
-  run_mode "$mode"
+  n=$((n + 1))
+  run_mode "$mode" "$n-"
 done
+echo "multihost: ${#modes[@]} mode run(s) in $SECONDS s, ${#failures[@]} failed"
 [ ${#failures[@]} = 0 ] || fail "failed mode(s): ${failures[*]}"
