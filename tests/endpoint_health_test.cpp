@@ -206,119 +206,119 @@ bool AwaitMatched(DdsParticipant& p, const std::string& topic, bool writer, int 
   return false;
 }
 
-TEST(EndpointRenewal, AReaderRenewedWhileSamplesFlowLosesAndRepeatsNothing) {
-  auto a = Participant("a");
-  auto b = Participant("b");
-  ASSERT_TRUE(a && b);
-  const TopicQos qos{.reliability = Reliability::kReliable, .depth = 10000};
-  auto w = a->CreateWriter("t", TypeInfoOf<msg::Counter>(), qos);
-  auto r = b->CreateReader("t", TypeInfoOf<msg::Counter>(), qos, nullptr);
-  ASSERT_TRUE(w.ok() && r.ok());
-  ASSERT_TRUE(AwaitMatched(*b, "t", false, 1));
+// Participant a writes Counter 1, 2, 3, ... on "t"; participant b reads them (depth large enough
+// that nothing is dropped for want of room).
+class EndpointRenewal : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    a_ = Participant("a");
+    b_ = Participant("b");
+    ASSERT_TRUE(a_ && b_);
+    const TopicQos qos{.reliability = Reliability::kReliable, .depth = 10000};
+    auto w = a_->CreateWriter("t", TypeInfoOf<msg::Counter>(), qos);
+    auto r = b_->CreateReader("t", TypeInfoOf<msg::Counter>(), qos, nullptr);
+    ASSERT_TRUE(w.ok() && r.ok());
+    writer_ = w.value();
+    reader_ = r.value();
+    ASSERT_TRUE(AwaitMatched(*a_, "t", true, 1));
+    ASSERT_TRUE(AwaitMatched(*b_, "t", false, 1));
+  }
+  void Write(int64_t value) {
+    msg::Counter c;
+    c.value(value);
+    ASSERT_TRUE(writer_->Write(&c).ok());
+  }
+  void Take() {
+    msg::Counter c;
+    while (reader_->TakeNext(&c)) got_.push_back(c.value());
+  }
+  // Takes until `last` arrived (5 s at most), then checks nothing came twice or out of order.
+  void TakeUntil(int64_t last) {
+    const auto deadline = SteadyClock::now() + std::chrono::seconds(5);
+    while ((got_.empty() || got_.back() != last) && SteadyClock::now() < deadline) {
+      Take();
+      std::this_thread::sleep_for(milliseconds(1));
+    }
+    ASSERT_FALSE(got_.empty());
+    EXPECT_EQ(got_.back(), last);
+    for (size_t i = 1; i < got_.size(); ++i) ASSERT_LT(got_[i - 1], got_[i]) << "repeated or reordered at " << i;
+  }
+  // got_ starts 1, 2, ..., n: nothing lost up to n.
+  void ExpectContiguousTo(size_t n) {
+    ASSERT_GE(got_.size(), n);
+    for (size_t i = 0; i < n; ++i) ASSERT_EQ(got_[i], static_cast<int64_t>(i + 1)) << "at " << i;
+  }
+
+  std::unique_ptr<DdsParticipant> a_, b_;
+  TypedWriter* writer_ = nullptr;
+  TypedReader* reader_ = nullptr;
+  std::vector<int64_t> got_;
+};
+
+TEST_F(EndpointRenewal, AReaderRenewedWhileSamplesFlowLosesAndRepeatsNothing) {
   std::atomic<bool> done{false};
   std::thread writer([&] {
     for (int64_t i = 1; i <= 1500; ++i) {
-      msg::Counter c;
-      c.value(i);
-      ASSERT_TRUE(w.value()->Write(&c).ok());
+      Write(i);
       std::this_thread::sleep_for(milliseconds(1));
     }
     done = true;
   });
-  std::vector<int64_t> got;
   int renewed = 0, refused = 0;
   const auto start = SteadyClock::now();
-  msg::Counter c;
-  while (!done || r.value()->Unread() > 0 || got.size() < 1500) {
-    while (r.value()->TakeNext(&c)) got.push_back(c.value());
+  while (!done || reader_->Unread() > 0 || got_.size() < 1500) {
+    Take();
     const double t = std::chrono::duration<double>(SteadyClock::now() - start).count();
-    if (renewed == 0 && t > 0.3) renewed += b->Renew("t", false, 2);  // matched 1 < 2: renewed
+    if (renewed == 0 && t > 0.3) renewed += b_->Renew("t", false, 2);  // matched 1 < 2: renewed
     if (renewed == 1 && refused == 0 && t > 0.8) {
       refused = 1;
-      EXPECT_EQ(b->Renew("t", false, 2), 0) << "one renewal at a time: the retired reader is still taken from";
+      EXPECT_EQ(b_->Renew("t", false, 2), 0) << "one renewal at a time: the retired reader is still taken from";
     }
-    b->Reap();
+    b_->Reap();
     if (t > 20) break;
     std::this_thread::sleep_for(milliseconds(1));
   }
   writer.join();
   EXPECT_EQ(renewed, 1);
-  EXPECT_EQ(b->Renew("t", false, 1), 0) << "a reader that matches what is expected is left alone";
-  ASSERT_EQ(got.size(), 1500u);
-  for (size_t i = 0; i < got.size(); ++i) ASSERT_EQ(got[i], static_cast<int64_t>(i + 1)) << "at " << i;
-  ASSERT_TRUE(AwaitMatched(*b, "t", false, 1));
+  EXPECT_EQ(b_->Renew("t", false, 1), 0) << "a reader that matches what is expected is left alone";
+  ASSERT_EQ(got_.size(), 1500u);
+  ExpectContiguousTo(1500);
+  ASSERT_TRUE(AwaitMatched(*b_, "t", false, 1));
 }
 
-TEST(EndpointRenewal, ARenewedWriterIsMatchedAgainAndNeverRepeatsASample) {
-  auto a = Participant("a");
-  auto b = Participant("b");
-  ASSERT_TRUE(a && b);
-  const TopicQos qos{.reliability = Reliability::kReliable, .depth = 10000};
-  auto w = a->CreateWriter("t", TypeInfoOf<msg::Counter>(), qos);
-  std::vector<int64_t> got;
-  auto r = b->CreateReader("t", TypeInfoOf<msg::Counter>(), qos, nullptr);
-  ASSERT_TRUE(w.ok() && r.ok());
-  ASSERT_TRUE(AwaitMatched(*a, "t", true, 1));
-  msg::Counter c;
+TEST_F(EndpointRenewal, ARenewedWriterIsMatchedAgainAndNeverRepeatsASample) {
   for (int64_t i = 1; i <= 400; ++i) {
     if (i == 200) {
-      ASSERT_EQ(a->Renew("t", true, 2), 1);
+      ASSERT_EQ(a_->Renew("t", true, 2), 1);
     }
-    c.value(i);
-    ASSERT_TRUE(w.value()->Write(&c).ok());
-    while (r.value()->TakeNext(&c)) got.push_back(c.value());
+    Write(i);
+    Take();
     std::this_thread::sleep_for(milliseconds(1));
   }
-  ASSERT_TRUE(AwaitMatched(*a, "t", true, 1));
-  const auto deadline = SteadyClock::now() + std::chrono::seconds(5);
-  while ((got.empty() || got.back() != 400) && SteadyClock::now() < deadline) {
-    while (r.value()->TakeNext(&c)) got.push_back(c.value());
-    std::this_thread::sleep_for(milliseconds(1));
-  }
-  ASSERT_FALSE(got.empty());
-  EXPECT_EQ(got.front(), 1);
-  EXPECT_EQ(got.back(), 400) << "the renewed writer's samples arrive";
-  for (size_t i = 1; i < got.size(); ++i) ASSERT_LT(got[i - 1], got[i]) << "repeated or reordered at " << i;
+  ASSERT_TRUE(AwaitMatched(*a_, "t", true, 1));
+  TakeUntil(400);  // the renewed writer's samples arrive
+  ExpectContiguousTo(199);
   // Samples written before the new writer matched the reader may be lost (at most those).
-  EXPECT_GE(got.size(), 200u);
+  EXPECT_GE(got_.size(), 200u);
 }
 
-TEST(EndpointRenewal, RenewedParticipantsKeepEveryEndpointWorking) {
-  auto a = Participant("a");
-  auto b = Participant("b");
-  ASSERT_TRUE(a && b);
-  const TopicQos qos{.reliability = Reliability::kReliable, .depth = 10000};
-  auto w = a->CreateWriter("t", TypeInfoOf<msg::Counter>(), qos);
-  auto r = b->CreateReader("t", TypeInfoOf<msg::Counter>(), qos, nullptr);
-  ASSERT_TRUE(w.ok() && r.ok());
-  ASSERT_TRUE(AwaitMatched(*b, "t", false, 1));
-  std::vector<int64_t> got;
-  msg::Counter c;
+TEST_F(EndpointRenewal, RenewedParticipantsKeepEveryEndpointWorking) {
   for (int64_t i = 1; i <= 600; ++i) {
     if (i == 200) {
-      ASSERT_TRUE(b->RenewParticipant());  // the reader's side: lossless
+      ASSERT_TRUE(b_->RenewParticipant());  // the reader's side: lossless
     }
     if (i == 400) {
-      ASSERT_TRUE(a->RenewParticipant());  // the writer's side
+      ASSERT_TRUE(a_->RenewParticipant());  // the writer's side
     }
-    c.value(i);
-    ASSERT_TRUE(w.value()->Write(&c).ok());
-    while (r.value()->TakeNext(&c)) got.push_back(c.value());
-    a->Reap();
-    b->Reap();
+    Write(i);
+    Take();
+    a_->Reap();
+    b_->Reap();
     std::this_thread::sleep_for(milliseconds(2));
   }
-  const auto deadline = SteadyClock::now() + std::chrono::seconds(5);
-  while ((got.empty() || got.back() != 600) && SteadyClock::now() < deadline) {
-    while (r.value()->TakeNext(&c)) got.push_back(c.value());
-    std::this_thread::sleep_for(milliseconds(1));
-  }
-  ASSERT_FALSE(got.empty());
-  EXPECT_EQ(got.back(), 600);
-  for (size_t i = 1; i < got.size(); ++i) ASSERT_LT(got[i - 1], got[i]) << "repeated or reordered at " << i;
-  // Up to 400 nothing may be missing: the reader's participant renewal is lossless.
-  for (size_t i = 0; i < 399; ++i) ASSERT_EQ(got[i], static_cast<int64_t>(i + 1)) << "at " << i;
-  ASSERT_TRUE(AwaitMatched(*b, "t", false, 1, a.get()));
+  TakeUntil(600);
+  ExpectContiguousTo(399);  // the reader's participant renewal is lossless
+  ASSERT_TRUE(AwaitMatched(*b_, "t", false, 1, a_.get()));
 }
 
 }  // namespace

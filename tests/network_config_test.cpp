@@ -282,6 +282,22 @@ TEST(NetworkQos, SharedMemoryComesFirstUnlessAWatcherAsksForUdpOnly) {
   EXPECT_EQ(watcher.transport().user_transports.size(), 1u);
 }
 
+// With a discovery server only the server watches a client's lease: an outage must end it less
+// easily (docs/distributed.md, "A pulled cable").
+TEST(NetworkQos, ParticipantsAnnounceEveryTenthOfTheLeaseWithADiscoveryServer) {
+  NetworkConfig net;
+  net.lease_s = 5;
+  EXPECT_DOUBLE_EQ(AnnouncementPeriodS(net), 1.25);
+  net.discovery = Discovery::kServer;
+  net.server_address = "127.0.0.1";
+  net.server_port = 11811;
+  EXPECT_DOUBLE_EQ(AnnouncementPeriodS(net), 0.5);
+  eprosima::fastdds::dds::DomainParticipantQos qos;
+  ASSERT_TRUE(ApplyNetwork(net, false, &qos).ok());
+  EXPECT_EQ(qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod,
+            eprosima::fastrtps::Duration_t(0.5));
+}
+
 TEST(NetworkQos, AnAddressThatDoesNotResolveNamesItsKey) {
   std::vector<Diagnostic> diags;
   const Graph g = Parse(Replace(kSplit, "mind: 10.77.0.2", "mind: no-such-host.invalid"), &diags);
