@@ -156,8 +156,9 @@ bool PlaceMessage(const Graph& graph, const ComponentConfig& c, const ComponentS
   else if (msg.rfind(" = ", 0) == 0) msg = msg.substr(1);  // "= 300: must be ...": Diagnostic shows "key = 300: ..."
   else if (!msg.empty() && msg[0] == ' ') msg = msg.substr(1);
   d->message = msg;
-  if (auto set = c.overridden.find(param); set != c.overridden.end()) {
-    d->mark = SourceMark{"--set " + set->second, 0, 0};
+  const std::string param_key = "components." + c.name + ".params." + param;
+  if (const std::string& from = graph.OriginOf(param_key); from.rfind("--set ", 0) == 0) {
+    d->mark = graph.MarkOf(param_key, YAML::Node());
     return true;
   }
   YAML::Node node = c.params && c.params.IsMap() ? c.params[param] : YAML::Node();
@@ -165,7 +166,7 @@ bool PlaceMessage(const Graph& graph, const ComponentConfig& c, const ComponentS
     d->mark = c.params_mark.line ? c.params_mark : c.mark;
     return true;
   }
-  d->mark = SourceMark::Of(graph.file, node);
+  d->mark = graph.MarkOf(param_key, node);
   // Walk into the value: a kYaml param (e.g. events) as written in the file.
   static const std::regex kStep(R"(\.([A-Za-z_][A-Za-z0-9_]*)|\[([0-9]+)\])");
   for (auto it = std::sregex_iterator(tail.begin(), tail.end(), kStep); it != std::sregex_iterator(); ++it) {
@@ -174,7 +175,7 @@ bool PlaceMessage(const Graph& graph, const ComponentConfig& c, const ComponentS
       for (const auto& kv : node)
         if (kv.first.Scalar() == (*it)[1].str()) next = kv.first;  // the key's own position
       if (next) {
-        d->mark = SourceMark::Of(graph.file, next);
+        d->mark = graph.MarkOf(param_key, next);
         node = node[(*it)[1].str()];
         continue;
       }
@@ -184,7 +185,7 @@ bool PlaceMessage(const Graph& graph, const ComponentConfig& c, const ComponentS
     }
     if (!next) break;
     node = next;
-    d->mark = SourceMark::Of(graph.file, node);
+    d->mark = graph.MarkOf(param_key, node);
   }
   return true;
 }

@@ -9,8 +9,8 @@
 #include <set>
 #include <sstream>
 
-#include <yaml-cpp/depthguard.h>
 
+#include "graph/graph_document.hpp"
 #include "graph/run_partition.hpp"
 
 namespace dyad {
@@ -20,10 +20,10 @@ namespace {
 const std::string kGraphNameRule = "must be 1 to 64 of the characters A-Z a-z 0-9 _ . - (it names the run's DDS partition)";
 
 
-// Collects diagnostics for one file.
+// Collects diagnostics; each at the file (or --set) that wrote the key (Graph::MarkOf).
 class Reader {
  public:
-  Reader(std::string file, std::vector<Diagnostic>* out) : file_(std::move(file)), out_(out) {}
+  Reader(const Graph* g, std::vector<Diagnostic>* out) : g_(g), out_(out) {}
 
   void Error(const YAML::Node& node, const std::string& key, const std::string& message) {
     out_->push_back(Diagnostic{Mark(node, key), key, message});
@@ -31,14 +31,7 @@ class Reader {
   void Error(const SourceMark& mark, const std::string& key, const std::string& message) {
     out_->push_back(Diagnostic{mark, key, message});
   }
-  SourceMark Mark(const YAML::Node& node) const { return SourceMark::Of(file_, node); }
-  // A node a `--set` put in: its problems are the command line's, not the file's.
-  SourceMark Mark(const YAML::Node& node, const std::string& key) const {
-    for (const auto& [set_key, mark] : cli_marks_)
-      if (key == set_key || key.rfind(set_key + ".", 0) == 0) return mark;
-    return Mark(node);
-  }
-  void SetFromCommandLine(const std::string& key, SourceMark mark) { cli_marks_[key] = std::move(mark); }
+  SourceMark Mark(const YAML::Node& node, const std::string& key) const { return g_->MarkOf(key, node); }
 
   // Checks `node` is a map, reports keys outside `allowed` and duplicate keys.
   bool Map(const YAML::Node& node, const std::string& key, const std::set<std::string>& allowed) {
@@ -82,12 +75,9 @@ class Reader {
     return false;
   }
 
-  const std::string& file() const { return file_; }
-
  private:
-  std::string file_;
+  const Graph* g_;
   std::vector<Diagnostic>* out_;
-  std::map<std::string, SourceMark> cli_marks_;
 };
 
 // "host:port" -> host and port (1..65535); false when malformed.
@@ -123,7 +113,7 @@ void ReadStringList(Reader& r, const YAML::Node& node, const std::string& key, s
 }
 
 void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
-  n->mark = r.Mark(node);
+  n->mark = r.Mark(node, "network");
   if (node.IsNull()) return;
   if (!r.Map(node, "network", {"discovery", "hosts", "peers", "server", "transport", "interfaces", "lease_s", "start_timeout_s",
                             "max_clock_offset_ms"}))
@@ -191,8 +181,8 @@ void ReadTopics(Reader& r, const YAML::Node& node, Graph* g) {
   for (const auto& kv : node) {
     TopicConfig t;
     t.name = kv.first.Scalar();
-    t.mark = r.Mark(kv.first);
     const std::string key = "topics." + t.name;
+    t.mark = r.Mark(kv.first, key);
     const YAML::Node spec = kv.second;
     if (spec.IsNull()) {
       g->topics.push_back(t);
@@ -201,7 +191,7 @@ void ReadTopics(Reader& r, const YAML::Node& node, Graph* g) {
     if (!r.Map(spec, key, {"type", "reliability", "depth", "deadline_ms", "liveliness_ms"})) continue;
     if (spec["type"]) {
       r.String(spec["type"], key + ".type", &t.type);
-      t.type_mark = r.Mark(spec["type"]);
+      t.type_mark = r.Mark(spec["type"], key + ".type");
     }
     if (spec["reliability"]) {
       std::string rel;
@@ -228,7 +218,7 @@ void ReadBindings(Reader& r, const YAML::Node& node, const std::string& key, std
   for (const auto& kv : node) {
     PortBinding b;
     b.port = kv.first.Scalar();
-    b.mark = r.Mark(kv.second);
+    b.mark = r.Mark(kv.second, key + "." + b.port);
     if (r.String(kv.second, key + "." + b.port, &b.topic)) out->push_back(b);
   }
 }
@@ -238,31 +228,31 @@ void ReadComponents(Reader& r, const YAML::Node& node, Graph* g) {
   for (const auto& kv : node) {
     ComponentConfig c;
     c.name = kv.first.Scalar();
-    c.mark = r.Mark(kv.first);
     const std::string key = "components." + c.name;
+    c.mark = r.Mark(kv.first, key);
     const YAML::Node spec = kv.second;
     if (!r.Map(spec, key, {"type", "rate_hz", "trigger", "process", "params", "inputs", "outputs"})) continue;
     if (spec["type"]) {
       r.String(spec["type"], key + ".type", &c.type);
-      c.type_mark = r.Mark(spec["type"]);
+      c.type_mark = r.Mark(spec["type"], key + ".type");
     } else {
       r.Error(kv.first, key + ".type", "missing (every component names its type)");
     }
     if (spec["rate_hz"]) {
-      c.rate_mark = r.Mark(spec["rate_hz"]);
+      c.rate_mark = r.Mark(spec["rate_hz"], key + ".rate_hz");
       if (r.Number(spec["rate_hz"], key + ".rate_hz", &c.rate_hz, "a number") && !(c.rate_hz > 0))
         r.Error(spec["rate_hz"], key + ".rate_hz", "must be > 0, got " + spec["rate_hz"].Scalar());
     }
     if (spec["trigger"]) {
-      c.trigger_mark = r.Mark(spec["trigger"]);
+      c.trigger_mark = r.Mark(spec["trigger"], key + ".trigger");
       r.String(spec["trigger"], key + ".trigger", &c.trigger);
     }
     if (spec["process"]) {
-      c.process_mark = r.Mark(spec["process"]);
+      c.process_mark = r.Mark(spec["process"], key + ".process");
       r.String(spec["process"], key + ".process", &c.process);
     }
     if (spec["params"]) {
-      c.params_mark = r.Mark(spec["params"]);
+      c.params_mark = r.Mark(spec["params"], key + ".params");
       if (spec["params"].IsNull()) c.params = YAML::Node(YAML::NodeType::Map);
       else if (r.Map(spec["params"], key + ".params", {})) c.params = spec["params"];
     } else {
@@ -272,72 +262,6 @@ void ReadComponents(Reader& r, const YAML::Node& node, Graph* g) {
     if (spec["inputs"] && !spec["inputs"].IsNull()) ReadBindings(r, spec["inputs"], key + ".inputs", &c.inputs);
     if (spec["outputs"] && !spec["outputs"].IsNull()) ReadBindings(r, spec["outputs"], key + ".outputs", &c.outputs);
     g->components.push_back(std::move(c));
-  }
-}
-
-// `--set KEY=VALUE` for one of the graph's own scalars (clock, seed, domain_id, graph), checked
-// like the file's. Returns false when KEY is not one of them.
-bool ApplyGraphOverride(const std::string& key, const std::string& value, const SourceMark& cli, Graph* g,
-                        YAML::Node root, std::vector<Diagnostic>* out) {
-  if (key == "clock") {
-    g->clock_mark = cli;
-    if (value == "wall") g->clock = ClockMode::kWall;
-    else if (value == "stepped") g->clock = ClockMode::kStepped;
-    else out->push_back({cli, "clock", "must be wall or stepped, got '" + value + "'"});
-  } else if (key == "seed" || key == "domain_id") {
-    char* end = nullptr;
-    errno = 0;
-    const unsigned long long v = std::strtoull(value.c_str(), &end, 10);
-    const bool number = !value.empty() && value[0] != '-' && *end == '\0' && errno == 0;
-    if (key == "seed") {
-      if (number) g->seed = v;
-      else out->push_back({cli, "seed", "must be a non-negative integer, got '" + value + "'"});
-    } else if (number && v <= 232) {
-      g->domain_id = static_cast<int>(v);
-    } else {
-      out->push_back({cli, "domain_id", "must be in 0..232 (DDS), got '" + value + "'"});
-    }
-  } else if (key == "graph") {
-    if (!IsPartitionWord(value)) out->push_back({cli, "graph", kGraphNameRule + (", got '" + value + "'")});
-    else g->name = value;
-  } else {
-    return false;
-  }
-  if (root.IsMap()) root[key] = value;  // the recorded graph is the graph as run
-  g->graph_overrides.push_back(cli.file.substr(6));
-  return true;
-}
-
-void ApplyOverrides(const std::vector<Override>& overrides, Graph* g, YAML::Node root, std::vector<Diagnostic>* out) {
-  for (const auto& o : overrides) {
-    const SourceMark cli{"--set " + o.text, 0, 0};
-    const auto eq = o.text.find('=');
-    const auto dot = o.text.find('.');
-    if (o.text.rfind("network.", 0) == 0 || o.text.rfind("processes.", 0) == 0) continue;  // read with their sections
-    if (eq != std::string::npos && (dot == std::string::npos || dot > eq) &&
-        ApplyGraphOverride(o.text.substr(0, eq), o.text.substr(eq + 1), cli, g, root, out))
-      continue;
-    if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || dot + 1 == eq) {
-      out->push_back({cli, o.text, "expected COMPONENT.PARAM=VALUE, clock|seed|domain_id|graph=VALUE, network.KEY=VALUE or processes.NAME.KEY=VALUE"});
-      continue;
-    }
-    const std::string comp = o.text.substr(0, dot);
-    std::string param = o.text.substr(dot + 1, eq - dot - 1);
-    if (param.rfind("params.", 0) == 0) param = param.substr(7);
-    const std::string value = o.text.substr(eq + 1);
-    ComponentConfig* c = nullptr;
-    for (auto& cc : g->components)
-      if (cc.name == comp) c = &cc;
-    if (c == nullptr) {
-      out->push_back({cli, "components." + comp, "no such component in the graph"});
-      continue;
-    }
-    try {
-      c->params[param] = YAML::Load(value);
-      c->overridden[param] = o.text;
-    } catch (const YAML::Exception& e) {
-      out->push_back({cli, "components." + comp + ".params." + param, "value is not valid YAML: " + e.msg});
-    }
   }
 }
 
@@ -384,68 +308,31 @@ std::string Graph::ProcessOf(const ComponentConfig& c) const {
   return "main";
 }
 
+const std::string& Graph::OriginOf(const std::string& key) const {
+  // The longest prefix of key listed: key itself, then key without its last part, ..., then "".
+  for (std::string k = key;;) {
+    if (auto it = origins.find(k); it != origins.end()) return it->second;
+    if (k.empty()) return file;
+    const auto dot = k.rfind('.');
+    k = dot == std::string::npos ? "" : k.substr(0, dot);
+  }
+}
+
+SourceMark Graph::MarkOf(const std::string& key, const YAML::Node& node) const {
+  const std::string& from = OriginOf(key);
+  if (from.rfind("--set ", 0) == 0) return SourceMark{from, 0, 0};
+  return SourceMark::Of(from, node);
+}
+
+std::string Graph::FolderOf(const std::string& key) const {
+  const std::string& from = OriginOf(key);
+  std::error_code ec;
+  if (from.rfind("--set ", 0) == 0) return std::filesystem::current_path(ec).string();
+  if (from == file) return folder;
+  return std::filesystem::absolute(from, ec).parent_path().lexically_normal().string();
+}
+
 namespace {
-
-// With overrides, yaml_text becomes the graph as run: the file's document with the overridden
-// params replaced, re-emitted (comments are lost), headed by the --set list. Recordings store it,
-// so analyses see what ran, not what the file said.
-void RecordOverrides(const std::vector<Override>& overrides, YAML::Node root, Graph* g) {
-  if (overrides.empty() || !root.IsMap() || !root["components"].IsMap()) return;
-  bool changed = !g->graph_overrides.empty();  // already written into root
-  for (const ComponentConfig& c : g->components) {
-    if (c.overridden.empty()) continue;
-    YAML::Node node = root["components"][c.name];
-    if (!node.IsMap()) continue;
-    for (const auto& [param, text] : c.overridden) node["params"][param] = YAML::Clone(c.params[param]);
-    changed = true;
-  }
-  if (!changed) return;
-  YAML::Emitter out;
-  out << root;
-  std::string header = "# the graph as run: " + g->file + " with";
-  for (const Override& o : overrides) header += " --set " + o.text;
-  g->yaml_text = header + "\n" + out.c_str() + "\n";
-}
-
-// `--set network.KEY=VALUE` and `--set processes.NAME.KEY=VALUE` go into the document before it
-// is read, so they are checked (and recorded) like the file's own; their problems name the --set.
-void InjectSectionOverrides(const std::vector<Override>& overrides, YAML::Node root, Reader& r, Graph* g,
-                            std::vector<Diagnostic>* diagnostics) {
-  for (const Override& o : overrides) {
-    const auto eq = o.text.find('=');
-    const bool network = o.text.rfind("network.", 0) == 0, process = o.text.rfind("processes.", 0) == 0;
-    if (!network && !process) continue;
-    const std::string section = network ? "network" : "processes";
-    const std::string path = eq == std::string::npos ? "" : o.text.substr(section.size() + 1, eq - section.size() - 1);
-    const SourceMark cli{"--set " + o.text, 0, 0};
-    const auto dot = path.find('.');
-    const std::string name = network ? "" : path.substr(0, dot == std::string::npos ? 0 : dot);
-    const std::string key = network ? path : dot == std::string::npos ? "" : path.substr(dot + 1);
-    if (key.empty() || key.find('.') != std::string::npos || (process && name.empty())) {
-      diagnostics->push_back({cli, section, network ? "expected network.KEY=VALUE" : "expected processes.NAME.KEY=VALUE"});
-      continue;
-    }
-    try {
-      // (No `YAML::Node n = ...; n = n[...]`: assigning to a yaml-cpp node overwrites what it refers to.)
-      if (!root[section] || root[section].IsNull()) root[section] = YAML::Node(YAML::NodeType::Map);
-      if (network) {
-        root[section][key] = YAML::Load(o.text.substr(eq + 1));
-      } else {
-        if (!root[section].IsMap() || !root[section][name]) {
-          diagnostics->push_back({cli, "processes." + name, "no such process in the graph's `processes:`"});
-          continue;
-        }
-        if (root[section][name].IsNull()) root[section][name] = YAML::Node(YAML::NodeType::Map);
-        if (!root[section][name].IsMap()) continue;  // the file's own error ("must be a mapping") says it
-        root[section][name][key] = YAML::Load(o.text.substr(eq + 1));
-      }
-      r.SetFromCommandLine(section + "." + path, cli);
-      g->graph_overrides.push_back(o.text);
-    } catch (const YAML::Exception& e) {
-      diagnostics->push_back({cli, section + "." + path, "value is not valid YAML: " + e.msg});
-    }
-  }
-}
 
 // The graph's own scalars: graph, domain_id, clock, seed, plugins, logs.
 void ReadGraphScalars(Reader& r, const YAML::Node& root, Graph* g) {
@@ -455,7 +342,7 @@ void ReadGraphScalars(Reader& r, const YAML::Node& root, Graph* g) {
       (g->domain_id < 0 || g->domain_id > 232))
     r.Error(root["domain_id"], "domain_id", "must be in 0..232 (DDS), got " + std::to_string(g->domain_id));
   if (root["clock"]) {
-    g->clock_mark = r.Mark(root["clock"]);
+    g->clock_mark = r.Mark(root["clock"], "clock");
     std::string mode;
     if (r.String(root["clock"], "clock", &mode)) {
       if (mode == "wall") g->clock = ClockMode::kWall;
@@ -464,8 +351,8 @@ void ReadGraphScalars(Reader& r, const YAML::Node& root, Graph* g) {
     }
   }
   if (root["seed"]) r.Number(root["seed"], "seed", &g->seed, "a non-negative integer");
-  const std::filesystem::path base = g->folder;  // plugins: like every path of the file
   if (const YAML::Node plugins = root["plugins"]) {
+    const std::filesystem::path base = g->FolderOf("plugins");  // like every path of a graph file
     if (!plugins.IsSequence()) {
       r.Error(plugins, "plugins", "must be a list of paths");
     } else {
@@ -474,12 +361,13 @@ void ReadGraphScalars(Reader& r, const YAML::Node& root, Graph* g) {
         if (!r.String(p, "plugins", &s)) continue;
         std::filesystem::path fp(s);
         g->plugins.push_back(fp.is_absolute() ? s : (base / fp).lexically_normal().string());
-        g->plugin_marks.push_back(r.Mark(p));
+        g->plugin_marks.push_back(r.Mark(p, "plugins"));
       }
     }
   }
   if (root["logs"]) {
     std::string logs;
+    const std::filesystem::path base = g->FolderOf("logs");
     if (r.String(root["logs"], "logs", &logs))
       g->logs = std::filesystem::path(logs).is_absolute() ? logs : (base / logs).lexically_normal().string();
   }
@@ -491,8 +379,8 @@ void ReadProcesses(Reader& r, const YAML::Node& procs, Graph* g) {
   for (const auto& kv : procs) {
     ProcessConfig p;
     p.name = kv.first.Scalar();
-    p.mark = r.Mark(kv.first);
     const std::string key = "processes." + p.name;
+    p.mark = r.Mark(kv.first, key);
     const YAML::Node spec = kv.second;
     if (!spec.IsNull() && r.Map(spec, key, {"host", "restart", "max_restarts", "backoff_s", "required", "tcp_port"})) {
       if (spec["host"] && r.String(spec["host"], key + ".host", &p.host) && !g->network.hosts.empty() &&
@@ -552,6 +440,34 @@ void CheckPlacement(Reader& r, const Graph& g) {
   }
 }
 
+// yaml_text for a graph with a chain or sets: the merged document, headed by what made it.
+std::string GraphAsRun(const GraphDocument& doc, const std::string& file) {
+  std::string header = "# the graph as run: " + file;
+  for (size_t i = 0; i < doc.bases.size(); ++i) header += (i == 0 ? " extends " : ", ") + doc.bases[i];
+  if (!doc.sets.empty()) header += " with";
+  for (const std::string& set : doc.sets) header += " --set " + set;
+  YAML::Emitter out;
+  out << doc.root;
+  return header + "\n" + out.c_str() + "\n";
+}
+
+// The --sets behind each component's params and the graph's own keys (for messages).
+void NoteOverrides(Graph* g) {
+  for (const auto& [key, from] : g->origins) {
+    if (from.rfind("--set ", 0) != 0) continue;
+    const std::string text = from.substr(6);
+    if (key.rfind("components.", 0) != 0) {
+      g->graph_overrides.push_back(text);
+      continue;
+    }
+    const auto params = key.find(".params.");
+    if (params == std::string::npos) continue;
+    const std::string name = key.substr(11, params - 11);
+    for (auto& c : g->components)
+      if (c.name == name) c.overridden[key.substr(params + 8)] = text;
+  }
+}
+
 }  // namespace
 
 Graph ParseGraph(const std::string& yaml_text, const std::string& path, const std::vector<Override>& overrides,
@@ -564,23 +480,12 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
     g.folder = (path.empty() ? cwd : std::filesystem::absolute(path, ec).parent_path()).lexically_normal().string();
   }
   g.yaml_text = yaml_text;
-  Reader r(path, diagnostics);
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::DeepRecursion& e) {  // yaml-cpp says only "bad file"
-    diagnostics->push_back({SourceMark{path, e.mark.line + 1, e.mark.column + 1}, "",
-                            "YAML syntax error: nested too deeply (" + std::to_string(e.depth()) + " levels)"});
-    return g;
-  } catch (const YAML::ParserException& e) {
-    diagnostics->push_back({SourceMark{path, e.mark.line + 1, e.mark.column + 1}, "", "YAML syntax error: " + e.msg});
-    return g;
-  }
-  if (!root.IsMap()) {
-    diagnostics->push_back({SourceMark{path, 1, 1}, "", "a graph file must be a YAML mapping"});
-    return g;
-  }
-  InjectSectionOverrides(overrides, root, r, &g, diagnostics);
+  GraphDocument doc = ReadGraphDocument(yaml_text, path, diagnostics);
+  if (!doc.root) return g;
+  ApplySets(overrides, &doc, diagnostics);
+  g.origins = doc.origins;
+  const YAML::Node root = doc.root;
+  Reader r(&g, diagnostics);
   r.Map(root, "", {"graph", "domain_id", "clock", "seed", "plugins", "logs", "network", "processes", "topics", "components"});
   ReadGraphScalars(r, root, &g);
   if (const YAML::Node network = root["network"]) ReadNetwork(r, network, &g.network);
@@ -589,8 +494,8 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, &g);
   else r.Error(SourceMark{path, 1, 1}, "components", "missing: a graph needs at least one component");
   CheckPlacement(r, g);
-  ApplyOverrides(overrides, &g, root, diagnostics);
-  RecordOverrides(overrides, root, &g);
+  NoteOverrides(&g);
+  if (!doc.bases.empty() || !doc.sets.empty()) g.yaml_text = GraphAsRun(doc, path);
   return g;
 }
 

@@ -41,8 +41,8 @@ std::string RangeError(const ParamSpec& spec, double v) {
   return os.str();
 }
 
-// A path param's value made absolute against `base` (the graph file's folder, or the working
-// folder for a --set); absolute and empty values are kept.
+// A path param's value made absolute against `base` (Graph::FolderOf); absolute and empty
+// values are kept.
 void ResolvePaths(const std::filesystem::path& base, ParamValue* value) {
   auto resolve = [&](std::string& p) {
     if (p.empty() || std::filesystem::path(p).is_absolute()) return;
@@ -202,11 +202,10 @@ class Validation {
       for (const auto& kv : c.params) {
         const std::string pname = kv.first.Scalar();
         const std::string pkey = key + ".params." + pname;
-        auto set = c.overridden.find(pname);
-        const SourceMark at = set != c.overridden.end() ? SourceMark{"--set " + set->second, 0, 0} : SourceMark::Of(graph_.file, kv.second);
+        const SourceMark at = graph_.MarkOf(pkey, kv.second);
         const ParamSpec* ps = spec.FindParam(pname);
         if (ps == nullptr) {
-          error(set != c.overridden.end() ? at : SourceMark::Of(graph_.file, kv.first), pkey,
+          error(graph_.MarkOf(pkey, kv.first), pkey,
                 "unknown parameter of " + c.type + " (known: " + Names(spec.params()) + ")");
           continue;
         }
@@ -215,12 +214,8 @@ class Validation {
           error(at, pkey, v.status().message());
           continue;
         }
-        if (ps->path) {
-          // Written in the file: relative to the file. Given with --set: relative to where the user is.
-          std::error_code ec;
-          ResolvePaths(set == c.overridden.end() ? std::filesystem::path(graph_.folder) : std::filesystem::current_path(ec),
-                       &v.value());
-        }
+        // Written in a file: relative to that file. Given with --set: relative to where the user is.
+        if (ps->path) ResolvePaths(graph_.FolderOf(pkey), &v.value());
         values[pname] = std::move(v.value());
       }
     }

@@ -63,7 +63,7 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
 
   auto* validate = app.add_subcommand("validate", "Check a graph file; print every problem (exit 2) or OK");
   validate->add_option("graph", run.graph_path, "Graph YAML file")->required();
-  validate->add_option("--set", sets, "Override a parameter: COMPONENT.PARAM=VALUE, network.KEY=VALUE, processes.NAME.KEY=VALUE (repeatable)");
+  validate->add_option("--set", sets, "Change a key of the graph: COMPONENT.PARAM=VALUE, COMPONENT.type=TYPE (rate_hz, trigger, process, inputs.PORT, outputs.PORT), clock|seed|domain_id|graph=VALUE, network.KEY=VALUE, processes.NAME.KEY=VALUE (repeatable)");
   validate->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
   validate->callback([st, &exit_code] {
     exit_code = ValidateGraphFile(st->run.graph_path, ToOverrides(st->sets), st->plugins, std::cout, std::cerr);
@@ -74,7 +74,7 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
   r->add_option("--process", run.process, "Run only the components placed in this process");
   r->add_option("--logs", run.logs_dir, "Folder for each process's log (<process>.log); default: the graph's logs:");
   r->add_option("--host", run.host, "This machine's name in the graph (processes: NAME: {host: ...}); default: its host name");
-  r->add_option("--set", sets, "Override a parameter: COMPONENT.PARAM=VALUE, network.KEY=VALUE, processes.NAME.KEY=VALUE (repeatable)");
+  r->add_option("--set", sets, "Change a key of the graph: COMPONENT.PARAM=VALUE, COMPONENT.type=TYPE (rate_hz, trigger, process, inputs.PORT, outputs.PORT), clock|seed|domain_id|graph=VALUE, network.KEY=VALUE, processes.NAME.KEY=VALUE (repeatable)");
   r->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
   r->add_option("--duration", run.duration_s, "Stop after this many seconds of wall time")->check(CLI::NonNegativeNumber);
   r->add_option("--steps", run.steps, "Stop after the fastest periodic component ran this many steps");

@@ -59,13 +59,16 @@ class DriverProcessTest : public ::testing::Test {
     if (!HasFailure()) fs::remove_all(dir_);
   }
   // The driver config with this test's domain and a state log appended.
-  fs::path Graph(const std::string& config_text, const std::string& name, const fs::path& log) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << "domain_id: " << domain_ << "\n"
-                     << config_text
-                     << "  log: {type: test_state_log, trigger: state, params: {file: " << log.string()
-                     << "}, inputs: {state: robot/state}}\n";
-    return p;
+  // configs/drivers/NAME, run here: virtual.yaml on this test's domain with a state log into
+  // `log`, and udp.yaml as it is (it extends virtual.yaml).
+  fs::path Graph(const std::string& name, const fs::path& log) {
+    std::ofstream(dir_ / "virtual.yaml") << "domain_id: " << domain_ << "\n"
+                                         << Read(fs::path(DYAD_CONFIG_DIR) / "drivers/virtual.yaml")
+                                         << "  log: {type: test_state_log, trigger: state, params: {file: " << log.string()
+                                         << "}, inputs: {state: robot/state}}\n";
+    if (name != "virtual.yaml")
+      fs::copy_file(fs::path(DYAD_CONFIG_DIR) / "drivers" / name, dir_ / name, fs::copy_options::overwrite_existing);
+    return dir_ / name;
   }
   std::vector<std::string> Dyad(std::vector<std::string> args) {
     args.insert(args.begin(), DYAD_EXE);
@@ -85,15 +88,15 @@ class DriverProcessTest : public ::testing::Test {
 };
 
 const std::string kVirtualLine = "    type: virtual_cartesian\n";
-const std::string kUdpLine = "    type: udp_cartesian\n";
 
-TEST_F(DriverProcessTest, ConfigsDifferOnlyInTheDriversType) {
-  const std::string v = Read(fs::path(DYAD_CONFIG_DIR) / "drivers/virtual.yaml");
-  const std::string u = Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml");
-  ASSERT_NE(v.find(kVirtualLine), std::string::npos);
-  std::string swapped = v;
-  swapped.replace(swapped.find(kVirtualLine), kVirtualLine.size(), kUdpLine);
-  EXPECT_EQ(swapped, u);
+// udp.yaml is virtual.yaml with only the driver's type changed, and says nothing else.
+TEST_F(DriverProcessTest, UdpConfigExtendsVirtualAndChangesOnlyTheDriversType) {
+  std::istringstream u(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"));
+  std::string keys;
+  for (std::string line; std::getline(u, line);)
+    if (!line.empty() && line[0] != '#') keys += line + "\n";
+  EXPECT_EQ(keys, "extends: virtual.yaml\ncomponents:\n  driver: {type: udp_cartesian}\n");
+  EXPECT_NE(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/virtual.yaml").find(kVirtualLine), std::string::npos);
 }
 
 // The same graph, once with each driver: the robot's states are published every step, follow the
@@ -101,11 +104,9 @@ TEST_F(DriverProcessTest, ConfigsDifferOnlyInTheDriversType) {
 // fake controller (both run VirtualRobot on the runtime clock's stamps).
 TEST_F(DriverProcessTest, SwappingTheDriverByTypeGivesTheSameRobotStates) {
   const fs::path vlog = dir_ / "virtual.txt", ulog = dir_ / "udp.txt";
-  const fs::path vg = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/virtual.yaml"), "virtual.yaml", vlog);
-  const fs::path ug = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"), "udp.yaml", ulog);
-
-  Child v(Dyad({"run", vg.string(), "--steps", "100", "--quiet"}), dir_, "virtual");
+  Child v(Dyad({"run", Graph("virtual.yaml", vlog).string(), "--steps", "100", "--quiet"}), dir_, "virtual");
   ASSERT_EQ(v.Wait(60), 0) << v.err();
+  const fs::path ug = Graph("udp.yaml", ulog);
 
   Child fake = FakeController({});
   ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
@@ -139,7 +140,7 @@ TEST_F(DriverProcessTest, SwappingTheDriverByTypeGivesTheSameRobotStates) {
 // are missing.
 TEST_F(DriverProcessTest, UdpDriverSurvivesALostAnOutOfOrderAndAMalformedPacket) {
   const fs::path log = dir_ / "udp.txt";
-  const fs::path g = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"), "udp.yaml", log);
+  const fs::path g = Graph("udp.yaml", log);
   Child fake = FakeController({"--drop", "10", "--delay", "20:150", "--malform", "30"});
   ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
   Child u(Dyad({"run", g.string(), "--steps", "50", "--quiet", "--set", PortSet(), "--set", "driver.reply_wait_ms=100"}),
@@ -168,12 +169,11 @@ TEST_F(DriverProcessTest, UdpDriverSurvivesALostAnOutOfOrderAndAMalformedPacket)
 // taken (and published, before the next reply) at the next step.
 TEST_F(DriverProcessTest, UdpDriverPublishesALateReplyAtTheNextStep) {
   const fs::path log = dir_ / "udp.txt";
-  std::string config = Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml");
-  config.replace(config.find("clock: stepped"), 14, "clock: wall");
-  const fs::path g = Graph(config, "udp.yaml", log);
+  const fs::path g = Graph("udp.yaml", log);
   Child fake = FakeController({"--delay", "5:70"});
   ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
-  Child u(Dyad({"run", g.string(), "--duration", "2.05", "--quiet", "--set", PortSet(), "--set", "driver.reply_wait_ms=40"}),
+  Child u(Dyad({"run", g.string(), "--duration", "2.05", "--quiet", "--set", "clock=wall", "--set", PortSet(), "--set",
+                "driver.reply_wait_ms=40"}),
           dir_, "udp");
   ASSERT_EQ(u.Wait(30), 0) << u.err();
   fake.Signal(SIGTERM);
@@ -192,7 +192,7 @@ TEST_F(DriverProcessTest, UdpDriverRunTwiceAgainstOneControllerStartsANewSession
   ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
   for (int run = 0; run < 2; ++run) {
     const fs::path log = dir_ / ("udp" + std::to_string(run) + ".txt");
-    const fs::path g = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"), "udp.yaml", log);
+    const fs::path g = Graph("udp.yaml", log);
     Child u(Dyad({"run", g.string(), "--steps", "30", "--quiet", "--set", PortSet(), "--set", "driver.reply_wait_ms=1000"}),
             dir_, "udp" + std::to_string(run));
     ASSERT_EQ(u.Wait(60), 0) << u.err();
@@ -206,7 +206,7 @@ TEST_F(DriverProcessTest, UdpDriverRunTwiceAgainstOneControllerStartsANewSession
 
 TEST_F(DriverProcessTest, UdpDriverEndsTheRunWhenTheControllerIsSilent) {
   const fs::path log = dir_ / "udp.txt";
-  const fs::path g = Graph(Read(fs::path(DYAD_CONFIG_DIR) / "drivers/udp.yaml"), "udp.yaml", log);
+  const fs::path g = Graph("udp.yaml", log);
   Child u(Dyad({"run", g.string(), "--steps", "100", "--quiet", "--set", PortSet()}), dir_, "udp");  // no controller
   const int rc = u.Wait(60);
   EXPECT_NE(rc, 0);

@@ -2,6 +2,8 @@
 //
 // File format (every key is checked; unknown keys are errors):
 //
+//   extends: demo.yaml          # optional: this file's keys merged over that graph's (maps key by
+//                               # key; `key: !reset` removes, `key: !override {...}` replaces a map)
 //   graph: demo                 # name, used in DDS participant names
 //   domain_id: 0                # DDS domain, 0..232
 //   clock: wall                 # wall | stepped
@@ -36,7 +38,7 @@
 //       inputs: {robot: robot/state}     # port name: topic
 //       outputs: {input: human/input}
 //
-// LoadGraph reads the file and applies `--set component.param=value` overrides;
+// LoadGraph reads the file (and the files it extends) and applies `--set` overrides;
 // ValidateGraph (validate.hpp) checks it against the component types. Both return every
 // problem found, each "file:line:col: key: message".
 #pragma once
@@ -157,9 +159,14 @@ struct Graph {
   std::vector<ProcessConfig> processes;
   std::vector<TopicConfig> topics;
   std::vector<ComponentConfig> components;
-  // The file as read; with --set overrides, the graph as run (overridden params replaced,
-  // re-emitted under a comment listing them). Recorders store it as metadata.
+  // The file as read; with `extends:` or --set overrides, the graph as run (the merged
+  // document re-emitted under a comment naming the files and the sets; relative paths as each
+  // file wrote them). Recorders store it as metadata.
   std::string yaml_text;
+  // Where each part of the graph was written: key path ("components.robot.params.model") -> a
+  // file of the `extends:` chain, or "--set TEXT". The longest listed prefix of a key holds
+  // ("" for all of it); a key under none was written in `file`.
+  std::map<std::string, std::string> origins;
   std::vector<std::string> graph_overrides;  // "clock=wall" etc.: --set of the graph's own scalars
   SourceMark clock_mark;                     // where `clock:` was set (file line, or the --set); empty: default
 
@@ -169,10 +176,19 @@ struct Graph {
   std::string ProcessOf(const ComponentConfig& c) const;
   // Every process that runs a component.
   std::set<std::string> ProcessNames() const;
+  // The file (or "--set TEXT") that wrote `key` (see origins).
+  const std::string& OriginOf(const std::string& key) const;
+  // Where `node`, the value at `key`, was written: its file's line, or the --set.
+  SourceMark MarkOf(const std::string& key, const YAML::Node& node) const;
+  // The folder a relative path at `key` is relative to: its file's folder, absolute; the
+  // working folder for a --set.
+  std::string FolderOf(const std::string& key) const;
 };
 
-// `--set NAME.PARAM=VALUE` (VALUE is parsed as YAML), `--set KEY=VALUE` for the graph's own
-// clock, seed, domain_id and graph name, or `--set network.KEY=VALUE` for the network section.
+// `--set KEY=VALUE`: VALUE (parsed as YAML) written at KEY, as if the file said it:
+// `NAME.PARAM=V` a component's parameter, `NAME.type=T` (rate_hz, trigger, process) its own keys,
+// `NAME.inputs.PORT=TOPIC`, `clock=wall` (seed, domain_id, graph, logs, plugins) the graph's,
+// `network.KEY=V`, `processes.NAME.KEY=V`, `topics.TOPIC.KEY=V` (graph_document.hpp).
 struct Override {
   std::string text;  // as given, for messages
 };
