@@ -10,7 +10,7 @@ packages=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
   libeigen3-dev libceres-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libzstd-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcivetweb-dev
-  python3 python3-matplotlib chromium
+  python3 python3-matplotlib chromium universal-ctags
   iproute2 nftables
 )
 if [ "${1:-}" = "sanitize" ]; then

@@ -65,6 +65,55 @@ bool IsIdentChar(char c) { return IsIdentStart(c) || (c >= '0' && c <= '9'); }
 bool IsDigit(char c) { return c >= '0' && c <= '9'; }
 
 // Splits IDL text into tokens, dropping comments and the preprocessor lines we ignore.
+// A preprocessor line (after its '#'): include, pragma and include guards are ignored; anything
+// else is an error, as we do not preprocess.
+void CheckDirective(std::string_view directive, int line) {
+  std::vector<std::string_view> words;
+  auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  for (size_t k = 0; k < directive.size();) {
+    while (k < directive.size() && blank(directive[k])) ++k;
+    const size_t b = k;
+    while (k < directive.size() && !blank(directive[k])) ++k;
+    if (k > b) words.push_back(directive.substr(b, k - b));
+  }
+  const std::string_view word = words.empty() ? std::string_view() : words[0];
+  const bool ignored = word == "include" || word == "pragma" || word == "endif" ||
+                       ((word == "ifndef" || word == "define") && words.size() == 2);
+  if (!ignored) {
+    throw ParseError{line, "preprocessor directive '#" + std::string(word) +
+                               "' is not supported (only #include, #pragma and include "
+                               "guards, which are ignored)",
+                     true};
+  }
+}
+
+// The token that starts at s[*i] (not blank, not a comment); *i moves past it.
+Token ReadToken(const std::string& s, size_t* i, int line) {
+  const size_t n = s.size();
+  const char c = s[*i];
+  Token t;
+  t.line = line;
+  const size_t b = *i;
+  if (IsIdentStart(c)) {
+    while (*i < n && IsIdentChar(s[*i])) ++*i;
+    t.type = Token::Type::kIdent;
+  } else if (IsDigit(c)) {
+    while (*i < n && (IsIdentChar(s[*i]) || s[*i] == '.')) ++*i;
+    t.type = Token::Type::kNumber;
+  } else if (c == '"' || c == '\'') {
+    ++*i;
+    while (*i < n && s[*i] != c && s[*i] != '\n') *i += (s[*i] == '\\' && *i + 1 < n) ? 2 : 1;
+    if (*i >= n || s[*i] != c) throw ParseError{line, "unterminated literal"};
+    ++*i;
+    t.type = Token::Type::kLiteral;
+  } else {
+    *i += (c == ':' && *i + 1 < n && s[*i + 1] == ':') ? 2 : 1;  // "::" or one character
+    t.type = Token::Type::kPunct;
+  }
+  t.text = s.substr(b, *i - b);
+  return t;
+}
+
 std::vector<Token> Tokenize(const std::string& s) {
   std::vector<Token> tokens;
   int line = 1;
@@ -77,87 +126,25 @@ std::vector<Token> Tokenize(const std::string& s) {
       ++line;
       line_start = true;
       ++i;
-      continue;
-    }
-    if (c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v') {
+    } else if (c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v') {
       ++i;
-      continue;
-    }
-    if (c == '/' && i + 1 < n && s[i + 1] == '/') {
+    } else if (c == '/' && i + 1 < n && s[i + 1] == '/') {
       while (i < n && s[i] != '\n') ++i;
-      continue;
-    }
-    if (c == '/' && i + 1 < n && s[i + 1] == '*') {
+    } else if (c == '/' && i + 1 < n && s[i + 1] == '*') {
       const int start = line;
-      i += 2;
-      while (i + 1 < n && !(s[i] == '*' && s[i + 1] == '/')) {
+      for (i += 2; i + 1 < n && !(s[i] == '*' && s[i + 1] == '/'); ++i)
         if (s[i] == '\n') ++line;
-        ++i;
-      }
       if (i + 1 >= n) throw ParseError{start, "unterminated /* comment"};
       i += 2;
-      continue;
-    }
-    if (c == '#' && line_start) {
+    } else if (c == '#' && line_start) {
       size_t e = s.find('\n', i);
       if (e == std::string::npos) e = n;
-      std::string_view directive(s.data() + i + 1, e - i - 1);
-      // Words of the directive.
-      std::vector<std::string_view> words;
-      for (size_t k = 0; k < directive.size();) {
-        while (k < directive.size() && (directive[k] == ' ' || directive[k] == '\t' ||
-                                        directive[k] == '\r')) {
-          ++k;
-        }
-        size_t b = k;
-        while (k < directive.size() && directive[k] != ' ' && directive[k] != '\t' &&
-               directive[k] != '\r') {
-          ++k;
-        }
-        if (k > b) words.push_back(directive.substr(b, k - b));
-      }
-      const std::string_view word = words.empty() ? std::string_view() : words[0];
-      const bool ignored = word == "include" || word == "pragma" || word == "endif" ||
-                           ((word == "ifndef" || word == "define") && words.size() == 2);
-      if (!ignored) {
-        throw ParseError{line, "preprocessor directive '#" + std::string(word) +
-                                   "' is not supported (only #include, #pragma and include "
-                                   "guards, which are ignored)",
-                         true};
-      }
+      CheckDirective(std::string_view(s.data() + i + 1, e - i - 1), line);
       i = e;
-      continue;
-    }
-    line_start = false;
-    Token t;
-    t.line = line;
-    if (IsIdentStart(c)) {
-      size_t b = i;
-      while (i < n && IsIdentChar(s[i])) ++i;
-      t.type = Token::Type::kIdent;
-      t.text = s.substr(b, i - b);
-    } else if (IsDigit(c)) {
-      size_t b = i;
-      while (i < n && (IsIdentChar(s[i]) || s[i] == '.')) ++i;
-      t.type = Token::Type::kNumber;
-      t.text = s.substr(b, i - b);
-    } else if (c == '"' || c == '\'') {
-      size_t b = i++;
-      while (i < n && s[i] != c && s[i] != '\n') i += (s[i] == '\\' && i + 1 < n) ? 2 : 1;
-      if (i >= n || s[i] != c) throw ParseError{line, "unterminated literal"};
-      ++i;
-      t.type = Token::Type::kLiteral;
-      t.text = s.substr(b, i - b);
-    } else if (c == ':' && i + 1 < n && s[i + 1] == ':') {
-      t.type = Token::Type::kPunct;
-      t.text = "::";
-      i += 2;
     } else {
-      t.type = Token::Type::kPunct;
-      t.text = std::string(1, c);
-      ++i;
+      line_start = false;
+      tokens.push_back(ReadToken(s, &i, line));
     }
-    tokens.push_back(std::move(t));
   }
   Token end;
   end.line = line;

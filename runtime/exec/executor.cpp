@@ -230,66 +230,13 @@ void Executor::Fail(const Status& status) {
 }
 
 Status Executor::Setup() {
-  const bool stepped = clock_->stepped();
-  const std::string participant_name = "dyad/" + graph_.name + "/" + options_.process;
-  if (options_.transport) {
-    auto t = options_.transport(participant_name, stepped);
-    if (!t.ok()) return t.status();
-    transport_ = std::move(t.value());
-  } else {
-    DdsParticipant::Options po;
-    po.scope = stepped ? DdsParticipant::Scope::kProcessOnly : DdsParticipant::Scope::kNetwork;
-    po.network = graph_.network;
-    po.process = options_.process;
-    po.partitions = {RunPartition(graph_)};
-    po.on_problem = [this](const std::string& msg) {
-      ++problems_;
-      StderrLogger("dds").Error(msg);
-    };
-    po.on_foreign_writer = [this](const std::string& msg) {
-      ++foreign_writers_;
-      StderrLogger("dds").Warn(msg);
-    };
-    auto p = DdsParticipant::Create(graph_.domain_id, participant_name, std::move(po));
-    if (!p.ok()) return p.status();
-    transport_ = std::move(p.value());
-  }
-
+  if (Status s = CreateTransport(); !s.ok()) return s;
   for (const auto& rc : resolved_.components) {
     if (graph_.ProcessOf(*rc.config) != options_.process) continue;
     auto inst = std::make_unique<Instance>();
     inst->rc = &rc;
-    const ComponentSpec& spec = rc.entry->spec;
-    Instance* raw = inst.get();
-    for (const auto& ps : spec.inputs()) {
-      auto port = ps.make_input();
-      const std::string topic = BoundTopic(rc.config->inputs, ps.name);
-      TypedReader* reader = nullptr;
-      if (!topic.empty()) {
-        const TopicQos qos = QosOf(resolved_.topics.at(topic));
-        std::function<void()> on_data;
-        if (!stepped && rc.config->trigger == ps.name) on_data = [this, raw] { TriggerStep(*raw); };
-        auto r = transport_->CreateReader(topic, *ps.type, qos, on_data);
-        if (!r.ok()) return r.status().WithContext(rc.config->name + "." + ps.name);
-        reader = r.value();
-        if (rc.config->trigger == ps.name) inst->trigger = reader;
-      }
-      port->Bind(ps.name, topic, reader);
-      inst->inputs.push_back(std::move(port));
-    }
-    for (const auto& ps : spec.outputs()) {
-      auto port = ps.make_output();
-      const std::string topic = BoundTopic(rc.config->outputs, ps.name);
-      TypedWriter* writer = nullptr;
-      if (!topic.empty()) {
-        auto w = transport_->CreateWriter(topic, *ps.type, QosOf(resolved_.topics.at(topic)));
-        if (!w.ok()) return w.status().WithContext(rc.config->name + "." + ps.name);
-        writer = w.value();
-      }
-      port->Bind(ps.name, topic, rc.config->name, writer, clock_.get());
-      inst->outputs.push_back(std::move(port));
-    }
-    inst->ctx = std::make_unique<ContextImpl>(this, raw);
+    if (Status s = BindPorts(*inst); !s.ok()) return s;
+    inst->ctx = std::make_unique<ContextImpl>(this, inst.get());
     inst->component = rc.entry->type.create();
     instances_.push_back(std::move(inst));
   }
@@ -312,6 +259,73 @@ Status Executor::Setup() {
     inst->configuring = false;
     if (!s.ok()) return s.WithContext(inst->name() + ": configure failed");
     inst->configured = true;
+  }
+  return Status::OK();
+}
+
+// The options' transport (tests), or a DDS participant named dyad/<graph>/<process> in the run's
+// partition: this process only in a stepped run, the network otherwise.
+Status Executor::CreateTransport() {
+  const bool stepped = clock_->stepped();
+  const std::string participant_name = "dyad/" + graph_.name + "/" + options_.process;
+  if (options_.transport) {
+    auto t = options_.transport(participant_name, stepped);
+    if (!t.ok()) return t.status();
+    transport_ = std::move(t.value());
+    return Status::OK();
+  }
+  DdsParticipant::Options po;
+  po.scope = stepped ? DdsParticipant::Scope::kProcessOnly : DdsParticipant::Scope::kNetwork;
+  po.network = graph_.network;
+  po.process = options_.process;
+  po.partitions = {RunPartition(graph_)};
+  po.on_problem = [this](const std::string& msg) {
+    ++problems_;
+    StderrLogger("dds").Error(msg);
+  };
+  po.on_foreign_writer = [this](const std::string& msg) {
+    ++foreign_writers_;
+    StderrLogger("dds").Warn(msg);
+  };
+  auto p = DdsParticipant::Create(graph_.domain_id, participant_name, std::move(po));
+  if (!p.ok()) return p.status();
+  transport_ = std::move(p.value());
+  return Status::OK();
+}
+
+// A reader for each bound input (whose arrival steps the component when it is the trigger, in
+// wall-clock runs) and a writer for each bound output; unbound ports stay empty.
+Status Executor::BindPorts(Instance& inst) {
+  const ComponentConfig& config = *inst.rc->config;
+  const ComponentSpec& spec = inst.rc->entry->spec;
+  const bool stepped = clock_->stepped();
+  Instance* raw = &inst;
+  for (const auto& ps : spec.inputs()) {
+    auto port = ps.make_input();
+    const std::string topic = BoundTopic(config.inputs, ps.name);
+    TypedReader* reader = nullptr;
+    if (!topic.empty()) {
+      std::function<void()> on_data;
+      if (!stepped && config.trigger == ps.name) on_data = [this, raw] { TriggerStep(*raw); };
+      auto r = transport_->CreateReader(topic, *ps.type, QosOf(resolved_.topics.at(topic)), on_data);
+      if (!r.ok()) return r.status().WithContext(config.name + "." + ps.name);
+      reader = r.value();
+      if (config.trigger == ps.name) inst.trigger = reader;
+    }
+    port->Bind(ps.name, topic, reader);
+    inst.inputs.push_back(std::move(port));
+  }
+  for (const auto& ps : spec.outputs()) {
+    auto port = ps.make_output();
+    const std::string topic = BoundTopic(config.outputs, ps.name);
+    TypedWriter* writer = nullptr;
+    if (!topic.empty()) {
+      auto w = transport_->CreateWriter(topic, *ps.type, QosOf(resolved_.topics.at(topic)));
+      if (!w.ok()) return w.status().WithContext(config.name + "." + ps.name);
+      writer = w.value();
+    }
+    port->Bind(ps.name, topic, config.name, writer, clock_.get());
+    inst.outputs.push_back(std::move(port));
   }
   return Status::OK();
 }

@@ -98,6 +98,8 @@ class Executor {
   class ClockImpl;
 
   Status Setup();
+  Status CreateTransport();
+  Status BindPorts(Instance& inst);
   void BuildTopicList();
   const TopicInfo* FindTopic(const std::string& name) const;
   Status StepOnce(Instance& inst, int64_t scheduled_ns, bool periodic);
