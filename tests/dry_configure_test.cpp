@@ -10,19 +10,12 @@
 #include <dyad/graph.hpp>
 #include <dyad/validate.hpp>
 
+#include "plugin_catalog.hpp"
+
 namespace dyad {
 namespace {
 
 namespace fs = std::filesystem;
-
-const Catalog& Builtins() {
-  static Catalog* catalog = [] {
-    auto* c = new Catalog();
-    EXPECT_TRUE(c->Load(DYAD_TEST_PLUGIN_DIR).ok());
-    return c;
-  }();
-  return *catalog;
-}
 
 // Three primitives of 5 steps, 2 DOF, in the NRL layout.
 std::string TinyDataset() {
@@ -41,8 +34,8 @@ std::vector<Diagnostic> Validate(const std::string& yaml, const std::vector<std:
   std::vector<Override> overrides;
   for (const auto& s : sets) overrides.push_back({s});
   Graph g = ParseGraph(yaml, "g.yaml", overrides, &diags);
-  ResolvedGraph r = ValidateGraph(g, Builtins(), &diags);
-  DryConfigure(g, r, Builtins(), &diags);
+  ResolvedGraph r = ValidateGraph(g, testing::BuiltPlugins(), &diags);
+  DryConfigure(g, r, testing::BuiltPlugins(), &diags);
   return diags;
 }
 
@@ -90,13 +83,13 @@ TEST(DryConfigure, OnlyTheComponentsOfTheGivenProcessAreConfigured) {
   y.replace(y.find("  b:\n    type: human_synthetic\n"), 31, "  b:\n    type: human_synthetic\n    process: pb\n");
   std::vector<Diagnostic> diags;
   Graph g = ParseGraph(y, "g.yaml", {}, &diags);
-  ResolvedGraph r = ValidateGraph(g, Builtins(), &diags);
+  ResolvedGraph r = ValidateGraph(g, testing::BuiltPlugins(), &diags);
   ASSERT_TRUE(diags.empty()) << diags[0].ToString();
-  DryConfigure(g, r, Builtins(), &diags, {"pb"});
+  DryConfigure(g, r, testing::BuiltPlugins(), &diags, {"pb"});
   ASSERT_EQ(diags.size(), 1u);
   EXPECT_EQ(diags[0].key, "components.b.params.events[0].primitve");
   diags.clear();
-  DryConfigure(g, r, Builtins(), &diags);  // the launcher: every component
+  DryConfigure(g, r, testing::BuiltPlugins(), &diags);  // the launcher: every component
   EXPECT_EQ(diags.size(), 2u);
 }
 
@@ -116,7 +109,7 @@ TEST(GraphValidation, TriggerOnAnUnboundOptionalInputIsAnError) {
                         "topics:\n  h: {type: HumanInput}\n  r: {type: Intention}\n";
   std::vector<Diagnostic> diags;
   Graph g = ParseGraph(y, "g.yaml", {}, &diags);
-  ValidateGraph(g, Builtins(), &diags);
+  ValidateGraph(g, testing::BuiltPlugins(), &diags);
   ASSERT_EQ(diags.size(), 1u) << diags[0].ToString();
   EXPECT_EQ(diags[0].ToString().rfind("g.yaml:7:14: components.mix.trigger: input 'state' is not bound", 0), 0u)
       << diags[0].ToString();

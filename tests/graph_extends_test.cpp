@@ -13,20 +13,12 @@
 #include <dyad/graph.hpp>
 #include <dyad/validate.hpp>
 
+#include "plugin_catalog.hpp"
+
 namespace dyad {
 namespace {
 
 namespace fs = std::filesystem;
-
-const Catalog& ExampleCatalog() {
-  static Catalog* catalog = [] {
-    auto* c = new Catalog();
-    Status s = c->Load(DYAD_TEST_PLUGIN_DIR);
-    EXPECT_TRUE(s.ok()) << s.ToString();
-    return c;
-  }();
-  return *catalog;
-}
 
 // The lab's graph in base/, a participant's overlay in mine/ (a sibling folder).
 class ExtendsTest : public ::testing::Test {
@@ -54,7 +46,7 @@ components:
   // Parses the overlay mine/NAME, validates it, returns every problem.
   const Graph& Load(const std::string& name, std::vector<Diagnostic>* diags, const std::vector<Override>& sets = {}) {
     graph_ = LoadGraph((dir_ / "mine" / name).string(), sets, diags);
-    resolved_ = ValidateGraph(graph_, ExampleCatalog(), diags);
+    resolved_ = ValidateGraph(graph_, testing::BuiltPlugins(), diags);
     return graph_;
   }
   const ResolvedComponent& Resolved(const std::string& name) const {
@@ -120,7 +112,7 @@ TEST_F(ExtendsTest, ProblemsNameTheFileAndLineThatWroteTheKey) {
   Write("mine/middle.yaml", "extends: ../base/demo.yaml\ncomponents:\n  src: {params: {noise: -1}}\n");
   Write("mine/my.yaml", "extends: middle.yaml\ncomponents:\n  sink: {params: {expect: many}}\n  src: {rate: 3}\n");
   std::vector<Diagnostic> diags;
-  ValidateGraph(LoadGraph((dir_ / "mine/my.yaml").string(), {}, &diags), ExampleCatalog(), &diags);
+  ValidateGraph(LoadGraph((dir_ / "mine/my.yaml").string(), {}, &diags), testing::BuiltPlugins(), &diags);
   std::string all;
   for (const auto& d : diags) all += d.ToString() + "\n";
   const std::string my = (dir_ / "mine/my.yaml").string(), middle = (dir_ / "mine/middle.yaml").string();

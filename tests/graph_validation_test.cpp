@@ -7,25 +7,17 @@
 #include <dyad/graph.hpp>
 #include <dyad/validate.hpp>
 
+#include "plugin_catalog.hpp"
+
 namespace dyad {
 namespace {
-
-const Catalog& ExampleCatalog() {
-  static Catalog* catalog = [] {
-    auto* c = new Catalog();
-    Status s = c->Load(DYAD_TEST_PLUGIN_DIR);
-    EXPECT_TRUE(s.ok()) << s.ToString();
-    return c;
-  }();
-  return *catalog;
-}
 
 std::vector<Diagnostic> Check(const std::string& yaml, const std::vector<std::string>& sets = {}) {
   std::vector<Diagnostic> diags;
   std::vector<Override> overrides;
   for (const auto& s : sets) overrides.push_back({s});
   Graph g = ParseGraph(yaml, "g.yaml", overrides, &diags);
-  if (!g.components.empty()) ValidateGraph(g, ExampleCatalog(), &diags);
+  if (!g.components.empty()) ValidateGraph(g, testing::BuiltPlugins(), &diags);
   return diags;
 }
 
@@ -192,7 +184,7 @@ TEST(GraphValidation, AnUnboundOutputAndADeclaredTopicNoComponentWritesAreWarnin
   std::vector<Diagnostic> diags;
   const std::string y = Replace(kValid, "    outputs: {out: count}\n", "") + "topics:\n  count: {type: Counter}\n";
   Graph g = ParseGraph(y, "g.yaml", {}, &diags);
-  const ResolvedGraph r = ValidateGraph(g, ExampleCatalog(), &diags);
+  const ResolvedGraph r = ValidateGraph(g, testing::BuiltPlugins(), &diags);
   EXPECT_TRUE(diags.empty()) << diags[0].ToString();
   ASSERT_EQ(r.warnings.size(), 2u);
   EXPECT_EQ(r.warnings[0].key, "components.src.outputs.out");
@@ -201,7 +193,7 @@ TEST(GraphValidation, AnUnboundOutputAndADeclaredTopicNoComponentWritesAreWarnin
   EXPECT_EQ(r.warnings[1].key, "topics.count");
   EXPECT_EQ(r.warnings[1].mark.line, 13);
   EXPECT_NE(r.warnings[1].message.find("no component of the graph writes"), std::string::npos);
-  EXPECT_TRUE(ValidateGraph(ParseGraph(kValid, "g.yaml", {}, &diags), ExampleCatalog(), &diags).warnings.empty());
+  EXPECT_TRUE(ValidateGraph(ParseGraph(kValid, "g.yaml", {}, &diags), testing::BuiltPlugins(), &diags).warnings.empty());
 }
 
 // A graph's name is part of its runs' DDS partition: no pattern characters, no spaces.
@@ -240,7 +232,7 @@ TEST(GraphValidation, OverridesAreInTheRecordedGraphText) {
 TEST(GraphValidation, FillsDefaultsAndResolvesPeriods) {
   std::vector<Diagnostic> diags;
   Graph g = ParseGraph(kValid, "g.yaml", {}, &diags);
-  ResolvedGraph r = ValidateGraph(g, ExampleCatalog(), &diags);
+  ResolvedGraph r = ValidateGraph(g, testing::BuiltPlugins(), &diags);
   ASSERT_TRUE(diags.empty());
   ASSERT_EQ(r.components.size(), 2u);
   EXPECT_EQ(r.components[0].period_ns, 100'000'000);
@@ -265,7 +257,7 @@ components:
 )";
   std::vector<Diagnostic> diags;
   Graph g = ParseGraph(graph, "/lab/graphs/g.yaml", {{"e.file=set/e.txt"}}, &diags);
-  ResolvedGraph r = ValidateGraph(g, ExampleCatalog(), &diags);
+  ResolvedGraph r = ValidateGraph(g, testing::BuiltPlugins(), &diags);
   ASSERT_TRUE(diags.empty()) << diags[0].ToString();
   ASSERT_EQ(r.components.size(), 6u);
   EXPECT_EQ(r.components[1].params.String("file"), "/lab/graphs/out/a.txt");
@@ -275,7 +267,7 @@ components:
   EXPECT_EQ(r.components[5].params.String("file"), (std::filesystem::current_path() / "set/e.txt").string());
   // A relative graph path is taken from the working folder first.
   g = ParseGraph(graph, "graphs/g.yaml", {}, &diags);
-  r = ValidateGraph(g, ExampleCatalog(), &diags);
+  r = ValidateGraph(g, testing::BuiltPlugins(), &diags);
   EXPECT_EQ(r.components[1].params.String("file"), (std::filesystem::current_path() / "graphs/out/a.txt").string());
 }
 

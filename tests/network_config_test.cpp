@@ -11,6 +11,7 @@
 #include <dyad/graph.hpp>
 
 #include "dds/network_qos.hpp"
+#include "graph/host_port.hpp"
 
 namespace dyad {
 namespace {
@@ -312,6 +313,28 @@ TEST(NetworkQos, AnAddressThatDoesNotResolveNamesItsKey) {
   EXPECT_EQ(s.code(), Status::Code::kInvalidArgument);
   EXPECT_NE(s.message().find("network.hosts.mind"), std::string::npos) << s.ToString();
   EXPECT_NE(s.message().find("no-such-host.invalid"), std::string::npos) << s.ToString();
+}
+
+}  // namespace
+}  // namespace dyad
+
+namespace dyad {
+namespace {
+
+// One reading of "host:port" for network.peers, network.server, TCP listeners and
+// `dyad discovery-server --listen`.
+TEST(HostPort, SplitsAtTheLastColonAndChecksThePort) {
+  HostPort hp;
+  ASSERT_TRUE(ParseHostPort("10.0.0.1:7412", &hp, true));
+  EXPECT_EQ(hp.host, "10.0.0.1");
+  EXPECT_EQ(hp.port, 7412);
+  ASSERT_TRUE(ParseHostPort("lab-pc", &hp, false));
+  EXPECT_EQ(hp.host, "lab-pc");
+  EXPECT_EQ(hp.port, 0);
+  for (const char* bad : {"lab-pc", "", ":7412", "a:", "a:0", "a:65536", "a:123456", "a:-1", "a:12x", "a: 12"})
+    EXPECT_FALSE(ParseHostPort(bad, &hp, true)) << bad;
+  EXPECT_FALSE(ParseHostPort("", &hp, false));
+  EXPECT_TRUE(ParseHostPort("a:65535", &hp, true));
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "dds/network_qos.hpp"
 
+#include "graph/host_port.hpp"
+
 #include <arpa/inet.h>
 #include <ifaddrs.h>
 #include <net/if.h>
@@ -66,13 +68,10 @@ bool NetworkUp(const NetworkConfig& net) {
 namespace {
 
 StatusOr<rtps::Locator_t> UdpLocator(const std::string& text, const std::string& key) {
-  std::string host = text;
-  uint32_t port = 0;
-  if (const auto colon = text.rfind(':'); colon != std::string::npos) {
-    host = text.substr(0, colon);
-    port = static_cast<uint32_t>(std::stoul(text.substr(colon + 1)));  // checked when the graph was read
-  }
-  auto address = ResolveIPv4(host);
+  HostPort hp;
+  if (!ParseHostPort(text, &hp, false)) return Status::InvalidArgument(key + ": '" + text + "' is not address or address:port");
+  const uint32_t port = static_cast<uint32_t>(hp.port);
+  auto address = ResolveIPv4(hp.host);
   if (!address.ok()) return address.status().WithContext(key);
   rtps::Locator_t l;
   l.kind = LOCATOR_KIND_UDPv4;
@@ -94,8 +93,9 @@ Status ApplyNetwork(const NetworkConfig& net, bool udp_only, eprosima::fastdds::
   if (net.transport == NetTransport::kTcp) {
     auto tcp = std::make_shared<eprosima::fastdds::rtps::TCPv4TransportDescriptor>();
     tcp->interfaceWhiteList = net.interfaces;
-    if (auto own = net.tcp_listeners.find(process); own != net.tcp_listeners.end())
-      tcp->add_listener_port(static_cast<uint16_t>(std::stoul(own->second.substr(own->second.rfind(':') + 1))));
+    HostPort own;
+    if (auto it = net.tcp_listeners.find(process); it != net.tcp_listeners.end() && ParseHostPort(it->second, &own, true))
+      tcp->add_listener_port(static_cast<uint16_t>(own.port));
     transport.user_transports.push_back(tcp);
     // One connection per pair: a process connects to the listeners of the processes named before
     // it (they connect to none of its own); a watcher, with no listener, to all. When both sides

@@ -11,6 +11,7 @@
 
 
 #include "graph/graph_document.hpp"
+#include "graph/host_port.hpp"
 #include "graph/run_partition.hpp"
 
 namespace dyad {
@@ -80,21 +81,6 @@ class Reader {
   std::vector<Diagnostic>* out_;
 };
 
-// "host:port" -> host and port (1..65535); false when malformed.
-bool SplitHostPort(const std::string& text, std::string* host, int* port, bool port_required) {
-  const auto colon = text.rfind(':');
-  if (colon == std::string::npos) {
-    *host = text;
-    *port = 0;
-    return !port_required && !text.empty();
-  }
-  *host = text.substr(0, colon);
-  const std::string p = text.substr(colon + 1);
-  if (host->empty() || p.empty() || p.size() > 5 || p.find_first_not_of("0123456789") != std::string::npos) return false;
-  *port = std::stoi(p);
-  return *port >= 1 && *port <= 65535;
-}
-
 std::string Names(const std::map<std::string, std::string>& m) {
   std::string list;
   for (const auto& [k, _] : m) list += (list.empty() ? "" : ", ") + k;
@@ -134,15 +120,17 @@ void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
   if (node["peers"]) {
     ReadStringList(r, node["peers"], "network.peers", &n->peers);
     for (const auto& p : n->peers) {
-      std::string host;
-      int port = 0;
-      if (!SplitHostPort(p, &host, &port, false))
+      HostPort hp;
+      if (!ParseHostPort(p, &hp, false))
         r.Error(node["peers"], "network.peers", "'" + p + "' is not address or address:port (port 1..65535)");
     }
   }
   if (node["server"] && r.String(node["server"], "network.server", &n->server)) {
-    std::string host;
-    if (!SplitHostPort(n->server, &host, &n->server_port, true)) {
+    HostPort hp;
+    const bool valid = ParseHostPort(n->server, &hp, true);
+    const std::string& host = hp.host;
+    n->server_port = hp.port;
+    if (!valid) {
       r.Error(node["server"], "network.server", "must be HOST:PORT (HOST a name of network.hosts or an address), got '" + n->server + "'");
     } else if (auto it = n->hosts.find(host); it != n->hosts.end()) {
       n->server_host = host;
@@ -308,6 +296,16 @@ std::string Graph::ProcessOf(const ComponentConfig& c) const {
   return "main";
 }
 
+const ProcessConfig* Graph::FindProcess(const std::string& n) const {
+  for (const auto& p : processes)
+    if (p.name == n) return &p;
+  return nullptr;
+}
+
+bool Graph::PlacedOnHosts() const {
+  return std::any_of(processes.begin(), processes.end(), [](const ProcessConfig& p) { return !p.host.empty(); });
+}
+
 const std::string& Graph::OriginOf(const std::string& key) const {
   // The longest prefix of key listed: key itself, then key without its last part, ..., then "".
   for (std::string k = key;;) {
@@ -418,10 +416,8 @@ void ReadProcesses(Reader& r, const YAML::Node& procs, Graph* g) {
     }
   }
   // A process without a host would start on every host's launcher: a second copy of it.
-  bool any_host = false;
-  for (const auto& p : g->processes) any_host |= !p.host.empty();
   for (const auto& p : g->processes)
-    if (any_host && p.host.empty())
+    if (g->PlacedOnHosts() && p.host.empty())
       r.Error(p.mark, "processes." + p.name + ".host", "missing: when one process names its host, every process must");
 }
 
@@ -429,9 +425,7 @@ void ReadProcesses(Reader& r, const YAML::Node& procs, Graph* g) {
 // A component left in the implicit process "main" of a graph placed on hosts would start on
 // every host's launcher.
 void CheckPlacement(Reader& r, const Graph& g) {
-  bool placed = false;
-  for (const auto& p : g.processes) placed |= !p.host.empty();
-  if (placed && g.processes.size() > 1) {
+  if (g.PlacedOnHosts() && g.processes.size() > 1) {
     for (const auto& c : g.components) {
       if (c.process.empty())
         r.Error(c.mark, "components." + c.name + ".process",

@@ -132,8 +132,7 @@ std::vector<msg::ClockOffset> ClockSync::Offsets() const {
     o.process_name(process_);
     o.host(host_);
     o.peer_process(name);
-    for (const auto& pc : graph_.processes)
-      if (pc.name == name) o.peer_host(pc.host);
+    if (const ProcessConfig* pc = graph_.FindProcess(name)) o.peer_host(pc->host);
     o.offset_ns(best.offset_ns);
     o.round_trip_ns(best.round_trip_ns);
     out.push_back(o);

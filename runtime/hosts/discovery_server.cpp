@@ -19,6 +19,7 @@
 
 #include "dyad/interrupt.hpp"
 #include "dds/network_qos.hpp"
+#include "graph/host_port.hpp"
 
 namespace fdds = eprosima::fastdds::dds;
 namespace rtps = eprosima::fastrtps::rtps;
@@ -47,16 +48,13 @@ Status CanBindUdp(const std::string& address, int port) {
 }  // namespace
 
 int RunDiscoveryServer(const std::string& listen, std::ostream& out, std::ostream& err) {
-  const auto colon = listen.rfind(':');
-  int port = 0;
-  if (colon != std::string::npos && colon + 1 < listen.size() && listen.size() - colon - 1 <= 5 &&
-      listen.find_first_not_of("0123456789", colon + 1) == std::string::npos)
-    port = std::stoi(listen.substr(colon + 1));
-  if (colon == std::string::npos || port < 1 || port > 65535) {
+  HostPort hp;
+  if (!ParseHostPort(listen, &hp, true)) {
     err << "dyad discovery-server: --listen " << listen << ": expected ADDRESS:PORT (port 1..65535)\n";
     return 2;
   }
-  auto address = ResolveIPv4(listen.substr(0, colon));
+  const int port = hp.port;
+  auto address = ResolveIPv4(hp.host);
   if (!address.ok()) {
     err << "dyad discovery-server: --listen " << listen << ": " << address.status().message() << "\n";
     return 2;

@@ -13,9 +13,8 @@
 namespace dyad {
 
 bool StartBarrier::Required(const std::string& process) const {
-  for (const auto& pc : graph_.processes)
-    if (pc.name == process) return pc.required;
-  return true;
+  const ProcessConfig* pc = graph_.FindProcess(process);
+  return pc == nullptr || pc->required;
 }
 
 bool StartBarrier::Awaited(const std::string& process) const { return process == process_ || Required(process); }

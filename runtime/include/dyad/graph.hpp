@@ -176,6 +176,11 @@ struct Graph {
   std::string ProcessOf(const ComponentConfig& c) const;
   // Every process that runs a component.
   std::set<std::string> ProcessNames() const;
+  // The process of that name under `processes:`; null when the file does not list it (it then
+  // has the defaults of ProcessConfig).
+  const ProcessConfig* FindProcess(const std::string& name) const;
+  // Whether the graph places its processes on hosts (then every process names one).
+  bool PlacedOnHosts() const;
   // The file (or "--set TEXT") that wrote `key` (see origins).
   const std::string& OriginOf(const std::string& key) const;
   // Where `node`, the value at `key`, was written: its file's line, or the --set.
