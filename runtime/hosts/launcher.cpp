@@ -21,6 +21,7 @@
 #include "dyad/interrupt.hpp"
 #include "hosts/launcher_link.hpp"
 #include "hosts/output_relay.hpp"
+#include "hosts/run_arguments.hpp"
 
 namespace dyad {
 namespace {
@@ -47,21 +48,14 @@ std::string LocalTime() {
   return text;
 }
 
-// Starts `args` as a child of the launcher (see LaunchChildren), with `restarts` in its
-// environment (DYAD_RESTARTS: it announces the count on dyad/processes) and its stdout and
-// stderr on `pipes`.
-pid_t StartChild(std::vector<std::string> args, int restarts, const OutputRelay::Pipes& pipes) {
+// Starts `args` (argv) as a child of the launcher (see LaunchChildren): `executable`, with its
+// stdout and stderr on `pipes`.
+pid_t StartChild(const std::string& executable, std::vector<std::string> args, const OutputRelay::Pipes& pipes) {
   // Everything the child needs is built before fork: after it, only exec.
-  std::vector<std::string> env;
-  for (char** e = environ; *e != nullptr; ++e)
-    if (std::string(*e).rfind("DYAD_RESTARTS=", 0) != 0) env.emplace_back(*e);
-  env.push_back("DYAD_RESTARTS=" + std::to_string(restarts));
-  std::vector<char*> envp;
-  for (auto& e : env) envp.push_back(e.data());
-  envp.push_back(nullptr);
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
+  const std::string failed = "dyad: exec of " + executable + " failed\n";
   const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid == 0) {
@@ -78,9 +72,8 @@ pid_t StartChild(std::vector<std::string> args, int restarts, const OutputRelay:
     sigset_t none;
     sigemptyset(&none);
     pthread_sigmask(SIG_SETMASK, &none, nullptr);
-    execve("/proc/self/exe", argv.data(), envp.data());
-    const char message[] = "dyad: exec of /proc/self/exe failed\n";  // no stdio after fork: its lock may be held
-    (void)!write(STDERR_FILENO, message, sizeof(message) - 1);
+    execve(executable.c_str(), argv.data(), environ);
+    (void)!write(STDERR_FILENO, failed.data(), failed.size());  // no stdio after fork: its lock may be held
     _exit(127);
   }
   if (pid > 0) setpgid(pid, pid);  // also here: no window in which a Ctrl-C reaches the child directly
@@ -138,25 +131,14 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
     err << options.graph_path << ": no process of the graph is placed on host '" << host << "'\n";
     return 2;
   }
-  auto child_args = [&](const std::string& p) {
-    std::vector<std::string> args = {"dyad", "run", options.graph_path, "--process", p};
-    for (const auto& o : options.overrides) args.insert(args.end(), {"--set", o.text});
-    for (const auto& pp : options.plugin_paths) args.insert(args.end(), {"--plugins", pp});
-    if (options.duration_s > 0) {
-      char text[40];
-      std::snprintf(text, sizeof(text), "%.17g", options.duration_s);  // to_string would round 1e-7 to 0
-      args.insert(args.end(), {"--duration", text});
-    }
-    if (options.stats_period_s != RunOptions{}.stats_period_s) {
-      char text[40];
-      std::snprintf(text, sizeof(text), "%.17g", options.stats_period_s);
-      args.insert(args.end(), {"--stats-period", text});
-    }
-    if (options.steps > 0) args.insert(args.end(), {"--steps", std::to_string(options.steps)});
-    if (options.quiet) args.push_back("--quiet");
-    if (options.strict) args.push_back("--strict");
-    if (!options.run_id.empty()) args.insert(args.end(), {"--run-id", options.run_id});
-    if (!options.host.empty()) args.insert(args.end(), {"--host", options.host});
+  // `dyad run GRAPH --process P`, with this launcher's options (the launcher alone writes the logs).
+  auto child_args = [&](const std::string& p, int restarts) {
+    RunOptions child = options;
+    child.process = p;
+    child.restart_count = restarts;
+    child.logs_dir.clear();
+    std::vector<std::string> args = RunArguments(child);
+    args.insert(args.begin(), "dyad");
     return args;
   };
 
@@ -202,7 +184,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
       say("cannot start process '" + name + "': " + pipes.status().message());
       return false;
     }
-    const pid_t pid = StartChild(std::move(args), restarts, pipes.value());
+    const pid_t pid = StartChild(options.executable, std::move(args), pipes.value());
     OutputRelay::CloseWriteEnds(pipes.value());
     if (pid < 0) {
       say("cannot start process '" + name + "'");
@@ -219,7 +201,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
       server = children.begin()->first;
     }
     for (const auto& p : names)
-      if (!stopping) start(p, child_args(p), 0);
+      if (!stopping) start(p, child_args(p, 0), 0);
   }
 
   int first_failure = 0;  // the exit code of the first required process that failed for good
@@ -247,7 +229,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
         }
         say("process '" + it->name + "': restarting (restart " + std::to_string(it->restarts) + " of " +
             std::to_string(ConfigOf(graph, it->name).max_restarts) + "): " + ResetClause(graph, it->name));
-        start(it->name, child_args(it->name), it->restarts);
+        start(it->name, child_args(it->name, it->restarts), it->restarts);
         it = pending.erase(it);
       }
       if (server != 0 && !server_stopped && pending.empty() && children.size() == 1 && children.count(server) &&

@@ -165,6 +165,12 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
     err << "dyad run: --run-id '" << options.run_id << "': must be 1 to 64 of the characters A-Z a-z 0-9 _ . -\n";
     return 2;
   }
+  if (options.restart_count < 0 || (options.restart_count > 0 && process.empty())) {
+    err << "dyad run: --restart-count " << options.restart_count
+        << (options.restart_count < 0 ? ": must be >= 0" : ": only with --process (the launcher gives it to a process it restarts)")
+        << "\n";
+    return 2;
+  }
   l.graph.run = options.run_id.empty() && process.empty() ? DefaultRunId(l.graph) : options.run_id;
   if (process.empty()) {
     if (NeedsLauncher(l.graph, options)) {
@@ -186,8 +192,7 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   eo.steps = options.steps;
   eo.stats_period_s = options.stats_period_s;
   // The launcher tells a child how often it restarted it (announced on dyad/processes).
-  uint32_t restarts = 0;
-  if (const char* r = std::getenv("DYAD_RESTARTS")) restarts = static_cast<uint32_t>(std::strtoul(r, nullptr, 10));
+  const auto restarts = static_cast<uint32_t>(options.restart_count);
   eo.session = [&graph = l.graph, process, host = eo.host, restarts] { return MakeGraphSession(graph, process, host, restarts); };
   std::atomic<Executor*> current{nullptr};
   Status result;
