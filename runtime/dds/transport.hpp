@@ -47,9 +47,10 @@ class TypedReader : public detail::ReaderEndpoint {
 class TypedWriter : public detail::WriterEndpoint {
  public:
   virtual int matched() const = 0;  // readers currently matched (local and remote)
-  // Waits until every matched reliable reader acknowledged what was written; false on timeout.
-  // A transport that delivers synchronously (the tests' in-memory one) has nothing to wait for.
-  virtual bool AwaitAcknowledged(double /*timeout_s*/) { return true; }
+  // Waits up to `timeout_s` until every matched reliable reader acknowledged what was written;
+  // false on timeout. A transport that delivers synchronously (the tests' in-memory one) has
+  // nothing to wait for and returns true. (The launchers' link waits on it: launcher_link.cpp.)
+  virtual bool AwaitAcknowledged(double timeout_s) = 0;
 };
 
 // A Context::SubscribeSerialized subscription.

@@ -1,34 +1,41 @@
 // The launcher: `dyad run GRAPH` for a graph of several processes, or with processes placed on
-// hosts. See run.hpp for what it does; this file is how.
+// hosts. See run.hpp for what it does; this file is how: the children are started by the
+// Spawner (spawner.hpp), what an exit means is decided by the supervisor (supervisor.hpp), and
+// Supervision below carries it out in a loop of short steps.
 #include "hosts/launcher.hpp"
 
 #include <signal.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <map>
 #include <mutex>
-#include <sstream>
 #include <thread>
 
 #include "dyad/interrupt.hpp"
 #include "hosts/launcher_link.hpp"
 #include "hosts/output_relay.hpp"
+#include "hosts/run_arguments.hpp"
+#include "hosts/spawner.hpp"
+#include "hosts/supervisor.hpp"
 
 namespace dyad {
 namespace {
 
-std::string HostOf(const Graph& g, const std::string& process) {
-  for (const auto& pc : g.processes)
-    if (pc.name == process) return pc.host;
-  return "";
+using SteadyTime = std::chrono::steady_clock::time_point;
+
+// How often the launcher looks for exited children, due restarts and the other hosts' news.
+constexpr std::chrono::milliseconds kPollPeriod{20};
+constexpr char kServerName[] = "discovery-server";
+
+// A process's config; the defaults for one the graph's `processes:` does not list.
+const ProcessConfig& ConfigOf(const Graph& g, const std::string& process) {
+  static const ProcessConfig kDefault;
+  const ProcessConfig* pc = g.FindProcess(process);
+  return pc != nullptr ? *pc : kDefault;
 }
 
 // <logs>/<process>.log: --logs (relative to the working folder) or the graph's `logs:`; "" when neither.
@@ -38,65 +45,248 @@ std::string LogPathOf(const RunOptions& options, const Graph& graph, const std::
   return (std::filesystem::path(dir) / (process + ".log")).string();
 }
 
-std::string LocalTime() {
-  char text[64];
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  localtime_r(&now, &tm);
-  std::strftime(text, sizeof(text), "%Y-%m-%d %H:%M:%S", &tm);
-  return text;
-}
-
-// Starts `args` as a child of the launcher (see LaunchChildren), with `restarts` in its
-// environment (DYAD_RESTARTS: it announces the count on dyad/processes) and its stdout and
-// stderr on `pipes`.
-pid_t StartChild(std::vector<std::string> args, int restarts, const OutputRelay::Pipes& pipes) {
-  // Everything the child needs is built before fork: after it, only exec.
-  std::vector<std::string> env;
-  for (char** e = environ; *e != nullptr; ++e)
-    if (std::string(*e).rfind("DYAD_RESTARTS=", 0) != 0) env.emplace_back(*e);
-  env.push_back("DYAD_RESTARTS=" + std::to_string(restarts));
-  std::vector<char*> envp;
-  for (auto& e : env) envp.push_back(e.data());
-  envp.push_back(nullptr);
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const pid_t parent = getpid();
-  const pid_t pid = fork();
-  if (pid == 0) {
-    // Its own process group: a terminal's Ctrl-C reaches the launcher only, which forwards it
-    // once (a child hit by both would take the second as "exit now" and skip its clean
-    // shutdown). And it ends if the launcher dies (SIGKILL) instead of running on unwatched.
-    setpgid(0, 0);
-    prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (getppid() != parent) _exit(1);
-    if (pipes.out_write >= 0) dup2(pipes.out_write, STDOUT_FILENO);
-    if (pipes.err_write >= 0) dup2(pipes.err_write, STDERR_FILENO);
-    // Nothing else of the launcher's: its DDS sockets (LauncherLink), other children's pipes.
-    close_range(3, ~0U, 0);
-    sigset_t none;
-    sigemptyset(&none);
-    pthread_sigmask(SIG_SETMASK, &none, nullptr);
-    execve("/proc/self/exe", argv.data(), envp.data());
-    const char message[] = "dyad: exec of /proc/self/exe failed\n";  // no stdio after fork: its lock may be held
-    (void)!write(STDERR_FILENO, message, sizeof(message) - 1);
-    _exit(127);
+// The processes of the graph placed on this host; says where each other one runs.
+std::vector<std::string> ProcessesHere(const RunOptions& options, const Graph& graph, std::ostream& err) {
+  std::vector<std::string> names;
+  for (const auto& p : graph.ProcessNames()) {
+    const std::string where = ConfigOf(graph, p).host;
+    if (!RunsHere(where, options)) {
+      err << "process '" << p << "' runs on host '" << where << "': start it there with `dyad run " << options.graph_path
+          << " --host " << where << "`\n";
+      continue;
+    }
+    names.push_back(p);
   }
-  if (pid > 0) setpgid(pid, pid);  // also here: no window in which a Ctrl-C reaches the child directly
-  return pid;
+  return names;
 }
 
-const ProcessConfig& ConfigOf(const Graph& g, const std::string& process) {
-  static const ProcessConfig kDefault;
-  for (const auto& pc : g.processes)
-    if (pc.name == process) return pc;
-  return kDefault;
+bool RunsServerHere(const Graph& graph, const RunOptions& options) {
+  const NetworkConfig& net = graph.network;
+  return net.discovery == Discovery::kServer && !net.server_host.empty() && RunsHere(net.server_host, options);
 }
 
-std::string DescribeExit(int code) {
-  if (code > 128 && code < 128 + 32) return std::to_string(code) + " (" + SignalName(code - 128) + ")";
-  return std::to_string(code);
+// One launch: the children of this host (and the discovery server, first: the processes retry
+// until it answers anyway), supervised until the last one exited. The signal thread (interrupt_)
+// and the loop share children_ and stopping_ under mutex_; everything else is the loop's.
+class Supervision {
+ public:
+  Supervision(const RunOptions& options, const Graph& graph, std::vector<std::string> names, bool runs_server,
+              std::ostream& out, std::ostream& err);
+  // The exit code of the run.
+  int Run();
+
+ private:
+  struct Child {
+    std::string name;
+    int restarts = 0;
+  };
+  struct PendingRestart {
+    std::string name;
+    int restarts;
+    SteadyTime due;
+  };
+
+  void ForwardSignal(int sig);
+  void OpenLink();
+  bool StartAll();
+  bool Spawn(const std::string& name, std::vector<std::string> args, int restarts);  // REQUIRES: mutex_ held
+  std::vector<std::string> ChildArguments(const std::string& process, int restarts) const;
+  void OnExit(pid_t pid, int status, std::unique_lock<std::mutex>& lock);
+  void StopAfterFailure(const ExitDecision& d, pid_t pid, const Child& child, std::unique_lock<std::mutex>& lock);
+  void StartDueRestarts(SteadyTime now);
+  void StopServerWhenDone();
+  void HearOtherHosts();
+  void StopAll(pid_t except);
+  int ExitCode();
+  void Say(const std::string& line) { relay_.Say(line); }
+
+  const RunOptions& options_;
+  const Graph& graph_;
+  const std::string host_;
+  const std::vector<std::string> names_;  // the processes of this host
+  const bool runs_server_;
+  std::mutex mutex_;
+  std::map<pid_t, Child> children_;
+  bool stopping_ = false;  // the user's signal was forwarded, or every child was told to stop
+  std::vector<PendingRestart> pending_;  // restarts waiting for their back-off
+  pid_t server_ = 0;
+  int first_failure_ = 0;  // the exit code of the first required process that failed for good
+  bool stopped_others_ = false, server_stopped_ = false;
+  // After what its callback touches. The relay after the watcher: its thread must inherit the
+  // blocked signals; destroyed before it, once every child has exited (it reads their pipes to
+  // the end).
+  InterruptWatcher interrupt_;
+  OutputRelay relay_;
+  Spawner spawner_;
+  // Graphs on several hosts: the launchers tell each other of a required process's failure.
+  std::unique_ptr<LauncherLink> link_;
+};
+
+Supervision::Supervision(const RunOptions& options, const Graph& graph, std::vector<std::string> names, bool runs_server,
+                         std::ostream& out, std::ostream& err)
+    : options_(options),
+      graph_(graph),
+      host_(ThisHost(options)),
+      names_(std::move(names)),
+      runs_server_(runs_server),
+      interrupt_([this](int sig) { ForwardSignal(sig); }),
+      relay_(out, err),
+      spawner_(options.executable, &relay_, host_) {}
+
+void Supervision::ForwardSignal(int sig) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (stopping_) return;  // already told to stop (SIGTERM): a second signal would mean "exit now"
+  stopping_ = true;
+  for (const auto& [pid, _] : children_) kill(pid, sig);
+}
+
+int Supervision::Run() {
+  OpenLink();
+  if (!StartAll()) return 1;
+  for (;;) {
+    // Reaped under the lock: the signal thread never kill()s a pid already reaped (and reused).
+    std::unique_lock<std::mutex> lock(mutex_);
+    int status = 0;
+    if (const pid_t pid = waitpid(-1, &status, WNOHANG); pid > 0) {
+      OnExit(pid, status, lock);
+      continue;
+    }
+    StartDueRestarts(std::chrono::steady_clock::now());
+    StopServerWhenDone();
+    if (children_.empty() && pending_.empty()) break;
+    HearOtherHosts();
+    lock.unlock();
+    std::this_thread::sleep_for(kPollPeriod);
+  }
+  return ExitCode();
+}
+
+void Supervision::OpenLink() {
+  if (!graph_.PlacedOnHosts()) return;
+  auto link = LauncherLink::Open(graph_, host_);
+  if (link.ok()) link_ = std::move(link.value());
+  else Say("warning: " + link.status().message() + ": a failure on another host will not end this host's run");
+}
+
+bool Supervision::StartAll() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (runs_server_) {
+    const NetworkConfig& net = graph_.network;
+    const std::string listen = net.server_address + ":" + std::to_string(net.server_port);
+    if (!Spawn(kServerName, {"dyad", "discovery-server", "--listen", listen}, 0)) return false;
+    server_ = children_.begin()->first;
+  }
+  for (const auto& p : names_)
+    if (!stopping_) Spawn(p, ChildArguments(p, 0), 0);
+  return true;
+}
+
+bool Supervision::Spawn(const std::string& name, std::vector<std::string> args, int restarts) {
+  auto pid = spawner_.Start(name, std::move(args), restarts, LogPathOf(options_, graph_, name));
+  if (!pid.ok()) {
+    Say(pid.status().message());
+    return false;
+  }
+  children_[pid.value()] = {name, restarts};
+  return true;
+}
+
+// `dyad run GRAPH --process P`, with this launcher's options (the launcher alone writes the logs).
+std::vector<std::string> Supervision::ChildArguments(const std::string& process, int restarts) const {
+  RunOptions child = options_;
+  child.process = process;
+  child.restart_count = restarts;
+  child.logs_dir.clear();
+  std::vector<std::string> args = RunArguments(child);
+  args.insert(args.begin(), "dyad");
+  return args;
+}
+
+void Supervision::OnExit(pid_t pid, int status, std::unique_lock<std::mutex>& lock) {
+  const auto found = children_.find(pid);
+  if (found == children_.end()) return;  // not ours (a process a plugin started, reparented to us)
+  const Child child = found->second;
+  children_.erase(found);
+  const ChildExit exit{child.name, child.restarts, WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status),
+                       pid == server_};
+  const LauncherState state{options_.steps > 0 || options_.duration_s > 0, stopping_, interrupt_.signal(), stopped_others_,
+                            server_stopped_};
+  const ExitDecision d = DecideExit(exit, ConfigOf(graph_, child.name), state);
+  if (!d.message.empty()) Say(d.message);
+  switch (d.action) {
+    case ExitDecision::Action::kIgnore:
+    case ExitDecision::Action::kGoOn: return;
+    case ExitDecision::Action::kRestart:
+      pending_.push_back({child.name, d.restart,
+                          std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                                  std::chrono::duration<double>(d.backoff_s))});
+      return;
+    case ExitDecision::Action::kStopAll: StopAfterFailure(d, pid, child, lock); return;
+  }
+}
+
+// One required process failing ends the experiment: on the other hosts (told first, while this
+// host's discovery server, if any, still runs), then here.
+void Supervision::StopAfterFailure(const ExitDecision& d, pid_t pid, const Child& child, std::unique_lock<std::mutex>& lock) {
+  if (first_failure_ == 0) first_failure_ = d.exit_code;
+  if (d.announce && link_ != nullptr) {
+    lock.unlock();
+    link_->AnnounceFailure(child.name, child.restarts);  // milliseconds; at most 2 s
+    lock.lock();
+    if (stopping_) return;  // a signal came meanwhile and was forwarded: no second one
+  }
+  StopAll(pid);
+}
+
+void Supervision::StartDueRestarts(SteadyTime now) {
+  if (stopping_) pending_.clear();
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    if (it->due > now) {
+      ++it;
+      continue;
+    }
+    Say("process '" + it->name + "': restarting (restart " + std::to_string(it->restarts) + " of " +
+        std::to_string(ConfigOf(graph_, it->name).max_restarts) + "): " + ResetClause(graph_, it->name));
+    Spawn(it->name, ChildArguments(it->name, it->restarts), it->restarts);
+    it = pending_.erase(it);
+  }
+}
+
+// The discovery server ends once the graph's processes here are done (none left, none due).
+void Supervision::StopServerWhenDone() {
+  if (server_ == 0 || server_stopped_ || names_.empty() || !pending_.empty()) return;
+  if (children_.size() != 1 || children_.count(server_) == 0) return;
+  server_stopped_ = true;
+  kill(server_, SIGTERM);
+}
+
+void Supervision::HearOtherHosts() {
+  if (link_ == nullptr || stopping_) return;
+  for (const auto& notice : link_->TakeRemoteRestarts()) Say(notice);
+  if (auto failure = link_->TakeRemoteFailure()) {
+    const ExitDecision d = DecideRemoteFailure(*failure, host_);
+    Say(d.message);
+    if (first_failure_ == 0) first_failure_ = d.exit_code;
+    StopAll(0);
+  }
+}
+
+// SIGTERM to every child but `except` (the one that failed); no restart after it. REQUIRES: mutex_ held.
+void Supervision::StopAll(pid_t except) {
+  stopping_ = stopped_others_ = true;
+  pending_.clear();
+  for (const auto& [other, _] : children_)
+    if (other != except) kill(other, SIGTERM);
+  if (server_ != 0 && server_ != except) server_stopped_ = true;  // signalled once, here
+}
+
+int Supervision::ExitCode() {
+  if (first_failure_ != 0) return first_failure_;
+  if (interrupt_.signal() != 0) {
+    Say(std::string("dyad run: interrupted (") + SignalName(interrupt_.signal()) + ")");
+    return ExitCodeForSignal(interrupt_.signal());
+  }
+  return 0;
 }
 
 }  // namespace
@@ -110,10 +300,7 @@ std::string ThisHost(const RunOptions& options) {
 
 // Whether the launcher (not a single in-process run) handles this graph here.
 bool NeedsLauncher(const Graph& g, const RunOptions& options) {
-  if (g.ProcessNames().size() > 1) return true;
-  for (const auto& pc : g.processes)
-    if (!pc.host.empty()) return true;
-  return g.network.discovery == Discovery::kServer && !g.network.server_host.empty() && RunsHere(g.network.server_host, options);
+  return g.ProcessNames().size() > 1 || g.PlacedOnHosts() || RunsServerHere(g, options);
 }
 
 bool RunsHere(const std::string& host, const RunOptions& options) {
@@ -121,204 +308,14 @@ bool RunsHere(const std::string& host, const RunOptions& options) {
 }
 
 int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& out, std::ostream& err) {
-  const std::string host = ThisHost(options);
-  std::vector<std::string> names;
-  for (const auto& p : graph.ProcessNames()) {
-    const std::string where = HostOf(graph, p);
-    if (!RunsHere(where, options)) {
-      err << "process '" << p << "' runs on host '" << where << "': start it there with `dyad run " << options.graph_path
-          << " --host " << where << "`\n";
-      continue;
-    }
-    names.push_back(p);
-  }
-  const NetworkConfig& net = graph.network;
-  const bool runs_server = net.discovery == Discovery::kServer && !net.server_host.empty() && RunsHere(net.server_host, options);
+  std::vector<std::string> names = ProcessesHere(options, graph, err);
+  const bool runs_server = RunsServerHere(graph, options);
   if (names.empty() && !runs_server) {
-    err << options.graph_path << ": no process of the graph is placed on host '" << host << "'\n";
+    err << options.graph_path << ": no process of the graph is placed on host '" << ThisHost(options) << "'\n";
     return 2;
   }
-  auto child_args = [&](const std::string& p) {
-    std::vector<std::string> args = {"dyad", "run", options.graph_path, "--process", p};
-    for (const auto& o : options.overrides) args.insert(args.end(), {"--set", o.text});
-    for (const auto& pp : options.plugin_paths) args.insert(args.end(), {"--plugins", pp});
-    if (options.duration_s > 0) {
-      char text[40];
-      std::snprintf(text, sizeof(text), "%.17g", options.duration_s);  // to_string would round 1e-7 to 0
-      args.insert(args.end(), {"--duration", text});
-    }
-    if (options.stats_period_s != RunOptions{}.stats_period_s) {
-      char text[40];
-      std::snprintf(text, sizeof(text), "%.17g", options.stats_period_s);
-      args.insert(args.end(), {"--stats-period", text});
-    }
-    if (options.steps > 0) args.insert(args.end(), {"--steps", std::to_string(options.steps)});
-    if (options.quiet) args.push_back("--quiet");
-    if (options.strict) args.push_back("--strict");
-    if (!options.run_id.empty()) args.insert(args.end(), {"--run-id", options.run_id});
-    if (!options.host.empty()) args.insert(args.end(), {"--host", options.host});
-    return args;
-  };
-
-  // One child per process of this host (and the discovery server, first: the processes retry
-  // until it answers anyway). The signal thread and this one share `children` and `stopping`.
-  struct Supervised {
-    std::string name;
-    int restarts = 0;
-  };
-  std::map<pid_t, Supervised> children;
-  struct Pending {
-    std::string name;
-    int restarts;
-    std::chrono::steady_clock::time_point due;
-  };
-  std::vector<Pending> pending;  // restarts waiting for their back-off
-  std::mutex mutex;
-  bool stopping = false;
-  pid_t server = 0;
-  InterruptWatcher interrupt([&](int sig) {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (stopping) return;  // already told to stop (SIGTERM): a second signal would mean "exit now"
-    stopping = true;
-    for (const auto& [pid, _] : children) kill(pid, sig);
-  });
-  // After the watcher: its thread must inherit the blocked signals. Destroyed first, once every
-  // child has exited (it reads their pipes to the end).
-  OutputRelay relay(out, err);
-  auto say = [&](const std::string& line) { relay.Say(line); };
-  // Graphs on several hosts: the launchers tell each other of a required process's failure.
-  std::unique_ptr<LauncherLink> link;
-  if (std::any_of(graph.processes.begin(), graph.processes.end(), [](const ProcessConfig& pc) { return !pc.host.empty(); })) {
-    auto l = LauncherLink::Open(graph, host);
-    if (l.ok()) link = std::move(l.value());
-    else say("warning: " + l.status().message() + ": a failure on another host will not end this host's run");
-  }
-  auto start = [&](const std::string& name, std::vector<std::string> args, int restarts) {
-    const std::string log = LogPathOf(options, graph, name);
-    auto pipes = relay.Add(name, log,
-                           "=== " + name + " started " + (restarts > 0 ? "(restart " + std::to_string(restarts) + ") " : "") +
-                               "at " + LocalTime() + " on host '" + host + "'");
-    if (!pipes.ok()) {
-      say("cannot start process '" + name + "': " + pipes.status().message());
-      return false;
-    }
-    const pid_t pid = StartChild(std::move(args), restarts, pipes.value());
-    OutputRelay::CloseWriteEnds(pipes.value());
-    if (pid < 0) {
-      say("cannot start process '" + name + "'");
-      return false;
-    }
-    children[pid] = {name, restarts};
-    return true;
-  };
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (runs_server) {
-      const std::string listen = net.server_address + ":" + std::to_string(net.server_port);
-      if (!start("discovery-server", {"dyad", "discovery-server", "--listen", listen}, 0)) return 1;
-      server = children.begin()->first;
-    }
-    for (const auto& p : names)
-      if (!stopping) start(p, child_args(p), 0);
-  }
-
-  int first_failure = 0;  // the exit code of the first required process that failed for good
-  bool stopped_others = false, server_stopped = false;
-  auto stop_all = [&](pid_t except) {  // REQUIRES: mutex held
-    stopping = stopped_others = true;
-    pending.clear();
-    for (const auto& [other, _] : children)
-      if (other != except) kill(other, SIGTERM);
-    if (server != 0 && server != except) server_stopped = true;  // signalled once, here
-  };
-  for (;;) {
-    int status = 0;
-    // Reaped under the lock: the signal thread never kill()s a pid already reaped (and reused).
-    std::unique_lock<std::mutex> lock(mutex);
-    const pid_t pid = waitpid(-1, &status, WNOHANG);
-    if (pid <= 0) {
-      // Restarts that are due; the discovery server once the graph's processes here are done.
-      const auto now = std::chrono::steady_clock::now();
-      if (stopping) pending.clear();
-      for (auto it = pending.begin(); it != pending.end();) {
-        if (it->due > now) {
-          ++it;
-          continue;
-        }
-        say("process '" + it->name + "': restarting (restart " + std::to_string(it->restarts) + " of " +
-            std::to_string(ConfigOf(graph, it->name).max_restarts) + "): " + ResetClause(graph, it->name));
-        start(it->name, child_args(it->name), it->restarts);
-        it = pending.erase(it);
-      }
-      if (server != 0 && !server_stopped && pending.empty() && children.size() == 1 && children.count(server) &&
-          !names.empty()) {
-        server_stopped = true;
-        kill(server, SIGTERM);
-      }
-      if (children.empty() && pending.empty()) break;
-      if (link != nullptr && !stopping) {
-        for (const auto& notice : link->TakeRemoteRestarts()) say(notice);
-        if (auto failure = link->TakeRemoteFailure()) {
-          say(*failure + ": stopping the processes of host '" + host + "'");
-          if (first_failure == 0) first_failure = 1;
-          stop_all(0);
-        }
-      }
-      lock.unlock();
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      continue;
-    }
-    const auto found = children.find(pid);
-    if (found == children.end()) continue;  // not ours (a process a plugin started, reparented to us)
-    const Supervised child = found->second;
-    children.erase(found);
-    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    // Stopped by us (the user's signal forwarded, or SIGTERM after another child failed): not a failure.
-    const bool stopped = (interrupt.signal() != 0 && code == ExitCodeForSignal(interrupt.signal())) ||
-                         ((stopped_others || (pid == server && server_stopped)) && code == ExitCodeForSignal(SIGTERM));
-    if (stopped || stopping) continue;
-    const ProcessConfig& pc = ConfigOf(graph, child.name);
-    // A clean exit of a run with an end (--steps, --duration) is that end, whatever the policy:
-    // `always` restarts clean exits only in runs that go on until Ctrl-C.
-    const bool run_has_end = options.steps > 0 || options.duration_s > 0;
-    const bool restart = pid != server && ((pc.restart == RestartPolicy::kAlways && (code != 0 || !run_has_end)) ||
-                                           (pc.restart == RestartPolicy::kOnFailure && code != 0));
-    if (restart && child.restarts < pc.max_restarts) {
-      const double backoff = std::min(10.0, pc.backoff_s * std::pow(2.0, child.restarts));
-      std::ostringstream line;
-      line << "process '" << child.name << "' exited with " << DescribeExit(code) << "; restarting in " << backoff << " s";
-      say(line.str());
-      pending.push_back({child.name, child.restarts + 1,
-                         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                                std::chrono::duration<double>(backoff))});
-      continue;
-    }
-    if (code == 0) continue;
-    const std::string given_up =
-        restart ? " (after " + std::to_string(child.restarts) + (child.restarts == 1 ? " restart)" : " restarts)") : "";
-    if (pid != server && !pc.required) {
-      say("process '" + child.name + "' exited with " + DescribeExit(code) + given_up +
-          "; it is not required: the experiment goes on without it");
-      continue;
-    }
-    say("process '" + child.name + "' exited with " + DescribeExit(code) + given_up);
-    if (first_failure == 0) first_failure = code;
-    // One required process failing ends the experiment: on the other hosts (told first, while
-    // this host's discovery server, if any, still runs), then here.
-    if (link != nullptr && pid != server) {
-      lock.unlock();
-      link->AnnounceFailure(child.name, child.restarts);  // milliseconds; at most 2 s
-      lock.lock();
-      if (stopping) continue;  // a signal came meanwhile and was forwarded: no second one
-    }
-    stop_all(pid);
-  }
-  if (first_failure != 0) return first_failure;
-  if (interrupt.signal() != 0) {
-    say(std::string("dyad run: interrupted (") + SignalName(interrupt.signal()) + ")");
-    return ExitCodeForSignal(interrupt.signal());
-  }
-  return 0;
+  Supervision supervision(options, graph, std::move(names), runs_server, out, err);
+  return supervision.Run();
 }
 
 }  // namespace dyad

@@ -1,7 +1,9 @@
 // The launcher of `dyad run` (internal to the runtime; the contract is in run.hpp): one child
 // `dyad run --process P` per process placed on this host, supervised (restart policy, required),
 // their output relayed with a "[process] " prefix and written to <logs>/<process>.log, and the
-// graph's discovery server when this host is named to run it.
+// graph's discovery server when this host is named to run it. The children are started by the
+// spawner (spawner.hpp) with the flags of run_arguments.hpp; what an exit means is the
+// supervisor's decision (supervisor.hpp).
 #pragma once
 
 #include <ostream>

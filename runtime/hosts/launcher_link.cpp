@@ -78,10 +78,7 @@ std::optional<std::string> LauncherLink::TakeRemoteFailure() {
   while (reader_->TakeNext(&m)) {
     if (reported_ || m.graph_name() != graph_.name || m.state() != "failed" || m.host() == host_) continue;
     if (m.header().stamp_ns() < started_ns_) continue;  // an earlier run's
-    bool required = true;
-    for (const auto& pc : graph_.processes)
-      if (pc.name == m.process_name()) required = pc.required;
-    if (!required) continue;
+    if (const ProcessConfig* pc = graph_.FindProcess(m.process_name()); pc != nullptr && !pc->required) continue;
     reported_ = true;
     std::string text = "process '" + m.process_name() + "' on host '" + m.host() + "' failed for good";
     if (m.restarts() > 0) text += " (after " + std::to_string(m.restarts()) + (m.restarts() == 1 ? " restart)" : " restarts)");

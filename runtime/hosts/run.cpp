@@ -41,13 +41,10 @@ struct Loaded {
 std::set<std::string> ProcessesToCheck(const Graph& g, const RunOptions* run) {
   if (run == nullptr) return {};
   if (!run->process.empty()) return {run->process};
-  bool placed = false;
-  for (const auto& pc : g.processes) placed |= !pc.host.empty();
-  if (!placed) return {};
+  if (!g.PlacedOnHosts()) return {};
   std::set<std::string> here;
   for (const auto& p : g.ProcessNames())
-    for (const auto& pc : g.processes)
-      if (pc.name == p && RunsHere(pc.host, *run)) here.insert(p);
+    if (const ProcessConfig* pc = g.FindProcess(p); pc != nullptr && RunsHere(pc->host, *run)) here.insert(p);
   return here.empty() ? std::set<std::string>{""} : here;  // {""}: none (only the discovery server)
 }
 
@@ -132,6 +129,96 @@ void PrintReport(const std::vector<Executor::Row>& rows, const std::string& proc
   out.unsetf(std::ios::fixed);
 }
 
+// The options RunGraph checks itself (the CLI checks the numbers' ranges); false after saying why.
+bool CheckRunOptions(const RunOptions& options, std::ostream& err) {
+  if (!options.run_id.empty() && !IsPartitionWord(options.run_id)) {
+    err << "dyad run: --run-id '" << options.run_id << "': must be 1 to 64 of the characters A-Z a-z 0-9 _ . -\n";
+    return false;
+  }
+  if (options.restart_count < 0 || (options.restart_count > 0 && options.process.empty())) {
+    err << "dyad run: --restart-count " << options.restart_count
+        << (options.restart_count < 0 ? ": must be >= 0" : ": only with --process (the launcher gives it to a process it restarts)")
+        << "\n";
+    return false;
+  }
+  return true;
+}
+
+// How one process's run ended.
+struct ProcessRun {
+  Status result;
+  std::vector<Executor::Row> rows;
+  int mismatches = 0;
+  int signal = 0;  // the signal that stopped it; 0: none
+};
+
+// Runs the components of `eo.process` until the run ends. SIGINT/SIGTERM stop it cleanly; a
+// process that cannot stop (a component or the DDS stack stuck) must not outlive its launcher
+// unseen: kStopGraceS after a signal it exits anyway, saying so, unless the run has ended by then
+// (the guard is cancelled before this returns).
+ProcessRun RunProcess(Loaded& l, const Executor::Options& eo) {
+  ProcessRun run;
+  std::atomic<Executor*> current{nullptr};
+  std::mutex guard_mutex;
+  std::condition_variable guard_cv;
+  bool run_over = false;
+  std::thread guard;
+  {
+    InterruptWatcher interrupt([&](int sig) {
+      if (Executor* ex = current.load()) ex->RequestStop(SignalName(sig));
+      std::lock_guard<std::mutex> lock(guard_mutex);
+      if (guard.joinable() || run_over) return;
+      guard = std::thread([&, sig] {
+        std::unique_lock<std::mutex> lock(guard_mutex);
+        if (guard_cv.wait_for(lock, std::chrono::duration<double>(kStopGraceS), [&] { return run_over; })) return;
+        std::fprintf(stderr, "dyad run: did not stop within %g s of %s: exiting without a clean shutdown\n", kStopGraceS,
+                     SignalName(sig));
+        std::_Exit(ExitCodeForSignal(sig));
+      });
+    });
+    Executor ex(l.graph, l.resolved, &l.catalog, eo);
+    current.store(&ex);
+    if (interrupt.signal() != 0) ex.RequestStop(SignalName(interrupt.signal()));  // before `current` was set
+    run.result = ex.Run();
+    run.rows = ex.Report();
+    run.mismatches = ex.type_mismatches();
+    current.store(nullptr);
+    run.signal = interrupt.signal();
+    {
+      std::lock_guard<std::mutex> lock(guard_mutex);
+      run_over = true;
+    }
+    guard_cv.notify_all();
+  }  // the signal thread has ended: `guard` is no longer written
+  if (guard.joinable()) guard.join();
+  return run;
+}
+
+// The timing table and what went wrong; the exit code of the run (run.hpp).
+int ReportRun(const ProcessRun& run, const Graph& g, const std::string& process, const RunOptions& options,
+              std::ostream& out, std::ostream& err) {
+  if (!options.quiet) PrintReport(run.rows, process, out);
+  if (run.signal != 0) {
+    // A person stopped it: the run ended cleanly (recordings closed), but it did not finish.
+    err << "dyad run: interrupted (" << SignalName(run.signal) << ")" << (run.result.ok() ? "" : ": " + run.result.message())
+        << "\n";
+    return ExitCodeForSignal(run.signal);
+  }
+  if (!run.result.ok()) {
+    err << "dyad run: " << run.result.message() << "\n";
+    return ExitCodeOf(run.result);
+  }
+  if (int idle = ReportIdleComponents(run.rows, g, process, options.strict, err); idle > 0 && options.strict) {
+    err << "dyad run: " << idle << " component" << (idle == 1 ? "" : "s") << " never stepped (--strict)\n";
+    return 1;
+  }
+  if (run.mismatches > 0) {
+    err << "dyad run: " << run.mismatches << " type/QoS mismatch(es) with peers (see above)\n";
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int ExitCodeOf(const Status& status) {
@@ -159,13 +246,10 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   // any (all of them, unless the graph places processes on hosts); a child checks its own (the
   // others' files may already be open in their processes).
   if (!LoadAndValidate(options.graph_path, options.overrides, options.plugin_paths, &l, err, &options)) return 2;
-  const std::set<std::string> procs = l.graph.ProcessNames();
+  if (!CheckRunOptions(options, err)) return 2;
   std::string process = options.process;
-  if (!options.run_id.empty() && !IsPartitionWord(options.run_id)) {
-    err << "dyad run: --run-id '" << options.run_id << "': must be 1 to 64 of the characters A-Z a-z 0-9 _ . -\n";
-    return 2;
-  }
   l.graph.run = options.run_id.empty() && process.empty() ? DefaultRunId(l.graph) : options.run_id;
+  const std::set<std::string> procs = l.graph.ProcessNames();
   if (process.empty()) {
     if (NeedsLauncher(l.graph, options)) {
       RunOptions launched = options;
@@ -186,67 +270,10 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   eo.steps = options.steps;
   eo.stats_period_s = options.stats_period_s;
   // The launcher tells a child how often it restarted it (announced on dyad/processes).
-  uint32_t restarts = 0;
-  if (const char* r = std::getenv("DYAD_RESTARTS")) restarts = static_cast<uint32_t>(std::strtoul(r, nullptr, 10));
+  const auto restarts = static_cast<uint32_t>(options.restart_count);
   eo.session = [&graph = l.graph, process, host = eo.host, restarts] { return MakeGraphSession(graph, process, host, restarts); };
-  std::atomic<Executor*> current{nullptr};
-  Status result;
-  std::vector<Executor::Row> rows;
-  int mismatches = 0, signal = 0;
-  // A process that cannot stop (a component or the DDS stack stuck) must not outlive its
-  // launcher unseen: kStopGraceS after a signal it exits anyway, saying so, unless the run has
-  // ended by then (the guard is cancelled when RunGraph returns).
-  std::mutex guard_mutex;
-  std::condition_variable guard_cv;
-  bool run_over = false;
-  std::thread guard;
-  {
-    InterruptWatcher interrupt([&](int sig) {
-      if (Executor* ex = current.load()) ex->RequestStop(SignalName(sig));
-      std::lock_guard<std::mutex> lock(guard_mutex);
-      if (guard.joinable() || run_over) return;
-      guard = std::thread([&, sig] {
-        std::unique_lock<std::mutex> lock(guard_mutex);
-        if (guard_cv.wait_for(lock, std::chrono::duration<double>(kStopGraceS), [&] { return run_over; })) return;
-        std::fprintf(stderr, "dyad run: did not stop within %g s of %s: exiting without a clean shutdown\n", kStopGraceS,
-                     SignalName(sig));
-        std::_Exit(ExitCodeForSignal(sig));
-      });
-    });
-    Executor ex(l.graph, l.resolved, &l.catalog, eo);
-    current.store(&ex);
-    if (interrupt.signal() != 0) ex.RequestStop(SignalName(interrupt.signal()));  // before `current` was set
-    result = ex.Run();
-    rows = ex.Report();
-    mismatches = ex.type_mismatches();
-    current.store(nullptr);
-    signal = interrupt.signal();
-    {
-      std::lock_guard<std::mutex> lock(guard_mutex);
-      run_over = true;
-    }
-    guard_cv.notify_all();
-  }  // the signal thread has ended: `guard` is no longer written
-  if (guard.joinable()) guard.join();
-  if (!options.quiet) PrintReport(rows, process, out);
-  if (signal != 0) {
-    // A person stopped it: the run ended cleanly (recordings closed), but it did not finish.
-    err << "dyad run: interrupted (" << SignalName(signal) << ")" << (result.ok() ? "" : ": " + result.message()) << "\n";
-    return ExitCodeForSignal(signal);
-  }
-  if (!result.ok()) {
-    err << "dyad run: " << result.message() << "\n";
-    return ExitCodeOf(result);
-  }
-  if (int idle = ReportIdleComponents(rows, l.graph, process, options.strict, err); idle > 0 && options.strict) {
-    err << "dyad run: " << idle << " component" << (idle == 1 ? "" : "s") << " never stepped (--strict)\n";
-    return 1;
-  }
-  if (mismatches > 0) {
-    err << "dyad run: " << mismatches << " type/QoS mismatch(es) with peers (see above)\n";
-    return 1;
-  }
-  return 0;
+  const ProcessRun run = RunProcess(l, eo);
+  return ReportRun(run, l.graph, process, options, out, err);
 }
 
 }  // namespace dyad

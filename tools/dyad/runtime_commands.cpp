@@ -17,6 +17,11 @@
 namespace dyad::cli {
 namespace {
 
+// `--set` of validate and run (docs/runtime.md, "Composing graphs").
+const char* const kSetHelp =
+    "Change a key of the graph: COMPONENT.PARAM=VALUE, COMPONENT.type=TYPE (rate_hz, trigger, process, inputs.PORT, "
+    "outputs.PORT), clock|seed|domain_id|graph=VALUE, network.KEY=VALUE, processes.NAME.KEY=VALUE (repeatable)";
+
 std::vector<Override> ToOverrides(const std::vector<std::string>& sets) {
   std::vector<Override> out;
   for (const auto& s : sets) out.push_back(Override{s});
@@ -63,33 +68,13 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
 
   auto* validate = app.add_subcommand("validate", "Check a graph file; print every problem (exit 2) or OK");
   validate->add_option("graph", run.graph_path, "Graph YAML file")->required();
-  validate->add_option("--set", sets, "Change a key of the graph: COMPONENT.PARAM=VALUE, COMPONENT.type=TYPE (rate_hz, trigger, process, inputs.PORT, outputs.PORT), clock|seed|domain_id|graph=VALUE, network.KEY=VALUE, processes.NAME.KEY=VALUE (repeatable)");
+  validate->add_option("--set", sets, kSetHelp);
   validate->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
   validate->callback([st, &exit_code] {
     exit_code = ValidateGraphFile(st->run.graph_path, ToOverrides(st->sets), st->plugins, std::cout, std::cerr);
   });
 
-  auto* r = app.add_subcommand("run", "Run a graph (the components of one process, or launch every process)");
-  r->add_option("graph", run.graph_path, "Graph YAML file")->required();
-  r->add_option("--process", run.process, "Run only the components placed in this process");
-  r->add_option("--logs", run.logs_dir, "Folder for each process's log (<process>.log); default: the graph's logs:");
-  r->add_option("--host", run.host, "This machine's name in the graph (processes: NAME: {host: ...}); default: its host name");
-  r->add_option("--set", sets, "Change a key of the graph: COMPONENT.PARAM=VALUE, COMPONENT.type=TYPE (rate_hz, trigger, process, inputs.PORT, outputs.PORT), clock|seed|domain_id|graph=VALUE, network.KEY=VALUE, processes.NAME.KEY=VALUE (repeatable)");
-  r->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
-  r->add_option("--duration", run.duration_s, "Stop after this many seconds of wall time")->check(CLI::NonNegativeNumber);
-  r->add_option("--steps", run.steps, "Stop after the fastest periodic component ran this many steps");
-  r->add_option("--stats-period", run.stats_period_s, "Seconds between ComponentStats samples on dyad/stats")
-      ->check(CLI::PositiveNumber);
-  r->add_option("--run-id", run.run_id,
-                "This run's id: with the graph's name, the DDS partition that keeps it apart from other runs on the domain "
-                "(default: a fresh one for a graph on one host, 'shared' for a graph on several; give the same one on every host)");
-  r->add_flag("--quiet", run.quiet, "Do not print the timing table at exit");
-  r->add_flag("--strict", run.strict, "A component that never stepped is an error (exit 1), not only a warning");
-  r->callback([st, &exit_code] {
-    st->run.overrides = ToOverrides(st->sets);
-    st->run.plugin_paths = st->plugins;
-    exit_code = RunGraph(st->run, std::cout, std::cerr);
-  });
+  AddRunCommand(app, [&exit_code](const RunOptions& options) { exit_code = RunGraph(options, std::cout, std::cerr); });
 
   auto* ds = app.add_subcommand("discovery-server", "Run a Fast DDS discovery server for graphs with network.discovery: server");
   ds->add_option("--listen", st->listen, "ADDRESS:PORT to listen on (UDP)")->required();
@@ -130,6 +115,44 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
     std::cout << listed.str();
     exit_code = catalog.entries().empty() ? 1 : 0;
   });
+}
+
+CLI::App* AddRunCommand(CLI::App& app, std::function<void(const RunOptions&)> on_run) {
+  // Per registration, as in AddRuntimeCommands.
+  struct State {
+    RunOptions run;
+    std::vector<std::string> sets, plugins;
+  };
+  auto st = std::make_shared<State>();
+  RunOptions& run = st->run;
+  std::vector<std::string>& sets = st->sets;
+  std::vector<std::string>& plugins = st->plugins;
+  auto* r = app.add_subcommand("run", "Run a graph (the components of one process, or launch every process)");
+  r->add_option("graph", run.graph_path, "Graph YAML file")->required();
+  r->add_option("--process", run.process, "Run only the components placed in this process");
+  r->add_option("--logs", run.logs_dir, "Folder for each process's log (<process>.log); default: the graph's logs:");
+  r->add_option("--host", run.host, "This machine's name in the graph (processes: NAME: {host: ...}); default: its host name");
+  r->add_option("--set", sets, kSetHelp);
+  r->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
+  r->add_option("--duration", run.duration_s, "Stop after this many seconds of wall time")->check(CLI::NonNegativeNumber);
+  r->add_option("--steps", run.steps, "Stop after the fastest periodic component ran this many steps");
+  r->add_option("--stats-period", run.stats_period_s, "Seconds between ComponentStats samples on dyad/stats")
+      ->check(CLI::PositiveNumber);
+  r->add_option("--run-id", run.run_id,
+                "This run's id: with the graph's name, the DDS partition that keeps it apart from other runs on the domain "
+                "(default: a fresh one for a graph on one host, 'shared' for a graph on several; give the same one on every host)");
+  r->add_flag("--quiet", run.quiet, "Do not print the timing table at exit");
+  r->add_flag("--strict", run.strict, "A component that never stepped is an error (exit 1), not only a warning");
+  // The launcher's, for a process it restarts: not in --help.
+  r->add_option("--restart-count", run.restart_count, "How often the launcher restarted this process (with --process)")
+      ->group("");
+  r->callback([st, on_run = std::move(on_run)] {
+    RunOptions options = st->run;
+    options.overrides = ToOverrides(st->sets);
+    options.plugin_paths = st->plugins;
+    on_run(options);
+  });
+  return r;
 }
 
 }  // namespace dyad::cli

@@ -16,6 +16,7 @@
 //     are supervised: `restart` (never | on-failure | always, max_restarts, backoff_s doubling
 //     up to 10 s) and `required` (a required process that fails for good stops the others and
 //     ends the run with its exit code; another one is reported and left out).
+//     The children are the program `executable` (this one unless told otherwise).
 // It returns when the run ends: SIGINT/SIGTERM, `duration_s`, `steps`, a component's
 // RequestStop(), or a failed step. At exit it prints a timing table (per component: steps, step
 // duration mean/p99/max, start jitter, deadline misses) and publishes the same as
@@ -59,6 +60,14 @@ struct RunOptions {
   // A component that never stepped during a run that went to its end is an error (exit 1), not
   // only a warning.
   bool strict = false;
+  // With `process`: how often the launcher has restarted this process (`dyad run --process P
+  // --restart-count N`, given by the launcher to a restarted child), announced with its state on
+  // dyad/processes (`dyad status` shows it). >= 0; must be 0 without `process`.
+  int restart_count = 0;
+  // The dyad executable the launcher starts its children with (`dyad run --process P`, `dyad
+  // discovery-server`). The default is this program, so a program other than dyad that calls
+  // RunGraph for a graph of several processes names dyad here.
+  std::string executable = "/proc/self/exe";
 };
 
 int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err);
