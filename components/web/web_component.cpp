@@ -13,9 +13,9 @@
 #include <nlohmann/json.hpp>
 
 #include <dyad/pvrnn/dataset.hpp>
+#include <dyad/topic_select.hpp>
 
 #include "pages.hpp"
-#include "topic_select.hpp"
 #include "web_human.hpp"
 
 namespace dyad::web {
@@ -107,7 +107,7 @@ Status WebComponent::Configure(Context& ctx) {
 
   std::vector<std::string> names;
   for (const auto& t : ctx.graph_topics()) names.push_back(t.name);
-  auto chosen = recorder::SelectTopics(p.StringList("topics"), names, "params.topics");
+  auto chosen = SelectTopics(p.StringList("topics"), names, "params.topics");
   if (!chosen.ok()) return chosen.status();
   std::vector<foxglove::Channel> channels;
   for (const auto& name : *chosen)
