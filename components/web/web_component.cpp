@@ -8,10 +8,9 @@
 #include <mutex>
 #include <random>
 
-#include <fastdds/dds/topic/TopicDataType.hpp>
-#include <fastdds/rtps/common/SerializedPayload.h>
 #include <nlohmann/json.hpp>
 
+#include <dyad/decode_sample.hpp>
 #include <dyad/pvrnn/dataset.hpp>
 #include <dyad/topic_select.hpp>
 
@@ -33,26 +32,17 @@ std::string RandomToken() {
   return t;
 }
 
-// The newest ComponentStats of every component of the graph, from dyad/stats (any process).
 }  // namespace
 
+// The newest ComponentStats of every component of the graph, from dyad/stats (any process).
 struct WebComponent::StatsTable {
   std::mutex mutex;
   std::map<std::pair<std::string, std::string>, msg::ComponentStats> rows;  // (process, component)
-  std::unique_ptr<eprosima::fastdds::dds::TopicDataType> support{TypeInfoOf<msg::ComponentStats>().make_type_support()};
   void Add(std::span<const uint8_t> cdr) {
-    eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<uint32_t>(cdr.size()));
-    std::copy(cdr.begin(), cdr.end(), payload.data);
-    payload.length = static_cast<uint32_t>(cdr.size());
     msg::ComponentStats s;
-    bool ok = false;
-    try {  // fastcdr throws on short input
-      ok = support->deserialize(&payload, &s);
-    } catch (...) {
-    }
-    if (!ok) return;
+    if (!DecodeSample(cdr, &s).ok()) return;  // not from a dyad runtime of this version: not shown
     std::lock_guard<std::mutex> lock(mutex);
-    rows[{s.process_name(), s.component_name()}] = s;
+    rows[{s.process_name(), s.component_name()}] = std::move(s);
   }
   std::string Json() {
     nlohmann::json list = nlohmann::json::array();

@@ -2,6 +2,8 @@
 
 #include "dds/network_qos.hpp"
 
+#include <dyad/decode_sample.hpp>
+
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
@@ -441,6 +443,23 @@ struct SerializedScratch {
   void* sample = nullptr;
   eprosima::fastrtps::rtps::SerializedPayload_t payload;
 };
+
+// Decodes `cdr` into `sample` through `support`, copying the bytes into `payload` (grown as
+// needed). False when they do not decode (fastcdr throws on short input: nothing escapes).
+static bool DecodeInto(fdds::TopicDataType& support, eprosima::fastrtps::rtps::SerializedPayload_t& payload,
+                       std::span<const uint8_t> cdr, void* sample) {
+  if (cdr.size() > UINT32_MAX) return false;
+  if (payload.max_size < cdr.size()) payload.reserve(static_cast<uint32_t>(cdr.size()));
+  std::copy(cdr.begin(), cdr.end(), payload.data);
+  payload.length = static_cast<uint32_t>(cdr.size());
+  payload.pos = 0;
+  try {
+    return support.deserialize(&payload, sample);
+  } catch (...) {
+    return false;
+  }
+}
+
 struct DdsSerializedReader::Scratch : SerializedScratch {
   using SerializedScratch::SerializedScratch;
 };
@@ -575,22 +594,20 @@ Status DdsSerializedWriter::Write(std::span<const uint8_t> cdr, int64_t source_s
   std::lock_guard<std::mutex> lock(mutex_);
   Scratch& s = *scratch_;
   if (cdr.size() > UINT32_MAX) return Status::InvalidArgument("topic '" + topic_ + "': sample of " + std::to_string(cdr.size()) + " bytes is too large");
-  if (s.payload.max_size < cdr.size()) s.payload.reserve(static_cast<uint32_t>(cdr.size()));
-  std::copy(cdr.begin(), cdr.end(), s.payload.data);
-  s.payload.length = static_cast<uint32_t>(cdr.size());
-  s.payload.pos = 0;
-  bool decoded = false;
-  try {  // fastcdr throws on short input; nothing may escape to the component
-    decoded = s.support->deserialize(&s.payload, s.sample);
-  } catch (...) {
-    decoded = false;
-  }
-  if (!decoded)
+  if (!DecodeInto(*s.support, s.payload, cdr, s.sample))
     return Status::InvalidArgument("topic '" + topic_ + "': " + std::to_string(cdr.size()) + " bytes do not decode as " + type_->name);
   const int64_t stamp = source_stamp_ns >= 0 ? source_stamp_ns : clock_->now_ns();
   if (writer_->write_w_timestamp(s.sample, fdds::HANDLE_NIL, TimeOfNs(stamp)) != ReturnCode_t::RETCODE_OK)
     return Status::IOError("topic '" + topic_ + "': DDS write failed");
   ++written_;
+  return Status::OK();
+}
+
+Status DecodeSample(std::span<const uint8_t> cdr, const TypeInfo& type, void* sample) {
+  std::unique_ptr<fdds::TopicDataType> support(type.make_type_support());
+  eprosima::fastrtps::rtps::SerializedPayload_t payload;
+  if (!DecodeInto(*support, payload, cdr, sample))
+    return Status::InvalidArgument(std::to_string(cdr.size()) + " bytes do not decode as " + type.name);
   return Status::OK();
 }
 
