@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <dyad/decode_sample.hpp>
+#include <dyad/on_demand_subscription.hpp>
 #include <dyad/pvrnn/dataset.hpp>
 #include <dyad/topic_select.hpp>
 
@@ -169,11 +170,13 @@ Status WebComponent::Configure(Context& ctx) {
       WebServer::Endpoint{"/subject/ws", {}, subject_.get(), /*viewers=*/false},
       WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get()},
   };
+  // Read only while a client subscribes (the bridge starts and stops them).
   FoxgloveBridge* bridge = bridge_.get();
   for (const auto& c : channels) {
     const uint32_t id = c.id;
-    Status s = ctx.SubscribeSerialized(c.topic, [bridge, id](const SerializedSample& sample) { bridge->OnSample(id, sample); });
-    if (!s.ok()) return s.WithContext("params.topics: '" + c.topic + "'");
+    auto sub = SubscribeSerializedOnDemand(ctx, c.topic, [bridge, id](const SerializedSample& sample) { bridge->OnSample(id, sample); });
+    if (!sub.ok()) return sub.status().WithContext("params.topics: '" + c.topic + "'");
+    bridge_->SetSubscription(id, *sub);
   }
   return Status::OK();
 }
