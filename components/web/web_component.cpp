@@ -142,7 +142,8 @@ Status WebComponent::Configure(Context& ctx) {
     pointer_sample_.x(x);
     pointer_sample_.y(y);
     pointer_sample_.engaged(engaged);
-    pointer_->Publish(pointer_sample_);  // serialised by SubjectChannel
+    // Serialised by SubjectChannel (component.hpp: one Output's Publish calls must not overlap).
+    if (Status s = pointer_->Publish(pointer_sample_); !s.ok()) ctx_->log().Warn("pointer: " + s.ToString());
   });
 
   intention_ = &ctx.input<msg::Intention>("intention");
@@ -151,7 +152,8 @@ Status WebComponent::Configure(Context& ctx) {
   experimenter_ = std::make_unique<ExperimenterChannel>([this](const std::string& text) {
     note_.author("experimenter");
     note_.text(text);
-    notes_->Publish(note_);  // serialised by ExperimenterChannel
+    // Serialised by ExperimenterChannel.
+    if (Status s = notes_->Publish(note_); !s.ok()) ctx_->log().Warn("notes: experimenter's note lost: " + s.ToString());
   });
   stats_ = std::make_shared<StatsTable>();
   for (const auto& t : ctx.graph_topics())
