@@ -40,7 +40,7 @@ using ClientId = uint64_t;
 
 // What the application does with WebSocket clients. Threads:
 //   - OnOpen and OnClose run on the civetweb worker thread that serves the client's connection
-//     (OnClose also inside ~WebServer, which waits for it, for clients still open then).
+//     (for a client still open when the server stops, while ~WebServer waits for it).
 //   - OnText and OnBinary run on the server's one handler thread (a normal stack: civetweb's are
 //     small), one message at a time across all clients, while the client's worker waits.
 // So one client's calls never overlap and come in order (OnOpen, messages, OnClose), and two
