@@ -10,6 +10,7 @@
 #include <thread>
 
 #include <dyad/msg/types.hpp>
+#include <dyad/on_demand_subscription.hpp>
 
 #include "memory_transport.hpp"
 
@@ -56,6 +57,9 @@ class Probe : public Component {
     spec.Param("fail_step", 2);
     spec.Param("sleep_ms", 0.0);
     spec.Param("tap", "");  // a topic to subscribe serialized (sleeping sleep_ms per callback)
+    // tap on demand: started at step tap_start, stopped at step tap_stop (-1: never)
+    spec.Param("tap_start", -1);
+    spec.Param("tap_stop", -1);
     spec.Input<msg::Counter>("in").Optional();
     spec.Output<msg::Counter>("out");
   }
@@ -71,12 +75,20 @@ class Probe : public Component {
     sleep_ = std::chrono::duration<double, std::milli>(ctx.params().Double("sleep_ms"));
     in_ = &ctx.input<msg::Counter>("in");
     out_ = &ctx.output<msg::Counter>("out");
+    tap_start_ = ctx.params().Int("tap_start");
+    tap_stop_ = ctx.params().Int("tap_stop");
     if (const std::string tap = ctx.params().String("tap"); !tap.empty()) {
-      Status s = ctx.SubscribeSerialized(tap, [this](const SerializedSample&) {
+      SerializedCallback cb = [this](const SerializedSample&) {
         std::this_thread::sleep_for(sleep_);
         ++tapped_;
-      });
-      if (!s.ok()) return s;
+      };
+      if (tap_start_ >= 0) {
+        auto sub = SubscribeSerializedOnDemand(ctx, tap, std::move(cb));
+        if (!sub.ok()) return sub.status();
+        on_demand_ = *sub;
+      } else if (Status s = ctx.SubscribeSerialized(tap, std::move(cb)); !s.ok()) {
+        return s;
+      }
     }
     if (fail_ == "configure") return Fail(code_, "boom");
     return Status::OK();
@@ -90,6 +102,9 @@ class Probe : public Component {
     for (const auto& s : in_->received()) g_log->Add(name_ + " got " + std::to_string(s.value()));
     g_log->Add(name_ + " step " + std::to_string(info.index));
     if (sleep_.count() > 0 && tapped_ == 0) std::this_thread::sleep_for(sleep_);
+    if (on_demand_ != nullptr && static_cast<int64_t>(info.index) == tap_start_)
+      if (Status st = on_demand_->Start(); !st.ok()) return st;
+    if (on_demand_ != nullptr && static_cast<int64_t>(info.index) == tap_stop_) on_demand_->Stop();
     msg::Counter c;
     c.value(static_cast<int64_t>(info.index));
     Status s = out_->Publish(c);
@@ -111,6 +126,8 @@ class Probe : public Component {
   Output<msg::Counter>* out_ = nullptr;
   std::atomic<bool> busy_{false};
   std::atomic<int> tapped_{0};
+  int64_t tap_start_ = -1, tap_stop_ = -1;
+  OnDemandSubscription* on_demand_ = nullptr;  // owned by the runtime
 };
 
 void RegisterProbe(PluginRegistry& r) { r.Add<Probe>("probe"); }
@@ -302,6 +319,39 @@ components:
   EXPECT_EQ(Stats("rec").deliveries, 5u);
   EXPECT_GE(Stats("rec").delivery_mean_s, 0.009);
   EXPECT_LT(Stats("a").max_s, 0.005) << "publisher charged with its subscriber's callback";
+}
+
+// An on-demand subscription calls back only between Start() and Stop(): a viewer with no client
+// costs its publishers nothing.
+TEST_F(ExecutorTest, OnDemandSubscriptionDeliversOnlyBetweenStartAndStop) {
+  ASSERT_TRUE(Run(R"(graph: t
+clock: stepped
+components:
+  a: {type: probe, rate_hz: 10, outputs: {out: ab}}
+  viewer: {type: probe, rate_hz: 10, params: {tap: ab, tap_start: 3, tap_stop: 6}}
+)", 10).ok());
+  // a publishes before the viewer steps at each instant: samples 4, 5 and 6 only.
+  EXPECT_EQ(Stats("viewer").deliveries, 3u);
+  EXPECT_EQ(log_.Matching("viewer deactivate"), (std::vector<std::string>{"viewer deactivate (tapped 3)"}));
+}
+
+TEST(SubscribeSerializedOnDemand, IsUnimplementedOnAContextOfTheTests) {
+  struct FakeContext final : Context {
+    const std::string& name() const override { return name_; }
+    const Params& params() const override { return params_; }
+    const Clock& clock() const override { std::abort(); }
+    Logger& log() override { std::abort(); }
+    uint64_t seed() const override { return 0; }
+    int64_t period_ns() const override { return 0; }
+    void RequestStop(std::string) override {}
+    InputBase* FindInput(std::string_view, const TypeInfo&) override { return nullptr; }
+    OutputBase* FindOutput(std::string_view, const TypeInfo&) override { return nullptr; }
+    std::string name_ = "fake";
+    Params params_;
+  } ctx;
+  auto s = SubscribeSerializedOnDemand(ctx, "ab", [](const SerializedSample&) {});
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.status().code(), Status::Code::kUnimplemented);
 }
 
 }  // namespace

@@ -48,7 +48,15 @@ class MemoryTransport final : public Transport {
   StatusOr<SerializedSubscription*> CreateSerializedReader(const std::string& topic, const TypeInfo& type, const TopicQos&,
                                                            const Clock* clock, SerializedCallback callback) override {
     if (Status s = CheckType(topic, type); !s.ok()) return s;
-    serialized_readers_.push_back(std::make_unique<SerializedReader>(clock, std::move(callback)));
+    serialized_readers_.push_back(std::make_unique<SerializedReader>(topic, clock, std::move(callback), true));
+    topics_[topic].serialized.push_back(serialized_readers_.back().get());
+    return serialized_readers_.back().get();
+  }
+  // Stopped: samples are not kept (a KEEP_LAST history is not modelled).
+  StatusOr<OnDemandReader*> CreateOnDemandReader(const std::string& topic, const TypeInfo& type, const TopicQos&,
+                                                 const Clock* clock, SerializedCallback callback) override {
+    if (Status s = CheckType(topic, type); !s.ok()) return s;
+    serialized_readers_.push_back(std::make_unique<SerializedReader>(topic, clock, std::move(callback), false));
     topics_[topic].serialized.push_back(serialized_readers_.back().get());
     return serialized_readers_.back().get();
   }
@@ -103,17 +111,33 @@ class MemoryTransport final : public Transport {
     std::deque<Bytes> queue_;
   };
 
-  class SerializedReader final : public SerializedSubscription {
+  class SerializedReader final : public OnDemandReader {
    public:
-    SerializedReader(const Clock* clock, SerializedCallback cb) : clock_(clock), cb_(std::move(cb)) {}
+    SerializedReader(std::string topic, const Clock* clock, SerializedCallback cb, bool started)
+        : topic_(std::move(topic)), clock_(clock), cb_(std::move(cb)), started_(started) {}
     void Close() override {
       std::lock_guard<std::mutex> lock(mutex_);
       closed_ = true;
     }
     uint64_t delivered() const override { return delivered_; }
+    const std::string& topic() const override { return topic_; }
+    Status Start() override {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (closed_) return Status::FailedPrecondition("topic '" + topic_ + "': subscription closed");
+      started_ = true;
+      return Status::OK();
+    }
+    void Stop() override {
+      std::lock_guard<std::mutex> lock(mutex_);
+      started_ = false;
+    }
+    bool started() const override {
+      std::lock_guard<std::mutex> lock(mutex_);
+      return started_;
+    }
     void Deliver(const Bytes& b, int64_t stamp, uint64_t sequence) {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (closed_) return;
+      if (closed_ || !started_) return;
       SerializedSample s;
       s.cdr = std::span<const uint8_t>(b.data(), b.size());
       s.source_stamp_ns = stamp;
@@ -124,10 +148,12 @@ class MemoryTransport final : public Transport {
     }
 
    private:
+    std::string topic_;
     const Clock* clock_;
     SerializedCallback cb_;
-    std::mutex mutex_;
+    mutable std::mutex mutex_;
     bool closed_ = false;
+    bool started_;
     uint64_t delivered_ = 0;
   };
 

@@ -16,7 +16,9 @@ LAYERS = ["graph", "dds", "exec", "hosts"]
 # API every layer may use.
 PUBLIC = {
     "component.hpp": None, "message_traits.hpp": None, "status.hpp": None, "params.hpp": None,
-    "graph.hpp": "graph", "validate.hpp": "graph", "catalog.hpp": "graph",
+    "graph.hpp": "graph", "validate.hpp": "graph", "catalog.hpp": "graph", "topic_select.hpp": "graph",
+    "on_demand_subscription.hpp": "graph",
+    "decode_sample.hpp": "dds",
     "interrupt.hpp": "exec",
     "run.hpp": "hosts", "introspect.hpp": "hosts", "discovery_server.hpp": "hosts",
 }

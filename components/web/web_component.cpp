@@ -8,14 +8,14 @@
 #include <mutex>
 #include <random>
 
-#include <fastdds/dds/topic/TopicDataType.hpp>
-#include <fastdds/rtps/common/SerializedPayload.h>
 #include <nlohmann/json.hpp>
 
+#include <dyad/decode_sample.hpp>
+#include <dyad/on_demand_subscription.hpp>
 #include <dyad/pvrnn/dataset.hpp>
+#include <dyad/topic_select.hpp>
 
 #include "pages.hpp"
-#include "topic_select.hpp"
 #include "web_human.hpp"
 
 namespace dyad::web {
@@ -33,26 +33,17 @@ std::string RandomToken() {
   return t;
 }
 
-// The newest ComponentStats of every component of the graph, from dyad/stats (any process).
 }  // namespace
 
+// The newest ComponentStats of every component of the graph, from dyad/stats (any process).
 struct WebComponent::StatsTable {
   std::mutex mutex;
   std::map<std::pair<std::string, std::string>, msg::ComponentStats> rows;  // (process, component)
-  std::unique_ptr<eprosima::fastdds::dds::TopicDataType> support{TypeInfoOf<msg::ComponentStats>().make_type_support()};
   void Add(std::span<const uint8_t> cdr) {
-    eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<uint32_t>(cdr.size()));
-    std::copy(cdr.begin(), cdr.end(), payload.data);
-    payload.length = static_cast<uint32_t>(cdr.size());
     msg::ComponentStats s;
-    bool ok = false;
-    try {  // fastcdr throws on short input
-      ok = support->deserialize(&payload, &s);
-    } catch (...) {
-    }
-    if (!ok) return;
+    if (!DecodeSample(cdr, &s).ok()) return;  // not from a dyad runtime of this version: not shown
     std::lock_guard<std::mutex> lock(mutex);
-    rows[{s.process_name(), s.component_name()}] = s;
+    rows[{s.process_name(), s.component_name()}] = std::move(s);
   }
   std::string Json() {
     nlohmann::json list = nlohmann::json::array();
@@ -107,7 +98,7 @@ Status WebComponent::Configure(Context& ctx) {
 
   std::vector<std::string> names;
   for (const auto& t : ctx.graph_topics()) names.push_back(t.name);
-  auto chosen = recorder::SelectTopics(p.StringList("topics"), names, "params.topics");
+  auto chosen = SelectTopics(p.StringList("topics"), names, "params.topics");
   if (!chosen.ok()) return chosen.status();
   std::vector<foxglove::Channel> channels;
   for (const auto& name : *chosen)
@@ -151,7 +142,8 @@ Status WebComponent::Configure(Context& ctx) {
     pointer_sample_.x(x);
     pointer_sample_.y(y);
     pointer_sample_.engaged(engaged);
-    pointer_->Publish(pointer_sample_);  // serialised by SubjectChannel
+    // Serialised by SubjectChannel (component.hpp: one Output's Publish calls must not overlap).
+    if (Status s = pointer_->Publish(pointer_sample_); !s.ok()) ctx_->log().Warn("pointer: " + s.ToString());
   });
 
   intention_ = &ctx.input<msg::Intention>("intention");
@@ -160,7 +152,8 @@ Status WebComponent::Configure(Context& ctx) {
   experimenter_ = std::make_unique<ExperimenterChannel>([this](const std::string& text) {
     note_.author("experimenter");
     note_.text(text);
-    notes_->Publish(note_);  // serialised by ExperimenterChannel
+    // Serialised by ExperimenterChannel.
+    if (Status s = notes_->Publish(note_); !s.ok()) ctx_->log().Warn("notes: experimenter's note lost: " + s.ToString());
   });
   stats_ = std::make_shared<StatsTable>();
   for (const auto& t : ctx.graph_topics())
@@ -179,11 +172,13 @@ Status WebComponent::Configure(Context& ctx) {
       WebServer::Endpoint{"/subject/ws", {}, subject_.get(), /*viewers=*/false},
       WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get()},
   };
+  // Read only while a client subscribes (the bridge starts and stops them).
   FoxgloveBridge* bridge = bridge_.get();
   for (const auto& c : channels) {
     const uint32_t id = c.id;
-    Status s = ctx.SubscribeSerialized(c.topic, [bridge, id](const SerializedSample& sample) { bridge->OnSample(id, sample); });
-    if (!s.ok()) return s.WithContext("params.topics: '" + c.topic + "'");
+    auto sub = SubscribeSerializedOnDemand(ctx, c.topic, [bridge, id](const SerializedSample& sample) { bridge->OnSample(id, sample); });
+    if (!sub.ok()) return sub.status().WithContext("params.topics: '" + c.topic + "'");
+    bridge_->SetSubscription(id, *sub);
   }
   return Status::OK();
 }

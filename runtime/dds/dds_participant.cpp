@@ -2,6 +2,8 @@
 
 #include "dds/network_qos.hpp"
 
+#include <dyad/decode_sample.hpp>
+
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/DomainParticipantListener.hpp>
@@ -426,6 +428,8 @@ Status DdsWriter::WriteStamped(const void* sample, int64_t stamp_ns) {
 
 // A serialized reader's listener: its samples, and its matches (EndpointHealth).
 const fdds::StatusMask kSerializedMask = fdds::StatusMask::data_available() << fdds::StatusMask::subscription_matched();
+// A stopped on-demand reader's: its matches only (nothing is taken, so nothing is decoded).
+const fdds::StatusMask kStoppedMask = fdds::StatusMask::subscription_matched();
 
 // What a serialized endpoint reuses for every sample: its own (unregistered) type support for
 // (de)serialising, one sample object and one payload buffer.
@@ -441,6 +445,23 @@ struct SerializedScratch {
   void* sample = nullptr;
   eprosima::fastrtps::rtps::SerializedPayload_t payload;
 };
+
+// Decodes `cdr` into `sample` through `support`, copying the bytes into `payload` (grown as
+// needed). False when they do not decode (fastcdr throws on short input: nothing escapes).
+static bool DecodeInto(fdds::TopicDataType& support, eprosima::fastrtps::rtps::SerializedPayload_t& payload,
+                       std::span<const uint8_t> cdr, void* sample) {
+  if (cdr.size() > UINT32_MAX) return false;
+  if (payload.max_size < cdr.size()) payload.reserve(static_cast<uint32_t>(cdr.size()));
+  std::copy(cdr.begin(), cdr.end(), payload.data);
+  payload.length = static_cast<uint32_t>(cdr.size());
+  payload.pos = 0;
+  try {
+    return support.deserialize(&payload, sample);
+  } catch (...) {
+    return false;
+  }
+}
+
 struct DdsSerializedReader::Scratch : SerializedScratch {
   using SerializedScratch::SerializedScratch;
 };
@@ -489,16 +510,62 @@ DdsSerializedReader::~DdsSerializedReader() {
 void DdsSerializedReader::Close() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (closed_) return;
-  if (reader_ != nullptr) Drain();
+  Drain();
   closed_ = true;
+}
+
+Status DdsSerializedReader::Start() {
+  std::lock_guard<std::mutex> entity(entity_mutex_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (closed_) return Status::FailedPrecondition("topic '" + topic_ + "': subscription closed (the run is stopping)");
+    if (started_) return Status::OK();
+  }
+  if (!exists()) {
+    // The listener is attached below, once the reader is in place (as at creation).
+    fdds::DataReader* fresh = make_();
+    if (fresh == nullptr) return Status::Internal("cannot create reader on topic '" + topic_ + "'");
+    listener_->SetCurrent(fresh);
+    std::lock_guard<std::mutex> lock(mutex_);
+    reader_ = fresh;
+    exists_.store(true, std::memory_order_release);
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    started_ = true;
+  }
+  // reader_ changes under entity_mutex_ only, which this thread holds.
+  reader_->set_listener(listener_.get(), kSerializedMask);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!closed_) Drain();  // what the history kept, and what came before the listener
+  return Status::OK();
+}
+
+void DdsSerializedReader::Stop() {
+  std::lock_guard<std::mutex> entity(entity_mutex_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);  // waits for a running callback
+    if (!started_) return;
+    started_ = false;
+  }
+  // Samples still arrive into the KEEP_LAST history, replacing older ones; none is taken.
+  if (reader_ != nullptr) reader_->set_listener(listener_.get(), kStoppedMask);
+}
+
+bool DdsSerializedReader::started() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return started_;
 }
 
 int DdsSerializedReader::Matched() const { return listener_->matched(); }
 
 bool DdsSerializedReader::Renew() {
+  std::lock_guard<std::mutex> entity(entity_mutex_);
+  bool started = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (retired_ != nullptr || closed_) return false;  // one renewal at a time
+    if (retired_ != nullptr || closed_ || reader_ == nullptr) return false;  // one renewal at a time; none before Start()
+    started = started_;
   }
   fdds::DataReader* fresh = make_();
   if (fresh == nullptr) return false;
@@ -510,7 +577,7 @@ bool DdsSerializedReader::Renew() {
     reader_ = fresh;
     retired_at_ = std::chrono::steady_clock::now();
   }
-  fresh->set_listener(listener_.get(), kSerializedMask);
+  fresh->set_listener(listener_.get(), started ? kSerializedMask : kStoppedMask);
   std::lock_guard<std::mutex> lock(mutex_);
   if (!closed_) Drain();
   return true;
@@ -521,13 +588,14 @@ bool DdsSerializedReader::Reap(bool force) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (retired_ == nullptr) return true;
     if (!force && !RetiredDone(retired_, retired_at_)) return false;
-    if (!closed_) Drain(retired_);
+    if (!closed_ && started_) Drain(retired_);
     graveyard_.push_back(std::exchange(retired_, nullptr));  // drained, deleted with this reader (kRetireS)
   }
   return true;
 }
 
 void DdsSerializedReader::Drain() {
+  if (!started_ || reader_ == nullptr) return;  // stopped: the KEEP_LAST history holds what comes
   for (fdds::DataReader* d : graveyard_) Drain(d);  // KEEP_ALL: what still reaches them must not pile up
   if (retired_ != nullptr) Drain(retired_);  // its samples are older
   Drain(reader_);
@@ -575,22 +643,20 @@ Status DdsSerializedWriter::Write(std::span<const uint8_t> cdr, int64_t source_s
   std::lock_guard<std::mutex> lock(mutex_);
   Scratch& s = *scratch_;
   if (cdr.size() > UINT32_MAX) return Status::InvalidArgument("topic '" + topic_ + "': sample of " + std::to_string(cdr.size()) + " bytes is too large");
-  if (s.payload.max_size < cdr.size()) s.payload.reserve(static_cast<uint32_t>(cdr.size()));
-  std::copy(cdr.begin(), cdr.end(), s.payload.data);
-  s.payload.length = static_cast<uint32_t>(cdr.size());
-  s.payload.pos = 0;
-  bool decoded = false;
-  try {  // fastcdr throws on short input; nothing may escape to the component
-    decoded = s.support->deserialize(&s.payload, s.sample);
-  } catch (...) {
-    decoded = false;
-  }
-  if (!decoded)
+  if (!DecodeInto(*s.support, s.payload, cdr, s.sample))
     return Status::InvalidArgument("topic '" + topic_ + "': " + std::to_string(cdr.size()) + " bytes do not decode as " + type_->name);
   const int64_t stamp = source_stamp_ns >= 0 ? source_stamp_ns : clock_->now_ns();
   if (writer_->write_w_timestamp(s.sample, fdds::HANDLE_NIL, TimeOfNs(stamp)) != ReturnCode_t::RETCODE_OK)
     return Status::IOError("topic '" + topic_ + "': DDS write failed");
   ++written_;
+  return Status::OK();
+}
+
+Status DecodeSample(std::span<const uint8_t> cdr, const TypeInfo& type, void* sample) {
+  std::unique_ptr<fdds::TopicDataType> support(type.make_type_support());
+  eprosima::fastrtps::rtps::SerializedPayload_t payload;
+  if (!DecodeInto(*support, payload, cdr, sample))
+    return Status::InvalidArgument(std::to_string(cdr.size()) + " bytes do not decode as " + type.name);
   return Status::OK();
 }
 
@@ -753,7 +819,8 @@ std::vector<EndpointMatch> DdsParticipant::Matches() const {
     out.push_back({w->topic_, true, true, WriterMatched(w->writer_)});
   }
   for (const auto& r : readers_) out.push_back({r->topic_, false, false, r->Matched()});
-  for (const auto& r : serialized_readers_) out.push_back({r->topic_, false, true, r->Matched()});
+  for (const auto& r : serialized_readers_)
+    if (r->exists()) out.push_back({r->topic_, false, true, r->Matched()});  // not an on-demand one never started
   return out;
 }
 
@@ -882,11 +949,25 @@ StatusOr<TypedWriter*> DdsParticipant::CreateWriter(const std::string& topic, co
   return writers_.back().get();
 }
 
-StatusOr<SerializedSubscription*> DdsParticipant::CreateSerializedReader(const std::string& topic,
-                                                                                      const TypeInfo& type,
-                                                                                      const TopicQos& qos,
-                                                                                      const Clock* clock,
-                                                                                      SerializedCallback callback) {
+StatusOr<SerializedSubscription*> DdsParticipant::CreateSerializedReader(const std::string& topic, const TypeInfo& type,
+                                                                        const TopicQos& qos, const Clock* clock,
+                                                                        SerializedCallback callback) {
+  auto r = MakeSerializedReader(topic, type, qos, clock, std::move(callback), /*on_demand=*/false);
+  if (!r.ok()) return r.status();
+  return r.value();
+}
+
+StatusOr<OnDemandReader*> DdsParticipant::CreateOnDemandReader(const std::string& topic, const TypeInfo& type,
+                                                               const TopicQos& qos, const Clock* clock,
+                                                               SerializedCallback callback) {
+  auto r = MakeSerializedReader(topic, type, qos, clock, std::move(callback), /*on_demand=*/true);
+  if (!r.ok()) return r.status();
+  return r.value();
+}
+
+StatusOr<DdsSerializedReader*> DdsParticipant::MakeSerializedReader(const std::string& topic, const TypeInfo& type,
+                                                                    const TopicQos& qos, const Clock* clock,
+                                                                    SerializedCallback callback, bool on_demand) {
   if (Status st = GetTopic(topic, type); !st.ok()) return st;
   fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
   ApplyQos(rq, qos);
@@ -908,11 +989,14 @@ StatusOr<SerializedSubscription*> DdsParticipant::CreateSerializedReader(const s
   // that came in between are drained right after. A renewal's new reader is made the same way.
   r->make_ = [this, topic, rq] { return NewReader(topic, rq); };
   r->destroy_ = DeleteReader;
-  r->reader_ = r->make_();
-  if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
-  r->listener_->SetCurrent(r->reader_);
-  r->reader_->set_listener(r->listener_.get(), kSerializedMask);
-  {
+  if (on_demand) {
+    r->started_ = false;  // no DDS reader until Start()
+  } else {
+    r->reader_ = r->make_();
+    if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
+    r->exists_.store(true, std::memory_order_release);
+    r->listener_->SetCurrent(r->reader_);
+    r->reader_->set_listener(r->listener_.get(), kSerializedMask);
     std::lock_guard<std::mutex> lock(r->mutex_);
     r->Drain();
   }

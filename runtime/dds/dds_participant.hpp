@@ -127,27 +127,39 @@ class DdsWriter final : public TypedWriter {
 // The sample is taken as the type's C++ object and serialised again (Fast DDS 2.9 offers no
 // public access to the received payload); the callback runs on the delivering thread under a
 // per-reader mutex, so never concurrently with itself.
-class DdsSerializedReader final : public SerializedSubscription {
+// On demand (SubscribeSerializedOnDemand): created stopped, with no DDS reader; the first Start()
+// creates it; Stop() stops taking (the DDS reader stays, KEEP_LAST, see kRetireS for why it is
+// not deleted) and no callback runs until the next Start(). A plain subscription is started at
+// creation and never stopped.
+class DdsSerializedReader final : public OnDemandReader {
  public:
   ~DdsSerializedReader() override;
   void Close() override;
-  const std::string& topic() const { return topic_; }
+  const std::string& topic() const override { return topic_; }
   uint64_t delivered() const override { return delivered_.load(std::memory_order_relaxed); }
+  Status Start() override;
+  void Stop() override;
+  bool started() const override;
 
  private:
   friend class DdsParticipant;
   class Listener;
   DdsSerializedReader();
-  void Drain();  // REQUIRES: mutex_ held
+  void Drain();  // REQUIRES: mutex_ held; nothing when stopped
   void Drain(eprosima::fastdds::dds::DataReader* reader);  // REQUIRES: mutex_ held
   int Matched() const;
+  bool exists() const { return exists_.load(std::memory_order_acquire); }  // a DDS reader was made
   bool Renew();
   bool Reap(bool force);  // true: nothing retired is left
   std::string topic_;
   const Clock* clock_ = nullptr;  // owned by the executor
   SerializedCallback callback_;
-  mutable std::mutex mutex_;  // serializes Drain (and the callback); reader_/retired_ change under it
+  // Serializes the DDS reader's life (Start, Stop, Renew); taken before mutex_, never by a callback.
+  std::mutex entity_mutex_;
+  mutable std::mutex mutex_;  // serializes Drain (and the callback); reader_/retired_/started_ change under it
   bool closed_ = false;
+  bool started_ = true;  // false for an on-demand subscription until Start(), and after Stop()
+  std::atomic<bool> exists_{false};
   std::atomic<uint64_t> delivered_{0};
   struct Scratch;
   std::unique_ptr<Scratch> scratch_;  // type support, sample, payload: reused for every sample
@@ -243,6 +255,8 @@ class DdsParticipant final : public Transport {
   StatusOr<SerializedSubscription*> CreateSerializedReader(const std::string& topic, const TypeInfo& type,
                                                            const TopicQos& qos, const Clock* clock,
                                                            SerializedCallback callback) override;
+  StatusOr<OnDemandReader*> CreateOnDemandReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
+                                                 const Clock* clock, SerializedCallback callback) override;
   StatusOr<SerializedWriter*> CreateSerializedWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
                                                      const Clock* clock) override;
 
@@ -280,6 +294,9 @@ class DdsParticipant final : public Transport {
   Status GetTopic(const std::string& topic, const TypeInfo& type);  // on the current generation
   eprosima::fastdds::dds::DataReader* NewReader(const std::string& topic, const eprosima::fastdds::dds::DataReaderQos& qos);
   eprosima::fastdds::dds::DataWriter* NewWriter(const std::string& topic, const eprosima::fastdds::dds::DataWriterQos& qos);
+  // A serialized reader, started (plain) or stopped with no DDS reader yet (on demand).
+  StatusOr<DdsSerializedReader*> MakeSerializedReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
+                                                      const Clock* clock, SerializedCallback callback, bool on_demand);
 
   std::string name_;
   int domain_id_ = 0;

@@ -22,6 +22,7 @@
 
 #include <dyad/component.hpp>
 #include <dyad/graph.hpp>
+#include <dyad/on_demand_subscription.hpp>
 #include <dyad/status.hpp>
 
 #include "graph/runtime_topics.hpp"
@@ -62,6 +63,10 @@ class SerializedSubscription {
   virtual uint64_t delivered() const = 0;
 };
 
+// A SubscribeSerializedOnDemand subscription (dyad/on_demand_subscription.hpp): created
+// stopped, reads only between Start() and Stop(); Close() ends it for good, as above.
+class OnDemandReader : public SerializedSubscription, public OnDemandSubscription {};
+
 class Transport {
  public:
   virtual ~Transport() = default;
@@ -86,6 +91,12 @@ class Transport {
   virtual StatusOr<SerializedSubscription*> CreateSerializedReader(const std::string& topic, const TypeInfo& type,
                                                                    const TopicQos& qos, const Clock* clock,
                                                                    SerializedCallback callback) = 0;
+  // The same, created stopped: no reader, no callback until Start(); `qos` should be KEEP_LAST.
+  // A transport without it answers Unimplemented.
+  virtual StatusOr<OnDemandReader*> CreateOnDemandReader(const std::string& topic, const TypeInfo&, const TopicQos&,
+                                                         const Clock*, SerializedCallback) {
+    return Status::Unimplemented("topic '" + topic + "': this transport has no on-demand subscriptions");
+  }
   virtual StatusOr<SerializedWriter*> CreateSerializedWriter(const std::string& topic, const TypeInfo& type,
                                                              const TopicQos& qos, const Clock* clock) = 0;
 };

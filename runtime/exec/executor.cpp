@@ -101,7 +101,7 @@ struct Executor::Instance {
   const std::string& name() const { return rc->config->name; }
 };
 
-class Executor::ContextImpl final : public Context {
+class Executor::ContextImpl final : public Context, public detail::ContextExtensions {
  public:
   ContextImpl(Executor* ex, Instance* inst)
       : ex_(ex), inst_(inst), logger_(inst->name()), seed_(ComponentSeed(ex->graph_.seed, inst->name())) {}
@@ -124,25 +124,13 @@ class Executor::ContextImpl final : public Context {
     return ex_->catalog_ ? ex_->catalog_->FindMessageType(std::string(name)) : nullptr;
   }
   Status SubscribeSerialized(const std::string& topic, SerializedCallback callback) override {
-    if (!inst_->configuring) return Status::FailedPrecondition(inst_->name() + ": SubscribeSerialized('" + topic + "') outside Configure()");
-    const TopicInfo* info = ex_->FindTopic(topic);
-    if (info == nullptr) return Status::NotFound("topic '" + topic + "' is not a topic of graph '" + ex_->graph_.name + "'");
-    // KEEP_ALL: the reader never drops a sample. Reliability follows the topic's writers, except
-    // that writers all in this process deliver synchronously inside write(): a BEST_EFFORT reader
-    // then loses nothing and costs a third of a RELIABLE one (bench/recorder).
-    const bool reliable = info->reliable && !info->writers_local;
-    TopicQos qos{reliable ? Reliability::kReliable : Reliability::kBestEffort, info->depth, 0, true};
-    // The callback's time is the subscriber's, not that of the step whose Publish() delivers it.
-    StepStats* stats = &inst_->stats;
-    SerializedCallback timed = [cb = std::move(callback), stats](const SerializedSample& sample) {
-      NestedTimer timer;
-      cb(sample);
-      stats->RecordDelivery(timer.Stop());
-    };
-    auto r = ex_->transport_->CreateSerializedReader(topic, *info->type, qos, ex_->clock_.get(), std::move(timed));
-    if (!r.ok()) return r.status().WithContext(inst_->name() + ": SubscribeSerialized('" + topic + "')");
-    inst_->serialized_readers.push_back(r.value());
-    return Status::OK();
+    auto r = Subscribe("SubscribeSerialized", topic, std::move(callback), /*on_demand=*/false);
+    return r.ok() ? Status::OK() : r.status();
+  }
+  StatusOr<OnDemandSubscription*> SubscribeSerializedOnDemand(const std::string& topic, SerializedCallback callback) override {
+    auto r = Subscribe("SubscribeSerializedOnDemand", topic, std::move(callback), /*on_demand=*/true);
+    if (!r.ok()) return r.status();
+    return static_cast<OnDemandReader*>(r.value());
   }
   StatusOr<SerializedWriter*> AdvertiseSerialized(const std::string& topic, const TypeInfo& type) override {
     if (!inst_->configuring) return Status::FailedPrecondition(inst_->name() + ": AdvertiseSerialized('" + topic + "') outside Configure()");
@@ -184,6 +172,38 @@ class Executor::ContextImpl final : public Context {
   }
 
  private:
+  // A serialized subscription for the component; `on_demand`: created stopped, KEEP_LAST.
+  StatusOr<SerializedSubscription*> Subscribe(const char* call, const std::string& topic, SerializedCallback callback,
+                                              bool on_demand) {
+    const std::string what = inst_->name() + ": " + call + "('" + topic + "')";
+    if (!inst_->configuring) return Status::FailedPrecondition(what + " outside Configure()");
+    const TopicInfo* info = ex_->FindTopic(topic);
+    if (info == nullptr) return Status::NotFound("topic '" + topic + "' is not a topic of graph '" + ex_->graph_.name + "'");
+    // KEEP_ALL: the reader never drops a sample (on demand, a viewer's: the topic's depth).
+    // Reliability follows the topic's writers, except that writers all in this process deliver
+    // synchronously inside write(): a BEST_EFFORT reader then loses nothing and costs a third of
+    // a RELIABLE one (bench/recorder).
+    const bool reliable = info->reliable && !info->writers_local;
+    TopicQos qos{reliable ? Reliability::kReliable : Reliability::kBestEffort,
+                 on_demand ? std::max(info->depth, 1) : info->depth, 0, !on_demand};
+    // The callback's time is the subscriber's, not that of the step whose Publish() delivers it.
+    StepStats* stats = &inst_->stats;
+    SerializedCallback timed = [cb = std::move(callback), stats](const SerializedSample& sample) {
+      NestedTimer timer;
+      cb(sample);
+      stats->RecordDelivery(timer.Stop());
+    };
+    if (on_demand) {
+      auto d = ex_->transport_->CreateOnDemandReader(topic, *info->type, qos, ex_->clock_.get(), std::move(timed));
+      if (!d.ok()) return d.status().WithContext(what);
+      inst_->serialized_readers.push_back(d.value());
+      return static_cast<SerializedSubscription*>(d.value());
+    }
+    auto r = ex_->transport_->CreateSerializedReader(topic, *info->type, qos, ex_->clock_.get(), std::move(timed));
+    if (!r.ok()) return r.status().WithContext(what);
+    inst_->serialized_readers.push_back(r.value());
+    return r;
+  }
   [[noreturn]] void Abort(const char* kind, std::string_view port, const TypeInfo& type) {
     std::fprintf(stderr, "dyad: component '%s' (%s) asked for %s '%.*s' of type %s, which it did not declare so\n",
                  inst_->name().c_str(), inst_->rc->config->type.c_str(), kind, static_cast<int>(port.size()), port.data(),

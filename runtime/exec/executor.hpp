@@ -32,8 +32,9 @@
 // component stops once that many of its periods have passed since the graph's start, plus a
 // second for the last samples to arrive.
 //
-// Serialized subscriptions (Context::SubscribeSerialized) call back on the delivering thread; each
-// is closed (unread samples delivered first) just before its component's Deactivate(). The last
+// Serialized subscriptions (Context::SubscribeSerialized, and SubscribeSerializedOnDemand's while
+// started) call back on the delivering thread; each is closed (unread samples delivered first)
+// just before its component's Deactivate(). The last
 // stats are published before any component is deactivated, so a recorder sees them.
 //
 // Ownership: the transport owns every endpoint; it is destroyed before components and ports,

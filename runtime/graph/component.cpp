@@ -1,6 +1,8 @@
 // Out-of-line parts of the component API (compiled into the runtime library).
 #include "dyad/component.hpp"
 
+#include <dyad/on_demand_subscription.hpp>
+
 #include <cstdio>
 #include <cstdlib>
 
@@ -32,6 +34,13 @@ Status Context::SubscribeSerialized(const std::string& topic, SerializedCallback
 }
 StatusOr<SerializedWriter*> Context::AdvertiseSerialized(const std::string& topic, const TypeInfo&) {
   return Status::Unimplemented("AdvertiseSerialized('" + topic + "'): this context has no DDS topics");
+}
+
+StatusOr<OnDemandSubscription*> SubscribeSerializedOnDemand(Context& ctx, const std::string& topic,
+                                                            SerializedCallback callback) {
+  auto* ext = dynamic_cast<detail::ContextExtensions*>(&ctx);
+  if (ext == nullptr) return Status::Unimplemented("SubscribeSerializedOnDemand('" + topic + "'): this context has no DDS topics");
+  return ext->SubscribeSerializedOnDemand(topic, std::move(callback));
 }
 
 ParamSpec& ComponentSpec::AddParam(std::string name, ParamType type, std::optional<ParamValue> default_value) {

@@ -21,6 +21,7 @@
 #include <span>
 #include <sstream>
 
+#include <dyad/on_demand_subscription.hpp>
 #include <dyad/validate.hpp>
 
 #include "graph/graph_topics.hpp"
@@ -48,6 +49,18 @@ class NullSerializedWriter final : public SerializedWriter {
   std::string topic_;
   const TypeInfo& type_;
 };
+class NullOnDemandSubscription final : public OnDemandSubscription {
+ public:
+  explicit NullOnDemandSubscription(std::string topic) : topic_(std::move(topic)) {}
+  const std::string& topic() const override { return topic_; }
+  Status Start() override { started_ = true; return Status::OK(); }
+  void Stop() override { started_ = false; }
+  bool started() const override { return started_; }
+
+ private:
+  std::string topic_;
+  bool started_ = false;
+};
 class ZeroClock final : public Clock {
  public:
   int64_t now_ns() const override { return 0; }
@@ -57,7 +70,7 @@ class QuietLogger final : public Logger {
   void Write(Level, std::string_view) override {}
 };
 
-class DryContext final : public Context {
+class DryContext final : public Context, public detail::ContextExtensions {
  public:
   DryContext(const Graph& graph, const ResolvedComponent& rc, const Catalog& catalog, const std::vector<TopicInfo>& topics)
       : graph_(graph), rc_(rc), catalog_(catalog), topics_(topics) {
@@ -97,6 +110,11 @@ class DryContext final : public Context {
       if (t.name == topic) return Status::OK();
     return Status::NotFound("topic '" + topic + "' is not a topic of graph '" + graph_.name + "'");
   }
+  StatusOr<OnDemandSubscription*> SubscribeSerializedOnDemand(const std::string& topic, SerializedCallback callback) override {
+    if (Status s = SubscribeSerialized(topic, std::move(callback)); !s.ok()) return s;
+    on_demand_.push_back(std::make_unique<NullOnDemandSubscription>(topic));
+    return on_demand_.back().get();
+  }
   StatusOr<SerializedWriter*> AdvertiseSerialized(const std::string& topic, const TypeInfo& type) override {
     for (const auto& t : topics_)
       if (t.name == topic && t.type->name != type.name)
@@ -134,6 +152,7 @@ class DryContext final : public Context {
   std::vector<std::unique_ptr<InputBase>> inputs_;
   std::vector<std::unique_ptr<OutputBase>> outputs_;
   std::vector<std::unique_ptr<NullSerializedWriter>> writers_;
+  std::vector<std::unique_ptr<NullOnDemandSubscription>> on_demand_;
 };
 
 // Where a Configure message points: "components.<c>.params.<path>: msg", "params.<path>: msg" or

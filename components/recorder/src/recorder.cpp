@@ -4,7 +4,7 @@
 #include <ctime>
 #include <filesystem>
 
-#include "topic_select.hpp"
+#include <dyad/topic_select.hpp>
 
 namespace dyad::recorder {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "topic_select.hpp"
+#include <dyad/topic_select.hpp>
 
 namespace dyad::recorder {
 namespace {

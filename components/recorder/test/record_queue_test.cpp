@@ -1,10 +1,9 @@
-// RecordQueue and SelectTopics: the recorder's hand-over queue and its topic choice.
+// RecordQueue: the recorder's hand-over queue.
 #include <gtest/gtest.h>
 
 #include <thread>
 
 #include "record_queue.hpp"
-#include "topic_select.hpp"
 
 namespace dyad::recorder {
 namespace {
@@ -75,31 +74,6 @@ TEST(RecordQueue, ARecordLargerThanAnArenaIsAcceptedWhole) {
   size_t seen = 0;
   b.ForEach([&](const RecordEntry&, std::span<const uint8_t> d) { seen = d.size(); });
   EXPECT_EQ(seen, 100000u);
-}
-
-TEST(SelectTopics, EmptyChoosesAllButTheExcluded) {
-  auto r = SelectTopics({}, {"a", "b", "dyad/stats"}, "params.topics", {"dyad/stats"});
-  ASSERT_TRUE(r.ok());
-  EXPECT_EQ(*r, (std::vector<std::string>{"a", "b"}));
-}
-
-TEST(SelectTopics, NamesAndRegexesMatchWholeNamesInGraphOrder) {
-  auto r = SelectTopics({"robot/.*", "human/input"}, {"human/input", "robot/command", "robot/state", "xrobot/y"}, "p");
-  ASSERT_TRUE(r.ok());
-  EXPECT_EQ(*r, (std::vector<std::string>{"human/input", "robot/command", "robot/state"}));
-}
-
-TEST(SelectTopics, APatternMatchingNothingNamesTheParamEntry) {
-  auto r = SelectTopics({"a", "nope"}, {"a", "b"}, "params.topics");
-  ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.status().message(), "params.topics[1] = 'nope': matches no topic (topics: a, b)");
-}
-
-TEST(SelectTopics, AnInvalidRegexNamesTheParamEntry) {
-  auto r = SelectTopics({"a[b"}, {"a"}, "params.topics");
-  ASSERT_FALSE(r.ok());
-  EXPECT_NE(r.status().message().find("params.topics[0] = 'a[b': neither a topic nor a valid regular expression"), std::string::npos)
-      << r.status().message();
 }
 
 }  // namespace

@@ -8,6 +8,33 @@ FoxgloveBridge::FoxgloveBridge(std::string server_name, std::vector<foxglove::Ch
                                std::map<std::string, SerializedWriter*> writers)
     : server_name_(std::move(server_name)), channels_(std::move(channels)), writers_(std::move(writers)) {}
 
+void FoxgloveBridge::SetSubscription(uint32_t channel_id, OnDemandSubscription* subscription) {
+  std::lock_guard<std::mutex> demand(demand_mutex_);
+  subscriptions_[channel_id] = subscription;
+}
+
+std::vector<std::string> FoxgloveBridge::SyncSubscriptions(const std::set<uint32_t>& channels) {
+  std::vector<std::string> problems;
+  std::lock_guard<std::mutex> demand(demand_mutex_);
+  for (uint32_t channel : channels) {
+    auto sub = subscriptions_.find(channel);
+    if (sub == subscriptions_.end() || sub->second == nullptr) continue;
+    bool wanted = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      auto r = routes_.find(channel);
+      wanted = r != routes_.end() && !r->second.empty();
+    }
+    if (wanted == sub->second->started()) continue;
+    if (!wanted) {
+      sub->second->Stop();
+    } else if (Status s = sub->second->Start(); !s.ok()) {
+      problems.push_back("subscribe: channel " + std::to_string(channel) + ": " + s.message());
+    }
+  }
+  return problems;
+}
+
 void FoxgloveBridge::OnSample(uint32_t channel_id, const SerializedSample& sample) {
   std::vector<std::pair<ClientId, uint32_t>> to;
   {
@@ -64,6 +91,7 @@ Status FoxgloveBridge::OnText(ClientId client, std::string_view text) {
   auto parsed = foxglove::ParseClientText(text);
   if (!parsed.ok()) return parsed.status();
   std::vector<std::string> problems;
+  std::set<uint32_t> changed;  // channels whose routes changed
   {
     std::lock_guard<std::mutex> lock(mutex_);
     ClientState& st = clients_[client];
@@ -79,6 +107,7 @@ Status FoxgloveBridge::OnText(ClientId client, std::string_view text) {
         }
         st.subscriptions[sub] = channel;
         routes_[channel].emplace_back(client, sub);
+        changed.insert(channel);
       }
     } else if (auto* u = std::get_if<foxglove::Unsubscribe>(&*parsed)) {
       for (uint32_t sub : u->subscription_ids) {
@@ -86,6 +115,7 @@ Status FoxgloveBridge::OnText(ClientId client, std::string_view text) {
         if (it == st.subscriptions.end()) continue;
         auto& r = routes_[it->second];
         std::erase(r, std::make_pair(client, sub));
+        changed.insert(it->second);
         st.subscriptions.erase(it);
       }
     } else if (auto* a = std::get_if<foxglove::ClientAdvertise>(&*parsed)) {
@@ -106,6 +136,7 @@ Status FoxgloveBridge::OnText(ClientId client, std::string_view text) {
       problems.push_back("op '" + other->op + "' is not supported by this server");
     }
   }
+  for (auto& p : SyncSubscriptions(changed)) problems.push_back(std::move(p));
   for (const auto& p : problems) SendStatus(client, foxglove::Level::kError, p);
   return Status::OK();
 }
@@ -132,11 +163,18 @@ Status FoxgloveBridge::OnBinary(ClientId client, std::span<const uint8_t> bytes)
 }
 
 void FoxgloveBridge::OnClose(ClientId client) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  auto it = clients_.find(client);
-  if (it == clients_.end()) return;
-  for (const auto& [sub, channel] : it->second.subscriptions) std::erase(routes_[channel], std::make_pair(client, sub));
-  clients_.erase(it);
+  std::set<uint32_t> changed;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = clients_.find(client);
+    if (it == clients_.end()) return;
+    for (const auto& [sub, channel] : it->second.subscriptions) {
+      std::erase(routes_[channel], std::make_pair(client, sub));
+      changed.insert(channel);
+    }
+    clients_.erase(it);
+  }
+  SyncSubscriptions(changed);  // a stop cannot fail
 }
 
 uint64_t FoxgloveBridge::samples_sent() const {

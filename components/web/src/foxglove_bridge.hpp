@@ -8,6 +8,12 @@
 /// bridge through the runtime's serialized subscriptions and are only queued here (WebServer's
 /// per-client SendQueue): the experiment never waits for a client.
 ///
+/// Reading on demand, as foxglove_bridge does: each channel's subscription (an
+/// OnDemandSubscription) is started when the first client subscribes to the channel and stopped
+/// when the last one unsubscribes or closes; a topic nobody watches is neither read nor decoded
+/// (no DDS reader at all until it is first watched). A subscription that cannot start is
+/// reported to the subscribing client as a status error.
+///
 /// Client publishing: only on topics listed as writable; anything else is refused with a status
 /// error. A malformed JSON or binary message closes that client with the reason.
 #pragma once
@@ -22,6 +28,7 @@
 #include <vector>
 
 #include <dyad/component.hpp>
+#include <dyad/on_demand_subscription.hpp>
 
 #include "foxglove_protocol.hpp"
 #include "web_server.hpp"
@@ -36,6 +43,10 @@ class FoxgloveBridge final : public ClientHandler {
                  std::map<std::string, SerializedWriter*> writers);
   // Set once the server runs; null again before it stops. Samples and clients before that are ignored.
   void SetServer(WebServer* server) { server_.store(server); }
+  // The subscription feeding channel `channel_id` (its samples go to OnSample), owned by the
+  // runtime; started and stopped with the channel's client subscriptions. Set each before the
+  // server starts; a channel without one is fed by whatever calls OnSample.
+  void SetSubscription(uint32_t channel_id, OnDemandSubscription* subscription);
 
   // A sample of channel `channel_id` (called on the graph's delivering threads).
   void OnSample(uint32_t channel_id, const SerializedSample& sample);
@@ -55,6 +66,10 @@ class FoxgloveBridge final : public ClientHandler {
     std::map<uint32_t, SerializedWriter*> publishing;  // client channel id -> writer
   };
   void SendStatus(ClientId client, foxglove::Level level, const std::string& message);
+  // Starts or stops each channel's subscription to match whether any client subscribes to it;
+  // returns the problems of those that failed to start. Called without mutex_ held (Stop waits
+  // for a running OnSample, which takes it).
+  std::vector<std::string> SyncSubscriptions(const std::set<uint32_t>& channels);
 
   const std::string server_name_;
   const std::vector<foxglove::Channel> channels_;
@@ -65,6 +80,9 @@ class FoxgloveBridge final : public ClientHandler {
   // channel id -> (client, subscription id): what OnSample sends to.
   std::map<uint32_t, std::vector<std::pair<ClientId, uint32_t>>> routes_;
   uint64_t sent_ = 0;
+  // Serializes SyncSubscriptions (client threads: the handler thread, civetweb's on close).
+  std::mutex demand_mutex_;
+  std::map<uint32_t, OnDemandSubscription*> subscriptions_;  // by channel id; set before the server
 };
 
 }  // namespace dyad::web

@@ -14,50 +14,58 @@ void SendQueue::PushControl(std::string json) {
 }
 
 bool SendQueue::PushData(uint32_t channel, std::string bytes, bool binary, std::shared_ptr<const std::string> tail) {
-  bool wake = false;
+  bool queued = false, wake = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (closed_) return false;
-    Frame frame{binary, std::move(bytes), std::move(tail), channel, 0};
-    const size_t size = frame.size();
-    if (size > limit_) {
-      ++drops_[channel];
-      return false;
-    }
-    while (bytes_ + size > limit_) {
-      // The channel holding the most bytes gives up its oldest frame.
-      uint32_t busiest = 0;
-      size_t most = 0;
-      for (const auto& [c, b] : channel_bytes_)
-        if (b > most) most = b, busiest = c;
-      auto& q = data_[busiest];
-      bytes_ -= q.front().size();
-      channel_bytes_[busiest] -= q.front().size();
-      q.pop_front();
-      ++drops_[busiest];
-    }
-    bytes_ += size;
-    channel_bytes_[channel] += size;
-    frame.order = next_order_++;
-    data_[channel].push_back(std::move(frame));
-    wake = consumer_idle_;
-    consumer_idle_ = false;  // one wake-up is enough
-    if (wake) ++wakeups_by_producers_;
+    queued = PushDataLocked(channel, Frame{binary, std::move(bytes), std::move(tail), channel, 0}, &wake);
   }
   if (wake) cv_.notify_one();
-  return true;
+  return queued;
 }
 
 void SendQueue::PushLatest(uint32_t channel, std::string bytes, bool binary) {
+  bool wake = false;
   {
+    // One lock hold: two producers of the channel cannot both leave a frame queued.
     std::lock_guard<std::mutex> lock(mutex_);
     if (closed_) return;
-    auto& q = data_[channel];
-    for (const auto& f : q) bytes_ -= f.size();
-    channel_bytes_[channel] = 0;
-    q.clear();
+    if (auto it = data_.find(channel); it != data_.end()) {
+      for (const auto& f : it->second) bytes_ -= f.size();
+      it->second.clear();
+      channel_bytes_[channel] = 0;
+    }
+    PushDataLocked(channel, Frame{binary, std::move(bytes), nullptr, channel, 0}, &wake);
   }
-  PushData(channel, std::move(bytes), binary);
+  if (wake) cv_.notify_one();
+}
+
+bool SendQueue::PushDataLocked(uint32_t channel, Frame frame, bool* wake) {
+  if (closed_) return false;
+  const size_t size = frame.size();
+  if (size > limit_) {
+    ++drops_[channel];
+    return false;
+  }
+  while (bytes_ + size > limit_) {
+    // The channel holding the most bytes gives up its oldest frame (a scan of the channels).
+    uint32_t busiest = 0;
+    size_t most = 0;
+    for (const auto& [c, b] : channel_bytes_)
+      if (b > most) most = b, busiest = c;
+    auto& q = data_[busiest];
+    bytes_ -= q.front().size();
+    channel_bytes_[busiest] -= q.front().size();
+    q.pop_front();
+    ++drops_[busiest];
+  }
+  bytes_ += size;
+  channel_bytes_[channel] += size;
+  frame.order = next_order_++;
+  data_[channel].push_back(std::move(frame));
+  *wake = consumer_idle_;
+  consumer_idle_ = false;  // one wake-up is enough
+  if (*wake) ++wakeups_by_producers_;
+  return true;
 }
 
 bool SendQueue::PopAll(std::vector<Frame>* out) {
@@ -82,7 +90,7 @@ bool SendQueue::PopAll(std::vector<Frame>* out) {
       consumer_idle_ = false;
     }
     last_flush_ = std::chrono::steady_clock::now();
-    // O(1) under the lock: producers (graph threads) wait for it.
+    // Swaps, no copies: producers (graph threads) wait for this lock.
     control.swap(control_);
     data.swap(data_);
     channel_bytes_.clear();

@@ -15,8 +15,12 @@
 /// client's consumer sleeps until there is something to send (no polling). Control frames and
 /// Close() always wake it at once.
 ///
-/// Memory: at most `limit_bytes` queued, plus the batch the consumer is writing. A producer holds
-/// the queue's mutex for O(1) work, and so does the consumer (it takes a batch by swapping).
+/// Memory: at most `limit_bytes` queued, plus the batch the consumer is writing. Work under the
+/// queue's mutex: a push that fits is O(log channels) (per-channel maps); a push past the limit
+/// also scans the channels once per frame it drops, to find the busiest (channels number tens);
+/// PushLatest frees the frames it replaces; the consumer takes a batch by swapping the queues and
+/// clears the per-channel byte counts (O(channels)). Merging a batch into push order happens
+/// after the lock is released.
 ///
 /// Thread-safe: any number of producers, one consumer (the client's sender thread) blocking in
 /// PopAll().
@@ -59,7 +63,8 @@ class SendQueue {
   // dropped itself. Returns false if dropped.
   bool PushData(uint32_t channel, std::string bytes, bool binary = true, std::shared_ptr<const std::string> tail = nullptr);
   // Queues a data frame that replaces any frame of `channel` still queued (newest only: a slow
-  // page gets the latest robot state, never a backlog).
+  // page gets the latest robot state, never a backlog). Atomic: whatever the producers, at most
+  // one frame of `channel` is queued after each call. Replaced frames are not counted as drops.
   void PushLatest(uint32_t channel, std::string bytes, bool binary = true);
   // Waits until there is something to send (see "Waking the consumer"), then moves every queued
   // frame to `out` (replacing its contents): control frames first, then data in push order.
@@ -77,6 +82,8 @@ class SendQueue {
 
  private:
   bool HasData() const;  // REQUIRES: mutex_ held
+  // PushData's work; sets *wake when the consumer must be notified. REQUIRES: mutex_ held.
+  bool PushDataLocked(uint32_t channel, Frame frame, bool* wake);
   const size_t limit_;
   const std::chrono::steady_clock::duration flush_interval_;
   mutable std::mutex mutex_;

@@ -38,8 +38,14 @@ namespace dyad::web {
 
 using ClientId = uint64_t;
 
-// What the application does with WebSocket clients. Called from civetweb's threads; one
-// client's calls never overlap, different clients' may.
+// What the application does with WebSocket clients. Threads:
+//   - OnOpen and OnClose run on the civetweb worker thread that serves the client's connection
+//     (for a client still open when the server stops, while ~WebServer waits for it).
+//   - OnText and OnBinary run on the server's one handler thread (a normal stack: civetweb's are
+//     small), one message at a time across all clients, while the client's worker waits.
+// So one client's calls never overlap and come in order (OnOpen, messages, OnClose), and two
+// clients' messages never overlap either; but one client's OnOpen or OnClose may run while
+// another client's OnText or OnBinary does. Producers calling Send* run on their own threads.
 class ClientHandler {
  public:
   virtual ~ClientHandler() = default;

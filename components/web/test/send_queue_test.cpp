@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <thread>
 
@@ -178,6 +179,42 @@ TEST(SendQueue, AZeroIntervalSendsEachSampleAtOnce) {
   q.Close();
   consumer.join();
   EXPECT_EQ(q.wakeups_by_producers(), 3u);
+}
+
+TEST(SendQueue, PushLatestKeepsOnlyTheNewestFrameOfItsChannel) {
+  SendQueue q(1000);
+  q.PushData(2, "other");
+  q.PushLatest(1, "old");
+  q.PushLatest(1, "new");
+  EXPECT_EQ(q.queued_bytes(), 8u);
+  EXPECT_TRUE(q.TakeDrops().empty());  // replaced, not dropped
+  std::vector<Frame> batch;
+  ASSERT_TRUE(q.PopAll(&batch));
+  EXPECT_EQ(Texts(batch), (std::vector<std::string>{"other", "new"}));
+}
+
+TEST(SendQueue, PushLatestFromTwoProducersAtOnceNeverQueuesTwoFrames) {
+  // Clearing the channel and queueing the new frame in separate lock holds let two producers
+  // both clear, then both queue: two frames where "newest only" promises one. Each producer
+  // looks right after its own push, when the other's frame would still be there.
+  SendQueue q(1 << 20);
+  constexpr int kEach = 200000;
+  std::atomic<size_t> most{0};
+  auto produce = [&](char who) {
+    size_t seen = 0;
+    for (int i = 0; i < kEach; ++i) {
+      q.PushLatest(1, std::string(1, who));
+      seen = std::max(seen, q.queued_bytes());
+    }
+    size_t m = most.load();
+    while (seen > m && !most.compare_exchange_weak(m, seen)) {
+    }
+  };
+  std::thread a(produce, 'a'), b(produce, 'b');
+  a.join();
+  b.join();
+  EXPECT_EQ(most.load(), 1u);
+  EXPECT_EQ(q.queued_bytes(), 1u);
 }
 
 }  // namespace

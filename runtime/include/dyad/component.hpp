@@ -23,6 +23,16 @@
 // synchronises), so a component needs no locks for state only its lifecycle calls touch;
 // serialized-subscription callbacks (below) are the exception: they run on delivering threads,
 // concurrently with Step().
+// Publishing from a component's own thread: Output<T>::Publish() may also be called outside
+// Step(), from a thread the component owns (a server's handler, a device callback), between
+// Activate() and Deactivate(), where it stops that thread (ports stay valid until Shutdown()
+// returns, but once the run stops no triggered component steps on what is published). The
+// transport's write is thread-safe; the port is not: calls on one Output must never overlap
+// (Publish fills the sample's header and counts the sequence number without a lock), so
+// serialise them, or give each thread its own output. Serialized callbacks of this process run
+// on the publishing thread; so do the steps of triggered components under the wall clock (still
+// never concurrently with themselves). Under the stepped clock such a sample is seen at
+// whichever instant comes next: the run is no longer deterministic.
 // Time: the timing the runtime reports for a component (`dyad/stats`, the table at exit) is the
 // time of its own steps and callbacks; downstream work that runs inside its Publish() is not.
 //

@@ -1,9 +1,9 @@
-#include "topic_select.hpp"
+#include <dyad/topic_select.hpp>
 
 #include <algorithm>
 #include <regex>
 
-namespace dyad::recorder {
+namespace dyad {
 
 StatusOr<std::vector<std::string>> SelectTopics(const std::vector<std::string>& patterns,
                                                 const std::vector<std::string>& available, const std::string& param,
@@ -40,4 +40,4 @@ StatusOr<std::vector<std::string>> SelectTopics(const std::vector<std::string>& 
   return out;
 }
 
-}  // namespace dyad::recorder
+}  // namespace dyad
