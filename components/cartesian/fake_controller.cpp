@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
     const auto now = Clock::now();
     for (size_t i = 0; i < pending.size();) {
       if (pending[i].due <= now) {
-        (void)socket->SendTo(pending[i].bytes.data(), pending[i].bytes.size(), pending[i].to);
+        socket->SendTo(pending[i].bytes.data(), pending[i].bytes.size(), pending[i].to).IgnoreError();  // UDP: the driver handles a lost reply
         pending.erase(pending.begin() + static_cast<long>(i));
       } else {
         ++i;
@@ -173,7 +173,7 @@ int main(int argc, char** argv) {
       ++delayed;
       pending.push_back({Clock::now() + std::chrono::milliseconds(delay_ms), tx, from});
     } else {
-      (void)socket->SendTo(tx.data(), tx.size(), from);
+      socket->SendTo(tx.data(), tx.size(), from).IgnoreError();  // as above
     }
   }
   std::printf("commands received %llu, driver sessions %llu, last applied sequence %u, dropped %llu, delayed %llu, "

@@ -21,10 +21,6 @@
 namespace dyad::web {
 namespace {
 
-bool IsLoopback(const std::string& address) {
-  return address.rfind("127.", 0) == 0 || address == "localhost" || address == "::1";
-}
-
 std::string RandomToken() {
   std::random_device rd;
   static const char* hex = "0123456789abcdef";

@@ -89,7 +89,9 @@ class Executor {
     StepStats::Snapshot stats;
   };
   std::vector<Row> Report() const;
-  int type_mismatches() const { return problems_.load(); }
+  // Type mismatches and incompatible QoS with peers (DdsParticipant::Options::on_problem): data
+  // that cannot flow where the graph says it should.
+  int wiring_problems() const { return problems_.load(); }
   // Writers of this process's topics seen in another run's partition (ignored; warned about).
   int foreign_writers() const { return foreign_writers_.load(); }
 

@@ -44,7 +44,7 @@ void ClockSync::Start(double period_s) {
       for (auto& a : answers) {
         a.t3_ns(WallNowNs());
         a.header().stamp_ns(a.t3_ns());
-        (void)probe_writer_->Write(&a);
+        probe_writer_->Write(&a).IgnoreError();  // a lost answer is a lost sample: the peer probes again
       }
       const auto now = std::chrono::steady_clock::now();
       if (now >= next_ask) {
@@ -88,7 +88,7 @@ void ClockSync::Ask() {
   p.t1_ns(t1);
   asked_[next_id_++] = t1;
   lock.unlock();
-  (void)probe_writer_->Write(&p);
+  probe_writer_->Write(&p).IgnoreError();  // a lost probe: the next period probes again
 }
 
 void ClockSync::OnProbes() {
@@ -160,7 +160,7 @@ void ClockSync::Publish() {
     }
     peer.warned = std::abs(offset_ms) > bound_ms;
     lock.unlock();
-    (void)offset_writer_->Write(&o);
+    offset_writer_->Write(&o).IgnoreError();  // reported again each period
   }
 }
 

@@ -41,13 +41,13 @@ class GraphSession final : public ProcessSession {
   Status Heartbeat() override {
     barrier_.Announce("running");
     // Last check's events go out now: after a renewal, the new writer has had a period to match.
-    for (auto& e : pending_) (void)health_writer_->Write(&e);  // the log has said them too
+    for (auto& e : pending_) health_writer_->Write(&e).IgnoreError();  // the log has said them too
     pending_.clear();
     const StartBarrier::Peers peers = barrier_.Hear(EndpointHealth::kFreshS);
     return health_.Check(transport_, peers.running, peers.silence_s);
   }
   void Stopping() override {
-    for (auto& e : pending_) (void)health_writer_->Write(&e);
+    for (auto& e : pending_) health_writer_->Write(&e).IgnoreError();  // as above
     pending_.clear();
     barrier_.Announce("stopping");
   }

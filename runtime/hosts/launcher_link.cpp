@@ -62,7 +62,7 @@ bool LauncherLink::AnnounceFailure(const std::string& process, int restarts) {
   m.pid(static_cast<int32_t>(getpid()));  // the launcher's: the process is gone
   m.state("failed");
   m.restarts(static_cast<uint32_t>(restarts));
-  (void)processes_writer_->Write(&m);  // for `dyad status` and the recorder: no waiting
+  processes_writer_->Write(&m).IgnoreError();  // best effort, for `dyad status` and the recorder: no waiting
   if (!launchers_writer_->Write(&m).ok()) return false;
   // Every other host's launcher (this one's own reader matches too), then their acknowledgments.
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);

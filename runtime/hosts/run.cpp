@@ -181,7 +181,7 @@ ProcessRun RunProcess(Loaded& l, const Executor::Options& eo) {
     if (interrupt.signal() != 0) ex.RequestStop(SignalName(interrupt.signal()));  // before `current` was set
     run.result = ex.Run();
     run.rows = ex.Report();
-    run.mismatches = ex.type_mismatches();
+    run.mismatches = ex.wiring_problems();
     current.store(nullptr);
     run.signal = interrupt.signal();
     {

@@ -295,7 +295,7 @@ Status Writer::Impl::Close() {
   if (s.ok()) s = CloseChunk();
   closed_ = true;
   if (!s.ok()) {
-    file_.Close();  // The first error is the one to report.
+    file_.Close().IgnoreError();  // The first error is the one to report.
     return close_status_ = s;
   }
 
@@ -357,7 +357,7 @@ Writer::Writer(Writer&&) noexcept = default;
 Writer& Writer::operator=(Writer&&) noexcept = default;
 
 Writer::~Writer() {
-  if (impl_) impl_->Close();
+  if (impl_) impl_->Close().IgnoreError();  // a destructor cannot report: callers that care call Close()
 }
 
 StatusOr<Writer> Writer::Open(const std::string& path, const WriterOptions& options) {

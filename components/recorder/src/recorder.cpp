@@ -203,7 +203,9 @@ void Recorder::Shutdown() {
     queue_->Close();
     thread_.join();
   }
-  if (writer_) (void)writer_->Close();
+  // Deactivate closed the file and reported how; here only when it never ran (a failed start).
+  if (writer_)
+    if (Status s = writer_->Close(); !s.ok()) ctx_->log().Error(path_ + ": " + s.message());
 }
 
 }  // namespace dyad::recorder

@@ -31,11 +31,11 @@ std::string QueryValue(const char* query, const std::string& key) {
   return n >= 0 ? std::string(buf, static_cast<size_t>(n)) : "";
 }
 
+}  // namespace
+
 bool IsLoopback(const std::string& address) {
   return address.rfind("127.", 0) == 0 || address == "localhost" || address == "::1";
 }
-
-}  // namespace
 
 // civetweb's worker threads have small stacks (an ASan build overflowed one parsing a small JSON
 // message): client messages are handled on this thread of ours, with a normal stack, one at a

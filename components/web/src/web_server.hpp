@@ -38,6 +38,10 @@ namespace dyad::web {
 
 using ClientId = uint64_t;
 
+// Whether a listen address reaches only this machine (127.x, localhost, ::1): then the server
+// needs no token, and pages from localhost origins are accepted.
+bool IsLoopback(const std::string& address);
+
 // What the application does with WebSocket clients. Threads:
 //   - OnOpen and OnClose run on the civetweb worker thread that serves the client's connection
 //     (for a client still open when the server stops, while ~WebServer waits for it).

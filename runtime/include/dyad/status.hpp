@@ -11,6 +11,9 @@
 //
 // StatusOr<T> holds either a T or a non-OK Status; value() on an error aborts with the message
 // (a broken caller assumption), so check ok() first. Header-only: libraries without DDS use it.
+//
+// Both are [[nodiscard]]: an error dropped by accident is a warning (an error in CI). A caller
+// that means to drop one says so with IgnoreError(), the reason in a comment beside it.
 #pragma once
 
 #include <cstdio>
@@ -22,7 +25,7 @@
 
 namespace dyad {
 
-class Status {
+class [[nodiscard]] Status {
  public:
   enum class Code {
     kOk,
@@ -58,6 +61,9 @@ class Status {
 
   bool ok() const { return code_ == Code::kOk; }
   Code code() const { return code_; }
+  // Drops this result on purpose (a best-effort write the next one repeats; cleanup after the
+  // first error, which is the one reported). Say why beside the call.
+  void IgnoreError() const {}
   // Empty when ok().
   const std::string& message() const { return message_; }
   // "OK" or "<code name>: <message>", e.g. "I/O error: run.mcap: open: Permission denied".
@@ -93,7 +99,7 @@ class Status {
 // Either a value or the Status saying why there is none.
 // REQUIRES: the Status given to the constructor is not OK.
 template <class T>
-class StatusOr {
+class [[nodiscard]] StatusOr {
  public:
   StatusOr(T value) : value_(std::move(value)) {}  // NOLINT: implicit by design
   StatusOr(Status status) : status_(std::move(status)) {  // NOLINT: implicit by design
