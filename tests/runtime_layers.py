@@ -15,7 +15,7 @@ LAYERS = ["graph", "dds", "exec", "hosts"]
 # Public headers (runtime/include/dyad) by the layer that implements them; None: the component
 # API every layer may use.
 PUBLIC = {
-    "component.hpp": None, "message_traits.hpp": None, "status.hpp": None, "params.hpp": None,
+    "component.hpp": None, "join_list.hpp": None, "message_traits.hpp": None, "status.hpp": None, "params.hpp": None,
     "graph.hpp": "graph", "validate.hpp": "graph", "catalog.hpp": "graph", "topic_select.hpp": "graph",
     "on_demand_subscription.hpp": "graph",
     "decode_sample.hpp": "dds",

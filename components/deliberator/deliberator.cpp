@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <dyad/join_list.hpp>
+
 #include "dyad/pvrnn/model_file.hpp"
 
 namespace dyad::deliberator {
@@ -39,8 +41,7 @@ Status ApplyMap(const std::string& param, const std::string& yaml_text,
       }
     }
     if (!found) {
-      std::string known;
-      for (const auto& f : fields) known += std::string(known.empty() ? "" : ", ") + f.first;
+      const std::string known = JoinList(fields, [](const auto& f) -> const auto& { return f.first; });
       return Status::InvalidArgument("params." + param + "." + key + ": unknown key (known: " + known + ")");
     }
   }

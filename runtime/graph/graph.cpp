@@ -1,5 +1,6 @@
 // Reads an experiment graph from YAML, keeping every node's position for error messages.
 #include "dyad/graph.hpp"
+#include "dyad/join_list.hpp"
 
 #include <filesystem>
 #include <algorithm>
@@ -46,9 +47,7 @@ class Reader {
       const std::string path = key.empty() ? k : key + "." + k;
       if (!seen.insert(k).second) Error(kv.first, path, "duplicate key");
       if (!allowed.empty() && !allowed.count(k)) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        Error(kv.first, path, "unknown key (expected one of: " + list + ")");
+        Error(kv.first, path, "unknown key (expected one of: " + JoinList(allowed) + ")");
       }
     }
     return true;
@@ -82,9 +81,7 @@ class Reader {
 };
 
 std::string Names(const std::map<std::string, std::string>& m) {
-  std::string list;
-  for (const auto& [k, _] : m) list += (list.empty() ? "" : ", ") + k;
-  return list;
+  return JoinList(m, [](const auto& kv) -> const std::string& { return kv.first; });
 }
 
 void ReadStringList(Reader& r, const YAML::Node& node, const std::string& key, std::vector<std::string>* out) {

@@ -1,4 +1,5 @@
 #include <dyad/topic_select.hpp>
+#include <dyad/join_list.hpp>
 
 #include <algorithm>
 #include <regex>
@@ -13,8 +14,7 @@ StatusOr<std::vector<std::string>> SelectTopics(const std::vector<std::string>& 
     for (size_t i = 0; i < available.size(); ++i)
       chosen[i] = std::find(default_excluded.begin(), default_excluded.end(), available[i]) == default_excluded.end();
   }
-  std::string known;
-  for (const auto& a : available) known += (known.empty() ? "" : ", ") + a;
+  const std::string known = JoinList(available);
   for (size_t p = 0; p < patterns.size(); ++p) {
     const std::string& pat = patterns[p];
     const std::string where = param + "[" + std::to_string(p) + "] = '" + pat + "'";

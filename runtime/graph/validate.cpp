@@ -1,5 +1,6 @@
 // Graph validation: every check in one pass, every problem reported.
 #include "dyad/validate.hpp"
+#include "dyad/join_list.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,18 +11,12 @@
 namespace dyad {
 namespace {
 
-std::string Join(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
-  return s;
-}
-
 // "a, b, c" of the `name`s of params or ports, or "none".
 template <class Spec>
 std::string Names(const std::vector<Spec>& specs) {
   std::vector<std::string> names;
   for (const auto& s : specs) names.push_back(s.name);
-  return names.empty() ? "none" : Join(names);
+  return names.empty() ? "none" : JoinList(names);
 }
 
 bool ScalarAs(const YAML::Node& node, double* out) {
@@ -88,7 +83,7 @@ StatusOr<ParamValue> ParamFromYaml(const ParamSpec& spec, const YAML::Node& node
     case ParamType::kString: {
       if (!node.IsScalar()) return fail("a string");
       if (!spec.choices.empty() && std::find(spec.choices.begin(), spec.choices.end(), node.Scalar()) == spec.choices.end())
-        return fail("one of: " + Join(spec.choices));
+        return fail("one of: " + JoinList(spec.choices));
       return ParamValue(node.Scalar());
     }
     case ParamType::kDoubleList: {
@@ -170,7 +165,7 @@ class Validation {
       if (!c.type.empty()) {
         std::vector<std::string> known;
         for (const auto& [name, e] : catalog_.entries()) known.push_back(name);
-        error(c.type_mark, key + ".type", "unknown component type '" + c.type + "' (known: " + Join(known) + ")");
+        error(c.type_mark, key + ".type", "unknown component type '" + c.type + "' (known: " + JoinList(known) + ")");
       }
       return;
     }
@@ -264,7 +259,7 @@ class Validation {
       if (!t.type.empty() && catalog_.FindMessageType(t.type) == nullptr) {
         std::vector<std::string> known;
         for (const auto* ti : catalog_.MessageTypes()) known.push_back(ti->short_name());
-        error(t.type_mark, "topics." + t.name + ".type", "unknown message type '" + t.type + "' (known: " + Join(known) + ")");
+        error(t.type_mark, "topics." + t.name + ".type", "unknown message type '" + t.type + "' (known: " + JoinList(known) + ")");
       }
     }
   }

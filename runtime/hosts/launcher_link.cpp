@@ -8,6 +8,7 @@
 #include <thread>
 
 #include <dyad/message_traits.hpp>
+#include <dyad/join_list.hpp>
 #include <dyad/msg/types.hpp>
 
 #include "graph/run_partition.hpp"
@@ -102,10 +103,10 @@ std::vector<std::string> LauncherLink::TakeRemoteRestarts() {
 }
 
 std::string ResetClause(const Graph& graph, const std::string& process) {
-  std::string components;
+  std::vector<std::string> components;
   for (const auto& c : graph.components)
-    if (graph.ProcessOf(c) == process) components += (components.empty() ? "" : ", ") + c.name + ": " + c.type;
-  return "its components' state is reset (" + components + ")";
+    if (graph.ProcessOf(c) == process) components.push_back(c.name + ": " + c.type);
+  return "its components' state is reset (" + JoinList(components) + ")";
 }
 
 std::string RestartNotice(const Graph& graph, const std::string& process, const std::string& host, uint32_t restarts) {

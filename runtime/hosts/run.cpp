@@ -1,6 +1,7 @@
 // `dyad run` and `dyad validate`: load, validate, then run in this process or launch one child
 // per process of the graph.
 #include "dyad/run.hpp"
+#include "dyad/join_list.hpp"
 
 
 #include <atomic>
@@ -258,9 +259,8 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
     }
     process = *procs.begin();
   } else if (!procs.count(process)) {
-    std::string list;
-    for (const auto& p : procs) list += (list.empty() ? "" : ", ") + p;
-    err << options.graph_path << ": --process " << process << ": no component is placed there (processes: " << list << ")\n";
+    err << options.graph_path << ": --process " << process << ": no component is placed there (processes: " << JoinList(procs)
+        << ")\n";
     return 2;
   }
   Executor::Options eo;

@@ -1,5 +1,7 @@
 #include "dyad/pvrnn/train_config.hpp"
 
+#include <dyad/join_list.hpp>
+
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
@@ -38,9 +40,7 @@ class Reader {
       const std::string k = kv.first.as<std::string>();
       const std::string child = key.empty() ? k : key + "." + k;
       if (!allowed.count(k)) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        Error(kv.first, child, "unknown key (allowed: " + list + ")");
+        Error(kv.first, child, "unknown key (expected one of: " + JoinList(allowed) + ")");
       } else if (!seen.insert(k).second) {
         Error(kv.first, child, "duplicate key");
       }

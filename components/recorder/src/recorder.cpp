@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include <dyad/topic_select.hpp>
+#include <dyad/join_list.hpp>
 
 namespace dyad::recorder {
 namespace {
@@ -136,8 +137,7 @@ Status Recorder::OpenFile() {
       !s.ok())
     return s;
   thread_ = std::thread([this] { WriterLoop(); });
-  std::string list;
-  for (const auto& c : channels_) list += (list.empty() ? "" : ", ") + c->topic->name;
+  const std::string list = JoinList(channels_, [](const auto& c) -> const std::string& { return c->topic->name; });
   ctx_->log().Info("recording " + std::to_string(channels_.size()) + " topic(s) into " + path_ + ": " + list);
   return Status::OK();
 }
