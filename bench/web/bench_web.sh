@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The web component, one run, ratios (bash bench/web/bench_web.sh [BUILD_DIR]):
 #   1. pointer: the subject's page (Chromium), 500 moves at 100 Hz: the event's wall-clock stamp
-#      to its publication on the graph (same machine, same clock), and the round trip to the ack;
+#      to its publication on the graph (same machine, same clock), per hop (page -> civetweb's
+#      worker has the frame -> our one handler thread starts on it -> published), and the round
+#      trip to the ack;
 #   2. Foxglove bridge throughput to one client: bench_bridge feeds the bridge 100-byte samples as
 #      fast as one thread can (no graph in the way); samples/s the client receives;
 #   3. the experiment's step time p99 at 100 Hz (wall) with no client, with 4 Foxglove clients
@@ -49,6 +51,7 @@ start wall.yaml
 pointer=$(node "$node_dir/bench_clients.mjs" pointer "http://127.0.0.1:$port" 500)
 stop
 arrival=$(grep -o "pointer event -> published: .*" run.err || echo "none")
+hops=$(grep -o "pointer hops: .*" run.err | sed 's/^pointer hops: //' || echo "none")
 
 coproc BRIDGE { "$build/bin/bench_bridge" 6 2> bridge.err; }
 read -r port <&"${BRIDGE[0]}"
@@ -79,6 +82,7 @@ done
 echo "| what | result |"
 echo "| --- | --- |"
 echo "| pointer event (page's wall stamp) -> published on the graph | $arrival |"
+echo "| ... of which, per hop | $hops |"
 echo "| pointer round trip page -> component -> page (500 moves) | $pointer |"
 echo "| bridge to one client, 100-byte samples | $throughput |"
 for c in $conditions; do

@@ -235,14 +235,28 @@ Status WebComponent::Deactivate() {
   experimenter_->SetServer(nullptr);
   server_.reset();
   ctx_->log().Info(std::to_string(bridge_->samples_sent()) + " samples sent to clients");
-  if (auto a = subject_->arrival_ms(); !a.empty()) {
-    std::sort(a.begin(), a.end());
-    char line[160];
-    std::snprintf(line, sizeof line, "pointer event -> published: median %.2f ms, p99 %.2f ms (%zu samples)", a[a.size() / 2],
-                  a[std::min(a.size() - 1, a.size() * 99 / 100)], a.size());
-    ctx_->log().Info(line);
-  }
+  LogPointerDelays();
   return Status::OK();
+}
+
+namespace {
+// "median M ms, p99 P ms" of `ms`.
+std::string MedianAndP99(std::vector<double> ms) {
+  std::sort(ms.begin(), ms.end());
+  char text[80];
+  std::snprintf(text, sizeof text, "median %.2f ms, p99 %.2f ms", ms[ms.size() / 2], ms[std::min(ms.size() - 1, ms.size() * 99 / 100)]);
+  return text;
+}
+}  // namespace
+
+// Where the subject's pointer samples spent their time (bench/web/bench_web.sh prints both lines).
+void WebComponent::LogPointerDelays() {
+  const SubjectChannel::PointerDelays d = subject_->pointer_delays();
+  if (d.total.empty()) return;
+  ctx_->log().Info("pointer event -> published: " + MedianAndP99(d.total) + " (" + std::to_string(d.total.size()) + " samples)");
+  if (d.page_to_socket.empty()) return;
+  ctx_->log().Info("pointer hops: page -> socket " + MedianAndP99(d.page_to_socket) + "; socket -> handler thread " +
+                   MedianAndP99(d.socket_to_handler) + "; handler -> published " + MedianAndP99(d.handler_to_published));
 }
 
 }  // namespace dyad::web

@@ -36,6 +36,7 @@ class WebComponent final : public Component {
   Status Deactivate() override;  // stops it (every client closed)
 
  private:
+  void LogPointerDelays();
   Context* ctx_ = nullptr;
   WebServer::Options options_;
   std::string port_file_;

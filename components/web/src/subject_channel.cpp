@@ -21,10 +21,16 @@ size_t SubjectChannel::pages() const {
   return pages_.size();
 }
 
-std::vector<double> SubjectChannel::arrival_ms() const {
+SubjectChannel::PointerDelays SubjectChannel::pointer_delays() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return arrival_ms_;
+  return delays_;
 }
+
+namespace {
+double WallNowMs() {
+  return std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+}  // namespace
 
 void SubjectChannel::BroadcastState(double x, double y) {
   WebServer* server = server_.load();
@@ -68,6 +74,7 @@ void SubjectChannel::OnOpen(ClientId client) {
 }
 
 Status SubjectChannel::OnText(ClientId client, std::string_view text) {
+  const double handler_ms = WallNowMs();
   if (!JsonDepthWithin(text)) return Status::InvalidArgument("nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   const json j = json::parse(text.begin(), text.end(), nullptr, false);
   if (j.is_discarded() || !j.is_object()) return Status::InvalidArgument("not a JSON object");
@@ -87,10 +94,15 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
       last_x_ = std::clamp(px, -h, h);
       last_y_ = std::clamp(py, -h, h);
       sink_(last_x_, last_y_, engaged->get<bool>());
-      if (auto wall = j.find("wall"); wall != j.end() && wall->is_number() && arrival_ms_.size() < 100000) {
-        const double now_ms =
-            std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
-        arrival_ms_.push_back(now_ms - wall->get<double>());
+      if (auto wall = j.find("wall"); wall != j.end() && wall->is_number() && delays_.total.size() < 100000) {
+        const double event_ms = wall->get<double>(), published_ms = WallNowMs();
+        delays_.total.push_back(published_ms - event_ms);
+        if (WebServer* server = server_.load(); server != nullptr && server->message_received_ns() > 0) {
+          const double received_ms = static_cast<double>(server->message_received_ns()) / 1e6;
+          delays_.page_to_socket.push_back(received_ms - event_ms);
+          delays_.socket_to_handler.push_back(handler_ms - received_ms);
+          delays_.handler_to_published.push_back(published_ms - handler_ms);
+        }
       }
     }
     if (auto t = j.find("t"); t != j.end() && t->is_number())

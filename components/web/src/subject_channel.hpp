@@ -42,10 +42,16 @@ class SubjectChannel final : public ClientHandler {
   // Sends the robot's position to every page (newest only).
   void BroadcastState(double x, double y);
   size_t pages() const;
-  // Milliseconds from the page's event (its "wall" stamp) to the sample's publication, for every
-  // pointer sample that carried one (meaningful when page and server share a clock); at most
-  // the last 100,000.
-  std::vector<double> arrival_ms() const;
+  // Where a pointer sample's time went, in ms, for each sample that carried the page's "wall"
+  // stamp (meaningful when page and server share a clock; the first 100,000). The hops add up to
+  // the total; the hops are empty when no server delivered the samples.
+  struct PointerDelays {
+    std::vector<double> total;                 // the page's event -> published on the graph
+    std::vector<double> page_to_socket;        // -> civetweb's worker has the frame (page, socket)
+    std::vector<double> socket_to_handler;     // -> the one handler thread starts on it (its queue)
+    std::vector<double> handler_to_published;  // -> published (JSON parse, the DDS write)
+  };
+  PointerDelays pointer_delays() const;
 
   void OnOpen(ClientId client) override;
   Status OnText(ClientId client, std::string_view text) override;
@@ -61,7 +67,7 @@ class SubjectChannel final : public ClientHandler {
   std::vector<ClientId> pages_;  // in connection order
   ClientId steering_ = 0;        // 0: none
   double last_x_ = 0, last_y_ = 0;
-  std::vector<double> arrival_ms_;
+  PointerDelays delays_;
 };
 
 }  // namespace dyad::web

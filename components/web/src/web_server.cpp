@@ -5,6 +5,7 @@
 #include <sched.h>
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <cstring>
@@ -263,7 +264,10 @@ int WebServer::OnData(mg_connection* conn, int bits, char* data, size_t len, voi
     return 0;
   }
   Status s;
+  const int64_t received_ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
   self->handler_thread_->Run([&] {
+    self->message_received_ns_ = received_ns;
     if (opcode == MG_WEBSOCKET_OPCODE_TEXT) s = handler->OnText(id, std::string_view(data, len));
     else if (opcode == MG_WEBSOCKET_OPCODE_BINARY)
       s = handler->OnBinary(id, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(data), len));

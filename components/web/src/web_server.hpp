@@ -107,6 +107,10 @@ class WebServer {
   // Per-channel drops of a client since the last call.
   std::map<uint32_t, uint64_t> TakeDrops(ClientId client);
   std::vector<ClientId> clients() const;
+  // Inside OnText/OnBinary only (the handler thread): the wall-clock time (ns since the epoch)
+  // civetweb's worker received the message; the handler's own start minus this is the wait for
+  // the handler thread (bench/web prints it).
+  int64_t message_received_ns() const { return message_received_ns_; }
 
  private:
   struct Client;
@@ -123,6 +127,7 @@ class WebServer {
 
   Options options_;
   std::unique_ptr<HandlerThread> handler_thread_;  // runs OnText/OnBinary (see web_server.cpp)
+  int64_t message_received_ns_ = 0;                 // written and read on the handler thread only
   mg_context* ctx_ = nullptr;
   int port_ = 0;
   std::vector<std::unique_ptr<EndpointState>> endpoints_;  // civetweb keeps pointers into these

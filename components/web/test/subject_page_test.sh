@@ -35,3 +35,7 @@ kill -INT $pid
 wait $pid || true
 cat run.out
 node "$node_dir/check_subject_run.mjs" browser.json rec.mcap 100
+# The page stamps its events: the web component says where their time went, hop by hop
+# (bench/web/bench_web.sh prints the same line).
+grep -E "pointer hops: page -> socket median -?[0-9.]+ ms, p99 -?[0-9.]+ ms; socket -> handler thread median -?[0-9.]+ ms, p99 -?[0-9.]+ ms; handler -> published median -?[0-9.]+ ms" run.err \
+  || { echo "no per-hop line in run.err"; cat run.err; exit 1; }
