@@ -1,6 +1,7 @@
 #include "web_component.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -30,6 +31,15 @@ std::string RandomToken() {
 }
 
 }  // namespace
+
+// A sample of dyad/processes or dyad/health into the experimenter's list of run events (one not
+// from a dyad runtime of this version is not shown).
+template <class Message>
+void AddEvent(RunEvents& events, const SerializedSample& sample) {
+  Message m;
+  if (!DecodeSample(sample.cdr, &m).ok()) return;
+  events.Add(m, std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
+}
 
 // The newest ComponentStats of every component of the graph, from dyad/stats (any process).
 struct WebComponent::StatsTable {
@@ -152,12 +162,19 @@ Status WebComponent::Configure(Context& ctx) {
     if (Status s = notes_->Publish(note_); !s.ok()) ctx_->log().Warn("notes: experimenter's note lost: " + s.ToString());
   });
   stats_ = std::make_shared<StatsTable>();
-  for (const auto& t : ctx.graph_topics())
+  events_ = std::make_shared<RunEvents>();
+  for (const auto& t : ctx.graph_topics()) {
+    Status s;
     if (t.name == "dyad/stats") {
       std::shared_ptr<StatsTable> table = stats_;
-      Status s = ctx.SubscribeSerialized(t.name, [table](const SerializedSample& sample) { table->Add(sample.cdr); });
-      if (!s.ok()) return s;
+      s = ctx.SubscribeSerialized(t.name, [table](const SerializedSample& sample) { table->Add(sample.cdr); });
+    } else if (t.name == "dyad/processes") {
+      s = ctx.SubscribeSerialized(t.name, [events = events_](const SerializedSample& sample) { AddEvent<msg::ProcessState>(*events, sample); });
+    } else if (t.name == "dyad/health") {
+      s = ctx.SubscribeSerialized(t.name, [events = events_](const SerializedSample& sample) { AddEvent<msg::HealthEvent>(*events, sample); });
     }
+    if (!s.ok()) return s;
+  }
 
   options_.pages["/"] = WebServer::Page{"text/html; charset=utf-8", kIndexHtml, ""};
   options_.pages["/subject"] = WebServer::Page{"text/html; charset=utf-8", kSubjectHtml, ""};
@@ -222,6 +239,7 @@ Status WebComponent::Step(const StepInfo& info) {
   if (info.now_ns - last_stats_ns_ >= 1'000'000'000) {
     last_stats_ns_ = info.now_ns;
     experimenter_->Broadcast(2, stats_->Json());
+    if (std::string events = events_->Json(); !events.empty()) experimenter_->Broadcast(3, std::move(events));
   }
   bridge_->ReportDrops();
   return Status::OK();

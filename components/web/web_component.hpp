@@ -22,6 +22,7 @@
 
 #include "src/experimenter_channel.hpp"
 #include "src/foxglove_bridge.hpp"
+#include "src/run_events.hpp"
 #include "src/subject_channel.hpp"
 #include "src/web_server.hpp"
 
@@ -48,6 +49,7 @@ class WebComponent final : public Component {
   std::unique_ptr<ExperimenterChannel> experimenter_;
   struct StatsTable;
   std::shared_ptr<StatsTable> stats_;  // filled by the dyad/stats subscription
+  std::shared_ptr<RunEvents> events_;  // filled by the dyad/processes and dyad/health subscriptions
   int64_t last_stats_ns_ = 0;
   msg::Annotation note_;
   std::unique_ptr<FoxgloveBridge> bridge_;

@@ -4,7 +4,8 @@
 /// "t":s, "nelbo":.., "congruence":.., "human":k, "robot":k} (the deliberator's N-ELBO, the
 /// observer's P(C_t) and most likely primitives; null when not known yet), {"op":"stats","rows":
 /// [{component, process, steps, mean_ms, p99_ms, max_ms, misses}]} once a second,
-/// {"op":"noted","t":s} when a note was published.
+/// {"op":"events","items":[{t, text}]} once a second when any (RunEvents: restarts, failures,
+/// endpoints renewed), {"op":"noted","t":s} when a note was published.
 /// Page -> server: {"op":"note","text":".."}: published as an Annotation (author "experimenter")
 /// on the web component's `notes` output, which the recorder keeps (stamped by the runtime clock,
 /// so the analysis aligns it with everything else). Notes are capped at 4 KiB.

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# A restart is said on the experimenter's page: a graph of two processes, the `worker` killed
+# once mid-run (its launcher restarts it), a client of /experimenter/ws must be told
+# "process 'worker' ... restarted (restart 1)" (components/web/src/run_events.hpp).
+#   run_events_test.sh BUILD_DIR WORK_DIR
+set -euo pipefail
+build=$1
+work=$2
+node_dir=$(cd "$(dirname "$0")" && pwd)/node
+if [ ! -d "$node_dir/node_modules" ]; then
+  echo "SKIP: run tools/setup.sh (npm ci in components/web/test/node)"; exit 77
+fi
+rm -rf "$work"; mkdir -p "$work"; cd "$work"
+cat > graph.yaml <<YAML
+graph: run_events
+clock: wall
+domain_id: $(( 1 + $$ % 200 ))
+processes:
+  ui: {}
+  worker: {restart: on-failure, backoff_s: 0.2}
+components:
+  web: {type: web, rate_hz: 10, process: ui, params: {port: 0, port_file: web.port}, outputs: {pointer: web/pointer}}
+  human: {type: web_human, rate_hz: 10, process: worker, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
+topics:
+  human/input: {type: HumanInput}
+YAML
+"$build/bin/dyad" run graph.yaml --duration 40 > run.out 2> run.err &
+pid=$!
+for _ in $(seq 200); do [ -s web.port ] && break; sleep 0.1; done
+[ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
+sleep 2  # the worker's process is up (the graph's processes start together)
+worker=$(pgrep -f -- "run graph.yaml --process worker" | head -1)
+[ -n "$worker" ] || { echo "no worker process"; cat run.err; kill $pid; exit 1; }
+kill -KILL "$worker"
+status=0
+node -e '
+const WebSocket = require(process.argv[1] + "/node_modules/ws");
+const ws = new WebSocket(process.argv[2] + "/experimenter/ws");
+const give_up = setTimeout(() => { console.log("FAIL: no restart event within 20 s"); process.exit(1); }, 20000);
+ws.on("message", (d) => {
+  const m = JSON.parse(d.toString());
+  if (m.op !== "events") return;
+  const e = m.items.find((i) => /^process .worker.* restarted \(restart 1\): its components started afresh/.test(i.text));
+  if (e) { console.log("told: " + e.text); clearTimeout(give_up); ws.close(); process.exit(0); }
+});' "$node_dir" "ws://127.0.0.1:$(cat web.port)" || status=1
+kill -INT $pid; wait $pid || true
+[ $status -eq 0 ] || cat run.err
+exit $status
