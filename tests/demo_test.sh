@@ -24,6 +24,9 @@ for topic in human/input robot/intention robot/command robot/state observer/labe
 done
 report="$work/$name/report"
 grep -q "^- steps: 300 of 100.0 ms" "$report/report.md" || fail "report.md: $(head -20 "$report/report.md")"
+# One process, nothing lost: the report says so (a partition would be listed here, writer by writer).
+grep -q "^  none: every writer's samples are contiguous to the end" "$report/report.md" ||
+  fail "report.md has no transport section: $(head -30 "$report/report.md")"
 # 300 steps hold the first of the 8 planned events; the other 7 are after the end and not scored.
 [ "$(grep -c '^| [0-9]' "$report/report.md")" -eq 1 ] || fail "report.md should score exactly the 1 event in 300 steps"
 grep -q "^- 7 planned events after the end of the recording (not scored)" "$report/report.md" ||

@@ -13,6 +13,7 @@
 #include "demonstrations.hpp"
 #include "dyad/mcap/reader.hpp"
 #include "experiment_analysis.hpp"
+#include "losses.hpp"
 #include "recording_tables.hpp"
 #include "report_writer.hpp"
 
@@ -89,6 +90,8 @@ int RunAnalyze(const Options& o) {
     return kBadInput;
   }
   report.timeline = std::move(*timeline);
+  if (auto losses = bag::FindLosses(*reader); losses.ok()) report.transport = bag::FormatLosses(*losses);
+  else std::cerr << "dyad analyze: " << o.recording << ": losses not read: " << losses.status().message() << "\n";
   const auto events = analyze::Events(report.timeline, report.plan);
   report.events = analyze::SummariseEvents(report.timeline, events);
   report.confusion = analyze::HumanConfusion(report.timeline, events);

@@ -89,6 +89,8 @@ std::string FormatMarkdown(const Report& r) {
     for (const std::string& t : r.timeline.missing_topics) s << " `" << t << "`";
     s << "\n";
   }
+  // A partition or a stalled writer shows here before it skews a number below.
+  if (!r.transport.empty()) s << "\n## Transport: what the recording lost, what the runtime healed\n\n```\n" << r.transport << "```\n\n";
   std::vector<double> opt_ms, c_engaged, c_free, nelbo;
   int64_t engaged_steps = 0;
   for (const StepSample& x : r.timeline.steps) {

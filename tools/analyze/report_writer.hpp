@@ -23,6 +23,9 @@ struct Report {
   Timeline timeline;
   std::vector<EventSummary> events;
   std::vector<std::vector<int64_t>> confusion;
+  // What the recording lost in transport and what the runtime healed: `dyad bag info`'s losses:
+  // and health: sections (tools/bag/losses.hpp); empty: not read.
+  std::string transport;
 };
 
 // Creates `dir` if needed. Fails with IOError naming the file that cannot be written.

@@ -313,6 +313,18 @@ TEST(Analyze, WithoutObserverTheReportSaysWhatIsMissing) {
   EXPECT_NE(md.find("Not available"), std::string::npos) << md;
 }
 
+// What `dyad bag info` says of losses and health is in the report, before the numbers it may skew.
+TEST(Analyze, TheTransportSectionComesBeforeTheScores) {
+  Report r = Analyse(WriteExperiment(TempPath("a.mcap"), /*with_observer=*/true));
+  EXPECT_EQ(FormatMarkdown(r).find("## Transport"), std::string::npos);  // not read: not shown
+  r.transport = "losses:      per writer\n  robot/state  lab/robot  10 samples, 1..13: 3 missing\n";
+  const std::string md = FormatMarkdown(r);
+  const auto at = md.find("## Transport: what the recording lost, what the runtime healed\n\n```\nlosses:");
+  ASSERT_NE(at, std::string::npos) << md;
+  EXPECT_NE(md.find("3 missing\n```\n"), std::string::npos) << md;
+  EXPECT_LT(at, md.find("| ")) << md;
+}
+
 TEST(Analyze, CellParsersRejectWhatIsNotANumber) {
   double v = 0;
   EXPECT_TRUE(ParseNumber("-1.5e3", &v));
