@@ -64,6 +64,7 @@ class GraphSession final : public ProcessSession {
     e.graph_name(graph_name_);
     e.process_name(process_);
     e.host(host_);
+    if (e.action() == "renewed") barrier_.SetRenewals(++renewals_);
     pending_.push_back(std::move(e));
   }
 
@@ -72,6 +73,7 @@ class GraphSession final : public ProcessSession {
   Transport* transport_ = nullptr;
   TypedWriter* health_writer_ = nullptr;
   uint64_t health_sequence_ = 0;
+  uint32_t renewals_ = 0;  // "renewed" health events so far
   std::vector<msg::HealthEvent> pending_;  // published with the next heartbeat
 };
 

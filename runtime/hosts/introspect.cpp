@@ -289,7 +289,7 @@ int ShowStatus(const IntrospectOptions& o, const std::string& graph_name, std::o
   }
   std::set<std::string> process_names;
   out << std::left << std::setw(24) << "process" << std::setw(16) << "host" << std::setw(9) << "pid" << std::setw(10) << "state"
-      << std::setw(10) << "restarts" << "running for\n";
+      << std::setw(10) << "restarts" << std::setw(10) << "renewals" << "running for\n";
   const int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
   for (const auto& [key, ps] : procs) {
     process_names.insert(ps.process_name());
@@ -297,7 +297,7 @@ int ShowStatus(const IntrospectOptions& o, const std::string& graph_name, std::o
     if (ps.start_ns() > 0 && ps.state() == "running")
       running << std::fixed << std::setprecision(1) << (now_ns - ps.start_ns()) * 1e-9 << " s";
     out << std::left << std::setw(24) << key << std::setw(16) << ps.host() << std::setw(9) << ps.pid() << std::setw(10) << ps.state()
-        << std::setw(10) << ps.restarts() << running.str() << "\n";
+        << std::setw(10) << ps.restarts() << std::setw(10) << ps.renewals() << running.str() << "\n";
   }
   out << "\nclock offsets (the peer's clock minus the measuring process's, from the exchange with the least round trip):\n";
   if (clock.empty()) out << "  none measured yet (every 2 s once the graph runs)\n";

@@ -54,6 +54,7 @@ void StartBarrier::Announce(const std::string& state) {
   m.ready_ns(ready_ns_);
   m.start_ns(start_ns_);
   m.restarts(restarts_);
+  m.renewals(renewals_);
   writer_->Write(&m).IgnoreError();  // best effort: a lost announcement is repeated with the next change
 }
 

@@ -61,6 +61,9 @@ class StartBarrier {
 
   // Publishes this process's state ("running" with the start instant, "stopping").
   void Announce(const std::string& state);
+  // The renewals this process's endpoint health check has made so far, announced from the next
+  // Announce on (`dyad status` lists them).
+  void SetRenewals(uint32_t renewals) { renewals_ = renewals; }
 
   // What this process hears of the others (takes what arrived first). On the thread that calls
   // Wait, after it.
@@ -90,6 +93,7 @@ class StartBarrier {
   TypedReader* reader_ = nullptr;
   uint64_t sequence_ = 0;
   uint32_t restarts_ = 0;
+  uint32_t renewals_ = 0;
   int64_t ready_ns_ = 0, start_ns_ = 0, graph_start_ns_ = 0;
 };
 
