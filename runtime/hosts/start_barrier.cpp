@@ -8,6 +8,8 @@
 #include <set>
 #include <thread>
 
+#include <cstdio>
+
 #include <dyad/message_traits.hpp>
 
 namespace dyad {
@@ -126,8 +128,9 @@ StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
       std::string what;
       if (!not_heard.empty()) what = "processes not ready: " + not_heard;
       if (!missing_endpoints.empty()) what += std::string(what.empty() ? "" : "; ") + "here: " + missing_endpoints;
-      return Status::FailedPrecondition("process '" + process_ + "' waited " +
-                                        std::to_string(static_cast<int>(graph_.network.start_timeout_s)) +
+      char waited[32];
+      std::snprintf(waited, sizeof waited, "%g", graph_.network.start_timeout_s);  // 0.5 s, not "0 s"
+      return Status::FailedPrecondition("process '" + process_ + "' waited " + waited +
                                         " s (network.start_timeout_s) for the graph to start together: " + what);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
