@@ -37,7 +37,7 @@ TEST(Spawner, AChildInheritsNoDescriptorButItsOutputAndRunsInItsOwnGroup) {
     Spawner spawner("/bin/sh", &relay, "here");
     // argv[0] "sh"; the shell lists its open descriptors (its own for reading the directory aside).
     auto started = spawner.Start(
-        "probe", {"sh", "-c", "ls /proc/self/fd | tr '\\n' ' '; echo; echo pgid=$(ps -o pgid= $$ | tr -d ' ') pid=$$"}, 0, "");
+        "probe", {"sh", "-c", "ls /proc/self/fd | tr '\\n' ' '; echo; echo pgid=$(cut -d' ' -f5 /proc/$$/stat) pid=$$"}, 0, "");
     ASSERT_TRUE(started.ok()) << started.status().message();
     pid = started.value();
     EXPECT_EQ(WaitFor(pid), 0);
