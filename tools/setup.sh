@@ -11,7 +11,7 @@ packages=(
   libeigen3-dev libceres-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libzstd-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcivetweb-dev
   python3 python3-matplotlib chromium universal-ctags
-  iproute2 nftables
+  iproute2 nftables procps
 )
 if [ "${1:-}" = "sanitize" ]; then
   packages+=(clang-14 libclang-rt-14-dev llvm-14)
