@@ -395,6 +395,19 @@ int FreeUdpPort() {
   return port;
 }
 
+// The steps of `component` in a `dyad run` timing table printed in `out` (0: not found).
+size_t StepsOf(const std::string& out, const std::string& component) {
+  std::istringstream lines(out);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("[", 0) == 0 && line.find("] ") != std::string::npos) line.erase(0, line.find("] ") + 2);  // "[a] "
+    std::istringstream row(line);
+    std::string name;
+    size_t steps = 0;
+    if (row >> name >> steps && name == component) return steps;
+  }
+  return 0;
+}
+
 class DiscoveryModeTest : public ProcessTest, public ::testing::WithParamInterface<const char*> {
  protected:
   // Two "hosts" on loopback, in this test's discovery mode: a (h1) counts at 50 Hz into b's (h2)
@@ -420,8 +433,13 @@ TEST_P(DiscoveryModeTest, ProcessesStartedApartStartTogetherAndLoseNothing) {
   Child b(Dyad({"run", g.string(), "--host", "h2", "--steps", "40"}), dir_, "b");
   ASSERT_EQ(a.Wait(60), 0) << a.err();
   ASSERT_EQ(b.Wait(60), 0) << b.err();
+  // Every sample the source wrote, from its first: as many as its steps. On the wall clock a
+  // loaded machine (the sanitizer suite) may skip a late period at the end (a deadline miss,
+  // counted), so the count is the source's own, not 40.
+  const size_t written = StepsOf(a.out(), "src");
+  EXPECT_GE(written, 35u) << a.out();
   const auto received = ReadSink(out);
-  ASSERT_EQ(received.size(), 40u) << a.err() << b.err();
+  ASSERT_EQ(received.size(), written) << a.out() << a.err() << b.err();
   for (size_t i = 0; i < received.size(); ++i) EXPECT_EQ(received[i].sequence, i + 1);
   if (std::string(GetParam()) == "server") {
     EXPECT_NE(a.out().find("dyad discovery-server: listening on 127.0.0.1:" + std::to_string(server_port)), std::string::npos)
