@@ -3,7 +3,9 @@
 // dyad/testing/dds_domain.hpp): the link opens its own participant, so no in-memory transport.
 // A failure announced by one host's launcher is taken by the other's, once, and not by its own;
 // announcements stamped before a link started (an earlier run's), of another graph, of this
-// host or of a process that is not required are not taken.
+// host or of a process that is not required are not taken. Over TCP the links need two
+// machines' addresses (one loopback makes both sides dial each other, which Fast DDS 2.9 drops):
+// tests/multihost_test.sh failure:tcp covers it.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -131,14 +133,6 @@ TEST(LauncherLink, OnlyAFreshFailureOfThisGraphsRequiredProcessOnAnotherHostIsTa
 TEST(LauncherLink, RestartNoticeNamesTheProcessAndWhatIsReset) {
   const Graph g = Split();
   EXPECT_EQ(RestartNotice(g, "mind", "h2", 2), "process 'mind' on host 'h2' restarted (restart 2): its components' state is reset (m: delib)");
-}
-
-TEST(LauncherLink, NotWithTcp) {
-  Graph g = Split();
-  g.network.transport = NetTransport::kTcp;
-  auto l = LauncherLink::Open(g, "h1");
-  ASSERT_FALSE(l.ok());
-  EXPECT_EQ(l.status().code(), Status::Code::kUnimplemented);
 }
 
 }  // namespace

@@ -21,7 +21,7 @@
 #              intentions resume after the restart (first one within 2.5 s of the kill) and after
 #              the link is back, the gap on mind's topic only; no command moves further than
 #              the mixer's max_step (5) from the one before.
-#   failure    multicast, mind without restarts (--set processes.mind.restart=never) and
+#   failure[:D] multicast (or discovery mode D, as above: failure:tcp), mind without restarts (--set processes.mind.restart=never) and
 #              `kill -9` of mind's process about step 100: mind's launcher exits 137 naming it;
 #              lab's and rec's launchers hear of it (their launchers' link, dyad/processes) and
 #              exit 1 within 10 s of the kill, naming mind and its host, their processes stopped
@@ -42,7 +42,7 @@
 # MULTIHOST_STAGGER=S: the time between the starts of rec, mind and lab (default 2 s, 0: at once);
 # MULTIHOST_SHARED_SHM=1: the hosts share this machine's /dev/shm (default: one tmpfs each).
 set -euo pipefail
-[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|tcp|faults|failure|cut:D:H:S|matrix|net|MODE*N...]" >&2; exit 2; }
+[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|tcp|faults|failure[:D]|cut:D:H:S|matrix|net|MODE*N...]" >&2; exit 2; }
 repo=$(cd "$1" && pwd) build=$(cd "$2" && pwd) work=$3
 shift 3
 modes=()
@@ -66,6 +66,8 @@ done
 for mode in "${modes[@]}"; do
   case $mode in
     multicast | peers | server | tcp | faults | failure | net) ;;
+    failure:*) [[ $mode =~ ^failure:(multicast|peers|server|tcp)$ ]] ||
+                 { echo "bad mode '$mode': failure:DISCOVERY (multicast|peers|server|tcp)" >&2; exit 2; } ;;
     cut:*) [[ $mode =~ ^cut:(multicast|peers|server|tcp):(lab|mind|rec):[0-9]+(\.[0-9]+)?$ ]] ||
              { echo "bad mode '$mode': cut:DISCOVERY:HOST:SECONDS (DISCOVERY multicast|peers|server|tcp, HOST lab|mind|rec)" >&2; exit 2; } ;;
     *) echo "unknown mode '$mode'" >&2; exit 2 ;;
@@ -534,7 +536,9 @@ run_mode() {
   local net=$mode cut_host="" cut_s=""
   [[ $mode == cut:* ]] && IFS=: read -r _ net cut_host cut_s <<< "$mode"
   [ "$mode" = faults ] && net=multicast
-  [ "$mode" = failure ] && net=multicast
+  local failure=0
+  [[ $mode == failure* ]] && failure=1 net=multicast
+  [[ $mode == failure:* ]] && net=${mode#failure:}
   if [ "$net" = peers ] || [ "$net" = server ]; then block_multicast; fi
   [ "$net" = tcp ] && block_multicast udp
   local discovery=$net
@@ -543,7 +547,7 @@ run_mode() {
   [ "$net" = tcp ] && transport=tcp
   local sets=(--set "network.discovery=$discovery" --set "network.transport=$transport" --set "human.dataset=$dataset" --set "mind.model=$model"
               --set "observer.model=$observer" --set "recorder.file=$out/split.mcap")
-  [ "$mode" = failure ] && sets+=(--set processes.mind.restart=never)
+  [ $failure = 1 ] && sets+=(--set processes.mind.restart=never)
   # Each host gets its own /dev/shm (a tmpfs in the mount namespace of `ip netns exec`), as on
   # separate machines: nothing can pass through shared memory between hosts, and Fast DDS's
   # port files cannot collide with another host's or another test's. MULTIHOST_SHARED_SHM=1: no.
@@ -568,7 +572,7 @@ run_mode() {
   if [ "$mode" = faults ]; then
     inject_faults "$out" &
     injector=$!
-  elif [ "$mode" = failure ]; then
+  elif [ $failure = 1 ]; then
     kill_mind "$out" &
     injector=$!
   elif [ -n "$cut_host" ]; then
@@ -603,7 +607,7 @@ run_mode() {
   for h in "${hosts[@]}"; do
     code=0
     wait "${lpid[$h]}" || code=$?
-    if [ "$mode" = failure ]; then
+    if [ $failure = 1 ]; then
       local want=1
       [ "$h" = mind ] && want=137
       if [ $code != $want ]; then
@@ -659,15 +663,15 @@ PY
     echo "FAIL: multihost $mode: dyad status (see above)" >&2
     failures+=("$mode"); return 0
   fi
-  if [ "$mode" = failure ]; then
+  if [ $failure = 1 ]; then
     local t_kill t_end ok=1
-    t_kill=$(cat "$out/killed" 2> /dev/null) || { echo "FAIL: multihost failure: mind was not killed" >&2; failures+=("$mode"); return 0; }
+    t_kill=$(cat "$out/killed" 2> /dev/null) || { echo "FAIL: multihost $mode: mind was not killed" >&2; failures+=("$mode"); return 0; }
     grep -q "process 'mind' exited with 137 (SIGKILL)$" "$out/mind.log" || { echo "mind's launcher did not name mind's end"; ok=0; }
     for h in lab rec; do
       grep -q "process 'mind' on host 'mind' failed for good: stopping the processes of host '$h'" "$out/$h.log" ||
         { echo "$h's launcher did not say mind failed:"; cat "$out/$h.log"; ok=0; }
       t_end=$(stat -c %Y "$out/$h.code")
-      echo "multihost: failure: $h's launcher ended $((t_end - t_kill / 1000000000)) s after the kill"
+      echo "multihost: $mode: $h's launcher ended $((t_end - t_kill / 1000000000)) s after the kill"
       [ $((t_end - t_kill / 1000000000)) -le 10 ] || { echo "$h's launcher took longer than 10 s"; ok=0; }
     done
     local info
@@ -677,10 +681,10 @@ PY
     grep -q ",mind,mind,.*,failed," "$out/csv/dyad_processes.csv" 2> /dev/null ||
       { echo "no 'failed' state of mind in the recording's dyad/processes:"; head -3 "$out/csv/dyad_processes.csv" 2>&1; ok=0; }
     if [ $ok = 0 ]; then
-      echo "FAIL: multihost failure: see above" >&2
+      echo "FAIL: multihost $mode: see above" >&2
       failures+=("$mode"); return 0
     fi
-    echo "PASS: multihost failure: mind killed with no restart left: every host's launcher ended the run within 10 s, naming it; the recording is complete and holds the failure"
+    echo "PASS: multihost $mode: mind killed with no restart left: every host's launcher ended the run within 10 s, naming it; the recording is complete and holds the failure"
     return 0
   fi
   if [ "$mode" = faults ]; then

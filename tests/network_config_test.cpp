@@ -47,6 +47,15 @@ std::string Replace(std::string s, const std::string& from, const std::string& t
   return s;
 }
 
+// kSplit over TCP: each process's port, and the launchers' (its processes are on two hosts);
+// launcher_tcp_port takes start_timeout_s's line, so the lines below it keep their numbers.
+std::string Tcp(const std::string& yaml) {
+  return Replace(Replace(Replace(Replace(yaml, "transport: udp", "transport: tcp"), "  start_timeout_s: 12\n",
+                                 "  launcher_tcp_port: 7600\n"),
+                         "a: {host: lab}", "a: {host: lab, tcp_port: 7601}"),
+                 "b: {host: mind}", "b: {host: mind, tcp_port: 7602}");
+}
+
 TEST(NetworkConfig, ReadsEveryKey) {
   std::vector<Diagnostic> diags;
   const Graph g = Parse(kSplit, &diags);
@@ -119,11 +128,14 @@ INSTANTIATE_TEST_SUITE_P(
             "processes.b.host", "every process must"},
         Bad{"ComponentWithoutProcessInAGraphOnHosts", Replace(kSplit, "process: b, ", ""), "g.yaml:16:3",
             "components.sink.process", "each component names its process"},
-        Bad{"TcpWithoutPeers",
-            Replace(Replace(Replace(Replace(kSplit, "transport: udp", "transport: tcp"), "discovery: peers", "discovery: multicast"),
-                            "a: {host: lab}", "a: {host: lab, tcp_port: 7601}"),
-                    "b: {host: mind}", "b: {host: mind, tcp_port: 7602}"),
-            "g.yaml:7:14", "network.transport", "tcp: needs discovery: peers"},
+        Bad{"TcpWithoutPeers", Replace(Tcp(kSplit), "discovery: peers", "discovery: multicast"), "g.yaml:7:14",
+            "network.transport", "tcp: needs discovery: peers"},
+        Bad{"TcpOnTwoHostsWithoutALauncherPort", Replace(Tcp(kSplit), "  launcher_tcp_port: 7600\n", ""), "g.yaml:3:3",
+            "network.launcher_tcp_port", "each host's launcher listens on it"},
+        Bad{"TcpLauncherPortTakenByAProcess", Replace(Tcp(kSplit), "launcher_tcp_port: 7600", "launcher_tcp_port: 7602"),
+            "g.yaml:3:3", "network.launcher_tcp_port", "listens on 10.77.0.2:7602, as b does"},
+        Bad{"TcpLauncherPortOutOfRange", Replace(Tcp(kSplit), "launcher_tcp_port: 7600", "launcher_tcp_port: 70000"),
+            "g.yaml:10:22", "network.launcher_tcp_port", "1..65535"},
         Bad{"TcpWithoutAPort", Replace(Replace(kSplit, "transport: udp", "transport: tcp"), "a: {host: lab}", "a: {host: lab, tcp_port: 7601}"),
             "g.yaml:13:3", "processes.b.tcp_port", "needs each process's tcp_port"},
         Bad{"BackoffTooShort", Replace(kSplit, "a: {host: lab}", "a: {host: lab, restart: always, backoff_s: 0}"), "g.yaml:12:46",
@@ -200,14 +212,12 @@ TEST(NetworkConfig, ASetOverridesAProcesssKeyAndItsProblemNamesTheSet) {
   EXPECT_NE(diags[0].message.find("must be a mapping"), std::string::npos) << diags[0].ToString();
 }
 
-// TCP: each process listens on its port at its host's address, and connects only to the
-// processes named before it (one connection per pair); a watcher connects to all.
+// TCP: each process listens on its port at its host's address, each host's launcher on
+// launcher_tcp_port, and each connects only to the listeners named before it (one connection
+// per pair); a watcher connects to all.
 TEST(NetworkQos, TcpListensOnTheProcesssPortAndConnectsToTheEarlierProcesses) {
   std::vector<Diagnostic> diags;
-  const std::string yaml = Replace(Replace(Replace(kSplit, "transport: udp", "transport: tcp"), "a: {host: lab}",
-                                           "a: {host: lab, tcp_port: 7601}"),
-                                   "b: {host: mind}", "b: {host: mind, tcp_port: 7602}");
-  const Graph g = Parse(yaml, &diags);
+  const Graph g = Parse(Tcp(kSplit), &diags);
   ASSERT_TRUE(diags.empty()) << diags[0].ToString();
   EXPECT_EQ(g.network.tcp_listeners.at("b"), "10.77.0.2:7602");
   auto peers_of = [&](const std::string& process, std::vector<uint16_t>* listening) {
@@ -227,7 +237,13 @@ TEST(NetworkQos, TcpListensOnTheProcesssPortAndConnectsToTheEarlierProcesses) {
   EXPECT_EQ(listening, std::vector<uint16_t>{7601});
   EXPECT_EQ(peers_of("b", &listening), std::vector<std::string>{"10.77.0.1:7601"});
   EXPECT_EQ(listening, std::vector<uint16_t>{7602});
-  EXPECT_EQ(peers_of("", &listening), (std::vector<std::string>{"10.77.0.1:7601", "10.77.0.2:7602"}));
+  EXPECT_EQ(peers_of(LauncherParticipantName("lab"), &listening), (std::vector<std::string>{"10.77.0.1:7601", "10.77.0.2:7602"}));
+  EXPECT_EQ(listening, std::vector<uint16_t>{7600});
+  EXPECT_EQ(peers_of(LauncherParticipantName("mind"), &listening),
+            (std::vector<std::string>{"10.77.0.1:7601", "10.77.0.2:7602", "10.77.0.1:7600"}));
+  EXPECT_EQ(listening, std::vector<uint16_t>{7600});
+  EXPECT_EQ(peers_of("", &listening),
+            (std::vector<std::string>{"10.77.0.1:7601", "10.77.0.2:7602", "10.77.0.1:7600", "10.77.0.2:7600"}));
   EXPECT_TRUE(listening.empty());
 }
 

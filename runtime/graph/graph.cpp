@@ -99,7 +99,7 @@ void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
   n->mark = r.Mark(node, "network");
   if (node.IsNull()) return;
   if (!r.Map(node, "network", {"discovery", "hosts", "peers", "server", "transport", "interfaces", "lease_s", "start_timeout_s",
-                            "max_clock_offset_ms"}))
+                            "max_clock_offset_ms", "launcher_tcp_port"}))
     return;
   std::string s;
   if (node["discovery"] && r.String(node["discovery"], "network.discovery", &s)) {
@@ -143,6 +143,10 @@ void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
     else r.Error(node["transport"], "network.transport", "must be shm+udp, udp or tcp, got '" + s + "'");
   }
   if (node["interfaces"]) ReadStringList(r, node["interfaces"], "network.interfaces", &n->interfaces);
+  if (node["launcher_tcp_port"] &&
+      r.Number(node["launcher_tcp_port"], "network.launcher_tcp_port", &n->launcher_tcp_port, "an integer") &&
+      (n->launcher_tcp_port < 1 || n->launcher_tcp_port > 65535))
+    r.Error(node["launcher_tcp_port"], "network.launcher_tcp_port", "must be in 1..65535");
   if (node["lease_s"] && r.Number(node["lease_s"], "network.lease_s", &n->lease_s, "a number") && !(n->lease_s >= 1))
     r.Error(node["lease_s"], "network.lease_s", "must be >= 1 (a shorter lease declares live processes gone)");
   if (node["start_timeout_s"] && r.Number(node["start_timeout_s"], "network.start_timeout_s", &n->start_timeout_s, "a number") &&
@@ -368,6 +372,44 @@ void ReadGraphScalars(Reader& r, const YAML::Node& root, Graph* g) {
   }
 }
 
+// transport: tcp: each process listens on its tcp_port at its host's address; with processes on
+// several hosts, each host's launcher on network.launcher_tcp_port (the launchers must meet to
+// end every host's run when a required process fails for good: hosts/launcher_link.hpp).
+void ListTcpListeners(Reader& r, Graph* g) {
+  NetworkConfig& net = g->network;
+  std::map<std::string, std::string> taken;  // address:port -> who listens there
+  auto listen = [&](const std::string& who, const std::string& address, int port, const SourceMark& mark,
+                    const std::string& key) {
+    const std::string at = address + ":" + std::to_string(port);
+    if (auto [it, fresh] = taken.emplace(at, who); !fresh)
+      r.Error(mark, key, "listens on " + at + ", as " + it->second + " does: give each its own port");
+    else
+      net.tcp_listeners[who] = at;
+  };
+  std::set<std::string> hosts;
+  for (const auto& p : g->processes) {
+    auto address = net.hosts.find(p.host);
+    if (p.tcp_port == 0 || address == net.hosts.end()) {
+      r.Error(p.mark, "processes." + p.name + ".tcp_port",
+              "network.transport tcp needs each process's tcp_port and a host listed in network.hosts");
+      continue;
+    }
+    hosts.insert(p.host);
+    listen(p.name, address->second, p.tcp_port, p.mark, "processes." + p.name + ".tcp_port");
+  }
+  if (hosts.size() < 2) return;
+  if (net.launcher_tcp_port == 0) {
+    r.Error(net.mark, "network.launcher_tcp_port",
+            "missing: with transport tcp and processes on several hosts, each host's launcher listens on it "
+            "(else a required process that fails for good ends only its own host's run)");
+    return;
+  }
+  if (net.launcher_tcp_port > 65535) return;  // reported with the network section
+  for (const std::string& host : hosts)
+    listen(LauncherParticipantName(host), net.hosts.at(host), net.launcher_tcp_port, net.mark,
+           "network.launcher_tcp_port");
+}
+
 // `processes:`: each process's host, restart policy and port; then the rules across them.
 void ReadProcesses(Reader& r, const YAML::Node& procs, Graph* g) {
   if (!r.Map(procs, "processes", {})) return;
@@ -401,17 +443,7 @@ void ReadProcesses(Reader& r, const YAML::Node& procs, Graph* g) {
     }
     g->processes.push_back(p);
   }
-  // transport: tcp: each process listens on its port, at its host's address.
-  if (g->network.transport == NetTransport::kTcp) {
-    for (const auto& p : g->processes) {
-      auto address = g->network.hosts.find(p.host);
-      if (p.tcp_port == 0 || address == g->network.hosts.end())
-        r.Error(p.mark, "processes." + p.name + ".tcp_port",
-                "network.transport tcp needs each process's tcp_port and a host listed in network.hosts");
-      else
-        g->network.tcp_listeners[p.name] = address->second + ":" + std::to_string(p.tcp_port);
-    }
-  }
+  if (g->network.transport == NetTransport::kTcp) ListTcpListeners(r, g);
   // A process without a host would start on every host's launcher: a second copy of it.
   for (const auto& p : g->processes)
     if (g->PlacedOnHosts() && p.host.empty())

@@ -22,8 +22,6 @@ LauncherLink::LauncherLink(const Graph& graph, std::string host) : graph_(graph)
 LauncherLink::~LauncherLink() = default;
 
 StatusOr<std::unique_ptr<LauncherLink>> LauncherLink::Open(const Graph& graph, const std::string& host) {
-  if (graph.network.transport == NetTransport::kTcp)
-    return Status::Unimplemented("with network.transport: tcp the launchers cannot reach each other (only the processes listen)");
   std::unique_ptr<LauncherLink> link(new LauncherLink(graph, host));
   link->started_ns_ = WallNowNs();
   std::set<std::string> others;
@@ -33,8 +31,9 @@ StatusOr<std::unique_ptr<LauncherLink>> LauncherLink::Open(const Graph& graph, c
   DdsParticipant::Options po;
   po.scope = DdsParticipant::Scope::kWatcher;
   po.network = graph.network;
+  po.process = LauncherParticipantName(host);  // transport tcp: its listener (graph.hpp, tcp_listeners)
   po.partitions = {RunPartition(graph)};  // another run's launchers are not ours to hear
-  auto p = DdsParticipant::Create(graph.domain_id, "dyad/launcher/" + host, std::move(po));
+  auto p = DdsParticipant::Create(graph.domain_id, LauncherParticipantName(host), std::move(po));
   if (!p.ok()) return p.status();
   link->participant_ = std::move(p.value());
   auto lw = CreateRuntimeWriter(link->participant_.get(), runtime_topics::kLaunchers);
@@ -54,7 +53,7 @@ StatusOr<std::unique_ptr<LauncherLink>> LauncherLink::Open(const Graph& graph, c
 
 bool LauncherLink::AnnounceFailure(const std::string& process, int restarts) {
   msg::ProcessState m;
-  m.header().source("dyad/launcher/" + host_);
+  m.header().source(LauncherParticipantName(host_));
   m.header().sequence_number(1);
   m.header().stamp_ns(WallNowNs());
   m.graph_name(graph_.name);

@@ -14,9 +14,11 @@
 //     after this launcher started (an older one belongs to an earlier run of the same graph): its
 //     launcher then stops its own processes (SIGTERM: they deactivate cleanly) and exits 1,
 //     naming the process and its host.
-// Not with `transport: tcp`: a watcher there only connects to the processes' listeners, so two
-// launchers never meet (the launcher warns). A whole machine that disappears (power, cable)
-// says nothing: the others see its writers gone ("Health") and go on.
+// With `transport: tcp` each launcher also listens, on network.launcher_tcp_port at its host's
+// address (validation requires it when processes are on several hosts), and dials the listeners
+// named before its own (graph.hpp, tcp_listeners), so the launchers meet as the processes do.
+// A whole machine that disappears (power, cable) says nothing: the others see its writers gone
+// ("Health") and go on.
 #pragma once
 
 #include <map>
@@ -38,7 +40,7 @@ class TypedWriter;
 
 class LauncherLink {
  public:
-  // Joins the graph's domain as the launcher of `host`. Unimplemented with `transport: tcp`.
+  // Joins the graph's domain as the launcher of `host` (LauncherParticipantName(host)).
   static StatusOr<std::unique_ptr<LauncherLink>> Open(const Graph& graph, const std::string& host);
   ~LauncherLink();
   LauncherLink(const LauncherLink&) = delete;

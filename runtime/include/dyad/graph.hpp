@@ -87,6 +87,9 @@ struct TopicConfig {
 enum class Discovery { kMulticast, kPeers, kServer };
 enum class NetTransport { kShmUdp, kUdp, kTcp };
 
+// The DDS participant name of a host's launcher (its link to the other hosts' launchers).
+inline std::string LauncherParticipantName(const std::string& host) { return "dyad/launcher/" + host; }
+
 // The `network:` section, mapped onto Fast DDS participant QoS by the runtime.
 struct NetworkConfig {
   Discovery discovery = Discovery::kMulticast;
@@ -97,8 +100,11 @@ struct NetworkConfig {
   int server_port = 0;
   std::string server_host;                   // the host of `hosts` that runs the server; empty: external
   NetTransport transport = NetTransport::kShmUdp;
-  // transport: tcp: every process's listener, "address:port" (network.hosts[host]:tcp_port).
-  std::map<std::string, std::string> tcp_listeners;  // process -> address:port
+  // transport: tcp: every listener, "address:port": each process's (network.hosts[host]:tcp_port)
+  // and, with processes on several hosts, each host's launcher's (LauncherParticipantName(host)
+  // -> network.hosts[host]:launcher_tcp_port). Each pair connects once: the later name dials.
+  std::map<std::string, std::string> tcp_listeners;  // process or launcher -> address:port
+  int launcher_tcp_port = 0;
   std::vector<std::string> interfaces;
   double lease_s = 5;
   double start_timeout_s = 30;
