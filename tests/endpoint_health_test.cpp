@@ -182,6 +182,24 @@ TEST(EndpointHealth, RenewsTheParticipantOnlyOnceTheNetworkIsUp) {
   EXPECT_EQ(health.participant_renewals(), 1);
 }
 
+// transport: tcp: a silent process keeps its participant (a new one could not listen on the
+// process's port); its endpoints are still checked.
+TEST(EndpointHealth, WithTcpNeverRenewsTheParticipant) {
+  Graph g = ThreeProcesses();
+  g.network.transport = NetTransport::kTcp;
+  EndpointHealth health(g, "rec", 5);
+  FakeTransport t;
+  t.matches = {{"robot/intention", false, false, 0}};
+  for (double s = 0; s < 12; s += 1) ASSERT_TRUE(health.Check(&t, {}, 5.0 + s, At(s)).ok());
+  EXPECT_EQ(t.participant_renewals, 0);
+  EXPECT_EQ(health.participant_renewals(), 0);
+  t.matches = {{"robot/intention", false, false, 0}};  // mind heard running again, its writer missing
+  ASSERT_TRUE(health.Check(&t, {"mind"}, 0, At(12)).ok());
+  ASSERT_TRUE(health.Check(&t, {"mind"}, 0, At(12 + EndpointHealth::kReaderS)).ok());
+  ASSERT_EQ(t.renewals.size(), 1u);
+  EXPECT_EQ(t.renewals[0].topic, "robot/intention");
+}
+
 // --- the renewal on Fast DDS -----------------------------------------------------------------
 
 std::unique_ptr<DdsParticipant> Participant(const std::string& name) {

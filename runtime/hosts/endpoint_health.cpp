@@ -6,7 +6,10 @@
 namespace dyad {
 
 EndpointHealth::EndpointHealth(const Graph& graph, std::string process, double lost_s, Report report)
-    : process_(std::move(process)), lost_s_(lost_s), report_(std::move(report)) {
+    : process_(std::move(process)),
+      lost_s_(lost_s),
+      report_(std::move(report)),
+      tcp_(graph.network.transport == NetTransport::kTcp) {
   for (const auto& c : graph.components) {
     const std::string p = graph.ProcessOf(c);
     for (const auto& b : c.outputs) ++writers_in_[b.topic][p];
@@ -45,7 +48,14 @@ int EndpointHealth::Expected(const std::string& topic, bool writer, const std::s
 Status EndpointHealth::Check(Transport* transport, const std::set<std::string>& running, double silence_s,
                              std::chrono::steady_clock::time_point now) {
   transport->Reap();
-  if (silence_s >= lost_s_ &&
+  if (tcp_ && silence_s >= lost_s_ && !silence_said_) {
+    silence_said_ = true;
+    StderrLogger("health").Warn("no other process heard for " + std::to_string(static_cast<int>(silence_s)) +
+                                " s although one should be running; with transport tcp the participant is not renewed "
+                                "(its listener's port is taken): TCP reconnects once the network is back");
+  }
+  if (silence_s < lost_s_) silence_said_ = false;
+  if (!tcp_ && silence_s >= lost_s_ &&
       (participant_renewals_ == 0 || std::chrono::duration<double>(now - participant_renewed_).count() >= lost_s_)) {
     RenewParticipant(transport, silence_s, now);
     return Status::OK();

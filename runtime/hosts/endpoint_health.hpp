@@ -26,6 +26,11 @@
 // `lost_s`. If the others really are gone this costs a new participant, and it never fails the
 // process: their launchers say whether they failed.
 //
+// Not with transport: tcp: the renewed participant cannot listen on the process's tcp_port while
+// the retired one holds it, and Fast DDS 2.9 then aborted the process at exit ("pure virtual
+// method called", measured in tests/multihost_test.sh cut:tcp modes). There the silence is said
+// once and endpoints are renewed as usual; TCP itself reconnects when the cable returns.
+//
 // Guests (watchers, `dyad echo`) add matches a writer may count: a starved writer whose topic
 // also has a guest reader is not seen (its readers in the graph are, on their side).
 #pragma once
@@ -85,6 +90,8 @@ class EndpointHealth {
   std::chrono::steady_clock::time_point participant_renewed_{};
   int participant_renewals_ = 0;
   bool postponed_ = false;  // a participant renewal waits for the network (said once)
+  const bool tcp_;          // transport tcp: the participant is never renewed
+  bool silence_said_ = false;
   // topic -> process -> endpoints the graph binds there (readers: inputs; writers: outputs);
   // dyad/processes has one of each in every process.
   std::map<std::string, std::map<std::string, int>> readers_in_, writers_in_;
