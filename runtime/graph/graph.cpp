@@ -252,23 +252,6 @@ void ReadComponents(Reader& r, const YAML::Node& node, Graph* g) {
 
 }  // namespace
 
-SourceMark SourceMark::Of(const std::string& file, const YAML::Node& node) {
-  const YAML::Mark m = node.Mark();
-  if (m.is_null()) return SourceMark{file, 0, 0};
-  return SourceMark{file, m.line + 1, m.column + 1};
-}
-
-std::string SourceMark::ToString() const {
-  if (line <= 0) return file;
-  return file + ":" + std::to_string(line) + ":" + std::to_string(column);
-}
-
-std::string Diagnostic::ToString() const {
-  // "key = value: why" when the message starts with the offending value ("= 300: must be ...").
-  const bool value_first = message.rfind("= ", 0) == 0;
-  return mark.ToString() + ": " + (key.empty() ? "" : key + (value_first ? " " : ": ")) + message;
-}
-
 const ComponentConfig* Graph::FindComponent(const std::string& n) const {
   for (const auto& c : components)
     if (c.name == n) return &c;
