@@ -1,6 +1,7 @@
 // Reads an experiment graph from YAML, keeping every node's position for error messages.
 #include "dyad/graph.hpp"
 #include "dyad/join_list.hpp"
+#include "dyad/strict_yaml.hpp"
 
 #include <filesystem>
 #include <algorithm>
@@ -21,70 +22,11 @@ namespace {
 // Graph names become part of DDS partition names (graph/run_partition.hpp).
 const std::string kGraphNameRule = "must be 1 to 64 of the characters A-Z a-z 0-9 _ . - (it names the run's DDS partition)";
 
-
-// Collects diagnostics; each at the file (or --set) that wrote the key (Graph::MarkOf).
-class Reader {
- public:
-  Reader(const Graph* g, std::vector<Diagnostic>* out) : g_(g), out_(out) {}
-
-  void Error(const YAML::Node& node, const std::string& key, const std::string& message) {
-    out_->push_back(Diagnostic{Mark(node, key), key, message});
-  }
-  void Error(const SourceMark& mark, const std::string& key, const std::string& message) {
-    out_->push_back(Diagnostic{mark, key, message});
-  }
-  SourceMark Mark(const YAML::Node& node, const std::string& key) const { return g_->MarkOf(key, node); }
-
-  // Checks `node` is a map, reports keys outside `allowed` and duplicate keys.
-  bool Map(const YAML::Node& node, const std::string& key, const std::set<std::string>& allowed) {
-    if (!node.IsMap()) {
-      Error(node, key, "must be a mapping");
-      return false;
-    }
-    std::set<std::string> seen;
-    for (const auto& kv : node) {
-      const std::string k = kv.first.Scalar();
-      const std::string path = key.empty() ? k : key + "." + k;
-      if (!seen.insert(k).second) Error(kv.first, path, "duplicate key");
-      if (!allowed.empty() && !allowed.count(k)) {
-        Error(kv.first, path, "unknown key (expected one of: " + JoinList(allowed) + ")");
-      }
-    }
-    return true;
-  }
-
-  bool String(const YAML::Node& node, const std::string& key, std::string* out) {
-    if (!node.IsScalar() || node.Scalar().empty()) {
-      Error(node, key, "must be a non-empty string");
-      return false;
-    }
-    *out = node.Scalar();
-    return true;
-  }
-
-  template <class T>
-  bool Number(const YAML::Node& node, const std::string& key, T* out, const char* what) {
-    if (node.IsScalar()) {
-      try {
-        *out = node.as<T>();
-        return true;
-      } catch (const YAML::Exception&) {
-      }
-    }
-    Error(node, key, std::string("must be ") + what + (node.IsScalar() ? ", got '" + node.Scalar() + "'" : ""));
-    return false;
-  }
-
- private:
-  const Graph* g_;
-  std::vector<Diagnostic>* out_;
-};
-
 std::string Names(const std::map<std::string, std::string>& m) {
   return JoinList(m, [](const auto& kv) -> const std::string& { return kv.first; });
 }
 
-void ReadStringList(Reader& r, const YAML::Node& node, const std::string& key, std::vector<std::string>* out) {
+void ReadStringList(StrictYaml& r, const YAML::Node& node, const std::string& key, std::vector<std::string>* out) {
   if (!node.IsSequence()) {
     r.Error(node, key, "must be a list");
     return;
@@ -95,7 +37,7 @@ void ReadStringList(Reader& r, const YAML::Node& node, const std::string& key, s
   }
 }
 
-void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
+void ReadNetwork(StrictYaml& r, const YAML::Node& node, NetworkConfig* n) {
   n->mark = r.Mark(node, "network");
   if (node.IsNull()) return;
   if (!r.Map(node, "network", {"discovery", "hosts", "peers", "server", "transport", "interfaces", "lease_s", "start_timeout_s",
@@ -144,16 +86,16 @@ void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
   }
   if (node["interfaces"]) ReadStringList(r, node["interfaces"], "network.interfaces", &n->interfaces);
   if (node["launcher_tcp_port"] &&
-      r.Number(node["launcher_tcp_port"], "network.launcher_tcp_port", &n->launcher_tcp_port, "an integer") &&
+      r.Get(node["launcher_tcp_port"], "network.launcher_tcp_port", &n->launcher_tcp_port, "an integer") &&
       (n->launcher_tcp_port < 1 || n->launcher_tcp_port > 65535))
     r.Error(node["launcher_tcp_port"], "network.launcher_tcp_port", "must be in 1..65535");
-  if (node["lease_s"] && r.Number(node["lease_s"], "network.lease_s", &n->lease_s, "a number") && !(n->lease_s >= 1))
+  if (node["lease_s"] && r.Get(node["lease_s"], "network.lease_s", &n->lease_s, "a number") && !(n->lease_s >= 1))
     r.Error(node["lease_s"], "network.lease_s", "must be >= 1 (a shorter lease declares live processes gone)");
-  if (node["start_timeout_s"] && r.Number(node["start_timeout_s"], "network.start_timeout_s", &n->start_timeout_s, "a number") &&
+  if (node["start_timeout_s"] && r.Get(node["start_timeout_s"], "network.start_timeout_s", &n->start_timeout_s, "a number") &&
       !(n->start_timeout_s > 0))
     r.Error(node["start_timeout_s"], "network.start_timeout_s", "must be > 0");
   if (node["max_clock_offset_ms"] &&
-      r.Number(node["max_clock_offset_ms"], "network.max_clock_offset_ms", &n->max_clock_offset_ms, "a number") &&
+      r.Get(node["max_clock_offset_ms"], "network.max_clock_offset_ms", &n->max_clock_offset_ms, "a number") &&
       !(n->max_clock_offset_ms > 0))
     r.Error(node["max_clock_offset_ms"], "network.max_clock_offset_ms", "must be > 0");
   if (n->discovery == Discovery::kPeers && n->peers.empty() && n->hosts.empty())
@@ -165,7 +107,7 @@ void ReadNetwork(Reader& r, const YAML::Node& node, NetworkConfig* n) {
     r.Error(node["discovery"], "network.discovery", "server: needs network.server (HOST:PORT of the discovery server)");
 }
 
-void ReadTopics(Reader& r, const YAML::Node& node, Graph* g) {
+void ReadTopics(StrictYaml& r, const YAML::Node& node, Graph* g) {
   if (!r.Map(node, "topics", {})) return;
   for (const auto& kv : node) {
     TopicConfig t;
@@ -190,19 +132,19 @@ void ReadTopics(Reader& r, const YAML::Node& node, Graph* g) {
         else r.Error(spec["reliability"], key + ".reliability", "must be reliable or best_effort, got '" + rel + "'");
       }
     }
-    if (spec["depth"] && r.Number(spec["depth"], key + ".depth", &t.depth, "an integer") && t.depth < 1)
+    if (spec["depth"] && r.Get(spec["depth"], key + ".depth", &t.depth, "an integer") && t.depth < 1)
       r.Error(spec["depth"], key + ".depth", "must be >= 1, got " + std::to_string(t.depth));
-    if (spec["deadline_ms"] && r.Number(spec["deadline_ms"], key + ".deadline_ms", &t.deadline_ms, "a number") &&
+    if (spec["deadline_ms"] && r.Get(spec["deadline_ms"], key + ".deadline_ms", &t.deadline_ms, "a number") &&
         t.deadline_ms < 0)
       r.Error(spec["deadline_ms"], key + ".deadline_ms", "must be >= 0");
-    if (spec["liveliness_ms"] && r.Number(spec["liveliness_ms"], key + ".liveliness_ms", &t.liveliness_ms, "a number") &&
+    if (spec["liveliness_ms"] && r.Get(spec["liveliness_ms"], key + ".liveliness_ms", &t.liveliness_ms, "a number") &&
         t.liveliness_ms < 0)
       r.Error(spec["liveliness_ms"], key + ".liveliness_ms", "must be >= 0");
     g->topics.push_back(t);
   }
 }
 
-void ReadBindings(Reader& r, const YAML::Node& node, const std::string& key, std::vector<PortBinding>* out) {
+void ReadBindings(StrictYaml& r, const YAML::Node& node, const std::string& key, std::vector<PortBinding>* out) {
   if (!r.Map(node, key, {})) return;
   for (const auto& kv : node) {
     PortBinding b;
@@ -212,7 +154,7 @@ void ReadBindings(Reader& r, const YAML::Node& node, const std::string& key, std
   }
 }
 
-void ReadComponents(Reader& r, const YAML::Node& node, Graph* g) {
+void ReadComponents(StrictYaml& r, const YAML::Node& node, Graph* g) {
   if (!r.Map(node, "components", {})) return;
   for (const auto& kv : node) {
     ComponentConfig c;
@@ -229,7 +171,7 @@ void ReadComponents(Reader& r, const YAML::Node& node, Graph* g) {
     }
     if (spec["rate_hz"]) {
       c.rate_mark = r.Mark(spec["rate_hz"], key + ".rate_hz");
-      if (r.Number(spec["rate_hz"], key + ".rate_hz", &c.rate_hz, "a number") && !(c.rate_hz > 0))
+      if (r.Get(spec["rate_hz"], key + ".rate_hz", &c.rate_hz, "a number") && !(c.rate_hz > 0))
         r.Error(spec["rate_hz"], key + ".rate_hz", "must be > 0, got " + spec["rate_hz"].Scalar());
     }
     if (spec["trigger"]) {
@@ -255,23 +197,6 @@ void ReadComponents(Reader& r, const YAML::Node& node, Graph* g) {
 }
 
 }  // namespace
-
-SourceMark SourceMark::Of(const std::string& file, const YAML::Node& node) {
-  const YAML::Mark m = node.Mark();
-  if (m.is_null()) return SourceMark{file, 0, 0};
-  return SourceMark{file, m.line + 1, m.column + 1};
-}
-
-std::string SourceMark::ToString() const {
-  if (line <= 0) return file;
-  return file + ":" + std::to_string(line) + ":" + std::to_string(column);
-}
-
-std::string Diagnostic::ToString() const {
-  // "key = value: why" when the message starts with the offending value ("= 300: must be ...").
-  const bool value_first = message.rfind("= ", 0) == 0;
-  return mark.ToString() + ": " + (key.empty() ? "" : key + (value_first ? " " : ": ")) + message;
-}
 
 const ComponentConfig* Graph::FindComponent(const std::string& n) const {
   for (const auto& c : components)
@@ -334,10 +259,10 @@ std::string Graph::FolderOf(const std::string& key) const {
 namespace {
 
 // The graph's own scalars: graph, domain_id, clock, seed, plugins, logs.
-void ReadGraphScalars(Reader& r, const YAML::Node& root, Graph* g) {
+void ReadGraphScalars(StrictYaml& r, const YAML::Node& root, Graph* g) {
   if (root["graph"] && r.String(root["graph"], "graph", &g->name) && !IsPartitionWord(g->name))
     r.Error(root["graph"], "graph", kGraphNameRule + (", got '" + g->name + "'"));
-  if (root["domain_id"] && r.Number(root["domain_id"], "domain_id", &g->domain_id, "an integer") &&
+  if (root["domain_id"] && r.Get(root["domain_id"], "domain_id", &g->domain_id, "an integer") &&
       (g->domain_id < 0 || g->domain_id > 232))
     r.Error(root["domain_id"], "domain_id", "must be in 0..232 (DDS), got " + std::to_string(g->domain_id));
   if (root["clock"]) {
@@ -349,7 +274,7 @@ void ReadGraphScalars(Reader& r, const YAML::Node& root, Graph* g) {
       else r.Error(root["clock"], "clock", "must be wall or stepped, got '" + mode + "'");
     }
   }
-  if (root["seed"]) r.Number(root["seed"], "seed", &g->seed, "a non-negative integer");
+  if (root["seed"]) r.Get(root["seed"], "seed", &g->seed, "a non-negative integer");
   if (const YAML::Node plugins = root["plugins"]) {
     const std::filesystem::path base = g->FolderOf("plugins");  // like every path of a graph file
     if (!plugins.IsSequence()) {
@@ -375,7 +300,7 @@ void ReadGraphScalars(Reader& r, const YAML::Node& root, Graph* g) {
 // transport: tcp: each process listens on its tcp_port at its host's address; with processes on
 // several hosts, each host's launcher on network.launcher_tcp_port (the launchers must meet to
 // end every host's run when a required process fails for good: hosts/launcher_link.hpp).
-void ListTcpListeners(Reader& r, Graph* g) {
+void ListTcpListeners(StrictYaml& r, Graph* g) {
   NetworkConfig& net = g->network;
   std::map<std::string, std::string> taken;  // address:port -> who listens there
   auto listen = [&](const std::string& who, const std::string& address, int port, const SourceMark& mark,
@@ -411,7 +336,7 @@ void ListTcpListeners(Reader& r, Graph* g) {
 }
 
 // `processes:`: each process's host, restart policy and port; then the rules across them.
-void ReadProcesses(Reader& r, const YAML::Node& procs, Graph* g) {
+void ReadProcesses(StrictYaml& r, const YAML::Node& procs, Graph* g) {
   if (!r.Map(procs, "processes", {})) return;
   for (const auto& kv : procs) {
     ProcessConfig p;
@@ -430,14 +355,14 @@ void ReadProcesses(Reader& r, const YAML::Node& procs, Graph* g) {
         else if (policy == "always") p.restart = RestartPolicy::kAlways;
         else r.Error(spec["restart"], key + ".restart", "must be never, on-failure or always, got '" + policy + "'");
       }
-      if (spec["max_restarts"] && r.Number(spec["max_restarts"], key + ".max_restarts", &p.max_restarts, "an integer") &&
+      if (spec["max_restarts"] && r.Get(spec["max_restarts"], key + ".max_restarts", &p.max_restarts, "an integer") &&
           p.max_restarts < 0)
         r.Error(spec["max_restarts"], key + ".max_restarts", "must be >= 0");
-      if (spec["backoff_s"] && r.Number(spec["backoff_s"], key + ".backoff_s", &p.backoff_s, "a number") &&
+      if (spec["backoff_s"] && r.Get(spec["backoff_s"], key + ".backoff_s", &p.backoff_s, "a number") &&
           !(p.backoff_s >= 0.05 && p.backoff_s <= 60))
         r.Error(spec["backoff_s"], key + ".backoff_s", "must be in 0.05..60 (a shorter one restarts a crashing process in a tight loop)");
-      if (spec["required"]) r.Number(spec["required"], key + ".required", &p.required, "true or false");
-      if (spec["tcp_port"] && r.Number(spec["tcp_port"], key + ".tcp_port", &p.tcp_port, "an integer") &&
+      if (spec["required"]) r.Get(spec["required"], key + ".required", &p.required, "true or false");
+      if (spec["tcp_port"] && r.Get(spec["tcp_port"], key + ".tcp_port", &p.tcp_port, "an integer") &&
           (p.tcp_port < 1 || p.tcp_port > 65535))
         r.Error(spec["tcp_port"], key + ".tcp_port", "must be in 1..65535");
     }
@@ -453,7 +378,7 @@ void ReadProcesses(Reader& r, const YAML::Node& procs, Graph* g) {
 
 // A component left in the implicit process "main" of a graph placed on hosts would start on
 // every host's launcher.
-void CheckPlacement(Reader& r, const Graph& g) {
+void CheckPlacement(StrictYaml& r, const Graph& g) {
   if (g.PlacedOnHosts() && g.processes.size() > 1) {
     for (const auto& c : g.components) {
       if (c.process.empty())
@@ -508,7 +433,8 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   ApplySets(overrides, &doc, diagnostics);
   g.origins = doc.origins;
   const YAML::Node root = doc.root;
-  Reader r(&g, diagnostics);
+  // Each problem at the file (or --set) that wrote its key.
+  StrictYaml r([&g](const std::string& key, const YAML::Node& node) { return g.MarkOf(key, node); }, diagnostics);
   r.Map(root, "", {"graph", "domain_id", "clock", "seed", "plugins", "logs", "network", "processes", "topics", "components"});
   ReadGraphScalars(r, root, &g);
   if (const YAML::Node network = root["network"]) ReadNetwork(r, network, &g.network);

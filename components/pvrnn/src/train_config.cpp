@@ -1,117 +1,41 @@
 #include "dyad/pvrnn/train_config.hpp"
 
-#include <dyad/join_list.hpp>
+#include <dyad/strict_yaml.hpp>
 
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
-#include <set>
+#include <map>
 #include <sstream>
+#include <type_traits>
 
 namespace dyad::pvrnn {
 namespace {
 
-// Collects every error of a config with its position, at most one per key; one per load.
-class Reader {
- public:
-  Reader(std::string file, std::set<std::string> overridden)
-      : file_(std::move(file)), overridden_(std::move(overridden)) {}
+// A rule of a config-only field (one no settings struct validates), at `key` of the top level.
+template <typename T>
+void Check(StrictYaml& r, bool ok, const YAML::Node& root, const std::string& key, const char* rule, const T& value) {
+  if (ok) return;
+  std::ostringstream s;
+  s << rule << ", got ";
+  if constexpr (std::is_convertible_v<T, std::string>) s << "'" << value << "'";  // the graph's wording
+  else s << value;
+  const YAML::Node n = root[key];
+  r.Error(n ? n : root, key, s.str());
+}
 
-  // "file:line:col: key" (1-based), "--set key" for a value from the command line, or
-  // "file: key" where the node has no position (an empty file).
-  std::string Where(const YAML::Node& n, const std::string& key) const {
-    if (Overridden(key)) return "--set " + key;
-    const YAML::Mark m = n.Mark();
-    if (m.is_null() || m.line < 0) return file_ + ": " + key;
-    return file_ + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1) + ": " + key;
-  }
-  void Error(const YAML::Node& n, const std::string& key, const std::string& msg) {
-    if (!reported_.insert(key).second) return;
-    errors_.push_back(Where(n, key) + ": " + msg);
-  }
-  // Checks that `map` (at `key`, "" for the top level) is a mapping of allowed, distinct keys.
-  bool Keys(const YAML::Node& map, const std::string& key, const std::set<std::string>& allowed) {
-    if (!map.IsMap()) {
-      Error(map, key.empty() ? "(top level)" : key, "must be a mapping");
-      return false;
-    }
-    std::set<std::string> seen;
-    for (const auto& kv : map) {
-      const std::string k = kv.first.as<std::string>();
-      const std::string child = key.empty() ? k : key + "." + k;
-      if (!allowed.count(k)) {
-        Error(kv.first, child, "unknown key (expected one of: " + JoinList(allowed) + ")");
-      } else if (!seen.insert(k).second) {
-        Error(kv.first, child, "duplicate key");
-      }
-    }
-    return true;
-  }
-  template <typename T>
-  bool Get(const YAML::Node& parent, const std::string& name, const std::string& key, const char* type, T* out,
-           bool required = false) {
-    const YAML::Node n = parent[name];
-    if (!n) {
-      if (required) Error(parent, key, "required key missing");
-      return false;
-    }
-    try {
-      *out = n.as<T>();
-      return true;
-    } catch (const YAML::Exception&) {
-      Error(n, key, std::string("must be ") + type + (n.IsScalar() ? ", got " + n.Scalar() : ""));
-      return false;
-    }
-  }
-  template <typename T>
-  bool Get(const YAML::Node& list, size_t index, const std::string& key, const char* type, T* out) {
-    try {
-      *out = list[index].template as<T>();
-      return true;
-    } catch (const YAML::Exception&) {
-      Error(list[index], key, std::string("must be ") + type);
-      return false;
-    }
-  }
-  // A rule of a config-only field (one no settings struct validates).
-  template <typename T>
-  void Check(bool ok, const YAML::Node& parent, const std::string& name, const std::string& key, const char* rule,
-             const T& value) {
-    if (ok) return;
-    std::ostringstream s;
-    s << rule << ", got " << value;
-    const YAML::Node n = parent[name];
-    Error(n ? n : parent, key, s.str());
-  }
-  const std::vector<std::string>& errors() const { return errors_; }
-
-  // A path at `key`: written in the file, relative to the file's folder; given with --set,
-  // relative to the working folder. Absolute and empty paths are kept.
-  void ResolvePath(const std::string& key, std::string* value) const {
-    if (value->empty() || std::filesystem::path(*value).is_absolute()) return;
-    std::error_code ec;
-    const std::filesystem::path base =
-        Overridden(key) ? std::filesystem::current_path(ec) : std::filesystem::absolute(file_, ec).parent_path();
-    *value = (base / *value).lexically_normal().string();
-  }
-
- private:
-  // True when --set replaced the value at `key`, at a key containing it ("adam" for
-  // "adam.lr") or inside it ("adam.lr.x" for "adam.lr").
-  bool Overridden(const std::string& key) const {
-    auto within = [](const std::string& inner, const std::string& outer) {
-      return inner == outer || (inner.size() > outer.size() && inner.rfind(outer, 0) == 0 &&
-                                (inner[outer.size()] == '.' || inner[outer.size()] == '['));
-    };
-    for (const auto& o : overridden_)
-      if (within(key, o) || within(o, key)) return true;
-    return false;
-  }
-  std::string file_;
-  std::set<std::string> overridden_;
-  std::set<std::string> reported_;
-  std::vector<std::string> errors_;
-};
+// A path at top-level `key`: written in the file, relative to the file's folder; given with
+// --set, relative to the working folder. Absolute and empty paths are kept.
+void ReadPath(StrictYaml& r, const std::string& file, const YAML::Node& root, const std::string& key,
+              std::string* value, bool required = false) {
+  if (!r.Get(root, key, key, value, "a path", required)) return;
+  if (value->empty() || std::filesystem::path(*value).is_absolute()) return;
+  std::error_code ec;
+  const std::filesystem::path base = r.Mark(root[key], key).FromCommandLine()
+                                         ? std::filesystem::current_path(ec)
+                                         : std::filesystem::absolute(file, ec).parent_path();
+  *value = (base / *value).lexically_normal().string();
+}
 
 // The config key of a settings field: the spec's output encoding is `encoding` in the config.
 std::string ConfigKey(const std::string& field) {
@@ -205,73 +129,89 @@ Status ApplyOverride(YAML::Node root, const std::string& spec) {
 
 namespace {
 
-TrainConfig Read(const YAML::Node& root, Reader& r) {
-  TrainConfig c;
-  if (!r.Keys(root, "", {"dataset", "loops", "layers", "encoding", "epochs", "adam", "seed", "scalar", "noise", "log_every",
-                         "checkpoint_every", "output", "checkpoint", "log_csv"}))
-    return c;
-  if (r.Get(root, "dataset", "dataset", "a path", &c.dataset, true)) r.ResolvePath("dataset", &c.dataset);
-  if (r.Get(root, "loops", "loops", "an integer", &c.loops))
-    r.Check(c.loops >= 1 && c.loops <= 100, root, "loops", "loops", "must be in 1..100", c.loops);
-  // Types here; value rules come from ModelSpec/AdamOptions::Problems() (one place), below.
-  // Entries that cannot be read keep a valid default so that indices stay aligned.
+// Types here; value rules come from ModelSpec::Problems() (one place), in Read.
+// Entries that cannot be read keep a valid default so that indices stay aligned.
+void ReadLayers(StrictYaml& r, const YAML::Node& root, ModelSpec* spec) {
   const YAML::Node layers = root["layers"];
   if (!layers) {
     r.Error(root, "layers", "required key missing");
-  } else if (!layers.IsSequence() || layers.size() == 0) {
+    return;
+  }
+  if (!layers.IsSequence() || layers.size() == 0) {
     r.Error(layers, "layers", "must be a non-empty list of {d, z, tau, w}");
-  } else {
-    for (size_t k = 0; k < layers.size(); ++k) {
-      const YAML::Node l = layers[k];
-      const std::string p = "layers[" + std::to_string(k) + "]";
-      LayerSpec ls;
-      if (r.Keys(l, p, {"d", "z", "tau", "w"})) {
-        r.Get(l, "d", p + ".d", "an integer", &ls.d, true);
-        r.Get(l, "z", p + ".z", "an integer", &ls.z, true);
-        r.Get(l, "tau", p + ".tau", "a number", &ls.tau, true);
-        r.Get(l, "w", p + ".w", "a number", &ls.w, true);
+    return;
+  }
+  for (size_t k = 0; k < layers.size(); ++k) {
+    const YAML::Node l = layers[k];
+    const std::string p = "layers[" + std::to_string(k) + "]";
+    LayerSpec ls;
+    if (r.Map(l, p, {"d", "z", "tau", "w"})) {
+      r.Get(l, "d", p + ".d", &ls.d, "an integer", true);
+      r.Get(l, "z", p + ".z", &ls.z, "an integer", true);
+      r.Get(l, "tau", p + ".tau", &ls.tau, "a number", true);
+      r.Get(l, "w", p + ".w", &ls.w, "a number", true);
+    }
+    spec->layers.push_back(ls);
+  }
+}
+
+void ReadEncoding(StrictYaml& r, const YAML::Node& root, OutputEncoding* output) {
+  output->dofs = {{-50, 50}, {-50, 50}};
+  const YAML::Node e = root["encoding"];
+  if (!e || !r.Map(e, "encoding", {"dofs", "dsoft", "sigma"})) return;
+  if (const YAML::Node dofs = e["dofs"]) {
+    if (!dofs.IsSequence()) {
+      r.Error(dofs, "encoding.dofs", "must be a list of [min, max]");
+    } else {
+      output->dofs.clear();
+      for (size_t i = 0; i < dofs.size(); ++i) {
+        const std::string key = "encoding.dofs[" + std::to_string(i) + "]";
+        std::vector<double> range;
+        if (r.Get(dofs[i], key, &range, "[min, max]") && range.size() != 2) r.Error(dofs[i], key, "must be [min, max]");
+        output->dofs.push_back(range.size() == 2 ? DofRange{range[0], range[1]} : DofRange{});
       }
-      c.spec.layers.push_back(ls);
     }
   }
-  c.spec.output.dofs = {{-50, 50}, {-50, 50}};
-  if (const YAML::Node e = root["encoding"]; e && r.Keys(e, "encoding", {"dofs", "dsoft", "sigma"})) {
-    if (const YAML::Node dofs = e["dofs"]) {
-      if (!dofs.IsSequence()) {
-        r.Error(dofs, "encoding.dofs", "must be a list of [min, max]");
-      } else {
-        c.spec.output.dofs.clear();
-        for (size_t i = 0; i < dofs.size(); ++i) {
-          std::vector<double> range;
-          if (r.Get(dofs, i, "encoding.dofs[" + std::to_string(i) + "]", "[min, max]", &range) && range.size() != 2)
-            r.Error(dofs[i], "encoding.dofs[" + std::to_string(i) + "]", "must be [min, max]");
-          c.spec.output.dofs.push_back(range.size() == 2 ? DofRange{range[0], range[1]} : DofRange{});
-        }
-      }
-    }
-    r.Get(e, "dsoft", "encoding.dsoft", "a number", &c.spec.output.dsoft);
-    r.Get(e, "sigma", "encoding.sigma", "a number", &c.spec.output.sigma);
-  }
-  if (r.Get(root, "epochs", "epochs", "an integer", &c.epochs)) r.Check(c.epochs > 0, root, "epochs", "epochs", "must be > 0", c.epochs);
-  if (const YAML::Node a = root["adam"]; a && r.Keys(a, "adam", {"lr", "beta1", "beta2", "epsilon"})) {
-    r.Get(a, "lr", "adam.lr", "a number", &c.adam.lr);
-    r.Get(a, "beta1", "adam.beta1", "a number", &c.adam.beta1);
-    r.Get(a, "beta2", "adam.beta2", "a number", &c.adam.beta2);
-    r.Get(a, "epsilon", "adam.epsilon", "a number", &c.adam.epsilon);
-  }
-  r.Get(root, "seed", "seed", "a non-negative integer", &c.seed);
-  if (r.Get(root, "scalar", "scalar", "a string", &c.scalar))
-    r.Check(c.scalar == "float" || c.scalar == "double", root, "scalar", "scalar", "must be float or double", c.scalar);
-  r.Get(root, "noise", "noise", "true or false", &c.noise);
-  if (r.Get(root, "log_every", "log_every", "an integer", &c.log_every))
-    r.Check(c.log_every > 0, root, "log_every", "log_every", "must be > 0", c.log_every);
-  if (r.Get(root, "checkpoint_every", "checkpoint_every", "an integer", &c.checkpoint_every))
-    r.Check(c.checkpoint_every >= 0, root, "checkpoint_every", "checkpoint_every", "must be >= 0", c.checkpoint_every);
-  if (r.Get(root, "output", "output", "a path", &c.output, true)) r.ResolvePath("output", &c.output);
-  if (r.Get(root, "checkpoint", "checkpoint", "a path", &c.checkpoint)) r.ResolvePath("checkpoint", &c.checkpoint);
-  if (r.Get(root, "log_csv", "log_csv", "a path", &c.log_csv)) r.ResolvePath("log_csv", &c.log_csv);
+  r.Get(e, "dsoft", "encoding.dsoft", &output->dsoft, "a number");
+  r.Get(e, "sigma", "encoding.sigma", &output->sigma, "a number");
+}
+
+void ReadAdam(StrictYaml& r, const YAML::Node& root, AdamOptions* adam) {
+  const YAML::Node a = root["adam"];
+  if (!a || !r.Map(a, "adam", {"lr", "beta1", "beta2", "epsilon"})) return;
+  r.Get(a, "lr", "adam.lr", &adam->lr, "a number");
+  r.Get(a, "beta1", "adam.beta1", &adam->beta1, "a number");
+  r.Get(a, "beta2", "adam.beta2", &adam->beta2, "a number");
+  r.Get(a, "epsilon", "adam.epsilon", &adam->epsilon, "a number");
+}
+
+TrainConfig Read(StrictYaml& r, const std::string& file, const YAML::Node& root) {
+  TrainConfig c;
+  if (!r.Map(root, "", {"dataset", "loops", "layers", "encoding", "epochs", "adam", "seed", "scalar", "noise",
+                        "log_every", "checkpoint_every", "output", "checkpoint", "log_csv"}))
+    return c;
+  ReadPath(r, file, root, "dataset", &c.dataset, true);
+  if (r.Get(root, "loops", "loops", &c.loops, "an integer"))
+    Check(r, c.loops >= 1 && c.loops <= 100, root, "loops", "must be in 1..100", c.loops);
+  ReadLayers(r, root, &c.spec);
+  ReadEncoding(r, root, &c.spec.output);
+  if (r.Get(root, "epochs", "epochs", &c.epochs, "an integer"))
+    Check(r, c.epochs > 0, root, "epochs", "must be > 0", c.epochs);
+  ReadAdam(r, root, &c.adam);
+  r.Get(root, "seed", "seed", &c.seed, "a non-negative integer");
+  if (r.Get(root, "scalar", "scalar", &c.scalar, "a string"))
+    Check(r, c.scalar == "float" || c.scalar == "double", root, "scalar", "must be float or double", c.scalar);
+  r.Get(root, "noise", "noise", &c.noise, "true or false");
+  if (r.Get(root, "log_every", "log_every", &c.log_every, "an integer"))
+    Check(r, c.log_every > 0, root, "log_every", "must be > 0", c.log_every);
+  if (r.Get(root, "checkpoint_every", "checkpoint_every", &c.checkpoint_every, "an integer"))
+    Check(r, c.checkpoint_every >= 0, root, "checkpoint_every", "must be >= 0", c.checkpoint_every);
+  ReadPath(r, file, root, "output", &c.output, true);
+  ReadPath(r, file, root, "checkpoint", &c.checkpoint);
+  ReadPath(r, file, root, "log_csv", &c.log_csv);
   if (c.checkpoint.empty() && !c.output.empty()) c.checkpoint = c.output + ".ckpt";
   if (c.log_csv.empty() && !c.output.empty()) c.log_csv = c.output + ".csv";
+  // The settings' value rules, each at the config key of its field.
   std::vector<FieldProblem> problems = c.spec.Problems();
   for (FieldProblem& p : c.adam.Problems()) problems.push_back(std::move(p));
   for (const FieldProblem& p : problems) {
@@ -296,21 +236,22 @@ StatusOr<TrainConfig> LoadTrainConfig(const std::string& path, const std::vector
     return Status::InvalidArgument(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
                                    ": " + e.msg);
   }
-  std::set<std::string> overridden;
+  std::map<std::string, std::string> sets;  // key as messages spell it -> the --set text
   for (const auto& o : overrides) {
     if (Status s = ApplyOverride(root, o); !s.ok()) return s;
-    overridden.insert(MessageKey(o.substr(0, o.find('='))));
+    sets[MessageKey(o.substr(0, o.find('=')))] = o;
   }
-  Reader r(path, overridden);
+  std::vector<Diagnostic> problems;
+  StrictYaml r(StrictYaml::InFile(path, sets), &problems);
   TrainConfig c;
   try {
-    c = Read(root, r);
+    c = Read(r, path, root);
   } catch (const YAML::Exception& e) {  // e.g. a key that is itself a list: not our format
     return Status::InvalidArgument(path + ": " + e.msg);
   }
-  if (!r.errors().empty()) {
+  if (!problems.empty()) {
     std::string all;
-    for (const auto& e : r.errors()) all += (all.empty() ? "" : "\n") + e;
+    for (const Diagnostic& d : problems) all += (all.empty() ? "" : "\n") + d.ToString();
     return Status::InvalidArgument(all);
   }
   return c;

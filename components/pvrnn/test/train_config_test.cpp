@@ -85,24 +85,26 @@ TEST(TrainConfig, LoopsDefaultsToOneAndIsRangeChecked) {
   EXPECT_EQ(two->loops, 2);
   auto zero = LoadTrainConfig(kDir + "/valid_train.yaml", {"loops=0"});
   ASSERT_FALSE(zero.ok());
-  EXPECT_EQ(zero.status().message(), "--set loops: must be in 1..100, got 0");
+  EXPECT_EQ(zero.status().message(), "--set loops=0: loops: must be in 1..100, got 0");
 }
 
 TEST(TrainConfig, BadOverrideIsNamed) {
   auto c = LoadTrainConfig(kDir + "/valid_train.yaml", {"epochs=-3"});
   ASSERT_FALSE(c.ok());
-  EXPECT_EQ(c.status().message(), "--set epochs: must be > 0, got -3");
+  EXPECT_EQ(c.status().message(), "--set epochs=-3: epochs: must be > 0, got -3");
   auto d = LoadTrainConfig(kDir + "/valid_train.yaml", {"adam.momentum=0.5"});
   ASSERT_FALSE(d.ok());
-  EXPECT_NE(d.status().message().find("--set adam.momentum: unknown key"), std::string::npos) << d.status().message();
+  EXPECT_NE(d.status().message().find("--set adam.momentum=0.5: adam.momentum: unknown key"), std::string::npos)
+      << d.status().message();
 }
 
-// A value rule broken by --set names the --set key, not a place in the file.
+// A value rule broken by --set names the --set, not a place in the file.
 TEST(TrainConfig, OverrideBreakingASpecRuleIsNamed) {
   auto c = LoadTrainConfig(kDir + "/valid_train.yaml", {"layers.0.d=0", "adam={lr: -1}"});
   ASSERT_FALSE(c.ok());
   EXPECT_EQ(c.status().message(),
-            "--set layers[0].d: must be in 1..100000, got 0\n--set adam.lr: must be finite and > 0, got -1");
+            "--set layers.0.d=0: layers[0].d: must be in 1..100000, got 0\n"
+            "--set adam={lr: -1}: adam.lr: must be finite and > 0, got -1");
 }
 
 // --set through a scalar or past a list's end is an error, never an exception.

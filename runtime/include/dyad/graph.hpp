@@ -51,24 +51,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "dyad/diagnostic.hpp"
+
 namespace dyad {
-
-// A position in a source file (1-based); line 0 means "not from a file" (command line).
-struct SourceMark {
-  std::string file;
-  int line = 0;
-  int column = 0;
-  std::string ToString() const;  // "file:line:col" or "file"
-  // Where `node` starts in `file` (yaml-cpp counts from 0; we count from 1).
-  static SourceMark Of(const std::string& file, const YAML::Node& node);
-};
-
-struct Diagnostic {
-  SourceMark mark;
-  std::string key;      // dotted path, e.g. "components.mixer.params.gain"
-  std::string message;
-  std::string ToString() const;  // "file:line:col: key: message" ("key = value: why" for "= value: why")
-};
 
 enum class Reliability { kReliable, kBestEffort };
 enum class ClockMode { kWall, kStepped };

@@ -19,7 +19,8 @@
 //
 // Contract: unknown keys, wrong types and invalid values are errors, each reported as
 // "file:line:col: key: message" (1-based), all of them at once. `overrides` ("adam.lr=0.002")
-// replace values before validation and are reported as "--set key: message".
+// replace values before validation and are reported as "--set KEY=VALUE: key: message"
+// (dyad/strict_yaml.hpp, the reader the graph file uses too).
 // Paths (dataset, output, checkpoint, log_csv) come back absolute: written in the file, relative
 // to the file's folder; given as an override, relative to the working folder.
 #pragma once
