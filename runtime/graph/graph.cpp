@@ -13,6 +13,7 @@
 
 
 #include "graph/graph_document.hpp"
+#include "graph/graph_keys.hpp"
 #include "graph/host_port.hpp"
 #include "graph/run_partition.hpp"
 
@@ -40,9 +41,7 @@ void ReadStringList(StrictYaml& r, const YAML::Node& node, const std::string& ke
 void ReadNetwork(StrictYaml& r, const YAML::Node& node, NetworkConfig* n) {
   n->mark = r.Mark(node, "network");
   if (node.IsNull()) return;
-  if (!r.Map(node, "network", {"discovery", "hosts", "peers", "server", "transport", "interfaces", "lease_s", "start_timeout_s",
-                            "max_clock_offset_ms", "launcher_tcp_port"}))
-    return;
+  if (!r.Map(node, "network", graph_keys::kNetwork)) return;
   std::string s;
   if (node["discovery"] && r.String(node["discovery"], "network.discovery", &s)) {
     if (s == "multicast") n->discovery = Discovery::kMulticast;
@@ -119,7 +118,7 @@ void ReadTopics(StrictYaml& r, const YAML::Node& node, Graph* g) {
       g->topics.push_back(t);
       continue;
     }
-    if (!r.Map(spec, key, {"type", "reliability", "depth", "deadline_ms", "liveliness_ms"})) continue;
+    if (!r.Map(spec, key, graph_keys::kTopic)) continue;
     if (spec["type"]) {
       r.String(spec["type"], key + ".type", &t.type);
       t.type_mark = r.Mark(spec["type"], key + ".type");
@@ -162,7 +161,7 @@ void ReadComponents(StrictYaml& r, const YAML::Node& node, Graph* g) {
     const std::string key = "components." + c.name;
     c.mark = r.Mark(kv.first, key);
     const YAML::Node spec = kv.second;
-    if (!r.Map(spec, key, {"type", "rate_hz", "trigger", "process", "params", "inputs", "outputs"})) continue;
+    if (!r.Map(spec, key, graph_keys::kComponent)) continue;
     if (spec["type"]) {
       r.String(spec["type"], key + ".type", &c.type);
       c.type_mark = r.Mark(spec["type"], key + ".type");
@@ -344,7 +343,7 @@ void ReadProcesses(StrictYaml& r, const YAML::Node& procs, Graph* g) {
     const std::string key = "processes." + p.name;
     p.mark = r.Mark(kv.first, key);
     const YAML::Node spec = kv.second;
-    if (!spec.IsNull() && r.Map(spec, key, {"host", "restart", "max_restarts", "backoff_s", "required", "tcp_port"})) {
+    if (!spec.IsNull() && r.Map(spec, key, graph_keys::kProcess)) {
       if (spec["host"] && r.String(spec["host"], key + ".host", &p.host) && !g->network.hosts.empty() &&
           !g->network.hosts.count(p.host))
         r.Error(spec["host"], key + ".host", "'" + p.host + "' is not one of network.hosts (" + Names(g->network.hosts) + ")");
@@ -435,7 +434,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   const YAML::Node root = doc.root;
   // Each problem at the file (or --set) that wrote its key.
   StrictYaml r([&g](const std::string& key, const YAML::Node& node) { return g.MarkOf(key, node); }, diagnostics);
-  r.Map(root, "", {"graph", "domain_id", "clock", "seed", "plugins", "logs", "network", "processes", "topics", "components"});
+  r.Map(root, "", graph_keys::kTopLevel);
   ReadGraphScalars(r, root, &g);
   if (const YAML::Node network = root["network"]) ReadNetwork(r, network, &g.network);
   if (const YAML::Node procs = root["processes"]) ReadProcesses(r, procs, &g);

@@ -1,5 +1,6 @@
 // The document a graph file stands for: its `extends:` chain merged, the --sets written in.
 #include "graph/graph_document.hpp"
+#include "graph/graph_keys.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -149,8 +150,6 @@ std::vector<std::pair<std::string, YAML::Node>> ReadChain(const std::string& pat
 // Where an override writes: its key path in the document; empty (reported) when it cannot be placed.
 std::vector<std::string> SetPath(const std::string& text, const YAML::Node& root, const SourceMark& cli,
                                  std::vector<Diagnostic>* out) {
-  static const std::set<std::string> kGraphKeys = {"clock", "seed", "domain_id", "graph", "logs", "plugins"};
-  static const std::set<std::string> kComponentKeys = {"type", "rate_hz", "trigger", "process"};
   const auto eq = text.find('=');
   const std::string keys = eq == std::string::npos ? "" : text.substr(0, eq);
   std::vector<std::string> parts;
@@ -166,7 +165,7 @@ std::vector<std::string> SetPath(const std::string& text, const YAML::Node& root
                       "network.KEY=VALUE or processes.NAME.KEY=VALUE");
   const std::string& head = parts[0];
   if (parts.size() == 1) {
-    if (kGraphKeys.count(head)) return parts;
+    if (graph_keys::kScalars.count(head)) return parts;
     return fail(text, "expected COMPONENT.PARAM=VALUE, COMPONENT.type=TYPE, clock|seed|domain_id|graph=VALUE, "
                       "network.KEY=VALUE or processes.NAME.KEY=VALUE");
   }
@@ -182,7 +181,7 @@ std::vector<std::string> SetPath(const std::string& text, const YAML::Node& root
   const YAML::Node comps = root["components"];
   if (!comps.IsMap() || !comps[head]) return fail("components." + head, "no such component in the graph");
   std::vector<std::string> path = {"components", head};
-  if (parts.size() == 2 && (kComponentKeys.count(parts[1]) || parts[1] == "params")) {
+  if (parts.size() == 2 && (graph_keys::kComponentScalars.count(parts[1]) || parts[1] == "params")) {
     path.push_back(parts[1]);
   } else if ((parts[1] == "inputs" || parts[1] == "outputs") && parts.size() == 3) {
     path.insert(path.end(), {parts[1], parts[2]});
