@@ -1,0 +1,98 @@
+// Process-level tests of the watchers: `dyad topics`, `echo`, `hz` and `status` on a running
+// graph, as another program on the domain.
+#include "process_fixture.hpp"
+
+#include <signal.h>
+
+namespace {
+
+using namespace dyad::testing;
+
+// topics, echo and hz join the domain from outside and see a running graph.
+TEST_F(ProcessTest, IntrospectionSeesARunningGraph) {
+  const std::string domain = std::to_string(domain_);
+  const fs::path g = Write("g.yaml", "graph: intro\ndomain_id: " + domain +
+                                         "\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 50, params: {start: 1000}, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, inputs: {in: count}}\n");
+  Child run(Dyad({"run", g.string(), "--duration", "20", "--stats-period", "0.5"}), dir_, "run");
+
+  // Generous discovery waits (they end at the first writer found): a loaded CI machine may take
+  // seconds to start the graph. `topics` goes after `echo`, which proves the graph is up.
+  Child echo(Dyad({"echo", "count", "--domain", domain, "-n", "3", "--wait", "20"}), dir_, "echo");
+  ASSERT_EQ(echo.Wait(30), 0) << echo.err();
+  const std::string e = echo.out();
+  EXPECT_EQ(std::count(e.begin(), e.end(), '\n'), 3) << e;
+  EXPECT_NE(e.find("{\"header\":{\"source\":\"src\",\"sequence_number\":"), std::string::npos) << e;
+  EXPECT_NE(e.find("\"value\":1"), std::string::npos) << e;  // values start at 1000
+
+  Child stats(Dyad({"echo", "dyad/stats", "--domain", domain, "-n", "1", "--wait", "20"}), dir_, "stats");
+  ASSERT_EQ(stats.Wait(30), 0) << stats.err();
+  EXPECT_NE(stats.out().find("\"process_name\":\"main\""), std::string::npos) << stats.out();
+
+  Child topics(Dyad({"topics", "--domain", domain, "--wait", "4"}), dir_, "topics");
+  ASSERT_EQ(topics.Wait(30), 0) << topics.err() << topics.out();
+  EXPECT_NE(topics.out().find("count  dyad::msg::Counter#"), std::string::npos) << topics.out();
+  EXPECT_NE(topics.out().find("dyad/intro/main"), std::string::npos) << topics.out();
+
+
+  Child hz(Dyad({"hz", "count", "--domain", domain, "--duration", "2.5", "--wait", "20"}), dir_, "hz");
+  ASSERT_EQ(hz.Wait(30), 0) << hz.err();
+  double rate = 0;
+  ASSERT_EQ(std::sscanf(hz.out().c_str(), "rate %lf Hz", &rate), 1) << hz.out();
+  EXPECT_NEAR(rate, 50.0, 5.0) << hz.out();
+
+  // Domain 231 is outside the tests' 1..200: nothing there, and `topics` says so.
+  Child empty(Dyad({"topics", "--domain", "231", "--wait", "0.3"}), dir_, "empty");
+  EXPECT_EQ(empty.Wait(30), 1);
+  EXPECT_NE(empty.err().find("no endpoint discovered on domain 231 within 0.3 s"), std::string::npos) << empty.err();
+
+  Child none(Dyad({"echo", "no/such/topic", "--domain", domain, "--wait", "1"}), dir_, "none");
+  EXPECT_EQ(none.Wait(30), 1);
+  EXPECT_NE(none.err().find("no writer of topic 'no/such/topic'"), std::string::npos) << none.err();
+
+  run.Signal(SIGINT);
+  EXPECT_EQ(run.Wait(15), 130) << run.err();
+  EXPECT_NE(run.err().find("dyad run: interrupted (SIGINT)"), std::string::npos) << run.err();
+}
+
+// `dyad status` on a split graph whose second process's clock is 25 ms ahead (the test-only
+// DYAD_TEST_CLOCK_OFFSET_MS): both processes listed with their hosts and pids, the offset
+// measured within 1 ms both ways, and the warning said by the process that measured it.
+TEST_F(ProcessTest, StatusListsTheProcessesAndTheMeasuredClockOffsets) {
+  const fs::path g = Write("g.yaml", "graph: clocks\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\nnetwork: {discovery: peers, hosts: {h1: 127.0.0.1, h2: 127.0.0.1}}\n"
+                                         "processes: {a: {host: h1}, b: {host: h2}}\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 20, process: a, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: b, inputs: {in: count}}\n");
+  Child a(Dyad({"run", g.string(), "--host", "h1", "--steps", "200"}), dir_, "a");
+  Child b(Dyad({"run", g.string(), "--host", "h2", "--steps", "200"}), dir_, "b", {"DYAD_TEST_CLOCK_OFFSET_MS=25"});
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  Child status(Dyad({"status", "--graph", g.string(), "--wait", "4"}), dir_, "status");
+  ASSERT_EQ(status.Wait(30), 0) << status.err();
+  const pid_t pid_a = ChildPid(g, "a"), pid_b = ChildPid(g, "b");
+  ASSERT_EQ(a.Wait(60), 0) << a.err();
+  ASSERT_EQ(b.Wait(60), 0) << b.err();
+  const std::string out = status.out();
+  EXPECT_NE(out.find("clocks/a                h1              " + std::to_string(pid_a) + " "), std::string::npos) << out;
+  EXPECT_NE(out.find("clocks/b                h2              " + std::to_string(pid_b) + " "), std::string::npos) << out;
+  EXPECT_NE(out.find("running"), std::string::npos) << out;
+  auto offset_ms = [&](const std::string& from, const std::string& to) {
+    const std::string key = "  " + from + std::string(16 - from.size(), ' ') + "-> " + to;
+    const auto at = out.find(key);
+    EXPECT_NE(at, std::string::npos) << key << "\n" << out;
+    return at == std::string::npos ? 0.0 : std::stod(out.substr(at + key.size(), 40));
+  };
+  // Within 1 ms; an instrumented build's scheduling delays make the round trips lopsided.
+#ifdef DYAD_SANITIZED
+  const double tolerance_ms = 5;
+#else
+  const double tolerance_ms = 1;
+#endif
+  EXPECT_NEAR(offset_ms("a", "b"), 25.0, tolerance_ms) << out;
+  EXPECT_NEAR(offset_ms("b", "a"), -25.0, tolerance_ms) << out;
+  EXPECT_NE(a.err().find("[warn] clock: the clock of process 'b' is +2"), std::string::npos) << a.err();
+  EXPECT_NE(out.find("src                 a"), std::string::npos) << out;  // step stats
+}
+
+}  // namespace
