@@ -9,10 +9,13 @@ namespace dyad::mixer {
 
 void ComplianceMixer::Describe(ComponentSpec& spec) {
   spec.Summary("Blends human and robot positions into the driver's command (g*human + (1-g)*robot while engaged), "
-               "saturates its change per step, holds it when inputs go stale.");
+               "saturates its change per step and per second, holds it when inputs go stale.");
   spec.Param("gain", 0.9).Range(0, 1).Doc("weight of the human while engaged (the study: 0.9)");
   spec.Param("max_step", 5.0).Min(0).Unit("workspace units").Doc(
       "max change of the command per step, vector norm (the study: 5; 0: no limit)");
+  spec.Param("max_speed", 50.0).Min(0).Unit("workspace units/s").Doc(
+      "max speed of the command, vector norm, on the runtime clock's time between commands: a burst of "
+      "trigger samples moves it no faster (the study: 5 per 100 ms step = 50; 0: no limit)");
   spec.Param("mode", "blend").OneOf({"blend", "pi"}).Doc(
       "blend: command = blend; pi: command = state + kp*e + ki*integral(e), e = blend - state");
   spec.Param("kp", 1.0).Min(0).Doc("mode pi: proportional gain (kp 1, ki 0 = plain blend)");
@@ -36,6 +39,7 @@ Status ComplianceMixer::Configure(Context& ctx) {
   MixerOptions o;
   o.gain = p.Double("gain");
   o.max_step = p.Double("max_step");
+  o.max_speed = p.Double("max_speed");
   o.mode = p.String("mode") == "pi" ? Mode::kPi : Mode::kBlend;
   o.kp = p.Double("kp");
   o.ki = p.Double("ki");

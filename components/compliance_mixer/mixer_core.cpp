@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace dyad::mixer {
 
@@ -21,6 +22,7 @@ Status Bad(const char* field, double value, const char* constraint) {
 Status MixerOptions::Validate() const {
   if (!(gain >= 0 && gain <= 1)) return Bad("gain", gain, "must be in [0, 1]");
   if (!(max_step >= 0)) return Bad("max_step", max_step, "must be >= 0");
+  if (!(max_speed >= 0)) return Bad("max_speed", max_speed, "must be >= 0");
   if (!(kp >= 0)) return Bad("kp", kp, "must be >= 0");
   if (!(ki >= 0)) return Bad("ki", ki, "must be >= 0");
   if (!(integral_limit >= 0)) return Bad("integral_limit", integral_limit, "must be >= 0");
@@ -52,6 +54,13 @@ MixerCore::MixerCore(const MixerOptions& options) : options_(options) {
   assert(options_.Validate().ok());
 }
 
+double MixerCore::StepLimit(int64_t now_ns) const {
+  double limit = options_.max_step > 0 ? options_.max_step : std::numeric_limits<double>::infinity();
+  if (options_.max_speed > 0 && last_command_ns_ >= 0)
+    limit = std::min(limit, options_.max_speed * std::max<int64_t>(now_ns - last_command_ns_, 0) * 1e-9);
+  return limit;
+}
+
 MixerCore::Result MixerCore::Update(const Inputs& in, int64_t now_ns) {
   Result r;
   const bool pi = options_.mode == Mode::kPi;
@@ -73,6 +82,7 @@ MixerCore::Result MixerCore::Update(const Inputs& in, int64_t now_ns) {
     r.has_command = has_last_;
     r.position = last_;
     r.hold = true;
+    if (has_last_) last_command_ns_ = now_ns;
     return r;
   }
 
@@ -97,13 +107,23 @@ MixerCore::Result MixerCore::Update(const Inputs& in, int64_t now_ns) {
   const Vec2 ref = has_last_ ? last_ : in.state.position;
   Vec2 command = desired;
   if (have_ref) {
-    const Vec2 step = SaturateNorm({desired.x - ref.x, desired.y - ref.y}, options_.max_step, &r.saturated);
+    const Vec2 delta{desired.x - ref.x, desired.y - ref.y};
+    const double limit = has_last_ ? StepLimit(now_ns) : (options_.max_step > 0 ? options_.max_step : 0);
+    // SaturateNorm reads a limit of 0 as none; a speed limit with no time elapsed is no motion.
+    Vec2 step = delta;
+    if (limit == 0 && has_last_) {
+      step = {0, 0};
+      r.saturated = delta.x != 0 || delta.y != 0;
+    } else if (std::isfinite(limit)) {
+      step = SaturateNorm(delta, limit, &r.saturated);
+    }
     command = {ref.x + step.x, ref.y + step.y};
   }
   if (pi && !r.saturated) integral_ = next_integral;
 
   has_last_ = true;
   last_ = command;
+  last_command_ns_ = now_ns;
   r.has_command = true;
   r.position = command;
   return r;

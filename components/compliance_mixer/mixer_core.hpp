@@ -9,8 +9,11 @@
 ///                (a PI loop closed around the driver's measured position; kp = 1, ki = 0
 ///                gives the plain blend back; anti-windup: I is clamped per axis to
 ///                +-integral_limit and not accumulated on an update whose command saturated)
-///   then the change from the previous command is saturated to `max_step` (vector norm, so the
-///   direction of motion is kept; the study: 5 units per step). The first command is saturated
+///   then the change from the previous command is saturated (vector norm, so the direction of
+///   motion is kept) to `max_step` per command and to `max_speed` times the runtime clock's time
+///   since the previous command (the study: 5 units per 100 ms step, 50 units/s): a burst of
+///   updates (a writer flooding the trigger input) moves the command no faster than max_speed,
+///   and two updates at one instant do not move it. The first command is saturated to max_step
 ///   against the measured state when one is known, else taken as is.
 /// Stale inputs: if the robot or human sample (or, in kPi, the state) is older than
 /// `stale_timeout_ns` or missing, Update() repeats the previous command with hold = true (or
@@ -41,6 +44,7 @@ enum class Mode { kBlend, kPi };
 struct MixerOptions {
   double gain = 0.9;                     // weight of the human while engaged, [0, 1]
   double max_step = 5.0;                 // max change of the command per update, workspace units (norm); 0 = none
+  double max_speed = 50.0;               // max change per second of runtime-clock time between commands; 0 = none
   Mode mode = Mode::kBlend;
   double kp = 1.0;                       // kPi: proportional gain, >= 0
   double ki = 0.0;                       // kPi: integral gain, 1/s, >= 0
@@ -93,6 +97,10 @@ class MixerCore {
   Vec2 last_;                 // previous command
   Vec2 integral_;             // kPi: sum of e*dt
   int64_t last_update_ns_ = -1;
+  int64_t last_command_ns_ = -1;  // when the previous command (a hold too) was made
+
+  // The longest change allowed from the previous command at `now_ns` (infinity: none).
+  double StepLimit(int64_t now_ns) const;
 };
 
 // Shortens `delta` to norm `max_norm` (unchanged when shorter or max_norm <= 0). Sets *clipped.

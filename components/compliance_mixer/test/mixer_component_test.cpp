@@ -63,5 +63,24 @@ TEST(MixerComponent, AnInputThatStopsIsStale) {
       << m.Warnings()[0];
 }
 
+// The trigger input flooded: 100 intentions far away, a step for each, 1 ms apart. The commands
+// move max_speed (50 units/s) x the clock's 100 ms, not 100 x max_step.
+TEST(MixerComponent, AFloodedTriggerMovesTheCommandsNoFasterThanMaxSpeed) {
+  Mixer m;
+  m.Step(true, true);  // the first command, at the origin
+  msg::Intention far;
+  far.x(1000);
+  for (int i = 1; i <= 100; ++i) {
+    m.ctx.clock_.now = i * 1'000'000;
+    m.robot.queue.push_back(far);
+    m.human.queue.push_back(msg::HumanInput());
+    m.ctx.PollInputs();
+    ASSERT_TRUE(m.mixer.Step(StepInfo{m.ctx.clock_.now, m.index++, kStep}).ok());
+  }
+  ASSERT_EQ(m.out.samples.size(), 101u);
+  EXPECT_NEAR(m.out.samples.back().x(), 5.0, 1e-9);
+  for (const auto& c : m.out.samples) EXPECT_LE(c.x(), 5.0 + 1e-9);
+}
+
 }  // namespace
 }  // namespace dyad::mixer

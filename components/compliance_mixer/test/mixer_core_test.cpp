@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace dyad::mixer {
@@ -29,6 +30,7 @@ TEST(MixerOptions, DefaultsAreValidAndTheStudys) {
   EXPECT_TRUE(o.Validate().ok());
   EXPECT_EQ(o.gain, 0.9);
   EXPECT_EQ(o.max_step, 5.0);
+  EXPECT_EQ(o.max_speed, 50.0);  // 5 units per 100 ms step
 }
 
 TEST(MixerOptions, ErrorsNameFieldValueAndConstraint) {
@@ -41,6 +43,9 @@ TEST(MixerOptions, ErrorsNameFieldValueAndConstraint) {
   o = MixerOptions();
   o.ki = -1;
   EXPECT_EQ(o.Validate().message(), "ki = -1: must be >= 0");
+  o = MixerOptions();
+  o.max_speed = -2;
+  EXPECT_EQ(o.Validate().message(), "max_speed = -2: must be >= 0");
 }
 
 TEST(MixerCore, EngagedHumanBlendsWithGain) {
@@ -87,6 +92,53 @@ TEST(MixerCore, ChangePerStepIsSaturatedToFiveUnitsByNorm) {
   r = m.Update(Fresh({30, 40}, {0, 0}, false, 11 * kStep), 11 * kStep);
   EXPECT_FALSE(r.saturated);
   EXPECT_DOUBLE_EQ(r.position.x, 30);
+}
+
+// A writer flooding the trigger input (a buggy or hostile one, spoofed UDP states): 50 updates
+// in 100 ms used to allow 50 x 5 = 250 units; per second of the runtime clock it is 50 units/s,
+// so 5 units in those 100 ms, whatever the number of updates.
+TEST(MixerCore, AFloodOfUpdatesMovesTheCommandNoFasterThanMaxSpeed) {
+  MixerCore m{MixerOptions()};
+  auto r = m.Update(Fresh({0, 0}, {0, 0}, false, 0), 0);
+  ASSERT_DOUBLE_EQ(r.position.x, 0);
+  const int64_t every = 2'000'000;  // 2 ms
+  double furthest = 0;
+  for (int k = 1; k <= 50; ++k) {
+    r = m.Update(Fresh({1000, 0}, {0, 0}, false, k * every), k * every);
+    EXPECT_TRUE(r.saturated) << k;
+    furthest = std::max(furthest, std::hypot(r.position.x, r.position.y));
+  }
+  EXPECT_NEAR(r.position.x, 50.0 * 0.1, 1e-9);  // max_speed x 100 ms
+  EXPECT_LE(furthest, 5.0 + 1e-9);
+  // Two updates at one instant: no time, no motion.
+  const Vec2 at = r.position;
+  r = m.Update(Fresh({1000, 0}, {0, 0}, false, 50 * every), 50 * every);
+  EXPECT_DOUBLE_EQ(r.position.x, at.x);
+  EXPECT_TRUE(r.saturated);
+}
+
+TEST(MixerCore, MaxSpeedZeroLimitsPerStepOnly) {
+  MixerOptions o;
+  o.max_speed = 0;
+  MixerCore m(o);
+  m.Update(Fresh({0, 0}, {0, 0}, false, 0), 0);
+  MixerCore::Result r;
+  for (int k = 1; k <= 50; ++k) r = m.Update(Fresh({1000, 0}, {0, 0}, false, k * 2'000'000), k * 2'000'000);
+  EXPECT_NEAR(r.position.x, 250, 1e-9);  // 5 per update: what the flood got before max_speed
+}
+
+// After a hold, the time since the held command counts, not since the last moving one: max_step
+// still caps the first move.
+TEST(MixerCore, AfterAHoldTheCommandMovesAtMostMaxStep) {
+  MixerOptions o;
+  o.stale_timeout_ns = 50'000'000;
+  MixerCore m(o);
+  m.Update(Fresh({0, 0}, {0, 0}, false, 0), 0);
+  MixerCore::Inputs stale = Fresh({1000, 0}, {0, 0}, false, 0);
+  stale.robot.receive_ns = 0;
+  for (int k = 1; k <= 20; ++k) EXPECT_TRUE(m.Update(stale, k * kStep).hold);
+  const auto r = m.Update(Fresh({1000, 0}, {0, 0}, false, 21 * kStep), 21 * kStep);
+  EXPECT_NEAR(r.position.x, 5, 1e-9);
 }
 
 TEST(MixerCore, FirstCommandIsSaturatedAgainstTheMeasuredState) {
