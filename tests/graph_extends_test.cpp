@@ -179,5 +179,21 @@ TEST_F(ExtendsTest, ASetWritesAComponentsTypeBindingsAndOwnKeys) {
   EXPECT_NE(diags[0].message.find("no such component"), std::string::npos);
 }
 
+// A --set that goes through a list or a scalar cannot be placed: an error at the --set (it was
+// dropped without a word, the file being fine there).
+TEST_F(ExtendsTest, ASetThroughAListOrAScalarIsAnErrorAtTheSet) {
+  Write("mine/net.yaml", "extends: ../base/demo.yaml\nnetwork: {discovery: peers, peers: [10.0.0.9], hosts: {lab: 10.0.0.1}}\n");
+  for (const auto& [set, says] : std::vector<std::pair<std::string, std::string>>{
+           {"network.peers.0=10.0.0.8", "cannot set '0' inside network.peers, which is a list: set network.peers as a whole"},
+           {"network.hosts.lab.port=7400", "cannot set 'port' inside network.hosts.lab, which is a scalar"}}) {
+    std::vector<Diagnostic> diags;
+    const Graph g = LoadGraph((dir_ / "mine/net.yaml").string(), {{set}}, &diags);
+    ASSERT_EQ(diags.size(), 1u) << set;
+    EXPECT_EQ(diags[0].mark.ToString(), "--set " + set);
+    EXPECT_NE(diags[0].message.find(says), std::string::npos) << diags[0].ToString();
+    EXPECT_EQ(g.network.peers, std::vector<std::string>{"10.0.0.9"});  // the file's value stands
+  }
+}
+
 }  // namespace
 }  // namespace dyad

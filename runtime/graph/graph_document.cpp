@@ -192,16 +192,21 @@ std::vector<std::string> SetPath(const std::string& text, const YAML::Node& root
   return path;
 }
 
-// node[path[i]][path[i+1]]... = value, making the maps on the way; false where a non-map is in it.
-bool WriteAt(YAML::Node node, const std::vector<std::string>& path, size_t i, const YAML::Node& value) {
+// node[path[i]][path[i+1]]... = value, making the maps on the way. Returns path.size() when
+// written, else the index of the part that is not a mapping, and *kind says what it is.
+size_t WriteAt(YAML::Node node, const std::vector<std::string>& path, size_t i, const YAML::Node& value,
+               std::string* kind) {
   if (i + 1 == path.size()) {
     node[path[i]] = value;
-    return true;
+    return path.size();
   }
   // (No `YAML::Node n = ...; n = n[...]`: assigning to a yaml-cpp node overwrites what it refers to.)
   if (!node[path[i]] || node[path[i]].IsNull()) node[path[i]] = YAML::Node(YAML::NodeType::Map);
-  if (!node[path[i]].IsMap()) return false;
-  return WriteAt(node[path[i]], path, i + 1, value);
+  if (!node[path[i]].IsMap()) {
+    *kind = node[path[i]].IsSequence() ? "a list" : "a scalar";
+    return i;
+  }
+  return WriteAt(node[path[i]], path, i + 1, value, kind);
 }
 
 }  // namespace
@@ -233,7 +238,14 @@ void ApplySets(const std::vector<Override>& overrides, GraphDocument* doc, std::
       diagnostics->push_back({cli, key, "value is not valid YAML: " + e.msg});
       continue;
     }
-    if (!WriteAt(doc->root, path, 0, value)) continue;  // the file's own error ("must be a mapping") says it
+    std::string kind;
+    if (const size_t at = WriteAt(doc->root, path, 0, value, &kind); at != path.size()) {
+      // A list or scalar in the way (the file may be fine there): the set cannot be placed.
+      const std::string in = Join(path, 0, at + 1);
+      diagnostics->push_back({cli, key, "cannot set '" + path[at + 1] + "' inside " + in + ", which is " + kind +
+                                            ": set " + in + " as a whole"});
+      continue;
+    }
     SetOrigin(&doc->origins, key, cli.file);
     doc->sets.push_back(o.text);
   }
