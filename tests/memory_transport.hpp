@@ -1,5 +1,6 @@
 // MemoryTransport — an in-memory Transport (runtime/dds/transport.hpp) for the executor's unit
-// tests: no DDS, no threads of its own. A write is delivered synchronously, inside Write(), to
+// tests: no DDS, no threads of its own (endpoints may be made while other threads write: the
+// ClockSync and StartBarrier tests do). A write is delivered synchronously, inside Write(), to
 // every reader of the topic, as Fast DDS does within a process; samples travel as CDR made by
 // the type's own TypeSupport. KEEP_LAST keeps `depth` samples per reader (the oldest dropped),
 // KEEP_ALL keeps everything. Test code only.
@@ -35,18 +36,21 @@ class MemoryTransport final : public Transport {
 
   StatusOr<TypedReader*> CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
                                       std::function<void()> on_data) override {
+    std::lock_guard<std::mutex> lock(topology_);  // endpoints may be made while others write
     if (Status s = CheckType(topic, type); !s.ok()) return s;
     readers_.push_back(std::make_unique<Reader>(type, qos, std::move(on_data), spurious_));
     topics_[topic].readers.push_back(readers_.back().get());
     return readers_.back().get();
   }
   StatusOr<TypedWriter*> CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos&) override {
+    std::lock_guard<std::mutex> lock(topology_);  // endpoints may be made while others write
     if (Status s = CheckType(topic, type); !s.ok()) return s;
     writers_.push_back(std::make_unique<Writer>(this, topic, type));
     return writers_.back().get();
   }
   StatusOr<SerializedSubscription*> CreateSerializedReader(const std::string& topic, const TypeInfo& type, const TopicQos&,
                                                            const Clock* clock, SerializedCallback callback) override {
+    std::lock_guard<std::mutex> lock(topology_);  // endpoints may be made while others write
     if (Status s = CheckType(topic, type); !s.ok()) return s;
     serialized_readers_.push_back(std::make_unique<SerializedReader>(topic, clock, std::move(callback), true));
     topics_[topic].serialized.push_back(serialized_readers_.back().get());
@@ -55,6 +59,7 @@ class MemoryTransport final : public Transport {
   // Stopped: samples are not kept (a KEEP_LAST history is not modelled).
   StatusOr<OnDemandReader*> CreateOnDemandReader(const std::string& topic, const TypeInfo& type, const TopicQos&,
                                                  const Clock* clock, SerializedCallback callback) override {
+    std::lock_guard<std::mutex> lock(topology_);  // endpoints may be made while others write
     if (Status s = CheckType(topic, type); !s.ok()) return s;
     serialized_readers_.push_back(std::make_unique<SerializedReader>(topic, clock, std::move(callback), false));
     topics_[topic].serialized.push_back(serialized_readers_.back().get());
@@ -62,6 +67,7 @@ class MemoryTransport final : public Transport {
   }
   StatusOr<SerializedWriter*> CreateSerializedWriter(const std::string& topic, const TypeInfo& type, const TopicQos&,
                                                      const Clock*) override {
+    std::lock_guard<std::mutex> lock(topology_);  // endpoints may be made while others write
     if (Status s = CheckType(topic, type); !s.ok()) return s;
     serialized_writers_.push_back(std::make_unique<RawWriter>(this, topic, type));
     return serialized_writers_.back().get();
@@ -169,7 +175,10 @@ class MemoryTransport final : public Transport {
       t_->Publish(topic_, Bytes(payload.data, payload.data + payload.length), stamp_ns, ++sequence_);
       return Status::OK();
     }
-    int matched() const override { return static_cast<int>(t_->topics_[topic_].readers.size()); }
+    int matched() const override {
+      std::lock_guard<std::mutex> lock(t_->topology_);
+      return static_cast<int>(t_->topics_[topic_].readers.size());
+    }
     // Write() delivered to every reader before it returned: nothing is ever unacknowledged.
     bool AwaitAcknowledged(double /*timeout_s*/) override { return true; }
 
@@ -210,14 +219,24 @@ class MemoryTransport final : public Transport {
     if (t.type != type.dds_name()) return Status::InvalidArgument("topic '" + topic + "' already carries " + t.type);
     return Status::OK();
   }
+  // Delivers outside the lock (a reader's callback may write, or make an endpoint); the readers
+  // themselves live as long as the transport.
   void Publish(const std::string& topic, const Bytes& bytes, int64_t stamp, uint64_t sequence) {
-    Topic& t = topics_[topic];
-    for (Reader* r : t.readers) r->Deliver(bytes);
-    for (SerializedReader* r : t.serialized) r->Deliver(bytes, stamp, sequence);
+    std::vector<Reader*> readers;
+    std::vector<SerializedReader*> serialized;
+    {
+      std::lock_guard<std::mutex> lock(topology_);
+      const Topic& t = topics_[topic];
+      readers = t.readers;
+      serialized = t.serialized;
+    }
+    for (Reader* r : readers) r->Deliver(bytes);
+    for (SerializedReader* r : serialized) r->Deliver(bytes, stamp, sequence);
   }
 
   Log log_;
   bool spurious_ = false;
+  std::mutex topology_;  // topics_ and the endpoint lists: threads write while another makes endpoints
   std::map<std::string, Topic> topics_;
   std::vector<std::unique_ptr<Reader>> readers_;
   std::vector<std::unique_ptr<Writer>> writers_;
