@@ -56,7 +56,7 @@ MixerCore::MixerCore(const MixerOptions& options) : options_(options) {
 
 double MixerCore::StepLimit(int64_t now_ns) const {
   double limit = options_.max_step > 0 ? options_.max_step : std::numeric_limits<double>::infinity();
-  if (options_.max_speed > 0 && last_command_ns_ >= 0)
+  if (options_.max_speed > 0 && has_last_)
     limit = std::min(limit, options_.max_speed * std::max<int64_t>(now_ns - last_command_ns_, 0) * 1e-9);
   return limit;
 }
@@ -108,10 +108,9 @@ MixerCore::Result MixerCore::Update(const Inputs& in, int64_t now_ns) {
   Vec2 command = desired;
   if (have_ref) {
     const Vec2 delta{desired.x - ref.x, desired.y - ref.y};
-    const double limit = has_last_ ? StepLimit(now_ns) : (options_.max_step > 0 ? options_.max_step : 0);
-    // SaturateNorm reads a limit of 0 as none; a speed limit with no time elapsed is no motion.
+    const double limit = StepLimit(now_ns);
     Vec2 step = delta;
-    if (limit == 0 && has_last_) {
+    if (limit == 0) {  // no time since the previous command: no motion (SaturateNorm reads 0 as none)
       step = {0, 0};
       r.saturated = delta.x != 0 || delta.y != 0;
     } else if (std::isfinite(limit)) {

@@ -99,7 +99,8 @@ class MixerCore {
   int64_t last_update_ns_ = -1;
   int64_t last_command_ns_ = -1;  // when the previous command (a hold too) was made
 
-  // The longest change allowed from the previous command at `now_ns` (infinity: none).
+  // The longest change allowed at `now_ns` from the previous command (or, for the first, from
+  // the measured state): max_step, and max_speed x the time since the previous command; infinity: none.
   double StepLimit(int64_t now_ns) const;
 };
 
