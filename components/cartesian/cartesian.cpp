@@ -1,5 +1,6 @@
 #include "cartesian.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -68,7 +69,7 @@ Status VirtualCartesian::Step(const StepInfo& info) {
         nonfinite_logged_ = true;
         ctx_->log().Warn(NonFiniteMessage(c));
       }
-    } else if (robot_->SetTarget({c.x(), c.y()}, info.now_ns)) {
+    } else if (c.hold() ? robot_->Hold({c.x(), c.y()}, info.now_ns) : robot_->SetTarget({c.x(), c.y()}, info.now_ns)) {
       z_ = c.z();
     }
     if (robot_->state().clamped && !clamp_logged_) {
@@ -109,6 +110,10 @@ void UdpCartesian::Describe(ComponentSpec& spec) {
       "no state for this long after a command (runtime clock): the step fails and the run ends");
   spec.Param("reply_wait_ms", int64_t{20}).Range(0, 1000).Unit("ms").Doc(
       "wall time to wait for the reply to this step's command before publishing");
+  spec.Param("x_limits", std::vector<double>{-60, 60}).Unit("workspace units").Doc(
+      "[min, max] of x; targets outside are clamped before they are sent (logged once, counted)");
+  spec.Param("y_limits", std::vector<double>{-60, 60}).Unit("workspace units").Doc(
+      "[min, max] of y; targets outside are clamped before they are sent (logged once, counted)");
   spec.Input<msg::CartesianCommand>("command").Doc("target position, one packet per new sample");
   spec.Output<msg::CartesianState>("state").Doc("the controller's measured state, each published once");
 }
@@ -122,6 +127,14 @@ Status UdpCartesian::Configure(Context& ctx) {
   local_port_ = static_cast<uint16_t>(p.Int("local_port"));
   timeout_ns_ = SecondsToNs(p.Double("timeout_s"));
   reply_wait_ms_ = static_cast<int>(p.Int("reply_wait_ms"));
+  const std::string prefix = "components." + ctx.name() + ".params.";
+  for (const char* key : {"x_limits", "y_limits"}) {
+    const auto& l = p.DoubleList(key);
+    if (l.size() != 2 || !std::isfinite(l[0]) || !std::isfinite(l[1]) || !(l[0] < l[1]))
+      return Status::InvalidArgument(prefix + key + ": must be [min, max], finite, min < max");
+  }
+  x_limits_ = {p.DoubleList("x_limits")[0], p.DoubleList("x_limits")[1]};
+  y_limits_ = {p.DoubleList("y_limits")[0], p.DoubleList("y_limits")[1]};
   command_ = &ctx.input<msg::CartesianCommand>("command");
   state_ = &ctx.output<msg::CartesianState>("state");
   return Status::OK();
@@ -199,8 +212,20 @@ Status UdpCartesian::Step(const StepInfo& info) {
     packet.session = session_;
     packet.sequence = ++sent_seq_;
     packet.stamp_ns = info.now_ns;
-    packet.x = c.x(), packet.y = c.y(), packet.z = c.z();
+    // The controller is sent nothing outside the workspace box, whatever the mixer asked for.
+    packet.x = std::clamp(c.x(), x_limits_[0], x_limits_[1]);
+    packet.y = std::clamp(c.y(), y_limits_[0], y_limits_[1]);
+    packet.z = c.z();
     packet.hold = c.hold();
+    if (packet.x != c.x() || packet.y != c.y()) {
+      ++clamped_;
+      if (!clamp_logged_) {
+        clamp_logged_ = true;
+        ctx_->log().Warn("target (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) +
+                         ") outside the workspace: clamped to (" + std::to_string(packet.x) + ", " +
+                         std::to_string(packet.y) + ") (logged once)");
+      }
+    }
     udp::Encode(packet, tx_);
     if (Status s = socket_->SendTo(tx_.data(), tx_.size(), controller_); !s.ok()) {
       ++socket_errors_;
@@ -238,7 +263,8 @@ Status UdpCartesian::Deactivate() {
                    std::to_string(c.out_of_order) + " out of order, " + std::to_string(c.malformed) + " malformed, " +
                    std::to_string(missed_replies_) + " replies missed, " + std::to_string(foreign_) + " foreign, " +
                    std::to_string(socket_errors_) + " socket errors, " + std::to_string(c.sessions) +
-                   " controller sessions, " + std::to_string(nonfinite_) + " non-finite commands not sent");
+                   " controller sessions, " + std::to_string(nonfinite_) + " non-finite commands not sent, " +
+                   std::to_string(clamped_) + " clamped to the workspace");
   return Status::OK();
 }
 

@@ -6,7 +6,8 @@
 /// inputs:  command (CartesianCommand): target position
 /// outputs: state (CartesianState): simulated position and velocity, stopped = watchdog stop
 /// A command with a NaN or infinite coordinate is rejected (logged once): the robot keeps its
-/// last target, and the watchdog is not fed.
+/// last target, and the watchdog is not fed. A command with hold = true keeps the robot's target
+/// (feeding the watchdog); a robot with no position yet starts at rest at the hold's x, y.
 /// params:
 ///   max_velocity (double, 100, > 0, units/s): speed limit, vector norm
 ///   max_acceleration (double, 2000, > 0, units/s^2): acceleration limit, vector norm
@@ -31,6 +32,9 @@
 ///     the step fails and the run ends
 ///   reply_wait_ms (int, 20, [0, 1000], ms, wall time): after sending, wait this long at most for
 ///     the reply, so that the state of this step's command is published in this step
+///   x_limits, y_limits (double list [min, max], [-60, 60], units): workspace box; targets
+///     outside are clamped before they are sent (logged once, counted)
+/// A command with hold = true goes out with the hold flag: the controller keeps its target.
 /// Every accepted state is published once, in order (a late one in the next step, before the
 /// reply to that step's command); out-of-order, duplicate and malformed packets are dropped.
 /// @endcomponent
@@ -109,8 +113,9 @@ class UdpCartesian final : public Component {
   udp::StatePacket newest_{};
   bool has_newest_ = false;
   int64_t waiting_since_ns_ = -1;  // first command sent since the last accepted state
-  uint64_t missed_replies_ = 0, foreign_ = 0, socket_errors_ = 0, nonfinite_ = 0;
-  bool malformed_logged_ = false, error_logged_ = false, nonfinite_logged_ = false;
+  std::array<double, 2> x_limits_{}, y_limits_{};  // workspace box: [min, max]
+  uint64_t missed_replies_ = 0, foreign_ = 0, socket_errors_ = 0, nonfinite_ = 0, clamped_ = 0;
+  bool malformed_logged_ = false, error_logged_ = false, nonfinite_logged_ = false, clamp_logged_ = false;
   msg::CartesianState out_;
 };
 

@@ -151,7 +151,8 @@ int main(int argc, char** argv) {
     }
     has_applied = true;
     applied = c.sequence;
-    robot->SetTarget({c.x, c.y}, c.stamp_ns);
+    if (c.hold) robot->Hold({c.x, c.y}, c.stamp_ns);  // stay (a robot not placed yet starts there)
+    else robot->SetTarget({c.x, c.y}, c.stamp_ns);
     const auto& s = robot->Advance(c.stamp_ns);
     udp::StatePacket st;
     st.session = session;

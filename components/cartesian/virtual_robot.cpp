@@ -60,6 +60,15 @@ bool VirtualRobot::SetTarget(Vec2 target, int64_t now_ns) {
   return true;
 }
 
+bool VirtualRobot::Hold(Vec2 start, int64_t now_ns) {
+  if (!started_) return SetTarget(start, now_ns);
+  if (!has_target_) target_ = state_.position;
+  has_target_ = true;
+  target_ns_ = now_ns;
+  state_.clamped = false;
+  return true;
+}
+
 const VirtualRobot::State& VirtualRobot::Advance(int64_t now_ns) {
   const int64_t elapsed = advanced_ns_ >= 0 ? std::max<int64_t>(now_ns - advanced_ns_, 0) : 0;
   advanced_ns_ = now_ns;

@@ -61,6 +61,10 @@ class VirtualRobot {
   // infinite coordinate is rejected (returns false, changes nothing, does not feed the
   // watchdog): clamping cannot make it safe, and one would poison the position for good.
   bool SetTarget(Vec2 target, int64_t now_ns);
+  // Stay: keep the current target (with none yet, the current position) and feed the watchdog.
+  // A robot without a position yet appears at rest at `start` (where the experiment begins);
+  // then, as SetTarget, a NaN or infinite `start` is rejected (returns false, changes nothing).
+  bool Hold(Vec2 start, int64_t now_ns);
   // Moves the robot to time `now_ns` (never decreasing) and returns its state.
   const State& Advance(int64_t now_ns);
 

@@ -29,7 +29,9 @@ void ComplianceMixer::Describe(ComponentSpec& spec) {
   spec.Input<msg::HumanInput>("human").Doc("the human's hand position and engaged flag");
   spec.Input<msg::Intention>("robot").Doc("the robot's intended position");
   spec.Input<msg::CartesianState>("state").Optional().Doc(
-      "measured position: required by mode pi; saturates the first command");
+      "measured position: required by mode pi; bound, the first command waits for it (until then: hold "
+      "commands, the driver stays where it is) and moves at most max_step from it; unbound, the first "
+      "command is not limited");
   spec.Output<msg::CartesianCommand>("command").Doc("target position for the driver; hold while inputs are stale");
 }
 
@@ -53,6 +55,10 @@ Status ComplianceMixer::Configure(Context& ctx) {
   command_ = &ctx.output<msg::CartesianCommand>("command");
   if (o.mode == Mode::kPi && !state_->bound())
     return Status::InvalidArgument("components." + ctx.name() + ".params.mode = pi: needs input 'state' bound to the driver's state topic");
+  o.wait_for_state = state_->bound();
+  if (!state_->bound() && (o.max_step > 0 || o.max_speed > 0))
+    ctx.log().Warn("input 'state' is not bound: the first command cannot start from where the arm is, and is not "
+                   "limited (bind it to the driver's state topic)");
   core_.emplace(o);
   return Status::OK();
 }

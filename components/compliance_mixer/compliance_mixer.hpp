@@ -7,11 +7,14 @@
 /// inputs:
 ///   human (HumanInput): the human's hand position and engaged flag
 ///   robot (Intention): the robot's intended position
-///   state (CartesianState, optional): the measured position; needed by mode: pi, used by both
-///     modes to saturate the very first command
+///   state (CartesianState, optional): the measured position; needed by mode: pi. Bound, the
+///     first command waits for it: until the arm's state arrives the mixer sends hold commands
+///     (the driver stays where it is and reports it), then moves at most max_step from there.
+///     Unbound, the first command is the target itself (a warning at Configure says so)
 /// outputs:
 ///   command (CartesianCommand): target position; hold = true while inputs are stale (or a
-///     position it needs is NaN or infinite)
+///     position it needs is NaN or infinite) or while it waits for the arm's first state: the
+///     driver keeps its target (x, y repeat the last command, or the intended start)
 /// params:
 ///   gain (double, 0.9, [0, 1]): weight of the human while engaged
 ///   max_step (double, 5, >= 0, workspace units): max change of the command per step, vector

@@ -64,12 +64,14 @@ double MixerCore::StepLimit(int64_t now_ns) const {
 MixerCore::Result MixerCore::Update(const Inputs& in, int64_t now_ns) {
   Result r;
   const bool pi = options_.mode == Mode::kPi;
+  // Before the first command the arm's position must be known (wait_for_state): until it is, hold.
+  const bool waiting = options_.wait_for_state && !has_last_ && !Fresh(in.state, now_ns);
   if (!Fresh(in.robot, now_ns)) r.stale = Stale::kRobot;
   else if (!Fresh(in.human, now_ns)) r.stale = Stale::kHuman;
-  else if (pi && !Fresh(in.state, now_ns)) r.stale = Stale::kState;
+  else if (pi && !Fresh(in.state, now_ns) && !waiting) r.stale = Stale::kState;
   if (r.stale == Stale::kNone) {  // fresh, but a position it uses must be a number
     auto finite = [](const Sample& s) { return std::isfinite(s.position.x) && std::isfinite(s.position.y); };
-    const bool state_used = pi || (!has_last_ && in.state.receive_ns >= 0);
+    const bool state_used = !waiting && (pi || (!has_last_ && in.state.receive_ns >= 0));
     if (!finite(in.robot)) r.stale = Stale::kRobot;
     else if (in.engaged && !finite(in.human)) r.stale = Stale::kHuman;
     else if (state_used && !finite(in.state)) r.stale = Stale::kState;
@@ -90,6 +92,15 @@ MixerCore::Result MixerCore::Update(const Inputs& in, int64_t now_ns) {
   const double g = options_.gain;
   // Not engaged: the robot alone (not a blend with g = 0, which would turn 0 * inf into NaN).
   const Vec2 target = in.engaged ? Vec2{g * human.x + (1 - g) * robot.x, g * human.y + (1 - g) * robot.y} : robot;
+
+  if (waiting) {  // ask the driver to stay where it is (and report it) rather than go to `target`
+    r.has_command = true;
+    r.hold = true;
+    r.position = target;
+    r.stale = Stale::kState;
+    r.waiting_for_state = true;
+    return r;
+  }
 
   Vec2 desired = target;
   Vec2 next_integral = integral_;  // kPi: kept below only if the command does not saturate (anti-windup)

@@ -14,7 +14,12 @@
 ///   since the previous command (the study: 5 units per 100 ms step, 50 units/s): a burst of
 ///   updates (a writer flooding the trigger input) moves the command no faster than max_speed,
 ///   and two updates at one instant do not move it. The first command is saturated to max_step
-///   against the measured state when one is known, else taken as is.
+///   against the measured state. With `wait_for_state` (the component sets it when its `state`
+///   input is bound) there is no first command before a fresh state: until one arrives, Update()
+///   returns hold commands (hold = true, waiting_for_state = true) at the target, which ask the
+///   driver to stay where it is and report its position (a driver without a position yet starts
+///   there); then the first command moves at most max_step from the measured position. Without
+///   it, and without a state, the first command is the target itself: unlimited.
 /// Stale inputs: if the robot or human sample (or, in kPi, the state) is older than
 /// `stale_timeout_ns` or missing, Update() repeats the previous command with hold = true (or
 /// returns no command at all before the first one). An input whose position it would use
@@ -50,6 +55,7 @@ struct MixerOptions {
   double ki = 0.0;                       // kPi: integral gain, 1/s, >= 0
   double integral_limit = 10.0;          // kPi: |I| per axis, workspace units * s, >= 0
   int64_t stale_timeout_ns = 500'000'000;  // an input older than this is stale, > 0
+  bool wait_for_state = false;           // no first command before a fresh measured state (above)
 
   // OK, or InvalidArgument naming the field, its value and the broken constraint.
   Status Validate() const;
@@ -76,6 +82,7 @@ class MixerCore {
     bool saturated = false;    // the step limit shortened the change
     Stale stale = Stale::kNone;  // which input made it hold (the first found)
     bool non_finite = false;     // it held because that input's position is NaN or infinite
+    bool waiting_for_state = false;  // wait_for_state: a hold before the first command (stale = kState)
   };
 
   // REQUIRES: options.Validate().ok().

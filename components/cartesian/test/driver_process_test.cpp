@@ -16,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -304,13 +305,81 @@ TEST_F(DriverProcessTest, MixerBlendsSaturatesAndHoldsWhenTheHumanGoesSilent) {
     EXPECT_DOUBLE_EQ(cmds[42][1], cmds[41][1]);
     EXPECT_NE(c.err().find("input 'human' stale (no sample for more than 250 ms): holding the last command"), std::string::npos)
         << c.err();
-    EXPECT_NE(c.err().find("60 commands published, 18 held, 6 saturated"), std::string::npos) << c.err();
+    EXPECT_EQ(cmds[0][3], 1);  // waiting for the arm's first state: hold
+    EXPECT_EQ(cmds[1][3], 0);
+    EXPECT_NE(c.err().find("60 commands published, 19 held, 6 saturated"), std::string::npos) << c.err();
     // The driver followed every command within its step.
     const auto states = ReadStates(slog);
     ASSERT_EQ(states.size(), 60u);
     for (size_t k = 0; k < 60; ++k) EXPECT_NEAR(states[k].x, cmds[k][1], 1e-9) << k;
   }
   EXPECT_EQ(command_files[0], command_files[1]);
+}
+
+// The arm at rest at 0, the robot's intention at 1000 from the first step. The mixer's first
+// command used to be 1000 (no state yet, and a driver triggered by commands reports only after
+// one): now it holds until the arm reports, then moves 5 per step from where the arm is. The
+// same with each driver (the fake controller starts its robot at 0 too).
+TEST_F(DriverProcessTest, TheFirstCommandStartsWhereTheArmIs) {
+  for (const std::string driver : {"virtual_cartesian", "udp_cartesian"}) {
+    SCOPED_TRACE(driver);
+    const fs::path clog = dir_ / (driver + "_commands.txt"), slog = dir_ / (driver + "_states.txt");
+    const fs::path g = dir_ / (driver + ".yaml");
+    std::ofstream(g) << "graph: first\nclock: stepped\ndomain_id: " << domain_ << "\ncomponents:\n"
+                     << "  human: {type: test_human, rate_hz: 10, outputs: {out: human/input}}\n"
+                     << "  robot: {type: test_intention, rate_hz: 10, params: {start: [1000, 0], speed: 0}, outputs: {out: robot/intention}}\n"
+                     << "  mixer: {type: compliance_mixer, trigger: robot, inputs: {human: human/input, robot: robot/intention, "
+                        "state: robot/state}, outputs: {command: robot/command}}\n"
+                     << "  driver: {type: " << driver << ", trigger: command, params: "
+                     << (driver == "virtual_cartesian" ? "{initial_position: [0, 0]}"
+                                                       : "{controller_port: " + std::to_string(port_) + ", reply_wait_ms: 1000}")
+                     << ", inputs: {command: robot/command}, outputs: {state: robot/state}}\n"
+                     << "  clog: {type: test_command_log, trigger: command, params: {file: " << clog.string()
+                     << "}, inputs: {command: robot/command}}\n"
+                     << "  slog: {type: test_state_log, trigger: state, params: {file: " << slog.string()
+                     << "}, inputs: {state: robot/state}}\n";
+    std::optional<Child> fake;
+    if (driver == "udp_cartesian") {
+      fake.emplace(std::vector<std::string>{DYAD_FAKE_CONTROLLER, "--port", std::to_string(port_), "--idle-exit", "60",
+                                            "--initial", "0,0"},
+                   dir_, "fake");
+      ASSERT_TRUE(fake->WaitForOutput("listening", 10)) << fake->err();
+    }
+    Child c(Dyad({"run", g.string(), "--steps", "10", "--quiet"}), dir_, driver);
+    ASSERT_EQ(c.Wait(60), 0) << c.err();
+    if (fake) {
+      fake->Signal(SIGTERM);
+      EXPECT_EQ(fake->Wait(10), 0);
+    }
+    std::istringstream in(Read(clog));
+    std::vector<std::array<double, 4>> cmds;  // stamp x y hold
+    std::array<double, 4> r{};
+    while (in >> r[0] >> r[1] >> r[2] >> r[3]) cmds.push_back(r);
+    ASSERT_EQ(cmds.size(), 10u);
+    EXPECT_EQ(cmds[0][3], 1) << "the first command must hold: the arm's position is not known yet";
+    const auto states = ReadStates(slog);
+    ASSERT_EQ(states.size(), 10u);
+    EXPECT_EQ(states[0].x, 0);  // the hold did not move the arm
+    for (size_t k = 1; k < 10; ++k) {
+      EXPECT_EQ(cmds[k][3], 0) << k;
+      EXPECT_NEAR(cmds[k][1], 5.0 * k, 1e-9) << k;  // 5 units per step from the arm at 0
+      EXPECT_LE(states[k].x, 5.0 * k + 1e-9) << k;
+    }
+  }
+}
+
+// Without the state, the mixer cannot know where the arm is: it says so.
+TEST_F(DriverProcessTest, MixerWithoutStateWarnsThatItsFirstCommandIsNotLimited) {
+  const fs::path g = dir_ / "nostate.yaml";
+  std::ofstream(g) << "graph: nostate\nclock: stepped\ndomain_id: " << domain_ << "\ncomponents:\n"
+                   << "  human: {type: test_human, rate_hz: 10, outputs: {out: h}}\n"
+                   << "  robot: {type: test_intention, rate_hz: 10, outputs: {out: r}}\n"
+                   << "  mixer: {type: compliance_mixer, trigger: robot, inputs: {human: h, robot: r}, outputs: {command: c}}\n";
+  Child c(Dyad({"run", g.string(), "--steps", "3"}), dir_, "nostate");
+  EXPECT_EQ(c.Wait(30), 0) << c.err();
+  EXPECT_NE(c.err().find("input 'state' is not bound: the first command cannot start from where the arm is"),
+            std::string::npos)
+      << c.err();
 }
 
 TEST_F(DriverProcessTest, MixerInPiModeWithoutStateIsAConfigurationError) {

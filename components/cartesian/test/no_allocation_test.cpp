@@ -1,6 +1,7 @@
 // The drivers' steps promise no heap allocation (10 Hz hot path): both run here inside a fake
 // runtime Context, with the global operator new replaced to count allocations. udp_cartesian
-// talks to a controller played by the test on loopback.
+// talks to a controller played by the test on loopback. The driver tests that need that fake
+// Context and controller live here too: non-finite commands, the udp workspace clamp.
 #include <gtest/gtest.h>
 
 #include "dyad/testing/allocation_counter.hpp"
@@ -104,6 +105,12 @@ std::map<std::string, ParamValue> VirtualParams() {
           {"y_limits", std::vector<double>{-60, 60}}, {"watchdog_s", 0.5}, {"initial_position", std::vector<double>{}}};
 }
 
+std::map<std::string, ParamValue> UdpParams(uint16_t controller_port) {
+  return {{"controller_host", std::string("127.0.0.1")}, {"controller_port", int64_t{controller_port}},
+          {"local_port", int64_t{0}}, {"timeout_s", 5.0}, {"reply_wait_ms", int64_t{0}},
+          {"x_limits", std::vector<double>{-60, 60}}, {"y_limits", std::vector<double>{-50, 40}}};
+}
+
 TEST(NoAllocation, VirtualCartesianStepAllocatesNothing) {
   FakeContext ctx(VirtualParams());
   VirtualCartesian driver;
@@ -126,11 +133,7 @@ TEST(NoAllocation, VirtualCartesianStepAllocatesNothing) {
 TEST(NoAllocation, UdpCartesianStepAllocatesNothing) {
   auto controller = UdpSocket::Open(0);
   ASSERT_TRUE(controller.ok()) << controller.status().ToString();
-  FakeContext ctx({{"controller_host", std::string("127.0.0.1")},
-                   {"controller_port", int64_t{controller->local_port()}},
-                   {"local_port", int64_t{0}},
-                   {"timeout_s", 5.0},
-                   {"reply_wait_ms", int64_t{0}}});  // the test replies between steps
+  FakeContext ctx(UdpParams(controller->local_port()));  // the test replies between steps
   UdpCartesian driver;
   ASSERT_TRUE(driver.Configure(ctx).ok());
   ASSERT_TRUE(driver.Activate().ok());
@@ -190,11 +193,7 @@ TEST(NonFiniteCommand, VirtualCartesianKeepsItsLastTargetAndSaysSo) {
 TEST(NonFiniteCommand, UdpCartesianDoesNotSendIt) {
   auto controller = UdpSocket::Open(0);
   ASSERT_TRUE(controller.ok()) << controller.status().ToString();
-  FakeContext ctx({{"controller_host", std::string("127.0.0.1")},
-                   {"controller_port", int64_t{controller->local_port()}},
-                   {"local_port", int64_t{0}},
-                   {"timeout_s", 5.0},
-                   {"reply_wait_ms", int64_t{0}}});
+  FakeContext ctx(UdpParams(controller->local_port()));
   UdpCartesian driver;
   ASSERT_TRUE(driver.Configure(ctx).ok());
   ASSERT_TRUE(driver.Activate().ok());
@@ -217,6 +216,50 @@ TEST(NonFiniteCommand, UdpCartesianDoesNotSendIt) {
   for (const auto& l : ctx.logger.lines) logged |= l.find("not finite") != std::string::npos;
   EXPECT_TRUE(logged);
   driver.Shutdown();
+}
+
+// The controller is never sent a target outside the workspace box: clamped, logged once, counted.
+TEST(UdpWorkspace, TargetsOutsideTheBoxAreClampedBeforeTheyAreSent) {
+  auto controller = UdpSocket::Open(0);
+  ASSERT_TRUE(controller.ok()) << controller.status().ToString();
+  FakeContext ctx(UdpParams(controller->local_port()));
+  UdpCartesian driver;
+  ASSERT_TRUE(driver.Configure(ctx).ok());
+  ASSERT_TRUE(driver.Activate().ok());
+  const std::array<std::array<double, 2>, 3> sent{{{1000, -1000}, {-70, 10}, {5, 6}}};
+  const std::array<std::array<double, 2>, 3> expected{{{60, -50}, {-60, 10}, {5, 6}}};
+  for (size_t k = 0; k < sent.size(); ++k) {
+    msg::CartesianCommand c = Command(sent[k][0]);
+    c.y(sent[k][1]);
+    ctx.commands.queue.push_back(c);
+    ASSERT_TRUE(ctx.StepOnce(driver, k).ok());
+    ASSERT_TRUE(controller->WaitReadable(1000)) << k;
+    std::array<uint8_t, udp::kMaxPacket> rx{};
+    sockaddr_in from{};
+    const long n = controller->Receive(rx.data(), rx.size(), &from);
+    udp::CommandPacket p;
+    ASSERT_EQ(udp::DecodeCommand(rx.data(), static_cast<size_t>(n), &p), udp::Decode::kOk);
+    EXPECT_EQ(p.x, expected[k][0]) << k;
+    EXPECT_EQ(p.y, expected[k][1]) << k;
+  }
+  int logged = 0;
+  for (const auto& l : ctx.logger.lines) logged += l.find("outside the workspace: clamped") != std::string::npos;
+  EXPECT_EQ(logged, 1);
+  ASSERT_TRUE(driver.Deactivate().ok());
+  EXPECT_NE(ctx.logger.lines.back().find("2 clamped to the workspace"), std::string::npos) << ctx.logger.lines.back();
+  driver.Shutdown();
+}
+
+TEST(UdpWorkspace, LimitsMustBeAnOrderedFinitePair) {
+  for (const auto& bad : {std::vector<double>{10, -10}, std::vector<double>{1}, std::vector<double>{0, INFINITY}}) {
+    auto params = UdpParams(47000);
+    params["y_limits"] = bad;
+    FakeContext ctx(params);
+    UdpCartesian driver;
+    const Status s = driver.Configure(ctx);
+    EXPECT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("params.y_limits: must be [min, max], finite, min < max"), std::string::npos) << s.message();
+  }
 }
 
 }  // namespace

@@ -191,5 +191,33 @@ TEST(VirtualRobot, NonFiniteTargetsAreRejectedAndDoNotFeedTheWatchdog) {
   }
 }
 
+// The mixer's hold: the robot stays (on its target, or where it is) and the watchdog is fed; a
+// robot with no position yet starts at rest where the hold says the experiment begins.
+TEST(VirtualRobot, HoldKeepsTheRobotWhereItIsAndFeedsTheWatchdog) {
+  VirtualRobotOptions o;
+  o.initial = Vec2{0, 0};
+  VirtualRobot r(o);
+  r.Advance(0);
+  for (int64_t k = 1; k <= 10; ++k) {
+    ASSERT_TRUE(r.Hold({50, 0}, k * kStep));  // the start it names is ignored: the robot has a position
+    const auto& s = r.Advance(k * kStep);
+    EXPECT_EQ(s.position.x, 0) << k;
+    EXPECT_FALSE(s.stopped) << k;
+  }
+  ASSERT_TRUE(r.SetTarget({3, 0}, 11 * kStep));
+  r.Advance(12 * kStep);
+  ASSERT_TRUE(r.Hold({50, 0}, 13 * kStep));  // keeps the target it had
+  EXPECT_NEAR(r.Advance(20 * kStep).position.x, 3, 1e-9);
+
+  VirtualRobot fresh{VirtualRobotOptions()};
+  EXPECT_FALSE(fresh.Hold({std::nan(""), 0}, 0));
+  EXPECT_FALSE(fresh.started());
+  ASSERT_TRUE(fresh.Hold({7, -2}, 0));
+  const auto& s = fresh.Advance(kStep);
+  EXPECT_EQ(s.position.x, 7);
+  EXPECT_EQ(s.position.y, -2);
+  EXPECT_EQ(Norm(s.velocity), 0);
+}
+
 }  // namespace
 }  // namespace dyad::cartesian

@@ -14,6 +14,7 @@ struct Mixer {
   testing::FakeContext ctx{&ComplianceMixer::Describe, {}};
   testing::QueueReader<msg::Intention>& robot = ctx.Feed<msg::Intention>("robot");
   testing::QueueReader<msg::HumanInput>& human = ctx.Feed<msg::HumanInput>("human");
+  testing::QueueReader<msg::CartesianState>& state = ctx.Feed<msg::CartesianState>("state");  // the arm, at 0
   testing::CapturingWriter<msg::CartesianCommand>& out = ctx.Capture<msg::CartesianCommand>("command");
   ComplianceMixer mixer;
   uint64_t index = 0;
@@ -24,6 +25,7 @@ struct Mixer {
     ctx.clock_.now = static_cast<int64_t>(index) * kStep;
     if (robot_sample) robot.queue.push_back(msg::Intention());
     if (human_sample) human.queue.push_back(msg::HumanInput());
+    state.queue.push_back(msg::CartesianState());
     ctx.PollInputs();
     ASSERT_TRUE(mixer.Step(StepInfo{ctx.clock_.now, index++, kStep}).ok());
   }
@@ -80,6 +82,18 @@ TEST(MixerComponent, AFloodedTriggerMovesTheCommandsNoFasterThanMaxSpeed) {
   ASSERT_EQ(m.out.samples.size(), 101u);
   EXPECT_NEAR(m.out.samples.back().x(), 5.0, 1e-9);
   for (const auto& c : m.out.samples) EXPECT_LE(c.x(), 5.0 + 1e-9);
+}
+
+// Unbound, the state cannot limit the first command: Configure says so, once.
+TEST(MixerComponentWithoutState, WarnsThatTheFirstCommandIsNotLimited) {
+  testing::FakeContext ctx{&ComplianceMixer::Describe, {}};
+  ctx.Feed<msg::Intention>("robot");
+  ctx.Feed<msg::HumanInput>("human");
+  ctx.Capture<msg::CartesianCommand>("command");
+  ComplianceMixer mixer;
+  ASSERT_TRUE(mixer.Configure(ctx).ok());
+  ASSERT_EQ(ctx.log_.lines.size(), 1u);
+  EXPECT_NE(ctx.log_.lines[0].find("input 'state' is not bound"), std::string::npos) << ctx.log_.lines[0];
 }
 
 }  // namespace

@@ -150,6 +150,49 @@ TEST(MixerCore, FirstCommandIsSaturatedAgainstTheMeasuredState) {
   EXPECT_DOUBLE_EQ(r.position.x, 5);
 }
 
+// wait_for_state: no motion before the arm's position is known. Holds at the target (the
+// driver stays where it is and reports), then the first command moves max_step from the state.
+TEST(MixerCore, WaitsForTheArmsStateBeforeItsFirstCommand) {
+  for (const Mode mode : {Mode::kBlend, Mode::kPi}) {
+    SCOPED_TRACE(mode == Mode::kPi ? "pi" : "blend");
+    MixerOptions o;
+    o.wait_for_state = true;
+    o.mode = mode;
+    MixerCore m(o);
+    for (int k = 0; k < 3; ++k) {
+      const auto r = m.Update(Fresh({1000, 0}, {0, 0}, false, k * kStep), k * kStep);
+      EXPECT_TRUE(r.has_command) << k;
+      EXPECT_TRUE(r.hold) << k;
+      EXPECT_TRUE(r.waiting_for_state) << k;
+      EXPECT_EQ(r.stale, MixerCore::Stale::kState) << k;
+      EXPECT_FALSE(r.non_finite) << k;
+    }
+    auto in = Fresh({1000, 0}, {0, 0}, false, 3 * kStep);
+    in.state = {{-2, 0}, 3 * kStep};
+    auto r = m.Update(in, 3 * kStep);
+    EXPECT_FALSE(r.hold);
+    EXPECT_FALSE(r.waiting_for_state);
+    EXPECT_TRUE(r.saturated);
+    EXPECT_DOUBLE_EQ(r.position.x, 3);  // -2 + max_step
+    // From now on the previous command is the reference: a state gone stale does not matter in blend.
+    in = Fresh({1000, 0}, {0, 0}, false, 4 * kStep);
+    in.state = {{-2, 0}, mode == Mode::kPi ? 4 * kStep : 3 * kStep};
+    r = m.Update(in, 4 * kStep);
+    EXPECT_FALSE(r.hold);
+    EXPECT_DOUBLE_EQ(r.position.x, 8);  // pi too: its desired 1000 is saturated against the last command
+  }
+}
+
+// A state that arrived long ago is not where the arm is now: the first command waits for a fresh one.
+TEST(MixerCore, AStaleStateDoesNotStartTheFirstCommand) {
+  MixerOptions o;
+  o.wait_for_state = true;
+  MixerCore m(o);
+  auto in = Fresh({1000, 0}, {0, 0}, false, 10 * kStep);
+  in.state = {{0, 0}, 0};
+  EXPECT_TRUE(m.Update(in, 10 * kStep).waiting_for_state);
+}
+
 TEST(MixerCore, StaleHumanHoldsTheLastCommandThenResumes) {
   MixerOptions o = NoLimit();
   o.stale_timeout_ns = 250'000'000;
