@@ -75,6 +75,30 @@ TEST_F(OutputRelayTest, LinesArePrefixedOnTheStreamsAndPlainInTheLog) {
   for (const char* line : {"\nhello\n", "\nworld\n", "\noops\n", "\nno newline yet\n"})
     EXPECT_NE(file.find(line), std::string::npos) << line << " in " << file;
   EXPECT_EQ(file.find("[mind]"), std::string::npos) << file;
+  // A subject's session is in these lines: private to the user running the launcher.
+  EXPECT_EQ(fs::status(log).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_EQ(fs::status(log.parent_path()).permissions() & fs::perms::all, fs::perms::owner_all);
+}
+
+// A symlink planted where a process's log goes is refused (said on the launcher's stderr); its
+// target is untouched, and the process's output still reaches the terminal.
+TEST_F(OutputRelayTest, ALogPathThatIsASymlinkIsRefused) {
+  const fs::path target = dir_ / "victim.txt", log = dir_ / "mind.log";
+  fs::create_directories(dir_);
+  std::ofstream(target) << "precious\n";
+  fs::create_symlink(target, log);
+  {
+    OutputRelay relay(out_, err_);
+    auto pipes = relay.Add("mind", log.string(), "=== mind");
+    ASSERT_TRUE(pipes.ok()) << pipes.status().message();
+    Write(pipes.value().out_write, "hello\n");
+    OutputRelay::CloseWriteEnds(pipes.value());
+  }
+  EXPECT_EQ(Read(target), "precious\n");
+  EXPECT_EQ(out_.str(), "[mind] hello\n");
+  EXPECT_NE(err_.str().find("[mind] warning: cannot write its log: " + log.string() + ": is a symbolic link: refused"),
+            std::string::npos)
+      << err_.str();
 }
 
 TEST_F(OutputRelayTest, EachChildKeepsItsOwnPrefixAndARestartAppendsToTheSameLog) {

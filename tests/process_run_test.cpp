@@ -242,4 +242,30 @@ TEST_F(ProcessTest, PluginThatDoesNotLoadIsAGraphErrorWithItsLine) {
   EXPECT_NE(d.err().find((dir_ / "absent.yaml").string() + ": cannot open graph file"), std::string::npos) << d.err();
 }
 
+// A graph file is code: validating it runs its plugins. --no-plugins runs none (the marker
+// plugin's file is not created), notes what it could not check, and validates the rest; without
+// the flag the same graph's plugin does run (so the check can fail).
+TEST_F(ProcessTest, ValidateWithoutPluginsRunsNoneOfTheGraphs) {
+  const fs::path marker = dir_ / "plugin_was_loaded";
+  ASSERT_EQ(setenv("DYAD_TEST_PLUGIN_MARKER", marker.c_str(), 1), 0);
+  const fs::path g = Write("g.yaml", std::string("graph: p\nplugins: [") + DYAD_TEST_MARKER_PLUGIN + "]\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 10, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, inputs: {in: count}}\n"
+                                         "  arm: {type: from_the_plugin, rate_hz: 10}\n");
+  Child safe(Dyad({"validate", g.string(), "--no-plugins"}), dir_, "safe");
+  EXPECT_EQ(safe.Wait(30), 0) << safe.err();
+  EXPECT_FALSE(fs::exists(marker)) << "validate --no-plugins loaded the graph's plugin";
+  EXPECT_NE(safe.err().find(g.string() + ":2:11: note: plugin not loaded (--no-plugins)"), std::string::npos) << safe.err();
+  EXPECT_NE(safe.err().find(g.string() + ":6:15: components.arm.type: note: not checked"), std::string::npos) << safe.err();
+  // The rest is still checked.
+  Child bad(Dyad({"validate", g.string(), "--no-plugins", "--set", "src.noise=-1"}), dir_, "bad");
+  EXPECT_EQ(bad.Wait(30), 2) << bad.err();
+  EXPECT_FALSE(fs::exists(marker));
+
+  Child full(Dyad({"validate", g.string()}), dir_, "full");
+  EXPECT_EQ(full.Wait(30), 2);  // from_the_plugin is not a type the marker registers
+  EXPECT_TRUE(fs::exists(marker)) << full.err();
+  unsetenv("DYAD_TEST_PLUGIN_MARKER");
+}
+
 }  // namespace

@@ -20,7 +20,7 @@ PUBLIC = {
     "diagnostic.hpp": "graph", "strict_yaml.hpp": "graph",
     "on_demand_subscription.hpp": "graph",
     "decode_sample.hpp": "dds",
-    "interrupt.hpp": "exec",
+    "interrupt.hpp": "exec", "private_file.hpp": "exec",
     "run.hpp": "hosts", "introspect.hpp": "hosts", "discovery_server.hpp": "hosts",
 }
 FASTDDS_ALLOWED = {"hosts/discovery_server.cpp"}

@@ -1,5 +1,7 @@
 #include "hosts/output_relay.hpp"
 
+#include "dyad/private_file.hpp"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <unistd.h>
@@ -10,6 +12,19 @@
 #include <filesystem>
 
 namespace dyad {
+
+LogFile::~LogFile() { close(fd_); }
+
+void LogFile::AppendLine(const std::string& line) {
+  const std::string text = line + "\n";
+  size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = write(fd_, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;
+    done += static_cast<size_t>(n);
+  }
+}
 
 OutputRelay::OutputRelay(std::ostream& out, std::ostream& err) : out_(out), err_(err) {
   if (pipe2(wake_, O_CLOEXEC) != 0) wake_[0] = wake_[1] = -1;
@@ -36,22 +51,19 @@ StatusOr<OutputRelay::Pipes> OutputRelay::Add(const std::string& name, const std
     close(out_pipe[1]);
     return Status::IOError("pipe: " + std::string(std::strerror(errno)));
   }
-  std::shared_ptr<std::ofstream> log;
+  std::shared_ptr<LogFile> log;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!log_path.empty()) {
       auto& open = logs_[log_path];
       if (!open) {
-        std::error_code ec;
-        std::filesystem::create_directories(std::filesystem::path(log_path).parent_path(), ec);
-        open = std::make_shared<std::ofstream>(log_path, std::ios::app);
-        if (!*open) {
-          err_ << "[" << name << "] warning: cannot write its log " << log_path << "\n";
-          open.reset();
-        }
+        Status folder = CreatePrivateDirectories(std::filesystem::path(log_path).parent_path().string());
+        auto fd = folder.ok() ? OpenPrivateLog(log_path) : StatusOr<int>(folder);
+        if (fd.ok()) open = std::make_shared<LogFile>(*fd);
+        else err_ << "[" << name << "] warning: cannot write its log: " << fd.status().message() << "\n";
       }
       log = open;
-      if (log) *log << header << "\n" << std::flush;
+      if (log) log->AppendLine(header);
     }
     sources_[out_pipe[0]] = Source{name, false, "", log};
     sources_[err_pipe[0]] = Source{name, true, "", log};
@@ -72,7 +84,7 @@ void OutputRelay::Say(const std::string& line) {
 
 void OutputRelay::Emit(const Source& s, const std::string& line) {
   (s.is_err ? err_ : out_) << "[" << s.name << "] " << line << "\n" << std::flush;
-  if (s.log) *s.log << line << "\n" << std::flush;
+  if (s.log) s.log->AppendLine(line);
 }
 
 void OutputRelay::Run() {

@@ -3,12 +3,12 @@
 // Each child's stdout and stderr arrive on pipes; a thread of the relay reads them all (poll)
 // and passes every line on to the launcher's own stdout or stderr prefixed with the process's
 // name ("[mind] ..."), and appends it, unprefixed, to the process's log file when there is one
-// (a restarted process appends to the same file after a header line). The launcher's own
+// (a restarted process appends to the same file after a header line). Log files are private:
+// created 0600 in folders created 0700, never through a symlink (dyad/private_file.hpp). The launcher's own
 // messages go through Say() so lines never interleave mid-line. A partial last line is passed
 // on when its pipe closes.
 #pragma once
 
-#include <fstream>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -20,6 +20,19 @@
 #include <dyad/status.hpp>
 
 namespace dyad {
+
+// One process's log file, appended to with write(2). Owns the descriptor.
+class LogFile {
+ public:
+  explicit LogFile(int fd) : fd_(fd) {}
+  ~LogFile();
+  LogFile(const LogFile&) = delete;
+  LogFile& operator=(const LogFile&) = delete;
+  void AppendLine(const std::string& line);  // a write error is ignored: the line still reached the terminal
+
+ private:
+  int fd_;
+};
 
 class OutputRelay {
  public:
@@ -47,7 +60,7 @@ class OutputRelay {
     std::string name;
     bool is_err = false;
     std::string partial;
-    std::shared_ptr<std::ofstream> log;
+    std::shared_ptr<LogFile> log;
   };
   void Run();
   void Emit(const Source& s, const std::string& line);  // REQUIRES: mutex_ held
@@ -56,7 +69,7 @@ class OutputRelay {
   std::ostream& err_;
   std::mutex mutex_;  // guards sources_, logs_, the streams
   std::map<int, Source> sources_;                          // read end -> its child
-  std::map<std::string, std::shared_ptr<std::ofstream>> logs_;  // log path -> open file
+  std::map<std::string, std::shared_ptr<LogFile>> logs_;  // log path -> open file
   int wake_[2] = {-1, -1};  // a byte here makes the thread re-read sources_
   bool closing_ = false;
   std::thread thread_;

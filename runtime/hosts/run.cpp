@@ -51,22 +51,42 @@ std::set<std::string> ProcessesToCheck(const Graph& g, const RunOptions* run) {
 
 // Returns false (after printing every problem) when the graph is invalid. `run`: what runs here
 // (see ProcessesToCheck); null: everything is checked (`dyad validate`).
+// kBuiltinOnly (validate --no-plugins): a component whose type no built-in plugin has cannot be
+// checked; its "unknown component type" becomes a note, and the rest of the graph is validated.
+void NoteUncheckedComponents(const Graph& g, std::vector<Diagnostic>* diags, std::ostream& err) {
+  for (size_t i = 0; i < g.plugins.size(); ++i)
+    err << g.plugin_marks[i].ToString() << ": note: plugin not loaded (--no-plugins): " << g.plugins[i] << "\n";
+  std::vector<Diagnostic> kept;
+  for (auto& d : *diags) {
+    if (d.message.rfind("unknown component type", 0) == 0)
+      err << d.mark.ToString() << ": " << d.key << ": note: not checked: its type is not built in (--no-plugins)\n";
+    else
+      kept.push_back(std::move(d));
+  }
+  *diags = std::move(kept);
+}
+
 bool LoadAndValidate(const std::string& path, const std::vector<Override>& overrides,
                      const std::vector<std::string>& plugin_paths, Loaded* l, std::ostream& err,
-                     const RunOptions* run = nullptr) {
+                     const RunOptions* run = nullptr, PluginLoading loading = PluginLoading::kAll) {
   std::vector<Diagnostic> diags;
   l->graph = LoadGraph(path, overrides, &diags);
-  // Plugins the graph or the command line names must load: their problems are the graph's.
-  for (size_t i = 0; i < l->graph.plugins.size(); ++i)
-    if (Status s = l->catalog.Load(l->graph.plugins[i]); !s.ok()) diags.push_back({l->graph.plugin_marks[i], "plugins", s.message()});
-  for (const auto& p : plugin_paths)
-    if (Status s = l->catalog.Load(p); !s.ok()) diags.push_back({SourceMark{"--plugins " + p, 0, 0}, "", s.message()});
-  // DYAD_PLUGIN_PATH and the built-in folder: a stray file there is worth a warning only.
-  if (Status s = l->catalog.LoadDefault({}); !s.ok()) err << "warning: " << s.message() << "\n";
+  if (loading == PluginLoading::kBuiltinOnly) {
+    if (Status s = l->catalog.Load(Catalog::BuiltinPluginDir()); !s.ok()) err << "warning: " << s.message() << "\n";
+  } else {
+    // Plugins the graph or the command line names must load: their problems are the graph's.
+    for (size_t i = 0; i < l->graph.plugins.size(); ++i)
+      if (Status s = l->catalog.Load(l->graph.plugins[i]); !s.ok()) diags.push_back({l->graph.plugin_marks[i], "plugins", s.message()});
+    for (const auto& p : plugin_paths)
+      if (Status s = l->catalog.Load(p); !s.ok()) diags.push_back({SourceMark{"--plugins " + p, 0, 0}, "", s.message()});
+    // DYAD_PLUGIN_PATH and the built-in folder: a stray file there is worth a warning only.
+    if (Status s = l->catalog.LoadDefault({}); !s.ok()) err << "warning: " << s.message() << "\n";
+  }
   if (!l->graph.components.empty()) {
     l->resolved = ValidateGraph(l->graph, l->catalog, &diags);
     DryConfigure(l->graph, l->resolved, l->catalog, &diags, ProcessesToCheck(l->graph, run));
   }
+  if (loading == PluginLoading::kBuiltinOnly) NoteUncheckedComponents(l->graph, &diags, err);
   // A launcher's children validate again: the warnings are said once, by the command a person ran.
   if (diags.empty() && (run == nullptr || run->process.empty()))
     for (const auto& w : l->resolved.warnings) err << "warning: " << w.ToString() << "\n";
@@ -233,9 +253,14 @@ int ExitCodeOf(const Status& status) {
 }
 
 int ValidateGraphFile(const std::string& path, const std::vector<Override>& overrides,
-                      const std::vector<std::string>& plugin_paths, std::ostream& out, std::ostream& err) {
+                      const std::vector<std::string>& plugin_paths, std::ostream& out, std::ostream& err,
+                      PluginLoading plugins) {
   Loaded l;
-  if (!LoadAndValidate(path, overrides, plugin_paths, &l, err)) return 2;
+  if (plugins == PluginLoading::kBuiltinOnly && !plugin_paths.empty()) {
+    err << "dyad validate: --plugins and --no-plugins exclude each other\n";
+    return 2;
+  }
+  if (!LoadAndValidate(path, overrides, plugin_paths, &l, err, nullptr, plugins)) return 2;
   out << path << ": OK (" << l.graph.components.size() << " components, " << l.resolved.topics.size() << " topics, "
       << l.graph.ProcessNames().size() << " process" << (l.graph.ProcessNames().size() == 1 ? "" : "es") << ")\n";
   return 0;

@@ -58,7 +58,7 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
   struct State {
     RunOptions run;
     std::vector<std::string> sets, plugins, type_names;
-    bool markdown = false, messages = false;
+    bool markdown = false, messages = false, no_plugins = false;
     std::string listen;  // discovery-server --listen
   };
   auto st = std::make_shared<State>();
@@ -69,9 +69,14 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
   auto* validate = app.add_subcommand("validate", "Check a graph file; print every problem (exit 2) or OK");
   validate->add_option("graph", run.graph_path, "Graph YAML file")->required();
   validate->add_option("--set", sets, kSetHelp);
-  validate->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
+  auto* validate_plugins = validate->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
+  validate->add_flag("--no-plugins", st->no_plugins,
+                     "Load no plugin but dyad's built-in ones (a graph's plugins: are code: check an untrusted graph "
+                     "without running it); components of other types are noted as not checked")
+      ->excludes(validate_plugins);
   validate->callback([st, &exit_code] {
-    exit_code = ValidateGraphFile(st->run.graph_path, ToOverrides(st->sets), st->plugins, std::cout, std::cerr);
+    exit_code = ValidateGraphFile(st->run.graph_path, ToOverrides(st->sets), st->plugins, std::cout, std::cerr,
+                                  st->no_plugins ? PluginLoading::kBuiltinOnly : PluginLoading::kAll);
   });
 
   AddRunCommand(app, [&exit_code](const RunOptions& options) { exit_code = RunGraph(options, std::cout, std::cerr); });

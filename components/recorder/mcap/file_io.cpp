@@ -1,5 +1,7 @@
 #include "file_io.hpp"
 
+#include "dyad/private_file.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -22,10 +24,11 @@ OutputFile::~OutputFile() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-Status OutputFile::Open(const std::string& path) {
+Status OutputFile::Open(const std::string& path, bool replace) {
   path_ = path;
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd_ < 0) return Status::IOError(path_, Errno("open for writing"));
+  auto fd = CreatePrivateFile(path, replace ? CreateMode::kReplace : CreateMode::kNew);
+  if (!fd.ok()) return fd.status();
+  fd_ = *fd;
   return Status::OK();
 }
 

@@ -21,8 +21,9 @@ class OutputFile {
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;
 
-  // Creates or truncates `path`.
-  Status Open(const std::string& path);
+  // Creates `path` private (dyad/private_file.hpp): a new file, or with `replace` one renamed
+  // onto an existing entry.
+  Status Open(const std::string& path, bool replace);
   // Writes every byte of every buffer (retrying short writes and EINTR).
   Status Write(std::span<const iovec> buffers);
   // fdatasync(2): survives power loss, not only process death.

@@ -104,7 +104,7 @@ class Writer::Impl {
 Status Writer::Impl::Open(const std::string& path, const WriterOptions& options) {
   if (Status s = options.Validate(); !s.ok()) return Status::InvalidArgument(path, s.message());
   options_ = options;
-  if (Status s = file_.Open(path); !s.ok()) return s;
+  if (Status s = file_.Open(path, options.replace_existing); !s.ok()) return s;
   if (options_.compression == Compression::kZstd) {
     zstd_.reset(ZSTD_createCCtx());
     if (!zstd_) return Status::IOError(path, "cannot create a zstd compression context");

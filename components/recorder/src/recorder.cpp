@@ -6,6 +6,7 @@
 
 #include <dyad/topic_select.hpp>
 #include <dyad/join_list.hpp>
+#include <dyad/private_file.hpp>
 
 namespace dyad::recorder {
 namespace {
@@ -43,7 +44,9 @@ uint64_t NonNegative(int64_t v) { return v < 0 ? 0 : static_cast<uint64_t>(v); }
 void Recorder::Describe(ComponentSpec& spec) {
   spec.Summary("Records graph topics (names or regexes, default all) into an MCAP file: omgidl schemas, CDR, zstd chunks.");
   spec.Param("file", "{graph}-{time}.mcap").Path().Doc("output path; {graph} = graph name, {time} = local start time YYYYMMDD-HHMMSS");
-  spec.Param("overwrite", false).Doc("replace an existing file (false: an existing file is an error, nothing is recorded over it)");
+  spec.Param("overwrite", false).Doc(
+      "replace an existing file (false: an existing file is an error, nothing is recorded over it); either way the "
+      "file is created 0600 and never through a symlink");
   spec.Param("topics", std::vector<std::string>{}).Doc("topic names or regexes (whole-name match); empty: every graph topic");
   spec.Param("chunk_size", int64_t{256 * 1024}).Range(1024, 1024.0 * 1024 * 1024).Unit("bytes").Doc("uncompressed bytes per chunk");
   spec.Param("compression", "zstd").OneOf({"zstd", "none"}).Doc("chunk compression");
@@ -64,8 +67,10 @@ Status Recorder::Configure(Context& ctx) {
   const Params& p = ctx.params();
   path_ = ExpandFileName(p.String("file"), ctx.graph_name(), LocalTimeStamp());
   if (path_.empty()) return Status::InvalidArgument("params.file: must not be empty");
-  // Checked before anything runs: a recording is never silently replaced by the next run.
-  if (!p.Bool("overwrite") && std::filesystem::exists(path_))
+  // Checked before anything runs: a recording is never silently replaced by the next run. (Said
+  // early; Activate's exclusive creation is what guarantees it.)
+  options_.replace_existing = p.Bool("overwrite");
+  if (!p.Bool("overwrite") && std::filesystem::exists(std::filesystem::symlink_status(path_)))
     return Status::InvalidArgument("params.file = '" + path_ +
                                    "': exists; set params.overwrite: true to replace it, or put {time} in the name");
   options_.chunk_size = static_cast<uint64_t>(p.Int("chunk_size"));
@@ -113,9 +118,10 @@ Status Recorder::Activate() {
 }
 
 Status Recorder::OpenFile() {
-  std::error_code ec;
-  const auto parent = std::filesystem::path(path_).parent_path();
-  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  // Missing folders are created 0700, the file 0600, exclusively (unless overwrite): a file or a
+  // symlink that appeared at the path since Configure is an error, its target untouched.
+  if (Status s = CreatePrivateDirectories(std::filesystem::path(path_).parent_path().string()); !s.ok())
+    return Status::IOError("params.file = '" + path_ + "': " + s.message());
   auto w = mcap::Writer::Open(path_, options_);
   if (!w.ok()) return Status::IOError("params.file = '" + path_ + "': " + Detail(w.status().message(), path_));
   writer_ = std::make_unique<mcap::Writer>(std::move(w.value()));

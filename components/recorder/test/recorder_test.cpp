@@ -297,6 +297,31 @@ TEST_F(RecorderTest, SteppedRecordingsOfTheSameGraphAreByteIdentical) {
   EXPECT_TRUE(a == b) << "stepped recordings differ (" << a.size() << " vs " << b.size() << " bytes)";
 }
 
+// A recording of a subject is private (0600), and a symlink planted at its path (to make the
+// recorder truncate or expose another file) is refused: with and without overwrite, the link's
+// target is untouched.
+TEST_F(RecorderTest, RecordingsArePrivateAndAPlantedSymlinkIsRefused) {
+  const fs::path out = dir_ / "subjects" / "P01.mcap";
+  const fs::path graph = Write("g.yaml", ThreePublishers("stepped", 100, 100, 50, "file: " + out.string()));
+  ASSERT_EQ(Run({"run", graph.string(), "--steps", "20", "--quiet"}), 0);
+  EXPECT_EQ(fs::status(out).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_EQ(fs::status(out.parent_path()).permissions() & fs::perms::all, fs::perms::owner_all);
+
+  const fs::path victim = dir_ / "victim.txt";
+  std::ofstream(victim) << "precious";
+  fs::remove(out);
+  fs::create_symlink(victim, out);
+  std::string err;
+  EXPECT_NE(Run({"run", graph.string(), "--steps", "20", "--quiet"}, nullptr, &err), 0);
+  EXPECT_NE(err.find("P01.mcap': exists; set params.overwrite: true"), std::string::npos) << err;
+  EXPECT_EQ(ReadFile(victim), "precious");
+  // overwrite replaces the link itself, never writes through it.
+  ASSERT_EQ(Run({"run", graph.string(), "--steps", "20", "--quiet", "--set", "rec.overwrite=true"}), 0);
+  EXPECT_FALSE(fs::is_symlink(out));
+  EXPECT_EQ(ReadFile(victim), "precious");
+  EXPECT_EQ(Read(out).by_topic.at("ca").size(), 20u);
+}
+
 TEST_F(RecorderTest, WallClockGraphLosesNoSampleAndSigintFlushesEverything) {
   const fs::path graph = Write("g.yaml", ThreePublishers("wall", 500, 400, 300, "file: " + (dir_ / "wall.mcap").string()));
   Child c(Dyad({"run", graph.string(), "--quiet"}), dir_, "wall");

@@ -76,7 +76,13 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err);
 int ExitCodeOf(const Status& status);
 
 // Loads and validates only. Prints "<file>: OK (...)" or every problem; returns 0 or 2.
+// A graph file is code: its `plugins:` are shared libraries, loaded (run) to validate it. With
+// `plugins` = kBuiltinOnly only dyad's built-in plugin folder is loaded (not the graph's
+// `plugins:`, not DYAD_PLUGIN_PATH; `plugin_paths` must be empty): a component of another type is
+// reported as not checked, and the rest of the graph is validated.
+enum class PluginLoading { kAll, kBuiltinOnly };
 int ValidateGraphFile(const std::string& path, const std::vector<Override>& overrides,
-                      const std::vector<std::string>& plugin_paths, std::ostream& out, std::ostream& err);
+                      const std::vector<std::string>& plugin_paths, std::ostream& out, std::ostream& err,
+                      PluginLoading plugins = PluginLoading::kAll);
 
 }  // namespace dyad

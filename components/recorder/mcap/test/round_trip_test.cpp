@@ -250,7 +250,7 @@ TEST(Writer, OpenFailureNamesThePath) {
   auto writer = Writer::Open("/nonexistent-dir/x.mcap");
   ASSERT_FALSE(writer.ok());
   EXPECT_EQ(writer.status().code(), Status::Code::kIOError);
-  EXPECT_EQ(writer.status().message().rfind("/nonexistent-dir/x.mcap: open for writing: ", 0), 0u)
+  EXPECT_EQ(writer.status().message().rfind("/nonexistent-dir/x.mcap: create: ", 0), 0u)
       << writer.status().message();
 }
 

@@ -70,6 +70,11 @@ struct WriterOptions {
   // Flush() also calls fdatasync(2), so flushed data survives power loss, not only a crash.
   // Costs milliseconds per call. Default: false.
   bool sync_on_flush = false;
+  // The file holds a subject's data: it is created 0600, never through a symlink
+  // (dyad/private_file.hpp). false: `path` must not exist (the check and the creation are one
+  // step); true: an existing file or link at `path` is replaced (a new file renamed onto it, so
+  // a link's target is never touched). Default: false.
+  bool replace_existing = false;
 
   // Ok, or InvalidArgument naming the field, its value and the broken constraint.
   Status Validate() const;
@@ -77,8 +82,9 @@ struct WriterOptions {
 
 class Writer {
  public:
-  // Creates `path` (truncating it) and writes magic + Header.
-  // Fails: InvalidArgument (bad options), IOError (cannot create).
+  // Creates `path` (0600; see replace_existing) and writes magic + Header.
+  // Fails: InvalidArgument (bad options), FailedPrecondition (`path` exists, or is a symlink,
+  // and replace_existing is false), IOError (cannot create).
   static StatusOr<Writer> Open(const std::string& path, const WriterOptions& options = {});
 
   Writer(Writer&&) noexcept;
