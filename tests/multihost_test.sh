@@ -33,6 +33,10 @@
 #              stops), and no gap ends later than 2.2 s after the return; what was lost is
 #              printed per writer. `matrix` expands to every D x H x (1, 3, 7 s) and the
 #              server's race (4.5 s); MODE*N repeats a mode (e.g. cut:server:rec:3*10).
+#   local      a one-process wall-clock graph with no network section on lab: `dyad echo` on
+#              lab receives its topic (loopback), while from rec a watcher sending unicast
+#              discovery straight to lab's address receives nothing; the same graph with `network: {scope: lan}`
+#              is seen from rec (so the check can fail)
 #   net        (for debugging) only the namespaces and the UDP probe, no dyad run
 # Needs root, `ip netns` and `nft` (skipped, exit 77, otherwise). Leaves nothing behind: the EXIT
 # trap kills every process in its namespaces and deletes them (each host has a /dev/shm of its
@@ -42,7 +46,7 @@
 # MULTIHOST_STAGGER=S: the time between the starts of rec, mind and lab (default 2 s, 0: at once);
 # MULTIHOST_SHARED_SHM=1: the hosts share this machine's /dev/shm (default: one tmpfs each).
 set -euo pipefail
-[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|tcp|faults|failure[:D]|cut:D:H:S|matrix|net|MODE*N...]" >&2; exit 2; }
+[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|tcp|faults|failure[:D]|cut:D:H:S|local|matrix|net|MODE*N...]" >&2; exit 2; }
 repo=$(cd "$1" && pwd) build=$(cd "$2" && pwd) work=$3
 shift 3
 modes=()
@@ -65,7 +69,7 @@ done
 [ ${#modes[@]} -gt 0 ] || modes=(multicast peers server tcp faults failure)
 for mode in "${modes[@]}"; do
   case $mode in
-    multicast | peers | server | tcp | faults | failure | net) ;;
+    multicast | peers | server | tcp | faults | failure | local | net) ;;
     failure:*) [[ $mode =~ ^failure:(multicast|peers|server|tcp)$ ]] ||
                  { echo "bad mode '$mode': failure:DISCOVERY (multicast|peers|server|tcp)" >&2; exit 2; } ;;
     cut:*) [[ $mode =~ ^cut:(multicast|peers|server|tcp):(lab|mind|rec):[0-9]+(\.[0-9]+)?$ ]] ||
@@ -730,14 +734,60 @@ PY
   echo "PASS: multihost $mode: 3 hosts, 300 steps, recording complete, no sample lost"
 }
 
+# local: who can see a graph that names no other machine (network.scope: local by default).
+# Reports in `failures` as run_mode does.
+run_local_mode() {
+  local out=$work/$1local scope graph_pid seen
+  mkdir -p "$out"
+  for scope in local lan; do
+    printf '%s\n' "graph: solo" "clock: wall" "network: {scope: $scope}" "components:" \
+      "  src: {type: counter_source, rate_hz: 10, outputs: {out: subject/pointer}}" > "$out/solo_$scope.yaml"
+  done
+  # The intruder on rec: unicast discovery sent straight to lab's address (no multicast needed).
+  printf '%s\n' "graph: solo" "network: {discovery: peers, peers: [${addr[lab]}]}" "components:" \
+    "  src: {type: counter_source, rate_hz: 10, outputs: {out: subject/pointer}}" > "$out/intruder.yaml"
+  for scope in local lan; do
+    ip netns exec "${ns[lab]}" "$dyad" run "$out/solo_$scope.yaml" --duration 20 --quiet > "$out/solo_$scope.log" 2>&1 &
+    graph_pid=$!; started+=($!)
+    sleep 2
+    # On lab, the watcher joins as the graph does (without --graph: local, as the default graph).
+    local own=()
+    [ $scope = lan ] && own=(--graph "$out/solo_lan.yaml")
+    ip netns exec "${ns[lab]}" "$dyad" echo subject/pointer "${own[@]}" --count 1 --wait 4 > "$out/lab_topics_$scope.txt" 2>&1 || true
+    ip netns exec "${ns[rec]}" "$dyad" echo subject/pointer --graph "$out/intruder.yaml" --count 1 --wait 6 \
+      > "$out/rec_topics_$scope.txt" 2>&1 || true
+    kill -INT "$graph_pid" 2> /dev/null || true
+    wait "$graph_pid" 2> /dev/null || true
+    if ! grep -q '"value"' "$out/lab_topics_$scope.txt"; then
+      echo "FAIL: multihost local: scope $scope: lab's own watcher did not see the graph:" >&2
+      cat "$out/lab_topics_$scope.txt" "$out/solo_$scope.log" >&2
+      failures+=(local); return 0
+    fi
+    seen=0
+    grep -q '"value"' "$out/rec_topics_$scope.txt" && seen=1
+    if [ $scope = local ] && [ $seen = 1 ]; then
+      echo "FAIL: multihost local: another machine saw the one-machine graph's topic:" >&2
+      cat "$out/rec_topics_$scope.txt" >&2
+      failures+=(local); return 0
+    fi
+    if [ $scope = lan ] && [ $seen = 0 ]; then
+      echo "FAIL: multihost local: with network.scope lan the intruder saw nothing (the check could not fail):" >&2
+      cat "$out/rec_topics_$scope.txt" >&2
+      failures+=(local); return 0
+    fi
+  done
+  echo "PASS: multihost local: a one-machine graph is seen on its machine only (and from rec with scope lan)"
+}
+
 # run_mode reports a failure in `failures` (not by its status: under `||` or `if`, set -e would
 # stop applying inside it).
 failures=()
 n=0
 for mode in "${modes[@]}"; do
   [ "$mode" = net ] && { echo "PASS: multihost net: namespaces and probe"; continue; }
-  make_models
   n=$((n + 1))
+  [ "$mode" = local ] && { run_local_mode "$n-"; continue; }
+  make_models
   run_mode "$mode" "$n-"
 done
 echo "multihost: ${#modes[@]} mode run(s) in $SECONDS s, ${#failures[@]} failed"

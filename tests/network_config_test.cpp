@@ -79,6 +79,22 @@ TEST(NetworkConfig, DefaultsToMulticastOverSharedMemoryAndUdp) {
   ASSERT_TRUE(diags.empty());
   EXPECT_EQ(g.network.discovery, Discovery::kMulticast);
   EXPECT_EQ(g.network.transport, NetTransport::kShmUdp);
+  EXPECT_EQ(g.network.scope, NetScope::kLocal);  // names no other machine: this machine only
+}
+
+// network.scope: local unless the graph points at another machine, whichever key does; lan on request.
+TEST(NetworkConfig, ScopeIsLocalUnlessTheGraphPointsAtAnotherMachine) {
+  const std::string plain = "components:\n  src: {type: counter_source, rate_hz: 10}\n";
+  for (const char* set : {"network.hosts.lab=10.0.0.1", "network.peers=[10.0.0.2]", "network.server=10.0.0.1:11811",
+                                 "network.interfaces=[10.0.0.1]", "network.discovery=peers", "network.scope=lan"}) {
+    std::vector<Diagnostic> diags;
+    const Graph g = Parse(plain, &diags, {set});
+    EXPECT_EQ(g.network.scope, NetScope::kLan) << set;
+  }
+  std::vector<Diagnostic> diags;
+  EXPECT_EQ(Parse(kSplit, &diags).network.scope, NetScope::kLan);
+  EXPECT_EQ(Parse(plain, &diags, {"network.scope=local"}).network.scope, NetScope::kLocal);
+  EXPECT_TRUE(diags.empty()) << diags[0].ToString();
 }
 
 struct Bad {
@@ -138,6 +154,15 @@ INSTANTIATE_TEST_SUITE_P(
             "g.yaml:10:22", "network.launcher_tcp_port", "1..65535"},
         Bad{"TcpWithoutAPort", Replace(Replace(kSplit, "transport: udp", "transport: tcp"), "a: {host: lab}", "a: {host: lab, tcp_port: 7601}"),
             "g.yaml:13:3", "processes.b.tcp_port", "needs each process's tcp_port"},
+        Bad{"ProcessNameThatIsAPath", Replace(kSplit, "a: {host: lab}", "../a: {host: lab}"), "g.yaml:12:3", "processes.../a",
+            "A-Z a-z 0-9 _ -, not starting with - (it names a log file and a DDS participant), got '../a'"},
+        Bad{"HostNameWithASlash",
+            Replace(Replace(kSplit, "mind: 10.77.0.2", "mi/nd: 10.77.0.2"), "b: {host: mind}", "b: {host: mi/nd}"),
+            "g.yaml:4:27", "network.hosts.mi/nd", "got 'mi/nd'"},
+        Bad{"LocalScopeOnHosts", Replace(kSplit, "  lease_s: 3\n", "  scope: local\n"), "g.yaml:9:10", "network.scope",
+            "local: this machine only, but the graph points at others (processes on hosts)"},
+        Bad{"UnknownScope", Replace(kSplit, "  lease_s: 3\n", "  scope: world\n"), "g.yaml:9:10", "network.scope",
+            "must be local (this machine only) or lan, got 'world'"},
         Bad{"BackoffTooShort", Replace(kSplit, "a: {host: lab}", "a: {host: lab, restart: always, backoff_s: 0}"), "g.yaml:12:46",
             "processes.a.backoff_s", "0.05..60"}),
     [](const auto& info) { return std::string(info.param.name); });
@@ -280,6 +305,35 @@ TEST(NetworkQos, PeersTurnMulticastOffAndListEveryHostAndPeer) {
   ASSERT_NE(udp, nullptr);
   EXPECT_EQ(udp->interfaceWhiteList, std::vector<std::string>{"veth0"});
   EXPECT_EQ(udp->maxInitialPeersRange, static_cast<uint32_t>(kPeerParticipants));
+}
+
+// scope local (a graph naming no other machine): loopback only, shared memory, no multicast,
+// discovery by unicast to 127.0.0.1.
+TEST(NetworkQos, LocalScopeBindsToLoopbackAndSendsNoMulticast) {
+  std::vector<Diagnostic> diags;
+  const Graph g = Parse("components:\n  src: {type: counter_source, rate_hz: 10}\n", &diags);
+  ASSERT_TRUE(diags.empty());
+  eprosima::fastdds::dds::DomainParticipantQos qos;
+  ASSERT_TRUE(ApplyNetwork(g.network, false, &qos).ok());
+  const auto& b = qos.wire_protocol().builtin;
+  ASSERT_EQ(b.metatrafficUnicastLocatorList.size(), 1u);  // keeps Fast DDS from adding the multicast one
+  EXPECT_TRUE(b.metatrafficMulticastLocatorList.empty());
+  ASSERT_EQ(b.initialPeersList.size(), 1u);
+  EXPECT_EQ(eprosima::fastrtps::rtps::IPLocator::ip_to_string(*b.initialPeersList.begin()), "127.0.0.1");
+  ASSERT_EQ(qos.transport().user_transports.size(), 2u);
+  EXPECT_NE(std::dynamic_pointer_cast<eprosima::fastdds::rtps::SharedMemTransportDescriptor>(qos.transport().user_transports[0]), nullptr);
+  auto udp = std::dynamic_pointer_cast<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(qos.transport().user_transports[1]);
+  ASSERT_NE(udp, nullptr);
+  EXPECT_EQ(udp->interfaceWhiteList, std::vector<std::string>{"127.0.0.1"});
+  EXPECT_EQ(udp->maxInitialPeersRange, static_cast<uint32_t>(kLocalParticipants));
+}
+
+// Fast DDS 2.9 whitelists by address only: an interface's name becomes its addresses.
+TEST(NetworkQos, AnInterfaceNameBecomesItsAddress) {
+  const auto qos = QosOf("network.interfaces=[lo, 10.77.0.1, no-such-interface]");
+  auto udp = std::dynamic_pointer_cast<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(qos.transport().user_transports.at(0));
+  ASSERT_NE(udp, nullptr);
+  EXPECT_EQ(udp->interfaceWhiteList, (std::vector<std::string>{"127.0.0.1", "10.77.0.1", "no-such-interface"}));
 }
 
 TEST(NetworkQos, ServerMakesAClientOfTheNamedHostsAddress) {

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/rtps/attributes/ServerAttributes.h>
@@ -67,6 +69,31 @@ bool NetworkUp(const NetworkConfig& net) {
 
 namespace {
 
+// Fast DDS 2.9 matches its interface whitelist against addresses only (IPFinder's info_IP.name),
+// so an interface named in `network.interfaces` (eth0) is turned into its IPv4 addresses here.
+// An entry that is neither stays as written: Fast DDS ignores it on this machine.
+std::vector<std::string> WhitelistAddresses(const std::vector<std::string>& entries) {
+  std::vector<std::string> out;
+  ifaddrs* list = nullptr;
+  const bool have_list = getifaddrs(&list) == 0;
+  for (const std::string& e : entries) {
+    in_addr a{};
+    bool named = false;
+    if (inet_pton(AF_INET, e.c_str(), &a) != 1 && have_list) {
+      for (ifaddrs* i = list; i != nullptr; i = i->ifa_next) {
+        if (i->ifa_addr == nullptr || i->ifa_addr->sa_family != AF_INET || e != i->ifa_name) continue;
+        char address[INET_ADDRSTRLEN] = {0};
+        inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(i->ifa_addr)->sin_addr, address, sizeof(address));
+        out.push_back(address);
+        named = true;
+      }
+    }
+    if (!named) out.push_back(e);
+  }
+  if (have_list) freeifaddrs(list);
+  return out;
+}
+
 StatusOr<rtps::Locator_t> UdpLocator(const std::string& text, const std::string& key) {
   HostPort hp;
   if (!ParseHostPort(text, &hp, false)) return Status::InvalidArgument(key + ": '" + text + "' is not address or address:port");
@@ -92,7 +119,7 @@ Status ApplyNetwork(const NetworkConfig& net, bool udp_only, eprosima::fastdds::
   builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(AnnouncementPeriodS(net));
   if (net.transport == NetTransport::kTcp) {
     auto tcp = std::make_shared<eprosima::fastdds::rtps::TCPv4TransportDescriptor>();
-    tcp->interfaceWhiteList = net.interfaces;
+    tcp->interfaceWhiteList = WhitelistAddresses(net.interfaces);
     HostPort own;
     if (auto it = net.tcp_listeners.find(process); it != net.tcp_listeners.end() && ParseHostPort(it->second, &own, true))
       tcp->add_listener_port(static_cast<uint16_t>(own.port));
@@ -115,11 +142,23 @@ Status ApplyNetwork(const NetworkConfig& net, bool udp_only, eprosima::fastdds::
   if (!udp_only && net.transport == NetTransport::kShmUdp)
     transport.user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
   auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
-  udp->interfaceWhiteList = net.interfaces;
+  udp->interfaceWhiteList = WhitelistAddresses(net.interfaces);
   udp->maxInitialPeersRange = kPeerParticipants;
   transport.user_transports.push_back(udp);
 
-  if (net.discovery == Discovery::kPeers) {
+  if (net.scope == NetScope::kLocal && net.discovery == Discovery::kMulticast) {
+    // This machine only: every socket bound to loopback (Fast DDS 2.9 whitelists by address), no
+    // multicast (loopback has none), discovery by unicast to this machine's well-known ports.
+    udp->interfaceWhiteList = {"127.0.0.1"};
+    udp->maxInitialPeersRange = kLocalParticipants;
+    rtps::Locator_t any;
+    any.kind = LOCATOR_KIND_UDPv4;
+    builtin.metatrafficUnicastLocatorList.push_back(any);
+    rtps::Locator_t self;
+    self.kind = LOCATOR_KIND_UDPv4;
+    rtps::IPLocator::setIPv4(self, "127.0.0.1");
+    builtin.initialPeersList.push_back(self);
+  } else if (net.discovery == Discovery::kPeers) {
     // A unicast metatraffic locator (address and port left to Fast DDS: every allowed interface,
     // the well-known port) keeps Fast DDS from creating the multicast one.
     rtps::Locator_t any;

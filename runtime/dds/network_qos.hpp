@@ -1,5 +1,9 @@
 // The graph's `network:` section as Fast DDS participant QoS (internal to the runtime).
 //
+//   scope local:         this machine only (the default of a graph that names no other machine):
+//                        UDP bound to 127.0.0.1, shared memory, no multicast, discovery by
+//                        unicast to 127.0.0.1's well-known ports (kLocalParticipants ids).
+//                        Everything below is scope lan.
 //   discovery multicast: Fast DDS's default SPDP (multicast 239.255.0.1 plus unicast).
 //   discovery peers:     no multicast at all: a unicast metatraffic locator (all interfaces, the
 //                        well-known port) and the initial peers list: every address of
@@ -27,6 +31,9 @@ namespace dyad {
 // Participant ids a peer address is tried on (Fast DDS's default is 4): each process and each
 // watcher (`dyad echo`, `dyad status`) on a host takes one.
 inline constexpr int kPeerParticipants = 12;
+// network.scope local: participant ids announced to on 127.0.0.1 (every process and watcher of
+// this machine on the domain; one beyond them is still found, as it announces to these).
+inline constexpr int kLocalParticipants = 32;
 
 // The discovery server's GUID prefix (Fast DDS's convention for server id 0, the one
 // `fast-discovery-server -i 0` uses too).

@@ -3,10 +3,10 @@
 #include "dyad/join_list.hpp"
 #include "dyad/strict_yaml.hpp"
 
-#include <filesystem>
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -22,6 +22,17 @@ namespace {
 
 // Graph names become part of DDS partition names (graph/run_partition.hpp).
 const std::string kGraphNameRule = "must be 1 to 64 of the characters A-Z a-z 0-9 _ . - (it names the run's DDS partition)";
+
+// Process and host names become file names (a process's log: <log dir>/<process>.log) and
+// DDS participant names: no '/', no '.', nothing a shell or a path would read twice.
+const std::string kPlaceNameRule =
+    "must be 1 to 64 of the characters A-Z a-z 0-9 _ -, not starting with - (it names a log file and a DDS participant)";
+bool IsPlaceName(const std::string& s) {
+  if (s.empty() || s.size() > 64 || s[0] == '-') return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+  });
+}
 
 std::string Names(const std::map<std::string, std::string>& m) {
   return JoinList(m, [](const auto& kv) -> const std::string& { return kv.first; });
@@ -51,6 +62,8 @@ void ReadNetwork(StrictYaml& r, const YAML::Node& node, NetworkConfig* n) {
   }
   if (const YAML::Node hosts = node["hosts"]; hosts && r.Map(hosts, "network.hosts", {})) {
     for (const auto& kv : hosts) {
+      if (!IsPlaceName(kv.first.Scalar()))
+        r.Error(kv.first, "network.hosts." + kv.first.Scalar(), kPlaceNameRule + (", got '" + kv.first.Scalar() + "'"));
       std::string address;
       if (r.String(kv.second, "network.hosts." + kv.first.Scalar(), &address)) n->hosts[kv.first.Scalar()] = address;
     }
@@ -104,6 +117,32 @@ void ReadNetwork(StrictYaml& r, const YAML::Node& node, NetworkConfig* n) {
                                                     "connects to the others' tcp_port)");
   if (n->discovery == Discovery::kServer && n->server.empty())
     r.Error(node["discovery"], "network.discovery", "server: needs network.server (HOST:PORT of the discovery server)");
+}
+
+// network.scope, given or implied (graph.hpp): a graph that points at no other machine is
+// reachable from this machine only.
+void ResolveScope(StrictYaml& r, const YAML::Node& network, Graph* g) {
+  NetworkConfig& n = g->network;
+  std::string why_lan;  // the first key that points at another machine
+  if (g->PlacedOnHosts()) why_lan = "processes on hosts";
+  else if (!n.hosts.empty()) why_lan = "network.hosts";
+  else if (!n.peers.empty()) why_lan = "network.peers";
+  else if (!n.server.empty()) why_lan = "network.server";
+  else if (!n.interfaces.empty()) why_lan = "network.interfaces";
+  else if (n.transport == NetTransport::kTcp) why_lan = "network.transport tcp";
+  else if (n.discovery != Discovery::kMulticast) why_lan = "network.discovery";
+  std::string s;
+  if (!network || !network["scope"] || !r.String(network["scope"], "network.scope", &s)) {
+    n.scope = why_lan.empty() ? NetScope::kLocal : NetScope::kLan;
+  } else if (s == "lan") {
+    n.scope = NetScope::kLan;
+  } else if (s == "local") {
+    n.scope = NetScope::kLocal;
+    if (!why_lan.empty())
+      r.Error(network["scope"], "network.scope", "local: this machine only, but the graph points at others (" + why_lan + ")");
+  } else {
+    r.Error(network["scope"], "network.scope", "must be local (this machine only) or lan, got '" + s + "'");
+  }
 }
 
 void ReadTopics(StrictYaml& r, const YAML::Node& node, Graph* g) {
@@ -342,6 +381,7 @@ void ReadProcesses(StrictYaml& r, const YAML::Node& procs, Graph* g) {
     p.name = kv.first.Scalar();
     const std::string key = "processes." + p.name;
     p.mark = r.Mark(kv.first, key);
+    if (!IsPlaceName(p.name)) r.Error(kv.first, key, kPlaceNameRule + (", got '" + p.name + "'"));
     const YAML::Node spec = kv.second;
     if (!spec.IsNull() && r.Map(spec, key, graph_keys::kProcess)) {
       if (spec["host"] && r.String(spec["host"], key + ".host", &p.host) && !g->network.hosts.empty() &&
@@ -438,6 +478,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   ReadGraphScalars(r, root, &g);
   if (const YAML::Node network = root["network"]) ReadNetwork(r, network, &g.network);
   if (const YAML::Node procs = root["processes"]) ReadProcesses(r, procs, &g);
+  ResolveScope(r, root["network"], &g);
   if (const YAML::Node topics = root["topics"]) ReadTopics(r, topics, &g);
   if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, &g);
   else r.Error(SourceMark{path, 1, 1}, "components", "missing: a graph needs at least one component");

@@ -12,7 +12,7 @@ namespace dyad::graph_keys {
 inline const std::set<std::string> kScalars = {"graph", "domain_id", "clock", "seed", "plugins", "logs"};
 inline const std::set<std::string> kTopLevel = {"graph",   "domain_id", "clock",     "seed",   "plugins",
                                                 "logs",    "network",   "processes", "topics", "components"};
-inline const std::set<std::string> kNetwork = {"discovery", "hosts",   "peers",           "server",
+inline const std::set<std::string> kNetwork = {"scope", "discovery", "hosts",   "peers",           "server",
                                                "transport", "interfaces", "lease_s",       "start_timeout_s",
                                                "max_clock_offset_ms", "launcher_tcp_port"};
 inline const std::set<std::string> kProcess = {"host", "restart", "max_restarts", "backoff_s", "required", "tcp_port"};

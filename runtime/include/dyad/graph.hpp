@@ -70,6 +70,10 @@ struct TopicConfig {
 };
 
 enum class Discovery { kMulticast, kPeers, kServer };
+// Who can reach the graph's participants. kLocal: this machine only (loopback and shared memory;
+// discovery by unicast on 127.0.0.1): the default of a graph that points at no other machine,
+// and of a watcher without --graph. kLan: the network the `network:` section describes.
+enum class NetScope { kLocal, kLan };
 enum class NetTransport { kShmUdp, kUdp, kTcp };
 
 // The DDS participant name of a host's launcher (its link to the other hosts' launchers).
@@ -77,6 +81,10 @@ inline std::string LauncherParticipantName(const std::string& host) { return "dy
 
 // The `network:` section, mapped onto Fast DDS participant QoS by the runtime.
 struct NetworkConfig {
+  // `network.scope`; when not given: kLan if the graph points at another machine (processes on
+  // hosts, network.hosts, peers, server, interfaces, transport tcp, discovery other than
+  // multicast), else kLocal.
+  NetScope scope = NetScope::kLocal;
   Discovery discovery = Discovery::kMulticast;
   std::map<std::string, std::string> hosts;  // host name -> address (IPv4 or DNS name)
   std::vector<std::string> peers;            // "address" or "address:port" (port 0: well-known ports)
