@@ -9,7 +9,7 @@ packages=(
   build-essential cmake git pkg-config
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
   libeigen3-dev libceres-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libzstd-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libcivetweb-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libcivetweb-dev libssl-dev openssl
   python3 python3-matplotlib chromium universal-ctags
   iproute2 nftables procps
 )

@@ -8,10 +8,12 @@
 #include <fstream>
 #include <mutex>
 #include <random>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
 #include <dyad/decode_sample.hpp>
+#include <dyad/graph.hpp>
 #include <dyad/on_demand_subscription.hpp>
 #include <dyad/pvrnn/dataset.hpp>
 #include <dyad/topic_select.hpp>
@@ -30,6 +32,15 @@ std::string RandomToken() {
   return t;
 }
 
+// Every (process, component) of the graph as run, placed as the runtime places them.
+std::set<std::pair<std::string, std::string>> GraphsComponents(const Context& ctx) {
+  std::vector<Diagnostic> diags;  // the runtime parsed this text before: none
+  const Graph g = ParseGraph(ctx.graph_yaml(), ctx.graph_folder() + "/graph.yaml", {}, &diags);
+  std::set<std::pair<std::string, std::string>> out;
+  for (const auto& c : g.components) out.insert({g.ProcessOf(c), c.name});
+  return out;
+}
+
 }  // namespace
 
 // A sample of dyad/processes or dyad/health into the experimenter's list of run events (one not
@@ -41,13 +52,17 @@ void AddEvent(RunEvents& events, const SerializedSample& sample) {
   events.Add(m, std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
 }
 
-// The newest ComponentStats of every component of the graph, from dyad/stats (any process).
+// The newest ComponentStats of every component of the graph, from dyad/stats (any process). Only
+// the graph's own (process, component) pairs are kept: a peer sending other names cannot grow
+// the table (or the experimenter's page).
 struct WebComponent::StatsTable {
   std::mutex mutex;
+  std::set<std::pair<std::string, std::string>> graphs_own;  // (process, component); set before subscribing
   std::map<std::pair<std::string, std::string>, msg::ComponentStats> rows;  // (process, component)
   void Add(std::span<const uint8_t> cdr) {
     msg::ComponentStats s;
     if (!DecodeSample(cdr, &s).ok()) return;  // not from a dyad runtime of this version: not shown
+    if (!graphs_own.count({s.process_name(), s.component_name()})) return;
     std::lock_guard<std::mutex> lock(mutex);
     rows[{s.process_name(), s.component_name()}] = std::move(s);
   }
@@ -162,6 +177,7 @@ Status WebComponent::Configure(Context& ctx) {
     if (Status s = notes_->Publish(note_); !s.ok()) ctx_->log().Warn("notes: experimenter's note lost: " + s.ToString());
   });
   stats_ = std::make_shared<StatsTable>();
+  stats_->graphs_own = GraphsComponents(ctx);
   events_ = std::make_shared<RunEvents>();
   for (const auto& t : ctx.graph_topics()) {
     Status s;
@@ -203,11 +219,13 @@ Status WebComponent::Activate() {
   bridge_->SetServer(server_.get());
   subject_->SetServer(server_.get());
   experimenter_->SetServer(server_.get());
-  const std::string host = options_.address.find(':') != std::string::npos ? "[" + options_.address + "]" : options_.address;
-  const std::string base = host + ":" + std::to_string(server_->port());
+  // Bound to a wildcard address, the URLs name the machine's real addresses (0.0.0.0 opens nothing).
   const std::string query = options_.token.empty() ? "" : "?token=" + options_.token;
-  ctx_->log().Info("subject's page: http://" + base + "/subject" + query + "  experimenter: http://" + base +
-                   "/experimenter" + query + "  Foxglove WebSocket: ws://" + base + "/" + query);
+  for (const std::string& host : UrlHosts(options_.address)) {
+    const std::string base = host + ":" + std::to_string(server_->port());
+    ctx_->log().Info("subject's page: http://" + base + "/subject" + query + "  experimenter: http://" + base +
+                     "/experimenter" + query + "  Foxglove WebSocket: ws://" + base + "/" + query);
+  }
   if (!port_file_.empty()) {
     std::ofstream f(port_file_);
     f << server_->port() << "\n";

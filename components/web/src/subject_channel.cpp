@@ -111,7 +111,7 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
   }
   if (*op == "steer") {
     auto token = j.find("token");
-    const bool ok = !options_.token.empty() && token != j.end() && token->is_string() && *token == options_.token;
+    const bool ok = token != j.end() && token->is_string() && TokenMatches(token->get<std::string>(), options_.token);
     if (!ok) {
       if (WebServer* server = server_.load())
         server->SendText(client, json{{"op", "error"}, {"message", "steering not taken: wrong or no token"}}.dump());

@@ -1,6 +1,10 @@
 #include "web_server.hpp"
 
+#include <arpa/inet.h>
 #include <civetweb.h>
+#include <ifaddrs.h>
+#include <net/if.h>
+#include <openssl/crypto.h>
 #include <pthread.h>
 #include <sched.h>
 
@@ -33,6 +37,31 @@ std::string QueryValue(const char* query, const std::string& key) {
 }
 
 }  // namespace
+
+bool TokenMatches(std::string_view given, std::string_view expected) {
+  if (expected.empty() || given.size() != expected.size()) return false;
+  return CRYPTO_memcmp(given.data(), expected.data(), expected.size()) == 0;
+}
+
+std::vector<std::string> UrlHosts(const std::string& address) {
+  if (address != "0.0.0.0" && address != "::" && address != "[::]")
+    return {address.find(':') != std::string::npos ? "[" + address + "]" : address};
+  std::vector<std::string> hosts;
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) == 0) {
+    for (ifaddrs* i = list; i != nullptr; i = i->ifa_next) {
+      if (i->ifa_addr == nullptr || i->ifa_addr->sa_family != AF_INET || (i->ifa_flags & IFF_LOOPBACK) ||
+          !(i->ifa_flags & IFF_UP))
+        continue;
+      char text[INET_ADDRSTRLEN] = {0};
+      inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(i->ifa_addr)->sin_addr, text, sizeof(text));
+      hosts.push_back(text);
+    }
+    freeifaddrs(list);
+  }
+  if (hosts.empty()) hosts.push_back("127.0.0.1");
+  return hosts;
+}
 
 bool IsLoopback(const std::string& address) {
   return address.rfind("127.", 0) == 0 || address == "localhost" || address == "::1";
@@ -189,7 +218,7 @@ int WebServer::OnConnect(const mg_connection* conn, void* endpoint) {
   auto* self = static_cast<EndpointState*>(endpoint)->server;
   const mg_request_info* info = mg_get_request_info(conn);
   if (const char* origin = mg_get_header(conn, "Origin"); origin != nullptr && !self->OriginAllowed(origin)) return 1;
-  if (!self->options_.token.empty() && QueryValue(info->query_string, "token") != self->options_.token) return 1;
+  if (!self->options_.token.empty() && !TokenMatches(QueryValue(info->query_string, "token"), self->options_.token)) return 1;
   std::lock_guard<std::mutex> lock(self->mutex_);
   if (static_cast<int>(self->admitted_.size()) >= self->options_.max_clients) return 1;
   self->admitted_.insert(conn);

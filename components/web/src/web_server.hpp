@@ -42,6 +42,15 @@ using ClientId = uint64_t;
 // needs no token, and pages from localhost origins are accepted.
 bool IsLoopback(const std::string& address);
 
+// Whether a client's token is the expected one, in time that does not depend on where they
+// differ (OpenSSL's CRYPTO_memcmp; only the length can be learnt). An empty `expected` matches
+// nothing.
+bool TokenMatches(std::string_view given, std::string_view expected);
+
+// The URLs' host for a server bound to `address`: itself, or for a wildcard (0.0.0.0, ::) this
+// machine's IPv4 addresses other than loopback (loopback when it has none).
+std::vector<std::string> UrlHosts(const std::string& address);
+
 // What the application does with WebSocket clients. Threads:
 //   - OnOpen and OnClose run on the civetweb worker thread that serves the client's connection
 //     (for a client still open when the server stops, while ~WebServer waits for it).

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A restart is said on the experimenter's page: a graph of two processes, the `worker` killed
 # once mid-run (its launcher restarts it), a client of /experimenter/ws must be told
-# "process 'worker' ... restarted (restart 1)" (components/web/src/run_events.hpp).
+# "process 'worker' ... restarted (restart 1)" (components/web/src/run_events.hpp), and its stats
+# table must list each component under its own process (ui/web, worker/human), nothing else.
 #   run_events_test.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 build=$1
@@ -36,12 +37,17 @@ status=0
 node -e '
 const WebSocket = require(process.argv[1] + "/node_modules/ws");
 const ws = new WebSocket(process.argv[2] + "/experimenter/ws");
-const give_up = setTimeout(() => { console.log("FAIL: no restart event within 20 s"); process.exit(1); }, 20000);
+const give_up = setTimeout(() => { console.log("FAIL: no restart event and stats of both processes within 20 s: " + seen); process.exit(1); }, 20000);
+let told = false, seen = "";
 ws.on("message", (d) => {
   const m = JSON.parse(d.toString());
-  if (m.op !== "events") return;
-  const e = m.items.find((i) => /^process .worker.* restarted \(restart 1\): its components started afresh/.test(i.text));
-  if (e) { console.log("told: " + e.text); clearTimeout(give_up); ws.close(); process.exit(0); }
+  if (m.op === "events") {
+    const e = m.items.find((i) => /^process .worker.* restarted \(restart 1\): its components started afresh/.test(i.text));
+    if (e && !told) { console.log("told: " + e.text); told = true; }
+  }
+  // The stats table: each component of the graph under its own process, and nothing else.
+  if (m.op === "stats") seen = m.rows.map((r) => r.process + "/" + r.component).sort().join(",");
+  if (told && seen === "ui/web,worker/human") { console.log("stats: " + seen); clearTimeout(give_up); ws.close(); process.exit(0); }
 });' "$node_dir" "ws://127.0.0.1:$(cat web.port)" || status=1
 kill -INT $pid; wait $pid || true
 [ $status -eq 0 ] || cat run.err
