@@ -114,6 +114,9 @@ void UdpCartesian::Describe(ComponentSpec& spec) {
       "[min, max] of x; targets outside are clamped before they are sent (logged once, counted)");
   spec.Param("y_limits", std::vector<double>{-60, 60}).Unit("workspace units").Doc(
       "[min, max] of y; targets outside are clamped before they are sent (logged once, counted)");
+  spec.Param("key_file", "").Path().Doc(
+      "pre-shared key (>= 32 bytes, mode 600): protocol v2, every packet authenticated (HMAC-SHA256), sessions by "
+      "handshake; empty: protocol v1, unauthenticated (warned at start)");
   spec.Input<msg::CartesianCommand>("command").Doc("target position, one packet per new sample");
   spec.Output<msg::CartesianState>("state").Doc("the controller's measured state, each published once");
 }
@@ -135,6 +138,14 @@ Status UdpCartesian::Configure(Context& ctx) {
   }
   x_limits_ = {p.DoubleList("x_limits")[0], p.DoubleList("x_limits")[1]};
   y_limits_ = {p.DoubleList("y_limits")[0], p.DoubleList("y_limits")[1]};
+  if (const std::string& file = p.String("key_file"); !file.empty()) {
+    auto key = udp::ReadKeyFile(file);
+    if (!key.ok()) return Status::InvalidArgument(prefix + "key_file", key.status().message());
+    key_ = std::move(*key);
+  } else {
+    ctx.log().Warn("protocol v1: packets to and from the controller are not authenticated (anyone on the network "
+                   "can command the robot); give params.key_file for protocol v2");
+  }
   command_ = &ctx.input<msg::CartesianCommand>("command");
   state_ = &ctx.output<msg::CartesianState>("state");
   return Status::OK();
@@ -146,9 +157,36 @@ Status UdpCartesian::Activate() {
   socket_.emplace(std::move(*s));
   session_ = udp::NewSession();
   sent_seq_ = 0;
+  welcomed_ = false;
   ctx_->log().Info("controller " + ToString(controller_) + ", local port " + std::to_string(socket_->local_port()) +
                    ", session " + std::to_string(session_));
   return Status::OK();
+}
+
+// One datagram from the controller's address: the state it carries, or why not (v2: a welcome
+// completes the handshake and carries no state).
+udp::Decode UdpCartesian::DecodeReply(size_t n, udp::StatePacket* s, bool* is_state) {
+  *is_state = false;
+  if (n > rx_.size()) return udp::Decode::kBadLength;
+  if (key_.empty()) {
+    *is_state = true;
+    return udp::DecodeState(rx_.data(), n, s);
+  }
+  if (udp::SignedKind(rx_.data(), n) == udp::kKindWelcome) {
+    udp::HandshakePacket w;
+    const udp::Decode d = udp::DecodeSignedHandshake(rx_.data(), n, udp::kKindWelcome, key_, &w);
+    if (d != udp::Decode::kOk) return d;
+    if (w.peer != session_) return udp::Decode::kBadMac;  // authentic, but not for this session: a replay
+    controller_session_ = w.session;
+    welcomed_ = true;
+    return udp::Decode::kOk;
+  }
+  uint32_t peer = 0;
+  const udp::Decode d = udp::DecodeSignedState(rx_.data(), n, key_, s, &peer);
+  if (d != udp::Decode::kOk) return d;
+  if (!welcomed_ || s->session != controller_session_ || peer != session_) return udp::Decode::kBadMac;
+  *is_state = true;
+  return udp::Decode::kOk;
 }
 
 Status UdpCartesian::Drain() {
@@ -169,8 +207,17 @@ Status UdpCartesian::Drain() {
       continue;
     }
     udp::StatePacket s;
-    const udp::Decode d = static_cast<size_t>(n) > rx_.size() ? udp::Decode::kBadLength
-                                                               : udp::DecodeState(rx_.data(), static_cast<size_t>(n), &s);
+    bool is_state = false;
+    const udp::Decode d = DecodeReply(static_cast<size_t>(n), &s, &is_state);
+    if (d == udp::Decode::kBadMac) {  // never acted on: another key, modified, or replayed
+      ++rejected_;
+      if (!rejected_logged_) {
+        rejected_logged_ = true;
+        ctx_->log().Warn("packet from the controller's address rejected (bad MAC or not of this session): dropped "
+                         "(logged once, counted)");
+      }
+      continue;
+    }
     if (d != udp::Decode::kOk) {
       tracker_.Malformed();
       if (!malformed_logged_) {
@@ -180,79 +227,123 @@ Status UdpCartesian::Drain() {
       }
       continue;
     }
-    const uint64_t sessions = tracker_.counts().sessions;
-    if (tracker_.Offer(s, awaiting_) == udp::StateTracker::Verdict::kOutOfOrder) continue;
-    if (sessions > 0 && tracker_.counts().sessions != sessions)
-      ctx_->log().Warn("controller session changed to " + std::to_string(s.session) + " (controller restarted?)");
-    newest_ = s;
-    has_newest_ = true;
-    waiting_since_ns_ = -1;
-    out_.x(s.x);
-    out_.y(s.y);
-    out_.z(s.z);
-    out_.vx(s.vx);
-    out_.vy(s.vy);
-    out_.vz(s.vz);
-    out_.stopped(s.stopped);
-    if (Status st = state_->Publish(out_); !st.ok()) return st;
+    if (!is_state) continue;  // the welcome
+    if (Status st = Accept(s); !st.ok()) return st;
   }
+}
+
+// A decoded state of the current session: in order, published once.
+Status UdpCartesian::Accept(const udp::StatePacket& s) {
+  const uint64_t sessions = tracker_.counts().sessions;
+  if (tracker_.Offer(s, awaiting_) == udp::StateTracker::Verdict::kOutOfOrder) return Status::OK();
+  if (sessions > 0 && tracker_.counts().sessions != sessions)
+    ctx_->log().Warn("controller session changed to " + std::to_string(s.session) + " (controller restarted?)");
+  newest_ = s;
+  has_newest_ = true;
+  waiting_since_ns_ = -1;
+  unanswered_ = 0;
+  out_.x(s.x);
+  out_.y(s.y);
+  out_.z(s.z);
+  out_.vx(s.vx);
+  out_.vy(s.vy);
+  out_.vz(s.vz);
+  out_.stopped(s.stopped);
+  return state_->Publish(out_);
+}
+
+void UdpCartesian::Send(const uint8_t* data, size_t size) {
+  if (Status s = socket_->SendTo(data, size, controller_); !s.ok()) {
+    ++socket_errors_;
+    if (!error_logged_) {
+      error_logged_ = true;
+      ctx_->log().Warn(s.message() + " (logged once)");
+    }
+  }
+}
+
+// Drains until `done` holds or reply_wait_ms (wall time) has passed; returns `done`.
+template <class Done>
+StatusOr<bool> UdpCartesian::AwaitReply(Done done) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(reply_wait_ms_);
+  for (;;) {
+    if (done()) return true;
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
+    if (left <= 0 || !socket_->WaitReadable(static_cast<int>(left))) return false;
+    if (Status s = Drain(); !s.ok()) return s;
+  }
+}
+
+// v2: a hello with our session, and a bounded wait for its welcome.
+Status UdpCartesian::Handshake(int64_t now_ns) {
+  udp::HandshakePacket hello;
+  hello.session = session_;
+  Send(tx_.data(), udp::EncodeSigned(udp::kKindHello, hello, key_, tx_));
+  if (waiting_since_ns_ < 0) waiting_since_ns_ = now_ns;
+  auto welcomed = AwaitReply([this] { return welcomed_; });
+  return welcomed.ok() ? Status::OK() : welcomed.status();
+}
+
+Status UdpCartesian::SendCommand(const msg::CartesianCommand& c, int64_t now_ns) {
+  udp::CommandPacket packet;
+  packet.session = session_;
+  packet.sequence = ++sent_seq_;
+  packet.stamp_ns = now_ns;
+  // The controller is sent nothing outside the workspace box, whatever the mixer asked for.
+  packet.x = std::clamp(c.x(), x_limits_[0], x_limits_[1]);
+  packet.y = std::clamp(c.y(), y_limits_[0], y_limits_[1]);
+  packet.z = c.z();
+  packet.hold = c.hold();
+  if (packet.x != c.x() || packet.y != c.y()) {
+    ++clamped_;
+    if (!clamp_logged_) {
+      clamp_logged_ = true;
+      ctx_->log().Warn("target (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) +
+                       ") outside the workspace: clamped to (" + std::to_string(packet.x) + ", " +
+                       std::to_string(packet.y) + ") (logged once)");
+    }
+  }
+  if (key_.empty()) {
+    udp::Encode(packet, v1_tx_);
+    Send(v1_tx_.data(), v1_tx_.size());
+  } else {
+    Send(tx_.data(), udp::EncodeSigned(packet, controller_session_, key_, tx_));
+  }
+  if (waiting_since_ns_ < 0) waiting_since_ns_ = now_ns;
+  awaiting_ = sent_seq_;
+  auto acked = AwaitReply([this] { return has_newest_ && newest_.ack == sent_seq_; });
+  awaiting_ = 0;
+  if (!acked.ok()) return acked.status();
+  if (!*acked) {
+    ++missed_replies_;
+    // v2: a controller that stopped answering may have restarted and forgotten our session.
+    if (!key_.empty() && ++unanswered_ >= kUnansweredBeforeHandshake) {
+      welcomed_ = false;
+      ctx_->log().Warn("no reply to " + std::to_string(unanswered_) + " commands: handshaking again");
+      unanswered_ = 0;
+    }
+  }
+  return Status::OK();
 }
 
 Status UdpCartesian::Step(const StepInfo& info) {
   if (Status s = Drain(); !s.ok()) return s;
+  if (!key_.empty() && !welcomed_)
+    if (Status s = Handshake(info.now_ns); !s.ok()) return s;
   if (command_->new_count() > 0 && !FiniteCommand(command_->received().back())) {
     ++nonfinite_;
     if (!nonfinite_logged_) {
       nonfinite_logged_ = true;
       ctx_->log().Warn(NonFiniteMessage(command_->received().back()) + "; not sent");
     }
-  } else if (command_->new_count() > 0) {
-    const msg::CartesianCommand& c = command_->received().back();
-    udp::CommandPacket packet;
-    packet.session = session_;
-    packet.sequence = ++sent_seq_;
-    packet.stamp_ns = info.now_ns;
-    // The controller is sent nothing outside the workspace box, whatever the mixer asked for.
-    packet.x = std::clamp(c.x(), x_limits_[0], x_limits_[1]);
-    packet.y = std::clamp(c.y(), y_limits_[0], y_limits_[1]);
-    packet.z = c.z();
-    packet.hold = c.hold();
-    if (packet.x != c.x() || packet.y != c.y()) {
-      ++clamped_;
-      if (!clamp_logged_) {
-        clamp_logged_ = true;
-        ctx_->log().Warn("target (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) +
-                         ") outside the workspace: clamped to (" + std::to_string(packet.x) + ", " +
-                         std::to_string(packet.y) + ") (logged once)");
-      }
-    }
-    udp::Encode(packet, tx_);
-    if (Status s = socket_->SendTo(tx_.data(), tx_.size(), controller_); !s.ok()) {
-      ++socket_errors_;
-      if (!error_logged_) {
-        error_logged_ = true;
-        ctx_->log().Warn(s.message() + " (logged once)");
-      }
-    }
-    if (waiting_since_ns_ < 0) waiting_since_ns_ = info.now_ns;
-    // Bounded wait (wall time) for the reply to this command.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(reply_wait_ms_);
-    awaiting_ = sent_seq_;
-    bool acked = false;
-    for (;;) {
-      acked = has_newest_ && newest_.ack == sent_seq_;
-      if (acked) break;
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
-      if (left <= 0 || !socket_->WaitReadable(static_cast<int>(left))) break;
-      if (Status s = Drain(); !s.ok()) return s;
-    }
-    awaiting_ = 0;
-    if (!acked) ++missed_replies_;
+  } else if (command_->new_count() > 0 && (key_.empty() || welcomed_)) {
+    if (Status s = SendCommand(command_->received().back(), info.now_ns); !s.ok()) return s;
   }
   if (waiting_since_ns_ >= 0 && info.now_ns - waiting_since_ns_ > timeout_ns_)
     return Status::IOError("controller " + ToString(controller_),
-                           "no state for " + std::to_string((info.now_ns - waiting_since_ns_) / 1'000'000) +
-                               " ms after a command (timeout_s)");
+                           std::string(key_.empty() || welcomed_ ? "no state" : "no welcome to our hello") + " for " +
+                               std::to_string((info.now_ns - waiting_since_ns_) / 1'000'000) + " ms" +
+                               (key_.empty() || welcomed_ ? " after a command" : "") + " (timeout_s)");
   return Status::OK();
 }
 
@@ -264,7 +355,8 @@ Status UdpCartesian::Deactivate() {
                    std::to_string(missed_replies_) + " replies missed, " + std::to_string(foreign_) + " foreign, " +
                    std::to_string(socket_errors_) + " socket errors, " + std::to_string(c.sessions) +
                    " controller sessions, " + std::to_string(nonfinite_) + " non-finite commands not sent, " +
-                   std::to_string(clamped_) + " clamped to the workspace");
+                   std::to_string(clamped_) + " clamped to the workspace, " + std::to_string(rejected_) +
+                   " rejected (protocol " + (key_.empty() ? "v1, unauthenticated)" : "v2)"));
   return Status::OK();
 }
 

@@ -34,6 +34,9 @@
 ///     the reply, so that the state of this step's command is published in this step
 ///   x_limits, y_limits (double list [min, max], [-60, 60], units): workspace box; targets
 ///     outside are clamped before they are sent (logged once, counted)
+///   key_file (string, "", path): a pre-shared key (>= 32 bytes, mode 600) for protocol v2:
+///     every packet authenticated (HMAC-SHA256), the session set by a handshake, replays and
+///     packets of other sessions rejected and counted; empty: protocol v1, unauthenticated
 /// A command with hold = true goes out with the hold flag: the controller keeps its target.
 /// Every accepted state is published once, in order (a late one in the next step, before the
 /// reply to that step's command); out-of-order, duplicate and malformed packets are dropped.
@@ -49,10 +52,12 @@
 
 #include <array>
 #include <optional>
+#include <string>
 
 #include <dyad/component.hpp>
 #include <dyad/msg/types.hpp>
 
+#include "udp_auth.hpp"
 #include "udp_protocol.hpp"
 #include "udp_socket.hpp"
 #include "virtual_robot.hpp"
@@ -95,6 +100,17 @@ class UdpCartesian final : public Component {
  private:
   // Takes every waiting datagram; publishes each accepted state at once, in order.
   Status Drain();
+  udp::Decode DecodeReply(size_t n, udp::StatePacket* s, bool* is_state);
+  Status Accept(const udp::StatePacket& s);
+  void Send(const uint8_t* data, size_t size);
+  template <class Done>
+  StatusOr<bool> AwaitReply(Done done);
+  Status Handshake(int64_t now_ns);
+  Status SendCommand(const msg::CartesianCommand& c, int64_t now_ns);
+
+  // v2: commands in a row without a reply before the driver handshakes again (the controller
+  // may have restarted and forgotten our session).
+  static constexpr int kUnansweredBeforeHandshake = 3;
 
   Context* ctx_ = nullptr;
   Input<msg::CartesianCommand>* command_ = nullptr;  // owned by the runtime
@@ -104,8 +120,15 @@ class UdpCartesian final : public Component {
   int64_t timeout_ns_ = 0;
   int reply_wait_ms_ = 0;
   std::optional<UdpSocket> socket_;
-  std::array<uint8_t, udp::kCommandSize> tx_{};
+  std::array<uint8_t, udp::kCommandSize> v1_tx_{};
+  std::array<uint8_t, udp::kMaxPacket> tx_{};  // v2 packets
   std::array<uint8_t, udp::kMaxPacket> rx_{};
+  std::string key_;        // v2's pre-shared key; empty: protocol v1
+  bool welcomed_ = false;  // v2: the handshake of this session is done
+  uint32_t controller_session_ = 0;  // v2: the session the controller welcomed us with
+  int unanswered_ = 0;     // v2: commands in a row without a reply
+  uint64_t rejected_ = 0;  // packets from the controller's address with a bad MAC or of another session
+  bool rejected_logged_ = false;
   uint32_t session_ = 0;   // ours, drawn at Activate
   uint32_t sent_seq_ = 0;
   uint32_t awaiting_ = 0;  // command whose reply is being waited for; 0: none

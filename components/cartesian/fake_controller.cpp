@@ -1,9 +1,13 @@
 // dyad_fake_controller: a Cartesian robot controller speaking the dyad UDP protocol (version 1,
-// docs/components.md), simulating the robot with VirtualRobot and its default limits. Used by
-// the udp_cartesian tests and for trying the driver without hardware.
+// or version 2 with --key-file: docs/components.md), simulating the robot with VirtualRobot and
+// its default limits. Used by the udp_cartesian tests and for trying the driver without hardware.
 //
 //   dyad_fake_controller --port 47000 [--drop N]... [--delay N:MS]... [--malform N]...
-//                        [--initial X,Y] [--idle-exit S]
+//                        [--initial X,Y] [--idle-exit S] [--key-file KEY]
+//
+// With --key-file it speaks protocol v2 only: hellos are welcomed with a fresh session, and a
+// command is applied only with a valid MAC, the session pair it follows (or welcomed last) and a
+// newer sequence; the others are counted as rejected (or out of order) and never acted on.
 //
 // Each valid command (sequence newer than the last applied) sets the robot's target and
 // advances the simulation to the command's stamp_ns (so a stepped run stays deterministic);
@@ -21,6 +25,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <csignal>
@@ -32,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "udp_auth.hpp"
 #include "udp_protocol.hpp"
 #include "udp_socket.hpp"
 #include "virtual_robot.hpp"
@@ -46,7 +52,8 @@ namespace udp = dyad::cartesian::udp;
 
 struct Delayed {
   Clock::time_point due;
-  std::array<uint8_t, udp::kStateSize> bytes;
+  std::array<uint8_t, udp::kMaxPacket> bytes;
+  size_t size;
   sockaddr_in to;
 };
 
@@ -58,13 +65,15 @@ int main(int argc, char** argv) {
   std::vector<uint32_t> drop_list, malform_list;
   std::vector<std::string> delay_specs;
   std::vector<double> initial;
-  CLI::App app{"A stand-in robot controller for udp_cartesian (protocol v1, docs/components.md): a virtual "
-               "robot behind a UDP port, with fault injection."};
+  std::string key_file;
+  CLI::App app{"A stand-in robot controller for udp_cartesian (protocol v1, or v2 with --key-file; "
+               "docs/components.md): a virtual robot behind a UDP port, with fault injection."};
   app.add_option("--port", port, "UDP port to listen on")->required()->check(CLI::Range(1, 65535));
   app.add_option("--drop", drop_list, "drop the reply to command N (1-based; repeatable)");
   app.add_option("--delay", delay_specs, "delay the reply to command N by MS milliseconds: N:MS (repeatable)");
   app.add_option("--malform", malform_list, "send a malformed reply to command N (repeatable)");
   app.add_option("--initial", initial, "initial position X,Y")->delimiter(',')->expected(2);
+  app.add_option("--key-file", key_file, "pre-shared key file (>= 32 bytes, mode 600): speak protocol v2 only");
   app.add_option("--idle-exit", idle_exit_s, "exit after this many seconds without a command (0: never)")
       ->check(CLI::NonNegativeNumber);
   try {
@@ -97,6 +106,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "dyad_fake_controller: %s\n", socket.status().ToString().c_str());
     return 1;
   }
+  std::string key;  // empty: protocol v1
+  if (!key_file.empty()) {
+    auto k = udp::ReadKeyFile(key_file);
+    if (!k.ok()) {
+      std::fprintf(stderr, "dyad_fake_controller: --key-file %s\n", k.status().message().c_str());
+      return 2;
+    }
+    key = std::move(*k);
+  }
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
   std::printf("listening on port %ld\n", port);
@@ -107,11 +125,13 @@ int main(int argc, char** argv) {
   uint32_t driver_session = 0;
   uint64_t sessions = 0;
   std::array<uint8_t, udp::kMaxPacket> rx{};
-  std::array<uint8_t, udp::kStateSize> tx{};
+  std::array<uint8_t, udp::kStateSize> tx_v1{};
+  std::array<uint8_t, udp::kMaxPacket> tx{};
+  udp::ControllerSessions v2;  // protocol v2: which driver session is followed
   std::vector<Delayed> pending;
   bool has_applied = false;
   uint32_t applied = 0, state_seq = 0;
-  uint64_t received = 0, malformed_in = 0, out_of_order = 0, dropped = 0, delayed = 0, malformed_out = 0;
+  uint64_t received = 0, malformed_in = 0, out_of_order = 0, dropped = 0, delayed = 0, malformed_out = 0, rejected = 0;
   auto last_packet = Clock::now();
 
   while (!g_stop) {
@@ -119,7 +139,7 @@ int main(int argc, char** argv) {
     const auto now = Clock::now();
     for (size_t i = 0; i < pending.size();) {
       if (pending[i].due <= now) {
-        socket->SendTo(pending[i].bytes.data(), pending[i].bytes.size(), pending[i].to).IgnoreError();  // UDP: the driver handles a lost reply
+        socket->SendTo(pending[i].bytes.data(), pending[i].size, pending[i].to).IgnoreError();  // UDP: the driver handles a lost reply
         pending.erase(pending.begin() + static_cast<long>(i));
       } else {
         ++i;
@@ -133,21 +153,64 @@ int main(int argc, char** argv) {
     last_packet = Clock::now();
     ++received;
     udp::CommandPacket c;
-    if (static_cast<size_t>(n) > rx.size() || udp::DecodeCommand(rx.data(), static_cast<size_t>(n), &c) != udp::Decode::kOk) {
-      ++malformed_in;
-      continue;
+    bool new_session = false;
+    const size_t size = static_cast<size_t>(n);
+    if (!key.empty()) {
+      // Protocol v2: a hello is welcomed with a fresh session; a command must carry a MAC with
+      // the key and the pair the controller follows (or welcomed last), and a newer sequence.
+      if (size <= rx.size() && udp::SignedKind(rx.data(), size) == udp::kKindHello) {
+        udp::HandshakePacket hello;
+        if (udp::DecodeSignedHandshake(rx.data(), size, udp::kKindHello, key, &hello) != udp::Decode::kOk) {
+          ++rejected;
+          continue;
+        }
+        const udp::HandshakePacket welcome{v2.Hello(hello.session), hello.session};
+        socket->SendTo(tx.data(), udp::EncodeSigned(udp::kKindWelcome, welcome, key, tx), from).IgnoreError();
+        continue;
+      }
+      uint32_t peer = 0;
+      const udp::Decode d = size > rx.size() ? udp::Decode::kBadLength : udp::DecodeSignedCommand(rx.data(), size, key, &c, &peer);
+      if (d == udp::Decode::kBadMac) {
+        ++rejected;
+        continue;
+      }
+      if (d != udp::Decode::kOk) {
+        ++malformed_in;
+        continue;
+      }
+      if (drop.count(c.sequence)) {
+        ++dropped;
+        continue;
+      }
+      const auto verdict = v2.Command(c.session, peer, c.sequence);
+      if (verdict == udp::ControllerSessions::Verdict::kStaleSession) {
+        ++rejected;
+        continue;
+      }
+      if (verdict == udp::ControllerSessions::Verdict::kOld) {
+        ++out_of_order;
+        continue;
+      }
+      new_session = verdict == udp::ControllerSessions::Verdict::kApplyNewSession;
+    } else {
+      if (size > rx.size() || udp::DecodeCommand(rx.data(), size, &c) != udp::Decode::kOk) {
+        ++malformed_in;
+        continue;
+      }
+      if (drop.count(c.sequence)) {
+        ++dropped;
+        continue;
+      }
+      if (has_applied && c.session == driver_session && !udp::Newer(c.sequence, applied)) {
+        ++out_of_order;
+        continue;
+      }
+      new_session = !has_applied || c.session != driver_session;
     }
-    if (drop.count(c.sequence)) {
-      ++dropped;
-      continue;
-    }
-    if (!has_applied || c.session != driver_session) {  // a (new) driver: start afresh
+    if (new_session) {  // a (new) driver: start afresh
       driver_session = c.session;
       robot.emplace(options);
       ++sessions;
-    } else if (!udp::Newer(c.sequence, applied)) {
-      ++out_of_order;
-      continue;
     }
     has_applied = true;
     applied = c.sequence;
@@ -155,14 +218,21 @@ int main(int argc, char** argv) {
     else robot->SetTarget({c.x, c.y}, c.stamp_ns);
     const auto& s = robot->Advance(c.stamp_ns);
     udp::StatePacket st;
-    st.session = session;
+    st.session = key.empty() ? session : v2.controller_session();
     st.sequence = ++state_seq;
     st.ack = c.sequence;
     st.stopped = s.stopped;
     st.stamp_ns = c.stamp_ns;
     st.x = s.position.x, st.y = s.position.y, st.z = c.z;
     st.vx = s.velocity.x, st.vy = s.velocity.y, st.vz = 0;
-    udp::Encode(st, tx);
+    size_t tx_size = 0;
+    if (key.empty()) {
+      udp::Encode(st, tx_v1);
+      std::copy(tx_v1.begin(), tx_v1.end(), tx.begin());
+      tx_size = tx_v1.size();
+    } else {
+      tx_size = udp::EncodeSigned(st, c.session, key, tx);
+    }
     if (malform.count(c.sequence)) {
       tx[0] ^= 0xFF;  // bad magic
       ++malformed_out;
@@ -172,15 +242,16 @@ int main(int argc, char** argv) {
       if (seq == c.sequence) delay_ms = ms;
     if (delay_ms >= 0) {
       ++delayed;
-      pending.push_back({Clock::now() + std::chrono::milliseconds(delay_ms), tx, from});
+      pending.push_back({Clock::now() + std::chrono::milliseconds(delay_ms), tx, tx_size, from});
     } else {
-      socket->SendTo(tx.data(), tx.size(), from).IgnoreError();  // as above
+      socket->SendTo(tx.data(), tx_size, from).IgnoreError();  // as above
     }
   }
   std::printf("commands received %llu, driver sessions %llu, last applied sequence %u, dropped %llu, delayed %llu, "
-              "malformed replies %llu, malformed commands %llu, out of order %llu\n",
+              "malformed replies %llu, malformed commands %llu, out of order %llu, rejected %llu\n",
               static_cast<unsigned long long>(received), static_cast<unsigned long long>(sessions), applied, static_cast<unsigned long long>(dropped),
               static_cast<unsigned long long>(delayed), static_cast<unsigned long long>(malformed_out),
-              static_cast<unsigned long long>(malformed_in), static_cast<unsigned long long>(out_of_order));
+              static_cast<unsigned long long>(malformed_in), static_cast<unsigned long long>(out_of_order),
+              static_cast<unsigned long long>(rejected));
   return 0;
 }

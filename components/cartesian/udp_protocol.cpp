@@ -69,6 +69,7 @@ const char* ToString(Decode d) {
     case Decode::kBadKind: return "unexpected kind";
     case Decode::kBadLength: return "bad length";
     case Decode::kNotFinite: return "a number is NaN or infinite";
+    case Decode::kBadMac: return "bad MAC (another key, or modified)";
   }
   return "?";
 }

@@ -1,5 +1,5 @@
 /// The dyad Cartesian UDP protocol, version 1: one datagram per message, little-endian, fixed
-/// sizes, no allocation. Specified in docs/components.md (## udp_cartesian); this header is its
+/// sizes, no allocation, no authentication (version 2, udp_auth.hpp, adds it). Specified in docs/components.md (## udp_cartesian); this header is its
 /// executable form, shared by the `udp_cartesian` driver and `dyad_fake_controller`.
 ///
 /// Every packet starts with a 16-byte header:
@@ -59,7 +59,7 @@ struct StatePacket {
 };
 
 // Why a datagram was rejected.
-enum class Decode { kOk, kTooShort, kBadMagic, kBadVersion, kBadKind, kBadLength, kNotFinite };
+enum class Decode { kOk, kTooShort, kBadMagic, kBadVersion, kBadKind, kBadLength, kNotFinite, kBadMac };
 const char* ToString(Decode d);
 
 void Encode(const CommandPacket& p, std::array<uint8_t, kCommandSize>& out);

@@ -6,6 +6,9 @@
 
 #include "dyad/testing/child_process.hpp"
 
+#include "udp_auth.hpp"
+#include "udp_socket.hpp"
+
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -380,6 +383,124 @@ TEST_F(DriverProcessTest, MixerWithoutStateWarnsThatItsFirstCommandIsNotLimited)
   EXPECT_NE(c.err().find("input 'state' is not bound: the first command cannot start from where the arm is"),
             std::string::npos)
       << c.err();
+}
+
+// A private key file of 32 random-looking bytes in the test's folder.
+std::string WriteKey(const fs::path& dir, char fill = 'k') {
+  const fs::path key = dir / (std::string("key_") + fill);
+  std::ofstream(key) << std::string(32, fill);
+  fs::permissions(key, fs::perms::owner_read | fs::perms::owner_write);
+  return key.string();
+}
+
+// Protocol v2 end to end: the same robot states as the virtual driver, nothing rejected.
+TEST_F(DriverProcessTest, UdpProtocolV2GivesTheSameRobotStates) {
+  const fs::path vlog = dir_ / "virtual.txt", ulog = dir_ / "udp.txt";
+  Child v(Dyad({"run", Graph("virtual.yaml", vlog).string(), "--steps", "100", "--quiet"}), dir_, "virtual");
+  ASSERT_EQ(v.Wait(60), 0) << v.err();
+  const fs::path ug = Graph("udp.yaml", ulog);
+  const std::string key = WriteKey(dir_);
+  Child fake = FakeController({"--key-file", key});
+  ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
+  Child u(Dyad({"run", ug.string(), "--steps", "100", "--quiet", "--set", PortSet(), "--set", "driver.reply_wait_ms=1000",
+                "--set", "driver.key_file=" + key}),
+          dir_, "udp");
+  ASSERT_EQ(u.Wait(120), 0) << u.err();
+  fake.Signal(SIGTERM);
+  EXPECT_EQ(fake.Wait(10), 0);
+  EXPECT_EQ(Read(vlog), Read(ulog));
+  EXPECT_EQ(ReadStates(ulog).size(), 100u);
+  EXPECT_NE(u.err().find("udp link: 100 commands sent, 100 states accepted, 0 late, 0 lost"), std::string::npos) << u.err();
+  EXPECT_NE(u.err().find("0 rejected (protocol v2)"), std::string::npos) << u.err();
+  EXPECT_EQ(u.err().find("not authenticated"), std::string::npos) << u.err();
+  EXPECT_NE(fake.out().find("rejected 0"), std::string::npos) << fake.out();
+}
+
+// The test plays the driver, then the attacker, against a v2 controller: only commands with the
+// key, of the welcomed session and newer than the last applied are answered (applied).
+TEST_F(DriverProcessTest, AV2ControllerRejectsSpoofedModifiedAndReplayedCommands) {
+  namespace udp = dyad::cartesian::udp;
+  const std::string key(32, 'k');
+  Child fake = FakeController({"--key-file", WriteKey(dir_)});
+  ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
+  auto sock = dyad::cartesian::UdpSocket::Open(0);
+  ASSERT_TRUE(sock.ok());
+  auto to = dyad::cartesian::UdpSocket::Resolve("127.0.0.1", static_cast<uint16_t>(port_));
+  ASSERT_TRUE(to.ok());
+  std::array<uint8_t, udp::kMaxPacket> tx{}, rx{};
+  // The reply to what was just sent, if any within 300 ms: its kind and, for a state, its ack.
+  auto reply = [&](uint32_t* ack_or_session) -> uint8_t {
+    if (!sock->WaitReadable(300)) return 0;
+    sockaddr_in from{};
+    const long n = sock->Receive(rx.data(), rx.size(), &from);
+    if (n <= 0) return 0;
+    const uint8_t kind = udp::SignedKind(rx.data(), static_cast<size_t>(n));
+    uint32_t peer = 0;
+    if (kind == udp::kKindWelcome) {
+      udp::HandshakePacket w;
+      EXPECT_EQ(udp::DecodeSignedHandshake(rx.data(), static_cast<size_t>(n), kind, key, &w), udp::Decode::kOk);
+      *ack_or_session = w.session;
+    } else if (kind == udp::kKindState) {
+      udp::StatePacket st;
+      EXPECT_EQ(udp::DecodeSignedState(rx.data(), static_cast<size_t>(n), key, &st, &peer), udp::Decode::kOk);
+      *ack_or_session = st.ack;
+    }
+    return kind;
+  };
+  auto command = [](uint32_t session, uint32_t seq, double x) {
+    udp::CommandPacket c;
+    c.session = session, c.sequence = seq, c.stamp_ns = seq * 100'000'000LL, c.x = x;
+    return c;
+  };
+  auto send = [&](size_t n) { ASSERT_TRUE(sock->SendTo(tx.data(), n, *to).ok()); };
+  uint32_t got = 0;
+  const uint32_t driver = 77;
+  send(udp::EncodeSigned(udp::kKindHello, udp::HandshakePacket{driver, 0}, key, tx));
+  ASSERT_EQ(reply(&got), udp::kKindWelcome);
+  const uint32_t controller = got;
+  const size_t n = udp::EncodeSigned(command(driver, 1, 3), controller, key, tx);
+  const auto first = tx;
+  send(n);
+  ASSERT_EQ(reply(&got), udp::kKindState);
+  EXPECT_EQ(got, 1u);
+  send(n);  // replayed as is
+  EXPECT_EQ(reply(&got), 0);
+  tx[udp::kHeader2Size + 8] ^= 0x40;  // x modified in flight
+  send(n);
+  EXPECT_EQ(reply(&got), 0);
+  send(udp::EncodeSigned(command(driver, 2, 50), controller, std::string(32, 'x'), tx));  // spoofed: another key
+  EXPECT_EQ(reply(&got), 0);
+  // A new handshake (a restarted driver); then the first session's traffic is dead, even newer.
+  send(udp::EncodeSigned(udp::kKindHello, udp::HandshakePacket{driver + 1, 0}, key, tx));
+  ASSERT_EQ(reply(&got), udp::kKindWelcome);
+  const uint32_t controller2 = got;
+  send(udp::EncodeSigned(command(driver + 1, 1, 4), controller2, key, tx));
+  ASSERT_EQ(reply(&got), udp::kKindState);
+  tx = first;
+  send(n);  // the first session's command, replayed into the new session
+  EXPECT_EQ(reply(&got), 0);
+  send(udp::EncodeSigned(command(driver, 5, 60), controller, key, tx));  // old pair, newer sequence
+  EXPECT_EQ(reply(&got), 0);
+  fake.Signal(SIGTERM);
+  ASSERT_EQ(fake.Wait(10), 0);
+  // Answered: 2 hellos and 2 commands; refused: the modified, spoofed and 2 old-session ones
+  // (rejected) and the replay of the current session (out of order).
+  EXPECT_NE(fake.out().find("driver sessions 2,"), std::string::npos) << fake.out();
+  EXPECT_NE(fake.out().find("out of order 1, rejected 4"), std::string::npos) << fake.out();
+}
+
+// A driver given a key against a controller that speaks v1 only: no welcome, the run ends.
+TEST_F(DriverProcessTest, AV2DriverEndsTheRunWhenTheControllerNeverWelcomesIt) {
+  const fs::path ug = Graph("udp.yaml", dir_ / "udp.txt");
+  Child fake = FakeController({});
+  ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
+  Child u(Dyad({"run", ug.string(), "--steps", "100", "--quiet", "--set", PortSet(), "--set", "driver.timeout_s=0.5",
+                "--set", "driver.key_file=" + WriteKey(dir_)}),
+          dir_, "udp");
+  EXPECT_NE(u.Wait(60), 0);
+  EXPECT_NE(u.err().find("no welcome to our hello"), std::string::npos) << u.err();
+  fake.Signal(SIGTERM);
+  fake.Wait(10);
 }
 
 TEST_F(DriverProcessTest, MixerInPiModeWithoutStateIsAConfigurationError) {

@@ -108,7 +108,8 @@ std::map<std::string, ParamValue> VirtualParams() {
 std::map<std::string, ParamValue> UdpParams(uint16_t controller_port) {
   return {{"controller_host", std::string("127.0.0.1")}, {"controller_port", int64_t{controller_port}},
           {"local_port", int64_t{0}}, {"timeout_s", 5.0}, {"reply_wait_ms", int64_t{0}},
-          {"x_limits", std::vector<double>{-60, 60}}, {"y_limits", std::vector<double>{-50, 40}}};
+          {"x_limits", std::vector<double>{-60, 60}}, {"y_limits", std::vector<double>{-50, 40}},
+          {"key_file", std::string()}};
 }
 
 TEST(NoAllocation, VirtualCartesianStepAllocatesNothing) {
