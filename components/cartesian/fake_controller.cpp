@@ -191,7 +191,10 @@ int main(int argc, char** argv) {
         ++out_of_order;
         continue;
       }
-      new_session = verdict == udp::ControllerSessions::Verdict::kApplyNewSession;
+      // A new driver starts a new robot; the same driver handshaking again (it missed replies)
+      // keeps it.
+      new_session = verdict == udp::ControllerSessions::Verdict::kApplyNewSession &&
+                    (!has_applied || c.session != driver_session);
     } else {
       if (size > rx.size() || udp::DecodeCommand(rx.data(), size, &c) != udp::Decode::kOk) {
         ++malformed_in;

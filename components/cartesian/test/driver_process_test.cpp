@@ -489,6 +489,28 @@ TEST_F(DriverProcessTest, AV2ControllerRejectsSpoofedModifiedAndReplayedCommands
   EXPECT_NE(fake.out().find("out of order 1, rejected 4"), std::string::npos) << fake.out();
 }
 
+// Three commands in a row lost (as after a controller restart): the v2 driver handshakes again
+// and goes on; the controller keeps its robot (the same driver).
+TEST_F(DriverProcessTest, AV2DriverHandshakesAgainAfterThreeUnansweredCommands) {
+  const fs::path ulog = dir_ / "udp.txt";
+  const fs::path ug = Graph("udp.yaml", ulog);
+  const std::string key = WriteKey(dir_);
+  Child fake = FakeController({"--key-file", key, "--drop", "10", "--drop", "11", "--drop", "12"});
+  ASSERT_TRUE(fake.WaitForOutput("listening", 10)) << fake.err();
+  Child u(Dyad({"run", ug.string(), "--steps", "30", "--quiet", "--set", PortSet(), "--set", "driver.reply_wait_ms=300",
+                "--set", "driver.key_file=" + key}),
+          dir_, "udp");
+  ASSERT_EQ(u.Wait(60), 0) << u.err();
+  fake.Signal(SIGTERM);
+  ASSERT_EQ(fake.Wait(10), 0);
+  EXPECT_NE(u.err().find("no reply to 3 commands: handshaking again"), std::string::npos) << u.err();
+  EXPECT_NE(u.err().find("30 commands sent, 27 states accepted"), std::string::npos) << u.err();
+  EXPECT_NE(fake.out().find("driver sessions 1,"), std::string::npos) << fake.out();
+  const auto states = ReadStates(ulog);
+  ASSERT_EQ(states.size(), 27u);
+  EXPECT_EQ(states.back().stamp, 29 * 100'000'000LL);  // to the end of the run
+}
+
 // A driver given a key against a controller that speaks v1 only: no welcome, the run ends.
 TEST_F(DriverProcessTest, AV2DriverEndsTheRunWhenTheControllerNeverWelcomesIt) {
   const fs::path ug = Graph("udp.yaml", dir_ / "udp.txt");
