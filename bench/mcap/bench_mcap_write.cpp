@@ -161,6 +161,7 @@ int main(int argc, char** argv) {
     options.compression = c.compression;
     options.zstd_level = c.level;
     options.chunk_size = c.chunk_size;
+    options.replace_existing = true;  // one scratch path for every configuration
     const Result r = RunMcap(path, samples, options);
     std::printf("%-28s %12.0f %10.1f %12.1f %10.2f\n", c.name, samples / r.seconds, payload_mb / r.seconds,
                 r.file_bytes / 1e6, base.seconds / r.seconds);

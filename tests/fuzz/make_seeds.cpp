@@ -89,6 +89,7 @@ void McapSeeds(const fs::path& work) {
     dyad::mcap::WriterOptions options;
     options.chunk_size = 1024;
     options.compression = compression;
+    options.replace_existing = true;  // the same work file for each compression
     auto w = dyad::mcap::Writer::Open(path.string(), options);
     Check(w.status(), "mcap open");
     const dyad::TypeInfo* type = dyad::msg::AllTypes().front();
