@@ -253,6 +253,7 @@ Status UdpCartesian::Accept(const udp::StatePacket& s) {
 }
 
 void UdpCartesian::Send(const uint8_t* data, size_t size) {
+  if (size == 0) return;  // v2: not signed (OpenSSL failed): never sent unsigned
   if (Status s = socket_->SendTo(data, size, controller_); !s.ok()) {
     ++socket_errors_;
     if (!error_logged_) {

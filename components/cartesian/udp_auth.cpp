@@ -14,9 +14,11 @@ namespace dyad::cartesian::udp {
 
 namespace {
 
-void Mac(std::string_view key, const uint8_t* data, size_t size, uint8_t* mac) {
+// False when OpenSSL fails (never seen): a packet is then neither signed nor accepted.
+bool Mac(std::string_view key, const uint8_t* data, size_t size, uint8_t* mac) {
   unsigned int length = 0;
-  HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()), data, size, mac, &length);
+  return HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()), data, size, mac, &length) != nullptr &&
+         length == kMacSize;
 }
 
 // v1 image <-> v2 packet: the v1 header and body around the peer field, then the MAC.
@@ -28,7 +30,7 @@ size_t Sign(const uint8_t* v1, size_t v1_size, uint32_t peer, std::string_view k
   out[7] = static_cast<uint8_t>(size >> 8);
   for (int i = 0; i < 4; ++i) out[kHeaderSize + i] = static_cast<uint8_t>(peer >> (8 * i));
   std::memcpy(out.data() + kHeader2Size, v1 + kHeaderSize, v1_size - kHeaderSize);
-  Mac(key, out.data(), size - kMacSize, out.data() + size - kMacSize);
+  if (!Mac(key, out.data(), size - kMacSize, out.data() + size - kMacSize)) return 0;  // nothing to send
   return size;
 }
 
@@ -44,8 +46,7 @@ Decode Verify(const uint8_t* p, size_t size, uint8_t kind, size_t expected, std:
   if (p[5] != kind) return Decode::kBadKind;
   if ((p[6] | (p[7] << 8)) != static_cast<int>(expected) || size != expected) return Decode::kBadLength;
   uint8_t mac[kMacSize];
-  Mac(key, p, size - kMacSize, mac);
-  if (CRYPTO_memcmp(mac, p + size - kMacSize, kMacSize) != 0) return Decode::kBadMac;
+  if (!Mac(key, p, size - kMacSize, mac) || CRYPTO_memcmp(mac, p + size - kMacSize, kMacSize) != 0) return Decode::kBadMac;
   const size_t v1_size = size - 4 - kMacSize;
   std::memcpy(v1.data(), p, kHeaderSize);
   v1[4] = kVersion;

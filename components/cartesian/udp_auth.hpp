@@ -57,7 +57,7 @@ struct HandshakePacket {
 // regular file, a symlink, readable or writable by group or others, shorter than kMinKeySize.
 StatusOr<std::string> ReadKeyFile(const std::string& path);
 
-// Encoders: the v2 packet into `out`; return its size. `peer`: see above.
+// Encoders: the v2 packet into `out`; return its size (0 if OpenSSL failed: send nothing). `peer`: see above.
 size_t EncodeSigned(const CommandPacket& p, uint32_t peer, std::string_view key, std::array<uint8_t, kMaxPacket>& out);
 size_t EncodeSigned(const StatePacket& p, uint32_t peer, std::string_view key, std::array<uint8_t, kMaxPacket>& out);
 size_t EncodeSigned(uint8_t kind, const HandshakePacket& p, std::string_view key, std::array<uint8_t, kMaxPacket>& out);

@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -16,10 +17,15 @@ namespace dyad {
 LogFile::~LogFile() { close(fd_); }
 
 void LogFile::AppendLine(const std::string& line) {
-  const std::string text = line + "\n";
+  // One writev of the line and its newline (no copy per line); a short write finishes the rest.
+  char newline = '\n';
+  iovec parts[2] = {{const_cast<char*>(line.data()), line.size()}, {&newline, 1}};
   size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = write(fd_, text.data() + done, text.size() - done);
+  const size_t total = line.size() + 1;
+  while (done < total) {
+    const ssize_t n = done == 0 ? writev(fd_, parts, 2)
+                                : done < line.size() ? write(fd_, line.data() + done, line.size() - done)
+                                                     : write(fd_, &newline, 1);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) return;
     done += static_cast<size_t>(n);

@@ -191,6 +191,15 @@ TEST(NonFiniteCommand, VirtualCartesianKeepsItsLastTargetAndSaysSo) {
   EXPECT_NE(ctx.logger.lines[0].find("not finite"), std::string::npos) << ctx.logger.lines[0];
 }
 
+// The next command the driver sent to the controller played by the test (v1), within 1 s.
+bool ReceiveCommand(UdpSocket& controller, udp::CommandPacket* c) {
+  if (!controller.WaitReadable(1000)) return false;
+  std::array<uint8_t, udp::kMaxPacket> rx{};
+  sockaddr_in from{};
+  const long n = controller.Receive(rx.data(), rx.size(), &from);
+  return n > 0 && udp::DecodeCommand(rx.data(), static_cast<size_t>(n), c) == udp::Decode::kOk;
+}
+
 TEST(NonFiniteCommand, UdpCartesianDoesNotSendIt) {
   auto controller = UdpSocket::Open(0);
   ASSERT_TRUE(controller.ok()) << controller.status().ToString();
@@ -205,12 +214,8 @@ TEST(NonFiniteCommand, UdpCartesianDoesNotSendIt) {
   EXPECT_FALSE(controller->WaitReadable(200)) << "a non-finite command was sent to the controller";
   ctx.commands.queue.push_back(Command(2));  // the next good one goes out as sequence 1
   ASSERT_TRUE(ctx.StepOnce(driver, 1).ok());
-  ASSERT_TRUE(controller->WaitReadable(1000));
-  std::array<uint8_t, udp::kMaxPacket> rx{};
-  sockaddr_in from{};
-  const long n = controller->Receive(rx.data(), rx.size(), &from);
   udp::CommandPacket c;
-  ASSERT_EQ(udp::DecodeCommand(rx.data(), static_cast<size_t>(n), &c), udp::Decode::kOk);
+  ASSERT_TRUE(ReceiveCommand(*controller, &c));
   EXPECT_EQ(c.sequence, 1u);
   EXPECT_EQ(c.x, 2);
   bool logged = false;
@@ -234,12 +239,8 @@ TEST(UdpWorkspace, TargetsOutsideTheBoxAreClampedBeforeTheyAreSent) {
     c.y(sent[k][1]);
     ctx.commands.queue.push_back(c);
     ASSERT_TRUE(ctx.StepOnce(driver, k).ok());
-    ASSERT_TRUE(controller->WaitReadable(1000)) << k;
-    std::array<uint8_t, udp::kMaxPacket> rx{};
-    sockaddr_in from{};
-    const long n = controller->Receive(rx.data(), rx.size(), &from);
     udp::CommandPacket p;
-    ASSERT_EQ(udp::DecodeCommand(rx.data(), static_cast<size_t>(n), &p), udp::Decode::kOk);
+    ASSERT_TRUE(ReceiveCommand(*controller, &p)) << k;
     EXPECT_EQ(p.x, expected[k][0]) << k;
     EXPECT_EQ(p.y, expected[k][1]) << k;
   }
