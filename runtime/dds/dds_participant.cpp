@@ -1,6 +1,7 @@
 #include "dds/dds_participant.hpp"
 
 #include "dds/network_qos.hpp"
+#include "dds/security_qos.hpp"
 
 #include <dyad/decode_sample.hpp>
 
@@ -678,6 +679,8 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
   fdds::DomainParticipantQos qos = factory->get_default_participant_qos();
   qos.name(name);
   p->scope_ = scope;
+  p->secured_ = options.security.enabled();
+  ApplySecurity(options.security, &qos);
   // A stepped run stays inside its process: the network section does not concern it.
   if (scope != Scope::kProcessOnly)
     if (Status s = ApplyNetwork(network, scope == Scope::kWatcher, &qos, process); !s.ok()) return s;
@@ -701,13 +704,22 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
   return p;
 }
 
+std::string DdsParticipant::SecurityHint(const std::string& verb) const {
+  if (!secured_) return "";
+  return " (DDS Security: the permissions of participant '" + name_ + "' do not let it " + verb +
+         " this topic; after changing the graph, rerun `dyad security init`)";
+}
+
 StatusOr<DdsParticipant::Generation> DdsParticipant::MakeGeneration() {
   fdds::StatusMask mask = fdds::StatusMask::none();
   mask << fdds::StatusMask::requested_incompatible_qos() << fdds::StatusMask::offered_incompatible_qos();
   Generation g;
   g.participant = fdds::DomainParticipantFactory::get_instance()->create_participant(domain_id_, *qos_, listener_.get(), mask);
   if (g.participant == nullptr)
-    return Status::Internal("cannot create DDS participant '" + name_ + "' on domain " + std::to_string(domain_id_));
+    return Status::Internal("cannot create DDS participant '" + name_ + "' on domain " + std::to_string(domain_id_) +
+                            (secured_ ? " (DDS Security refused its identity or documents: Fast DDS's log above says why; "
+                                        "`dyad validate` checks the keystore)"
+                                      : ""));
   fdds::PublisherQos pub_qos = fdds::PUBLISHER_QOS_DEFAULT;
   fdds::SubscriberQos sub_qos = fdds::SUBSCRIBER_QOS_DEFAULT;
   for (const auto& partition : partitions_) {
@@ -930,7 +942,7 @@ StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, co
   };
   r->destroy_ = DeleteReader;
   r->reader_ = r->make_();
-  if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
+  if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'" + SecurityHint("subscribe to"));
   readers_.push_back(std::move(r));
   return readers_.back().get();
 }
@@ -944,7 +956,7 @@ StatusOr<TypedWriter*> DdsParticipant::CreateWriter(const std::string& topic, co
   w->make_ = [this, topic, wq] { return NewWriter(topic, wq); };
   w->destroy_ = DeleteWriter;
   w->writer_ = w->make_();
-  if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'");
+  if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'" + SecurityHint("publish"));
   writers_.push_back(std::move(w));
   return writers_.back().get();
 }
@@ -993,7 +1005,7 @@ StatusOr<DdsSerializedReader*> DdsParticipant::MakeSerializedReader(const std::s
     r->started_ = false;  // no DDS reader until Start()
   } else {
     r->reader_ = r->make_();
-    if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'");
+    if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'" + SecurityHint("subscribe to"));
     r->exists_.store(true, std::memory_order_release);
     r->listener_->SetCurrent(r->reader_);
     r->reader_->set_listener(r->listener_.get(), kSerializedMask);
@@ -1019,7 +1031,7 @@ StatusOr<SerializedWriter*> DdsParticipant::CreateSerializedWriter(const std::st
   w->make_ = [this, topic, wq] { return NewWriter(topic, wq); };
   w->destroy_ = DeleteWriter;
   w->writer_ = w->make_();
-  if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'");
+  if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'" + SecurityHint("publish"));
   serialized_writers_.push_back(std::move(w));
   return serialized_writers_.back().get();
 }

@@ -22,6 +22,7 @@
 
 #include <dyad/component.hpp>
 #include <dyad/graph.hpp>
+#include <dyad/security.hpp>
 #include <dyad/status.hpp>
 
 #include "dds/transport.hpp"
@@ -236,6 +237,8 @@ class DdsParticipant final : public Transport {
     // its one partition (RunPartition, graph/runtime_topics.hpp): endpoints of another run of a
     // graph on the same domain do not match them. Watchers may use patterns ("dyad/demo/*").
     std::vector<std::string> partitions;
+    // DDS Security (dyad/security.hpp): this participant's identity; none: security off.
+    IdentityFiles security;
     // Type mismatches and incompatible QoS (data cannot flow where it should); Fast DDS threads.
     ProblemHandler on_problem;
     // A writer of one of this participant's topics in partitions none of ours matches: another
@@ -289,6 +292,8 @@ class DdsParticipant final : public Transport {
   };
   DdsParticipant();
   StatusOr<Generation> MakeGeneration();
+  // What a refused endpoint's error adds on a secured participant ("" otherwise).
+  std::string SecurityHint(const std::string& verb) const;
   static Status AddTopic(Generation& g, const std::string& topic, const TypeInfo& type);
   static void DeleteGeneration(Generation& g);
   Status GetTopic(const std::string& topic, const TypeInfo& type);  // on the current generation
@@ -309,6 +314,7 @@ class DdsParticipant final : public Transport {
   std::map<std::string, std::string> topic_types_;     // topic -> dds type name
   std::map<std::string, const TypeInfo*> topic_infos_;  // topic -> its type
   Scope scope_ = Scope::kNetwork;
+  bool secured_ = false;  // DDS Security on (Options::security)
   std::vector<std::string> partitions_;
   // Every endpoint created here; destroyed (in this order) by the destructor only.
   std::vector<std::unique_ptr<DdsSerializedReader>> serialized_readers_;

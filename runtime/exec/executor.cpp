@@ -299,6 +299,7 @@ Status Executor::CreateTransport() {
   po.network = graph_.network;
   po.process = options_.process;
   po.partitions = {RunPartition(graph_)};
+  po.security = IdentityOf(graph_, ProcessIdentity(options_.process));
   po.on_problem = [this](const std::string& msg) {
     ++problems_;
     StderrLogger("dds").Error(msg);

@@ -72,19 +72,27 @@ class QuietLogger final : public Logger {
 
 class DryContext final : public Context, public detail::ContextExtensions {
  public:
-  DryContext(const Graph& graph, const ResolvedComponent& rc, const Catalog& catalog, const std::vector<TopicInfo>& topics)
-      : graph_(graph), rc_(rc), catalog_(catalog), topics_(topics) {
+  // `access`, when given, collects the topics the component reads and writes.
+  DryContext(const Graph& graph, const ResolvedComponent& rc, const Catalog& catalog, const std::vector<TopicInfo>& topics,
+             TopicAccess* access)
+      : graph_(graph), rc_(rc), catalog_(catalog), topics_(topics), access_(access) {
     const ComponentSpec& spec = rc.entry->spec;
     for (const auto& ps : spec.inputs()) {
       auto port = ps.make_input();
       for (const auto& b : rc.config->inputs)
-        if (b.port == ps.name) port->Bind(ps.name, b.topic, &null_reader_);
+        if (b.port == ps.name) {
+          port->Bind(ps.name, b.topic, &null_reader_);
+          if (access_) access_->reads.insert(b.topic);
+        }
       inputs_.push_back(std::move(port));
     }
     for (const auto& ps : spec.outputs()) {
       auto port = ps.make_output();
       for (const auto& b : rc.config->outputs)
-        if (b.port == ps.name) port->Bind(ps.name, b.topic, rc.config->name, &null_writer_, &clock_);
+        if (b.port == ps.name) {
+          port->Bind(ps.name, b.topic, rc.config->name, &null_writer_, &clock_);
+          if (access_) access_->writes.insert(b.topic);
+        }
       outputs_.push_back(std::move(port));
     }
   }
@@ -107,7 +115,10 @@ class DryContext final : public Context, public detail::ContextExtensions {
   }
   Status SubscribeSerialized(const std::string& topic, SerializedCallback) override {
     for (const auto& t : topics_)
-      if (t.name == topic) return Status::OK();
+      if (t.name == topic) {
+        if (access_) access_->reads.insert(topic);
+        return Status::OK();
+      }
     return Status::NotFound("topic '" + topic + "' is not a topic of graph '" + graph_.name + "'");
   }
   StatusOr<OnDemandSubscription*> SubscribeSerializedOnDemand(const std::string& topic, SerializedCallback callback) override {
@@ -120,6 +131,7 @@ class DryContext final : public Context, public detail::ContextExtensions {
       if (t.name == topic && t.type->name != type.name)
         return Status::InvalidArgument("topic '" + topic + "' carries " + t.type->name + " in graph '" + graph_.name +
                                        "', not " + type.name);
+    if (access_) access_->writes.insert(topic);
     writers_.push_back(std::make_unique<NullSerializedWriter>(topic, type));
     return writers_.back().get();
   }
@@ -145,6 +157,7 @@ class DryContext final : public Context, public detail::ContextExtensions {
   const ResolvedComponent& rc_;
   const Catalog& catalog_;
   const std::vector<TopicInfo>& topics_;
+  TopicAccess* access_;
   ZeroClock clock_;
   QuietLogger logger_;
   NullReader null_reader_;
@@ -209,10 +222,9 @@ bool PlaceMessage(const Graph& graph, const ComponentConfig& c, const ComponentS
   return true;
 }
 
-}  // namespace
-
-void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
-                  std::vector<Diagnostic>* diagnostics, const std::set<std::string>& only_processes) {
+void Configure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
+               std::vector<Diagnostic>* diagnostics, const std::set<std::string>& only_processes,
+               std::map<std::string, TopicAccess>* access) {
   for (const auto& rc : resolved.components) {
     if (rc.entry == nullptr) continue;
     if (!only_processes.empty() && !only_processes.count(graph.ProcessOf(*rc.config))) continue;
@@ -221,8 +233,9 @@ void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catal
     for (const auto& d : *diagnostics)
       if (d.key == key || d.key.rfind(key + ".", 0) == 0) has_problem = true;
     if (has_problem) continue;
-    const auto topics = GraphTopics(graph, resolved, graph.ProcessOf(*rc.config));
-    DryContext ctx(graph, rc, catalog, topics);
+    const std::string process = graph.ProcessOf(*rc.config);
+    const auto topics = GraphTopics(graph, resolved, process);
+    DryContext ctx(graph, rc, catalog, topics, access ? &(*access)[process] : nullptr);
     std::unique_ptr<Component> component = rc.entry->type.create();
     const Status s = component->Configure(ctx);
     if (s.ok()) {
@@ -237,6 +250,21 @@ void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catal
     }
     diagnostics->push_back(std::move(d));
   }
+}
+
+}  // namespace
+
+void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
+                  std::vector<Diagnostic>* diagnostics, const std::set<std::string>& only_processes) {
+  Configure(graph, resolved, catalog, diagnostics, only_processes, nullptr);
+}
+
+std::map<std::string, TopicAccess> TopicAccessByProcess(const Graph& graph, const ResolvedGraph& resolved,
+                                                         const Catalog& catalog, std::vector<Diagnostic>* diagnostics) {
+  std::map<std::string, TopicAccess> access;
+  for (const std::string& p : graph.ProcessNames()) access[p];
+  Configure(graph, resolved, catalog, diagnostics, {}, &access);
+  return access;
 }
 
 }  // namespace dyad

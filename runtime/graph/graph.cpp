@@ -335,6 +335,23 @@ void ReadGraphScalars(StrictYaml& r, const YAML::Node& root, Graph* g) {
   }
 }
 
+void ReadSecurity(StrictYaml& r, const YAML::Node& node, Graph* g) {
+  if (!r.Map(node, "security", graph_keys::kSecurity)) return;
+  if (!node["keystore"]) {
+    r.Error(node, "security.keystore", "missing: the folder `dyad security init` made");
+    return;
+  }
+  std::string keystore;
+  g->security.mark = r.Mark(node["keystore"], "security.keystore");
+  if (!r.String(node["keystore"], "security.keystore", &keystore)) return;
+  if (keystore.empty()) {
+    r.Error(node["keystore"], "security.keystore", "must name a folder");
+    return;
+  }
+  const std::filesystem::path base = g->FolderOf("security.keystore");
+  g->security.keystore = std::filesystem::path(keystore).is_absolute() ? keystore : (base / keystore).lexically_normal().string();
+}
+
 // transport: tcp: each process listens on its tcp_port at its host's address; with processes on
 // several hosts, each host's launcher on network.launcher_tcp_port (the launchers must meet to
 // end every host's run when a required process fails for good: hosts/launcher_link.hpp).
@@ -478,6 +495,7 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
   ReadGraphScalars(r, root, &g);
   if (const YAML::Node network = root["network"]) ReadNetwork(r, network, &g.network);
   if (const YAML::Node procs = root["processes"]) ReadProcesses(r, procs, &g);
+  if (const YAML::Node security = root["security"]) ReadSecurity(r, security, &g);
   ResolveScope(r, root["network"], &g);
   if (const YAML::Node topics = root["topics"]) ReadTopics(r, topics, &g);
   if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, &g);

@@ -169,7 +169,7 @@ std::vector<std::string> SetPath(const std::string& text, const YAML::Node& root
     return fail(text, "expected COMPONENT.PARAM=VALUE, COMPONENT.type=TYPE, clock|seed|domain_id|graph=VALUE, "
                       "network.KEY=VALUE or processes.NAME.KEY=VALUE");
   }
-  if (head == "network") return parts;
+  if (head == "network" || head == "security") return parts;
   if (head == "topics") return parts.size() == 3 ? parts : fail("topics", "expected topics.TOPIC.KEY=VALUE");
   if (head == "processes") {
     if (parts.size() != 3) return fail("processes", "expected processes.NAME.KEY=VALUE");

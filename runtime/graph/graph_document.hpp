@@ -12,7 +12,7 @@
 // Every `--set KEY=VALUE` is an edit of the document at KEY (VALUE parsed as YAML), checked later
 // exactly like the file's own keys:
 //   clock|seed|domain_id|graph|logs|plugins=V     the graph's own keys
-//   network.KEY=V, topics.TOPIC.KEY=V             a key of a section
+//   network.KEY=V, security.KEY=V, topics.T.KEY=V a key of a section
 //   processes.NAME.KEY=V                          a key of a process the file declares
 //   C.type|rate_hz|trigger|process=V              a component's own keys
 //   C.inputs.PORT=TOPIC, C.outputs.PORT=TOPIC     a binding

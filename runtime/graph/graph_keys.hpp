@@ -11,7 +11,8 @@ namespace dyad::graph_keys {
 // The graph's own scalars: settable by their name alone (`--set seed=3`).
 inline const std::set<std::string> kScalars = {"graph", "domain_id", "clock", "seed", "plugins", "logs"};
 inline const std::set<std::string> kTopLevel = {"graph",   "domain_id", "clock",     "seed",   "plugins",
-                                                "logs",    "network",   "processes", "topics", "components"};
+                                                "logs",    "network",   "security",  "processes", "topics", "components"};
+inline const std::set<std::string> kSecurity = {"keystore"};
 inline const std::set<std::string> kNetwork = {"scope", "discovery", "hosts",   "peers",           "server",
                                                "transport", "interfaces", "lease_s",       "start_timeout_s",
                                                "max_clock_offset_ms", "launcher_tcp_port"};

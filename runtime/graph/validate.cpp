@@ -1,9 +1,11 @@
 // Graph validation: every check in one pass, every problem reported.
 #include "dyad/validate.hpp"
 #include "dyad/join_list.hpp"
+#include "dyad/security.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -137,6 +139,7 @@ class Validation {
     CheckDeclaredTypes();
     ResolveTopics();
     CheckClock(processes_used);
+    CheckSecurity();
     return std::move(out_);
   }
 
@@ -149,6 +152,17 @@ class Validation {
   };
 
   void error(const SourceMark& m, const std::string& key, const std::string& msg) { diags_->push_back(Diagnostic{m, key, msg}); }
+
+  // The keystore holds what every participant of the graph needs (dyad/security.hpp).
+  void CheckSecurity() {
+    const SecurityConfig& s = graph_.security;
+    if (!s.enabled()) return;
+    if (graph_.network.discovery == Discovery::kServer)
+      error(s.mark, "security.keystore",
+            "Fast DDS 2.9 has no secure discovery server: use network.discovery: peers (or multicast) with security");
+    for (const std::string& problem : CheckKeystore(graph_, static_cast<int64_t>(std::time(nullptr))))
+      error(s.mark, "security.keystore", problem);
+  }
   // Legal but likely a hole in the wiring: said, never refused.
   void warn(const SourceMark& m, const std::string& key, const std::string& msg) { out_.warnings.push_back(Diagnostic{m, key, msg}); }
 

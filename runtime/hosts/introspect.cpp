@@ -35,6 +35,7 @@ std::unique_ptr<DdsParticipant> Join(const IntrospectOptions& o, std::ostream& e
   DdsParticipant::Options po;
   po.scope = DdsParticipant::Scope::kWatcher;
   po.network = o.network;
+  po.security = o.security;
   po.partitions = {o.run_id.empty() || o.graph_name.empty() ? WatchPartition(o.graph_name) : RunPartition(o.graph_name, o.run_id)};
   auto p = DdsParticipant::Create(o.domain_id, "dyad/introspect", std::move(po));
   if (!p.ok()) {

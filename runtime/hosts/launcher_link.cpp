@@ -33,6 +33,11 @@ StatusOr<std::unique_ptr<LauncherLink>> LauncherLink::Open(const Graph& graph, c
   po.network = graph.network;
   po.process = LauncherParticipantName(host);  // transport tcp: its listener (graph.hpp, tcp_listeners)
   po.partitions = {RunPartition(graph)};  // another run's launchers are not ours to hear
+  if (graph.security.enabled()) {
+    auto identity = HostIdentityFor(graph, host);
+    if (!identity.ok()) return identity.status();
+    po.security = IdentityOf(graph, identity.value());
+  }
   auto p = DdsParticipant::Create(graph.domain_id, LauncherParticipantName(host), std::move(po));
   if (!p.ok()) return p.status();
   link->participant_ = std::move(p.value());

@@ -1,5 +1,8 @@
 #include "introspection_commands.hpp"
 
+#include <unistd.h>
+
+#include <ctime>
 #include <iomanip>
 #include <map>
 #include <memory>
@@ -9,6 +12,7 @@
 #include <dyad/cdr_decoder.hpp>
 #include <dyad/graph.hpp>
 #include <dyad/introspect.hpp>
+#include <dyad/security.hpp>
 
 namespace dyad::cli {
 namespace {
@@ -36,8 +40,16 @@ SamplePrinter JsonPrinter() {
 // Returns false, having said why, when the graph file cannot be read.
 // With a graph, the watcher also joins the way the graph's processes do: its domain (unless
 // --domain was given) and its network section (static peers, discovery server).
+std::string MachineName() {
+  char name[256] = {0};
+  gethostname(name, sizeof(name) - 1);
+  return name;
+}
+
+// A secured graph's watcher joins with the identity of this machine's host (`--host`, else the
+// machine's name; dyad/security.hpp).
 bool LoadWatcherCatalog(const std::string& graph_path, std::vector<std::string> plugins, Catalog* catalog,
-                        IntrospectOptions* options = nullptr, bool domain_given = false) {
+                        IntrospectOptions* options = nullptr, bool domain_given = false, const std::string& host = "") {
   if (!graph_path.empty()) {
     std::vector<Diagnostic> diagnostics;
     const Graph graph = LoadGraph(graph_path, {}, &diagnostics);
@@ -48,6 +60,14 @@ bool LoadWatcherCatalog(const std::string& graph_path, std::vector<std::string> 
       options->network = graph.network;
       options->graph_name = graph.name;
       if (!domain_given) options->domain_id = graph.domain_id;
+    }
+    if (options != nullptr && graph.security.enabled()) {
+      const std::vector<std::string> problems = CheckKeystore(graph, static_cast<int64_t>(std::time(nullptr)));
+      for (const std::string& p : problems) std::cerr << graph.security.mark.ToString() << ": security.keystore: " << p << "\n";
+      auto identity = HostIdentityFor(graph, host.empty() ? MachineName() : host);
+      if (!identity.ok()) std::cerr << graph_path << ": " << identity.status().message() << "\n";
+      if (!problems.empty() || !identity.ok()) return false;
+      options->security = IdentityOf(graph, identity.value());
     }
   }
   if (Status s = catalog->LoadDefault(plugins); !s.ok()) std::cerr << "warning: " << s.message() << "\n";
@@ -65,6 +85,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
     double duration = 0;
     std::vector<std::string> plugins;
     std::string graph;
+    std::string host;
     std::vector<CLI::Option*> domain_options;
     bool domain_given() const {
       for (auto* o : domain_options)
@@ -76,6 +97,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   auto add_common = [st](CLI::App* c) {
     st->domain_options.push_back(c->add_option("--domain", st->opts.domain_id, "DDS domain id (default: the --graph's, else 0)")->check(CLI::Range(0, 232)));
     c->add_option("--run-id", st->opts.run_id, "Watch only this run of the --graph (its `dyad run --run-id`); default: every run");
+    c->add_option("--host", st->host, "With --graph and its security: section: this machine's host in the graph, whose identity the watcher uses (default: the machine's name)");
     c->add_option("--wait", st->opts.wait_s, "Seconds of discovery before answering (topics) or giving up on a topic (echo, hz); default 5")->check(CLI::NonNegativeNumber);
   };
 
@@ -88,7 +110,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   status->add_option("--graph", st->graph, "The graph (its name, domain and network); default: every graph on the domain");
   status->callback([st, &exit_code] {
     Catalog catalog;
-    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given())) {
+    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given(), st->host)) {
       exit_code = 2;
       return;
     }
@@ -109,7 +131,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   echo->add_option("--graph", st->graph, "Know the message types of this graph's plugins");
   echo->callback([st, &exit_code] {
     Catalog catalog;
-    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given())) {
+    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given(), st->host)) {
       exit_code = 2;
       return;
     }
@@ -124,7 +146,7 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   hz->add_option("--graph", st->graph, "Know the message types of this graph's plugins");
   hz->callback([st, &exit_code] {
     Catalog catalog;
-    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given())) {
+    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given(), st->host)) {
       exit_code = 2;
       return;
     }

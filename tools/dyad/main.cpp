@@ -11,6 +11,7 @@
 #include "observer_commands.hpp"
 #include "pvrnn_commands.hpp"
 #include "runtime_commands.hpp"
+#include "security_commands.hpp"
 
 int main(int argc, char** argv) {
   // A closed output (`dyad echo T | head`) makes writes fail instead of killing the process, so
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   dyad::cli::AddRuntimeCommands(app, exit_code);
   dyad::cli::AddIntrospectionCommands(app, exit_code);
+  dyad::cli::AddSecurityCommands(app, exit_code);
   dyad::cli::AddBagCommands(app, exit_code);
   dyad::cli::AddPvrnnCommands(app, exit_code);
   dyad::cli::AddObserverCommands(app, exit_code);

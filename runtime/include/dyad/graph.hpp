@@ -21,6 +21,8 @@
 //     lease_s: 5                # a silent process is declared gone after this long
 //     start_timeout_s: 30       # how long a process waits for the others to start together
 //     max_clock_offset_ms: 5    # warn when another process's clock is further off than this
+//   security:                   # optional: DDS Security for every participant (dyad/security.hpp)
+//     keystore: keys/demo       # made by `dyad security init keys/demo --graph THIS_FILE`
 //   processes:                  # optional; default: one process "main"
 //     main: {}
 //     robot: {host: robot-pc}   # host: where `dyad run` without --process starts it (default: here;
@@ -105,6 +107,13 @@ struct NetworkConfig {
   SourceMark mark;
 };
 
+// The `security:` section: DDS Security for every participant (dyad/security.hpp).
+struct SecurityConfig {
+  std::string keystore;  // resolved against the file's folder; empty: no security
+  SourceMark mark;       // of `security.keystore`
+  bool enabled() const { return !keystore.empty(); }
+};
+
 enum class RestartPolicy { kNever, kOnFailure, kAlways };
 
 struct ProcessConfig {
@@ -155,6 +164,7 @@ struct Graph {
   std::string logs;                  // the launcher's per-process log folder, resolved; "": none
   std::vector<SourceMark> plugin_marks;  // where each of `plugins` is written
   NetworkConfig network;
+  SecurityConfig security;
   std::vector<ProcessConfig> processes;
   std::vector<TopicConfig> topics;
   std::vector<ComponentConfig> components;
@@ -192,7 +202,7 @@ struct Graph {
 // `--set KEY=VALUE`: VALUE (parsed as YAML) written at KEY, as if the file said it:
 // `NAME.PARAM=V` a component's parameter, `NAME.type=T` (rate_hz, trigger, process) its own keys,
 // `NAME.inputs.PORT=TOPIC`, `clock=wall` (seed, domain_id, graph, logs, plugins) the graph's,
-// `network.KEY=V`, `processes.NAME.KEY=V`, `topics.TOPIC.KEY=V` (graph_document.hpp).
+// `network.KEY=V`, `security.keystore=DIR`, `processes.NAME.KEY=V`, `topics.TOPIC.KEY=V` (graph_document.hpp).
 struct Override {
   std::string text;  // as given, for messages
 };

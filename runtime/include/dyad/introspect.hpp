@@ -21,6 +21,7 @@
 
 #include <dyad/catalog.hpp>
 #include <dyad/graph.hpp>
+#include <dyad/security.hpp>
 
 namespace dyad {
 
@@ -36,6 +37,8 @@ struct IntrospectOptions {
   // every dyad run on the domain; a name: that graph's runs; with run_id: that run only.
   std::string graph_name;
   std::string run_id;
+  // A secured graph's (dyad/security.hpp): the identity of this machine's host; none: no security.
+  IdentityFiles security;
 };
 
 // Prints one line per topic: name, type, writers, readers, participants. Returns 0, or 1 when

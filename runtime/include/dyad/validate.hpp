@@ -61,6 +61,18 @@ ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vec
 void DryConfigure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
                   std::vector<Diagnostic>* diagnostics, const std::set<std::string>& only_processes = {});
 
+// The topics one process's components read and write: their bound ports, and what their
+// Configure subscribes (SubscribeSerialized, on demand or not) and advertises
+// (AdvertiseSerialized), as the dry context sees it. The runtime's own dyad/ topics are not in
+// it. What DDS Security's permissions of each process grant (`dyad security init`).
+struct TopicAccess {
+  std::set<std::string> reads, writes;
+};
+// DryConfigure of every component, collecting each process's TopicAccess (every process that
+// runs a component has an entry). Diagnostics as DryConfigure's.
+std::map<std::string, TopicAccess> TopicAccessByProcess(const Graph& graph, const ResolvedGraph& resolved,
+                                                         const Catalog& catalog, std::vector<Diagnostic>* diagnostics);
+
 // Converts a YAML value to a param of `spec`'s type; InvalidArgument (message without location)
 // when it is not one.
 StatusOr<ParamValue> ParamFromYaml(const ParamSpec& spec, const YAML::Node& node);

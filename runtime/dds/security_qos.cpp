@@ -1,0 +1,25 @@
+#include "dds/security_qos.hpp"
+
+#include <string>
+
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+
+namespace dyad {
+
+void ApplySecurity(const IdentityFiles& identity, eprosima::fastdds::dds::DomainParticipantQos* qos) {
+  if (!identity.enabled()) return;
+  auto& p = qos->properties().properties();
+  auto set = [&p](const std::string& name, const std::string& value) { p.emplace_back(name, value); };
+  const std::string uri = "file://";
+  set("dds.sec.auth.plugin", "builtin.PKI-DH");
+  set("dds.sec.auth.builtin.PKI-DH.identity_ca", uri + identity.identity_ca);
+  set("dds.sec.auth.builtin.PKI-DH.identity_certificate", uri + identity.certificate);
+  set("dds.sec.auth.builtin.PKI-DH.private_key", uri + identity.private_key);
+  set("dds.sec.access.plugin", "builtin.Access-Permissions");
+  set("dds.sec.access.builtin.Access-Permissions.permissions_ca", uri + identity.permissions_ca);
+  set("dds.sec.access.builtin.Access-Permissions.governance", uri + identity.governance);
+  set("dds.sec.access.builtin.Access-Permissions.permissions", uri + identity.permissions);
+  set("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+}
+
+}  // namespace dyad

@@ -1,0 +1,125 @@
+#include <dyad/security.hpp>
+
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <memory>
+#include <set>
+#include <tuple>
+
+#include <openssl/pem.h>
+#include <openssl/x509.h>
+
+namespace dyad {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string FileIn(const std::string& folder, const std::string& name) { return (fs::path(folder) / name).string(); }
+
+// "" when `path` is a regular file that is not a symbolic link (and, for a key, not readable by
+// group or others); else what is wrong.
+std::string CheckFile(const std::string& path, bool secret) {
+  struct stat st {};
+  if (lstat(path.c_str(), &st) != 0) return path + ": missing";
+  if (S_ISLNK(st.st_mode)) return path + ": a symbolic link (refused: it may point anywhere)";
+  if (!S_ISREG(st.st_mode)) return path + ": not a regular file";
+  if (secret && (st.st_mode & 077) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
+    return path + ": a private key readable by others (mode " + mode + "; chmod 600 it)";
+  }
+  return "";
+}
+
+// "" when the PEM certificate at `path` is valid at `now_s`; else why not.
+std::string CheckCertificateDates(const std::string& path, int64_t now_s) {
+  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "r"), &std::fclose);
+  if (!f) return path + ": cannot be read";
+  std::unique_ptr<X509, void (*)(X509*)> cert(PEM_read_X509(f.get(), nullptr, nullptr, nullptr), &X509_free);
+  if (!cert) return path + ": not a PEM certificate";
+  time_t now = static_cast<time_t>(now_s);
+  if (X509_cmp_time(X509_get0_notBefore(cert.get()), &now) > 0) return path + ": certificate not valid yet (check this machine's clock)";
+  if (X509_cmp_time(X509_get0_notAfter(cert.get()), &now) < 0)
+    return path + ": certificate expired (renew it: dyad security init --renew)";
+  return "";
+}
+
+}  // namespace
+
+std::string ProcessIdentity(const std::string& process) { return "process." + process; }
+std::string HostIdentity(const std::string& host) { return "host." + host; }
+
+std::vector<std::string> IdentityHosts(const Graph& graph) {
+  std::set<std::string> hosts;
+  for (const auto& p : graph.processes)
+    if (!p.host.empty()) hosts.insert(p.host);
+  for (const auto& [host, address] : graph.network.hosts) hosts.insert(host);
+  if (hosts.empty()) hosts.insert(kLocalHost);
+  return {hosts.begin(), hosts.end()};
+}
+
+std::vector<std::string> GraphIdentities(const Graph& graph) {
+  std::vector<std::string> out;
+  for (const std::string& p : graph.ProcessNames()) out.push_back(ProcessIdentity(p));
+  for (const std::string& h : IdentityHosts(graph)) out.push_back(HostIdentity(h));
+  return out;
+}
+
+std::string IdentitySubject(const Graph& graph, const std::string& identity) {
+  const std::string host = "host.", process = "process.";
+  if (identity.rfind(host, 0) == 0) return "CN=dyad/" + graph.name + "/host/" + identity.substr(host.size());
+  return "CN=dyad/" + graph.name + "/" + identity.substr(identity.rfind(process, 0) == 0 ? process.size() : 0);
+}
+
+IdentityFiles IdentityOf(const Graph& graph, const std::string& identity) {
+  IdentityFiles f;
+  if (!graph.security.enabled()) return f;
+  const std::string& k = graph.security.keystore;
+  const std::string own = FileIn(FileIn(k, "identities"), identity);
+  f.identity_ca = FileIn(k, "identity_ca.cert.pem");
+  f.permissions_ca = FileIn(k, "permissions_ca.cert.pem");
+  f.governance = FileIn(k, "governance.p7s");
+  f.certificate = FileIn(own, "cert.pem");
+  f.private_key = FileIn(own, "key.pem");
+  f.permissions = FileIn(own, "permissions.p7s");
+  return f;
+}
+
+StatusOr<std::string> HostIdentityFor(const Graph& graph, const std::string& host) {
+  const std::vector<std::string> hosts = IdentityHosts(graph);
+  for (const std::string& h : hosts)
+    if (h == host) return HostIdentity(h);
+  if (hosts.size() == 1) return HostIdentity(hosts.front());
+  std::string names;
+  for (const std::string& h : hosts) names += (names.empty() ? "" : ", ") + h;
+  return Status::NotFound("this machine ('" + host + "') is none of the graph's hosts (" + names +
+                          "): say which one it is with --host");
+}
+
+std::vector<std::string> CheckKeystore(const Graph& graph, int64_t now_s) {
+  std::vector<std::string> problems;
+  if (!graph.security.enabled()) return problems;
+  if (!fs::is_directory(graph.security.keystore)) {
+    problems.push_back(graph.security.keystore + ": no such folder (make it with `dyad security init " +
+                       graph.security.keystore + " --graph " + graph.file + "`)");
+    return problems;
+  }
+  std::set<std::string> checked;
+  for (const std::string& identity : GraphIdentities(graph)) {
+    const IdentityFiles f = IdentityOf(graph, identity);
+    for (const auto& [path, secret, certificate] : {std::tuple{f.identity_ca, false, true}, {f.permissions_ca, false, true},
+                                                    {f.governance, false, false}, {f.certificate, false, true},
+                                                    {f.private_key, true, false}, {f.permissions, false, false}}) {
+      if (!checked.insert(path).second) continue;
+      std::string problem = CheckFile(path, secret);
+      if (problem.empty() && certificate) problem = CheckCertificateDates(path, now_s);
+      if (!problem.empty()) problems.push_back("identity '" + identity + "': " + problem);
+    }
+  }
+  return problems;
+}
+
+}  // namespace dyad

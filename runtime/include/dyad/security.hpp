@@ -1,0 +1,74 @@
+// dyad/security.hpp — DDS Security from the graph: the keystore's layout and its checks.
+//
+// A graph with a `security:` section runs every DDS participant it makes (each process's, each
+// launcher's, each watcher's) with DDS Security: Fast DDS's builtin.PKI-DH authentication,
+// builtin.Access-Permissions access control and builtin.AES-GCM-GMAC encryption. A participant
+// without an identity from the graph's identity CA is not let in (it discovers nothing and
+// receives nothing), and each participant may publish and subscribe only what its permissions
+// document grants. docs/security.md says what that protects and what it does not.
+//
+//   security:
+//     keystore: keys/demo      # made by `dyad security init keys/demo --graph GRAPH`
+//
+// The keystore (relative paths are relative to the graph file):
+//   identity_ca.cert.pem, permissions_ca.cert.pem   the two CAs' certificates
+//   governance.xml, governance.p7s                  the domain's rules, signed by the permissions CA
+//   ca/identity_ca.key.pem, ca/permissions_ca.key.pem
+//                                                   the CAs' keys: `dyad security` needs them to
+//                                                   issue identities; runs do not (keep them off
+//                                                   the experiment machines)
+//   identities/<identity>/cert.pem, key.pem, permissions.xml, permissions.p7s
+// Identities: "process.<p>" for each process of the graph (its participant is dyad/<graph>/<p>,
+// subject CN=dyad/<graph>/<p>) and "host.<h>" for each host's launcher and watchers (subject
+// CN=dyad/<graph>/host/<h>; "host.local" when the graph places nothing on hosts).
+//
+// Loading a graph checks the keystore (CheckKeystore): every identity the graph needs is there,
+// no private key is readable by others or a symbolic link, every certificate is valid now. Fast
+// DDS 2.9 has no secure discovery server, so `discovery: server` with security is refused.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <dyad/graph.hpp>
+#include <dyad/status.hpp>
+
+namespace dyad {
+
+// The files one participant's DDS Security needs (all absolute paths; empty keystore: none).
+struct IdentityFiles {
+  std::string identity_ca;     // the identity CA's certificate
+  std::string certificate;     // this identity's certificate, issued by the identity CA
+  std::string private_key;     // its key (0600)
+  std::string permissions_ca;  // the permissions CA's certificate
+  std::string governance;      // governance.p7s
+  std::string permissions;     // this identity's permissions.p7s
+  bool enabled() const { return !certificate.empty(); }
+};
+
+inline constexpr const char* kLocalHost = "local";
+
+std::string ProcessIdentity(const std::string& process);  // "process.<p>"
+std::string HostIdentity(const std::string& host);        // "host.<h>"
+// The hosts whose launchers and watchers get an identity: every host a process is placed on,
+// and those of network.hosts; {kLocalHost} for a graph on one machine.
+std::vector<std::string> IdentityHosts(const Graph& graph);
+// Every identity the graph needs: its processes', then its hosts'.
+std::vector<std::string> GraphIdentities(const Graph& graph);
+// The subject name of an identity's certificate and of its permissions grant.
+std::string IdentitySubject(const Graph& graph, const std::string& identity);
+
+// The files of `identity` in the graph's keystore (nothing when the graph has no security).
+IdentityFiles IdentityOf(const Graph& graph, const std::string& identity);
+// The identity a watcher or a launcher on `host` uses: host.<host> when the graph knows that
+// host, else host.local when it places nothing on hosts, else the only host identity there is;
+// NotFound naming the hosts otherwise.
+StatusOr<std::string> HostIdentityFor(const Graph& graph, const std::string& host);
+
+// The keystore's files for every identity of the graph exist as regular files (not symbolic
+// links), private keys are not readable by group or others, certificates are valid at
+// `now_s` (Unix seconds). Returns the problems, each naming its file.
+std::vector<std::string> CheckKeystore(const Graph& graph, int64_t now_s);
+
+}  // namespace dyad

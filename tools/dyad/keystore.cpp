@@ -1,0 +1,303 @@
+#include "keystore.hpp"
+
+#include <unistd.h>
+
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <ostream>
+#include <sstream>
+
+#include <openssl/bio.h>
+#include <openssl/err.h>
+#include <openssl/evp.h>
+#include <openssl/pem.h>
+#include <openssl/pkcs7.h>
+#include <openssl/rand.h>
+#include <openssl/x509.h>
+#include <openssl/x509v3.h>
+
+#include <dyad/private_file.hpp>
+#include <dyad/security.hpp>
+
+#include "access_documents.hpp"
+
+namespace dyad::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+template <typename T, void (*F)(T*)>
+struct Free {
+  void operator()(T* p) const { F(p); }
+};
+using Key = std::unique_ptr<EVP_PKEY, Free<EVP_PKEY, EVP_PKEY_free>>;
+using Cert = std::unique_ptr<X509, Free<X509, X509_free>>;
+using Bio = std::unique_ptr<BIO, Free<BIO, BIO_free_all>>;
+using Pkcs7 = std::unique_ptr<PKCS7, Free<PKCS7, PKCS7_free>>;
+
+// OpenSSL's reason for the last failure, for messages.
+std::string SslError() {
+  const unsigned long e = ERR_get_error();
+  if (e == 0) return "unknown OpenSSL error";
+  char buf[256];
+  ERR_error_string_n(e, buf, sizeof buf);
+  ERR_clear_error();
+  return buf;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+Status WriteText(const std::string& path, const std::string& text, CreateMode mode) {
+  auto fd = CreatePrivateFile(path, mode);
+  if (!fd.ok()) return fd.status();
+  size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd.value(), text.data() + done, text.size() - done);
+    if (n <= 0) {
+      ::close(fd.value());
+      return Status::Internal(path + ": write failed");
+    }
+    done += static_cast<size_t>(n);
+  }
+  if (::close(fd.value()) != 0) return Status::Internal(path + ": close failed");
+  return Status::OK();
+}
+
+std::string BioText(BIO* b) {
+  char* data = nullptr;
+  const long n = BIO_get_mem_data(b, &data);
+  return std::string(data, static_cast<size_t>(n));
+}
+
+StatusOr<Key> ReadKey(const std::string& path) {
+  Bio b(BIO_new_file(path.c_str(), "r"));
+  Key k(b ? PEM_read_bio_PrivateKey(b.get(), nullptr, nullptr, nullptr) : nullptr);
+  if (!k) return Status::InvalidArgument(path + ": not a PEM private key (" + SslError() + ")");
+  return k;
+}
+
+StatusOr<Cert> ReadCert(const std::string& path) {
+  Bio b(BIO_new_file(path.c_str(), "r"));
+  Cert c(b ? PEM_read_bio_X509(b.get(), nullptr, nullptr, nullptr) : nullptr);
+  if (!c) return Status::InvalidArgument(path + ": not a PEM certificate (" + SslError() + ")");
+  return c;
+}
+
+StatusOr<Key> NewKey() {
+  Key k(EVP_EC_gen("P-256"));
+  if (!k) return Status::Internal("cannot make an EC P-256 key: " + SslError());
+  return k;
+}
+
+bool AddExtension(X509* cert, X509* issuer, int nid, const char* value) {
+  X509V3_CTX ctx;
+  X509V3_set_ctx_nodb(&ctx);
+  X509V3_set_ctx(&ctx, issuer, cert, nullptr, nullptr, 0);
+  X509_EXTENSION* ext = X509V3_EXT_conf_nid(nullptr, &ctx, nid, value);
+  if (ext == nullptr) return false;
+  const bool ok = X509_add_ext(cert, ext, -1) == 1;
+  X509_EXTENSION_free(ext);
+  return ok;
+}
+
+// A certificate of `key` for `subject` ("CN=..."), signed by `issuer_key` (issuer: null for a
+// self-signed CA).
+StatusOr<Cert> Issue(EVP_PKEY* key, const std::string& subject, X509* issuer, EVP_PKEY* issuer_key, int days, bool ca) {
+  Cert c(X509_new());
+  X509_NAME* name = X509_NAME_new();
+  const std::string cn = subject.substr(subject.find('=') + 1);
+  bool ok = c && name &&
+            X509_NAME_add_entry_by_txt(name, "CN", MBSTRING_UTF8, reinterpret_cast<const unsigned char*>(cn.c_str()), -1, -1,
+                                       0) == 1 &&
+            X509_set_version(c.get(), 2) == 1 && X509_set_subject_name(c.get(), name) == 1 &&
+            X509_set_issuer_name(c.get(), issuer ? X509_get_subject_name(issuer) : name) == 1 &&
+            X509_set_pubkey(c.get(), key) == 1;
+  X509_NAME_free(name);
+  unsigned char serial[16];
+  ok = ok && RAND_bytes(serial, sizeof serial) == 1;
+  serial[0] &= 0x7f;  // a positive serial number
+  BIGNUM* bn = ok ? BN_bin2bn(serial, sizeof serial, nullptr) : nullptr;
+  ok = ok && bn != nullptr && BN_to_ASN1_INTEGER(bn, X509_get_serialNumber(c.get())) != nullptr;
+  BN_free(bn);
+  ok = ok && X509_gmtime_adj(X509_getm_notBefore(c.get()), -3600) != nullptr &&  // an hour of clock skew
+       X509_gmtime_adj(X509_getm_notAfter(c.get()), static_cast<long>(days) * 86400) != nullptr;
+  X509* signer = issuer ? issuer : c.get();
+  if (ca) {
+    ok = ok && AddExtension(c.get(), signer, NID_basic_constraints, "critical,CA:TRUE") &&
+         AddExtension(c.get(), signer, NID_key_usage, "critical,keyCertSign,cRLSign,digitalSignature");
+  } else {
+    ok = ok && AddExtension(c.get(), signer, NID_basic_constraints, "critical,CA:FALSE") &&
+         AddExtension(c.get(), signer, NID_key_usage, "critical,digitalSignature,keyAgreement");
+  }
+  ok = ok && AddExtension(c.get(), signer, NID_subject_key_identifier, "hash") &&
+       X509_sign(c.get(), issuer_key, EVP_sha256()) > 0;
+  if (!ok) return Status::Internal("cannot issue a certificate for " + subject + ": " + SslError());
+  return c;
+}
+
+std::string KeyPem(EVP_PKEY* k) {
+  Bio b(BIO_new(BIO_s_mem()));
+  PEM_write_bio_PrivateKey(b.get(), k, nullptr, nullptr, 0, nullptr, nullptr);
+  return BioText(b.get());
+}
+
+std::string CertPem(X509* c) {
+  Bio b(BIO_new(BIO_s_mem()));
+  PEM_write_bio_X509(b.get(), c);
+  return BioText(b.get());
+}
+
+// `text` as a clear-signed S/MIME message (openssl smime -sign -text).
+StatusOr<std::string> SmimeSigned(const std::string& text, X509* cert, EVP_PKEY* key) {
+  Bio in(BIO_new_mem_buf(text.data(), static_cast<int>(text.size())));
+  const int flags = PKCS7_DETACHED | PKCS7_TEXT | PKCS7_STREAM;
+  Pkcs7 p7(PKCS7_sign(cert, key, nullptr, in.get(), flags));
+  Bio out(BIO_new(BIO_s_mem()));
+  if (!p7 || !out || SMIME_write_PKCS7(out.get(), p7.get(), in.get(), flags) != 1)
+    return Status::Internal("cannot sign: " + SslError());
+  return BioText(out.get());
+}
+
+std::string Utc(time_t t) {
+  char buf[32];
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%S", &tm);
+  return buf;
+}
+
+// One CA of the keystore: its certificate (DIR/<name>.cert.pem) and key (DIR/ca/<name>.key.pem).
+class Authority {
+ public:
+  Authority(std::string name, std::string cert_path, std::string key_path)
+      : name_(std::move(name)), cert_path_(std::move(cert_path)), key_path_(std::move(key_path)) {}
+
+  // Reads the certificate, or makes the CA when neither its certificate nor its key exists.
+  Status Open(const std::string& subject, int days, std::ostream& out) {
+    if (fs::exists(fs::symlink_status(cert_path_))) {
+      auto c = ReadCert(cert_path_);
+      if (!c.ok()) return c.status();
+      cert_ = std::move(c.value());
+      out << "kept     " << cert_path_ << "\n";
+      return Status::OK();
+    }
+    if (fs::exists(fs::symlink_status(key_path_)))
+      return Status::FailedPrecondition(key_path_ + ": a CA key without its certificate " + cert_path_ +
+                                        ": restore the certificate (or remove the key to make a new CA)");
+    auto k = NewKey();
+    if (!k.ok()) return k.status();
+    auto c = Issue(k.value().get(), subject, nullptr, k.value().get(), days, true);
+    if (!c.ok()) return c.status();
+    if (Status s = WriteText(key_path_, KeyPem(k.value().get()), CreateMode::kNew); !s.ok()) return s;
+    if (Status s = WriteText(cert_path_, CertPem(c.value().get()), CreateMode::kNew); !s.ok()) return s;
+    key_ = std::move(k.value());
+    cert_ = std::move(c.value());
+    out << "made     " << name_ << ": " << cert_path_ << ", " << key_path_ << "\n";
+    return Status::OK();
+  }
+
+  // The key, read when first needed: a CA kept offline is only needed to issue or sign.
+  StatusOr<EVP_PKEY*> key(const std::string& why) {
+    if (key_) return key_.get();
+    if (!fs::exists(fs::symlink_status(key_path_)))
+      return Status::FailedPrecondition(key_path_ + ": the " + name_ + "'s key is not here, and it is needed to " + why +
+                                        " (bring the ca/ folder back for this step)");
+    auto k = ReadKey(key_path_);
+    if (!k.ok()) return k.status();
+    key_ = std::move(k.value());
+    return key_.get();
+  }
+  X509* cert() const { return cert_.get(); }
+
+ private:
+  std::string name_, cert_path_, key_path_;
+  Cert cert_;
+  Key key_;
+};
+
+// Writes `text` signed into `signed_path` (and `text` into `xml_path`) unless the XML is
+// already what is there.
+Status SignDocument(const std::string& xml_path, const std::string& signed_path, const std::string& text, Authority& ca,
+                    std::ostream& out) {
+  if (fs::exists(fs::symlink_status(signed_path)) && fs::exists(fs::symlink_status(xml_path)) && ReadText(xml_path) == text) {
+    out << "kept     " << signed_path << "\n";
+    return Status::OK();
+  }
+  auto key = ca.key("sign " + signed_path);
+  if (!key.ok()) return key.status();
+  auto signed_text = SmimeSigned(text, ca.cert(), key.value());
+  if (!signed_text.ok()) return signed_text.status().WithContext(signed_path);
+  if (Status s = WriteText(xml_path, text, CreateMode::kReplace); !s.ok()) return s;
+  if (Status s = WriteText(signed_path, signed_text.value(), CreateMode::kReplace); !s.ok()) return s;
+  out << "signed   " << signed_path << "\n";
+  return Status::OK();
+}
+
+}  // namespace
+
+Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>& access, const KeystoreOptions& options,
+                    std::ostream& out) {
+  const fs::path dir(options.dir);
+  for (const fs::path& d : {dir, dir / "ca", dir / "identities"})
+    if (Status s = CreatePrivateDirectories(d.string()); !s.ok()) return s;
+  Authority identity_ca("identity CA", (dir / "identity_ca.cert.pem").string(), (dir / "ca" / "identity_ca.key.pem").string());
+  Authority permissions_ca("permissions CA", (dir / "permissions_ca.cert.pem").string(),
+                           (dir / "ca" / "permissions_ca.key.pem").string());
+  if (Status s = identity_ca.Open("CN=dyad identity CA " + graph.name, options.ca_days, out); !s.ok()) return s;
+  if (Status s = permissions_ca.Open("CN=dyad permissions CA " + graph.name, options.ca_days, out); !s.ok()) return s;
+  if (Status s = SignDocument((dir / "governance.xml").string(), (dir / "governance.p7s").string(), GovernanceXml(),
+                              permissions_ca, out);
+      !s.ok())
+    return s;
+
+  for (const std::string& identity : GraphIdentities(graph)) {
+    const fs::path own = dir / "identities" / identity;
+    if (Status s = CreatePrivateDirectories(own.string()); !s.ok()) return s;
+    const std::string cert_path = (own / "cert.pem").string(), key_path = (own / "key.pem").string();
+    const bool renew = options.renew.count("all") > 0 || options.renew.count(identity) > 0;
+    const bool have = fs::exists(fs::symlink_status(cert_path)) && fs::exists(fs::symlink_status(key_path));
+    Cert cert;
+    if (have && !renew) {
+      auto c = ReadCert(cert_path);
+      if (!c.ok()) return c.status();
+      cert = std::move(c.value());
+      out << "kept     " << identity << ": " << cert_path << "\n";
+    } else {
+      auto ca_key = identity_ca.key("issue identity " + identity);
+      if (!ca_key.ok()) return ca_key.status();
+      auto k = NewKey();
+      if (!k.ok()) return k.status();
+      auto c = Issue(k.value().get(), IdentitySubject(graph, identity), identity_ca.cert(), ca_key.value(),
+                     options.identity_days, false);
+      if (!c.ok()) return c.status();
+      const CreateMode mode = renew ? CreateMode::kReplace : CreateMode::kNew;
+      if (Status s = WriteText(key_path, KeyPem(k.value().get()), mode); !s.ok()) return s;
+      if (Status s = WriteText(cert_path, CertPem(c.value().get()), mode); !s.ok()) return s;
+      cert = std::move(c.value());
+      out << (renew && have ? "renewed  " : "issued   ") << identity << ": " << cert_path << "\n";
+    }
+    // The grant is valid as long as the certificate.
+    time_t not_before = 0, not_after = 0;
+    {
+      std::tm tm{};
+      ASN1_TIME_to_tm(X509_get0_notBefore(cert.get()), &tm);
+      not_before = timegm(&tm);
+      ASN1_TIME_to_tm(X509_get0_notAfter(cert.get()), &tm);
+      not_after = timegm(&tm);
+    }
+    const std::string xml = PermissionsXml(graph, identity, access, Utc(not_before), Utc(not_after));
+    if (Status s = SignDocument((own / "permissions.xml").string(), (own / "permissions.p7s").string(), xml, permissions_ca, out);
+        !s.ok())
+      return s;
+  }
+  return Status::OK();
+}
+
+}  // namespace dyad::cli

@@ -1,0 +1,41 @@
+// `dyad security init`: the keystore of a graph (layout: dyad/security.hpp), made with OpenSSL's
+// library the way sros2 makes a ROS 2 keystore.
+//
+// Contract:
+//   - Two CAs (identity, permissions): self-signed ECDSA P-256, valid `ca_days`. Made once; their
+//     keys stay in DIR/ca/ (move that folder off the experiment machines after issuing: a run
+//     needs only the certificates; `init` needs the keys again only to issue or sign something).
+//   - One identity per process and per host (GraphIdentities): an ECDSA P-256 key and a
+//     certificate issued by the identity CA for `identity_days`, subject IdentitySubject.
+//   - governance.p7s and every permissions.p7s: the XML of access_documents.hpp, S/MIME-signed
+//     by the permissions CA (openssl smime -sign -text, as Fast DDS verifies it).
+//   - A rerun is safe: existing keys and certificates are kept (an identity the graph gained is
+//     issued: that is how a new host or process is admitted), documents are re-signed only when
+//     their text changed. `renew` names identities whose key and certificate are replaced
+//     (rotation); "all" renews every identity. CA keys are never replaced.
+//   - Folders 0700, files 0600, created O_EXCL | O_NOFOLLOW (dyad/private_file.hpp).
+// Each created or kept file is reported on `out`; errors name the file.
+#pragma once
+
+#include <iosfwd>
+#include <map>
+#include <set>
+#include <string>
+
+#include <dyad/graph.hpp>
+#include <dyad/status.hpp>
+#include <dyad/validate.hpp>
+
+namespace dyad::cli {
+
+struct KeystoreOptions {
+  std::string dir;
+  int ca_days = 3650;
+  int identity_days = 365;
+  std::set<std::string> renew;  // identities to reissue; {"all"}: every one
+};
+
+Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>& access, const KeystoreOptions& options,
+                    std::ostream& out);
+
+}  // namespace dyad::cli

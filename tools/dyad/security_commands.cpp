@@ -1,0 +1,87 @@
+#include "security_commands.hpp"
+
+#include <algorithm>
+#include <iostream>
+#include <memory>
+
+#include <dyad/catalog.hpp>
+#include <dyad/graph.hpp>
+#include <dyad/security.hpp>
+#include <dyad/validate.hpp>
+
+#include "keystore.hpp"
+
+namespace dyad::cli {
+namespace {
+
+// The graph, validated as `dyad validate` does (plugins included: permissions come from what
+// each component's Configure reads and writes), except for its own `security:` keystore,
+// which is what this command makes. Returns 2 having printed the problems, else 0.
+int LoadForKeystore(const std::string& path, const std::vector<std::string>& plugins, Graph* graph,
+                    std::map<std::string, TopicAccess>* access) {
+  std::vector<Diagnostic> diags;
+  *graph = LoadGraph(path, {}, &diags);
+  Catalog catalog;
+  for (size_t i = 0; i < graph->plugins.size(); ++i)
+    if (Status s = catalog.Load(graph->plugins[i]); !s.ok()) diags.push_back({graph->plugin_marks[i], "plugins", s.message()});
+  if (Status s = catalog.LoadDefault(plugins); !s.ok()) std::cerr << "warning: " << s.message() << "\n";
+  if (diags.empty()) {
+    const ResolvedGraph resolved = ValidateGraph(*graph, catalog, &diags);
+    std::vector<Diagnostic> kept;
+    for (auto& d : diags)
+      if (d.key.rfind("security", 0) != 0) kept.push_back(std::move(d));
+    diags = std::move(kept);
+    if (diags.empty()) *access = TopicAccessByProcess(*graph, resolved, catalog, &diags);
+  }
+  for (const auto& d : diags) std::cerr << d.ToString() << "\n";
+  if (diags.empty()) return 0;
+  std::cerr << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", no keystore was made\n";
+  return 2;
+}
+
+}  // namespace
+
+void AddSecurityCommands(CLI::App& app, int& exit_code) {
+  struct State {
+    KeystoreOptions keystore;
+    std::string graph;
+    std::vector<std::string> plugins, renew;
+  };
+  auto st = std::make_shared<State>();
+  auto* security = app.add_subcommand("security", "DDS Security for a graph: its keystore (docs/security.md)");
+  security->require_subcommand(1);
+  auto* init = security->add_subcommand(
+      "init", "Make or update DIR, the keystore of --graph: CAs, one identity per process and per host, governance, "
+              "permissions from what each process reads and writes; existing keys are kept");
+  init->add_option("dir", st->keystore.dir, "The keystore folder (the graph's security.keystore)")->required();
+  init->add_option("--graph", st->graph, "The graph")->required();
+  init->add_option("--plugins", st->plugins, "Extra plugin file or folder (repeatable)");
+  init->add_option("--renew", st->renew, "Replace the key and certificate of this identity (process.NAME, host.NAME, or all; repeatable)");
+  init->add_option("--days", st->keystore.identity_days, "Validity of newly issued identities, days (default 365)")->check(CLI::Range(1, 36500));
+  init->add_option("--ca-days", st->keystore.ca_days, "Validity of new CAs, days (default 3650)")->check(CLI::Range(1, 36500));
+  init->callback([st, &exit_code] {
+    Graph graph;
+    std::map<std::string, TopicAccess> access;
+    if ((exit_code = LoadForKeystore(st->graph, st->plugins, &graph, &access)) != 0) return;
+    const std::vector<std::string> identities = GraphIdentities(graph);
+    for (const std::string& r : st->renew)
+      if (r != "all" && std::find(identities.begin(), identities.end(), r) == identities.end()) {
+        std::cerr << "dyad security init: --renew " << r << ": not an identity of graph '" << graph.name << "' (";
+        for (size_t i = 0; i < identities.size(); ++i) std::cerr << (i ? ", " : "") << identities[i];
+        std::cerr << ")\n";
+        exit_code = 2;
+        return;
+      }
+    st->keystore.renew = {st->renew.begin(), st->renew.end()};
+    if (Status s = InitKeystore(graph, access, st->keystore, std::cout); !s.ok()) {
+      std::cerr << "dyad security init: " << s.message() << "\n";
+      exit_code = 1;
+      return;
+    }
+    std::cout << "keystore " << st->keystore.dir << ": " << identities.size()
+              << " identities; the graph uses it with `security: {keystore: " << st->keystore.dir << "}`\n";
+    exit_code = 0;
+  });
+}
+
+}  // namespace dyad::cli

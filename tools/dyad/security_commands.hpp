@@ -1,0 +1,11 @@
+// `dyad security init DIR --graph GRAPH`: the DDS Security keystore of a graph (keystore.hpp;
+// what a secured graph is: dyad/security.hpp, docs/security.md).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace dyad::cli {
+
+void AddSecurityCommands(CLI::App& app, int& exit_code);
+
+}  // namespace dyad::cli

@@ -1,0 +1,248 @@
+// `dyad security init`: the keystore it makes is read back by an independent reader (the openssl
+// command), files are private, a rerun keeps keys, --renew rotates one identity, CA keys can be
+// kept offline; `dyad validate` refuses a keystore that is incomplete, leaky or expired.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <dyad/security.hpp>
+
+#include "dyad/testing/child_process.hpp"
+#include "dyad/testing/cli.hpp"
+#include "runtime_commands.hpp"
+#include "security_commands.hpp"
+
+namespace dyad::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using dyad::testing::ReadFile;
+
+unsigned Mode(const fs::path& p) {
+  struct stat st {};
+  lstat(p.c_str(), &st);
+  return st.st_mode & 07777;
+}
+
+class KeystoreTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("dyad_keystore_" + std::to_string(getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    keys_ = dir_ / "keys";
+    graph_ = WriteGraph("");
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  // Two processes: pub writes ca and cb, rec records ca (the recorder subscribes in Configure).
+  fs::path WriteGraph(const std::string& extra, const std::string& name = "g.yaml") {
+    std::ofstream(dir_ / name) << "graph: sec\nprocesses:\n  pub: {}\n  rec: {}\n" << extra
+                               << "components:\n"
+                                  "  a: {type: counter_source, rate_hz: 10, process: pub, outputs: {out: ca}}\n"
+                                  "  b: {type: counter_source, rate_hz: 10, process: pub, outputs: {out: cb}}\n"
+                                  "  r: {type: recorder, rate_hz: 1, process: rec, params: {file: "
+                               << (dir_ / "out.mcap").string() << ", topics: [ca]}}\n";
+    return dir_ / name;
+  }
+  dyad::testing::CliRun Init(std::vector<std::string> extra = {}, const fs::path& graph = {}) {
+    std::vector<std::string> args = {"security", "init", keys_.string(), "--graph", (graph.empty() ? graph_ : graph).string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return dyad::testing::RunCommand(AddSecurityCommands, args);
+  }
+  // The openssl command's stdout; *code its exit status.
+  // (Line ends as LF: S/MIME's text mode carries the signed text with CRLF.)
+  std::string OpenSsl(const std::vector<std::string>& args, int* code) {
+    std::vector<std::string> argv = {"/usr/bin/openssl"};
+    argv.insert(argv.end(), args.begin(), args.end());
+    dyad::testing::ChildProcess c(argv, dir_, "openssl" + std::to_string(runs_++));
+    *code = c.Wait(60);
+    std::string out = c.out() + c.err();
+    std::erase(out, '\r');
+    return out;
+  }
+  fs::path Identity(const std::string& id, const std::string& file) { return keys_ / "identities" / id / file; }
+
+  fs::path dir_, keys_, graph_;
+  int runs_ = 0;
+};
+
+// The text between <tag> and </tag> (the first one), for reading a permissions grant.
+std::string Section(const std::string& xml, const std::string& tag) {
+  const size_t a = xml.find("<" + tag + ">"), b = xml.find("</" + tag + ">");
+  return a == std::string::npos || b == std::string::npos ? "" : xml.substr(a, b - a);
+}
+
+TEST_F(KeystoreTest, OpenSslVerifiesTheIdentitiesAndTheSignedDocuments) {
+  auto r = Init();
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* id : {"process.pub", "process.rec", "host.local"}) {
+    int code = -1;
+    const std::string verified = OpenSsl({"verify", "-CAfile", (keys_ / "identity_ca.cert.pem").string(),
+                                          Identity(id, "cert.pem").string()},
+                                         &code);
+    EXPECT_EQ(code, 0) << id << ": " << verified;
+    EXPECT_NE(verified.find(": OK"), std::string::npos) << verified;
+    // Not issued by the permissions CA: the two CAs are distinct.
+    OpenSsl({"verify", "-CAfile", (keys_ / "permissions_ca.cert.pem").string(), Identity(id, "cert.pem").string()}, &code);
+    EXPECT_NE(code, 0) << id;
+    const std::string subject = OpenSsl({"x509", "-noout", "-subject", "-nameopt", "RFC2253", "-in", Identity(id, "cert.pem").string()}, &code);
+    EXPECT_NE(subject.find("subject=" + std::string(id[0] == 'h' ? "CN=dyad/sec/host/local" : "CN=dyad/sec/") +
+                           (id[0] == 'h' ? "" : std::string(id).substr(8))),
+              std::string::npos)
+        << subject;
+    // The signed permissions verify against the permissions CA and carry exactly the XML.
+    const std::string content = OpenSsl({"smime", "-verify", "-text", "-in", Identity(id, "permissions.p7s").string(), "-CAfile",
+                                         (keys_ / "permissions_ca.cert.pem").string()},
+                                        &code);
+    EXPECT_EQ(code, 0) << content;
+    EXPECT_NE(content.find(ReadFile(Identity(id, "permissions.xml"))), std::string::npos) << content;
+  }
+  int code = -1;
+  const std::string gov = OpenSsl({"smime", "-verify", "-text", "-in", (keys_ / "governance.p7s").string(), "-CAfile",
+                                   (keys_ / "permissions_ca.cert.pem").string()},
+                                  &code);
+  EXPECT_EQ(code, 0) << gov;
+  EXPECT_NE(gov.find("<allow_unauthenticated_participants>false</allow_unauthenticated_participants>"), std::string::npos);
+  EXPECT_NE(gov.find("<data_protection_kind>ENCRYPT</data_protection_kind>"), std::string::npos);
+
+  // Private: folders 0700, every file 0600.
+  for (const auto& e : fs::recursive_directory_iterator(keys_))
+    EXPECT_EQ(Mode(e.path()), e.is_directory() ? 0700u : 0600u) << e.path();
+  EXPECT_EQ(Mode(keys_), 0700u);
+}
+
+TEST_F(KeystoreTest, PermissionsGrantWhatEachProcessWritesAndReads) {
+  ASSERT_EQ(Init().code, 0);
+  const std::string pub = ReadFile(Identity("process.pub", "permissions.xml"));
+  const std::string rec = ReadFile(Identity("process.rec", "permissions.xml"));
+  const std::string host = ReadFile(Identity("host.local", "permissions.xml"));
+  EXPECT_NE(pub.find("<subject_name>CN=dyad/sec/pub</subject_name>"), std::string::npos) << pub;
+  EXPECT_NE(Section(pub, "publish").find("<topic>ca</topic>"), std::string::npos) << pub;
+  EXPECT_NE(Section(pub, "publish").find("<topic>cb</topic>"), std::string::npos) << pub;
+  EXPECT_EQ(Section(pub, "subscribe").find("<topic>ca</topic>"), std::string::npos) << pub;
+  EXPECT_NE(Section(rec, "subscribe").find("<topic>ca</topic>"), std::string::npos) << rec;
+  EXPECT_EQ(Section(rec, "subscribe").find("<topic>cb</topic>"), std::string::npos) << "the recorder records ca only:\n" << rec;
+  EXPECT_EQ(Section(rec, "publish").find("<topic>ca</topic>"), std::string::npos) << rec;
+  EXPECT_NE(Section(rec, "publish").find("<topic>dyad/stats</topic>"), std::string::npos) << rec;
+  EXPECT_NE(pub.find("<partition>dyad/sec/*</partition>"), std::string::npos) << pub;
+  EXPECT_NE(pub.find("<default>DENY</default>"), std::string::npos);
+  EXPECT_NE(Section(host, "publish").find("<topic>dyad/launchers</topic>"), std::string::npos) << host;
+  EXPECT_NE(Section(host, "subscribe").find("<topic>*</topic>"), std::string::npos) << host;
+}
+
+TEST_F(KeystoreTest, ARerunKeepsKeysAndRenewReplacesOnlyTheNamedIdentity) {
+  ASSERT_EQ(Init().code, 0);
+  const std::string pub_key = ReadFile(Identity("process.pub", "key.pem"));
+  const std::string rec_key = ReadFile(Identity("process.rec", "key.pem"));
+  const std::string ca_cert = ReadFile(keys_ / "identity_ca.cert.pem");
+  auto again = Init();
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_EQ(again.out.find("issued"), std::string::npos) << again.out;
+  EXPECT_EQ(again.out.find("signed"), std::string::npos) << "nothing changed, nothing re-signed:\n" << again.out;
+  EXPECT_EQ(ReadFile(Identity("process.pub", "key.pem")), pub_key);
+
+  auto renew = Init({"--renew", "process.pub"});
+  ASSERT_EQ(renew.code, 0) << renew.err;
+  EXPECT_NE(renew.out.find("renewed  process.pub"), std::string::npos) << renew.out;
+  EXPECT_NE(ReadFile(Identity("process.pub", "key.pem")), pub_key);
+  EXPECT_EQ(ReadFile(Identity("process.rec", "key.pem")), rec_key);
+  EXPECT_EQ(ReadFile(keys_ / "identity_ca.cert.pem"), ca_cert);
+  EXPECT_EQ(Mode(Identity("process.pub", "key.pem")), 0600u);
+  int code = -1;
+  OpenSsl({"verify", "-CAfile", (keys_ / "identity_ca.cert.pem").string(), Identity("process.pub", "cert.pem").string()}, &code);
+  EXPECT_EQ(code, 0);
+
+  auto bad = Init({"--renew", "process.nobody"});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--renew process.nobody: not an identity of graph 'sec' (process.pub, process.rec, host.local)"),
+            std::string::npos)
+      << bad.err;
+}
+
+TEST_F(KeystoreTest, CaKeysKeptOfflineAreNeededOnlyToIssue) {
+  ASSERT_EQ(Init().code, 0);
+  fs::rename(keys_ / "ca", dir_ / "offline_ca");
+  auto kept = Init();
+  EXPECT_EQ(kept.code, 0) << "nothing to issue or sign: the CA keys are not needed\n" << kept.err;
+  // A graph that gained a process needs the identity CA's key.
+  const fs::path bigger = WriteGraph("", "g2.yaml");
+  std::string text = ReadFile(bigger);
+  text.replace(text.find("rec: {}"), 7, "rec: {}\n  extra: {}");
+  text += "  x: {type: counter_source, rate_hz: 10, process: extra, outputs: {out: cc}}\n";
+  std::ofstream(bigger) << text;
+  auto needs = Init({}, bigger);
+  EXPECT_EQ(needs.code, 1);
+  EXPECT_NE(needs.err.find((keys_ / "ca" / "identity_ca.key.pem").string() + ": the identity CA's key is not here"), std::string::npos)
+      << needs.err;
+  fs::rename(dir_ / "offline_ca", keys_ / "ca");
+  auto issued = Init({}, bigger);
+  ASSERT_EQ(issued.code, 0) << issued.err;
+  EXPECT_NE(issued.out.find("issued   process.extra"), std::string::npos) << issued.out;
+}
+
+TEST_F(KeystoreTest, ValidateRefusesAKeystoreThatIsIncompleteLeakyOrExpired) {
+  const fs::path secured = WriteGraph("security: {keystore: keys}\n", "secured.yaml");
+  auto validate = [&] { return dyad::testing::RunCommand(AddRuntimeCommands, {"validate", secured.string()}); };
+  auto missing = validate();
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.err.find("secured.yaml:5:22: security.keystore: " + keys_.string() + ": no such folder"), std::string::npos)
+      << missing.err;
+  ASSERT_EQ(Init().code, 0);
+  auto ok = validate();
+  EXPECT_EQ(ok.code, 0) << ok.err;
+
+  fs::permissions(Identity("process.rec", "key.pem"), fs::perms(0644));
+  auto leaky = validate();
+  EXPECT_EQ(leaky.code, 2);
+  EXPECT_NE(leaky.err.find("identity 'process.rec': " + Identity("process.rec", "key.pem").string() +
+                           ": a private key readable by others (mode 0644; chmod 600 it)"),
+            std::string::npos)
+      << leaky.err;
+  fs::permissions(Identity("process.rec", "key.pem"), fs::perms(0600));
+
+  fs::rename(Identity("process.pub", "key.pem"), dir_ / "elsewhere.pem");
+  fs::create_symlink(dir_ / "elsewhere.pem", Identity("process.pub", "key.pem"));
+  auto linked = validate();
+  EXPECT_NE(linked.err.find(Identity("process.pub", "key.pem").string() + ": a symbolic link"), std::string::npos) << linked.err;
+  fs::remove(Identity("process.pub", "key.pem"));
+  fs::rename(dir_ / "elsewhere.pem", Identity("process.pub", "key.pem"));
+
+  fs::remove(Identity("host.local", "permissions.p7s"));
+  auto incomplete = validate();
+  EXPECT_NE(incomplete.err.find("identity 'host.local': " + Identity("host.local", "permissions.p7s").string() + ": missing"),
+            std::string::npos)
+      << incomplete.err;
+  ASSERT_EQ(Init().code, 0);  // re-signs what is missing
+
+  // Certificates are checked against the clock: in two years the identities have expired.
+  std::vector<Diagnostic> diags;
+  const Graph g = LoadGraph(secured.string(), {}, &diags);
+  ASSERT_TRUE(diags.empty());
+  EXPECT_TRUE(CheckKeystore(g, static_cast<int64_t>(std::time(nullptr))).empty());
+  const auto later = CheckKeystore(g, static_cast<int64_t>(std::time(nullptr)) + 2 * 366 * 86400);
+  ASSERT_EQ(later.size(), 3u);  // the three identities; the CAs last ten years
+  EXPECT_NE(later[0].find("certificate expired"), std::string::npos) << later[0];
+  const auto earlier = CheckKeystore(g, static_cast<int64_t>(std::time(nullptr)) - 86400);
+  ASSERT_FALSE(earlier.empty());
+  EXPECT_NE(earlier[0].find("not valid yet"), std::string::npos) << earlier[0];
+}
+
+TEST_F(KeystoreTest, SecurityWithADiscoveryServerIsRefused) {
+  ASSERT_EQ(Init().code, 0);
+  const fs::path g = WriteGraph("network: {discovery: server, server: '127.0.0.1:11888'}\nsecurity: {keystore: keys}\n", "ds.yaml");
+  auto r = dyad::testing::RunCommand(AddRuntimeCommands, {"validate", g.string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("Fast DDS 2.9 has no secure discovery server: use network.discovery: peers"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace dyad::cli
