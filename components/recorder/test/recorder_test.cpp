@@ -531,7 +531,9 @@ TEST_F(RecorderTest, RecordsTopicsPublishedInAnotherProcessWithoutGaps) {
                                              "  b: {type: counter_source, rate_hz: 500, process: pub, outputs: {out: cb}}\n"
                                              "  rec: {type: recorder, rate_hz: 1, process: rec, params: {file: " + file.string() +
                                              ", topics: [ca, cb]}}\n");
-  ASSERT_EQ(Run({"run", graph.string(), "--duration", "2", "--quiet"}), 0);
+  // Three processes start, validate, discover each other and stop: seconds each under ASan on a
+  // loaded machine (CI ran it beside the browser tests and took more than 60 s once).
+  ASSERT_EQ(Run({"run", graph.string(), "--duration", "2", "--quiet"}, nullptr, nullptr, 240), 0);
   const Recording r = Read(file);
   for (const std::string t : {"ca", "cb"}) {
     const auto& v = r.by_topic.at(t);
