@@ -37,6 +37,16 @@
 #              lab receives its topic (loopback), while from rec a watcher sending unicast
 #              discovery straight to lab's address receives nothing; the same graph with `network: {scope: lan}`
 #              is seen from rec (so the check can fail)
+#   secure     DDS Security (`security:`, keystore from `dyad security init`): a graph on lab (arm:
+#              counter_sink and recorder of robot/command) and rec (a source named plaintextmarker
+#              writes robot/command); from mind an intruder with no identity and one with an
+#              identity of another CA (a valid keystore of the same graph) publish robot/command
+#              into the run and watch it. Checked: both launchers exit 0; the recording on lab is
+#              complete with one writer, contiguous; the sink on lab never received an intruder's
+#              sample (its file lists every sample's writer); the intruders' watcher heard nothing;
+#              a capture on the bridge port of lab saw no packet with "plaintextmarker". The same graph without
+#              security: the intruder's samples reach the sink and the marker is on the wire (so
+#              the checks can fail)
 #   net        (for debugging) only the namespaces and the UDP probe, no dyad run
 # Needs root, `ip netns` and `nft` (skipped, exit 77, otherwise). Leaves nothing behind: the EXIT
 # trap kills every process in its namespaces and deletes them (each host has a /dev/shm of its
@@ -46,7 +56,7 @@
 # MULTIHOST_STAGGER=S: the time between the starts of rec, mind and lab (default 2 s, 0: at once);
 # MULTIHOST_SHARED_SHM=1: the hosts share this machine's /dev/shm (default: one tmpfs each).
 set -euo pipefail
-[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|tcp|faults|failure[:D]|cut:D:H:S|local|matrix|net|MODE*N...]" >&2; exit 2; }
+[ $# -ge 3 ] || { echo "usage: multihost_test.sh REPO BUILD_DIR WORK_DIR [multicast|peers|server|tcp|faults|failure[:D]|cut:D:H:S|local|secure|matrix|net|MODE*N...]" >&2; exit 2; }
 repo=$(cd "$1" && pwd) build=$(cd "$2" && pwd) work=$3
 shift 3
 modes=()
@@ -69,7 +79,7 @@ done
 [ ${#modes[@]} -gt 0 ] || modes=(multicast peers server tcp faults failure)
 for mode in "${modes[@]}"; do
   case $mode in
-    multicast | peers | server | tcp | faults | failure | local | net) ;;
+    multicast | peers | server | tcp | faults | failure | local | secure | net) ;;
     failure:*) [[ $mode =~ ^failure:(multicast|peers|server|tcp)$ ]] ||
                  { echo "bad mode '$mode': failure:DISCOVERY (multicast|peers|server|tcp)" >&2; exit 2; } ;;
     cut:*) [[ $mode =~ ^cut:(multicast|peers|server|tcp):(lab|mind|rec):[0-9]+(\.[0-9]+)?$ ]] ||
@@ -779,6 +789,84 @@ run_local_mode() {
   echo "PASS: multihost local: a one-machine graph is seen on its machine only (and from rec with scope lan)"
 }
 
+# secure: see the header. One round with security, one without (the control).
+run_secure_mode() {
+  local out=$work/$1secure round sec i pids lab_pid rec_pid code_lab code_rec capture_pid marked
+  mkdir -p "$out"
+  local peers="network: {discovery: peers, hosts: {lab: ${addr[lab]}, rec: ${addr[rec]}}}"
+  for round in secured open; do
+    sec=()
+    [ $round = secured ] && sec=("security: {keystore: keys}")
+    printf '%s\n' "graph: guard" "clock: wall" "$peers" "${sec[@]}" "processes:" "  arm: {host: lab}" "  ctl: {host: rec}" \
+      "components:" \
+      "  sink: {type: counter_sink, trigger: in, process: arm, params: {file: $out/sink_$round.txt}, inputs: {in: robot/command}}" \
+      "  rec: {type: recorder, rate_hz: 1, process: arm, params: {file: $out/guard_$round.mcap, topics: [robot/command]}}" \
+      "  plaintextmarker: {type: counter_source, rate_hz: 20, process: ctl, outputs: {out: robot/command}}" \
+      > "$out/guard_$round.yaml"
+    # The intruder on mind: the same graph name and run, peers to lab and rec, its own writer.
+    sec=()
+    [ $round = secured ] && sec=("security: {keystore: other_keys}")
+    printf '%s\n' "graph: guard" "clock: wall" "network: {discovery: peers, peers: [${addr[lab]}, ${addr[rec]}]}" "${sec[@]}" \
+      "components:" "  intruder: {type: counter_source, rate_hz: 20, outputs: {out: robot/command}}" > "$out/intruder_$round.yaml"
+  done
+  "$dyad" security init "$out/keys" --graph "$out/guard_secured.yaml" > "$out/init.log" 2>&1 &&
+    "$dyad" security init "$out/other_keys" --graph "$out/intruder_secured.yaml" >> "$out/init.log" 2>&1 ||
+    { cat "$out/init.log" >&2; failures+=(secure); return 0; }
+  for round in secured open; do
+    ip netns exec "$sw" python3 "$repo/tests/capture_marker.py" plaintextmarker 12 vlab > "$out/capture_$round.txt" 2>&1 &
+    capture_pid=$!; started+=($!)
+    ip netns exec "${ns[lab]}" "$dyad" run "$out/guard_$round.yaml" --host lab --duration 20 --quiet > "$out/lab_$round.log" 2>&1 &
+    lab_pid=$!; started+=($!)
+    ip netns exec "${ns[rec]}" "$dyad" run "$out/guard_$round.yaml" --host rec --duration 20 --quiet > "$out/rec_$round.log" 2>&1 &
+    rec_pid=$!; started+=($!)
+    sleep 6
+    # Against the secured graph, both intruders (none of its identities, another CA's); else the bare one.
+    local intruders=(open)
+    [ $round = secured ] && intruders=(open secured)
+    pids=()
+    for i in "${intruders[@]}"; do
+      ip netns exec "${ns[mind]}" "$dyad" run "$out/intruder_$i.yaml" --run-id shared --duration 8 --quiet \
+        > "$out/intruder_${i}_in_$round.log" 2>&1 &
+      pids+=($!); started+=($!)
+    done
+    : > "$out/heard_$round.txt"
+    for i in "${intruders[@]}"; do
+      ip netns exec "${ns[mind]}" "$dyad" echo robot/command --graph "$out/intruder_$i.yaml" --run-id shared --count 1 --wait 6 \
+        >> "$out/heard_$round.txt" 2>&1 || true
+    done
+    wait "${pids[@]}" 2> /dev/null || true
+    code_lab=0; wait "$lab_pid" || code_lab=$?
+    code_rec=0; wait "$rec_pid" || code_rec=$?
+    wait "$capture_pid" || true
+    marked=$(awk '/^packets/ {print $4}' "$out/capture_$round.txt")
+    echo "multihost secure: $round: launchers exit $code_lab (lab) $code_rec (rec); $(grep '^packets' "$out/capture_$round.txt"); sink heard $(awk '{print $2}' "$out/sink_$round.txt" | sort | uniq -c | tr '\n' ' ')"
+    if [ "$code_lab" != 0 ] || [ "$code_rec" != 0 ]; then
+      echo "FAIL: multihost secure: $round: a launcher failed" >&2
+      tail -5 "$out/lab_$round.log" "$out/rec_$round.log" >&2
+      failures+=(secure); return 0
+    fi
+    if [ $round = secured ]; then
+      if ! check_recording "$out/guard_$round.mcap" "$out/csv_$round" 0 robot/command > "$out/check_$round.txt" 2>&1 ||
+        ! grep -q "robot/command: .* 1 writer(s): plaintextmarker 1\.\." "$out/check_$round.txt"; then
+        echo "FAIL: multihost secure: the secured run's recording is incomplete or has another writer:" >&2
+        cat "$out/check_$round.txt" >&2; failures+=(secure); return 0
+      fi
+      if grep -q " intruder " "$out/sink_$round.txt" || [ "$(grep -c ' plaintextmarker ' "$out/sink_$round.txt")" -lt 300 ]; then
+        echo "FAIL: multihost secure: the arm's sink heard an intruder, or too little of its own writer" >&2
+        failures+=(secure); return 0
+      fi
+      if grep -q '"value"' "$out/heard_$round.txt" || [ "${marked:-x}" != 0 ]; then
+        echo "FAIL: multihost secure: an intruder heard the graph, or the marker crossed the bridge in clear ($marked packets)" >&2
+        cat "$out/heard_$round.txt" >&2; failures+=(secure); return 0
+      fi
+    elif ! grep -q " intruder " "$out/sink_$round.txt" || ! grep -q '"value"' "$out/heard_$round.txt" || [ "${marked:-0}" = 0 ]; then
+      echo "FAIL: multihost secure: without security the intruder was not heard, or did not hear, or no marker was seen (the checks could not fail)" >&2
+      cat "$out/heard_$round.txt" "$out/capture_$round.txt" >&2; failures+=(secure); return 0
+    fi
+  done
+  echo "PASS: multihost secure: intruders with no identity or another CA's neither reach the arm nor hear the graph; nothing in clear on the wire (without security they do, and it is)"
+}
+
 # run_mode reports a failure in `failures` (not by its status: under `||` or `if`, set -e would
 # stop applying inside it).
 failures=()
@@ -787,6 +875,7 @@ for mode in "${modes[@]}"; do
   [ "$mode" = net ] && { echo "PASS: multihost net: namespaces and probe"; continue; }
   n=$((n + 1))
   [ "$mode" = local ] && { run_local_mode "$n-"; continue; }
+  [ "$mode" = secure ] && { run_secure_mode "$n-"; continue; }
   make_models
   run_mode "$mode" "$n-"
 done

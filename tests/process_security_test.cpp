@@ -93,7 +93,7 @@ TEST_F(SecurityTest, NothingOnTheWireIsInClear) {
   ASSERT_EQ(Init(dir_ / "keys", secured), 0);
   const fs::path open = Write("open.yaml", Graph("", udp));
   auto marked = [&](const fs::path& graph) {
-    Child capture({"/usr/bin/python3", DYAD_CAPTURE_LOOPBACK, "plaintextmarker", "8"}, dir_, "capture_" + graph.stem().string());
+    Child capture({"/usr/bin/python3", DYAD_CAPTURE_MARKER, "plaintextmarker", "8"}, dir_, "capture_" + graph.stem().string());
     EXPECT_TRUE(capture.WaitForOutput("capturing", 10)) << capture.err();
     Child run(Dyad({"run", graph.string(), "--duration", "5", "--quiet"}), dir_, "run_" + graph.stem().string());
     EXPECT_EQ(run.Wait(60), 0) << run.err();

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
-"""Counts the packets on the loopback interface that contain a marker, for SECONDS seconds (an
-independent look at what crosses the wire: process_security_test). Needs root (AF_PACKET).
+"""Counts the packets on an interface (default lo) that contain a marker, for SECONDS seconds: an
+independent look at what crosses the wire (process_security_test on loopback, multihost_test.sh's
+secure mode on the namespaces' bridge). Needs root (AF_PACKET).
 
-    capture_loopback.py MARKER SECONDS    prints "packets N marked M" and exits 0
+    capture_marker.py MARKER SECONDS [INTERFACE]    prints "packets N marked M" and exits 0
 """
 import socket
 import sys
@@ -10,12 +11,13 @@ import time
 
 
 def main():
-    if len(sys.argv) != 3:
+    if len(sys.argv) not in (3, 4):
         print(__doc__, file=sys.stderr)
         return 2
     marker, seconds = sys.argv[1].encode(), float(sys.argv[2])
+    interface = sys.argv[3] if len(sys.argv) == 4 else "lo"
     s = socket.socket(socket.AF_PACKET, socket.SOCK_RAW, socket.htons(0x0003))  # ETH_P_ALL
-    s.bind(("lo", 0))
+    s.bind((interface, 0))
     s.settimeout(0.2)
     print("capturing", flush=True)
     end = time.monotonic() + seconds
