@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libcivetweb-dev libssl-dev openssl
   python3 python3-matplotlib chromium universal-ctags
   iproute2 nftables procps
+  gdb  # the stacks of a process a test finds hung (tests' ChildProcess::Stacks, multihost_test.sh)
 )
 if [ "${1:-}" = "sanitize" ]; then
   packages+=(clang-14 libclang-rt-14-dev llvm-14)

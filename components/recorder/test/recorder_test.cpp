@@ -169,6 +169,7 @@ class RecorderTest : public ::testing::Test {
   int Run(std::vector<std::string> args, std::string* out = nullptr, std::string* err = nullptr, double timeout_s = 60) {
     Child c(Dyad(std::move(args)), dir_, "run" + std::to_string(runs_++));
     const int code = c.Wait(timeout_s);
+    if (code == -1) std::cerr << "dyad did not end within " << timeout_s << " s; its threads:\n" << c.Stacks();
     if (out) *out = c.out();
     if (err) *err = c.err();
     if (code != 0) std::cerr << "dyad exited " << code << ":\n" << c.err() << "\n";

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -92,6 +93,39 @@ class ChildProcess {
   }
   std::string out() const { return ReadFile(out_); }
   std::string err() const { return ReadFile(err_); }
+
+  // For a child that did not end in time: every thread's stack of it and of its descendants
+  // (gdb in batch mode, when installed), so that a rare hang in CI says where it hangs.
+  std::string Stacks() const {
+    std::vector<pid_t> pids = {pid_};
+    for (size_t i = 0; i < pids.size(); ++i) {  // descendants, breadth first, from /proc
+      for (const auto& e : std::filesystem::directory_iterator("/proc")) {
+        const std::string name = e.path().filename().string();
+        if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+        std::ifstream stat(e.path() / "stat");
+        std::string line;
+        std::getline(stat, line);
+        const size_t close = line.rfind(')');
+        if (close == std::string::npos) continue;
+        std::istringstream rest(line.substr(close + 2));
+        char state = 0;
+        pid_t parent = 0;
+        if (rest >> state >> parent && parent == pids[i]) pids.push_back(std::stoi(name));
+      }
+    }
+    if (!std::filesystem::exists("/usr/bin/gdb")) return "(no gdb: no stacks)";
+    std::string out;
+    for (pid_t p : pids) {
+      const std::filesystem::path file = out_.string() + ".stacks";
+      const std::string cmd = "timeout 60 /usr/bin/gdb -p " + std::to_string(p) +
+                              " -batch -ex 'thread apply all bt 20' 2>&1 | grep -E '^Thread|^#' > " + file.string();
+      std::string cmdline = ReadFile("/proc/" + std::to_string(p) + "/cmdline");
+      for (char& c : cmdline) c = c == '\0' ? ' ' : c;
+      out += "=== pid " + std::to_string(p) + ": " + cmdline + "\n";
+      if (std::system(cmd.c_str()) == 0) out += ReadFile(file);
+    }
+    return out;
+  }
 
  private:
   pid_t pid_ = -1;
