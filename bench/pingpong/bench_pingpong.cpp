@@ -3,7 +3,12 @@
 // one run. Prints median and p99 of each and their ratio.
 //
 //   build/bin/bench_pingpong [--rounds N] [--repeats R] [--payload BYTES]
-//                            [--processes [--pong-prefix "ip netns exec NS"]]
+//                            [--processes [--pong-prefix "ip netns exec NS"]] [--security]
+//
+// --security adds a third contender, alternating with the others: the same dyad graph with a
+// `security:` keystore (`dyad security init`: authentication, access control, everything
+// encrypted; docs/security.md), and the ratio secured/dyad. Use it with --processes: inside one
+// process samples never reach the wire, so there is nothing to encrypt.
 //
 // --processes puts pong in a second OS process (bare: this binary with --bare-pong; dyad: a
 // `dyad run --process pong` child of a two-process graph), started with the words of
@@ -231,11 +236,13 @@ void Stop(pid_t pid) {
   waitpid(pid, &status, 0);
 }
 
+// `secured`: with the keystore DIR/keys, made on first use.
 std::vector<int64_t> RunDyad(int domain, int rounds, size_t payload, const std::string& dir, bool processes,
-                             const std::vector<std::string>& pong_prefix) {
-  const std::string graph = dir + "/pingpong.yaml";
+                             const std::vector<std::string>& pong_prefix, bool secured = false) {
+  const std::string graph = dir + (secured ? "/pingpong_secured.yaml" : "/pingpong.yaml");
   const std::string out = dir + "/rtt.txt";
   std::ofstream(graph) << "graph: pingpong\nclock: wall\ndomain_id: " << domain
+                       << (secured ? "\nsecurity: {keystore: keys}" : "")
                        << (processes ? "\nprocesses: {ping: {}, pong: {}}" : "")
                        << "\ncomponents:\n"
                           "  pong: {type: bench_pong, trigger: in, inputs: {in: ping}, outputs: {out: pong}"
@@ -246,6 +253,15 @@ std::vector<int64_t> RunDyad(int domain, int rounds, size_t payload, const std::
                        << (processes ? ", process: ping" : "")
                        << "}\n"
                           "topics:\n  ping: {reliability: reliable, depth: 1}\n  pong: {reliability: reliable, depth: 1}\n";
+  if (secured && !std::filesystem::exists(dir + "/keys")) {
+    const pid_t init = Spawn({}, {DYAD_EXE, "security", "init", dir + "/keys", "--graph", graph, "--plugins", DYAD_BENCH_PLUGIN});
+    int status = 0;
+    waitpid(init, &status, 0);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      std::cerr << "bench_pingpong: dyad security init failed\n";
+      std::exit(1);
+    }
+  }
   dyad::RunOptions o;
   o.graph_path = graph;
   o.quiet = true;
@@ -305,11 +321,12 @@ std::vector<std::string> Words(const std::string& text) {
 int main(int argc, char** argv) {
   int rounds = 20000, repeats = 5;
   size_t payload = 0;
-  bool processes = false;
+  bool processes = false, security = false;
   std::vector<std::string> pong_prefix;
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
     if (!std::strcmp(argv[i], "--processes")) processes = true;
+    else if (!std::strcmp(argv[i], "--security")) security = true;
     else if (!std::strcmp(argv[i], "--bare-pong") && i + 2 < argc) return BarePongMain(std::atoi(argv[i + 1]), static_cast<size_t>(std::atoi(argv[i + 2])));
     else if (!has_value) break;
     else if (!std::strcmp(argv[i], "--rounds")) rounds = std::atoi(argv[++i]);
@@ -320,7 +337,7 @@ int main(int argc, char** argv) {
   const int domain = 1 + static_cast<int>(getpid() % 200);
   const std::string dir = std::filesystem::temp_directory_path() / ("dyad_pingpong_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
-  std::vector<int64_t> bare_all, dyad_all;
+  std::vector<int64_t> bare_all, dyad_all, secured_all;
   pid_t bare_pong = 0;
   if (processes) {
     const std::string self = std::filesystem::read_symlink("/proc/self/exe");
@@ -338,6 +355,10 @@ int main(int argc, char** argv) {
     bare_all.insert(bare_all.end(), b.begin() + b.size() / 10, b.end());
     auto d = RunDyad(domain + 1, rounds, payload, dir, processes, pong_prefix);
     dyad_all.insert(dyad_all.end(), d.begin() + d.size() / 10, d.end());
+    if (security) {
+      auto sec = RunDyad(domain + 1, rounds, payload, dir, processes, pong_prefix, true);
+      secured_all.insert(secured_all.end(), sec.begin() + sec.size() / 10, sec.end());
+    }
   }
   if (bare_pong != 0) Stop(bare_pong);
   std::filesystem::remove_all(dir);
@@ -351,5 +372,10 @@ int main(int argc, char** argv) {
   std::printf("%-22s %12.2f %12.2f %12.2f\n", "bare Fast DDS", bm, bp, ba);
   std::printf("%-22s %12.2f %12.2f %12.2f\n", "dyad components", dm, dp, da);
   std::printf("%-22s %12.3f %12.3f %12.3f\n", "ratio dyad/bare", dm / bm, dp / bp, da / ba);
+  if (security) {
+    const double sm = Percentile(secured_all, 0.5), sp = Percentile(secured_all, 0.99), sa = Mean(secured_all);
+    std::printf("%-22s %12.2f %12.2f %12.2f\n", "dyad with security", sm, sp, sa);
+    std::printf("%-22s %12.3f %12.3f %12.3f\n", "ratio secured/dyad", sm / dm, sp / dp, sa / da);
+  }
   return 0;
 }

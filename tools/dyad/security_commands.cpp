@@ -17,10 +17,12 @@ namespace {
 // The graph, validated as `dyad validate` does (plugins included: permissions come from what
 // each component's Configure reads and writes), except for its own `security:` keystore,
 // which is what this command makes. Returns 2 having printed the problems, else 0.
-int LoadForKeystore(const std::string& path, const std::vector<std::string>& plugins, Graph* graph,
-                    std::map<std::string, TopicAccess>* access) {
+int LoadForKeystore(const std::string& path, const std::vector<std::string>& sets, const std::vector<std::string>& plugins,
+                    Graph* graph, std::map<std::string, TopicAccess>* access) {
   std::vector<Diagnostic> diags;
-  *graph = LoadGraph(path, {}, &diags);
+  std::vector<Override> overrides;
+  for (const std::string& s : sets) overrides.push_back(Override{s});
+  *graph = LoadGraph(path, overrides, &diags);
   Catalog catalog;
   for (size_t i = 0; i < graph->plugins.size(); ++i)
     if (Status s = catalog.Load(graph->plugins[i]); !s.ok()) diags.push_back({graph->plugin_marks[i], "plugins", s.message()});
@@ -45,7 +47,7 @@ void AddSecurityCommands(CLI::App& app, int& exit_code) {
   struct State {
     KeystoreOptions keystore;
     std::string graph;
-    std::vector<std::string> plugins, renew;
+    std::vector<std::string> plugins, renew, sets;
   };
   auto st = std::make_shared<State>();
   auto* security = app.add_subcommand("security", "DDS Security for a graph: its keystore (docs/security.md)");
@@ -56,13 +58,14 @@ void AddSecurityCommands(CLI::App& app, int& exit_code) {
   init->add_option("dir", st->keystore.dir, "The keystore folder (the graph's security.keystore)")->required();
   init->add_option("--graph", st->graph, "The graph")->required();
   init->add_option("--plugins", st->plugins, "Extra plugin file or folder (repeatable)");
+  init->add_option("--set", st->sets, "Change a key of the graph, as `dyad run --set` does (the runs must use the same sets)");
   init->add_option("--renew", st->renew, "Replace the key and certificate of this identity (process.NAME, host.NAME, or all; repeatable)");
   init->add_option("--days", st->keystore.identity_days, "Validity of newly issued identities, days (default 365)")->check(CLI::Range(1, 36500));
   init->add_option("--ca-days", st->keystore.ca_days, "Validity of new CAs, days (default 3650)")->check(CLI::Range(1, 36500));
   init->callback([st, &exit_code] {
     Graph graph;
     std::map<std::string, TopicAccess> access;
-    if ((exit_code = LoadForKeystore(st->graph, st->plugins, &graph, &access)) != 0) return;
+    if ((exit_code = LoadForKeystore(st->graph, st->sets, st->plugins, &graph, &access)) != 0) return;
     const std::vector<std::string> identities = GraphIdentities(graph);
     for (const std::string& r : st->renew)
       if (r != "all" && std::find(identities.begin(), identities.end(), r) == identities.end()) {
