@@ -10,11 +10,15 @@
 #include <random>
 #include <set>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
 
 #include <dyad/decode_sample.hpp>
 #include <dyad/graph.hpp>
 #include <dyad/on_demand_subscription.hpp>
+#include <dyad/private_file.hpp>
 #include <dyad/pvrnn/dataset.hpp>
 #include <dyad/topic_select.hpp>
 
@@ -23,6 +27,23 @@
 
 namespace dyad::web {
 namespace {
+
+// The token kept in `path` (params.token_file): a regular file, not a link, readable by its owner
+// only, holding one token of 16..256 printable characters (a newline after it is allowed).
+StatusOr<std::string> ReadTokenFile(const std::string& path) {
+  const std::string key = "params.token_file = '" + path + "': ";
+  struct stat st {};
+  if (lstat(path.c_str(), &st) != 0) return Status::NotFound(key + "missing");
+  if (S_ISLNK(st.st_mode) || !S_ISREG(st.st_mode)) return Status::InvalidArgument(key + "not a regular file (a link is refused)");
+  if ((st.st_mode & 077) != 0) return Status::InvalidArgument(key + "readable by others: chmod 600 it");
+  std::ifstream in(path);
+  std::string token;
+  std::getline(in, token);
+  if (token.size() < 16 || token.size() > 256 ||
+      !std::all_of(token.begin(), token.end(), [](char c) { return c > ' ' && c < 127 && c != '&' && c != '#'; }))
+    return Status::InvalidArgument(key + "must hold one token of 16..256 printable characters without spaces, '&' or '#'");
+  return token;
+}
 
 std::string RandomToken() {
   std::random_device rd;
@@ -83,8 +104,10 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Param("port", 8765).Range(0, 65535).Doc("TCP port; 0 picks a free one (see port_file)");
   spec.Param("topics", std::vector<std::string>{}).Doc("topics to advertise, by name or regular expression (empty: all)");
   spec.Param("writable", std::vector<std::string>{}).Doc("topics Foxglove clients may publish on (empty: none)");
-  spec.Param("token", "").Doc("clients must connect with ?token=...; empty: none on loopback, else generated and printed "
-                              "(or DYAD_WEB_TOKEN)");
+  spec.Param("token", "").Secret().Doc("clients must connect with ?token=...; empty: token_file's, DYAD_WEB_TOKEN, none on "
+                                       "loopback, else generated and printed (kept out of recordings)");
+  spec.Param("token_file", "").Path().Doc("a 0600 file holding the token: read when it exists, else created with a new one "
+                                          "(bookmarked pages keep working across runs); the token is then not printed");
   spec.Param("allowed_origins", std::vector<std::string>{}).Doc("browser origins allowed besides localhost ('*': any)");
   spec.Param("max_clients", 8).Range(1, 64).Doc("WebSocket clients at once");
   spec.Param("client_buffer_kb", 4096).Range(16, 1 << 20).Doc("per-client send buffer; past it the busiest channel's oldest samples are dropped");
@@ -111,10 +134,33 @@ Status WebComponent::Configure(Context& ctx) {
   options_.client_buffer_bytes = static_cast<size_t>(p.Int("client_buffer_kb")) << 10;
   options_.max_frame_bytes = static_cast<size_t>(p.Int("max_frame_kb")) << 10;
 
+  // Where the token comes from, said in the printed URLs instead of the token itself; only a
+  // token dyad draws and keeps nowhere else is printed (else nobody could use it).
   options_.token = p.String("token");
+  token_shown_ = "<params.token>";
   if (options_.token.empty())
-    if (const char* env = std::getenv("DYAD_WEB_TOKEN")) options_.token = env;
-  if (options_.token.empty() && !IsLoopback(options_.address)) options_.token = RandomToken();
+    if (const char* env = std::getenv("DYAD_WEB_TOKEN")) {
+      options_.token = env;
+      token_shown_ = "<$DYAD_WEB_TOKEN>";
+    }
+  token_file_ = p.String("token_file");
+  create_token_file_ = false;
+  if (options_.token.empty() && !token_file_.empty()) {
+    auto kept = ReadTokenFile(token_file_);
+    token_shown_ = "<the token in " + token_file_ + ">";
+    if (kept.ok()) {
+      options_.token = kept.value();
+    } else if (kept.status().code() == Status::Code::kNotFound) {
+      options_.token = RandomToken();  // the file is created at Activate (Configure acts on nothing)
+      create_token_file_ = true;
+    } else {
+      return kept.status();
+    }
+  }
+  if (options_.token.empty() && !IsLoopback(options_.address)) {
+    options_.token = RandomToken();
+    token_shown_ = options_.token;
+  }
   port_file_ = p.String("port_file");
 
   std::vector<std::string> names;
@@ -219,8 +265,15 @@ Status WebComponent::Activate() {
   bridge_->SetServer(server_.get());
   subject_->SetServer(server_.get());
   experimenter_->SetServer(server_.get());
+  if (create_token_file_) {
+    auto fd = CreatePrivateFile(token_file_, CreateMode::kNew);
+    if (!fd.ok()) return fd.status().WithContext("params.token_file");
+    const std::string line = options_.token + "\n";
+    const bool written = ::write(fd.value(), line.data(), line.size()) == static_cast<ssize_t>(line.size());
+    if (::close(fd.value()) != 0 || !written) return Status::IOError("params.token_file = '" + token_file_ + "': cannot write");
+  }
   // Bound to a wildcard address, the URLs name the machine's real addresses (0.0.0.0 opens nothing).
-  const std::string query = options_.token.empty() ? "" : "?token=" + options_.token;
+  const std::string query = options_.token.empty() ? "" : "?token=" + token_shown_;
   for (const std::string& host : UrlHosts(options_.address)) {
     const std::string base = host + ":" + std::to_string(server_->port());
     ctx_->log().Info("subject's page: http://" + base + "/subject" + query + "  experimenter: http://" + base +

@@ -41,6 +41,9 @@ class WebComponent final : public Component {
   Context* ctx_ = nullptr;
   WebServer::Options options_;
   std::string port_file_;
+  std::string token_file_;          // params.token_file
+  std::string token_shown_;         // what the printed URLs show for the token (see Configure)
+  bool create_token_file_ = false;  // it did not exist at Configure: Activate creates it
   Input<msg::CartesianState>* robot_ = nullptr;   // owned by the runtime
   Output<msg::HumanInput>* pointer_ = nullptr;    // owned by the runtime
   Input<msg::Intention>* intention_ = nullptr;    // owned by the runtime

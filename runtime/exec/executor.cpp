@@ -114,7 +114,7 @@ class Executor::ContextImpl final : public Context, public detail::ContextExtens
   void RequestStop(std::string reason) override { ex_->RequestStop(inst_->name() + ": " + reason); }
 
   const std::string& graph_name() const override { return ex_->graph_.name; }
-  const std::string& graph_yaml() const override { return ex_->graph_.yaml_text; }
+  const std::string& graph_yaml() const override { return ex_->graph_yaml_; }
   const std::string& graph_folder() const override { return ex_->graph_.folder; }
   bool stepped() const override { return ex_->clock_->stepped(); }
   const std::vector<TopicInfo>& graph_topics() const override { return ex_->topics_; }
@@ -218,6 +218,7 @@ class Executor::ContextImpl final : public Context, public detail::ContextExtens
 
 Executor::Executor(const Graph& graph, const ResolvedGraph& resolved, const Catalog* catalog, Options options)
     : graph_(graph), resolved_(resolved), catalog_(catalog), options_(std::move(options)),
+      graph_yaml_(RedactedGraphYaml(graph, resolved)),
       clock_(std::make_unique<ClockImpl>(graph.clock == ClockMode::kStepped)) {}
 
 Executor::~Executor() {

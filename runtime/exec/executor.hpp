@@ -120,6 +120,7 @@ class Executor {
   const ResolvedGraph& resolved_;
   const Catalog* catalog_;
   Options options_;
+  std::string graph_yaml_;         // Context::graph_yaml(): secrets redacted
   std::vector<TopicInfo> topics_;  // Context::graph_topics()
   std::unique_ptr<ClockImpl> clock_;
   std::vector<std::unique_ptr<Instance>> instances_;

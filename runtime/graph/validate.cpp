@@ -330,6 +330,23 @@ class Validation {
 
 }  // namespace
 
+std::string RedactedGraphYaml(const Graph& graph, const ResolvedGraph& resolved) {
+  std::string text = graph.yaml_text;
+  for (const auto& rc : resolved.components) {
+    if (rc.entry == nullptr) continue;
+    for (const auto& spec : rc.entry->spec.params()) {
+      if (!spec.secret || !rc.params.Has(spec.name)) continue;
+      const std::string value = rc.params.String(spec.name);
+      if (value.empty()) continue;
+      for (size_t at = 0; (at = text.find(value, at)) != std::string::npos;) {
+        text.replace(at, value.size(), "<redacted>");
+        at += 10;
+      }
+    }
+  }
+  return text;
+}
+
 ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vector<Diagnostic>* diags) {
   return Validation(graph, catalog, diags).Run();
 }

@@ -114,7 +114,8 @@ namespace dyad {
 // 2: generic topics (above); the DDS source timestamp is the header's stamp.
 // 3: ParamSpec::path (relative paths resolved against the graph file), Context::graph_folder().
 // 4: input health (InputBase::writers_alive, writers_gone, deadline_misses).
-inline constexpr uint32_t kPluginAbiVersion = 4;
+// 5: ParamSpec::secret (redacted from Context::graph_yaml()).
+inline constexpr uint32_t kPluginAbiVersion = 5;
 
 // The runtime clock: wall time (ns since the Unix epoch) in `clock: wall` graphs, simulated time
 // (ns since start) in `clock: stepped` graphs. Thread-safe.

@@ -16,6 +16,11 @@
 // working folder (as a shell user expects); a default, as it is (the component's own choice).
 // The component always receives the resolved path; empty values stay empty.
 //
+// Secrets: a kString parameter marked Secret() (a token, a password) is the component's alone:
+// the graph text components receive (Context::graph_yaml(), which recorders keep with every
+// recording) has each secret's value replaced by "<redacted>", and dyad prints it nowhere.
+// (Secret() on any other type is refused when the plugin is loaded.)
+//
 // Values reach the component only after validation, so getters never fail on user input; asking
 // for an undeclared name or the wrong type is a programming error and aborts with a message.
 #pragma once
@@ -53,6 +58,7 @@ struct ParamSpec {
   std::string unit;
   std::string doc;
   bool path = false;                         // a file or folder (see the file comment)
+  bool secret = false;                       // redacted from the graph text (see the file comment)
 
   // Builder-style setters used in Describe().
   ParamSpec& Range(double lo, double hi) { min = lo; max = hi; return *this; }
@@ -62,6 +68,7 @@ struct ParamSpec {
   ParamSpec& Unit(std::string u) { unit = std::move(u); return *this; }
   ParamSpec& Doc(std::string d) { doc = std::move(d); return *this; }
   ParamSpec& Path() { path = true; return *this; }
+  ParamSpec& Secret() { secret = true; return *this; }
 };
 
 // Validated values of one component instance, defaults filled in.
