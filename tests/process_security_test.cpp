@@ -12,13 +12,13 @@ namespace {
 
 class SecurityTest : public ProcessTest {
  protected:
-  // pub (component `plaintextmarker` writes ca at 50 Hz) and sub (counter_sink of ca) in two
+  // pub (component marker_ writes ca at 50 Hz) and sub (counter_sink of ca) in two
   // processes; `extra` goes under network: and the components.
   std::string Graph(const std::string& keystore, const std::string& network = "", const std::string& extra = "") {
     return "graph: secure\ndomain_id: " + std::to_string(domain_) + "\n" + (network.empty() ? "" : "network: " + network + "\n") +
            (keystore.empty() ? "" : "security: {keystore: " + keystore + "}\n") +
            "processes:\n  pub: {}\n  sub: {}\ncomponents:\n"
-           "  plaintextmarker: {type: counter_source, rate_hz: 50, process: pub, outputs: {out: ca}}\n"
+           "  " + marker_ + ": {type: counter_source, rate_hz: 50, process: pub, outputs: {out: ca}}\n"
            "  sink: {type: counter_sink, trigger: in, process: sub, params: {file: " + (dir_ / "sink.txt").string() +
            "}, inputs: {in: ca}}\n" + extra;
   }
@@ -30,6 +30,9 @@ class SecurityTest : public ProcessTest {
     return code;
   }
   int inits_ = 0;
+  // The writer's name, in every sample it writes: the marker looked for on the wire. One per test
+  // process: a test running beside this one must not put its marker on the same loopback.
+  const std::string marker_ = "plaintextmarker" + std::to_string(getpid());
 };
 
 TEST_F(SecurityTest, ASecuredGraphDeliversToItsOwnAndNothingToIntruders) {
@@ -43,19 +46,19 @@ TEST_F(SecurityTest, ASecuredGraphDeliversToItsOwnAndNothingToIntruders) {
   // The graph's own watcher (identity host.local) hears the samples.
   Child own(Dyad({"echo", "ca", "--graph", graph.string(), "--count", "3", "--wait", "15"}), dir_, "own");
   ASSERT_EQ(own.Wait(60), 0) << own.err();
-  EXPECT_NE(own.out().find("\"plaintextmarker\""), std::string::npos) << own.out();
+  EXPECT_NE(own.out().find("\"" + marker_ + "\""), std::string::npos) << own.out();
 
   // No identity: the secured participants ignore it; it finds no writer of ca.
   Child bare(Dyad({"echo", "ca", "--domain", std::to_string(domain_), "--count", "1", "--wait", "4"}), dir_, "bare");
   EXPECT_NE(bare.Wait(60), 0);
-  EXPECT_EQ(bare.out().find("plaintextmarker"), std::string::npos) << bare.out();
+  EXPECT_EQ(bare.out().find(marker_), std::string::npos) << bare.out();
   Child topics(Dyad({"topics", "--domain", std::to_string(domain_), "--wait", "3"}), dir_, "topics");
   topics.Wait(60);
   EXPECT_EQ(topics.out().find("ca "), std::string::npos) << "an unauthenticated watcher discovered the graph:\n" << topics.out();
   // An identity from another CA: authentication fails, nothing is delivered.
   Child foreign(Dyad({"echo", "ca", "--graph", other.string(), "--count", "1", "--wait", "4"}), dir_, "foreign");
   EXPECT_NE(foreign.Wait(60), 0);
-  EXPECT_EQ(foreign.out().find("plaintextmarker"), std::string::npos) << foreign.out();
+  EXPECT_EQ(foreign.out().find(marker_), std::string::npos) << foreign.out();
 
   run.Signal(SIGINT);
   EXPECT_EQ(run.Wait(60), 130) << run.err();  // 128 + SIGINT: interrupted, as asked
@@ -67,7 +70,7 @@ TEST_F(SecurityTest, ASecuredGraphDeliversToItsOwnAndNothingToIntruders) {
   Child open_run(Dyad({"run", open.string(), "--duration", "15", "--quiet"}), dir_, "open_run");
   Child heard(Dyad({"echo", "ca", "--domain", std::to_string(domain_), "--count", "1", "--wait", "10"}), dir_, "heard");
   EXPECT_EQ(heard.Wait(60), 0) << heard.err();
-  EXPECT_NE(heard.out().find("plaintextmarker"), std::string::npos) << heard.out();
+  EXPECT_NE(heard.out().find(marker_), std::string::npos) << heard.out();
   open_run.Signal(SIGINT);
   open_run.Wait(60);
 }
@@ -93,7 +96,7 @@ TEST_F(SecurityTest, NothingOnTheWireIsInClear) {
   ASSERT_EQ(Init(dir_ / "keys", secured), 0);
   const fs::path open = Write("open.yaml", Graph("", udp));
   auto marked = [&](const fs::path& graph) {
-    Child capture({"/usr/bin/python3", DYAD_CAPTURE_MARKER, "plaintextmarker", "8"}, dir_, "capture_" + graph.stem().string());
+    Child capture({"/usr/bin/python3", DYAD_CAPTURE_MARKER, marker_, "8"}, dir_, "capture_" + graph.stem().string());
     EXPECT_TRUE(capture.WaitForOutput("capturing", 10)) << capture.err();
     Child run(Dyad({"run", graph.string(), "--duration", "5", "--quiet"}), dir_, "run_" + graph.stem().string());
     EXPECT_EQ(run.Wait(60), 0) << run.err();
