@@ -196,6 +196,27 @@ TEST(GraphValidation, AnUnboundOutputAndADeclaredTopicNoComponentWritesAreWarnin
   EXPECT_TRUE(ValidateGraph(ParseGraph(kValid, "g.yaml", {}, &diags), testing::BuiltPlugins(), &diags).warnings.empty());
 }
 
+// A graph open to the network without `interfaces` talks on every interface: a warning at the
+// network section; naming them, or staying on this machine, says nothing.
+TEST(GraphValidation, ANetworkGraphWithoutInterfacesIsWarnedAbout) {
+  auto warnings = [](const std::string& network) {
+    std::vector<Diagnostic> diags;
+    Graph g = ParseGraph("graph: n\nnetwork: " + network + "\n" + std::string(kValid).substr(std::string(kValid).find("components:")), "g.yaml", {}, &diags);
+    const ResolvedGraph r = ValidateGraph(g, testing::BuiltPlugins(), &diags);
+    EXPECT_TRUE(diags.empty()) << diags[0].ToString();
+    std::vector<Diagnostic> out;
+    for (const auto& w : r.warnings)
+      if (w.key == "network.interfaces") out.push_back(w);
+    return out;
+  };
+  const auto open = warnings("{scope: lan}");
+  ASSERT_EQ(open.size(), 1u);
+  EXPECT_EQ(open[0].mark.line, 2);
+  EXPECT_NE(open[0].message.find("every interface of each host (Wi-Fi included)"), std::string::npos) << open[0].ToString();
+  EXPECT_TRUE(warnings("{scope: lan, interfaces: [eth0]}").empty());
+  EXPECT_TRUE(warnings("{scope: local}").empty());
+}
+
 // A graph's name is part of its runs' DDS partition: no pattern characters, no spaces.
 TEST(GraphValidation, AGraphNameThatCannotNameAPartitionIsAnErrorAtItsLine) {
   for (const char* name : {"demo*", "my graph", "a/b"}) {

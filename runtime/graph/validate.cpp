@@ -139,6 +139,7 @@ class Validation {
     CheckDeclaredTypes();
     ResolveTopics();
     CheckClock(processes_used);
+    CheckInterfaces();
     CheckSecurity();
     return std::move(out_);
   }
@@ -152,6 +153,16 @@ class Validation {
   };
 
   void error(const SourceMark& m, const std::string& key, const std::string& msg) { diags_->push_back(Diagnostic{m, key, msg}); }
+
+  // A graph open to the network without `interfaces` talks on every interface of each host (the
+  // lab's Wi-Fi too): said, not refused (a lab may mean it).
+  void CheckInterfaces() {
+    const NetworkConfig& n = graph_.network;
+    if (n.scope != NetScope::kLan || !n.interfaces.empty()) return;
+    warn(n.mark.line > 0 ? n.mark : SourceMark{graph_.file, 1, 1}, "network.interfaces",
+         "not given: the graph's participants use every interface of each host (Wi-Fi included); name the experiment "
+         "network's (e.g. interfaces: [eth0]), and see docs/security.md for DDS Security");
+  }
 
   // The keystore holds what every participant of the graph needs (dyad/security.hpp).
   void CheckSecurity() {
