@@ -217,6 +217,32 @@ TEST(GraphValidation, ANetworkGraphWithoutInterfacesIsWarnedAbout) {
   EXPECT_TRUE(warnings("{scope: local}").empty());
 }
 
+// A secret param (the web component's token) is redacted where it stands whole, and never
+// inside a name that contains it: a token "web" leaves component `web` and topic `web/pointer`.
+TEST(GraphValidation, SecretParamsAreRedactedWholeFromTheGraphText) {
+  std::vector<Diagnostic> diags;
+  const std::string y =
+      "graph: red\ncomponents:\n"
+      "  web: {type: web, rate_hz: 10, params: {token: web}, outputs: {pointer: web/pointer}}\n"
+      "  human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}\n"
+      "topics:\n  human/input: {type: HumanInput}\n";
+  Graph g = ParseGraph(y, "g.yaml", {{"web.port=0"}}, &diags);
+  const ResolvedGraph r = ValidateGraph(g, testing::BuiltPlugins(), &diags);
+  ASSERT_TRUE(diags.empty()) << diags[0].ToString();
+  const std::string text = RedactedGraphYaml(g, r);
+  EXPECT_NE(text.find("token: <redacted>"), std::string::npos) << text;
+  EXPECT_NE(text.find("web/pointer"), std::string::npos) << text;
+  Graph again = ParseGraph(text, "g.yaml", {}, &diags);
+  ASSERT_TRUE(diags.empty()) << diags[0].ToString();
+  EXPECT_NE(again.FindComponent("web"), nullptr) << text;
+
+  Graph set = ParseGraph(y, "g.yaml", {{"web.token=LongS3cretToken"}}, &diags);
+  const ResolvedGraph rs = ValidateGraph(set, testing::BuiltPlugins(), &diags);
+  ASSERT_TRUE(diags.empty()) << diags[0].ToString();
+  const std::string redacted = RedactedGraphYaml(set, rs);
+  EXPECT_EQ(redacted.find("LongS3cretToken"), std::string::npos) << "the --set header keeps the token:\n" << redacted;
+}
+
 // A graph's name is part of its runs' DDS partition: no pattern characters, no spaces.
 TEST(GraphValidation, AGraphNameThatCannotNameAPartitionIsAnErrorAtItsLine) {
   for (const char* name : {"demo*", "my graph", "a/b"}) {

@@ -51,6 +51,20 @@ TEST_F(PrivateFileTest, NewFilesAre0600InFoldersCreated0700) {
   EXPECT_EQ(Mode(dir_ / "g"), fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec);
 }
 
+TEST_F(PrivateFileTest, WritePrivateFileWritesAllOfItOnceAndReplacesOnlyWhenAsked) {
+  const fs::path f = dir_ / "key.pem";
+  const std::string big(1 << 20, 'k');  // more than one write() may take
+  ASSERT_TRUE(WritePrivateFile(f.string(), big, CreateMode::kNew).ok());
+  EXPECT_EQ(Read(f), big);
+  EXPECT_EQ(Mode(f), fs::perms::owner_read | fs::perms::owner_write);
+  const Status again = WritePrivateFile(f.string(), "other", CreateMode::kNew);
+  EXPECT_FALSE(again.ok());
+  EXPECT_NE(again.message().find(": exists"), std::string::npos) << again.message();
+  EXPECT_EQ(Read(f), big);
+  ASSERT_TRUE(WritePrivateFile(f.string(), "other", CreateMode::kReplace).ok());
+  EXPECT_EQ(Read(f), "other");
+}
+
 TEST_F(PrivateFileTest, AnExistingFileIsAnErrorAndKeepsItsContent) {
   const fs::path f = dir_ / "run.mcap";
   std::ofstream(f) << "earlier recording";

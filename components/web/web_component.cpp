@@ -11,7 +11,6 @@
 #include <set>
 
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -266,11 +265,8 @@ Status WebComponent::Activate() {
   subject_->SetServer(server_.get());
   experimenter_->SetServer(server_.get());
   if (create_token_file_) {
-    auto fd = CreatePrivateFile(token_file_, CreateMode::kNew);
-    if (!fd.ok()) return fd.status().WithContext("params.token_file");
-    const std::string line = options_.token + "\n";
-    const bool written = ::write(fd.value(), line.data(), line.size()) == static_cast<ssize_t>(line.size());
-    if (::close(fd.value()) != 0 || !written) return Status::IOError("params.token_file = '" + token_file_ + "': cannot write");
+    if (Status s = WritePrivateFile(token_file_, options_.token + "\n", CreateMode::kNew); !s.ok())
+      return s.WithContext("params.token_file");
   }
   // Bound to a wildcard address, the URLs name the machine's real addresses (0.0.0.0 opens nothing).
   const std::string query = options_.token.empty() ? "" : "?token=" + token_shown_;

@@ -64,6 +64,23 @@ StatusOr<int> CreatePrivateFile(const std::string& path, CreateMode mode, const 
   return Status::IOError(path, "replace: no free temporary name");
 }
 
+Status WritePrivateFile(const std::string& path, const std::string& text, CreateMode mode, const PrivateFileOptions& options) {
+  auto fd = CreatePrivateFile(path, mode, options);
+  if (!fd.ok()) return fd.status();
+  for (size_t done = 0; done < text.size();) {
+    const ssize_t n = ::write(*fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = errno;
+      ::close(*fd);
+      return Errno(path, "write", err);
+    }
+    done += static_cast<size_t>(n);
+  }
+  if (::close(*fd) != 0) return Errno(path, "close", errno);
+  return Status::OK();
+}
+
 StatusOr<int> OpenPrivateLog(const std::string& path, const PrivateFileOptions& options) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_NOFOLLOW | O_CLOEXEC, FileMode(options));
   if (fd < 0) return Errno(path, "open for appending", errno);

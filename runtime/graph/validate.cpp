@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 namespace dyad {
 namespace {
@@ -349,7 +350,16 @@ std::string RedactedGraphYaml(const Graph& graph, const ResolvedGraph& resolved)
       if (!spec.secret || !rc.params.Has(spec.name)) continue;
       const std::string value = rc.params.String(spec.name);
       if (value.empty()) continue;
+      // Only where the value stands whole (`token: s3cret`, `'s3cret'`, `web.token=s3cret`), so a
+      // short secret never eats into a name that contains it (token `web`, component `web`).
+      auto before_ok = [](char c) { return std::string_view(" \t:'\"{[,=").find(c) != std::string_view::npos; };
+      auto after_ok = [](char c) { return std::string_view(" \t\r\n'\",}]#").find(c) != std::string_view::npos; };
       for (size_t at = 0; (at = text.find(value, at)) != std::string::npos;) {
+        const size_t end = at + value.size();
+        if ((at > 0 && !before_ok(text[at - 1])) || (end < text.size() && !after_ok(text[end]))) {
+          at = end;
+          continue;
+        }
         text.replace(at, value.size(), "<redacted>");
         at += 10;
       }

@@ -1,6 +1,5 @@
 #include "keystore.hpp"
 
-#include <unistd.h>
 
 #include <ctime>
 #include <filesystem>
@@ -52,22 +51,6 @@ std::string ReadText(const std::string& path) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
-}
-
-Status WriteText(const std::string& path, const std::string& text, CreateMode mode) {
-  auto fd = CreatePrivateFile(path, mode);
-  if (!fd.ok()) return fd.status();
-  size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd.value(), text.data() + done, text.size() - done);
-    if (n <= 0) {
-      ::close(fd.value());
-      return Status::Internal(path + ": write failed");
-    }
-    done += static_cast<size_t>(n);
-  }
-  if (::close(fd.value()) != 0) return Status::Internal(path + ": close failed");
-  return Status::OK();
 }
 
 std::string BioText(BIO* b) {
@@ -195,8 +178,8 @@ class Authority {
     if (!k.ok()) return k.status();
     auto c = Issue(k.value().get(), subject, nullptr, k.value().get(), days, true);
     if (!c.ok()) return c.status();
-    if (Status s = WriteText(key_path_, KeyPem(k.value().get()), CreateMode::kNew); !s.ok()) return s;
-    if (Status s = WriteText(cert_path_, CertPem(c.value().get()), CreateMode::kNew); !s.ok()) return s;
+    if (Status s = WritePrivateFile(key_path_, KeyPem(k.value().get()), CreateMode::kNew); !s.ok()) return s;
+    if (Status s = WritePrivateFile(cert_path_, CertPem(c.value().get()), CreateMode::kNew); !s.ok()) return s;
     key_ = std::move(k.value());
     cert_ = std::move(c.value());
     out << "made     " << name_ << ": " << cert_path_ << ", " << key_path_ << "\n";
@@ -234,8 +217,8 @@ Status SignDocument(const std::string& xml_path, const std::string& signed_path,
   if (!key.ok()) return key.status();
   auto signed_text = SmimeSigned(text, ca.cert(), key.value());
   if (!signed_text.ok()) return signed_text.status().WithContext(signed_path);
-  if (Status s = WriteText(xml_path, text, CreateMode::kReplace); !s.ok()) return s;
-  if (Status s = WriteText(signed_path, signed_text.value(), CreateMode::kReplace); !s.ok()) return s;
+  if (Status s = WritePrivateFile(xml_path, text, CreateMode::kReplace); !s.ok()) return s;
+  if (Status s = WritePrivateFile(signed_path, signed_text.value(), CreateMode::kReplace); !s.ok()) return s;
   out << "signed   " << signed_path << "\n";
   return Status::OK();
 }
@@ -278,8 +261,8 @@ Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>
                      options.identity_days, false);
       if (!c.ok()) return c.status();
       const CreateMode mode = renew ? CreateMode::kReplace : CreateMode::kNew;
-      if (Status s = WriteText(key_path, KeyPem(k.value().get()), mode); !s.ok()) return s;
-      if (Status s = WriteText(cert_path, CertPem(c.value().get()), mode); !s.ok()) return s;
+      if (Status s = WritePrivateFile(key_path, KeyPem(k.value().get()), mode); !s.ok()) return s;
+      if (Status s = WritePrivateFile(cert_path, CertPem(c.value().get()), mode); !s.ok()) return s;
       cert = std::move(c.value());
       out << (renew && have ? "renewed  " : "issued   ") << identity << ": " << cert_path << "\n";
     }

@@ -14,6 +14,8 @@
 //   - CreatePrivateDirectories(dir): creates each missing folder of `dir` with mode 0700 (0750
 //     with `group_readable`); folders that exist are left as they are. The functions above
 //     create no folder: call this first for a path whose folder may be missing.
+//   - WritePrivateFile(path, text, mode): CreatePrivateFile, then all of `text` written and the
+//     file closed (small files: keys, tokens, documents).
 // Every function returns a Status naming the path and the system's reason; the returned file
 // descriptor is O_CLOEXEC and owned by the caller. The umask still applies (it can only remove
 // permissions).
@@ -32,6 +34,8 @@ struct PrivateFileOptions {
 };
 
 StatusOr<int> CreatePrivateFile(const std::string& path, CreateMode mode, const PrivateFileOptions& options = {});
+Status WritePrivateFile(const std::string& path, const std::string& text, CreateMode mode,
+                        const PrivateFileOptions& options = {});
 StatusOr<int> OpenPrivateLog(const std::string& path, const PrivateFileOptions& options = {});
 Status CreatePrivateDirectories(const std::string& dir, const PrivateFileOptions& options = {});
 

@@ -74,8 +74,9 @@ std::map<std::string, TopicAccess> TopicAccessByProcess(const Graph& graph, cons
                                                          const Catalog& catalog, std::vector<Diagnostic>* diagnostics);
 
 // The graph's text (Graph::yaml_text) with the value of every Secret() param of its components
-// replaced by "<redacted>" wherever it appears (the param, a --set in the header of a graph as
-// run): what Context::graph_yaml() gives components, and recorders keep.
+// replaced by "<redacted>" wherever it stands as a whole value (the param, a --set in the header
+// of a graph as run; never inside a longer word): what Context::graph_yaml() gives components,
+// and recorders keep.
 std::string RedactedGraphYaml(const Graph& graph, const ResolvedGraph& resolved);
 
 // Converts a YAML value to a param of `spec`'s type; InvalidArgument (message without location)
