@@ -8,6 +8,8 @@
 #include <ostream>
 #include <sstream>
 
+#include <arpa/inet.h>
+
 #include <openssl/bio.h>
 #include <openssl/err.h>
 #include <openssl/evp.h>
@@ -92,7 +94,10 @@ bool AddExtension(X509* cert, X509* issuer, int nid, const char* value) {
 
 // A certificate of `key` for `subject` ("CN=..."), signed by `issuer_key` (issuer: null for a
 // self-signed CA).
-StatusOr<Cert> Issue(EVP_PKEY* key, const std::string& subject, X509* issuer, EVP_PKEY* issuer_key, int days, bool ca) {
+enum class Use { kCa, kIdentity, kTlsServer };
+
+StatusOr<Cert> Issue(EVP_PKEY* key, const std::string& subject, X509* issuer, EVP_PKEY* issuer_key, int days, Use use,
+                     const std::string& alt_names = "") {
   Cert c(X509_new());
   X509_NAME* name = X509_NAME_new();
   const std::string cn = subject.substr(subject.find('=') + 1);
@@ -112,9 +117,15 @@ StatusOr<Cert> Issue(EVP_PKEY* key, const std::string& subject, X509* issuer, EV
   ok = ok && X509_gmtime_adj(X509_getm_notBefore(c.get()), -3600) != nullptr &&  // an hour of clock skew
        X509_gmtime_adj(X509_getm_notAfter(c.get()), static_cast<long>(days) * 86400) != nullptr;
   X509* signer = issuer ? issuer : c.get();
-  if (ca) {
+  if (use == Use::kCa) {
     ok = ok && AddExtension(c.get(), signer, NID_basic_constraints, "critical,CA:TRUE") &&
          AddExtension(c.get(), signer, NID_key_usage, "critical,keyCertSign,cRLSign,digitalSignature");
+  } else if (use == Use::kTlsServer) {
+    ok = ok && AddExtension(c.get(), signer, NID_basic_constraints, "critical,CA:FALSE") &&
+         AddExtension(c.get(), signer, NID_key_usage, "critical,digitalSignature") &&
+         AddExtension(c.get(), signer, NID_ext_key_usage, "serverAuth") &&
+         AddExtension(c.get(), signer, NID_subject_alt_name, alt_names.c_str()) &&
+         AddExtension(c.get(), signer, NID_authority_key_identifier, "keyid");
   } else {
     ok = ok && AddExtension(c.get(), signer, NID_basic_constraints, "critical,CA:FALSE") &&
          AddExtension(c.get(), signer, NID_key_usage, "critical,digitalSignature,keyAgreement");
@@ -176,7 +187,7 @@ class Authority {
                                         ": restore the certificate (or remove the key to make a new CA)");
     auto k = NewKey();
     if (!k.ok()) return k.status();
-    auto c = Issue(k.value().get(), subject, nullptr, k.value().get(), days, true);
+    auto c = Issue(k.value().get(), subject, nullptr, k.value().get(), days, Use::kCa);
     if (!c.ok()) return c.status();
     if (Status s = WritePrivateFile(key_path_, KeyPem(k.value().get()), CreateMode::kNew); !s.ok()) return s;
     if (Status s = WritePrivateFile(cert_path_, CertPem(c.value().get()), CreateMode::kNew); !s.ok()) return s;
@@ -223,6 +234,48 @@ Status SignDocument(const std::string& xml_path, const std::string& signed_path,
   return Status::OK();
 }
 
+// "IP:a,DNS:b" for the hosts (an address is an IP entry, anything else a DNS name).
+std::string AltNames(const std::vector<std::string>& hosts) {
+  std::string out;
+  for (const std::string& h : hosts) {
+    unsigned char buf[16];
+    const bool ip = inet_pton(AF_INET, h.c_str(), buf) == 1 || inet_pton(AF_INET6, h.c_str(), buf) == 1;
+    if (!out.empty()) out += ',';
+    out.append(ip ? "IP:" : "DNS:").append(h);
+  }
+  return out;
+}
+
+// The web CA and web/tls.pem (see the header); the hosts a certificate was issued for are kept
+// in web/hosts, so a rerun with other hosts reissues it.
+Status InitWebCertificate(const Graph& graph, const KeystoreOptions& options, std::ostream& out) {
+  const fs::path dir = fs::path(options.dir), web = dir / "web";
+  if (Status s = CreatePrivateDirectories(web.string()); !s.ok()) return s;
+  Authority web_ca("web CA", (dir / "web_ca.cert.pem").string(), (dir / "ca" / "web_ca.key.pem").string());
+  if (Status s = web_ca.Open("CN=dyad web CA " + graph.name, options.ca_days, out); !s.ok()) return s;
+  const std::string alt = AltNames(options.web_hosts), tls_path = (web / "tls.pem").string(),
+                    hosts_path = (web / "hosts").string();
+  const bool have = fs::exists(fs::symlink_status(tls_path)) && fs::exists(fs::symlink_status(hosts_path));
+  const bool renew = options.renew.count("all") > 0 || options.renew.count("web") > 0;
+  if (have && !renew && ReadText(hosts_path) == alt + "\n") {
+    out << "kept     web: " << tls_path << "\n";
+    return Status::OK();
+  }
+  auto ca_key = web_ca.key("issue the web certificate");
+  if (!ca_key.ok()) return ca_key.status();
+  auto k = NewKey();
+  if (!k.ok()) return k.status();
+  auto c = Issue(k.value().get(), "CN=" + options.web_hosts.front(), web_ca.cert(), ca_key.value(), options.identity_days,
+                 Use::kTlsServer, alt);
+  if (!c.ok()) return c.status();
+  const CreateMode mode = have ? CreateMode::kReplace : CreateMode::kNew;
+  if (Status s = WritePrivateFile(tls_path, KeyPem(k.value().get()) + CertPem(c.value().get()), mode); !s.ok()) return s;
+  if (Status s = WritePrivateFile((web / "cert.pem").string(), CertPem(c.value().get()), CreateMode::kReplace); !s.ok()) return s;
+  if (Status s = WritePrivateFile(hosts_path, alt + "\n", CreateMode::kReplace); !s.ok()) return s;
+  out << (have ? "renewed  " : "issued   ") << "web (" << alt << "): " << tls_path << "\n";
+  return Status::OK();
+}
+
 }  // namespace
 
 Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>& access, const KeystoreOptions& options,
@@ -258,7 +311,7 @@ Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>
       auto k = NewKey();
       if (!k.ok()) return k.status();
       auto c = Issue(k.value().get(), IdentitySubject(graph, identity), identity_ca.cert(), ca_key.value(),
-                     options.identity_days, false);
+                     options.identity_days, Use::kIdentity);
       if (!c.ok()) return c.status();
       const CreateMode mode = renew ? CreateMode::kReplace : CreateMode::kNew;
       if (Status s = WritePrivateFile(key_path, KeyPem(k.value().get()), mode); !s.ok()) return s;
@@ -280,6 +333,7 @@ Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>
         !s.ok())
       return s;
   }
+  if (!options.web_hosts.empty()) return InitWebCertificate(graph, options, out);
   return Status::OK();
 }
 

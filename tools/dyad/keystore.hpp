@@ -13,6 +13,11 @@
 //     issued: that is how a new host or process is admitted), documents are re-signed only when
 //     their text changed. `renew` names identities whose key and certificate are replaced
 //     (rotation); "all" renews every identity. CA keys are never replaced.
+//   - With `web_hosts` (names or addresses the browsers use): a third CA, the web CA (made once,
+//     web_ca.cert.pem: what the browsers trust), and web/tls.pem, the web component's
+//     `tls_certificate`: a new ECDSA P-256 key and a TLS server certificate for exactly those
+//     hosts (subjectAltName), valid `identity_days`; web/cert.pem is the certificate alone. It is
+//     reissued when the hosts change or with `renew` "web" (or "all").
 //   - Folders 0700, files 0600, created O_EXCL | O_NOFOLLOW (dyad/private_file.hpp).
 // Each created or kept file is reported on `out`; errors name the file.
 #pragma once
@@ -21,6 +26,7 @@
 #include <map>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <dyad/graph.hpp>
 #include <dyad/status.hpp>
@@ -33,6 +39,7 @@ struct KeystoreOptions {
   int ca_days = 3650;
   int identity_days = 365;
   std::set<std::string> renew;  // identities to reissue; {"all"}: every one
+  std::vector<std::string> web_hosts;  // DNS names or IP addresses of the web component's TLS certificate
 };
 
 Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>& access, const KeystoreOptions& options,

@@ -59,8 +59,11 @@ void AddSecurityCommands(CLI::App& app, int& exit_code) {
   init->add_option("--graph", st->graph, "The graph")->required();
   init->add_option("--plugins", st->plugins, "Extra plugin file or folder (repeatable)");
   init->add_option("--set", st->sets, "Change a key of the graph, as `dyad run --set` does (the runs must use the same sets)");
-  init->add_option("--renew", st->renew, "Replace the key and certificate of this identity (process.NAME, host.NAME, or all; repeatable)");
+  init->add_option("--renew", st->renew, "Replace the key and certificate of this identity (process.NAME, host.NAME, web, or all; repeatable)");
   init->add_option("--days", st->keystore.identity_days, "Validity of newly issued identities, days (default 365)")->check(CLI::Range(1, 36500));
+  init->add_option("--web-host", st->keystore.web_hosts,
+                   "Also make the web CA and web/tls.pem, a TLS certificate for the web component (params.tls_certificate) "
+                   "valid for this DNS name or address (repeatable)");
   init->add_option("--ca-days", st->keystore.ca_days, "Validity of new CAs, days (default 3650)")->check(CLI::Range(1, 36500));
   init->callback([st, &exit_code] {
     Graph graph;
@@ -68,7 +71,7 @@ void AddSecurityCommands(CLI::App& app, int& exit_code) {
     if ((exit_code = LoadForKeystore(st->graph, st->sets, st->plugins, &graph, &access)) != 0) return;
     const std::vector<std::string> identities = GraphIdentities(graph);
     for (const std::string& r : st->renew)
-      if (r != "all" && std::find(identities.begin(), identities.end(), r) == identities.end()) {
+      if (r != "all" && r != "web" && std::find(identities.begin(), identities.end(), r) == identities.end()) {
         std::cerr << "dyad security init: --renew " << r << ": not an identity of graph '" << graph.name << "' (";
         for (size_t i = 0; i < identities.size(); ++i) std::cerr << (i ? ", " : "") << identities[i];
         std::cerr << ")\n";

@@ -120,6 +120,39 @@ TEST_F(KeystoreTest, OpenSslVerifiesTheIdentitiesAndTheSignedDocuments) {
   EXPECT_EQ(Mode(keys_), 0700u);
 }
 
+// --web-host: a TLS server certificate for exactly those hosts, issued by a web CA of its own
+// (what a browser is asked to trust signs nothing else), private, kept on a rerun with the same
+// hosts and reissued with others.
+TEST_F(KeystoreTest, WebHostsGetATlsServerCertificateFromTheWebCa) {
+  auto r = Init({"--web-host", "127.0.0.1", "--web-host", "lab-pc.local"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const fs::path tls = keys_ / "web" / "tls.pem", cert = keys_ / "web" / "cert.pem", ca = keys_ / "web_ca.cert.pem";
+  EXPECT_EQ(Mode(tls), 0600u);
+  EXPECT_EQ(Mode(keys_ / "ca" / "web_ca.key.pem"), 0600u);
+  int code = 0;
+  const std::string verify = OpenSsl({"verify", "-purpose", "sslserver", "-CAfile", ca.string(), cert.string()}, &code);
+  EXPECT_EQ(code, 0) << verify;
+  OpenSsl({"verify", "-CAfile", (keys_ / "identity_ca.cert.pem").string(), cert.string()}, &code);
+  EXPECT_NE(code, 0) << "the identity CA must not vouch for the web certificate";
+  const std::string ext = OpenSsl({"x509", "-in", cert.string(), "-noout", "-ext", "subjectAltName,extendedKeyUsage"}, &code);
+  EXPECT_NE(ext.find("IP Address:127.0.0.1, DNS:lab-pc.local"), std::string::npos) << ext;
+  EXPECT_NE(ext.find("TLS Web Server Authentication"), std::string::npos) << ext;
+  // tls.pem holds the key that goes with the certificate.
+  const std::string key_pub = OpenSsl({"pkey", "-in", tls.string(), "-pubout"}, &code);
+  const std::string cert_pub = OpenSsl({"x509", "-in", tls.string(), "-noout", "-pubkey"}, &code);
+  EXPECT_EQ(key_pub, cert_pub);
+
+  const std::string before = ReadFile(tls);
+  auto same = Init({"--web-host", "127.0.0.1", "--web-host", "lab-pc.local"});
+  ASSERT_EQ(same.code, 0) << same.err;
+  EXPECT_EQ(ReadFile(tls), before) << same.out;
+  auto other = Init({"--web-host", "10.0.0.7"});
+  ASSERT_EQ(other.code, 0) << other.err;
+  EXPECT_NE(other.out.find("renewed  web (IP:10.0.0.7)"), std::string::npos) << other.out;
+  EXPECT_NE(OpenSsl({"x509", "-in", cert.string(), "-noout", "-ext", "subjectAltName"}, &code).find("IP Address:10.0.0.7"),
+            std::string::npos);
+}
+
 TEST_F(KeystoreTest, PermissionsGrantWhatEachProcessWritesAndReads) {
   ASSERT_EQ(Init().code, 0);
   const std::string pub = ReadFile(Identity("process.pub", "permissions.xml"));
