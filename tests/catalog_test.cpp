@@ -119,5 +119,23 @@ TEST(Catalog, PathOnANonStringParamIsRefused) {
   EXPECT_NE(catalog.Find("good_path"), nullptr);
 }
 
+// Secret() is for strings only: the redaction replaces a value standing whole in the graph's
+// text, and a number or a list has no such value to hide.
+class ListMarkedAsSecret final : public Component {
+ public:
+  static void Describe(ComponentSpec& spec) { spec.Param("keys", std::vector<std::string>{}).Secret(); }
+  Status Configure(Context&) override { return Status::OK(); }
+  Status Step(const StepInfo&) override { return Status::OK(); }
+};
+
+TEST(Catalog, SecretOnANonStringParamIsRefused) {
+  Catalog catalog;
+  const Status s = catalog.Register("test-plugin", [](PluginRegistry& r) { r.Add<ListMarkedAsSecret>("bad_secret"); });
+  EXPECT_EQ(s.code(), Status::Code::kInvalidArgument);
+  EXPECT_EQ(s.message(), "test-plugin: component type 'bad_secret': param 'keys' is marked Secret() but is list of string "
+                         "(only a string can be a secret)");
+  EXPECT_EQ(catalog.Find("bad_secret"), nullptr);
+}
+
 }  // namespace
 }  // namespace dyad
