@@ -82,9 +82,9 @@ if [ "$name" = interactive ]; then
   rec="$out/interactive-$(date +%Y%m%d-%H%M%S).mcap"
   sets=(--set "web.dataset=$dataset" --set "mind.model=$model" --set "observer.model=$observer" --set "recorder.file=$rec")
   "$dyad" validate "$graph" "${sets[@]}"
-  echo "demo: a person steers: open http://127.0.0.1:8765/subject (hold the mouse button or Space),"
-  echo "demo: the experimenter's page http://127.0.0.1:8765/experimenter, or Foxglove on ws://127.0.0.1:8765"
-  echo "demo: Ctrl-C ends the session"
+  echo "demo: a person steers: open the subject's page at the address printed below ('web: subject's page:"
+  echo "demo: http://127.0.0.1:8765/subject?token=...'; hold the mouse button or Space), the experimenter's page or"
+  echo "demo: Foxglove at the addresses beside it (each link carries its role's token); Ctrl-C ends the session"
   "$dyad" run "$graph" "${sets[@]}" ${DEMO_DURATION:+--duration "$DEMO_DURATION"} || true
   "$dyad" analyze "$rec" -o "$out/report-$(basename "${rec%.mcap}")" --dataset "$dataset"
   echo "demo: recording $rec"

@@ -10,7 +10,7 @@ packages=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools default-jre-headless
   libeigen3-dev libceres-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libzstd-dev
   libgtest-dev libgmock-dev libbenchmark-dev libcivetweb-dev libssl-dev openssl
-  python3 python3-matplotlib chromium universal-ctags
+  python3 python3-matplotlib chromium libnss3-tools universal-ctags
   iproute2 nftables procps
   gdb  # the stacks of a process a test finds hung (tests' ChildProcess::Stacks, multihost_test.sh)
 )

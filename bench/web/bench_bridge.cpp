@@ -1,7 +1,7 @@
 // The Foxglove bridge's throughput to one client, without a graph in the way: FoxgloveBridge and
 // WebServer as the web component wires them, fed 100-byte CDR samples as fast as one thread can,
 // while a Foxglove client (npm @foxglove/ws-protocol, started by bench_web.sh) counts what it
-// receives. Prints the port, waits for a subscription, feeds for SECONDS, then prints the fed
+// receives (connecting with the viewer's token, `bench-viewer-token-01`). Prints the port, waits for a subscription, feeds for SECONDS, then prints the fed
 // count and the drops reported.
 //   bench_bridge SECONDS
 #include <chrono>
@@ -22,7 +22,8 @@ int main(int argc, char** argv) {
   FoxgloveBridge bridge("bench", {foxglove::Channel{1, "bench/samples", type.name, type.idl}}, {});
   WebServer::Options o;
   o.port = 0;
-  o.endpoints = {WebServer::Endpoint{"/", {foxglove::kSubprotocol}, &bridge}};
+  o.tokens = {{Role::kViewer, "bench-viewer-token-01"}};
+  o.endpoints = {WebServer::Endpoint{"/", {foxglove::kSubprotocol}, &bridge, {Role::kViewer}}};
   auto server = WebServer::Start(o);
   if (!server.ok()) {
     std::fprintf(stderr, "%s\n", server.status().message().c_str());

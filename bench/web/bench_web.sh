@@ -29,7 +29,7 @@ topics:
 components:
   pattern: {type: cartesian_pattern, rate_hz: $2, params: {shape: figure8, radius: 30, period_s: 4}, outputs: {command: robot/command}}
   driver: {type: virtual_cartesian, trigger: command, params: {max_velocity: 1e6, max_acceleration: 1e9}, inputs: {command: robot/command}, outputs: {state: robot/state}}
-  web: {type: web, rate_hz: 30, params: {port: 0, port_file: web.port}, inputs: {robot: robot/state}, outputs: {pointer: web/pointer}}
+  web: {type: web, rate_hz: 30, params: {port: 0, port_file: web.port, token: experimenter-token-0001, subject_token: subject-token-000001, viewer_token: viewer-token-0000001}, inputs: {robot: robot/state}, outputs: {pointer: web/pointer}}
   human: {type: web_human, rate_hz: 100, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
 YAML
 }
@@ -55,7 +55,7 @@ hops=$(grep -o "pointer hops: .*" run.err | sed 's/^pointer hops: //' || echo "n
 
 coproc BRIDGE { "$build/bin/bench_bridge" 6 2> bridge.err; }
 read -r port <&"${BRIDGE[0]}"
-throughput=$(node "$node_dir/bench_clients.mjs" foxglove "ws://127.0.0.1:$port" bench/samples 5 1)
+throughput=$(node "$node_dir/bench_clients.mjs" foxglove "ws://127.0.0.1:$port/?token=bench-viewer-token-01" bench/samples 5 1)
 wait $BRIDGE_PID || true
 throughput="$throughput; bridge: $(cat bridge.err)"
 
@@ -71,8 +71,8 @@ for _ in 1 2 3 4 5; do
     start wall.yaml
     case $c in
       base) sleep 13 ;;
-      four) node "$node_dir/bench_clients.mjs" foxglove "ws://127.0.0.1:$port" "" 13 4 > /dev/null ;;
-      hostile) node "$node_dir/hostile_clients.mjs" "ws://127.0.0.1:$port" 1000 10 > /dev/null ;;
+      four) node "$node_dir/bench_clients.mjs" foxglove "ws://127.0.0.1:$port/?token=viewer-token-0000001" "" 13 4 > /dev/null ;;
+      hostile) node "$node_dir/hostile_clients.mjs" "ws://127.0.0.1:$port/?token=viewer-token-0000001" 1000 10 > /dev/null ;;
     esac
     stop
     p99 pattern >> $c.pattern; p99 driver >> $c.driver

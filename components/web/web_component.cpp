@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -27,21 +28,52 @@
 namespace dyad::web {
 namespace {
 
-// The token kept in `path` (params.token_file): a regular file, not a link, readable by its owner
-// only, holding one token of 16..256 printable characters (a newline after it is allowed).
-StatusOr<std::string> ReadTokenFile(const std::string& path) {
-  const std::string key = "params.token_file = '" + path + "': ";
-  struct stat st {};
-  if (lstat(path.c_str(), &st) != 0) return Status::NotFound(key + "missing");
-  if (S_ISLNK(st.st_mode) || !S_ISREG(st.st_mode)) return Status::InvalidArgument(key + "not a regular file (a link is refused)");
-  if ((st.st_mode & 077) != 0) return Status::InvalidArgument(key + "readable by others: chmod 600 it");
-  std::ifstream in(path);
-  std::string token;
-  std::getline(in, token);
+// Where each role's token comes from, in order: its param, its environment variable, the
+// token_file's line for it, else a new one.
+struct RoleSource {
+  Role role;
+  const char* param;
+  const char* env;
+};
+constexpr RoleSource kRoleSources[] = {{Role::kExperimenter, "token", "DYAD_WEB_TOKEN"},
+                                       {Role::kSubject, "subject_token", "DYAD_WEB_SUBJECT_TOKEN"},
+                                       {Role::kViewer, "viewer_token", "DYAD_WEB_VIEWER_TOKEN"}};
+
+// A usable token: 16..256 printable characters that stand in a URL's query as they are.
+Status CheckToken(const std::string& token, const std::string& where) {
   if (token.size() < 16 || token.size() > 256 ||
-      !std::all_of(token.begin(), token.end(), [](char c) { return c > ' ' && c < 127 && c != '&' && c != '#'; }))
-    return Status::InvalidArgument(key + "must hold one token of 16..256 printable characters without spaces, '&' or '#'");
-  return token;
+      !std::all_of(token.begin(), token.end(), [](char c) { return c > ' ' && c < 127 && c != '&' && c != '#' && c != '+' && c != '%'; }))
+    return Status::InvalidArgument(where + ": a token is 16..256 printable characters without spaces, '&', '#', '+' or '%'");
+  return Status::OK();
+}
+
+// The tokens kept in `path` (params.token_file): a regular file, not a link, readable by its
+// owner only, with one line "ROLE TOKEN" for each of experimenter, subject and viewer.
+StatusOr<std::map<Role, std::string>> ReadTokenFile(const std::string& path) {
+  const std::string key = "params.token_file = '" + path + "'";
+  struct stat st {};
+  if (lstat(path.c_str(), &st) != 0) return Status::NotFound(key + ": missing");
+  if (S_ISLNK(st.st_mode) || !S_ISREG(st.st_mode)) return Status::InvalidArgument(key + ": not a regular file (a link is refused)");
+  if ((st.st_mode & 077) != 0) return Status::InvalidArgument(key + ": readable by others: chmod 600 it");
+  std::ifstream in(path);
+  std::map<Role, std::string> tokens;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    const std::string where = key + " line " + std::to_string(n);
+    const size_t space = line.find(' ');
+    std::optional<Role> role;
+    for (const auto& r : kRoleSources)
+      if (space != std::string::npos && line.compare(0, space, RoleName(r.role)) == 0) role = r.role;
+    if (!role) return Status::InvalidArgument(where + ": expected 'experimenter TOKEN', 'subject TOKEN' or 'viewer TOKEN'");
+    const std::string token = line.substr(space + 1);
+    if (Status s = CheckToken(token, where); !s.ok()) return s;
+    tokens[*role] = token;
+  }
+  for (const auto& r : kRoleSources)
+    if (!tokens.count(r.role))
+      return Status::InvalidArgument(key + ": no line for the " + RoleName(r.role) +
+                                     "'s token (a file from before per-role tokens: delete it and a new one is made)");
+  return tokens;
 }
 
 std::string RandomToken() {
@@ -99,14 +131,21 @@ struct WebComponent::StatsTable {
 
 void WebComponent::Describe(ComponentSpec& spec) {
   spec.Summary("Embedded web server with a live Foxglove WebSocket bridge over the graph's topics.");
-  spec.Param("address", "127.0.0.1").Doc("address to bind; anything but loopback requires a token");
+  spec.Param("address", "127.0.0.1").Doc("address to bind; anything but loopback needs tls_certificate (or plain_http)");
   spec.Param("port", 8765).Range(0, 65535).Doc("TCP port; 0 picks a free one (see port_file)");
   spec.Param("topics", std::vector<std::string>{}).Doc("topics to advertise, by name or regular expression (empty: all)");
   spec.Param("writable", std::vector<std::string>{}).Doc("topics Foxglove clients may publish on (empty: none)");
-  spec.Param("token", "").Secret().Doc("clients must connect with ?token=...; empty: token_file's, DYAD_WEB_TOKEN, none on "
-                                       "loopback, else generated and printed (kept out of recordings)");
-  spec.Param("token_file", "").Path().Doc("a 0600 file holding the token: read when it exists, else created with a new one "
-                                          "(bookmarked pages keep working across runs); the token is then not printed");
+  spec.Param("token", "").Secret().Doc("the experimenter's token (every page, notes, publishing on writable topics); empty: "
+                                       "$DYAD_WEB_TOKEN, token_file's, else generated and printed");
+  spec.Param("subject_token", "").Secret().Doc("the subject's token (the subject's page, steering); empty: "
+                                               "$DYAD_WEB_SUBJECT_TOKEN, token_file's, else generated and printed");
+  spec.Param("viewer_token", "").Secret().Doc("the viewer's token (watch only: pages without steering or notes, Foxglove "
+                                              "read-only); empty: $DYAD_WEB_VIEWER_TOKEN, token_file's, else generated");
+  spec.Param("token_file", "").Path().Doc("a 0600 file of 'ROLE TOKEN' lines: read when it exists, else created with new "
+                                          "tokens (bookmarked pages keep working across runs); its tokens are not printed");
+  spec.Param("tls_certificate", "").Path().Doc("PEM file (0600): private key, then certificate chain; the server then speaks "
+                                               "HTTPS and WSS only");
+  spec.Param("plain_http", false).Doc("allow a non-loopback address without TLS (tokens and data cross the network in clear)");
   spec.Param("allowed_origins", std::vector<std::string>{}).Doc("browser origins allowed besides localhost ('*': any)");
   spec.Param("max_clients", 8).Range(1, 64).Doc("WebSocket clients at once");
   spec.Param("client_buffer_kb", 4096).Range(16, 1 << 20).Doc("per-client send buffer; past it the busiest channel's oldest samples are dropped");
@@ -133,33 +172,8 @@ Status WebComponent::Configure(Context& ctx) {
   options_.client_buffer_bytes = static_cast<size_t>(p.Int("client_buffer_kb")) << 10;
   options_.max_frame_bytes = static_cast<size_t>(p.Int("max_frame_kb")) << 10;
 
-  // Where the token comes from, said in the printed URLs instead of the token itself; only a
-  // token dyad draws and keeps nowhere else is printed (else nobody could use it).
-  options_.token = p.String("token");
-  token_shown_ = "<params.token>";
-  if (options_.token.empty())
-    if (const char* env = std::getenv("DYAD_WEB_TOKEN")) {
-      options_.token = env;
-      token_shown_ = "<$DYAD_WEB_TOKEN>";
-    }
-  token_file_ = p.String("token_file");
-  create_token_file_ = false;
-  if (options_.token.empty() && !token_file_.empty()) {
-    auto kept = ReadTokenFile(token_file_);
-    token_shown_ = "<the token in " + token_file_ + ">";
-    if (kept.ok()) {
-      options_.token = kept.value();
-    } else if (kept.status().code() == Status::Code::kNotFound) {
-      options_.token = RandomToken();  // the file is created at Activate (Configure acts on nothing)
-      create_token_file_ = true;
-    } else {
-      return kept.status();
-    }
-  }
-  if (options_.token.empty() && !IsLoopback(options_.address)) {
-    options_.token = RandomToken();
-    token_shown_ = options_.token;
-  }
+  if (Status s = ChooseTokens(p); !s.ok()) return s;
+  if (Status s = ChooseTls(p); !s.ok()) return s;
   port_file_ = p.String("port_file");
 
   std::vector<std::string> names;
@@ -174,6 +188,7 @@ Status WebComponent::Configure(Context& ctx) {
 
   std::map<std::string, SerializedWriter*> writers;
   const auto writable = p.StringList("writable");
+  writable_ = writable;
   for (size_t i = 0; i < writable.size(); ++i) {
     const TopicInfo* info = nullptr;
     for (const auto& t : ctx.graph_topics())
@@ -190,7 +205,6 @@ Status WebComponent::Configure(Context& ctx) {
   SubjectChannel::Options so;
   so.engage_key = p.String("engage_key");
   so.half_width = p.Double("half_width");
-  so.token = options_.token;
   if (p.Bool("show_primitives")) {
     if (p.String("dataset").empty()) return Status::InvalidArgument("params.show_primitives: needs params.dataset (an NRL data set folder)");
     auto data = pvrnn::LoadNrlDataset(p.String("dataset"));
@@ -237,14 +251,17 @@ Status WebComponent::Configure(Context& ctx) {
     if (!s.ok()) return s;
   }
 
-  options_.pages["/"] = WebServer::Page{"text/html; charset=utf-8", kIndexHtml, ""};
-  options_.pages["/subject"] = WebServer::Page{"text/html; charset=utf-8", kSubjectHtml, ""};
-  options_.pages["/experimenter"] = WebServer::Page{"text/html; charset=utf-8", kExperimenterHtml, ""};
+  const std::set<Role> everyone = {Role::kViewer, Role::kSubject, Role::kExperimenter};
+  const std::set<Role> watchers = {Role::kViewer, Role::kExperimenter};  // not the subject: no stats, no notes
+  const std::string html = "text/html; charset=utf-8";
+  options_.pages["/"] = WebServer::Page{html, kIndexHtml, everyone, ""};
+  options_.pages["/subject"] = WebServer::Page{html, kSubjectHtml, everyone, ""};
+  options_.pages["/experimenter"] = WebServer::Page{html, kExperimenterHtml, watchers, ""};
   options_.endpoints = {
-      WebServer::Endpoint{"/", {foxglove::kSubprotocol, foxglove::kSubprotocolSdk}, bridge_.get()},
+      WebServer::Endpoint{"/", {foxglove::kSubprotocol, foxglove::kSubprotocolSdk}, bridge_.get(), watchers},
       // The subject steers by the robot state on this page: no batching delay.
-      WebServer::Endpoint{"/subject/ws", {}, subject_.get(), /*viewers=*/false},
-      WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get()},
+      WebServer::Endpoint{"/subject/ws", {}, subject_.get(), everyone, /*viewers=*/false},
+      WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get(), watchers},
   };
   // Read only while a client subscribes (the bridge starts and stops them).
   FoxgloveBridge* bridge = bridge_.get();
@@ -259,22 +276,16 @@ Status WebComponent::Configure(Context& ctx) {
 
 Status WebComponent::Activate() {
   auto s = WebServer::Start(options_);
-  if (!s.ok()) return s.status().WithContext("params.address/port");
+  if (!s.ok()) return s.status().WithContext(options_.tls_certificate.empty() ? "params.address/port" : "params.address/port/tls_certificate");
   server_ = std::move(s.value());
   bridge_->SetServer(server_.get());
   subject_->SetServer(server_.get());
   experimenter_->SetServer(server_.get());
-  if (create_token_file_) {
-    if (Status s = WritePrivateFile(token_file_, options_.token + "\n", CreateMode::kNew); !s.ok())
+  if (!token_file_text_.empty()) {
+    if (Status s = WritePrivateFile(token_file_, token_file_text_, CreateMode::kNew); !s.ok())
       return s.WithContext("params.token_file");
   }
-  // Bound to a wildcard address, the URLs name the machine's real addresses (0.0.0.0 opens nothing).
-  const std::string query = options_.token.empty() ? "" : "?token=" + token_shown_;
-  for (const std::string& host : UrlHosts(options_.address)) {
-    const std::string base = host + ":" + std::to_string(server_->port());
-    ctx_->log().Info("subject's page: http://" + base + "/subject" + query + "  experimenter: http://" + base +
-                     "/experimenter" + query + "  Foxglove WebSocket: ws://" + base + "/" + query);
-  }
+  LogUrls();
   if (!port_file_.empty()) {
     std::ofstream f(port_file_);
     f << server_->port() << "\n";
@@ -322,6 +333,84 @@ Status WebComponent::Deactivate() {
   ctx_->log().Info(std::to_string(bridge_->samples_sent()) + " samples sent to clients");
   LogPointerDelays();
   return Status::OK();
+}
+
+// Each role's token: its param, else its environment variable, else the token_file's, else a
+// new one. What the printed URLs show instead of a token says where it is; only a token dyad
+// drew and keeps nowhere else is printed (else nobody could use it).
+Status WebComponent::ChooseTokens(const Params& p) {
+  options_.tokens.clear();
+  shown_.clear();
+  token_file_ = p.String("token_file");
+  token_file_text_.clear();
+  std::map<Role, std::string> kept;
+  bool make_file = false;
+  if (!token_file_.empty()) {
+    auto read = ReadTokenFile(token_file_);
+    if (read.ok()) kept = std::move(read.value());
+    else if (read.status().code() == Status::Code::kNotFound) make_file = true;  // created at Activate
+    else return read.status();
+  }
+  for (const auto& r : kRoleSources) {
+    std::string& token = options_.tokens[r.role];
+    std::string& shown = shown_[r.role];
+    if (token = p.String(r.param); !token.empty()) {
+      shown = std::string("<params.") + r.param + ">";
+    } else if (const char* env = std::getenv(r.env); env != nullptr && *env != '\0') {
+      token = env;
+      shown = std::string("<$") + r.env + ">";
+    } else if (kept.count(r.role)) {
+      token = kept[r.role];
+      shown = std::string("<the ") + RoleName(r.role) + "'s token in " + token_file_ + ">";
+    } else {
+      token = RandomToken();
+      shown = make_file ? std::string("<the ") + RoleName(r.role) + "'s token in " + token_file_ + ">" : token;
+    }
+    const std::string where = shown.rfind("<params.", 0) == 0 ? std::string("params.") + r.param : shown;
+    if (Status s = CheckToken(token, where); !s.ok()) return s;
+    if (make_file) token_file_text_ += std::string(RoleName(r.role)) + " " + token + "\n";
+  }
+  for (const auto& a : kRoleSources)
+    for (const auto& b : kRoleSources)
+      if (a.role < b.role && options_.tokens[a.role] == options_.tokens[b.role])
+        return Status::InvalidArgument(std::string("params.") + a.param + " and params." + b.param +
+                                       ": the same token for two roles (a token says its role)");
+  return Status::OK();
+}
+
+// TLS off loopback: a certificate file that is private, or plain HTTP asked for by name.
+Status WebComponent::ChooseTls(const Params& p) {
+  options_.tls_certificate = p.String("tls_certificate");
+  if (options_.tls_certificate.empty()) {
+    if (IsLoopback(options_.address) || p.Bool("plain_http")) return Status::OK();
+    return Status::InvalidArgument("params.address = '" + options_.address +
+                                   "': off loopback the tokens and the subject's data would cross the network in clear: give "
+                                   "params.tls_certificate (dyad security init ... --web-host HOST makes one), or set "
+                                   "params.plain_http: true on a network you trust");
+  }
+  // A missing file is reported when the server starts: `dyad security init --web-host`
+  // configures this graph before it makes the file.
+  struct stat st {};
+  const std::string key = "params.tls_certificate = '" + options_.tls_certificate + "'";
+  if (lstat(options_.tls_certificate.c_str(), &st) != 0) return Status::OK();
+  if (!S_ISREG(st.st_mode))
+    return Status::InvalidArgument(key + ": not a regular file (a PEM file with the private key and the certificate chain)");
+  if ((st.st_mode & 077) != 0) return Status::InvalidArgument(key + ": holds a private key and is readable by others: chmod 600 it");
+  return Status::OK();
+}
+
+// One line per address the server answers on: each page with the token of the role it is for.
+void WebComponent::LogUrls() const {
+  const bool tls = !options_.tls_certificate.empty();
+  const std::string http = tls ? "https://" : "http://", ws = tls ? "wss://" : "ws://";
+  // Bound to a wildcard address, the URLs name the machine's real addresses (0.0.0.0 opens nothing).
+  for (const std::string& host : UrlHosts(options_.address)) {
+    const std::string base = host + ":" + std::to_string(server_->port());
+    ctx_->log().Info("subject's page: " + http + base + "/subject?token=" + shown_.at(Role::kSubject) +
+                     "  experimenter's page: " + http + base + "/experimenter?token=" + shown_.at(Role::kExperimenter) +
+                     "  Foxglove WebSocket: " + ws + base + "/?token=" + shown_.at(Role::kViewer) + " (viewer)" +
+                     (writable_.empty() ? "" : ", or the experimenter's token to publish"));
+  }
 }
 
 namespace {

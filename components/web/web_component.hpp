@@ -3,8 +3,11 @@
 ///   - `/experimenter`: the experimenter's page,
 ///   - `/`: an index page, and the Foxglove WebSocket bridge over the graph's topics for
 ///     Foxglove ("Foxglove WebSocket" connection to ws://ADDRESS:PORT).
-/// Pages are embedded in the plugin. The server binds 127.0.0.1 unless `address` says otherwise;
-/// then a token is required (generated and printed when not given). Its Step (its own rate, the
+/// Pages are embedded in the plugin. The server binds 127.0.0.1 unless `address` says otherwise
+/// (then it speaks TLS with `tls_certificate`). Every page and WebSocket needs a token, one per
+/// role: the subject's opens the subject's page and steers; the viewer's watches (subject's page,
+/// experimenter's page without notes, Foxglove read-only); the experimenter's opens everything,
+/// writes notes and publishes on `writable` topics. Its Step (its own rate, the
 /// pages' display rate, <= 60 Hz) sends the robot's newest position to the subject's pages and
 /// reports dropped samples to Foxglove clients; samples reach the bridge through serialized
 /// subscriptions and pointer samples leave on `pointer` as they come: nothing here ever waits
@@ -41,9 +44,13 @@ class WebComponent final : public Component {
   Context* ctx_ = nullptr;
   WebServer::Options options_;
   std::string port_file_;
-  std::string token_file_;          // params.token_file
-  std::string token_shown_;         // what the printed URLs show for the token (see Configure)
-  bool create_token_file_ = false;  // it did not exist at Configure: Activate creates it
+  Status ChooseTokens(const Params& p);
+  Status ChooseTls(const Params& p);
+  void LogUrls() const;
+  std::string token_file_;                // params.token_file
+  std::map<Role, std::string> shown_;     // what the printed URLs show for each token (see ChooseTokens)
+  std::string token_file_text_;           // what Activate writes to a token_file that did not exist; empty: none
+  std::vector<std::string> writable_;     // params.writable
   Input<msg::CartesianState>* robot_ = nullptr;   // owned by the runtime
   Output<msg::HumanInput>* pointer_ = nullptr;    // owned by the runtime
   Input<msg::Intention>* intention_ = nullptr;    // owned by the runtime

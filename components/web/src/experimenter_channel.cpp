@@ -23,9 +23,10 @@ void ExperimenterChannel::Broadcast(uint32_t channel, const std::string& text) {
   for (ClientId c : pages) server->SendLatest(c, channel, text, /*binary=*/false);
 }
 
-void ExperimenterChannel::OnOpen(ClientId client) {
+void ExperimenterChannel::OnOpen(ClientId client, Role role) {
   std::lock_guard<std::mutex> lock(mutex_);
   pages_.push_back(client);
+  roles_[client] = role;
 }
 
 Status ExperimenterChannel::OnText(ClientId client, std::string_view text) {
@@ -40,6 +41,8 @@ Status ExperimenterChannel::OnText(ClientId client, std::string_view text) {
   if (note.size() > kMaxNote) return Status::InvalidArgument("note: longer than 4 KiB");
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (roles_[client] != Role::kExperimenter)
+      return Status::FailedPrecondition(std::string("note: the ") + RoleName(roles_[client]) + "'s token may not write notes");
     sink_(note);
   }
   if (WebServer* server = server_.load()) server->SendText(client, json{{"op", "noted"}, {"length", note.size()}}.dump());
@@ -53,6 +56,7 @@ Status ExperimenterChannel::OnBinary(ClientId, std::span<const uint8_t>) {
 void ExperimenterChannel::OnClose(ClientId client) {
   std::lock_guard<std::mutex> lock(mutex_);
   std::erase(pages_, client);
+  roles_.erase(client);
 }
 
 }  // namespace dyad::web

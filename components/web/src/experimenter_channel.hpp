@@ -6,7 +6,8 @@
 /// [{component, process, steps, mean_ms, p99_ms, max_ms, misses}]} once a second,
 /// {"op":"events","items":[{t, text}]} once a second when any (RunEvents: restarts, failures,
 /// endpoints renewed), {"op":"noted","t":s} when a note was published.
-/// Page -> server: {"op":"note","text":".."}: published as an Annotation (author "experimenter")
+/// Page -> server: {"op":"note","text":".."} (the experimenter's token only; a viewer's page that
+/// sends one is closed): published as an Annotation (author "experimenter")
 /// on the web component's `notes` output, which the recorder keeps (stamped by the runtime clock,
 /// so the analysis aligns it with everything else). Notes are capped at 4 KiB.
 #pragma once
@@ -30,7 +31,7 @@ class ExperimenterChannel final : public ClientHandler {
   // Sends `json` to every page, replacing an unsent frame of the same kind (`channel`).
   void Broadcast(uint32_t channel, const std::string& json);
 
-  void OnOpen(ClientId client) override;
+  void OnOpen(ClientId client, Role role) override;
   Status OnText(ClientId client, std::string_view text) override;
   Status OnBinary(ClientId client, std::span<const uint8_t> bytes) override;
   void OnClose(ClientId client) override;
@@ -40,6 +41,7 @@ class ExperimenterChannel final : public ClientHandler {
   std::atomic<WebServer*> server_{nullptr};
   std::mutex mutex_;  // guards pages_, serialises sink_
   std::vector<ClientId> pages_;
+  std::map<ClientId, Role> roles_;
 };
 
 }  // namespace dyad::web

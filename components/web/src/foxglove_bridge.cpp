@@ -72,14 +72,15 @@ void FoxgloveBridge::ReportDrops() {
   }
 }
 
-void FoxgloveBridge::OnOpen(ClientId client) {
+void FoxgloveBridge::OnOpen(ClientId client, Role role) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    clients_[client];
+    clients_[client].role = role;
   }
   WebServer* server = server_.load();
   if (server == nullptr) return;
-  server->SendText(client, foxglove::ServerInfo(server_name_, !writers_.empty(), std::to_string(client), {}));
+  const bool may_publish = !writers_.empty() && role == Role::kExperimenter;
+  server->SendText(client, foxglove::ServerInfo(server_name_, may_publish, std::to_string(client), {}));
   server->SendText(client, foxglove::Advertise(channels_));
 }
 
@@ -105,6 +106,10 @@ Status FoxgloveBridge::OnText(ClientId client, std::string_view text) {
           problems.push_back("subscribe: subscription id " + std::to_string(sub) + " is already in use");
           continue;
         }
+        if (st.subscriptions.size() >= kMaxSubscriptions) {
+          problems.push_back("subscribe: a client holds at most " + std::to_string(kMaxSubscriptions) + " subscriptions");
+          break;
+        }
         st.subscriptions[sub] = channel;
         routes_[channel].emplace_back(client, sub);
         changed.insert(channel);
@@ -121,7 +126,13 @@ Status FoxgloveBridge::OnText(ClientId client, std::string_view text) {
     } else if (auto* a = std::get_if<foxglove::ClientAdvertise>(&*parsed)) {
       for (const auto& c : a->channels) {
         auto w = writers_.find(c.topic);
-        if (w == writers_.end()) {
+        if (st.role != Role::kExperimenter) {
+          problems.push_back(std::string("advertise: the ") + RoleName(st.role) + "'s token may not publish");
+          break;
+        } else if (st.publishing.size() >= kMaxClientChannels && !st.publishing.count(c.id)) {
+          problems.push_back("advertise: a client advertises at most " + std::to_string(kMaxClientChannels) + " channels");
+          break;
+        } else if (w == writers_.end()) {
           problems.push_back("advertise: topic '" + c.topic + "' is not writable" +
                              (writers_.empty() ? " (this server accepts no client publishing)" : ""));
         } else if (c.encoding != "cdr") {

@@ -14,8 +14,12 @@
 /// (no DDS reader at all until it is first watched). A subscription that cannot start is
 /// reported to the subscribing client as a status error.
 ///
-/// Client publishing: only on topics listed as writable; anything else is refused with a status
-/// error. A malformed JSON or binary message closes that client with the reason.
+/// Client publishing: only a client with the experimenter's token, only on topics listed as
+/// writable; anything else is refused with a status error (a viewer's serverInfo does not offer
+/// it). Each client holds at most kMaxSubscriptions subscriptions and kMaxClientChannels
+/// advertised channels; past that its requests are refused with a status error, so a client
+/// cannot grow the server's tables. A malformed JSON or binary message closes that client with
+/// the reason.
 #pragma once
 
 #include <atomic>
@@ -53,15 +57,18 @@ class FoxgloveBridge final : public ClientHandler {
   // Reports to each client what it lost since the last call (a status warning per client).
   void ReportDrops();
 
-  void OnOpen(ClientId client) override;
+  void OnOpen(ClientId client, Role role) override;
   Status OnText(ClientId client, std::string_view text) override;
   Status OnBinary(ClientId client, std::span<const uint8_t> bytes) override;
   void OnClose(ClientId client) override;
 
   uint64_t samples_sent() const;
 
+  static constexpr size_t kMaxSubscriptions = 1024, kMaxClientChannels = 64;
+
  private:
   struct ClientState {
+    Role role = Role::kViewer;
     std::map<uint32_t, uint32_t> subscriptions;        // subscription id -> channel id
     std::map<uint32_t, SerializedWriter*> publishing;  // client channel id -> writer
   };

@@ -4,13 +4,26 @@
 
 namespace dyad::web {
 
-void SendQueue::PushControl(std::string json) {
+bool SendQueue::PushControl(std::string json) {
+  bool queued = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (closed_) return;
-    control_.push_back(std::move(json));
+    if (closed_) return false;
+    if (control_bytes_ + json.size() > limit_) {
+      closed_ = overflowed_ = true;
+    } else {
+      control_bytes_ += json.size();
+      control_.push_back(std::move(json));
+      queued = true;
+    }
   }
-  cv_.notify_one();
+  cv_.notify_all();
+  return queued;
+}
+
+bool SendQueue::overflowed() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return overflowed_;
 }
 
 bool SendQueue::PushData(uint32_t channel, std::string bytes, bool binary, std::shared_ptr<const std::string> tail) {
@@ -92,6 +105,7 @@ bool SendQueue::PopAll(std::vector<Frame>* out) {
     last_flush_ = std::chrono::steady_clock::now();
     // Swaps, no copies: producers (graph threads) wait for this lock.
     control.swap(control_);
+    control_bytes_ = 0;
     data.swap(data_);
     channel_bytes_.clear();
     bytes_ = 0;

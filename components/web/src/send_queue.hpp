@@ -2,7 +2,9 @@
 /// producer (a graph component's Publish(), through the bridge's subscription callback).
 ///
 /// Two kinds of frames: control frames (JSON: advertise, status, ...) are never dropped and are
-/// sent first; data frames belong to a channel and are dropped when the buffer is full: past
+/// sent first, so they cannot be shed either: control frames past `limit_bytes` of their own (a
+/// client that sends requests and never reads the answers) close the queue as overflowed, and
+/// the server disconnects that client. Data frames belong to a channel and are dropped when the buffer is full: past
 /// `limit_bytes`, the oldest frames of the channel holding the most bytes are dropped until the
 /// new frame fits (a big, busy topic cannot starve the small ones, foxglove_bridge's lesson).
 /// Drops are counted per channel for the status message the sender reports.
@@ -15,7 +17,7 @@
 /// client's consumer sleeps until there is something to send (no polling). Control frames and
 /// Close() always wake it at once.
 ///
-/// Memory: at most `limit_bytes` queued, plus the batch the consumer is writing. Work under the
+/// Memory: at most `limit_bytes` of data and `limit_bytes` of control frames queued, plus the batch the consumer is writing. Work under the
 /// queue's mutex: a push that fits is O(log channels) (per-channel maps); a push past the limit
 /// also scans the channels once per frame it drops, to find the busiest (channels number tens);
 /// PushLatest frees the frames it replaces; the consumer takes a batch by swapping the queues and
@@ -56,8 +58,9 @@ class SendQueue {
   explicit SendQueue(size_t limit_bytes, std::chrono::steady_clock::duration flush_interval = kDefaultFlushInterval)
       : limit_(limit_bytes), flush_interval_(flush_interval) {}
 
-  // Queues a control frame (never dropped).
-  void PushControl(std::string json);
+  // Queues a control frame (never dropped); past the control limit, closes the queue as
+  // overflowed instead and returns false.
+  bool PushControl(std::string json);
   // Queues a data frame of `channel` (`bytes` followed by `tail`, when given); drops the busiest
   // channel's oldest frames to stay within the limit. A frame larger than the whole limit is
   // dropped itself. Returns false if dropped.
@@ -71,6 +74,8 @@ class SendQueue {
   // False once closed (frames still queued are discarded).
   bool PopAll(std::vector<Frame>* out);
   void Close();
+  // Whether PushControl closed the queue (the client's fault, not the server's).
+  bool overflowed() const;
 
   // Drops per channel since the last call (and resets them).
   std::map<uint32_t, uint64_t> TakeDrops();
@@ -88,7 +93,8 @@ class SendQueue {
   const std::chrono::steady_clock::duration flush_interval_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
-  bool closed_ = false;
+  bool closed_ = false, overflowed_ = false;
+  size_t control_bytes_ = 0;
   bool consumer_idle_ = false;  // the consumer waits with nothing queued: the next push wakes it
   uint64_t wakeups_by_producers_ = 0, idle_waits_ = 0;
   // min(), not the epoch: steady_clock's zero is boot time, and a machine up for less than one

@@ -49,12 +49,13 @@ void SubjectChannel::SendRole(ClientId client, bool steering) {
   if (WebServer* server = server_.load()) server->SendText(client, json{{"op", "role"}, {"steering", steering}}.dump());
 }
 
-void SubjectChannel::OnOpen(ClientId client) {
+void SubjectChannel::OnOpen(ClientId client, Role role) {
   bool steering = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     pages_.push_back(client);
-    if (steering_ == 0) steering_ = client, steering = true;
+    roles_[client] = role;
+    if (steering_ == 0 && role != Role::kViewer) steering_ = client, steering = true;
   }
   json prims = json::array();
   for (const auto& p : options_.primitives) {
@@ -68,7 +69,7 @@ void SubjectChannel::OnOpen(ClientId client) {
                                 {"steering", steering},
                                 {"half_width", options_.half_width},
                                 {"engage_key", options_.engage_key},
-                                {"token_required", !options_.token.empty()},
+                                {"role", RoleName(role)},
                                 {"primitives", prims}}
                                .dump());
 }
@@ -90,6 +91,7 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
     const double h = options_.half_width;
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("pointer: a viewer's token may not steer");
       if (client != steering_) return Status::OK();  // a watching page: ignored
       last_x_ = std::clamp(px, -h, h);
       last_y_ = std::clamp(py, -h, h);
@@ -110,16 +112,10 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
     return Status::OK();
   }
   if (*op == "steer") {
-    auto token = j.find("token");
-    const bool ok = token != j.end() && token->is_string() && TokenMatches(token->get<std::string>(), options_.token);
-    if (!ok) {
-      if (WebServer* server = server_.load())
-        server->SendText(client, json{{"op", "error"}, {"message", "steering not taken: wrong or no token"}}.dump());
-      return Status::OK();
-    }
     ClientId previous;
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("steer: a viewer's token may not steer");
       previous = steering_;
       if (previous == client) return Status::OK();
       steering_ = client;
@@ -141,9 +137,15 @@ void SubjectChannel::OnClose(ClientId client) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     std::erase(pages_, client);
+    roles_.erase(client);
     if (client != steering_) return;
     sink_(last_x_, last_y_, false);  // the subject left: disengaged at once
-    steering_ = pages_.empty() ? 0 : pages_.front();
+    steering_ = 0;
+    for (ClientId page : pages_)
+      if (roles_[page] != Role::kViewer) {
+        steering_ = page;
+        break;
+      }
     promoted = steering_;
   }
   if (promoted != 0) SendRole(promoted, true);

@@ -2,16 +2,18 @@
 /// the page, robot state to it.
 ///
 /// Page -> server (JSON text): {"op":"pointer","x":..,"y":..,"engaged":bool,"t":ms} on every
-/// pointer or key event and every 50 ms while engaged (a keepalive); {"op":"steer","token":".."}
-/// to take the steering role. Server -> page: {"op":"hello",...} (role, workspace, engage key,
+/// pointer or key event and every 50 ms while engaged (a keepalive); {"op":"steer"} to take the
+/// steering role. Server -> page: {"op":"hello",...} (role, steering, workspace, engage key,
 /// primitives for the watermark), {"op":"role","steering":bool}, {"op":"state","x","y"} (newest
 /// only: a slow page never builds a backlog), {"op":"ack","t":ms} after each pointer sample was
 /// published (the page measures the round trip). A pointer sample may carry "wall" (the event's
 /// time, ms since the epoch): the channel then keeps the event-to-publication delay.
 ///
-/// Several pages may watch; one steers: the first to connect, until it leaves (the oldest page
-/// left then steers) or a page presents the token (when one is set). Only the steering page's
-/// pointer reaches the graph; when it disconnects, a disengaged sample is published at once.
+/// Several pages may watch; one steers: the first to connect with the subject's or the
+/// experimenter's token, until it leaves (the oldest such page left then steers) or another such
+/// page asks to steer. A viewer's page only watches: a pointer sample or a steering request from
+/// it closes it. Only the steering page's pointer reaches the graph; when it disconnects, a
+/// disengaged sample is published at once.
 #pragma once
 
 #include <array>
@@ -31,7 +33,6 @@ class SubjectChannel final : public ClientHandler {
   struct Options {
     std::string engage_key = "Space";  // KeyboardEvent.code; the mouse button always engages
     double half_width = 50;            // the workspace is [-half_width, half_width]^2
-    std::string token;                 // empty: no page can take the steering role over
     std::vector<std::vector<std::array<double, 2>>> primitives;  // watermark; empty: none
   };
   // Publishes one pointer sample on the graph (called on civetweb threads, serialised here).
@@ -53,7 +54,7 @@ class SubjectChannel final : public ClientHandler {
   };
   PointerDelays pointer_delays() const;
 
-  void OnOpen(ClientId client) override;
+  void OnOpen(ClientId client, Role role) override;
   Status OnText(ClientId client, std::string_view text) override;
   Status OnBinary(ClientId client, std::span<const uint8_t> bytes) override;
   void OnClose(ClientId client) override;
@@ -65,6 +66,7 @@ class SubjectChannel final : public ClientHandler {
   std::atomic<WebServer*> server_{nullptr};
   mutable std::mutex mutex_;  // guards the members below and serialises sink_ calls
   std::vector<ClientId> pages_;  // in connection order
+  std::map<ClientId, Role> roles_;
   ClientId steering_ = 0;        // 0: none
   double last_x_ = 0, last_y_ = 0;
   PointerDelays delays_;

@@ -2,17 +2,21 @@
 
 #include <arpa/inet.h>
 #include <civetweb.h>
+#include <dirent.h>
+#include <dlfcn.h>
 #include <ifaddrs.h>
 #include <net/if.h>
 #include <openssl/crypto.h>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/socket.h>
 
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <cstring>
+#include <filesystem>
 
 namespace dyad::web {
 namespace {
@@ -29,6 +33,86 @@ void WriteClose(mg_connection* conn, int code, const std::string& reason) {
   mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE, payload.data(), payload.size());
 }
 
+// Writes a whole plain-text HTTP response (mg_send_http_error crashes in libcivetweb 1.15
+// without a document_root) and returns its status.
+int WriteResponse(mg_connection* conn, int status, const char* reason, const std::string& text) {
+  mg_printf(conn,
+            "HTTP/1.1 %d %s\r\nContent-Type: text/plain; charset=utf-8\r\nContent-Length: %zu\r\n"
+            "Cache-Control: no-store\r\nConnection: close\r\n\r\n",
+            status, reason, text.size());
+  mg_write(conn, text.data(), text.size());
+  return status;
+}
+
+// The address of a socket's end as "ip" and port.
+bool AddressOf(const sockaddr_storage& a, std::string* ip, int* port) {
+  char text[INET6_ADDRSTRLEN] = {0};
+  if (a.ss_family == AF_INET) {
+    const auto* in = reinterpret_cast<const sockaddr_in*>(&a);
+    inet_ntop(AF_INET, &in->sin_addr, text, sizeof(text));
+    *port = ntohs(in->sin_port);
+  } else if (a.ss_family == AF_INET6) {
+    const auto* in6 = reinterpret_cast<const sockaddr_in6*>(&a);
+    inet_ntop(AF_INET6, &in6->sin6_addr, text, sizeof(text));
+    *port = ntohs(in6->sin6_port);
+  } else {
+    return false;
+  }
+  *ip = text;
+  return true;
+}
+
+// Shuts down this process's socket of the TCP connection from `peer_ip`:`peer_port` to our
+// `local_port` (civetweb has no call that closes a server connection from another thread; the
+// worker reading it then sees the end and closes it the normal way). One scan of our fds.
+void ShutdownConnection(const std::string& peer_ip, int peer_port, int local_port) {
+  DIR* dir = opendir("/proc/self/fd");
+  if (dir == nullptr) return;
+  while (dirent* e = readdir(dir)) {
+    char* end = nullptr;
+    const long fd = std::strtol(e->d_name, &end, 10);
+    if (end == e->d_name || *end != '\0' || fd == dirfd(dir)) continue;
+    sockaddr_storage peer{}, local{};
+    socklen_t peer_len = sizeof(peer), local_len = sizeof(local);
+    if (getpeername(static_cast<int>(fd), reinterpret_cast<sockaddr*>(&peer), &peer_len) != 0 ||
+        getsockname(static_cast<int>(fd), reinterpret_cast<sockaddr*>(&local), &local_len) != 0)
+      continue;
+    std::string ip, unused;
+    int port = 0, lport = 0;
+    if (!AddressOf(peer, &ip, &port) || !AddressOf(local, &unused, &lport)) continue;
+    if (port == peer_port && lport == local_port && ip == peer_ip) {
+      shutdown(static_cast<int>(fd), SHUT_RDWR);
+      break;
+    }
+  }
+  closedir(dir);
+}
+
+// Makes civetweb's TLS usable with OpenSSL 3 (see the header): loads libdyad_civetweb_ssl.so,
+// found next to the code that holds this function (the web plugin) or where it was built.
+Status LoadCivetwebSslShim() {
+  static const Status loaded = [] {
+    std::vector<std::string> candidates;
+    Dl_info info{};
+    if (dladdr(reinterpret_cast<void*>(&LoadCivetwebSslShim), &info) != 0 && info.dli_fname != nullptr)
+      candidates.push_back((std::filesystem::path(info.dli_fname).parent_path() / "web" / "libdyad_civetweb_ssl.so").string());
+    candidates.push_back(DYAD_CIVETWEB_SSL_SHIM);
+    std::string tried;
+    for (const auto& path : candidates) {
+      if (dlopen(path.c_str(), RTLD_NOW | RTLD_GLOBAL) != nullptr) {
+        if ((mg_init_library(MG_FEATURES_TLS | MG_FEATURES_WEBSOCKET) & MG_FEATURES_TLS) == 0)
+          return Status::IOError("TLS: civetweb could not load OpenSSL (libssl.so; install libssl-dev)");
+        return Status::OK();
+      }
+      tried += (tried.empty() ? "" : ", ") + path;
+    }
+    return Status::IOError("TLS: cannot load libdyad_civetweb_ssl.so (tried " + tried + ")");
+  }();
+  return loaded;
+}
+
+thread_local std::string* start_log = nullptr;  // civetweb's messages while mg_start runs
+
 std::string QueryValue(const char* query, const std::string& key) {
   if (query == nullptr) return "";
   char buf[512];
@@ -37,6 +121,15 @@ std::string QueryValue(const char* query, const std::string& key) {
 }
 
 }  // namespace
+
+const char* RoleName(Role role) {
+  switch (role) {
+    case Role::kViewer: return "viewer";
+    case Role::kSubject: return "subject";
+    case Role::kExperimenter: return "experimenter";
+  }
+  return "?";
+}
 
 bool TokenMatches(std::string_view given, std::string_view expected) {
   if (expected.empty() || given.size() != expected.size()) return false;
@@ -117,6 +210,7 @@ struct WebServer::EndpointState {
   WebServer* server = nullptr;
   ClientHandler* handler = nullptr;
   bool viewers = true;
+  std::set<Role> roles;
   std::vector<const char*> protocol_ptrs;
   mg_websocket_subprotocols protocols{};
 };
@@ -132,22 +226,52 @@ struct WebServer::Client {
 };
 
 StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
-  mg_init_library(MG_FEATURES_WEBSOCKET);
+  if (options.tokens.empty()) return Status::InvalidArgument("web server: no token for any role (every client needs one)");
+  for (const auto& [role, token] : options.tokens) {
+    if (token.empty()) return Status::InvalidArgument(std::string("web server: the ") + RoleName(role) + "'s token is empty");
+    for (const auto& [other, other_token] : options.tokens)
+      if (other < role && token == other_token)
+        return Status::InvalidArgument(std::string("web server: the ") + RoleName(role) + " and the " + RoleName(other) +
+                                       " have the same token (a token must say its role)");
+  }
+  const bool tls = !options.tls_certificate.empty();
+  if (tls) {
+    if (Status st = LoadCivetwebSslShim(); !st.ok()) return st;
+  } else {
+    mg_init_library(MG_FEATURES_WEBSOCKET);
+  }
   std::unique_ptr<WebServer> s(new WebServer());
   s->options_ = options;
   s->handler_thread_ = std::make_unique<HandlerThread>();
   const std::string ports = (options.address.find(':') != std::string::npos ? "[" + options.address + "]" : options.address) +
-                            ":" + std::to_string(options.port);
+                            ":" + std::to_string(options.port) + (tls ? "s" : "");
   const std::string threads = std::to_string(options.max_clients + 4);
-  const char* opts[] = {"listening_ports", ports.c_str(), "num_threads", threads.c_str(), "request_timeout_ms", "5000",
-                        "websocket_timeout_ms", "3600000",
-                        // Small frames (pointer samples, acks) go out at once, not after Nagle's 40 ms.
-                        "tcp_nodelay", "1", nullptr};
+  const std::string timeout = std::to_string(options.write_timeout_ms);
+  std::vector<const char*> opts = {"listening_ports", ports.c_str(), "num_threads", threads.c_str(), "request_timeout_ms",
+                                   timeout.c_str(), "websocket_timeout_ms", "3600000",
+                                   // Small frames (pointer samples, acks) go out at once, not after Nagle's 40 ms.
+                                   "tcp_nodelay", "1"};
+  if (tls) {
+    // TLS 1.2 and later only (4); the browsers' own defaults for the rest.
+    for (const char* o : {"ssl_certificate", options.tls_certificate.c_str(), "ssl_protocol_version", "4"}) opts.push_back(o);
+  }
+  opts.push_back(nullptr);
   mg_callbacks callbacks{};
-  callbacks.log_message = [](const mg_connection*, const char*) { return 1; };  // no stderr noise per client
-  s->ctx_ = mg_start(&callbacks, s.get(), opts);
-  if (s->ctx_ == nullptr)
-    return Status::IOError("web server: cannot listen on " + ports + " (in use, or not an address of this machine)");
+  // No stderr noise per client; what goes wrong while starting is kept for the error.
+  callbacks.log_message = [](const mg_connection*, const char* message) {
+    if (start_log != nullptr) start_log->append(start_log->empty() ? "" : "; ").append(message);
+    return 1;
+  };
+  std::string log;
+  start_log = &log;
+  s->ctx_ = mg_start(&callbacks, s.get(), opts.data());
+  start_log = nullptr;
+  if (s->ctx_ == nullptr) {
+    if (tls && log.find("ssl") != std::string::npos)
+      return Status::IOError("web server: cannot use the TLS certificate '" + options.tls_certificate + "' (" + log + ")");
+    return Status::IOError("web server: cannot listen on " + ports + " (in use, or not an address of this machine)" +
+                           (log.empty() ? "" : ": " + log));
+  }
   mg_server_port sp[4];
   const int n = mg_get_server_ports(s->ctx_, 4, sp);
   s->port_ = n > 0 ? sp[0].port : options.port;
@@ -160,6 +284,7 @@ StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
     st->server = s.get();
     st->handler = e.handler;
     st->viewers = e.viewers;
+    st->roles = e.roles;
     for (const auto& p : e.subprotocols) st->protocol_ptrs.push_back(p.c_str());
     st->protocols.nb_subprotocols = static_cast<int>(st->protocol_ptrs.size());
     st->protocols.subprotocols = st->protocol_ptrs.data();
@@ -174,18 +299,36 @@ StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
 int WebServer::OnPage(mg_connection* conn, void* page_ptr) {
   const auto* page = static_cast<const Page*>(page_ptr);
   const mg_request_info* info = mg_get_request_info(conn);
+  auto* self = static_cast<WebServer*>(mg_get_user_data(mg_get_context(conn)));
   // Exact URIs only: civetweb matches prefixes ("/" would answer every path).
   // Answered here: civetweb's own file handling is off (no document_root) and must not run.
-  if (info->local_uri == nullptr || page->uri != info->local_uri) {
-    // (mg_send_http_error crashes in libcivetweb 1.15 without a document_root: write it out.)
-    static const char kNotFound[] =
-        "HTTP/1.1 404 Not Found\r\nContent-Type: text/plain\r\nContent-Length: 10\r\nConnection: close\r\n\r\nnot found\n";
-    mg_write(conn, kNotFound, sizeof(kNotFound) - 1);
-    return 404;
-  }
-  mg_send_http_ok(conn, page->mime.c_str(), static_cast<long long>(page->body.size()));
+  if (info->local_uri == nullptr || page->uri != info->local_uri) return WriteResponse(conn, 404, "Not Found", "not found\n");
+  const std::optional<Role> role = self->RoleOf(info->query_string);
+  if (!role)
+    return WriteResponse(conn, 401, "Unauthorized",
+                         "This page needs the link dyad printed, with its ?token=... (no token, or not this server's).\n");
+  if (!page->roles.count(*role))
+    return WriteResponse(conn, 403, "Forbidden", std::string("The ") + RoleName(*role) + "'s token does not open this page.\n");
+  mg_printf(conn,
+            "HTTP/1.1 200 OK\r\nContent-Type: %s\r\nContent-Length: %zu\r\nCache-Control: no-store\r\n"
+            "Referrer-Policy: no-referrer\r\nX-Frame-Options: DENY\r\nX-Content-Type-Options: nosniff\r\n"
+            "Connection: close\r\n\r\n",
+            page->mime.c_str(), page->body.size());
   mg_write(conn, page->body.data(), page->body.size());
   return 200;
+}
+
+std::optional<Role> WebServer::RoleOf(const char* query_string) const {
+  const std::string given = QueryValue(query_string, "token");
+  std::optional<Role> role;
+  for (const auto& [r, token] : options_.tokens)  // no early exit: every comparison is made
+    if (TokenMatches(given, token)) role = r;
+  return role;
+}
+
+void WebServer::Disconnect(Client& c) {
+  const mg_request_info* info = mg_get_request_info(c.conn);
+  if (info != nullptr) ShutdownConnection(info->remote_addr, info->remote_port, port_);
 }
 
 WebServer::~WebServer() {
@@ -218,10 +361,11 @@ int WebServer::OnConnect(const mg_connection* conn, void* endpoint) {
   auto* self = static_cast<EndpointState*>(endpoint)->server;
   const mg_request_info* info = mg_get_request_info(conn);
   if (const char* origin = mg_get_header(conn, "Origin"); origin != nullptr && !self->OriginAllowed(origin)) return 1;
-  if (!self->options_.token.empty() && !TokenMatches(QueryValue(info->query_string, "token"), self->options_.token)) return 1;
+  const std::optional<Role> role = self->RoleOf(info->query_string);
+  if (!role || !static_cast<EndpointState*>(endpoint)->roles.count(*role)) return 1;
   std::lock_guard<std::mutex> lock(self->mutex_);
   if (static_cast<int>(self->admitted_.size()) >= self->options_.max_clients) return 1;
-  self->admitted_.insert(conn);
+  self->admitted_[conn] = *role;
   return 0;
 }
 
@@ -232,14 +376,16 @@ void WebServer::OnReady(mg_connection* conn, void* endpoint) {
   auto c = std::make_shared<Client>(self->options_.client_buffer_bytes,
                                     viewers ? SendQueue::kDefaultFlushInterval : std::chrono::steady_clock::duration::zero());
   c->conn = conn;
+  Role role = Role::kViewer;
   {
     std::lock_guard<std::mutex> lock(self->mutex_);
+    role = self->admitted_.at(conn);
     c->id = self->next_id_++;
     self->clients_[c->id] = c;
     self->by_conn_[conn] = {c->id, handler};
   }
   Client* raw = c.get();
-  c->sender = std::thread([raw, viewers] {
+  c->sender = std::thread([self, raw, viewers] {
     if (viewers) {
       // Not SCHED_IDLE: a graph thread waiting for the queue's lock held by an idle-class sender
       // that was preempted waited up to 1.4 s on a loaded machine (no priority inheritance).
@@ -258,11 +404,19 @@ void WebServer::OnReady(mg_connection* conn, void* endpoint) {
         std::lock_guard<std::mutex> lock(raw->write_mutex);
         if (raw->closed) return;
         const int op = f.binary ? MG_WEBSOCKET_OPCODE_BINARY : MG_WEBSOCKET_OPCODE_TEXT;
-        if (mg_websocket_write(raw->conn, op, bytes->data(), bytes->size()) <= 0) return;
+        if (mg_websocket_write(raw->conn, op, bytes->data(), bytes->size()) <= 0) {
+          // Nothing more can reach this client in order: end it, not just its sender.
+          raw->queue.Close();
+          self->Disconnect(*raw);
+          return;
+        }
       }
     }
+    // Closed: by OnClosed (nothing to do) or by the queue itself (its control frames overflowed).
+    std::lock_guard<std::mutex> lock(raw->write_mutex);
+    if (!raw->closed && raw->queue.overflowed()) self->Disconnect(*raw);
   });
-  handler->OnOpen(c->id);
+  handler->OnOpen(c->id, role);
 }
 
 int WebServer::OnData(mg_connection* conn, int bits, char* data, size_t len, void* endpoint) {

@@ -6,12 +6,24 @@
 /// from the graph's delivering threads) only queue, so a slow, stuck or malicious client never
 /// blocks the experiment; it loses samples instead (SendQueue's policy). Received frames larger
 /// than `max_frame_bytes` close the client (1009); a client the handler rejects is closed with
-/// the handler's code and reason.
+/// the handler's code and reason. A client whose write fails (a peer that stopped reading for
+/// the write timeout, a dead link) or whose control frames outgrow its buffer is disconnected
+/// at once: its socket is shut down, so the worker ends it and the handler's OnClose runs.
 ///
-/// Admission: at most `max_clients` WebSocket clients; when `token` is set, a client must connect
-/// with `?token=<token>`; a request carrying an Origin header must name an allowed origin
-/// (`allowed_origins`, entries "scheme://host[:port]" or "*"; localhost origins are always
-/// allowed when the server binds a loopback address).
+/// Admission, for pages and WebSocket clients alike: every request carries `?token=<token>`,
+/// and the token says its role (`tokens`, one per role, compared in constant time); each page
+/// and endpoint names the roles it admits (401 without a known token, 403 for a role it does
+/// not admit). At most `max_clients` WebSocket clients. A request carrying an Origin header must
+/// name an allowed origin (`allowed_origins`, entries "scheme://host[:port]" or "*"; localhost
+/// origins are always allowed when the server binds a loopback address). Pages are sent with
+/// `Referrer-Policy: no-referrer` (their URL holds the token), `Cache-Control: no-store` and
+/// `X-Frame-Options: DENY` (no page of another site can frame the steering page).
+///
+/// TLS: with `tls_certificate` (a PEM file: private key, then certificate chain) the server
+/// speaks HTTPS and WSS only. Debian's civetweb 1.15 loads libssl by name and asks it for
+/// SSL_get_peer_certificate, which OpenSSL 3 no longer exports (a null call on the first
+/// connection); the server first loads dyad's libdyad_civetweb_ssl.so (civetweb_ssl_shim.c), a
+/// library named "libssl.so" that supplies it, so civetweb finds that one.
 #pragma once
 
 #include <cstdint>
@@ -19,6 +31,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <span>
 #include <string>
@@ -38,9 +51,14 @@ namespace dyad::web {
 
 using ClientId = uint64_t;
 
-// Whether a listen address reaches only this machine (127.x, localhost, ::1): then the server
-// needs no token, and pages from localhost origins are accepted.
+// Whether a listen address reaches only this machine (127.x, localhost, ::1): then pages from
+// localhost origins are accepted, and TLS is not needed.
 bool IsLoopback(const std::string& address);
+
+// What a client may do, said by its token. The server only admits by role; what each role may
+// do on an endpoint is the handler's to enforce.
+enum class Role { kViewer, kSubject, kExperimenter };
+const char* RoleName(Role role);
 
 // Whether a client's token is the expected one, in time that does not depend on where they
 // differ (OpenSSL's CRYPTO_memcmp; only the length can be learnt). An empty `expected` matches
@@ -62,7 +80,7 @@ std::vector<std::string> UrlHosts(const std::string& address);
 class ClientHandler {
  public:
   virtual ~ClientHandler() = default;
-  virtual void OnOpen(ClientId client) = 0;
+  virtual void OnOpen(ClientId client, Role role) = 0;
   // Return a non-OK Status to close the client with its message as the close reason.
   virtual Status OnText(ClientId client, std::string_view text) = 0;
   virtual Status OnBinary(ClientId client, std::span<const uint8_t> bytes) = 0;
@@ -74,12 +92,14 @@ class WebServer {
   struct Page {
     std::string mime;  // e.g. "text/html; charset=utf-8"
     std::string body;
-    std::string uri;  // filled by Start()
+    std::set<Role> roles;  // who may load it
+    std::string uri;       // filled by Start()
   };
   struct Endpoint {
     std::string uri;                        // e.g. "/"
     std::vector<std::string> subprotocols;  // empty: any
     ClientHandler* handler = nullptr;
+    std::set<Role> roles;  // who may connect
     // Its clients are viewers (Foxglove, the experimenter's page): their frames are batched per
     // display frame (SendQueue::kDefaultFlushInterval) and their sender threads are SCHED_BATCH,
     // which never preempt a running thread when they wake (a graph thread finishes its step
@@ -93,13 +113,16 @@ class WebServer {
     std::map<std::string, Page> pages;  // by exact URI
     std::vector<Endpoint> endpoints;
     std::vector<std::string> allowed_origins;
-    std::string token;  // empty: none required
+    std::map<Role, std::string> tokens;  // at least one; each distinct and non-empty
+    std::string tls_certificate;         // PEM: key and certificate chain; empty: plain HTTP
     int max_clients = 8;
+    int write_timeout_ms = 5000;  // a write blocked this long disconnects the client
     size_t max_frame_bytes = 1 << 20;
     size_t client_buffer_bytes = 4 << 20;
   };
 
-  // Starts listening; fails (IOError) when the address/port cannot be bound.
+  // Starts listening; fails (IOError) when the address/port cannot be bound or the certificate
+  // cannot be used, InvalidArgument when the tokens are missing, empty or not distinct.
   static StatusOr<std::unique_ptr<WebServer>> Start(const Options& options);
   ~WebServer();  // closes every client, stops the server, joins every thread
   WebServer(const WebServer&) = delete;
@@ -132,6 +155,11 @@ class WebServer {
   static int OnData(mg_connection* conn, int bits, char* data, size_t len, void* self);
   static void OnClosed(const mg_connection* conn, void* self);
   bool OriginAllowed(const std::string& origin) const;
+  // The role whose token the request's query carries (every token compared: constant time).
+  std::optional<Role> RoleOf(const char* query_string) const;
+  // Ends `c`'s connection from any thread (its socket shut down). REQUIRES: c->write_mutex held
+  // and c->closed false, so the connection is still open.
+  void Disconnect(Client& c);
   std::shared_ptr<Client> Find(ClientId id) const;
 
   Options options_;
@@ -144,7 +172,7 @@ class WebServer {
   std::map<ClientId, std::shared_ptr<Client>> clients_;
   std::map<const mg_connection*, std::pair<ClientId, ClientHandler*>> by_conn_;
   ClientId next_id_ = 1;
-  std::set<const mg_connection*> admitted_;  // past OnConnect, not yet closed
+  std::map<const mg_connection*, Role> admitted_;  // past OnConnect, not yet closed
 };
 
 }  // namespace dyad::web

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The web component's admission (token, Origin) and steering role (components/web/test/node/
-# admission.mjs says what is checked), against a running graph.
+# The web component's admission (a token per role, Origin) and steering role
+# (components/web/test/node/admission.mjs says what is checked), against a running graph.
 #   admission_test.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 build=$1
@@ -10,12 +10,13 @@ if [ ! -d "$node_dir/node_modules" ]; then
   echo "SKIP: run tools/setup.sh (npm ci in components/web/test/node)"; exit 77
 fi
 rm -rf "$work"; mkdir -p "$work"; cd "$work"
+experimenter=experimenter-s3cret-0001 subject=subject-s3cret-00001 viewer=viewer-s3cret-000001
 cat > graph.yaml <<YAML
 graph: admission
 clock: wall
 domain_id: $(( 1 + $$ % 200 ))
 components:
-  web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port, token: s3cret}, outputs: {pointer: web/pointer}}
+  web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port, token: $experimenter, subject_token: $subject, viewer_token: $viewer}, outputs: {pointer: web/pointer}}
   human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
 topics:
   human/input: {type: HumanInput}
@@ -25,7 +26,8 @@ pid=$!
 for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
 [ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
 status=0
-node "$node_dir/admission.mjs" "ws://127.0.0.1:$(cat web.port)" s3cret || status=1
+node "$node_dir/admission.mjs" "ws://127.0.0.1:$(cat web.port)" $experimenter $subject $viewer || status=1
 kill -INT $pid; wait $pid || true
-grep -q "?token=<params.token>" run.err && ! grep -q s3cret run.err || { echo "FAIL: the URLs printed do not say where the token is, or print it"; status=1; }
+grep -q "/subject?token=<params.subject_token>" run.err && grep -q "/experimenter?token=<params.token>" run.err &&
+  ! grep -q s3cret run.err || { echo "FAIL: the URLs printed do not say where the tokens are, or print them"; status=1; }
 exit $status

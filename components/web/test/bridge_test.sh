@@ -24,7 +24,7 @@ components:
   pattern: {type: cartesian_pattern, rate_hz: 50, params: {shape: figure8, radius: 30, period_s: 4}, outputs: {command: robot/command}}
   driver: {type: virtual_cartesian, trigger: command, inputs: {command: robot/command}, outputs: {state: robot/state}}
   recorder: {type: recorder, rate_hz: 10, params: {file: rec.mcap, topics: [robot/state]}}
-  web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port}}
+  web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port, token: experimenter-token-0001, subject_token: subject-token-000001, viewer_token: viewer-token-0000001}}
 YAML
 cd "$work"
 "$build/bin/dyad" run graph.yaml --duration 6 > run.out 2> run.err &
@@ -32,7 +32,8 @@ pid=$!
 for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
 [ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
 port=$(cat web.port)
-node "$node_dir/foxglove_client.mjs" watch "ws://127.0.0.1:$port" robot/state 3 client.json &
+# The experimenter's token: only it may try to publish (and be told robot/state is not writable).
+node "$node_dir/foxglove_client.mjs" watch "ws://127.0.0.1:$port/?token=experimenter-token-0001" robot/state 3 client.json &
 watcher=$!
 # While the client is connected its sender thread is SCHED_BATCH (policy 3, field 41 of the
 # thread's stat): it never preempts a graph thread when it wakes.

@@ -23,14 +23,14 @@ topics:
 components:
   pattern: {type: cartesian_pattern, rate_hz: 100, params: {shape: figure8, radius: 30, period_s: 4}, outputs: {command: robot/command}}
   driver: {type: virtual_cartesian, trigger: command, inputs: {command: robot/command}, outputs: {state: robot/state}}
-  web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port, client_buffer_kb: 64}}
+  web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port, client_buffer_kb: 64, token: experimenter-token-0001, subject_token: subject-token-000001, viewer_token: viewer-token-0000001}}
 YAML
 duration=20
 "$build/bin/dyad" run graph.yaml --duration $duration > run.out 2> run.err &
 pid=$!
 for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
 [ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
-node "$node_dir/hostile_clients.mjs" "ws://127.0.0.1:$(cat web.port)" 1000 3 | tee clients.json
+node "$node_dir/hostile_clients.mjs" "ws://127.0.0.1:$(cat web.port)/?token=viewer-token-0000001" 1000 3 | tee clients.json
 rss_kb=$(ps -o rss= -p $pid)
 wait $pid || { echo "FAIL: dyad run exited non-zero"; cat run.err; exit 1; }
 cat run.out

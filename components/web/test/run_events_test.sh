@@ -20,7 +20,7 @@ processes:
   ui: {}
   worker: {restart: on-failure, backoff_s: 0.2}
 components:
-  web: {type: web, rate_hz: 10, process: ui, params: {port: 0, port_file: web.port}, outputs: {pointer: web/pointer}}
+  web: {type: web, rate_hz: 10, process: ui, params: {port: 0, port_file: web.port, token: experimenter-token-0001, subject_token: subject-token-000001, viewer_token: viewer-token-0000001}, outputs: {pointer: web/pointer}}
   human: {type: web_human, rate_hz: 10, process: worker, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
 topics:
   human/input: {type: HumanInput}
@@ -36,7 +36,7 @@ kill -KILL "$worker"
 status=0
 node -e '
 const WebSocket = require(process.argv[1] + "/node_modules/ws");
-const ws = new WebSocket(process.argv[2] + "/experimenter/ws");
+const ws = new WebSocket(process.argv[2] + "/experimenter/ws?token=viewer-token-0000001");
 const give_up = setTimeout(() => { console.log("FAIL: no restart event and stats of both processes within 20 s: " + seen); process.exit(1); }, 20000);
 let told = false, seen = "";
 ws.on("message", (d) => {

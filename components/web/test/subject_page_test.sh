@@ -19,7 +19,7 @@ plugins: [$plugin]
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
 components:
-  web: {type: web, rate_hz: 30, params: {port: 0, port_file: web.port}, inputs: {robot: robot/state}, outputs: {pointer: web/pointer, notes: experiment/notes}}
+  web: {type: web, rate_hz: 30, params: {port: 0, port_file: web.port, token: experimenter-token-0001, subject_token: subject-token-000001, viewer_token: viewer-token-0000001}, inputs: {robot: robot/state}, outputs: {pointer: web/pointer, notes: experiment/notes}}
   human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
   mind: {type: intention_hold, rate_hz: 10, outputs: {intention: robot/intention}}
   mixer: {type: compliance_mixer, trigger: robot, params: {gain: 0.9, max_step: 5}, inputs: {human: human/input, robot: robot/intention}, outputs: {command: robot/command}}

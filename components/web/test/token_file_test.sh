@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# The web token kept private: params.token_file is created 0600 with a new token on the first run
-# and read on the next (a bookmarked page keeps working), the token is then never printed, a
-# token file others can read is refused; a token written in the graph is redacted from the graph
-# the recorder keeps (the MCAP file read raw: the token's bytes are nowhere in it).
+# The web tokens kept private: params.token_file is created 0600 with a new token per role on
+# the first run and read on the next (a bookmarked page keeps working), its tokens are never
+# printed, a token file others can read is refused; tokens written in the graph are redacted from
+# the graph the recorder keeps (the MCAP file read raw: their bytes are nowhere in it); with no
+# token anywhere, even on loopback, tokens are generated, printed and required.
 #   token_file_test.sh BUILD_DIR WORK_DIR
 set -euo pipefail
 build=$1
@@ -48,32 +49,51 @@ run_and_probe() {  # run_and_probe GRAPH TOKEN_OR_EMPTY: runs 4 s; the token (if
   wait $pid || { cat "${1%.yaml}.err"; fail "dyad run $1 failed"; }
 }
 
-# 1. token_file: created 0600 with a new token, not printed; the second run reads the same one.
+# 1. token_file: created 0600 with a new token per role, not printed; the second run reads them.
 graph first.yaml "token_file: keys/web.token"
 mkdir -m 700 keys
 run_and_probe first.yaml ""
 [ -f keys/web.token ] || fail "token_file not created"
 [ "$(stat -c %a keys/web.token)" = 600 ] || fail "token_file mode $(stat -c %a keys/web.token), not 600"
-token=$(cat keys/web.token)
-[[ $token =~ ^[0-9a-f]{32}$ ]] || fail "token_file holds '$token', not a 32-hex token"
-grep -q "?token=<the token in $work/keys/web.token>" first.err || { cat first.err; fail "the URLs do not say where the token is"; }
-! grep -q "$token" first.err first.out || fail "the token was printed"
+[ "$(cut -d' ' -f1 keys/web.token | tr '\n' ' ')" = "experimenter subject viewer " ] || fail "token_file roles: $(cat keys/web.token)"
+grep -Evq '^[a-z]+ [0-9a-f]{32}$' keys/web.token && fail "token_file lines are not 'ROLE 32-hex-token': $(cat keys/web.token)"
+viewer=$(awk '$1 == "viewer" {print $2}' keys/web.token)
+grep -q "/subject?token=<the subject's token in $work/keys/web.token>" first.err || { cat first.err; fail "the URLs do not say where the token is"; }
+for t in $(cut -d' ' -f2 keys/web.token); do ! grep -q "$t" first.err first.out || fail "a token was printed"; done
 cp first.yaml second.yaml
 sed -i 's/first.mcap/second.mcap/' second.yaml
-run_and_probe second.yaml "$token"
-[ "$(cat keys/web.token)" = "$token" ] || fail "the second run changed the token file"
+run_and_probe second.yaml "$viewer"
+[ "$(awk '$1 == "viewer" {print $2}' keys/web.token)" = "$viewer" ] || fail "the second run changed the token file"
 
-# 2. A token file others can read is refused, naming it.
+# 2. A token file others can read is refused, naming it; so is one of the old one-token format.
 chmod 644 keys/web.token
 if "$build/bin/dyad" run second.yaml --duration 1 > bad.out 2> bad.err; then fail "a 0644 token file was accepted"; fi
 grep -q "params.token_file = '$work/keys/web.token': readable by others: chmod 600 it" bad.err || { cat bad.err; fail "no clear error"; }
+echo 0123456789abcdef0123456789abcdef > keys/web.token
+chmod 600 keys/web.token
+if "$build/bin/dyad" run second.yaml --duration 1 > old.out 2> old.err; then fail "a one-token file was accepted"; fi
+grep -q "params.token_file = '$work/keys/web.token' line 1: expected 'experimenter TOKEN'" old.err || { cat old.err; fail "no clear error for the old format"; }
 
-# 3. A token written in the graph is redacted from the recorded graph.
+# 3. Tokens written in the graph are redacted from the recorded graph.
 secret=VeryS3cretTokenValue4217
-graph third.yaml "token: $secret"
-run_and_probe third.yaml "$secret"
+graph third.yaml "token: $secret, subject_token: ${secret}s, viewer_token: ${secret}v"
+run_and_probe third.yaml "${secret}v"
 [ -s third.mcap ] || fail "no recording"
-! grep -a -q "$secret" third.mcap || fail "the token is in the recording"
-grep -a -q "token: <redacted>" third.mcap || fail "the recorded graph does not say the token was redacted"
-! grep -q "$secret" third.out third.err || fail "the token was printed"
-echo "PASS: token_file private, kept across runs, not printed; a 0644 one refused; a graph's token redacted from the recording"
+! grep -a -q "$secret" third.mcap || fail "a token is in the recording"
+grep -a -q "subject_token: <redacted>" third.mcap || fail "the recorded graph does not say the token was redacted"
+! grep -q "$secret" third.out third.err || fail "a token was printed"
+
+# 4. No token anywhere, on loopback: tokens are generated and printed (nobody could use them
+# otherwise), and a client without one is refused.
+graph fourth.yaml "max_clients: 8"
+rm -f web.port
+"$build/bin/dyad" run fourth.yaml --duration 4 > fourth.out 2> fourth.err &
+pid=$!
+for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
+sleep 0.5
+printed=$(grep -o '/?token=[0-9a-f]\{32\} (viewer)' fourth.err | head -1 | cut -c9-40)
+[ -n "$printed" ] || { cat fourth.err; kill $pid; fail "no generated viewer token printed"; }
+admitted "ws://127.0.0.1:$(cat web.port)/?token=$printed" || fail "the printed token was refused"
+! admitted "ws://127.0.0.1:$(cat web.port)/" || fail "a client without a token was admitted on loopback"
+wait $pid || fail "dyad run fourth.yaml failed"
+echo "PASS: token_file private, per role, kept across runs, not printed; a 0644 or old one refused; tokens redacted from the recording; none given: generated, printed, required"

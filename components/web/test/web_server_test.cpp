@@ -1,7 +1,21 @@
-// The server's small helpers: token comparison and the URLs it prints.
+// The server against raw clients: tokens and their roles on pages and WebSockets, a client that
+// stops reading (disconnected, not left queuing), TLS; and its small helpers.
 #include "web_server.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <openssl/ssl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
 
 namespace dyad::web {
 namespace {
@@ -25,6 +39,232 @@ TEST(UrlHosts, AWildcardBecomesTheMachinesAddresses) {
     EXPECT_NE(h, "0.0.0.0");
     EXPECT_EQ(h.find(':'), std::string::npos) << h;  // IPv4 addresses
   }
+}
+
+const std::string kViewer = "viewer-0123456789ab", kSubject = "subject-0123456789a", kExperimenter = "experimenter-012345";
+
+// Records what the server tells it.
+class RecordingHandler final : public ClientHandler {
+ public:
+  void OnOpen(ClientId client, Role role) override {
+    last_client = client;
+    last_role = role;
+    ++opens;
+  }
+  Status OnText(ClientId, std::string_view) override { return Status::OK(); }
+  Status OnBinary(ClientId, std::span<const uint8_t>) override { return Status::OK(); }
+  void OnClose(ClientId) override { ++closes; }
+  std::atomic<int> opens{0}, closes{0};
+  std::atomic<ClientId> last_client{0};
+  std::atomic<Role> last_role{Role::kViewer};
+};
+
+WebServer::Options TestOptions(RecordingHandler* handler) {
+  WebServer::Options o;
+  o.port = 0;
+  o.tokens = {{Role::kViewer, kViewer}, {Role::kSubject, kSubject}, {Role::kExperimenter, kExperimenter}};
+  o.pages["/watch"] = WebServer::Page{"text/plain", "the page\n", {Role::kViewer, Role::kExperimenter}, ""};
+  o.endpoints = {WebServer::Endpoint{"/ws", {}, handler, {Role::kSubject, Role::kExperimenter}}};
+  return o;
+}
+
+// A TCP connection to the server, optionally with a small receive buffer (set before connecting,
+// so the window stays small).
+int Connect(int port, int receive_buffer = 0) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  if (receive_buffer > 0) setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof(receive_buffer));
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// Sends `request` and reads the response head (up to the blank line) or everything until the end.
+std::string Exchange(int fd, const std::string& request) {
+  if (send(fd, request.data(), request.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(request.size())) return "";
+  std::string out;
+  char buf[4096];
+  while (out.find("\r\n\r\n") == std::string::npos) {
+    const ssize_t n = recv(fd, buf, sizeof(buf), 0);
+    if (n <= 0) break;
+    out.append(buf, static_cast<size_t>(n));
+  }
+  return out;
+}
+
+std::string Get(int port, const std::string& target) {
+  const int fd = Connect(port);
+  std::string r = Exchange(fd, "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n");
+  close(fd);
+  return r;
+}
+
+std::string Upgrade(const std::string& target) {
+  return "GET " + target +
+         " HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+         "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n";
+}
+
+bool WaitFor(const std::function<bool()>& done, std::chrono::seconds limit) {
+  const auto until = std::chrono::steady_clock::now() + limit;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
+
+TEST(WebServer, APageNeedsATokenOfARoleItAdmits) {
+  RecordingHandler handler;
+  auto server = WebServer::Start(TestOptions(&handler));
+  ASSERT_TRUE(server.ok()) << server.status().ToString();
+  const int port = (*server)->port();
+  EXPECT_EQ(Get(port, "/watch").rfind("HTTP/1.1 401", 0), 0u);
+  EXPECT_EQ(Get(port, "/watch?token=not-a-token-at-all").rfind("HTTP/1.1 401", 0), 0u);
+  EXPECT_EQ(Get(port, "/watch?token=" + kSubject).rfind("HTTP/1.1 403", 0), 0u) << "the subject may not watch here";
+  const std::string ok = Get(port, "/watch?token=" + kViewer);
+  EXPECT_EQ(ok.rfind("HTTP/1.1 200", 0), 0u) << ok;
+  EXPECT_NE(ok.find("Referrer-Policy: no-referrer"), std::string::npos) << "the URL holds the token: never sent on";
+  EXPECT_NE(ok.find("X-Frame-Options: DENY"), std::string::npos);
+}
+
+TEST(WebServer, AWebSocketNeedsATokenOfARoleItsEndpointAdmits) {
+  RecordingHandler handler;
+  auto server = WebServer::Start(TestOptions(&handler));
+  ASSERT_TRUE(server.ok()) << server.status().ToString();
+  const int port = (*server)->port();
+  for (const std::string& refused : {std::string("/ws"), "/ws?token=" + kViewer, "/ws?token=" + kSubject + "x"}) {
+    const int fd = Connect(port);
+    EXPECT_EQ(Exchange(fd, Upgrade(refused)).find("101 Switching Protocols"), std::string::npos) << refused;
+    close(fd);
+  }
+  EXPECT_EQ(handler.opens, 0);
+  const int fd = Connect(port);
+  EXPECT_NE(Exchange(fd, Upgrade("/ws?token=" + kSubject)).find("101 Switching Protocols"), std::string::npos);
+  ASSERT_TRUE(WaitFor([&] { return handler.opens == 1; }, std::chrono::seconds(5)));
+  EXPECT_EQ(handler.last_role.load(), Role::kSubject);
+  close(fd);
+}
+
+TEST(WebServer, TokensMustBeGivenAndDistinct) {
+  RecordingHandler handler;
+  WebServer::Options o = TestOptions(&handler);
+  o.tokens[Role::kSubject] = kViewer;
+  EXPECT_EQ(WebServer::Start(o).status().code(), Status::Code::kInvalidArgument);
+  o.tokens.clear();
+  EXPECT_EQ(WebServer::Start(o).status().code(), Status::Code::kInvalidArgument);
+}
+
+// A client that stops reading: once a write has waited `write_timeout_ms`, the server ends the
+// connection (the handler hears OnClose) instead of keeping a sender-less client queuing.
+TEST(WebServer, AClientThatStopsReadingIsDisconnectedAfterTheWriteTimeout) {
+  RecordingHandler handler;
+  WebServer::Options o = TestOptions(&handler);
+  o.write_timeout_ms = 300;
+  o.client_buffer_bytes = 256 << 10;
+  auto server = WebServer::Start(o);
+  ASSERT_TRUE(server.ok()) << server.status().ToString();
+  const int fd = Connect((*server)->port(), 4096);
+  ASSERT_NE(Exchange(fd, Upgrade("/ws?token=" + kExperimenter)).find("101"), std::string::npos);
+  ASSERT_TRUE(WaitFor([&] { return handler.opens == 1; }, std::chrono::seconds(5)));
+  const std::string frame(60 << 10, 'x');
+  const bool closed = WaitFor(
+      [&] {
+        (*server)->SendData(handler.last_client, 1, frame);
+        return handler.closes == 1;
+      },
+      std::chrono::seconds(30));
+  EXPECT_TRUE(closed) << "a client that never reads was kept";
+  EXPECT_TRUE((*server)->clients().empty());
+  close(fd);
+}
+
+// Control frames are never dropped, so a client that never reads them is disconnected once they
+// outgrow its buffer (here long before the write timeout could).
+TEST(WebServer, ControlFramesPastTheBufferDisconnectTheClient) {
+  RecordingHandler handler;
+  WebServer::Options o = TestOptions(&handler);
+  o.write_timeout_ms = 600000;
+  o.client_buffer_bytes = 64 << 10;
+  auto server = WebServer::Start(o);
+  ASSERT_TRUE(server.ok()) << server.status().ToString();
+  const int fd = Connect((*server)->port(), 4096);
+  ASSERT_NE(Exchange(fd, Upgrade("/ws?token=" + kExperimenter)).find("101"), std::string::npos);
+  ASSERT_TRUE(WaitFor([&] { return handler.opens == 1; }, std::chrono::seconds(5)));
+  const std::string status(8 << 10, 's');
+  const bool closed = WaitFor(
+      [&] {
+        for (int i = 0; i < 16; ++i) (*server)->SendText(handler.last_client, status);
+        return handler.closes == 1;
+      },
+      std::chrono::seconds(30));
+  EXPECT_TRUE(closed) << "control frames grew without bound";
+  close(fd);
+}
+
+// A throwaway self-signed certificate for 127.0.0.1, made by the openssl command.
+std::string MakeCertificate(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  const std::string key = (dir / "key.pem").string(), cert = (dir / "cert.pem").string(), both = (dir / "tls.pem").string();
+  const std::string cmd = "openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:P-256 -nodes -days 2 -subj /CN=127.0.0.1 "
+                          "-addext subjectAltName=IP:127.0.0.1 -keyout " + key + " -out " + cert + " 2>/dev/null && cat " + key +
+                          " " + cert + " > " + both;
+  return std::system(cmd.c_str()) == 0 ? both : "";
+}
+
+TEST(WebServer, WithACertificateItSpeaksTlsOnly) {
+  const auto dir = std::filesystem::temp_directory_path() / ("dyad_web_tls_" + std::to_string(getpid()));
+  const std::string pem = MakeCertificate(dir);
+  if (pem.empty()) GTEST_SKIP() << "no openssl command";
+  RecordingHandler handler;
+  WebServer::Options o = TestOptions(&handler);
+  o.tls_certificate = pem;
+  auto server = WebServer::Start(o);
+  ASSERT_TRUE(server.ok()) << server.status().ToString();
+  const int port = (*server)->port();
+
+  SSL_CTX* ctx = SSL_CTX_new(TLS_client_method());
+  ASSERT_EQ(SSL_CTX_load_verify_locations(ctx, (dir / "cert.pem").c_str(), nullptr), 1);
+  SSL_CTX_set_verify(ctx, SSL_VERIFY_PEER, nullptr);
+  const int fd = Connect(port);
+  SSL* ssl = SSL_new(ctx);
+  SSL_set_fd(ssl, fd);
+  SSL_set1_host(ssl, "127.0.0.1");
+  ASSERT_EQ(SSL_connect(ssl), 1) << "TLS handshake failed (certificate not verified?)";
+  const std::string request = "GET /watch?token=" + kExperimenter + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
+  ASSERT_EQ(SSL_write(ssl, request.data(), static_cast<int>(request.size())), static_cast<int>(request.size()));
+  std::string response;
+  char buf[4096];
+  for (int n; (n = SSL_read(ssl, buf, sizeof(buf))) > 0;) response.append(buf, static_cast<size_t>(n));
+  EXPECT_EQ(response.rfind("HTTP/1.1 200", 0), 0u) << response;
+  EXPECT_NE(response.find("the page"), std::string::npos);
+  SSL_free(ssl);
+  close(fd);
+  SSL_CTX_free(ctx);
+
+  EXPECT_EQ(Get(port, "/watch?token=" + kExperimenter).find("200 OK"), std::string::npos) << "plain HTTP answered";
+  std::filesystem::remove_all(dir);
+}
+
+TEST(WebServer, AnUnusableCertificateIsAClearError) {
+  const auto dir = std::filesystem::temp_directory_path() / ("dyad_web_badtls_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string pem = (dir / "tls.pem").string();
+  std::FILE* f = std::fopen(pem.c_str(), "w");
+  std::fputs("not a certificate\n", f);
+  std::fclose(f);
+  RecordingHandler handler;
+  WebServer::Options o = TestOptions(&handler);
+  o.tls_certificate = pem;
+  auto server = WebServer::Start(o);
+  ASSERT_FALSE(server.ok());
+  EXPECT_NE(server.status().message().find(pem), std::string::npos) << server.status().ToString();
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -31,7 +31,7 @@ if (mode === "foxglove") {
   const samples = Number(rest[0]);
   const b = await chromium.launch({ executablePath: "/usr/bin/chromium", args: ["--headless", "--no-sandbox", "--disable-gpu"] });
   const p = await (await b.newContext({ viewport: { width: 800, height: 800 } })).newPage();
-  await p.goto(url + "/subject");
+  await p.goto(url + "/subject?token=subject-token-000001");  // bench_web.sh's graph
   await p.waitForFunction(() => document.getElementById("role").textContent === "you steer");
   await p.mouse.move(400, 400);
   await p.keyboard.down("Space");

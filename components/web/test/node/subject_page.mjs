@@ -22,7 +22,7 @@ const log = { moves: [], key: [], closed_at: null, rtts: [] };
 try {
   const context = await browser.newContext({ viewport: { width: 1000, height: 800 } });
   const page = await context.newPage();
-  await page.goto(base + "/subject");
+  await page.goto(base + "/subject?token=subject-token-000001");  // the test graph's tokens
   await page.waitForFunction(() => document.getElementById("role").textContent === "you steer", null, { timeout: 10000 });
   const rect = await page.evaluate(() => {
     const r = document.getElementById("canvas").getBoundingClientRect();
@@ -62,7 +62,7 @@ try {
   await page.close();
   await sleep(800);
   const exp = await context.newPage();
-  await exp.goto(base + "/experimenter");
+  await exp.goto(base + "/experimenter?token=experimenter-token-0001");
   await exp.waitForFunction(() => document.getElementById("conn").textContent === "live", null, { timeout: 10000 });
   await sleep(1500);
   log.note = { text: "subject reported fatigue", t: Date.now() };
