@@ -104,31 +104,6 @@ void AddEvent(RunEvents& events, const SerializedSample& sample) {
   events.Add(m, std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
 }
 
-// The newest ComponentStats of every component of the graph, from dyad/stats (any process). Only
-// the graph's own (process, component) pairs are kept: a peer sending other names cannot grow
-// the table (or the experimenter's page).
-struct WebComponent::StatsTable {
-  std::mutex mutex;
-  std::set<std::pair<std::string, std::string>> graphs_own;  // (process, component); set before subscribing
-  std::map<std::pair<std::string, std::string>, msg::ComponentStats> rows;  // (process, component)
-  void Add(std::span<const uint8_t> cdr) {
-    msg::ComponentStats s;
-    if (!DecodeSample(cdr, &s).ok()) return;  // not from a dyad runtime of this version: not shown
-    if (!graphs_own.count({s.process_name(), s.component_name()})) return;
-    std::lock_guard<std::mutex> lock(mutex);
-    rows[{s.process_name(), s.component_name()}] = std::move(s);
-  }
-  std::string Json() {
-    nlohmann::json list = nlohmann::json::array();
-    std::lock_guard<std::mutex> lock(mutex);
-    for (const auto& [key, s] : rows)
-      list.push_back({{"process", s.process_name()}, {"component", s.component_name()}, {"steps", s.steps()},
-                      {"mean_ms", s.step_mean_s() * 1e3}, {"p99_ms", s.step_p99_s() * 1e3}, {"max_ms", s.step_max_s() * 1e3},
-                      {"misses", s.deadline_misses()}});
-    return nlohmann::json{{"op", "stats"}, {"rows", list}}.dump();
-  }
-};
-
 void WebComponent::Describe(ComponentSpec& spec) {
   spec.Summary("Embedded web server with a live Foxglove WebSocket bridge over the graph's topics.");
   spec.Param("address", "127.0.0.1").Doc("address to bind; anything but loopback needs tls_certificate (or plain_http)");
@@ -235,8 +210,7 @@ Status WebComponent::Configure(Context& ctx) {
     // Serialised by ExperimenterChannel.
     if (Status s = notes_->Publish(note_); !s.ok()) ctx_->log().Warn("notes: experimenter's note lost: " + s.ToString());
   });
-  stats_ = std::make_shared<StatsTable>();
-  stats_->graphs_own = GraphsComponents(ctx);
+  stats_ = std::make_shared<StatsTable>(GraphsComponents(ctx));
   events_ = std::make_shared<RunEvents>();
   for (const auto& t : ctx.graph_topics()) {
     Status s;

@@ -26,6 +26,7 @@
 #include "src/experimenter_channel.hpp"
 #include "src/foxglove_bridge.hpp"
 #include "src/run_events.hpp"
+#include "src/stats_table.hpp"
 #include "src/subject_channel.hpp"
 #include "src/web_server.hpp"
 
@@ -57,7 +58,6 @@ class WebComponent final : public Component {
   Input<msg::IntentionLabel>* labels_ = nullptr;  // owned by the runtime
   Output<msg::Annotation>* notes_ = nullptr;      // owned by the runtime
   std::unique_ptr<ExperimenterChannel> experimenter_;
-  struct StatsTable;
   std::shared_ptr<StatsTable> stats_;  // filled by the dyad/stats subscription
   std::shared_ptr<RunEvents> events_;  // filled by the dyad/processes and dyad/health subscriptions
   int64_t last_stats_ns_ = 0;
