@@ -1,7 +1,5 @@
 #include "analyze_commands.hpp"
 
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -16,8 +14,7 @@
 #include "losses.hpp"
 #include "recording_tables.hpp"
 #include "report_writer.hpp"
-
-extern char** environ;
+#include "run_process.hpp"
 
 namespace dyad::cli {
 namespace {
@@ -35,18 +32,6 @@ std::string PlotScript() {
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (ec) return {};
   return (exe.parent_path().parent_path() / "share" / "dyad" / "plot_report.py").string();
-}
-
-// Runs argv, waits; returns its exit status (127 when it cannot start).
-int Spawn(const std::vector<std::string>& args) {
-  std::vector<char*> argv;
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return 127;
-  int status = 0;
-  if (waitpid(pid, &status, 0) < 0) return 127;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
 int RunAnalyze(const Options& o) {
@@ -126,7 +111,7 @@ int RunAnalyze(const Options& o) {
                 << " is not a folder from here; plots drawn without the watermark (pass --dataset)\n";
     }
   }
-  const int code = Spawn(args);
+  const int code = tools::RunProcess(args);
   if (code != 0) {
     std::cerr << "dyad analyze: " << script << " failed (exit " << code
               << "); is python3-matplotlib installed (tools/setup.sh)?\n";

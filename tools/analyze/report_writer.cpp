@@ -68,7 +68,64 @@ double Percentile(std::vector<double> v, double q) {
   return v[static_cast<size_t>(std::min<double>(v.size() - 1, std::floor(q * static_cast<double>(v.size()))))];
 }
 
+// Mean of the finite values; NaN when none.
+double FiniteMean(const std::vector<double>& v) {
+  double sum = 0;
+  int n = 0;
+  for (double x : v)
+    if (std::isfinite(x)) sum += x, ++n;
+  return n > 0 ? sum / n : std::nan("");
+}
+
+// {"name": value, ...} in RunMetrics' order; NaN (no value) as null.
+std::string MetricsJson(const Report& r) {
+  std::ostringstream s;
+  s << "{";
+  bool first = true;
+  for (const auto& [name, value] : RunMetrics(r)) {
+    s << (first ? "\n  " : ",\n  ") << '"' << name << "\": ";
+    if (std::isfinite(value)) {
+      s.precision(9);
+      s << value;
+    } else {
+      s << "null";
+    }
+    first = false;
+  }
+  s << "\n}\n";
+  return s.str();
+}
+
 }  // namespace
+
+std::vector<std::pair<std::string, double>> RunMetrics(const Report& r) {
+  std::vector<double> congruence, final_congruence, accuracy, follows, switch_s, switched, nelbo;
+  const double period_s = static_cast<double>(r.plan.period_ns) * 1e-9;
+  for (const EventSummary& e : r.events) {
+    congruence.push_back(e.mean_congruence);
+    final_congruence.push_back(e.final_congruence);
+    accuracy.push_back(e.human_accuracy);
+    follows.push_back(e.robot_follows);
+    switched.push_back(e.robot_switch_after >= 0 ? 1.0 : 0.0);
+    if (e.robot_switch_after >= 0) switch_s.push_back(static_cast<double>(e.robot_switch_after) * period_s);
+  }
+  int64_t engaged = 0;
+  for (const StepSample& x : r.timeline.steps) {
+    nelbo.push_back(x.nelbo);
+    engaged += x.engaged ? 1 : 0;
+  }
+  const double steps = static_cast<double>(r.timeline.steps.size());
+  return {{"steps", steps},
+          {"engaged_fraction", steps > 0 ? static_cast<double>(engaged) / steps : std::nan("")},
+          {"events", static_cast<double>(r.events.size())},
+          {"mean_congruence", FiniteMean(congruence)},
+          {"final_congruence", FiniteMean(final_congruence)},
+          {"observer_accuracy", FiniteMean(accuracy)},
+          {"robot_follows", FiniteMean(follows)},
+          {"switched_fraction", FiniteMean(switched)},
+          {"switch_latency_s", FiniteMean(switch_s)},
+          {"nelbo_mean", FiniteMean(nelbo)}};
+}
 
 std::string FormatMarkdown(const Report& r) {
   std::ostringstream s;
@@ -175,7 +232,7 @@ Status WriteReport(const Report& r, const std::string& dir) {
   if (ec) return Status::IOError(dir, "cannot create the report folder: " + ec.message());
   const std::pair<const char*, std::string> files[] = {
       {"report.md", FormatMarkdown(r)}, {"events.csv", EventsCsv(r)},     {"confusion.csv", ConfusionCsv(r)},
-      {"timeline.csv", TimelineCsv(r)}, {"graph.yaml", r.graph_yaml},
+      {"timeline.csv", TimelineCsv(r)}, {"graph.yaml", r.graph_yaml},    {"metrics.json", MetricsJson(r)},
   };
   for (const auto& [name, text] : files) {
     if (Status s = WriteFile(dir + "/" + name, text); !s.ok()) return s;

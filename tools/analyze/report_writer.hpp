@@ -5,10 +5,12 @@
 //   confusion.csv  observer confusion on the human's traces: true,predicted,count
 //   timeline.csv   one row per step: positions, engagement, N-ELBO terms, congruence, argmaxes
 //   graph.yaml     the recorded graph (when the recording has it)
+//   metrics.json   the run in numbers (RunMetrics): what `dyad sweep` tabulates
 // The PNG plots are drawn from timeline.csv and events.csv by tools/analyze/plot_report.py.
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dyad/status.hpp"
@@ -33,5 +35,14 @@ Status WriteReport(const Report& report, const std::string& dir);
 
 // The report.md text (also used by tests).
 std::string FormatMarkdown(const Report& report);
+
+// The run in numbers, in a fixed order (NaN: not defined for this run, e.g. no event scored):
+//   steps, engaged_fraction (of the steps), events (scored), mean_congruence and
+//   final_congruence (mean over events), observer_accuracy (the observer on the human's traces),
+//   robot_follows (fraction of an event's labelled steps the robot's intention matched the
+//   human's primitive), switched_fraction (events where it ever did), switch_latency_s (mean
+//   delay to that first step, over events that switched), nelbo_mean (over steps). Only what a
+//   stepped run determines: no wall-clock timing (a sweep's table is the same on any machine).
+std::vector<std::pair<std::string, double>> RunMetrics(const Report& report);
 
 }  // namespace dyad::analyze

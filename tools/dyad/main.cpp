@@ -12,6 +12,7 @@
 #include "pvrnn_commands.hpp"
 #include "runtime_commands.hpp"
 #include "security_commands.hpp"
+#include "sweep_commands.hpp"
 
 int main(int argc, char** argv) {
   // A closed output (`dyad echo T | head`) makes writes fail instead of killing the process, so
@@ -28,6 +29,7 @@ int main(int argc, char** argv) {
   dyad::cli::AddPvrnnCommands(app, exit_code);
   dyad::cli::AddObserverCommands(app, exit_code);
   dyad::cli::AddAnalyzeCommands(app, exit_code);
+  dyad::cli::AddSweepCommands(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

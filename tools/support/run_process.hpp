@@ -1,0 +1,19 @@
+// tools/support/run_process.hpp: run a program and wait for it (the CLI's helpers: the plot
+// scripts, a sweep's runs).
+//
+// Contract of RunProcess(args, log):
+//   - args[0] is a path, or a name looked up in PATH; the child inherits the environment.
+//   - `log` empty: the child writes to our stdout and stderr; else both go to that file
+//     (created 0600, or truncated).
+//   - Returns the child's exit status, 128 + N when signal N ended it, 127 when it could not be
+//     started. Thread-safe (each call waits for its own child only).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace dyad::tools {
+
+int RunProcess(const std::vector<std::string>& args, const std::string& log = "");
+
+}  // namespace dyad::tools

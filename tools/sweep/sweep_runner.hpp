@@ -1,0 +1,40 @@
+// tools/sweep/sweep_runner.hpp: the runs of a sweep on this machine's cores, and their table.
+//
+// Contract of RunSweep:
+//   - Each run gets OUT/runs/<id>/: `dyad run` (stepped, hermetic: a stepped run's DDS stays in
+//     its process, so concurrent runs never see each other) recording rec.mcap, then `dyad
+//     analyze --no-plots` into report/, then metrics.json (the report's, copied last, by rename:
+//     its presence means the run finished). run.log and analyze.log keep what they printed.
+//   - A run whose folder has metrics.json is skipped (resuming a killed sweep). A run that fails
+//     (a non-zero exit, a crash, no metrics) gets failed.txt (the command, how it ended, the end
+//     of its log) and the sweep goes on; a later sweep tries it again.
+//   - `workers` runs at once; each finished run prints a line to `log` with its count, its
+//     status and the estimated time left.
+// Contract of WriteSweepCsv: OUT/sweep.csv, one row per run in the plan's order (not the order
+// they finished): run, status (ok, failed, missing), each swept key, seed, then every metric of
+// metrics.json in its order (empty where a run has none). The same runs give the same file
+// whatever the workers, and after a resume.
+#pragma once
+
+#include <ostream>
+#include <string>
+
+#include "dyad/status.hpp"
+#include "sweep_plan.hpp"
+
+namespace dyad::sweep {
+
+struct RunnerOptions {
+  std::string out;   // the sweep's folder
+  int workers = 1;
+  std::string dyad;  // the dyad executable the runs use
+};
+
+struct RunnerResult {
+  int ran = 0, skipped = 0, failed = 0;
+};
+
+RunnerResult RunSweep(const SweepPlan& plan, const RunnerOptions& options, std::ostream& log);
+Status WriteSweepCsv(const SweepPlan& plan, const std::string& out);
+
+}  // namespace dyad::sweep
