@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `dyad sweep` throughput: a 64-run sweep of the demo (8 compliance gains x 8 seeds, 200 steps
+# `dyad sweep` throughput: a 64-run sweep of the demo (8 compliance gains x 8 seeds, 2,000 steps
 # each, models trained briefly here) with 2 workers against 1, measured in one run, and the
 # per-run cost of the sweep (its `dyad analyze` and bookkeeping) against a bare `dyad run` of
 # the same graph. Prints a table.
@@ -19,7 +19,7 @@ sets="human.dataset: $work/data, mind.model: $work/demo.dpvrnn, observer.model: 
 cat > s.yaml <<YAML
 sweep: bench
 graph: $repo/configs/demo.yaml
-duration: 20
+duration: 200
 set: {$sets}
 grid:
   mixer.gain: [0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9]
@@ -32,7 +32,7 @@ cmp -s one/sweep.csv two/sweep.csv || { echo "the tables differ"; exit 1; }
 bare_runs=16
 t3=$(now)
 for i in $(seq $bare_runs); do
-  "$dyad" run "$repo/configs/demo.yaml" --quiet --duration 20 --set clock=stepped --set seed=$i \
+  "$dyad" run "$repo/configs/demo.yaml" --quiet --duration 200 --set clock=stepped --set seed=$i \
     --set human.dataset="$work/data" --set mind.model="$work/demo.dpvrnn" --set observer.model="$work/demo.dobs" \
     --set recorder.file="$work/bare.mcap" --set recorder.overwrite=true > /dev/null 2>&1
 done

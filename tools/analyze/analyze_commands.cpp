@@ -4,10 +4,12 @@
 
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "build_report.hpp"
 #include "demonstrations.hpp"
 #include "dyad/mcap/reader.hpp"
 #include "experiment_analysis.hpp"
@@ -39,47 +41,14 @@ int RunAnalyze(const Options& o) {
     std::cerr << "dyad analyze: --dataset " << o.dataset << ": not a folder\n";
     return kBadInput;
   }
-  auto reader = mcap::Reader::Open(o.recording);
-  if (!reader.ok()) {
-    std::cerr << "dyad analyze: " << reader.status().message() << "\n";
+  std::ostringstream warnings;
+  auto built = analyze::BuildReport(o.recording, warnings);
+  std::cerr << warnings.str();
+  if (!built.ok()) {
+    std::cerr << "dyad analyze: " << built.status().message() << "\n";
     return kBadInput;
   }
-  if (reader->recovery().truncated) std::cerr << "dyad analyze: " << o.recording << ": " << reader->recovery().Describe() << "\n";
-  analyze::Report report;
-  report.recording = o.recording;
-  report.graph_yaml = analyze::GraphMetadata(*reader, "yaml");
-  auto plan = analyze::PlanFromGraphYaml(report.graph_yaml);
-  if (!plan.ok()) {
-    std::cerr << "dyad analyze: " << o.recording << ": " << plan.status().message() << "\n";
-    return kBadInput;
-  }
-  report.plan = *plan;
-  // The graph's data set path is relative to the graph file's folder (recorded with it).
-  if (const std::string folder = analyze::GraphMetadata(*reader, "folder");
-      !folder.empty() && !report.plan.dataset.empty() && std::filesystem::path(report.plan.dataset).is_relative())
-    report.plan.dataset = (std::filesystem::path(folder) / report.plan.dataset).lexically_normal().string();
-  auto tables = analyze::ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels",
-                                              "dyad/clock_offsets"});
-  if (!tables.ok()) {
-    std::cerr << "dyad analyze: " << tables.status().message() << "\n";
-    return kBadInput;
-  }
-  auto corrections = analyze::ClockCorrections(*tables, report.plan);
-  if (!corrections.ok()) {
-    std::cerr << "dyad analyze: " << o.recording << ": " << corrections.status().message() << "\n";
-    return kBadInput;
-  }
-  auto timeline = analyze::BuildTimeline(*tables, report.plan, *corrections);
-  if (!timeline.ok()) {
-    std::cerr << "dyad analyze: " << o.recording << ": " << timeline.status().message() << "\n";
-    return kBadInput;
-  }
-  report.timeline = std::move(*timeline);
-  if (auto losses = bag::FindLosses(*reader); losses.ok()) report.transport = bag::FormatLosses(*losses);
-  else std::cerr << "dyad analyze: " << o.recording << ": losses not read: " << losses.status().message() << "\n";
-  const auto events = analyze::Events(report.timeline, report.plan);
-  report.events = analyze::SummariseEvents(report.timeline, events);
-  report.confusion = analyze::HumanConfusion(report.timeline, events);
+  analyze::Report& report = *built;
 
   std::string out = o.out;
   if (out.empty()) {

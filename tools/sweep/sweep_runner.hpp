@@ -2,8 +2,8 @@
 //
 // Contract of RunSweep:
 //   - Each run gets OUT/runs/<id>/: `dyad run` (stepped, hermetic: a stepped run's DDS stays in
-//     its process, so concurrent runs never see each other) recording rec.mcap, then `dyad
-//     analyze --no-plots` into report/, then metrics.json (the report's, copied last, by rename:
+//     its process, so concurrent runs never see each other) recording rec.mcap, then what `dyad
+//     analyze --no-plots` writes, into report/ (in this process), then metrics.json (the report's, copied last, by rename:
 //     its presence means the run finished). run.log and analyze.log keep what they printed.
 //   - A run whose folder has metrics.json is skipped (resuming a killed sweep). A run that fails
 //     (a non-zero exit, a crash, no metrics) gets failed.txt (the command, how it ended, the end

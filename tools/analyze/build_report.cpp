@@ -1,0 +1,41 @@
+#include "build_report.hpp"
+
+#include <filesystem>
+
+#include "dyad/mcap/reader.hpp"
+#include "experiment_analysis.hpp"
+#include "losses.hpp"
+#include "recording_tables.hpp"
+
+namespace dyad::analyze {
+
+StatusOr<Report> BuildReport(const std::string& recording, std::ostream& warnings) {
+  auto reader = mcap::Reader::Open(recording);
+  if (!reader.ok()) return reader.status();
+  if (reader->recovery().truncated) warnings << "dyad analyze: " << recording << ": " << reader->recovery().Describe() << "\n";
+  Report report;
+  report.recording = recording;
+  report.graph_yaml = GraphMetadata(*reader, "yaml");
+  auto plan = PlanFromGraphYaml(report.graph_yaml);
+  if (!plan.ok()) return plan.status().WithContext(recording);
+  report.plan = *plan;
+  // The graph's data set path is relative to the graph file's folder (recorded with it).
+  if (const std::string folder = GraphMetadata(*reader, "folder");
+      !folder.empty() && !report.plan.dataset.empty() && std::filesystem::path(report.plan.dataset).is_relative())
+    report.plan.dataset = (std::filesystem::path(folder) / report.plan.dataset).lexically_normal().string();
+  auto tables = ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels", "dyad/clock_offsets"});
+  if (!tables.ok()) return tables.status();
+  auto corrections = ClockCorrections(*tables, report.plan);
+  if (!corrections.ok()) return corrections.status().WithContext(recording);
+  auto timeline = BuildTimeline(*tables, report.plan, *corrections);
+  if (!timeline.ok()) return timeline.status().WithContext(recording);
+  report.timeline = std::move(*timeline);
+  if (auto losses = bag::FindLosses(*reader); losses.ok()) report.transport = bag::FormatLosses(*losses);
+  else warnings << "dyad analyze: " << recording << ": losses not read: " << losses.status().message() << "\n";
+  const auto events = Events(report.timeline, report.plan);
+  report.events = SummariseEvents(report.timeline, events);
+  report.confusion = HumanConfusion(report.timeline, events);
+  return report;
+}
+
+}  // namespace dyad::analyze
