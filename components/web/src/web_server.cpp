@@ -10,6 +10,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <sys/socket.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -331,8 +332,46 @@ void WebServer::Disconnect(Client& c) {
   if (info != nullptr) ShutdownConnection(info->remote_addr, info->remote_port, port_);
 }
 
+// civetweb's master thread polls its listening socket 2 s at a time and sees mg_stop's flag only
+// between polls: a connection of our own wakes it (else every stop, a Ctrl-C of the graph
+// included, waited up to 2 s).
+void WakeListener(const std::string& address, int port) {
+  const bool v6 = address.find(':') != std::string::npos;
+  const std::string target = address == "0.0.0.0" ? "127.0.0.1" : address == "::" ? "::1" : address;
+  const int fd = socket(v6 ? AF_INET6 : AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return;
+  sockaddr_storage a{};
+  socklen_t len = 0;
+  if (v6) {
+    auto* in6 = reinterpret_cast<sockaddr_in6*>(&a);
+    in6->sin6_family = AF_INET6;
+    in6->sin6_port = htons(static_cast<uint16_t>(port));
+    inet_pton(AF_INET6, target.c_str(), &in6->sin6_addr);
+    len = sizeof(sockaddr_in6);
+  } else {
+    auto* in = reinterpret_cast<sockaddr_in*>(&a);
+    in->sin_family = AF_INET;
+    in->sin_port = htons(static_cast<uint16_t>(port));
+    inet_pton(AF_INET, target.c_str(), &in->sin_addr);
+    len = sizeof(sockaddr_in);
+  }
+  connect(fd, reinterpret_cast<sockaddr*>(&a), len);
+  close(fd);
+}
+
 WebServer::~WebServer() {
-  if (ctx_ != nullptr) mg_stop(ctx_);  // closes every connection (OnClosed joins each sender)
+  if (ctx_ != nullptr) {
+    std::atomic<bool> stopped{false};
+    std::thread waker([&] {
+      for (int i = 0; i < 200 && !stopped.load(); ++i) {  // until mg_stop returns (at most 2 s)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        WakeListener(options_.address, port_);
+      }
+    });
+    mg_stop(ctx_);  // closes every connection (OnClosed joins each sender)
+    stopped = true;
+    waker.join();
+  }
   handler_thread_.reset();             // after mg_stop: no worker waits on it any more
   std::lock_guard<std::mutex> lock(mutex_);
   for (auto& [id, c] : clients_) {
