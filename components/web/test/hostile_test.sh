@@ -44,7 +44,11 @@ const c = JSON.parse(require("fs").readFileSync("clients.json", "utf8"));
 if (c.closed !== 1000) { console.error("FAIL: " + c.closed + " of 1000 bad clients closed by the server"); process.exit(1); }
 '
 steps=$(awk '$1 == "pattern" {print $2}' run.out)
-# 100 Hz for the run (started before the clients): at least 95% of the periods stepped.
-[ "$steps" -ge $(( duration * 100 * 95 / 100 )) ] || { echo "FAIL: pattern stepped $steps times in $duration s at 100 Hz"; exit 1; }
+# 100 Hz for the run (started before the clients): at least 95% of the periods stepped (85%
+# under ASan, where node's storm and the instrumented process share 2 cores: 91% seen once). A
+# step thread blocked by the web component would lose far more.
+min_percent=95
+[ -n "${ASAN_OPTIONS:-}" ] && min_percent=85
+[ "$steps" -ge $(( duration * 100 * min_percent / 100 )) ] || { echo "FAIL: pattern stepped $steps times in $duration s at 100 Hz"; exit 1; }
 
 echo PASS
