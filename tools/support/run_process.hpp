@@ -7,6 +7,8 @@
 //     (created 0600, or truncated).
 //   - Returns the child's exit status, 128 + N when signal N ended it, 127 when it could not be
 //     started. Thread-safe (each call waits for its own child only).
+// ShellQuoted(args): the command line a POSIX shell turns back into exactly `args` (arguments
+// with anything but [A-Za-z0-9_./=:,+@%-] in single quotes), for logs and generated scripts.
 #pragma once
 
 #include <string>
@@ -15,5 +17,6 @@
 namespace dyad::tools {
 
 int RunProcess(const std::vector<std::string>& args, const std::string& log = "");
+std::string ShellQuoted(const std::vector<std::string>& args);
 
 }  // namespace dyad::tools

@@ -10,6 +10,7 @@
 #include "run_process.hpp"
 #include "sweep_plan.hpp"
 #include "sweep_runner.hpp"
+#include "sweep_slurm.hpp"
 
 namespace dyad::cli {
 namespace {
@@ -22,6 +23,9 @@ struct Options {
   int workers = 0;
   std::vector<std::string> plugins;
   bool plots = true, dry_run = false;
+  bool slurm = false, collect = false;
+  std::string task;  // "i/N": this array task's chunk only
+  sweep::SlurmOptions slurm_options;
 };
 
 // <prefix>/share/dyad/plot_sweep.py next to the executable's bin/ (build and installed trees).
@@ -46,27 +50,106 @@ struct RestoreCwd {
   }
 };
 
+void Plots(const Options& o, const fs::path& out) {
+  if (!o.plots) return;
+  if (int rc = Plot((out / "sweep.csv").string(), (out / "plots").string()); rc != 0)
+    std::cerr << "dyad sweep: warning: the plots were not drawn (python3 with matplotlib; exit " << rc << ")\n";
+  else
+    std::cout << "plots: " << (out / "plots").string() << "/\n";
+}
+
+// The runs of `plan` here, `workers` at once; with `table`, then sweep.csv and the plots.
+int RunHere(const Options& o, const sweep::SweepPlan& plan, const fs::path& out, int workers, bool table) {
+  std::error_code ec;
+  if (fs::create_directories(out / "runs", ec); ec) {
+    std::cerr << "dyad sweep: " << out.string() << ": " << ec.message() << "\n";
+    return kFailure;
+  }
+  const sweep::RunnerResult r = sweep::RunSweep(plan, sweep::RunnerOptions{out.string(), workers, Self()}, std::cout);
+  std::cout << "sweep " << plan.name << (o.task.empty() ? "" : " task " + o.task) << ": " << r.ran << " ran, " << r.skipped
+            << " done before, " << r.failed << " failed";
+  if (!table) {
+    std::cout << "\n";
+    return r.failed > 0 ? kFailure : kOk;
+  }
+  if (Status s = sweep::WriteSweepCsv(plan, out.string()); !s.ok()) {
+    std::cerr << "\ndyad sweep: " << s.message() << "\n";
+    return kFailure;
+  }
+  std::cout << "; table: " << (out / "sweep.csv").string() << "\n" << std::flush;
+  if (r.ran + r.skipped > 0) Plots(o, out);
+  return r.failed > 0 ? kFailure : kOk;
+}
+
+// --collect: the table of what the runs left in OUT (the Slurm array's last job, or by hand).
+int Collect(const Options& o, const sweep::SweepPlan& plan, const fs::path& out) {
+  if (!fs::is_directory(out / "runs")) {
+    std::cerr << "dyad sweep --collect: " << out.string() << ": no runs in this folder (none has started yet, or -o names another)\n";
+    return kFailure;
+  }
+  if (Status s = sweep::WriteSweepCsv(plan, out.string()); !s.ok()) {
+    std::cerr << "dyad sweep: " << s.message() << "\n";
+    return kFailure;
+  }
+  size_t ok = 0, failed = 0;
+  for (const auto& run : plan.runs) {
+    ok += fs::exists(out / "runs" / run.id / "metrics.json");
+    failed += !fs::exists(out / "runs" / run.id / "metrics.json") && fs::exists(out / "runs" / run.id / "failed.txt");
+  }
+  const size_t missing = plan.runs.size() - ok - failed;
+  std::cout << "sweep " << plan.name << " collected: " << ok << " ok, " << failed << " failed, " << missing
+            << " missing; table: " << (out / "sweep.csv").string() << "\n" << std::flush;
+  if (ok > 0) Plots(o, out);
+  if (missing > 0)
+    std::cerr << "dyad sweep: " << missing << " runs have not run (tasks still queued, or lost): `squeue`, then submit again (finished runs are skipped)\n";
+  return failed + missing > 0 ? kFailure : kOk;
+}
+
+int Submit(const Options& o, const sweep::SweepPlan& plan, const fs::path& file, const fs::path& out) {
+  auto job = sweep::SubmitToSlurm(plan, file.string(), out.string(), Self(), o.plugins, o.plots, o.slurm_options);
+  if (!job.ok()) {
+    std::cerr << "dyad sweep --slurm: " << job.status().message() << "\n";
+    return kFailure;
+  }
+  std::cout << "submitted: job " << job->array_id << " (" << job->tasks << " array tasks; logs "
+            << (out / "slurm" / "task-N.log").string() << "), then job " << job->collect_id << " writes "
+            << (out / "sweep.csv").string() << "\nwatch: squeue -j " << job->array_id << "," << job->collect_id << "\n";
+  return kOk;
+}
+
 int RunSweepCommand(Options o) {
   std::error_code ec;
   const fs::path file = fs::absolute(o.file, ec);
   // Paths in the sweep file (its graph, its set: values) are relative to it, as a graph's are.
   const fs::path cwd = fs::current_path(ec);
   RestoreCwd restore{cwd};
+  sweep::TaskSlice task;
+  if (!o.task.empty())
+    if (Status s = sweep::ParseTask(o.task, &task); !s.ok()) {
+      std::cerr << "dyad sweep: " << s.message() << "\n";
+      return kBadInput;
+    }
   if (fs::current_path(file.parent_path(), ec); ec) {
     std::cerr << "dyad sweep: " << o.file << ": cannot enter its folder: " << ec.message() << "\n";
     return kBadInput;
   }
   std::vector<Diagnostic> problems;
-  const sweep::SweepPlan plan = sweep::LoadSweep(file.string(), o.plugins, &problems);
+  sweep::SweepPlan plan = sweep::LoadSweep(file.string(), o.plugins, &problems);
   if (!problems.empty()) {
     for (const auto& p : problems) std::cerr << p.ToString() << "\n";
     std::cerr << o.file << ": " << problems.size() << " problem" << (problems.size() == 1 ? "" : "s") << ", nothing was run\n";
     return kBadInput;
   }
   const fs::path out = o.out.empty() ? cwd / ("sweep-" + plan.name) : fs::absolute(cwd / o.out);
+  if (o.collect) return Collect(o, plan, out);
+  if (o.slurm) return Submit(o, plan, file, out);
+  const size_t all = plan.runs.size();
+  if (!o.task.empty()) plan.runs = sweep::TaskRuns(plan.runs, task);
   const int workers = o.workers > 0 ? o.workers : std::max(1u, std::thread::hardware_concurrency());
-  std::cout << "sweep " << plan.name << ": " << plan.runs.size() << " runs of " << plan.graph << " (" << plan.duration_s
-            << " s each, stepped), " << workers << " at once, into " << out.string() << "\n";
+  std::cout << "sweep " << plan.name << ": " << plan.runs.size() << " runs";
+  if (!o.task.empty()) std::cout << " (task " << o.task << " of " << all << " runs)";
+  std::cout << " of " << plan.graph << " (" << plan.duration_s << " s each, stepped), " << workers << " at once, into "
+            << out.string() << "\n";
   if (o.dry_run) {
     for (const auto& r : plan.runs) {
       std::cout << r.id;
@@ -75,25 +158,7 @@ int RunSweepCommand(Options o) {
     }
     return kOk;
   }
-  if (fs::create_directories(out / "runs", ec); ec) {
-    std::cerr << "dyad sweep: " << out.string() << ": " << ec.message() << "\n";
-    return kFailure;
-  }
-  const sweep::RunnerResult r = sweep::RunSweep(plan, sweep::RunnerOptions{out.string(), workers, Self()}, std::cout);
-  if (Status s = sweep::WriteSweepCsv(plan, out.string()); !s.ok()) {
-    std::cerr << "dyad sweep: " << s.message() << "\n";
-    return kFailure;
-  }
-  std::cout << "sweep " << plan.name << ": " << r.ran << " ran, " << r.skipped << " done before, " << r.failed
-            << " failed; table: " << (out / "sweep.csv").string() << "\n";
-  std::cout << std::flush;
-  if (o.plots && r.ran + r.skipped > 0) {
-    if (int rc = Plot((out / "sweep.csv").string(), (out / "plots").string()); rc != 0)
-      std::cerr << "dyad sweep: warning: the plots were not drawn (python3 with matplotlib; exit " << rc << ")\n";
-    else
-      std::cout << "plots: " << (out / "plots").string() << "/\n";
-  }
-  return r.failed > 0 ? kFailure : kOk;
+  return RunHere(o, plan, out, workers, o.task.empty());
 }
 
 }  // namespace
@@ -106,7 +171,20 @@ void AddSweepCommands(CLI::App& app, int& exit_code) {
   cmd->add_option("-j,--workers", o->workers, "Runs at once (default: the cores)")->check(CLI::Range(1, 1024));
   cmd->add_option("--plugins", o->plugins, "Extra plugin file or folder (repeatable)");
   cmd->add_flag("!--no-plots", o->plots, "sweep.csv only");
-  cmd->add_flag("--dry-run", o->dry_run, "check the sweep file and list its runs; run nothing");
+  auto* dry = cmd->add_flag("--dry-run", o->dry_run, "check the sweep file and list its runs; run nothing");
+  auto* task = cmd->add_option("--task", o->task, "Run only chunk I of N (I counted from 0): what a Slurm array task runs");
+  auto* collect = cmd->add_flag("--collect", o->collect, "Run nothing: write sweep.csv (and plots) from the runs in the sweep folder");
+  auto* slurm = cmd->add_flag("--slurm", o->slurm, "Submit the runs to Slurm as an array job, then a job that collects the table");
+  slurm->excludes(task)->excludes(collect)->excludes(dry);
+  collect->excludes(task)->excludes(dry);
+  auto* group = "Slurm (with --slurm)";
+  cmd->add_option("--partition", o->slurm_options.partition, "sbatch --partition")->group(group)->needs(slurm);
+  cmd->add_option("--time", o->slurm_options.time, "sbatch --time of each task (e.g. 1:00:00)")->group(group)->needs(slurm);
+  cmd->add_option("--tasks", o->slurm_options.tasks, "Array tasks (default: one per run, at most 100)")->check(CLI::Range(1, 100000))->group(group)->needs(slurm);
+  cmd->add_option("--cpus-per-task", o->slurm_options.cpus_per_task, "Cores per task: its runs at once (default 1)")
+      ->check(CLI::Range(1, 1024))->group(group)->needs(slurm);
+  cmd->add_option("--sbatch-arg", o->slurm_options.sbatch_args, "Another #SBATCH line, e.g. --sbatch-arg=--account=lab (repeatable)")
+      ->group(group)->needs(slurm);
   cmd->callback([o, &exit_code] { exit_code = RunSweepCommand(*o); });
 }
 

@@ -34,12 +34,6 @@ std::string Tail(const std::string& path, size_t lines) {
   return out;
 }
 
-std::string Quoted(const std::vector<std::string>& args) {
-  std::string s;
-  for (const auto& a : args) s += (s.empty() ? "" : " ") + (a.find_first_of(" '\"") == std::string::npos ? a : "'" + a + "'");
-  return s;
-}
-
 enum class Outcome { kOk, kSkipped, kFailed };
 
 // `dyad analyze --no-plots`, in this process (a second process per run cost a fifth of a short
@@ -63,7 +57,7 @@ Outcome DoRun(const SweepPlan& plan, const SweepRun& run, const RunnerOptions& o
   run_args.insert(run_args.end(), {"--set", plan.recorder + ".file=" + (dir / "rec.mcap").string()});
   std::string failed;
   if (int rc = tools::RunProcess(run_args, (dir / "run.log").string()); rc != 0) {
-    failed = Quoted(run_args) + "\nexited " + std::to_string(rc) + "; the end of run.log:\n" + Tail((dir / "run.log").string(), 20);
+    failed = tools::ShellQuoted(run_args) + "\nexited " + std::to_string(rc) + "; the end of run.log:\n" + Tail((dir / "run.log").string(), 20);
   } else if (Status s = Analyze((dir / "rec.mcap").string(), (dir / "report").string()); !s.ok()) {
     failed = "dyad analyze " + (dir / "rec.mcap").string() + ": " + s.message() + "\n";
   } else {

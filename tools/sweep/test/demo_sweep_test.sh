@@ -8,11 +8,9 @@ set -euo pipefail
 repo=$1 build=$2 work=$3
 dyad=$build/bin/dyad
 fail() { echo "FAIL: $*" >&2; exit 1; }
+here=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$work"; mkdir -p "$work"; cd "$work"
-"$dyad" generate dataset --out data > /dev/null
-"$dyad" train "$repo/configs/train/demo.yaml" --set dataset="$work/data" --set output="$work/demo.dpvrnn" \
-  --set epochs=200 --set log_every=200 > train.log
-"$dyad" train-observer demo.dpvrnn -o demo.dobs --epochs 200 > observer.log
+bash "$here/demo_models.sh" "$repo" "$dyad" "$work"
 cat > s.yaml <<YAML
 sweep: demo_test
 graph: $repo/configs/demo.yaml

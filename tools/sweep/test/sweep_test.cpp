@@ -11,6 +11,7 @@
 #include "dyad/testing/child_process.hpp"
 #include "dyad/testing/cli.hpp"
 #include "sweep_commands.hpp"
+#include "sweep_slurm.hpp"
 
 namespace dyad::cli {
 namespace {
@@ -40,10 +41,10 @@ class SweepTest : public ::testing::Test {
     return dir_ / name;
   }
   // The dyad executable, as a user runs it (its runs are processes of their own).
-  int Sweep(const std::vector<std::string>& args, std::string* out = nullptr) {
+  int Sweep(const std::vector<std::string>& args, std::string* out = nullptr, std::vector<std::string> env = {}) {
     std::vector<std::string> argv = {std::string(DYAD_BIN_DIR) + "/dyad", "sweep"};
     argv.insert(argv.end(), args.begin(), args.end());
-    dyad::testing::ChildProcess p(argv, dir_, "sweep" + std::to_string(runs_++));
+    dyad::testing::ChildProcess p(argv, dir_, "sweep" + std::to_string(runs_++), std::move(env));
     const int code = p.Wait(300);
     if (out) *out = p.out() + p.err();
     return code;
@@ -109,6 +110,97 @@ TEST_F(SweepTest, AFailingRunIsRecordedTheRestRunAndARerunResumes) {
   EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "-j", "2", "--no-plots"}, &out), 0) << out;
   EXPECT_NE(out.find("1 ran, 2 done before, 0 failed"), std::string::npos) << out;
   EXPECT_EQ(ReadFile(dir_ / "o" / "sweep.csv").find("failed"), std::string::npos);
+}
+
+TEST(SweepTask, ChunksHoldEveryRunOnceInOrder) {
+  std::vector<sweep::SweepRun> runs(11);
+  for (size_t i = 0; i < runs.size(); ++i) runs[i].id = std::to_string(i);
+  for (int count : {1, 2, 3, 4, 11, 15}) {
+    std::vector<std::string> seen;
+    for (int i = 0; i < count; ++i) {
+      const auto chunk = sweep::TaskRuns(runs, {i, count});
+      EXPECT_LE(chunk.size(), runs.size() / static_cast<size_t>(count) + 1);
+      for (const auto& r : chunk) seen.push_back(r.id);
+    }
+    ASSERT_EQ(seen.size(), runs.size()) << count << " tasks";
+    for (size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(seen[i], runs[i].id) << count << " tasks";
+  }
+  sweep::TaskSlice t;
+  EXPECT_TRUE(sweep::ParseTask("3/4", &t).ok());
+  EXPECT_EQ(t.index, 3);
+  EXPECT_EQ(t.count, 4);
+  for (const char* bad : {"4/4", "1/0", "-1/4", "1", "a/b", "1/4x", "", "/4"}) EXPECT_FALSE(sweep::ParseTask(bad, &t).ok()) << bad;
+}
+
+// What a Slurm array does, by hand: every task's chunk into one folder, then --collect.
+TEST_F(SweepTest, TasksThenCollectGiveTheLocalTable) {
+  const fs::path file = Write("sweep: s\ngraph: g.yaml\nduration: 1\ngrid:\n  src.start: [0, 100, 7]\nseeds: [1, 2]\n");
+  std::string out;
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "local").string(), "--no-plots"}, &out), 0) << out;
+  // Collected before any task ran, then with half of them: what is missing is said, exit 1.
+  EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "tasks").string(), "--collect", "--no-plots"}, &out), 1) << out;
+  EXPECT_NE(out.find("tasks: no runs in this folder"), std::string::npos) << out;
+  for (int i = 0; i < 4; ++i) {
+    if (i == 2) {
+      EXPECT_FALSE(fs::exists(dir_ / "tasks" / "sweep.csv")) << "a task wrote the table (of its chunk only)";
+      EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "tasks").string(), "--collect", "--no-plots"}, &out), 1) << out;
+      EXPECT_NE(out.find("3 ok, 0 failed, 3 missing"), std::string::npos) << out;
+      EXPECT_NE(ReadFile(dir_ / "tasks" / "sweep.csv").find(",missing,"), std::string::npos);
+    }
+    ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "tasks").string(), "--task", std::to_string(i) + "/4", "-j", "1"}, &out), 0) << out;
+    EXPECT_NE(out.find(i % 2 == 0 ? "1 ran, 0 done before" : "2 ran, 0 done before"), std::string::npos) << out;
+  }
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "tasks").string(), "--collect", "--no-plots"}, &out), 0) << out;
+  EXPECT_NE(out.find("6 ok, 0 failed, 0 missing"), std::string::npos) << out;
+  EXPECT_EQ(ReadFile(dir_ / "tasks" / "sweep.csv"), ReadFile(dir_ / "local" / "sweep.csv"));
+  EXPECT_EQ(Sweep({file.string(), "--task", "4/4"}, &out), 2);
+  EXPECT_NE(out.find("--task 4/4: want I/N with 0 <= I < N"), std::string::npos) << out;
+}
+
+// --slurm against a stand-in sbatch that logs its arguments: the scripts, then the array and the
+// collect job after it. The real Slurm runs them in slurm_sweep_test.sh.
+TEST_F(SweepTest, SlurmGetsAnArrayThenACollectJobThatWaitsForIt) {
+  const fs::path file = Write("sweep: s\ngraph: g.yaml\nduration: 1\ngrid:\n  src.start: [0, 100, 7]\nseeds: [1, 2]\n");
+  fs::create_directories(dir_ / "bin");
+  Write("#!/bin/sh\necho \"$*\" >> " + (dir_ / "sbatch.calls").string() + "\necho 'sbatch: warning: a note'\n" +
+            "n=$(wc -l < " + (dir_ / "sbatch.calls").string() + ")\necho \"$((41 + n));cluster\"\n",
+        "bin/sbatch");
+  fs::permissions(dir_ / "bin" / "sbatch", fs::perms::owner_all);
+  const std::string path = "PATH=" + (dir_ / "bin").string() + ":/usr/bin:/bin";
+  std::string out;
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--slurm", "--tasks", "4", "--partition", "short", "--time",
+                   "0:10:00", "--cpus-per-task", "2", "--sbatch-arg=--account=lab"},
+                  &out, {path}),
+            0)
+      << out;
+  EXPECT_NE(out.find("submitted: job 42 (4 array tasks"), std::string::npos) << out;
+  EXPECT_NE(out.find("then job 43 writes"), std::string::npos) << out;
+  const std::string calls = ReadFile(dir_ / "sbatch.calls");
+  EXPECT_EQ(calls, "--parsable " + (dir_ / "o" / "slurm" / "runs.sbatch").string() + "\n--parsable --dependency=afterany:42 " +
+                       (dir_ / "o" / "slurm" / "collect.sbatch").string() + "\n");
+  const std::string runs = ReadFile(dir_ / "o" / "slurm" / "runs.sbatch");
+  for (const std::string line : {"#SBATCH --array=0-3\n", "#SBATCH --partition=short\n", "#SBATCH --time=0:10:00\n",
+                                 "#SBATCH --cpus-per-task=2\n", "#SBATCH --account=lab\n",
+                                 " --task \"$SLURM_ARRAY_TASK_ID/4\" -j \"${SLURM_CPUS_PER_TASK:-1}\" -o "})
+    EXPECT_NE(runs.find(line), std::string::npos) << line << " not in\n" << runs;
+  EXPECT_NE(ReadFile(dir_ / "o" / "slurm" / "collect.sbatch").find(" --collect -o " + (dir_ / "o").string()), std::string::npos);
+  // More tasks than runs: one per run.
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "p").string(), "--slurm", "--tasks", "50"}, &out, {path}), 0) << out;
+  EXPECT_NE(ReadFile(dir_ / "p" / "slurm" / "runs.sbatch").find("#SBATCH --array=0-5\n"), std::string::npos);
+}
+
+TEST_F(SweepTest, SlurmNotReachableIsSaidInItsOwnWords) {
+  const fs::path file = Write("sweep: s\ngraph: g.yaml\nduration: 1\ngrid:\n  src.start: [0]\n");
+  std::string out;
+  EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--slurm"}, &out, {"PATH=" + (dir_ / "none").string()}), 1);
+  EXPECT_NE(out.find("sbatch is not on PATH"), std::string::npos) << out;
+  fs::create_directories(dir_ / "bin");
+  Write("#!/bin/sh\necho 'sbatch: error: Batch job submission failed: Unable to contact slurm controller' >&2\nexit 1\n", "bin/sbatch");
+  fs::permissions(dir_ / "bin" / "sbatch", fs::perms::owner_all);
+  EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--slurm"}, &out, {"PATH=" + (dir_ / "bin").string() + ":/usr/bin:/bin"}), 1);
+  EXPECT_NE(out.find("failed (exit 1): sbatch: error: Batch job submission failed: Unable to contact slurm controller"), std::string::npos) << out;
+  EXPECT_EQ(Sweep({file.string(), "--partition", "p"}, &out), 2) << "an option of --slurm without it";
+  EXPECT_NE(out.find("--partition requires --slurm"), std::string::npos) << out;
 }
 
 }  // namespace

@@ -1,0 +1,125 @@
+#include "sweep_slurm.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "run_process.hpp"
+
+namespace dyad::sweep {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kDefaultMaxTasks = 100;  // one run per task up to here: Slurm schedules them well
+
+bool ParseCount(const std::string& s, int* value) {
+  if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos) return false;
+  *value = std::atoi(s.c_str());
+  return true;
+}
+
+std::string Slurped(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  return text;
+}
+
+// The #SBATCH header both scripts share.
+std::string Header(const SweepPlan& plan, const SlurmOptions& o, const std::string& job, const std::string& log) {
+  std::string h = "#!/bin/bash\n";
+  h += "# Written by `dyad sweep --slurm` for the sweep " + plan.name + " (" + plan.file + "); docs/sweep.md.\n";
+  h += "#SBATCH --job-name=" + job + "\n#SBATCH --output=" + log + "\n";
+  if (!o.partition.empty()) h += "#SBATCH --partition=" + o.partition + "\n";
+  if (!o.time.empty()) h += "#SBATCH --time=" + o.time + "\n";
+  for (const auto& a : o.sbatch_args) h += "#SBATCH " + a + "\n";
+  return h;
+}
+
+Status WriteScript(const fs::path& path, const std::string& text) {
+  std::ofstream f(path, std::ios::trunc);
+  f << text;
+  f.close();
+  if (!f) return Status::IOError(path.string(), "cannot write");
+  fs::permissions(path, fs::perms::owner_all | fs::perms::group_read | fs::perms::group_exec, fs::perm_options::replace);
+  return Status::OK();
+}
+
+// `sbatch --parsable ARGS... SCRIPT`: the job's id, or sbatch's own words.
+StatusOr<std::string> Sbatch(std::vector<std::string> args, const fs::path& script, const fs::path& said) {
+  args.insert(args.begin(), {"sbatch", "--parsable"});
+  args.push_back(script.string());
+  const int rc = tools::RunProcess(args, said.string());
+  const std::string out = Slurped(said);
+  if (rc == 127 && out.empty())
+    return Status::FailedPrecondition("sbatch is not on PATH: run --slurm on a machine that submits Slurm jobs (a login node; Debian: slurm-client)");
+  const std::string id = out.substr(out.find_last_of('\n') + 1);  // sbatch warns on lines before the id
+  if (rc != 0 || id.empty() || id.find_first_not_of("0123456789;_abcdefghijklmnopqrstuvwxyz") != std::string::npos)
+    return Status::FailedPrecondition(tools::ShellQuoted(args) + " failed (exit " + std::to_string(rc) + "): " + out);
+  return id.substr(0, id.find(';'));  // "id;cluster" on a federation
+}
+
+}  // namespace
+
+Status ParseTask(const std::string& text, TaskSlice* task) {
+  const size_t slash = text.find('/');
+  TaskSlice t;
+  if (slash == std::string::npos || !ParseCount(text.substr(0, slash), &t.index) ||
+      !ParseCount(text.substr(slash + 1), &t.count) || t.count < 1 || t.index >= t.count)
+    return Status::InvalidArgument("--task " + text, "want I/N with 0 <= I < N (the array task's index, counted from 0, and the number of tasks)");
+  *task = t;
+  return Status::OK();
+}
+
+std::vector<SweepRun> TaskRuns(const std::vector<SweepRun>& runs, TaskSlice task) {
+  const size_t n = runs.size(), count = static_cast<size_t>(task.count), i = static_cast<size_t>(task.index);
+  const size_t begin = n * i / count, end = n * (i + 1) / count;
+  return {runs.begin() + static_cast<std::ptrdiff_t>(begin), runs.begin() + static_cast<std::ptrdiff_t>(end)};
+}
+
+StatusOr<SlurmJob> SubmitToSlurm(const SweepPlan& plan, const std::string& sweep_file, const std::string& out,
+                                 const std::string& dyad, const std::vector<std::string>& plugins, bool plots,
+                                 const SlurmOptions& o) {
+  const int runs = static_cast<int>(plan.runs.size());
+  const int tasks = std::max(1, std::min(runs, o.tasks > 0 ? o.tasks : kDefaultMaxTasks));
+  const fs::path dir = fs::path(out) / "slurm";
+  std::error_code ec;
+  if (fs::create_directories(dir, ec); ec) return Status::IOError(dir.string(), ec.message());
+  std::vector<std::string> extra;
+  for (const auto& p : plugins) extra.insert(extra.end(), {"--plugins", p});
+  if (!plots) extra.push_back("--no-plots");
+
+  std::string array = Header(plan, o, "dyad-sweep-" + plan.name, (dir / "task-%a.log").string());
+  array += "#SBATCH --array=0-" + std::to_string(tasks - 1) + "\n#SBATCH --cpus-per-task=" + std::to_string(o.cpus_per_task) + "\n";
+  array += "# " + std::to_string(runs) + " runs in " + std::to_string(tasks) + " tasks; a task skips its runs that finished before.\n";
+  std::vector<std::string> task_args = {"-o", out, "--no-plots"};
+  for (const auto& p : plugins) task_args.insert(task_args.end(), {"--plugins", p});
+  array += "exec " + tools::ShellQuoted({dyad, "sweep", sweep_file}) + " --task \"$SLURM_ARRAY_TASK_ID/" + std::to_string(tasks) +
+           "\" -j \"${SLURM_CPUS_PER_TASK:-1}\" " + tools::ShellQuoted(task_args) + "\n";
+  std::vector<std::string> collect_args = {dyad, "sweep", sweep_file, "--collect", "-o", out};
+  collect_args.insert(collect_args.end(), extra.begin(), extra.end());
+  const std::string collect = Header(plan, o, "dyad-sweep-" + plan.name + "-collect", (dir / "collect.log").string()) +
+                              "exec " + tools::ShellQuoted(collect_args) + "\n";
+  if (Status s = WriteScript(dir / "runs.sbatch", array); !s.ok()) return s;
+  if (Status s = WriteScript(dir / "collect.sbatch", collect); !s.ok()) return s;
+
+  SlurmJob job;
+  job.tasks = tasks;
+  auto array_id = Sbatch({}, dir / "runs.sbatch", dir / "sbatch.out");
+  if (!array_id.ok()) return array_id.status();
+  job.array_id = *array_id;
+  auto collect_id = Sbatch({"--dependency=afterany:" + job.array_id}, dir / "collect.sbatch", dir / "sbatch.out");
+  if (!collect_id.ok())
+    return Status::FailedPrecondition("the runs were submitted (job " + job.array_id + ") but not their collection: " +
+                                      collect_id.status().message() + "; run `dyad sweep " + sweep_file + " --collect -o " + out +
+                                      "` once they have ended");
+  job.collect_id = *collect_id;
+  return job;
+}
+
+}  // namespace dyad::sweep
