@@ -23,7 +23,7 @@ struct Options {
   int workers = 0;
   std::vector<std::string> plugins;
   bool plots = true, dry_run = false;
-  bool slurm = false, collect = false;
+  bool slurm = false, collect = false, train_only = false;
   std::string task;  // "i/N": this array task's chunk only
   sweep::SlurmOptions slurm_options;
 };
@@ -65,7 +65,14 @@ int RunHere(const Options& o, const sweep::SweepPlan& plan, const fs::path& out,
     std::cerr << "dyad sweep: " << out.string() << ": " << ec.message() << "\n";
     return kFailure;
   }
-  const sweep::RunnerResult r = sweep::RunSweep(plan, sweep::RunnerOptions{out.string(), workers, Self()}, std::cout);
+  const sweep::RunnerOptions runner{out.string(), workers, Self()};
+  // A Slurm task of runs does not train: the training job before it did (or failed, said per run).
+  if (o.task.empty() && !plan.trainings.empty()) {
+    std::cout << "training " << plan.trainings.size() << " model" << (plan.trainings.size() == 1 ? "" : "s") << " into "
+              << (out / "models").string() << "\n";
+    sweep::TrainModels(plan, plan.trainings, runner, std::cout);
+  }
+  const sweep::RunnerResult r = sweep::RunSweep(plan, runner, std::cout);
   std::cout << "sweep " << plan.name << (o.task.empty() ? "" : " task " + o.task) << ": " << r.ran << " ran, " << r.skipped
             << " done before, " << r.failed << " failed";
   if (!table) {
@@ -105,15 +112,29 @@ int Collect(const Options& o, const sweep::SweepPlan& plan, const fs::path& out)
   return failed + missing > 0 ? kFailure : kOk;
 }
 
+// --train-only: the models (this task's chunk of them), no runs: a Slurm training task.
+int TrainOnly(const Options& o, const sweep::SweepPlan& plan, const fs::path& out, int workers, sweep::TaskSlice task) {
+  const auto trainings = o.task.empty() ? plan.trainings : sweep::TaskChunk(plan.trainings, task);
+  std::cout << "sweep " << plan.name << ": " << trainings.size() << " of " << plan.trainings.size() << " models into "
+            << (out / "models").string() << "\n";
+  const sweep::RunnerResult r = sweep::TrainModels(plan, trainings, sweep::RunnerOptions{out.string(), workers, Self()}, std::cout);
+  std::cout << "sweep " << plan.name << ": " << r.ran << " trained, " << r.skipped << " there before, " << r.failed << " failed\n";
+  return r.failed > 0 ? kFailure : kOk;
+}
+
 int Submit(const Options& o, const sweep::SweepPlan& plan, const fs::path& file, const fs::path& out) {
   auto job = sweep::SubmitToSlurm(plan, file.string(), out.string(), Self(), o.plugins, o.plots, o.slurm_options);
   if (!job.ok()) {
     std::cerr << "dyad sweep --slurm: " << job.status().message() << "\n";
     return kFailure;
   }
+  if (!job->train_id.empty())
+    std::cout << "submitted: job " << job->train_id << " trains " << plan.trainings.size() << " models ("
+              << job->train_tasks << " array tasks; logs " << (out / "slurm" / "train-N.log").string() << "); the runs wait for it\n";
   std::cout << "submitted: job " << job->array_id << " (" << job->tasks << " array tasks; logs "
             << (out / "slurm" / "task-N.log").string() << "), then job " << job->collect_id << " writes "
-            << (out / "sweep.csv").string() << "\nwatch: squeue -j " << job->array_id << "," << job->collect_id << "\n";
+            << (out / "sweep.csv").string() << "\nwatch: squeue -j " << (job->train_id.empty() ? "" : job->train_id + ",")
+            << job->array_id << "," << job->collect_id << "\n";
   return kOk;
 }
 
@@ -143,14 +164,22 @@ int RunSweepCommand(Options o) {
   const fs::path out = o.out.empty() ? cwd / ("sweep-" + plan.name) : fs::absolute(cwd / o.out);
   if (o.collect) return Collect(o, plan, out);
   if (o.slurm) return Submit(o, plan, file, out);
-  const size_t all = plan.runs.size();
-  if (!o.task.empty()) plan.runs = sweep::TaskRuns(plan.runs, task);
   const int workers = o.workers > 0 ? o.workers : std::max(1u, std::thread::hardware_concurrency());
+  if (o.train_only) return TrainOnly(o, plan, out, workers, task);
+  const size_t all = plan.runs.size();
+  if (!o.task.empty()) plan.runs = sweep::TaskChunk(plan.runs, task);
   std::cout << "sweep " << plan.name << ": " << plan.runs.size() << " runs";
   if (!o.task.empty()) std::cout << " (task " << o.task << " of " << all << " runs)";
-  std::cout << " of " << plan.graph << " (" << plan.duration_s << " s each, stepped), " << workers << " at once, into "
+  std::cout << " of " << plan.graph;
+  if (!plan.trainings.empty()) std::cout << " with " << plan.trainings.size() << " trained model" << (plan.trainings.size() == 1 ? "" : "s");
+  std::cout << " (" << plan.duration_s << " s each, stepped), " << workers << " at once, into "
             << out.string() << "\n";
   if (o.dry_run) {
+    for (const auto& t : plan.trainings) {
+      std::cout << "model " << t.id << ": dyad train " << plan.train_config;
+      for (const auto& s : t.sets) std::cout << " --set " << s;
+      std::cout << "\n";
+    }
     for (const auto& r : plan.runs) {
       std::cout << r.id;
       for (const auto& s : r.sets) std::cout << " --set " << s;
@@ -174,9 +203,11 @@ void AddSweepCommands(CLI::App& app, int& exit_code) {
   auto* dry = cmd->add_flag("--dry-run", o->dry_run, "check the sweep file and list its runs; run nothing");
   auto* task = cmd->add_option("--task", o->task, "Run only chunk I of N (I counted from 0): what a Slurm array task runs");
   auto* collect = cmd->add_flag("--collect", o->collect, "Run nothing: write sweep.csv (and plots) from the runs in the sweep folder");
+  auto* train = cmd->add_flag("--train-only", o->train_only, "Train the sweep's models (with --task, chunk I of N of them); run nothing");
   auto* slurm = cmd->add_flag("--slurm", o->slurm, "Submit the runs to Slurm as an array job, then a job that collects the table");
-  slurm->excludes(task)->excludes(collect)->excludes(dry);
-  collect->excludes(task)->excludes(dry);
+  slurm->excludes(task)->excludes(collect)->excludes(dry)->excludes(train);
+  collect->excludes(task)->excludes(dry)->excludes(train);
+  train->excludes(dry);
   auto* group = "Slurm (with --slurm)";
   cmd->add_option("--partition", o->slurm_options.partition, "sbatch --partition")->group(group)->needs(slurm);
   cmd->add_option("--time", o->slurm_options.time, "sbatch --time of each task (e.g. 1:00:00)")->group(group)->needs(slurm);

@@ -1,5 +1,6 @@
 #include "sweep_plan.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dyad/graph.hpp"
+#include "dyad/pvrnn/train_config.hpp"
 #include "dyad/run.hpp"
 #include "dyad/strict_yaml.hpp"
 
@@ -37,16 +39,51 @@ uint64_t Fnv1a(const std::string& s, uint64_t h = 1469598103934665603ull) {
   return h;
 }
 
-struct Override {
+struct SweptValue {
   std::string key, value;
   YAML::Node node;  // where the sweep file wrote the value
   std::string where;  // "grid.KEY" or "runs[i].KEY"
 };
 
+// A list of values per key (a grid), into *grid and *columns.
+void ReadGrid(StrictYaml& y, const YAML::Node& g, const std::string& at, const std::string& column_prefix,
+              std::vector<std::string>* columns, std::vector<std::vector<SweptValue>>* grid) {
+  if (!y.Map(g, at, {})) return;
+  if (g.size() == 0) y.Error(g, at, "an empty grid: name at least one key and its values");
+  for (const auto& kv : g) {
+    const std::string key = kv.first.Scalar(), where = at + "." + key;
+    if (!kv.second.IsSequence() || kv.second.size() == 0) {
+      y.Error(kv.second, where, "must be a non-empty list of values");
+      continue;
+    }
+    columns->push_back(column_prefix + key);
+    grid->emplace_back();
+    for (const auto& v : kv.second) grid->back().push_back({key, ValueText(v), v, where});
+  }
+}
+
+// The train: section (see the header).
+void ReadTrain(StrictYaml& y, const YAML::Node& t, const std::string& path, SweepPlan* plan, std::vector<std::string>* base_sets,
+               std::vector<std::vector<SweptValue>>* grid) {
+  if (!y.Map(t, "train", {"config", "model", "set", "grid"})) return;
+  std::string config;
+  if (y.Get(t, "config", "train.config", &config, "a path", true)) {
+    fs::path c(config);
+    if (c.is_relative()) c = fs::absolute(fs::path(path).parent_path()) / c;
+    std::error_code ec;
+    if (!fs::is_regular_file(c, ec)) y.Error(t["config"], "train.config", "no such file: " + c.lexically_normal().string());
+    plan->train_config = c.lexically_normal().string();
+  }
+  y.Get(t, "model", "train.model", &plan->model_key, "a graph key (COMPONENT.PARAM)");
+  if (const YAML::Node set = t["set"]; set && y.Map(set, "train.set", {}))
+    for (const auto& kv : set) base_sets->push_back(kv.first.Scalar() + "=" + ValueText(kv.second));
+  if (t["grid"]) ReadGrid(y, t["grid"], "train.grid", "train.", &plan->parameters, grid);
+}
+
 // Reads the parts of the file; the overrides it names go to *swept (grid) or *listed (runs).
 void ReadFile(StrictYaml& y, const YAML::Node& root, const std::string& path, SweepPlan* plan,
-              std::vector<std::string>* base_sets, std::vector<std::vector<Override>>* grid,
-              std::vector<std::vector<Override>>* listed, std::vector<int64_t>* seeds) {
+              std::vector<std::string>* base_sets, std::vector<std::vector<SweptValue>>* grid,
+              std::vector<std::vector<SweptValue>>* listed, std::vector<int64_t>* seeds) {
   if (y.Get(root, "sweep", "sweep", &plan->name, "a name", true) &&
       (plan->name.empty() || plan->name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
                                  std::string::npos))
@@ -67,19 +104,7 @@ void ReadFile(StrictYaml& y, const YAML::Node& root, const std::string& path, Sw
   const YAML::Node g = root["grid"], r = root["runs"];
   if (g && r) y.Error(root["runs"], "runs", "give grid or runs, not both");
   if (!g && !r) y.Error(root, "grid", "required key missing (or runs)");
-  if (g && y.Map(g, "grid", {})) {
-    if (g.size() == 0) y.Error(g, "grid", "an empty grid: name at least one key and its values");
-    for (const auto& kv : g) {
-      const std::string key = kv.first.Scalar(), where = "grid." + key;
-      if (!kv.second.IsSequence() || kv.second.size() == 0) {
-        y.Error(kv.second, where, "must be a non-empty list of values");
-        continue;
-      }
-      plan->parameters.push_back(key);
-      grid->emplace_back();
-      for (const auto& v : kv.second) grid->back().push_back({key, ValueText(v), v, where});
-    }
-  }
+  if (g) ReadGrid(y, g, "grid", "", &plan->parameters, grid);
   if (r) {
     if (!r.IsSequence() || r.size() == 0) {
       y.Error(r, "runs", "must be a non-empty list of override sets");
@@ -110,18 +135,33 @@ void ReadFile(StrictYaml& y, const YAML::Node& root, const std::string& path, Sw
   }
 }
 
-// The graph's own verdict on `sets` (as `dyad validate --set`): empty when it passes.
-std::string Check(const std::string& graph, const std::vector<std::string>& sets, const std::vector<std::string>& plugins) {
+// The graph's own verdict on `sets` (as `dyad validate --set`): empty when it passes. Problems
+// of the key `replaced` ("components.mind.params.model": the sweep gives it a trained model in
+// every run) do not count: the graph's own value is never used.
+std::string Check(const std::string& graph, const std::vector<std::string>& sets, const std::vector<std::string>& plugins,
+                  const std::string& replaced = "") {
   std::vector<dyad::Override> overrides;
   for (const auto& s : sets) overrides.push_back({s});
   std::ostringstream out, err;
   if (ValidateGraphFile(graph, overrides, plugins, out, err) == 0) return "";
-  std::string text = err.str();
-  while (!text.empty() && text.back() == '\n') text.pop_back();
-  // Its closing "GRAPH: N problems, nothing was started" is about a run that is not this sweep.
-  if (const size_t last = text.rfind('\n'); last != std::string::npos && text.find("nothing was started", last) != std::string::npos)
-    text.erase(last);
+  std::string text;
+  std::istringstream lines(err.str());
+  for (std::string line; std::getline(lines, line);) {
+    // Its closing "GRAPH: N problems, nothing was started" is about a run that is not this sweep.
+    if (line.find("nothing was started") != std::string::npos) continue;
+    if (!replaced.empty() && line.find(": " + replaced + ": ") != std::string::npos) continue;
+    text += (text.empty() ? "" : "\n") + line;
+  }
+  if (!replaced.empty()) return text;
   return text.empty() ? "the graph does not validate" : text;
+}
+
+// "mind.model" or "mind.params.model" as the validator names it: "components.mind.params.model".
+std::string ValidatorKey(const std::string& key) {
+  const size_t dot = key.find('.');
+  if (dot == std::string::npos) return key;
+  const std::string param = key.substr(dot + 1);
+  return "components." + key.substr(0, dot) + ".params." + (param.rfind("params.", 0) == 0 ? param.substr(7) : param);
 }
 
 std::string ReadText(const std::string& path) {
@@ -132,9 +172,9 @@ std::string ReadText(const std::string& path) {
 }
 
 // The combinations: the grid's product (first key slowest), or the list as given.
-std::vector<std::vector<const Override*>> Combinations(const std::vector<std::vector<Override>>& grid,
-                                                      const std::vector<std::vector<Override>>& listed) {
-  std::vector<std::vector<const Override*>> combos;
+std::vector<std::vector<const SweptValue*>> Combinations(const std::vector<std::vector<SweptValue>>& grid,
+                                                      const std::vector<std::vector<SweptValue>>& listed) {
+  std::vector<std::vector<const SweptValue*>> combos;
   if (grid.empty()) {
     for (const auto& run : listed) {
       combos.emplace_back();
@@ -144,7 +184,7 @@ std::vector<std::vector<const Override*>> Combinations(const std::vector<std::ve
   }
   combos.emplace_back();
   for (const auto& values : grid) {
-    std::vector<std::vector<const Override*>> next;
+    std::vector<std::vector<const SweptValue*>> next;
     for (const auto& combo : combos)
       for (const auto& v : values) {
         next.push_back(combo);
@@ -155,7 +195,97 @@ std::vector<std::vector<const Override*>> Combinations(const std::vector<std::ve
   return combos;
 }
 
+// The files of a data set folder, names and contents, in name order: its training's model
+// changes when they do.
+uint64_t HashFolder(const std::string& dir, uint64_t h) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (it->is_regular_file(ec)) files.push_back(it->path());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) h = Fnv1a(ReadText(f.string()), Fnv1a(fs::relative(f, dir, ec).string() + "\n", h));
+  return h;
+}
+
+std::string Hex(uint64_t h) {
+  char id[17];
+  std::snprintf(id, sizeof id, "%016llx", static_cast<unsigned long long>(h));
+  return id;
+}
+
+// `dyad train`'s own verdict on `sets`: empty when it passes; else the data set's folder.
+std::string CheckTraining(const std::string& config, const std::vector<std::string>& sets, std::string* dataset = nullptr) {
+  auto c = pvrnn::LoadTrainConfig(config, sets);
+  if (!c.ok()) return c.status().message();
+  if (dataset) *dataset = c->dataset;
+  return "";
+}
+
+// The trainings a train: section asks for (see the header); problems at the sweep file's lines.
+void PlanTrainings(StrictYaml& y, const YAML::Node& t, const std::vector<std::string>& base,
+                   const std::vector<std::vector<SweptValue>>& grid, SweepPlan* plan) {
+  if (std::string why = CheckTraining(plan->train_config, base); !why.empty()) {
+    y.Error(t["set"] ? t["set"] : t["config"], t["set"] ? "train.set" : "train.config", "does not train:\n" + why);
+    return;
+  }
+  bool bad = false;
+  for (const auto& values : grid)
+    for (const auto& o : values) {
+      std::vector<std::string> sets = base;
+      sets.push_back(o.key + "=" + o.value);
+      if (std::string why = CheckTraining(plan->train_config, sets); !why.empty()) {
+        y.Error(o.node, o.where, "does not train:\n" + why);
+        bad = true;
+      }
+    }
+  if (bad) return;
+  std::vector<std::vector<const SweptValue*>> combos = Combinations(grid, {});
+  if (combos.empty()) combos.emplace_back();  // no grid: one model
+  const uint64_t config_hash = Fnv1a(ReadText(plan->train_config));
+  for (const auto& combo : combos) {
+    SweepTraining training;
+    training.sets = base;
+    for (const SweptValue* o : combo) {
+      training.params.emplace_back("train." + o->key, o->value);
+      training.sets.push_back(o->key + "=" + o->value);
+    }
+    std::string dataset;
+    CheckTraining(plan->train_config, training.sets, &dataset);
+    uint64_t h = HashFolder(dataset, config_hash);
+    for (const auto& s : training.sets) h = Fnv1a(s + "\n", h);
+    training.id = Hex(Fnv1a(DYAD_VERSION, h));
+    plan->trainings.push_back(std::move(training));
+  }
+}
+
+// `train.model` names a parameter the graph sets (COMPONENT.PARAM or COMPONENT.params.PARAM).
+void CheckModelKey(StrictYaml& y, const YAML::Node& t, const std::string& graph_path, const std::vector<std::string>& base,
+                   const SweepPlan& plan) {
+  const YAML::Node at = t["model"] ? t["model"] : t;
+  std::string key = plan.model_key;
+  const size_t dot = key.find('.');
+  if (dot == std::string::npos) return y.Error(at, "train.model", "want COMPONENT.PARAM, got '" + key + "'");
+  const std::string component = key.substr(0, dot);
+  std::string param = key.substr(dot + 1);
+  if (param.rfind("params.", 0) == 0) param = param.substr(7);
+  std::vector<dyad::Override> overrides;
+  for (const auto& s : base) overrides.push_back({s});
+  std::vector<Diagnostic> ignored;
+  const Graph g = LoadGraph(graph_path, overrides, &ignored);
+  for (const auto& c : g.components)
+    if (c.name == component) {
+      if (!c.params || !c.params.IsMap() || !c.params[param])
+        y.Error(at, "train.model", "the graph's " + component + " has no parameter " + param + " to give the trained model to");
+      return;
+    }
+  y.Error(at, "train.model", "the graph has no component " + component);
+}
+
 }  // namespace
+
+std::string ModelPath(const std::string& out, const SweepTraining& training) {
+  return (fs::path(out) / "models" / (training.id + ".dpvrnn")).string();
+}
 
 SweepPlan LoadSweep(const std::string& path, const std::vector<std::string>& plugins, std::vector<Diagnostic>* problems) {
   SweepPlan plan;
@@ -171,53 +301,63 @@ SweepPlan LoadSweep(const std::string& path, const std::vector<std::string>& plu
     return plan;
   }
   StrictYaml y(StrictYaml::InFile(path, {}), problems);
-  if (!y.Map(root, "", {"sweep", "graph", "duration", "recorder", "set", "grid", "runs", "seeds"})) return plan;
-  std::vector<std::string> base;
-  std::vector<std::vector<Override>> grid, listed;
+  if (!y.Map(root, "", {"sweep", "graph", "duration", "recorder", "set", "grid", "runs", "seeds", "train"})) return plan;
+  std::vector<std::string> base, train_base;
+  std::vector<std::vector<SweptValue>> grid, listed, train_grid;
   std::vector<int64_t> seeds;
+  if (root["train"]) ReadTrain(y, root["train"], path, &plan, &train_base, &train_grid);
   ReadFile(y, root, path, &plan, &base, &grid, &listed, &seeds);
   if (!problems->empty()) return plan;
 
   // Hermetic and deterministic: stepped, and the recording where the sweep says.
   base.push_back("clock=stepped");
   base.push_back(plan.recorder + ".overwrite=true");
-  if (std::string why = Check(plan.graph, base, plugins); !why.empty()) {
+  const std::string replaced = root["train"] ? ValidatorKey(plan.model_key) : "";
+  if (std::string why = Check(plan.graph, base, plugins, replaced); !why.empty()) {
     y.Error(root["set"] ? root["set"] : root, root["set"] ? "set" : "graph", "the graph with these overrides does not validate:\n" + why);
     return plan;
   }
   std::set<std::string> checked;
-  auto check = [&](const Override& o) {
+  auto check = [&](const SweptValue& o) {
+    if (!o.key.empty() && root["train"] && o.key == plan.model_key)
+      return y.Error(o.node, o.where, "the sweep trains the models of " + plan.model_key + " (train.model): sweep one or the other");
     if (!checked.insert(o.key + "=" + o.value).second) return;
     std::vector<std::string> sets = base;
     sets.push_back(o.key + "=" + o.value);
-    if (std::string why = Check(plan.graph, sets, plugins); !why.empty()) y.Error(o.node, o.where, "does not validate:\n" + why);
+    if (std::string why = Check(plan.graph, sets, plugins, replaced); !why.empty()) y.Error(o.node, o.where, "does not validate:\n" + why);
   };
   for (const auto& values : grid)
     for (const auto& o : values) check(o);
   for (const auto& run : listed)
     for (const auto& o : run) check(o);
+  if (root["train"]) {
+    CheckModelKey(y, root["train"], plan.graph, base, plan);
+    PlanTrainings(y, root["train"], train_base, train_grid, &plan);
+  }
   if (!problems->empty()) return plan;
 
-  const std::vector<std::vector<const Override*>> combos = Combinations(grid, listed);
+  const std::vector<std::vector<const SweptValue*>> combos = Combinations(grid, listed);
   const std::string graph_text = ReadText(plan.graph);
-  for (const auto& combo : combos)
-    for (int64_t seed : seeds) {
-      SweepRun run;
-      run.seed = seed;
-      run.sets = base;
-      for (const Override* o : combo) {
-        run.params.emplace_back(o->key, o->value);
-        run.sets.push_back(o->key + "=" + o->value);
+  const int trainings = static_cast<int>(plan.trainings.size());
+  for (int t = trainings > 0 ? 0 : -1; t < trainings; ++t)
+    for (const auto& combo : combos)
+      for (int64_t seed : seeds) {
+        SweepRun run;
+        run.seed = seed;
+        run.sets = base;
+        run.training = t;
+        if (t >= 0) run.params = plan.trainings[static_cast<size_t>(t)].params;
+        for (const SweptValue* o : combo) {
+          run.params.emplace_back(o->key, o->value);
+          run.sets.push_back(o->key + "=" + o->value);
+        }
+        run.sets.push_back("seed=" + std::to_string(seed));
+        uint64_t h = Fnv1a(graph_text);
+        for (const auto& s : run.sets) h = Fnv1a(s + "\n", h);
+        if (t >= 0) h = Fnv1a("model " + plan.trainings[static_cast<size_t>(t)].id + "\n", h);
+        run.id = Hex(Fnv1a(DYAD_VERSION, h));
+        plan.runs.push_back(std::move(run));
       }
-      run.sets.push_back("seed=" + std::to_string(seed));
-      uint64_t h = Fnv1a(graph_text);
-      for (const auto& s : run.sets) h = Fnv1a(s + "\n", h);
-      h = Fnv1a(DYAD_VERSION, h);
-      char id[17];
-      std::snprintf(id, sizeof id, "%016llx", static_cast<unsigned long long>(h));
-      run.id = id;
-      plan.runs.push_back(std::move(run));
-    }
   return plan;
 }
 

@@ -11,6 +11,11 @@
 //   runs:                            # ...or explicit override sets (one of grid and runs)
 //     - {mixer.gain: 0.3, mind.optimizer: ceres}
 //   seeds: [1, 2, 3]                 # each combination once per seed (graph key `seed`); default [1]
+//   train:                           # optional: the runs use models the sweep trains
+//     config: ../train/demo.yaml     # `dyad train`'s config, relative to this file
+//     model: mind.model              # the graph's key each trained model goes to (default mind.model)
+//     set: {epochs: 5000}            # overrides of every training, as `dyad train --set` takes them
+//     grid: {layers.0.w: [0.001, 0.01]}   # one model per combination (default: one model)
 //
 // Contract of LoadSweep:
 //   - Every problem of the file at once, each "file:line:col: key: message" (strict YAML: unknown
@@ -18,9 +23,15 @@
 //   - Every override (each value of each key) is checked against the graph, as `dyad validate
 //     --set` would: a key the graph lacks, a value its component refuses. Its problems are
 //     reported at the sweep file's line of that value.
-//   - Runs come in a fixed order: grid (or list) order, then seeds. Each run's id is a hash of
-//     the graph file's text, its overrides and the dyad version: the same run in any sweep, and
-//     in a resumed one, has the same id.
+//   - Every training value is checked as `dyad train --set` would (the training config's own
+//     reader), at the sweep file's line; `model` must name a parameter the graph already sets
+//     (a component that takes a model has one).
+//   - A training's id is a hash of the config file's text, the content of every file of its
+//     data set, its overrides and the dyad version: its model is OUT/models/<id>.dpvrnn, trained
+//     once and reused by any sweep into that folder until one of those changes.
+//   - Runs come in a fixed order: trainings, then grid (or list) order, then seeds. Each run's
+//     id is a hash of the graph file's text, its overrides, its training's id and the dyad
+//     version: the same run in any sweep, and in a resumed one, has the same id.
 #pragma once
 
 #include <cstdint>
@@ -36,7 +47,14 @@ struct SweepRun {
   std::string id;                                          // 16 hex digits
   std::vector<std::pair<std::string, std::string>> params;  // the swept keys' values (YAML text), in column order
   int64_t seed = 1;
-  std::vector<std::string> sets;  // every `--set KEY=VALUE` of its `dyad run`, but the output file
+  std::vector<std::string> sets;  // every `--set KEY=VALUE` of its `dyad run`, but the output file and the model
+  int training = -1;              // index in SweepPlan::trainings of the model it runs with; -1: none
+};
+
+struct SweepTraining {
+  std::string id;                                          // 16 hex digits: names its model file
+  std::vector<std::pair<std::string, std::string>> params;  // the swept training keys' values ("train.KEY")
+  std::vector<std::string> sets;                            // every `dyad train --set` of it, but the output
 };
 
 struct SweepPlan {
@@ -45,9 +63,15 @@ struct SweepPlan {
   std::string graph;  // the base graph, absolute
   double duration_s = 0;
   std::string recorder = "recorder";
-  std::vector<std::string> parameters;  // the swept keys, in column order
+  std::vector<std::string> parameters;  // the swept keys, in column order ("train.KEY" first)
   std::vector<SweepRun> runs;
+  std::string train_config;  // absolute; empty: the sweep trains nothing
+  std::string model_key = "mind.model";
+  std::vector<SweepTraining> trainings;
 };
+
+// Where a sweep into `out` keeps the model of `training`.
+std::string ModelPath(const std::string& out, const SweepTraining& training);
 
 // Reads and checks `path` (see above); problems are appended to *problems and make the plan
 // unusable (check problems->empty()). `plugins`: extra plugin files or folders for the checks.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -56,7 +57,15 @@ Outcome DoRun(const SweepPlan& plan, const SweepRun& run, const RunnerOptions& o
   for (const auto& s : run.sets) run_args.insert(run_args.end(), {"--set", s});
   run_args.insert(run_args.end(), {"--set", plan.recorder + ".file=" + (dir / "rec.mcap").string()});
   std::string failed;
-  if (int rc = tools::RunProcess(run_args, (dir / "run.log").string()); rc != 0) {
+  if (run.training >= 0) {
+    const SweepTraining& training = plan.trainings[static_cast<size_t>(run.training)];
+    const std::string model = ModelPath(o.out, training);
+    run_args.insert(run_args.end(), {"--set", plan.model_key + "=" + model});
+    if (!fs::exists(model))
+      failed = "its model " + model + " was not trained (see " + (fs::path(o.out) / "models" / (training.id + ".log")).string() + ")\n";
+  }
+  if (!failed.empty()) {
+  } else if (int rc = tools::RunProcess(run_args, (dir / "run.log").string()); rc != 0) {
     failed = tools::ShellQuoted(run_args) + "\nexited " + std::to_string(rc) + "; the end of run.log:\n" + Tail((dir / "run.log").string(), 20);
   } else if (Status s = Analyze((dir / "rec.mcap").string(), (dir / "report").string()); !s.ok()) {
     failed = "dyad analyze " + (dir / "rec.mcap").string() + ": " + s.message() + "\n";
@@ -85,31 +94,34 @@ std::string CsvField(const std::string& s) {
   return q + "\"";
 }
 
-}  // namespace
+// What Pool runs: job i, what it is (for the log), and the file that says why it failed.
+struct PoolJobs {
+  std::function<Outcome(size_t)> run;
+  std::function<std::string(size_t)> what, why_file;
+};
 
-RunnerResult RunSweep(const SweepPlan& plan, const RunnerOptions& options, std::ostream& log) {
+// Runs jobs 0..count-1, `workers` at once; after each, a line to `log`: its count, what it was,
+// how it ended, and the estimated time left.
+RunnerResult Pool(size_t count, int workers, std::ostream& log, const PoolJobs& jobs) {
   RunnerResult result;
   std::atomic<size_t> next{0};
   std::mutex mutex;  // guards result, log, the counts below
   size_t finished = 0, executed = 0;
   const auto t0 = Clock::now();
   auto worker = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < plan.runs.size();) {
-      const SweepRun& run = plan.runs[i];
+    for (size_t i; (i = next.fetch_add(1)) < count;) {
       const auto start = Clock::now();
-      const Outcome outcome = DoRun(plan, run, options);
+      const Outcome outcome = jobs.run(i);
       const double secs = std::chrono::duration<double>(Clock::now() - start).count();
       std::lock_guard<std::mutex> lock(mutex);
       ++finished;
-      std::string what = "ok";
-      if (outcome == Outcome::kSkipped) ++result.skipped, what = "done before";
+      std::string how = "ok";
+      if (outcome == Outcome::kSkipped) ++result.skipped, how = "done before";
       else ++executed, ++(outcome == Outcome::kOk ? result.ran : result.failed);
-      if (outcome == Outcome::kFailed) what = "FAILED (runs/" + run.id + "/failed.txt)";
+      if (outcome == Outcome::kFailed) how = "FAILED (" + jobs.why_file(i) + ")";
       const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
-      const size_t left = plan.runs.size() - finished;
-      std::string params;
-      for (const auto& [k, v] : run.params) params += " " + k + "=" + v;
-      log << "[" << finished << "/" << plan.runs.size() << "] " << run.id << params << " seed=" << run.seed << ": " << what;
+      const size_t left = count - finished;
+      log << "[" << finished << "/" << count << "] " << jobs.what(i) << ": " << how;
       if (outcome != Outcome::kSkipped) {
         char s[32];
         std::snprintf(s, sizeof s, " in %.1f s", secs);
@@ -120,9 +132,51 @@ RunnerResult RunSweep(const SweepPlan& plan, const RunnerOptions& options, std::
     }
   };
   std::vector<std::thread> threads;
-  for (int w = 0; w < std::max(1, options.workers); ++w) threads.emplace_back(worker);
+  for (int w = 0; w < std::max(1, workers); ++w) threads.emplace_back(worker);
   for (auto& t : threads) t.join();
   return result;
+}
+
+Outcome Train(const SweepPlan& plan, const SweepTraining& training, const RunnerOptions& o) {
+  const std::string model = ModelPath(o.out, training);
+  const fs::path dir = fs::path(model).parent_path();
+  if (fs::exists(model)) return Outcome::kSkipped;
+  fs::create_directories(dir);
+  fs::remove(dir / (training.id + ".failed.txt"));
+  std::vector<std::string> args = {o.dyad, "train", plan.train_config};
+  for (const auto& s : training.sets) args.insert(args.end(), {"--set", s});
+  args.insert(args.end(), {"--set", "output=" + model});
+  const std::string log = (dir / (training.id + ".log")).string();
+  const int rc = tools::RunProcess(args, log);
+  if (rc == 0 && fs::exists(model)) return Outcome::kOk;
+  std::ofstream(dir / (training.id + ".failed.txt"))
+      << tools::ShellQuoted(args) << "\nexited " << rc << "; the end of its log:\n" << Tail(log, 20);
+  return Outcome::kFailed;
+}
+
+std::string Params(const std::vector<std::pair<std::string, std::string>>& params) {
+  std::string s;
+  for (const auto& [k, v] : params) s += " " + k + "=" + v;
+  return s;
+}
+
+}  // namespace
+
+RunnerResult RunSweep(const SweepPlan& plan, const RunnerOptions& options, std::ostream& log) {
+  PoolJobs jobs;
+  jobs.run = [&](size_t i) { return DoRun(plan, plan.runs[i], options); };
+  jobs.what = [&](size_t i) { return plan.runs[i].id + Params(plan.runs[i].params) + " seed=" + std::to_string(plan.runs[i].seed); };
+  jobs.why_file = [&](size_t i) { return "runs/" + plan.runs[i].id + "/failed.txt"; };
+  return Pool(plan.runs.size(), options.workers, log, jobs);
+}
+
+RunnerResult TrainModels(const SweepPlan& plan, const std::vector<SweepTraining>& trainings, const RunnerOptions& options,
+                         std::ostream& log) {
+  PoolJobs jobs;
+  jobs.run = [&](size_t i) { return Train(plan, trainings[i], options); };
+  jobs.what = [&](size_t i) { return "model " + trainings[i].id + Params(trainings[i].params); };
+  jobs.why_file = [&](size_t i) { return "models/" + trainings[i].id + ".failed.txt"; };
+  return Pool(trainings.size(), options.workers, log, jobs);
 }
 
 Status WriteSweepCsv(const SweepPlan& plan, const std::string& out) {

@@ -10,6 +10,13 @@
 //     of its log) and the sweep goes on; a later sweep tries it again.
 //   - `workers` runs at once; each finished run prints a line to `log` with its count, its
 //     status and the estimated time left.
+//   - A run with a training gets `--set MODEL_KEY=OUT/models/<id>.dpvrnn`; when that model is
+//     not there (its training failed, or has not run: a Slurm task does not train), the run
+//     fails saying so.
+// Contract of TrainModels: `dyad train CONFIG --set ... --set output=OUT/models/<id>.dpvrnn` for
+// each of `trainings` whose model is not there yet (`workers` at once; its log beside it as
+// <id>.log, and <id>.failed.txt when it failed). The model file appears whole or not at all
+// (dyad train writes it by rename), so its presence means it trained.
 // Contract of WriteSweepCsv: OUT/sweep.csv, one row per run in the plan's order (not the order
 // they finished): run, status (ok, failed, missing), each swept key, seed, then every metric of
 // metrics.json in its order (empty where a run has none). The same runs give the same file
@@ -18,6 +25,7 @@
 
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "dyad/status.hpp"
 #include "sweep_plan.hpp"
@@ -35,6 +43,8 @@ struct RunnerResult {
 };
 
 RunnerResult RunSweep(const SweepPlan& plan, const RunnerOptions& options, std::ostream& log);
+RunnerResult TrainModels(const SweepPlan& plan, const std::vector<SweepTraining>& trainings, const RunnerOptions& options,
+                         std::ostream& log);
 Status WriteSweepCsv(const SweepPlan& plan, const std::string& out);
 
 }  // namespace dyad::sweep

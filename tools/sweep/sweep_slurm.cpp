@@ -76,42 +76,62 @@ Status ParseTask(const std::string& text, TaskSlice* task) {
   return Status::OK();
 }
 
-std::vector<SweepRun> TaskRuns(const std::vector<SweepRun>& runs, TaskSlice task) {
-  const size_t n = runs.size(), count = static_cast<size_t>(task.count), i = static_cast<size_t>(task.index);
-  const size_t begin = n * i / count, end = n * (i + 1) / count;
-  return {runs.begin() + static_cast<std::ptrdiff_t>(begin), runs.begin() + static_cast<std::ptrdiff_t>(end)};
-}
-
 StatusOr<SlurmJob> SubmitToSlurm(const SweepPlan& plan, const std::string& sweep_file, const std::string& out,
                                  const std::string& dyad, const std::vector<std::string>& plugins, bool plots,
                                  const SlurmOptions& o) {
-  const int runs = static_cast<int>(plan.runs.size());
-  const int tasks = std::max(1, std::min(runs, o.tasks > 0 ? o.tasks : kDefaultMaxTasks));
   const fs::path dir = fs::path(out) / "slurm";
   std::error_code ec;
   if (fs::create_directories(dir, ec); ec) return Status::IOError(dir.string(), ec.message());
-  std::vector<std::string> extra;
-  for (const auto& p : plugins) extra.insert(extra.end(), {"--plugins", p});
-  if (!plots) extra.push_back("--no-plots");
-
-  std::string array = Header(plan, o, "dyad-sweep-" + plan.name, (dir / "task-%a.log").string());
-  array += "#SBATCH --array=0-" + std::to_string(tasks - 1) + "\n#SBATCH --cpus-per-task=" + std::to_string(o.cpus_per_task) + "\n";
-  array += "# " + std::to_string(runs) + " runs in " + std::to_string(tasks) + " tasks; a task skips its runs that finished before.\n";
-  std::vector<std::string> task_args = {"-o", out, "--no-plots"};
-  for (const auto& p : plugins) task_args.insert(task_args.end(), {"--plugins", p});
-  array += "exec " + tools::ShellQuoted({dyad, "sweep", sweep_file}) + " --task \"$SLURM_ARRAY_TASK_ID/" + std::to_string(tasks) +
-           "\" -j \"${SLURM_CPUS_PER_TASK:-1}\" " + tools::ShellQuoted(task_args) + "\n";
-  std::vector<std::string> collect_args = {dyad, "sweep", sweep_file, "--collect", "-o", out};
-  collect_args.insert(collect_args.end(), extra.begin(), extra.end());
-  const std::string collect = Header(plan, o, "dyad-sweep-" + plan.name + "-collect", (dir / "collect.log").string()) +
-                              "exec " + tools::ShellQuoted(collect_args) + "\n";
-  if (Status s = WriteScript(dir / "runs.sbatch", array); !s.ok()) return s;
-  if (Status s = WriteScript(dir / "collect.sbatch", collect); !s.ok()) return s;
-
+  std::vector<std::string> plugin_args;
+  for (const auto& p : plugins) plugin_args.insert(plugin_args.end(), {"--plugins", p});
+  // An array of `dyad sweep SWEEP --task $SLURM_ARRAY_TASK_ID/N ARGS...`.
+  auto array_script = [&](const std::string& job, const std::string& log, int tasks, const std::string& what,
+                          std::vector<std::string> args) {
+    args.insert(args.end(), plugin_args.begin(), plugin_args.end());
+    return Header(plan, o, job, (dir / log).string()) + "#SBATCH --array=0-" + std::to_string(tasks - 1) +
+           "\n#SBATCH --cpus-per-task=" + std::to_string(o.cpus_per_task) + "\n# " + what + "\nexec " +
+           tools::ShellQuoted({dyad, "sweep", sweep_file}) + " --task \"$SLURM_ARRAY_TASK_ID/" + std::to_string(tasks) +
+           "\" -j \"${SLURM_CPUS_PER_TASK:-1}\" " + tools::ShellQuoted(args) + "\n";
+  };
   SlurmJob job;
-  job.tasks = tasks;
-  auto array_id = Sbatch({}, dir / "runs.sbatch", dir / "sbatch.out");
-  if (!array_id.ok()) return array_id.status();
+  bool train = false;
+  for (const auto& t : plan.trainings) train = train || !fs::exists(ModelPath(out, t));
+  if (train) {
+    job.train_tasks = std::min(static_cast<int>(plan.trainings.size()), kDefaultMaxTasks);
+    const std::string what = std::to_string(plan.trainings.size()) + " models in " + std::to_string(job.train_tasks) +
+                             " tasks; a task skips a model that is there.";
+    if (Status s = WriteScript(dir / "train.sbatch", array_script("dyad-sweep-" + plan.name + "-train", "train-%a.log",
+                                                                  job.train_tasks, what, {"-o", out, "--train-only"}));
+        !s.ok())
+      return s;
+  }
+  const int runs = static_cast<int>(plan.runs.size());
+  job.tasks = std::max(1, std::min(runs, o.tasks > 0 ? o.tasks : kDefaultMaxTasks));
+  const std::string what = std::to_string(runs) + " runs in " + std::to_string(job.tasks) + " tasks; a task skips its runs that finished before.";
+  std::vector<std::string> collect_args = {dyad, "sweep", sweep_file, "--collect", "-o", out};
+  collect_args.insert(collect_args.end(), plugin_args.begin(), plugin_args.end());
+  if (!plots) collect_args.push_back("--no-plots");
+  if (Status s = WriteScript(dir / "runs.sbatch", array_script("dyad-sweep-" + plan.name, "task-%a.log", job.tasks, what,
+                                                               {"-o", out, "--no-plots"}));
+      !s.ok())
+    return s;
+  if (Status s = WriteScript(dir / "collect.sbatch", Header(plan, o, "dyad-sweep-" + plan.name + "-collect", (dir / "collect.log").string()) +
+                                                         "exec " + tools::ShellQuoted(collect_args) + "\n");
+      !s.ok())
+    return s;
+
+  if (train) {
+    auto id = Sbatch({}, dir / "train.sbatch", dir / "sbatch.out");
+    if (!id.ok()) return id.status();
+    job.train_id = *id;
+  }
+  auto array_id = Sbatch(train ? std::vector<std::string>{"--dependency=afterany:" + job.train_id} : std::vector<std::string>{},
+                         dir / "runs.sbatch", dir / "sbatch.out");
+  if (!array_id.ok()) {
+    if (!train) return array_id.status();
+    return Status::FailedPrecondition("the trainings were submitted (job " + job.train_id + ") but not the runs: " +
+                                      array_id.status().message() + "; submit again once they have ended (the models are kept)");
+  }
   job.array_id = *array_id;
   auto collect_id = Sbatch({"--dependency=afterany:" + job.array_id}, dir / "collect.sbatch", dir / "sbatch.out");
   if (!collect_id.ok())

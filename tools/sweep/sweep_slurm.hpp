@@ -6,10 +6,14 @@
 //
 // Contract of ParseTask: "i/N" with 0 <= i < N (Slurm's SLURM_ARRAY_TASK_ID counts from 0 in
 // the array we submit); anything else is an error naming what was given.
-// Contract of TaskRuns: chunk i of N of the plan's runs, contiguous and in the plan's order;
-// the chunks of 0..N-1 hold every run exactly once (sizes differ by at most one). It depends
-// only on the plan and N, so a task computes its chunk alone.
+// Contract of TaskChunk: chunk i of N of a plan's runs (or trainings), contiguous and in the
+// plan's order; the chunks of 0..N-1 hold every item exactly once (sizes differ by at most
+// one). It depends only on the plan and N, so a task computes its chunk alone.
 // Contract of SubmitToSlurm:
+//   - When a model of the sweep's trainings is not in OUT/models yet: OUT/slurm/train.sbatch,
+//     an array of `dyad sweep SWEEP --train-only --task i/M` (one training per task), submitted
+//     first; the runs' array then waits for it with `--dependency=afterany:TRAIN` (a run whose
+//     model failed to train is recorded as failed, saying so, and the table still comes).
 //   - Writes OUT/slurm/runs.sbatch (the array: min(tasks, runs) tasks, each `dyad sweep SWEEP
 //     --task $SLURM_ARRAY_TASK_ID/N -j $SLURM_CPUS_PER_TASK`) and OUT/slurm/collect.sbatch
 //     (`dyad sweep SWEEP --collect`), every path absolute; logs go to OUT/slurm/*.log.
@@ -36,7 +40,11 @@ struct TaskSlice {
 };
 
 Status ParseTask(const std::string& text, TaskSlice* task);
-std::vector<SweepRun> TaskRuns(const std::vector<SweepRun>& runs, TaskSlice task);
+template <class T>
+std::vector<T> TaskChunk(const std::vector<T>& all, TaskSlice task) {
+  const size_t n = all.size(), count = static_cast<size_t>(task.count), i = static_cast<size_t>(task.index);
+  return {all.begin() + static_cast<std::ptrdiff_t>(n * i / count), all.begin() + static_cast<std::ptrdiff_t>(n * (i + 1) / count)};
+}
 
 struct SlurmOptions {
   std::string partition, time;           // sbatch --partition, --time (empty: the cluster's default)
@@ -46,8 +54,9 @@ struct SlurmOptions {
 };
 
 struct SlurmJob {
+  std::string train_id;  // empty: every model was there
   std::string array_id, collect_id;
-  int tasks = 0;
+  int train_tasks = 0, tasks = 0;
 };
 
 // `sweep_file` and `out` absolute; `dyad` the executable the jobs run; `plugins` and `plots`

@@ -112,13 +112,101 @@ TEST_F(SweepTest, AFailingRunIsRecordedTheRestRunAndARerunResumes) {
   EXPECT_EQ(ReadFile(dir_ / "o" / "sweep.csv").find("failed"), std::string::npos);
 }
 
+// The demo graph with models the sweep trains (20 epochs: a fraction of a second each).
+class TrainingSweepTest : public SweepTest {
+ protected:
+  void SetUp() override {
+    SweepTest::SetUp();
+    std::string out;
+    ASSERT_EQ(Dyad({"generate", "dataset", "--out", (dir_ / "data").string()}, &out), 0) << out;
+    // The observer the graph needs (trained on a model of its own).
+    ASSERT_EQ(Dyad({"train", std::string(DYAD_SOURCE_DIR) + "/configs/train/demo.yaml", "--set", "dataset=" + (dir_ / "data").string(),
+                    "--set", "output=" + (dir_ / "m.dpvrnn").string(), "--set", "epochs=20", "--set", "log_every=10"},
+                   &out),
+              0)
+        << out;
+    ASSERT_EQ(Dyad({"train-observer", (dir_ / "m.dpvrnn").string(), "-o", (dir_ / "o.dobs").string(), "--epochs", "20"}, &out), 0) << out;
+  }
+  int Dyad(const std::vector<std::string>& args, std::string* out) {
+    std::vector<std::string> argv = {std::string(DYAD_BIN_DIR) + "/dyad"};
+    argv.insert(argv.end(), args.begin(), args.end());
+    dyad::testing::ChildProcess p(argv, dir_, "dyad" + std::to_string(runs_++));
+    const int code = p.Wait(300);
+    *out = p.out() + p.err();
+    return code;
+  }
+  fs::path WriteSweep(const std::string& train_extra, const std::string& grid = "grid: {mixer.gain: [0.5]}\n") {
+    const std::string repo = DYAD_SOURCE_DIR;
+    return Write("sweep: t\ngraph: " + repo + "/configs/demo.yaml\nduration: 10\n"
+                 "set: {human.dataset: " + (dir_ / "data").string() + ", observer.model: " + (dir_ / "o.dobs").string() + "}\n"
+                 "train:\n  config: " + repo + "/configs/train/demo.yaml\n"
+                 "  set: {dataset: " + (dir_ / "data").string() + ", epochs: 20, log_every: 10}\n" + train_extra + grid);
+  }
+};
+
+TEST_F(TrainingSweepTest, OneModelPerTrainingValueCachedByContent) {
+  const fs::path file = WriteSweep("  grid: {layers.0.w: [0.001, 0.01]}\n");
+  std::string out;
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--no-plots"}, &out), 0) << out;
+  EXPECT_NE(out.find("2 runs of"), std::string::npos) << out;
+  EXPECT_NE(out.find("with 2 trained models"), std::string::npos) << out;
+  size_t models = 0;
+  for (const auto& f : fs::directory_iterator(dir_ / "o" / "models")) models += f.path().extension() == ".dpvrnn";
+  EXPECT_EQ(models, 2u);
+  const std::string csv = ReadFile(dir_ / "o" / "sweep.csv");
+  EXPECT_EQ(csv.rfind("run,status,train.layers.0.w,mixer.gain,seed,", 0), 0u) << csv;
+  EXPECT_NE(csv.find(",ok,0.001,0.5,1,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",ok,0.01,0.5,1,"), std::string::npos) << csv;
+  // Again: nothing trains, nothing runs.
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--no-plots"}, &out), 0) << out;
+  EXPECT_EQ(out.find(": ok in"), std::string::npos) << "something ran again:\n" << out;
+  EXPECT_NE(out.find("0 ran, 2 done before"), std::string::npos) << out;
+  // The data set changed: new models, new runs (the old ones stay beside them).
+  std::ofstream(dir_ / "data" / "notes.txt") << "a new file in the data set\n";
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--no-plots"}, &out), 0) << out;
+  EXPECT_NE(out.find("2 ran, 0 done before"), std::string::npos) << out;
+  models = 0;
+  for (const auto& f : fs::directory_iterator(dir_ / "o" / "models")) models += f.path().extension() == ".dpvrnn";
+  EXPECT_EQ(models, 4u);
+}
+
+TEST_F(TrainingSweepTest, BadTrainingsAreRefusedAtTheirLine) {
+  std::string out;
+  const fs::path bad = WriteSweep("  model: mind.modl\n  grid:\n    layers.0.w: [0.001, -1]\n");
+  EXPECT_EQ(Sweep({bad.string(), "-o", (dir_ / "o").string()}, &out), 2) << out;
+  EXPECT_NE(out.find("s.yaml:8:10: train.model: the graph's mind has no parameter modl"), std::string::npos) << out;
+  EXPECT_NE(out.find("s.yaml:10:25: train.grid.layers.0.w: does not train:\n--set layers.0.w=-1: layers[0].w: must be finite and >= 0"),
+            std::string::npos)
+      << out;
+  const fs::path both = WriteSweep("", "grid: {mind.model: [x.dpvrnn]}\n");
+  EXPECT_EQ(Sweep({both.string(), "-o", (dir_ / "o").string()}, &out), 2) << out;
+  EXPECT_NE(out.find("grid.mind.model: the sweep trains the models of mind.model (train.model): sweep one or the other"),
+            std::string::npos)
+      << out;
+  EXPECT_FALSE(fs::exists(dir_ / "o")) << "a refused sweep ran something";
+}
+
+// A Slurm task of runs does not train: a run without its model fails, saying which.
+TEST_F(TrainingSweepTest, ARunWhoseModelDidNotTrainFailsSayingSo) {
+  const fs::path file = WriteSweep("");
+  std::string out;
+  EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--task", "0/1", "--no-plots"}, &out), 1) << out;
+  bool said = false;
+  for (const auto& run : fs::directory_iterator(dir_ / "o" / "runs"))
+    said = said || ReadFile(run.path() / "failed.txt").find("was not trained") != std::string::npos;
+  EXPECT_TRUE(said);
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--train-only", "--task", "0/1"}, &out), 0) << out;
+  EXPECT_NE(out.find("1 trained, 0 there before, 0 failed"), std::string::npos) << out;
+  EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--task", "0/1", "--no-plots"}, &out), 0) << out;
+}
+
 TEST(SweepTask, ChunksHoldEveryRunOnceInOrder) {
   std::vector<sweep::SweepRun> runs(11);
   for (size_t i = 0; i < runs.size(); ++i) runs[i].id = std::to_string(i);
   for (int count : {1, 2, 3, 4, 11, 15}) {
     std::vector<std::string> seen;
     for (int i = 0; i < count; ++i) {
-      const auto chunk = sweep::TaskRuns(runs, {i, count});
+      const auto chunk = sweep::TaskChunk(runs, {i, count});
       EXPECT_LE(chunk.size(), runs.size() / static_cast<size_t>(count) + 1);
       for (const auto& r : chunk) seen.push_back(r.id);
     }
