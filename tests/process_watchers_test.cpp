@@ -35,6 +35,20 @@ TEST_F(ProcessTest, IntrospectionSeesARunningGraph) {
   EXPECT_NE(topics.out().find("count  dyad::msg::Counter#"), std::string::npos) << topics.out();
   EXPECT_NE(topics.out().find("dyad/intro/main"), std::string::npos) << topics.out();
 
+  // With --graph, `topics` and `status` end once they have seen what the graph says is there:
+  // long before the 30 s they may wait. A graph of one process is in `status` too.
+  const auto asked = std::chrono::steady_clock::now();
+  Child graph_topics(Dyad({"topics", "--graph", g.string(), "--wait", "30"}), dir_, "graph_topics");
+  ASSERT_EQ(graph_topics.Wait(60), 0) << graph_topics.err();
+  EXPECT_NE(graph_topics.out().find("count  dyad::msg::Counter#"), std::string::npos) << graph_topics.out();
+  Child status(Dyad({"status", "--graph", g.string(), "--wait", "30"}), dir_, "status");
+  ASSERT_EQ(status.Wait(60), 0) << status.err();
+  EXPECT_LT(std::chrono::steady_clock::now() - asked, std::chrono::seconds(10)) << "a watcher waited for its upper bound";
+  EXPECT_NE(status.out().find("intro/main "), std::string::npos) << status.out();
+  EXPECT_NE(status.out().find("running"), std::string::npos) << status.out();
+  EXPECT_NE(status.out().find("src                 main"), std::string::npos) << status.out();
+  EXPECT_NE(status.out().find("sink                main"), std::string::npos) << status.out();
+
 
   Child hz(Dyad({"hz", "count", "--domain", domain, "--duration", "2.5", "--wait", "20"}), dir_, "hz");
   ASSERT_EQ(hz.Wait(30), 0) << hz.err();
@@ -67,9 +81,16 @@ TEST_F(ProcessTest, StatusListsTheProcessesAndTheMeasuredClockOffsets) {
                                          "  sink: {type: counter_sink, trigger: in, process: b, inputs: {in: count}}\n");
   Child a(Dyad({"run", g.string(), "--host", "h1", "--steps", "200"}), dir_, "a");
   Child b(Dyad({"run", g.string(), "--host", "h2", "--steps", "200"}), dir_, "b", {"DYAD_TEST_CLOCK_OFFSET_MS=25"});
-  std::this_thread::sleep_for(std::chrono::seconds(3));
-  Child status(Dyad({"status", "--graph", g.string(), "--wait", "4"}), dir_, "status");
-  ASSERT_EQ(status.Wait(30), 0) << status.err();
+  // Both have measured the other (each warns: 25 ms is past max_clock_offset_ms), and published it.
+  const std::string warned = "[warn] clock: the clock of process";
+  for (int i = 0; i < 300 && (a.err().find(warned) == std::string::npos || b.err().find(warned) == std::string::npos); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  // With --graph it ends once it has heard all of it: long before the 30 s it may wait.
+  const auto asked = std::chrono::steady_clock::now();
+  Child status(Dyad({"status", "--graph", g.string(), "--wait", "30"}), dir_, "status");
+  ASSERT_EQ(status.Wait(60), 0) << status.err();
+  EXPECT_LT(std::chrono::steady_clock::now() - asked, std::chrono::seconds(10)) << "status waited for its upper bound";
   const pid_t pid_a = ChildPid(g, "a"), pid_b = ChildPid(g, "b");
   ASSERT_EQ(a.Wait(60), 0) << a.err();
   ASSERT_EQ(b.Wait(60), 0) << b.err();

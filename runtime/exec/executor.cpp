@@ -494,7 +494,7 @@ Status Executor::RunWall() {
   // that joined late (restarted) ends with the others (at once when that end has passed), and one
   // without the fastest component a second after the last step.
   int64_t duration_ns = options_.duration_s > 0 ? static_cast<int64_t>(std::min(options_.duration_s, 1e9) * 1e9) : 0;
-  if (session_) {
+  if (session_ && session_->shared_start()) {
     const int64_t late = start_wall_ns - session_->graph_start_ns();
     if (duration_ns > 0) duration_ns = std::max<int64_t>(duration_ns - late, 1);
     if (options_.steps > 0) {

@@ -1,7 +1,9 @@
 // ProcessSession — what the executor of one process needs from the other processes of its graph,
 // behind a small interface so that the executor stays about one process. The hosts layer
-// implements it (hosts/graph_session.hpp: start barrier, clock sync, state announcements); a
-// graph of one process, or a stepped one, runs without a session.
+// implements it (hosts/graph_session.hpp: start barrier, clock sync, state announcements). A
+// wall-clock graph of one process has a session that only announces its state (for `dyad
+// status`; shared_start() false: it starts at once and ends as a lone process does); a stepped
+// graph runs without one.
 //
 // Calls, all from the executor's Run() thread except Close():
 //   Open(transport)       after the components' ports exist, before Activate
@@ -34,6 +36,8 @@ class ProcessSession {
   virtual Status Heartbeat() = 0;
   virtual void Stopping() = 0;
   virtual void Close() = 0;
+  // True when the start (and so the end of --duration and --steps) is agreed with other processes.
+  virtual bool shared_start() const { return true; }
 };
 
 }  // namespace dyad

@@ -7,8 +7,8 @@
 //                       launchers, `dyad status`; TRANSIENT_LOCAL so a late joiner hears it
 //   dyad/launchers      the launchers' link: a required process failed for good
 //   dyad/clock          clock-sync probes and answers between processes (best effort)
-//   dyad/clock_offsets  each process's measured offsets to the others
-//   dyad/stats          every component's timing, once per stats period
+//   dyad/clock_offsets  each process's measured offsets to the others (TRANSIENT_LOCAL)
+//   dyad/stats          every component's timing, once per stats period (TRANSIENT_LOCAL)
 //   dyad/health         what a process did about endpoints discovery lost (hosts/endpoint_health)
 //
 // `reader` is for the runtime's and the recorder's readers, which must not lose a sample;
@@ -56,20 +56,24 @@ inline const RuntimeTopic kClock{
     .watcher = {.reliability = Reliability::kBestEffort, .depth = 32},
 };
 
+// Offsets and stats keep their last samples (TRANSIENT_LOCAL, KEEP_LAST) so that `dyad status`
+// has them the moment it joins instead of waiting for the next period. Its reader is reliable to
+// get that history; with KEEP_LAST a writer never waits for it (an unacknowledged sample is
+// simply replaced). 64 stats: one round of a process with up to 64 components.
 inline const RuntimeTopic kClockOffsets{
     .name = "dyad/clock_offsets",
     .type = &TypeInfoOf<msg::ClockOffset>,
-    .writer = {.reliability = Reliability::kReliable, .depth = 16},
+    .writer = {.reliability = Reliability::kReliable, .depth = 16, .transient_local = true},
     .reader = {.reliability = Reliability::kReliable, .depth = 16},
-    .watcher = {.reliability = Reliability::kBestEffort, .depth = 256},
+    .watcher = {.reliability = Reliability::kReliable, .depth = 256, .transient_local = true},
 };
 
 inline const RuntimeTopic kStats{
     .name = "dyad/stats",
     .type = &TypeInfoOf<msg::ComponentStats>,
-    .writer = {.reliability = Reliability::kReliable, .depth = 16},
+    .writer = {.reliability = Reliability::kReliable, .depth = 64, .transient_local = true},
     .reader = {.reliability = Reliability::kReliable, .depth = 16},
-    .watcher = {.reliability = Reliability::kBestEffort, .depth = 256},
+    .watcher = {.reliability = Reliability::kReliable, .depth = 256, .transient_local = true},
 };
 
 inline const RuntimeTopic kHealth{

@@ -77,11 +77,37 @@ class GraphSession final : public ProcessSession {
   std::vector<msg::HealthEvent> pending_;  // published with the next heartbeat
 };
 
+// A wall-clock graph of one process: nobody to wait for or to measure; its state is announced
+// (RELIABLE, TRANSIENT_LOCAL, one sample) so that `dyad status` finds it as it finds the others.
+class SoloSession final : public ProcessSession {
+ public:
+  SoloSession(const Graph& graph, const std::string& process, const std::string& host, uint32_t restarts)
+      : announcer_(graph, process, host, restarts) {}
+  Status Open(Transport* transport) override { return announcer_.Open(transport); }
+  StatusOr<int64_t> AwaitStart(const std::function<bool()>&) override {
+    announcer_.StartAlone(WallNowNs());
+    return announcer_.graph_start_ns();
+  }
+  int64_t graph_start_ns() const override { return announcer_.graph_start_ns(); }
+  void Started() override { announcer_.Announce("running"); }
+  Status Heartbeat() override {
+    announcer_.Announce("running");
+    return Status::OK();
+  }
+  void Stopping() override { announcer_.Announce("stopping"); }
+  void Close() override {}
+  bool shared_start() const override { return false; }
+
+ private:
+  StartBarrier announcer_;  // its announcements only: StartAlone() instead of Wait()
+};
+
 }  // namespace
 
 std::unique_ptr<ProcessSession> MakeGraphSession(const Graph& graph, const std::string& process, const std::string& host,
                                                  uint32_t restarts) {
-  if (graph.clock != ClockMode::kWall || graph.ProcessNames().size() < 2) return nullptr;
+  if (graph.clock != ClockMode::kWall) return nullptr;
+  if (graph.ProcessNames().size() < 2) return std::make_unique<SoloSession>(graph, process, host, restarts);
   return std::make_unique<GraphSession>(graph, process, host, restarts);
 }
 

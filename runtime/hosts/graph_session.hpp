@@ -13,8 +13,9 @@
 
 namespace dyad {
 
-// The session of `process` (on `host`), or null when it needs none: a stepped graph, or a graph
-// of one process. `restarts`: how often the launcher has restarted this process (announced).
+// The session of `process` (on `host`), or null when it needs none: a stepped graph. A graph of
+// one process gets a session that only announces its state on dyad/processes (`dyad status`
+// finds it); it waits for nobody. `restarts`: how often the launcher has restarted this process.
 std::unique_ptr<ProcessSession> MakeGraphSession(const Graph& graph, const std::string& process, const std::string& host,
                                                  uint32_t restarts);
 

@@ -153,14 +153,61 @@ std::optional<TopicTap> Tap(const IntrospectOptions& o, const Catalog& catalog, 
   return tap;
 }
 
+// `dyad status --graph`: every process heard; the step statistics of every component of the
+// running ones; the offsets between every two processes running for 3 s (measured every 2 s).
+bool HeardAll(const Graph& graph, const std::map<std::string, msg::ProcessState>& procs,
+              const std::map<std::string, msg::ComponentStats>& components,
+              const std::map<std::pair<std::string, std::string>, msg::ClockOffset>& clock) {
+  const int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  std::vector<std::string> settled;  // running for 3 s: they have measured each other
+  for (const std::string& process : graph.ProcessNames()) {
+    auto it = procs.find(graph.name + "/" + process);
+    if (it == procs.end()) return false;
+    if (it->second.state() != "running") continue;
+    for (const auto& c : graph.components)
+      if (graph.ProcessOf(c) == process && !components.count(process + "/" + c.name)) return false;
+    if (it->second.start_ns() > 0 && now_ns - it->second.start_ns() > 3'000'000'000) settled.push_back(process);
+  }
+  for (const auto& a : settled)
+    for (const auto& b : settled)
+      if (a != b && !clock.count({a, b})) return false;
+  return true;
+}
+
+// `dyad topics --graph`: every topic the components bind has a writer (if one writes it) and a
+// reader (if one reads it), and every process's participant was discovered.
+bool DiscoveredAll(const Graph& graph, const std::vector<DiscoveredEndpoint>& found) {
+  std::set<std::pair<std::string, bool>> seen;  // (topic, writer)
+  std::set<std::string> participants;
+  for (const auto& e : found) seen.insert({e.topic, e.writer}), participants.insert(e.participant);
+  for (const auto& c : graph.components) {
+    for (const auto& port : c.outputs)
+      if (!port.topic.empty() && !seen.count({port.topic, true})) return false;
+    for (const auto& port : c.inputs)
+      if (!port.topic.empty() && !seen.count({port.topic, false})) return false;
+  }
+  for (const std::string& process : graph.ProcessNames()) {
+    const std::string suffix = "/" + graph.name + "/" + process;
+    if (std::none_of(participants.begin(), participants.end(), [&](const std::string& name) {
+          return name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+        }))
+      return false;
+  }
+  return true;
+}
+
 }  // namespace
 
-int ListTopics(const IntrospectOptions& o, std::ostream& out) {
+int ListTopics(const IntrospectOptions& o, std::ostream& out, const Graph* graph) {
   InterruptWatcher interrupt;  // before the participant: its threads inherit the blocked signals
   auto p = Join(o, out);
   if (!p) return 1;
-  const auto end = Steady::now() + std::chrono::duration<double>(o.wait_s);
-  while (Steady::now() < end && !interrupt.interrupted()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  Steady::time_point end = Steady::now() + std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(o.wait_s));
+  while (Steady::now() < end && !interrupt.interrupted()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    // The rest of that discovery burst (another reader of a topic) comes within a moment.
+    if (graph && DiscoveredAll(*graph, p->Discovered())) end = std::min(end, Steady::now() + std::chrono::milliseconds(200));
+  }
   if (interrupt.interrupted()) return 0;
   struct Row {
     std::set<std::string> types, participants;
@@ -184,7 +231,8 @@ int ListTopics(const IntrospectOptions& o, std::ostream& out) {
   }
   if (rows.empty()) {
     std::cerr << "dyad topics: no endpoint discovered on domain " << o.domain_id << " within " << o.wait_s
-              << " s (a longer --wait helps on a loaded machine or network)\n";
+              << " s (a longer --wait helps on a loaded machine or network; a stepped run, clock: stepped, is"
+                 " private to its process and never seen here)\n";
     return 1;
   }
   return 0;
@@ -255,7 +303,8 @@ int TopicHz(const IntrospectOptions& o, const Catalog& catalog, const std::strin
   return total == 0 ? 1 : 0;
 }
 
-int ShowStatus(const IntrospectOptions& o, const std::string& graph_name, std::ostream& out, std::ostream& err) {
+int ShowStatus(const IntrospectOptions& o, const Graph* graph, std::ostream& out, std::ostream& err) {
+  const std::string graph_name = graph ? graph->name : "";
   InterruptWatcher interrupt;  // before the participant: its threads inherit the blocked signals
   auto p = Join(o, err);
   if (!p) return 1;
@@ -269,11 +318,13 @@ int ShowStatus(const IntrospectOptions& o, const std::string& graph_name, std::o
     return 1;
   }
   std::map<std::string, msg::ProcessState> procs;             // "graph/process" -> newest
-  std::map<std::string, msg::ComponentStats> components;      // component -> newest
+  std::map<std::string, msg::ComponentStats> components;      // "process/component" -> newest
   std::map<std::pair<std::string, std::string>, msg::ClockOffset> clock;  // (measurer, peer) -> newest
-  const auto end = Steady::now() + std::chrono::duration<double>(o.wait_s);
+  Steady::time_point end = Steady::now() + std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(o.wait_s));
   while (Steady::now() < end && !interrupt.interrupted()) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    // Heard all: the rest of the late joiner's burst (the offsets beside the stats) comes within a moment.
+    if (graph && HeardAll(*graph, procs, components, clock)) end = std::min(end, Steady::now() + std::chrono::milliseconds(150));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
     msg::ProcessState ps;
     while (processes.value()->TakeNext(&ps))
       if (graph_name.empty() || ps.graph_name() == graph_name) procs[ps.graph_name() + "/" + ps.process_name()] = ps;

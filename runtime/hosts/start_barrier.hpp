@@ -55,6 +55,10 @@ class StartBarrier {
   // is missing).
   StatusOr<int64_t> Wait(const std::function<bool()>& stopping);
 
+  // Instead of Wait(), for the only process of a graph: there is no one to wait for; it starts
+  // at `start_ns` (and announces so).
+  void StartAlone(int64_t start_ns) { ready_ns_ = start_ns_ = graph_start_ns_ = start_ns; }
+
   // When the graph started: the agreed instant, or for a process that joined a running graph,
   // the others' (valid after Wait()).
   int64_t graph_start_ns() const { return graph_start_ns_; }

@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <map>
 #include <memory>
+#include <optional>
 #include <iostream>
 #include <sstream>
 
@@ -74,6 +75,17 @@ bool LoadWatcherCatalog(const std::string& graph_path, std::vector<std::string> 
   return true;
 }
 
+// The --graph a watcher expects to see (LoadWatcherCatalog has said its problems already).
+std::optional<Graph> WatchedGraph(const std::string& path) {
+  if (path.empty()) return std::nullopt;
+  std::vector<Diagnostic> ignored;
+  Graph graph = LoadGraph(path, {}, &ignored);
+  if (graph.clock == ClockMode::kStepped)
+    std::cerr << "warning: " << path << ": clock: stepped: a stepped run keeps its DDS inside its process; watchers see "
+                 "only a run with --set clock=wall\n";
+  return graph;
+}
+
 }  // namespace
 
 void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
@@ -103,23 +115,28 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
 
   auto* topics = app.add_subcommand("topics", "List the topics on the DDS domain with their types and endpoints");
   add_common(topics);
-  topics->callback([st, &exit_code] { exit_code = ListTopics(st->opts, std::cout); });
+  topics->add_option("--graph", st->graph, "The graph (its domain and network); ends as soon as its topics and processes are found");
+  topics->callback([st, &exit_code] {
+    Catalog catalog;
+    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given(), st->host)) {
+      exit_code = 2;
+      return;
+    }
+    const std::optional<Graph> graph = WatchedGraph(st->graph);
+    exit_code = ListTopics(st->opts, std::cout, graph ? &*graph : nullptr);
+  });
 
   auto* status = app.add_subcommand("status", "Every process of a running graph: host, pid, state, restarts, clock offsets, step stats");
   add_common(status);
-  status->add_option("--graph", st->graph, "The graph (its name, domain and network); default: every graph on the domain");
+  status->add_option("--graph", st->graph, "The graph (its name, domain and network); default: every graph on the domain. Ends as soon as it has heard all of it");
   status->callback([st, &exit_code] {
     Catalog catalog;
     if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given(), st->host)) {
       exit_code = 2;
       return;
     }
-    std::string name;
-    if (!st->graph.empty()) {
-      std::vector<Diagnostic> ignored;
-      name = LoadGraph(st->graph, {}, &ignored).name;
-    }
-    exit_code = ShowStatus(st->opts, name, std::cout, std::cerr);
+    const std::optional<Graph> graph = WatchedGraph(st->graph);
+    exit_code = ShowStatus(st->opts, graph ? &*graph : nullptr, std::cout, std::cerr);
   });
 
   auto* echo = app.add_subcommand("echo", "Print the samples published on a topic");

@@ -41,9 +41,14 @@ struct IntrospectOptions {
   IdentityFiles security;
 };
 
+// Given the graph (`--graph`), a watcher ends as soon as it has seen what the graph says should
+// be there; `wait_s` is then only an upper bound (what it has not seen by then is said).
+
 // Prints one line per topic: name, type, writers, readers, participants. Returns 0, or 1 when
-// nothing was found.
-int ListTopics(const IntrospectOptions& options, std::ostream& out);
+// nothing was found. With `graph`: ends once every topic its components bind has a writer (when
+// a component writes it) and a reader (when one reads it), and every process's participant was
+// discovered, plus 0.2 s for the rest of that discovery burst.
+int ListTopics(const IntrospectOptions& options, std::ostream& out, const Graph* graph = nullptr);
 
 // Turns one serialized sample (CDR with encapsulation) of `type` into text.
 using SamplePrinter = std::function<std::string(const TypeInfo& type, const uint8_t* data, size_t size)>;
@@ -57,10 +62,13 @@ int EchoTopic(const IntrospectOptions& options, const Catalog& catalog, const st
 int TopicHz(const IntrospectOptions& options, const Catalog& catalog, const std::string& topic, double duration_s,
             std::ostream& out, std::ostream& err);
 
-// `dyad status`: listens `wait_s` to dyad/processes, dyad/stats and dyad/clock_offsets, then
-// prints every process of the graph named `graph_name` (empty: every graph on the domain) with
-// its host, pid, state and restarts, the clock offsets the processes measured of each other, and
-// each component's step statistics. Returns 0, or 1 when no process was heard.
-int ShowStatus(const IntrospectOptions& options, const std::string& graph_name, std::ostream& out, std::ostream& err);
+// `dyad status`: listens to dyad/processes, dyad/stats and dyad/clock_offsets (all three keep
+// their last samples for a late joiner), then prints every process of `graph` (null: of every
+// graph on the domain, listening `wait_s`) with its host, pid, state and restarts, the clock
+// offsets the processes measured of each other, and each component's step statistics. With a
+// graph it ends once it has heard every process, the step statistics of every component of the
+// running ones, and the offsets between every two processes running for 3 s (they are measured
+// every 2 s), plus 0.15 s for the rest of that burst. Returns 0, or 1 when no process was heard.
+int ShowStatus(const IntrospectOptions& options, const Graph* graph, std::ostream& out, std::ostream& err);
 
 }  // namespace dyad
