@@ -14,6 +14,7 @@ packages=(
   iproute2 nftables procps
   gdb  # the stacks of a process a test finds hung (tests' ChildProcess::Stacks, multihost_test.sh)
   slurm-wlm munge  # `dyad sweep --slurm` tested against a single-node Slurm (tools/sweep/test)
+  graphviz  # `dyad graph --svg`
 )
 if [ "${1:-}" = "sanitize" ]; then
   packages+=(clang-14 libclang-rt-14-dev llvm-14)

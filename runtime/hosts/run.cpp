@@ -3,7 +3,7 @@
 #include "dyad/run.hpp"
 #include "dyad/join_list.hpp"
 
-
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <thread>
@@ -218,7 +218,10 @@ ProcessRun RunProcess(Loaded& l, const Executor::Options& eo) {
 // The timing table and what went wrong; the exit code of the run (run.hpp).
 int ReportRun(const ProcessRun& run, const Graph& g, const std::string& process, const RunOptions& options,
               std::ostream& out, std::ostream& err) {
-  if (!options.quiet) PrintReport(run.rows, process, out);
+  // A run that failed before any step has no timing to show: a table of zeros would only push
+  // the error it ends with out of sight.
+  const bool stepped = std::any_of(run.rows.begin(), run.rows.end(), [](const Executor::Row& r) { return r.stats.steps > 0; });
+  if (!options.quiet && (stepped || run.result.ok())) PrintReport(run.rows, process, out);
   if (run.signal != 0) {
     // A person stopped it: the run ended cleanly (recordings closed), but it did not finish.
     err << "dyad run: interrupted (" << SignalName(run.signal) << ")" << (run.result.ok() ? "" : ": " + run.result.message())

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "bag_filter.hpp"
 #include "bag_info.hpp"
 #include "losses.hpp"
 #include "csv_export.hpp"
@@ -119,6 +120,22 @@ int RunExport(const std::string& path, const std::string& dir, const std::vector
   return code;
 }
 
+int RunFilter(const std::string& in, const std::string& out, const bag::FilterOptions& options) {
+  if (options.end_s >= 0 && options.end_s < options.start_s) {
+    std::cerr << "dyad bag filter: --end " << options.end_s << " is before --start " << options.start_s << "\n";
+    return kBadInput;
+  }
+  auto r = bag::FilterRecording(in, out, options, std::cerr);
+  if (!r.ok()) {
+    std::cerr << "dyad bag filter: " << r.status().message() << "\n";
+    return r.status().code() == Status::Code::kInvalidArgument ? kBadInput : kFailure;
+  }
+  std::cout << "wrote " << out << ": " << r->kept << " messages";
+  if (!options.topics.empty() || options.start_s > 0 || options.end_s >= 0) std::cout << " (of the recording's, chosen)";
+  std::cout << "\n";
+  return kOk;
+}
+
 }  // namespace
 
 void AddBagCommands(CLI::App& app, int& exit_code) {
@@ -148,6 +165,21 @@ void AddBagCommands(CLI::App& app, int& exit_code) {
   exp->callback([export_args, &exit_code] {
     exit_code = RunExport(export_args->file, export_args->csv_dir, export_args->topics);
   });
+
+  struct FilterArgs {
+    std::string in, out;
+    bag::FilterOptions options;
+  };
+  auto filter_args = std::make_shared<FilterArgs>();
+  CLI::App* filter = bag->add_subcommand("filter", "Copy some topics and a time window of a recording into a new MCAP file");
+  filter->add_option("FILE", filter_args->in, "MCAP file")->required();
+  filter->add_option("-o,--output", filter_args->out, "The new MCAP file")->required();
+  filter->add_option("--topics", filter_args->options.topics, "Only these topics (default: all)");
+  filter->add_option("--start", filter_args->options.start_s, "Seconds after the first message to begin at (default 0)")
+      ->check(CLI::NonNegativeNumber);
+  filter->add_option("--end", filter_args->options.end_s, "Seconds after the first message to end at (default: the end)")
+      ->check(CLI::NonNegativeNumber);
+  filter->callback([filter_args, &exit_code] { exit_code = RunFilter(filter_args->in, filter_args->out, filter_args->options); });
 }
 
 }  // namespace dyad::cli

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <optional>
 #include <iomanip>
 #include <sstream>
@@ -12,7 +14,11 @@
 #include <dyad/discovery_server.hpp>
 #include <dyad/run.hpp>
 
+#include <dyad/validate.hpp>
+
+#include "graph_dot.hpp"
 #include "reference_markdown.hpp"
+#include "run_process.hpp"
 
 namespace dyad::cli {
 namespace {
@@ -50,6 +56,46 @@ void PrintType(const std::string& name, const CatalogEntry& e, std::ostream& out
   }
 }
 
+// `dyad graph`: the graph checked against the component types (not configured: a picture needs
+// no model file), as DOT on stdout or rendered by Graphviz's dot into an SVG.
+int DrawGraph(const std::string& path, const std::vector<std::string>& sets, const std::vector<std::string>& plugins,
+              const std::string& svg) {
+  std::vector<Diagnostic> diags;
+  const Graph graph = LoadGraph(path, ToOverrides(sets), &diags);
+  Catalog catalog;
+  for (size_t i = 0; i < graph.plugins.size(); ++i)
+    if (Status s = catalog.Load(graph.plugins[i]); !s.ok()) diags.push_back({graph.plugin_marks[i], "plugins", s.message()});
+  for (const auto& p : plugins)
+    if (Status s = catalog.Load(p); !s.ok()) diags.push_back({SourceMark{"--plugins " + p, 0, 0}, "", s.message()});
+  if (Status s = catalog.LoadDefault({}); !s.ok()) std::cerr << "warning: " << s.message() << "\n";
+  ResolvedGraph resolved;
+  if (diags.empty()) resolved = ValidateGraph(graph, catalog, &diags);
+  for (const auto& d : diags) std::cerr << d.ToString() << "\n";
+  if (!diags.empty()) {
+    std::cerr << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", nothing was drawn\n";
+    return 2;
+  }
+  const std::string dot = GraphDot(graph, resolved);
+  if (svg.empty()) {
+    std::cout << dot;
+    return 0;
+  }
+  const std::string dot_file = svg + ".dot";
+  std::ofstream(dot_file) << dot;
+  const int rc = tools::RunProcess({"dot", "-Tsvg", "-o", svg, dot_file});
+  if (rc == 127) {
+    std::cerr << "dyad graph --svg: Graphviz's dot is not on PATH (Debian: apt install graphviz); the DOT text is in " << dot_file << "\n";
+    return 1;
+  }
+  if (rc != 0) {
+    std::cerr << "dyad graph --svg: dot -Tsvg " << dot_file << " failed (exit " << rc << ")\n";
+    return 1;
+  }
+  std::filesystem::remove(dot_file);
+  std::cout << "wrote " << svg << "\n";
+  return 0;
+}
+
 }  // namespace
 
 void AddRuntimeCommands(CLI::App& app, int& exit_code) {
@@ -60,6 +106,8 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
     std::vector<std::string> sets, plugins, type_names;
     bool markdown = false, messages = false, no_plugins = false;
     std::string listen;  // discovery-server --listen
+    std::string svg;     // graph --svg
+    bool dot = false;    // graph --dot
   };
   auto st = std::make_shared<State>();
   RunOptions& run = st->run;
@@ -80,6 +128,14 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
   });
 
   AddRunCommand(app, [&exit_code](const RunOptions& options) { exit_code = RunGraph(options, std::cout, std::cerr); });
+
+  auto* graph = app.add_subcommand("graph", "Draw a graph: components, topics, processes and hosts (Graphviz DOT, or SVG)");
+  graph->add_option("graph", run.graph_path, "Graph YAML file")->required();
+  graph->add_option("--set", sets, kSetHelp);
+  graph->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
+  auto* svg = graph->add_option("--svg", st->svg, "Render into this SVG file with Graphviz's dot (Debian: graphviz)");
+  graph->add_flag("--dot", st->dot, "Print the DOT text (the default)")->excludes(svg);
+  graph->callback([st, &exit_code] { exit_code = DrawGraph(st->run.graph_path, st->sets, st->plugins, st->svg); });
 
   auto* ds = app.add_subcommand("discovery-server", "Run a Fast DDS discovery server for graphs with network.discovery: server");
   ds->add_option("--listen", st->listen, "ADDRESS:PORT to listen on (UDP)")->required();

@@ -1,10 +1,12 @@
-// `dyad bag info` and `dyad bag export`: reports, CSV contents, decoders, errors and exit codes.
+// `dyad bag info`, `dyad bag export` and `dyad bag filter`: reports, CSV contents, decoders, errors and exit codes.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
+#include <tuple>
 
 #include <fastdds/rtps/common/SerializedPayload.h>
 
@@ -325,6 +327,53 @@ TEST(BagLosses, SaysPerWriterWhatWasLostAndWhen) {
   EXPECT_NE(text.find("  c  a  47 samples, 1..50: 3 missing\n    3 lost from +0.2 s to +0.6 s\n"
                       "    silent for the last 5.0 s of the recording\n"), std::string::npos) << text;
   EXPECT_EQ(text.find("  c  b "), std::string::npos) << "a complete writer is not listed\n" << text;
+}
+
+// `dyad bag filter`: read back by the reader (an independent path from the writer's buffers):
+// the chosen topic and window, every field of each message kept, the graph's metadata and a note.
+TEST(BagFilter, KeepsTheChosenTopicsAndWindowExactly) {
+  const std::string in = WriteSample(TempPath("in.mcap"), "graph: g\n");
+  const std::string out = TempPath("out.mcap");
+  std::string err;
+  // Messages at 1..6 s (robot at 1, 2, 4, 5 s); from 1 s to 2.5 s after the first: robot at 2 s only.
+  ASSERT_EQ(RunCli({"bag", "filter", in, "-o", out, "--topics", "/robot/pose", "--start", "1", "--end", "2.5"}, &err), 0) << err;
+  auto r = mcap::Reader::Open(out);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  std::vector<std::tuple<std::string, std::uint32_t, std::uint64_t, std::uint64_t, std::vector<std::uint8_t>>> got;
+  ASSERT_TRUE(r->ReadMessages({}, [&](const mcap::MessageView& m) {
+                  got.emplace_back(m.channel->topic, m.sequence, m.log_time, m.publish_time,
+                                   std::vector<std::uint8_t>(m.data.begin(), m.data.end()));
+                  return true;
+                }).ok());
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0], std::make_tuple(std::string("/robot/pose"), 1u, 2'000'000'000ull, 1001ull, std::vector<std::uint8_t>{0, 1, 0xAB}));
+  ASSERT_EQ(r->schemas().size(), 1u);
+  EXPECT_EQ(r->schemas().begin()->second.name, "dyad::msg::Pose2");
+  EXPECT_EQ(r->schemas().begin()->second.encoding, "omgidl");
+  std::map<std::string, std::map<std::string, std::string>> metadata;
+  for (const auto& m : r->metadata()) metadata[m.name] = m.entries;
+  EXPECT_EQ(metadata["dyad.graph"]["yaml"], "graph: g\n");
+  EXPECT_EQ(metadata["dyad.filter"]["topics"], "/robot/pose");
+  EXPECT_EQ(metadata["dyad.filter"]["source"], in);
+  // Everything: the same six messages.
+  ASSERT_EQ(RunCli({"bag", "filter", in, "-o", out}, &err), 0) << err;
+  auto all = mcap::Reader::Open(out);
+  ASSERT_TRUE(all.ok());
+  EXPECT_EQ(all->statistics().message_count, 6u);
+}
+
+TEST(BagFilter, RefusesAnUnknownTopicAnInvertedWindowAndItsOwnInput) {
+  const std::string in = WriteSample(TempPath("in.mcap"));
+  const std::string out = TempPath("out.mcap");
+  std::string err;
+  EXPECT_EQ(RunCli({"bag", "filter", in, "-o", out, "--topics", "/nope"}, &err), 2);
+  EXPECT_NE(err.find("has no topic '/nope' (it has: /human/pose, /robot/pose)"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_FALSE(std::filesystem::exists(out + ".tmp"));
+  EXPECT_EQ(RunCli({"bag", "filter", in, "-o", out, "--start", "3", "--end", "2"}, &err), 2);
+  EXPECT_NE(err.find("--end 2 is before --start 3"), std::string::npos) << err;
+  EXPECT_EQ(RunCli({"bag", "filter", in, "-o", in}, &err), 2);
+  EXPECT_NE(err.find("the output must be another file"), std::string::npos) << err;
 }
 
 }  // namespace
