@@ -29,11 +29,11 @@ struct Options {
 };
 
 // share/dyad/plot_report.py next to the executable's bin/ (build tree and installed tree alike).
-std::string PlotScript() {
+std::string PlotScript(const std::string& name = "plot_report.py") {
   std::error_code ec;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (ec) return {};
-  return (exe.parent_path().parent_path() / "share" / "dyad" / "plot_report.py").string();
+  return (exe.parent_path().parent_path() / "share" / "dyad" / name).string();
 }
 
 int RunAnalyze(const Options& o) {
@@ -91,9 +91,43 @@ int RunAnalyze(const Options& o) {
 }
 
 struct FromRecordingOptions {
-  std::string recording, out;
+  std::string recording, out, preview;
   analyze::DemonstrationOptions demo;
 };
+
+// The segments found and which became which primitive; the warnings (see demonstrations.hpp).
+void SayWhatWasCut(const analyze::Demonstrations& d, std::ostream& out, std::ostream& err) {
+  out << "segments (engaged, in recording order):\n";
+  char line[160];
+  for (size_t i = 0; i < d.segments.size(); ++i) {
+    const auto& s = d.segments[i];
+    std::string used;
+    for (size_t k = 0; k < d.chosen.size(); ++k)
+      if (d.chosen[k] == static_cast<int>(i)) used += (used.empty() ? " -> primitive " : ", ") + std::to_string(k);
+    std::snprintf(line, sizeof line, "  %2zu  at %7.1f s  %5.1f s  %4d samples  %d lap%s", i, s.start_s, s.duration_s, s.samples,
+                  s.laps, s.laps == 1 ? "" : "s");
+    out << line << (used.empty() ? "  (not used)" : used) << "\n";
+  }
+  for (const auto& w : d.warnings) err << "warning: " << w << "\n";
+}
+
+// --preview: the primitives drawn, each titled with its segment (and its first warning).
+int DrawPreview(const FromRecordingOptions& o, const analyze::Demonstrations& d) {
+  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  std::vector<std::string> args = {python, PlotScript("plot_dataset.py"), o.out, o.preview};
+  for (size_t k = 0; k < d.chosen.size(); ++k) {
+    std::string label = "primitive " + std::to_string(k) + " <- segment " + std::to_string(d.chosen[k]);
+    const auto& s = d.segments[static_cast<size_t>(d.chosen[k])];
+    if (s.laps > 1) label += "\n(" + std::to_string(s.laps) + " laps!)";
+    args.insert(args.end(), {"--label", std::to_string(k) + "=" + label});
+  }
+  if (int code = tools::RunProcess(args); code != 0) {
+    std::cerr << "dyad dataset from-recording: the preview was not drawn (exit " << code << "; python3-matplotlib: tools/setup.sh)\n";
+    return kFailure;
+  }
+  std::cout << "preview: " << o.preview << "\n";
+  return kOk;
+}
 
 int RunFromRecording(const FromRecordingOptions& o) {
   auto reader = mcap::Reader::Open(o.recording);
@@ -120,11 +154,12 @@ int RunFromRecording(const FromRecordingOptions& o) {
     std::cerr << "dyad dataset from-recording: " << s.message() << "\n";
     return kFailure;
   }
+  SayWhatWasCut(*demos, std::cout, std::cerr);
   std::cout << o.out << ": " << demos->dataset.size() << " primitive(s) of " << o.demo.steps << " steps from the engaged segments of '"
             << o.demo.topic << "'";
   if (demos->skipped > 0) std::cout << " (" << demos->skipped << " shorter than " << o.demo.min_samples << " samples skipped)";
-  std::cout << "\n";
-  return kOk;
+  std::cout << "\n" << std::flush;
+  return o.preview.empty() ? kOk : DrawPreview(o, *demos);
 }
 
 }  // namespace
@@ -141,6 +176,9 @@ void AddAnalyzeCommands(CLI::App& app, int& exit_code) {
     fr->add_option("--topic", o->demo.topic, "HumanInput topic (default human/input)");
     fr->add_option("--steps", o->demo.steps, "steps T of every primitive (default 72)");
     fr->add_option("--min-samples", o->demo.min_samples, "shorter engaged segments are skipped (default 10)");
+    fr->add_option("--segments", o->demo.choose, "which segments become the primitives, in order, e.g. 2,0,1 (default: all)")
+        ->delimiter(',');
+    fr->add_option("--preview", o->preview, "PNG file: the primitives drawn, each with its segment");
     fr->callback([o, &exit_code] { exit_code = RunFromRecording(*o); });
   }
   auto options = std::make_shared<Options>();

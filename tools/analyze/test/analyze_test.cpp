@@ -459,5 +459,87 @@ TEST(Demonstrations, CliRefusesWhatHasNoDemonstration) {
   EXPECT_EQ(r.code, 2);
 }
 
+// A HumanInput table of engaged circles of radius 10 (`laps` each, `per_lap` samples a lap,
+// `period_ms` apart), separated by one disengaged sample.
+TopicTable Circles(const std::vector<std::pair<double, int>>& segments, int per_lap, double period_ms) {
+  TopicTable t;
+  t.columns = {"header.stamp_ns", "x", "y", "engaged"};
+  double stamp = 1e9;
+  auto add = [&](double x, double y, bool engaged) {
+    t.rows.push_back({std::to_string(static_cast<long long>(stamp)), std::to_string(x), std::to_string(y), engaged ? "true" : "false"});
+    stamp += period_ms * 1e6;
+  };
+  for (const auto& [laps, offset] : segments) {
+    const int n = static_cast<int>(laps * per_lap);
+    for (int i = 0; i <= n; ++i) {
+      const double a = 2 * M_PI * i / per_lap;
+      add(offset + 10 * std::cos(a), 10 * std::sin(a), true);
+    }
+    add(0, 0, false);
+  }
+  return t;
+}
+
+TEST(Demonstrations, SeveralLapsInOneHoldAndAnotherPaceAreSaid) {
+  DemonstrationOptions o;
+  // One lap of 71 intervals (72 samples) -> no warning; two laps in one hold -> said.
+  auto one = DemonstrationsFromTable(Circles({{1, 0}}, 71, 100), o);
+  ASSERT_TRUE(one.ok()) << one.status().ToString();
+  EXPECT_EQ(one->segments.at(0).laps, 1);
+  EXPECT_TRUE(one->warnings.empty()) << one->warnings.front();
+  EXPECT_NEAR(one->dataset.sampling_period_ms, 100, 1e-6);
+  auto two = DemonstrationsFromTable(Circles({{2, 0}}, 71, 100), o);
+  ASSERT_TRUE(two.ok());
+  EXPECT_EQ(two->segments.at(0).laps, 2);
+  ASSERT_EQ(two->warnings.size(), 2u);  // two laps, and 143 samples squeezed into 72 steps
+  EXPECT_NE(two->warnings[0].find("primitive 0 (segment 0): holds 2 laps of its shape"), std::string::npos) << two->warnings[0];
+  EXPECT_NE(two->warnings[1].find("drawn in 143 samples 100 ms apart, resampled to steps 200 ms apart"), std::string::npos)
+      << two->warnings[1];
+  EXPECT_NE(two->warnings[1].find("--steps 143 keeps it"), std::string::npos) << two->warnings[1];
+  // Half a lap again (an open arc): one lap, and the pace of 108 samples onto 72 steps is said.
+  auto arc = DemonstrationsFromTable(Circles({{0.5, 0}}, 214, 100), o);
+  ASSERT_TRUE(arc.ok());
+  EXPECT_EQ(arc->segments.at(0).laps, 1);
+  ASSERT_EQ(arc->warnings.size(), 1u);
+  EXPECT_NE(arc->warnings[0].find("resampled to steps 151 ms apart"), std::string::npos) << arc->warnings[0];
+}
+
+TEST(Demonstrations, SegmentsChooseWhichBecomesWhichPrimitive) {
+  DemonstrationOptions o;
+  o.choose = {2, 0, 2};  // skip 1, reorder, reuse
+  const TopicTable table = Circles({{1, 0}, {1, 100}, {1, 200}}, 71, 100);
+  auto d = DemonstrationsFromTable(table, o);
+  ASSERT_TRUE(d.ok()) << d.status().ToString();
+  ASSERT_EQ(d->segments.size(), 3u);
+  ASSERT_EQ(d->dataset.size(), 3);
+  EXPECT_NEAR(d->dataset.sequences[0](0, 0), 210, 1e-4);  // segment 2 starts at x = 200 + 10
+  EXPECT_NEAR(d->dataset.sequences[1](0, 0), 10, 1e-4);
+  EXPECT_NEAR(d->dataset.sequences[2](0, 0), 210, 1e-4);
+  EXPECT_NEAR(d->segments[1].start_s, 7.3, 1e-9);  // 73 samples of 100 ms before it
+  o.choose = {3};
+  auto bad = DemonstrationsFromTable(table, o);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("--segments: no segment 3; the recording has 3: 0 (at 0.0 s, 7.1 s long), 1 (at 7.3 s"),
+            std::string::npos)
+      << bad.status().message();
+}
+
+TEST(Demonstrations, CliTakesSegmentsAndDrawsAPreview) {
+  const std::string rec = WriteExperiment(TempPath("d.mcap"));
+  const std::string out = TempPath("chosen"), png = TempPath("preview.png");
+  auto r = dyad::testing::RunCommand(dyad::cli::AddAnalyzeCommands, {"dataset", "from-recording", rec, "--out", out, "--min-samples",
+                                                                     "4", "--segments", "1,0", "--preview", png});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("   0  at     1.0 s    0.9 s    10 samples  1 lap -> primitive 1"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("   1  at     3.0 s    0.3 s     4 samples  1 lap -> primitive 0"), std::string::npos) << r.out;
+  auto data = pvrnn::LoadNrlDataset(out);
+  ASSERT_TRUE(data.ok());
+  EXPECT_NEAR(data->sequences[0](0, 0), 30, 1e-6);  // segment 1 (steps 30-33) first
+  std::ifstream f(png, std::ios::binary);
+  char magic[4] = {};
+  f.read(magic, 4);
+  EXPECT_EQ(std::string(magic + 1, 3), "PNG") << "no preview at " << png << "\n" << r.err;
+}
+
 }  // namespace
 }  // namespace dyad::analyze
