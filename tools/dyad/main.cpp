@@ -16,6 +16,7 @@
 #include "pvrnn_commands.hpp"
 #include "runtime_commands.hpp"
 #include "security_commands.hpp"
+#include "study_commands.hpp"
 #include "sweep_commands.hpp"
 
 #if defined(__has_feature)
@@ -64,6 +65,7 @@ int main(int argc, char** argv) {
   dyad::cli::AddObserverCommands(app, exit_code);
   dyad::cli::AddAnalyzeCommands(app, exit_code);
   dyad::cli::AddSweepCommands(app, exit_code);
+  dyad::cli::AddStudyCommands(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

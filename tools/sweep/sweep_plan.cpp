@@ -12,23 +12,15 @@
 
 #include "dyad/graph.hpp"
 #include "dyad/pvrnn/train_config.hpp"
-#include "dyad/run.hpp"
 #include "dyad/strict_yaml.hpp"
+#include "graph_check.hpp"
+#include "yaml_file.hpp"
 
 namespace dyad::sweep {
 namespace {
 
 namespace fs = std::filesystem;
 
-// A value as `--set` takes it: a scalar as written, anything else as flow YAML.
-std::string ValueText(const YAML::Node& n) {
-  if (n.IsScalar()) return n.Scalar();
-  YAML::Emitter e;
-  e.SetSeqFormat(YAML::Flow);
-  e.SetMapFormat(YAML::Flow);
-  e << n;
-  return e.c_str();
-}
 
 // FNV-1a: stable across builds and machines (a run's id names its folder).
 uint64_t Fnv1a(const std::string& s, uint64_t h = 1469598103934665603ull) {
@@ -58,7 +50,7 @@ void ReadGrid(StrictYaml& y, const YAML::Node& g, const std::string& at, const s
     }
     columns->push_back(column_prefix + key);
     grid->emplace_back();
-    for (const auto& v : kv.second) grid->back().push_back({key, ValueText(v), v, where});
+    for (const auto& v : kv.second) grid->back().push_back({key, tools::SetText(v), v, where});
   }
 }
 
@@ -76,7 +68,7 @@ void ReadTrain(StrictYaml& y, const YAML::Node& t, const std::string& path, Swee
   }
   y.Get(t, "model", "train.model", &plan->model_key, "a graph key (COMPONENT.PARAM)");
   if (const YAML::Node set = t["set"]; set && y.Map(set, "train.set", {}))
-    for (const auto& kv : set) base_sets->push_back(kv.first.Scalar() + "=" + ValueText(kv.second));
+    for (const auto& kv : set) base_sets->push_back(kv.first.Scalar() + "=" + tools::SetText(kv.second));
   if (t["grid"]) ReadGrid(y, t["grid"], "train.grid", "train.", &plan->parameters, grid);
 }
 
@@ -100,7 +92,7 @@ void ReadFile(StrictYaml& y, const YAML::Node& root, const std::string& path, Sw
     y.Error(root["duration"], "duration", "must be > 0");
   y.Get(root, "recorder", "recorder", &plan->recorder, "a component name");
   if (const YAML::Node set = root["set"]; set && y.Map(set, "set", {}))
-    for (const auto& kv : set) base_sets->push_back(kv.first.Scalar() + "=" + ValueText(kv.second));
+    for (const auto& kv : set) base_sets->push_back(kv.first.Scalar() + "=" + tools::SetText(kv.second));
   const YAML::Node g = root["grid"], r = root["runs"];
   if (g && r) y.Error(root["runs"], "runs", "give grid or runs, not both");
   if (!g && !r) y.Error(root, "grid", "required key missing (or runs)");
@@ -117,7 +109,7 @@ void ReadFile(StrictYaml& y, const YAML::Node& root, const std::string& path, Sw
           const std::string key = kv.first.Scalar();
           if (std::find(plan->parameters.begin(), plan->parameters.end(), key) == plan->parameters.end())
             plan->parameters.push_back(key);
-          listed->back().push_back({key, ValueText(kv.second), kv.second, where + "." + key});
+          listed->back().push_back({key, tools::SetText(kv.second), kv.second, where + "." + key});
         }
       }
     }
@@ -133,35 +125,6 @@ void ReadFile(StrictYaml& y, const YAML::Node& root, const std::string& path, Sw
   } else {
     seeds->push_back(1);
   }
-}
-
-// The graph's own verdict on `sets` (as `dyad validate --set`): empty when it passes. Problems
-// of the key `replaced` ("components.mind.params.model": the sweep gives it a trained model in
-// every run) do not count: the graph's own value is never used.
-std::string Check(const std::string& graph, const std::vector<std::string>& sets, const std::vector<std::string>& plugins,
-                  const std::string& replaced = "") {
-  std::vector<dyad::Override> overrides;
-  for (const auto& s : sets) overrides.push_back({s});
-  std::ostringstream out, err;
-  if (ValidateGraphFile(graph, overrides, plugins, out, err) == 0) return "";
-  std::string text;
-  std::istringstream lines(err.str());
-  for (std::string line; std::getline(lines, line);) {
-    // Its closing "GRAPH: N problems, nothing was started" is about a run that is not this sweep.
-    if (line.find("nothing was started") != std::string::npos) continue;
-    if (!replaced.empty() && line.find(": " + replaced + ": ") != std::string::npos) continue;
-    text += (text.empty() ? "" : "\n") + line;
-  }
-  if (!replaced.empty()) return text;
-  return text.empty() ? "the graph does not validate" : text;
-}
-
-// "mind.model" or "mind.params.model" as the validator names it: "components.mind.params.model".
-std::string ValidatorKey(const std::string& key) {
-  const size_t dot = key.find('.');
-  if (dot == std::string::npos) return key;
-  const std::string param = key.substr(dot + 1);
-  return "components." + key.substr(0, dot) + ".params." + (param.rfind("params.", 0) == 0 ? param.substr(7) : param);
 }
 
 std::string ReadText(const std::string& path) {
@@ -291,15 +254,7 @@ SweepPlan LoadSweep(const std::string& path, const std::vector<std::string>& plu
   SweepPlan plan;
   plan.file = path;
   YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    problems->push_back({SourceMark{path, 0, 0}, "", "cannot read the sweep file"});
-    return plan;
-  } catch (const YAML::Exception& e) {
-    problems->push_back({SourceMark{path, e.mark.line + 1, e.mark.column + 1}, "", e.msg});
-    return plan;
-  }
+  if (!tools::LoadYamlFile(path, "sweep", &root, problems)) return plan;
   StrictYaml y(StrictYaml::InFile(path, {}), problems);
   if (!y.Map(root, "", {"sweep", "graph", "duration", "recorder", "set", "grid", "runs", "seeds", "train"})) return plan;
   std::vector<std::string> base, train_base;
@@ -312,8 +267,8 @@ SweepPlan LoadSweep(const std::string& path, const std::vector<std::string>& plu
   // Hermetic and deterministic: stepped, and the recording where the sweep says.
   base.push_back("clock=stepped");
   base.push_back(plan.recorder + ".overwrite=true");
-  const std::string replaced = root["train"] ? ValidatorKey(plan.model_key) : "";
-  if (std::string why = Check(plan.graph, base, plugins, replaced); !why.empty()) {
+  const std::string replaced = root["train"] ? tools::ValidatorKey(plan.model_key) : "";
+  if (std::string why = tools::GraphProblems(plan.graph, base, plugins, replaced); !why.empty()) {
     y.Error(root["set"] ? root["set"] : root, root["set"] ? "set" : "graph", "the graph with these overrides does not validate:\n" + why);
     return plan;
   }
@@ -324,7 +279,7 @@ SweepPlan LoadSweep(const std::string& path, const std::vector<std::string>& plu
     if (!checked.insert(o.key + "=" + o.value).second) return;
     std::vector<std::string> sets = base;
     sets.push_back(o.key + "=" + o.value);
-    if (std::string why = Check(plan.graph, sets, plugins, replaced); !why.empty()) y.Error(o.node, o.where, "does not validate:\n" + why);
+    if (std::string why = tools::GraphProblems(plan.graph, sets, plugins, replaced); !why.empty()) y.Error(o.node, o.where, "does not validate:\n" + why);
   };
   for (const auto& values : grid)
     for (const auto& o : values) check(o);

@@ -1,0 +1,158 @@
+#include "study_file.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <regex>
+
+#include <yaml-cpp/yaml.h>
+
+#include "dyad/strict_yaml.hpp"
+#include "graph_check.hpp"
+#include "yaml_file.hpp"
+#include "latin_square.hpp"
+
+namespace dyad::study {
+namespace {
+
+namespace fs = std::filesystem;
+
+
+bool IsName(const std::string& s) {
+  return !s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") == std::string::npos;
+}
+
+std::string Resolved(const std::string& path, const std::string& relative_to_file) {
+  fs::path p(path);
+  if (p.is_relative()) p = fs::absolute(fs::path(relative_to_file).parent_path()) / p;
+  return p.lexically_normal().string();
+}
+
+void ReadScalars(StrictYaml& y, const YAML::Node& root, const std::string& path, Study* s) {
+  if (y.Get(root, "study", "study", &s->name, "a name", true) && !IsName(s->name))
+    y.Error(root["study"], "study", "a name is letters, digits, '_' and '-'");
+  std::string graph;
+  if (y.Get(root, "graph", "graph", &graph, "a path", true)) {
+    const std::string g = Resolved(graph, path);
+    std::error_code ec;
+    if (fs::is_regular_file(g, ec)) s->graph = g;
+    else y.Error(root["graph"], "graph", "no such file: " + g);
+  }
+  std::string data = s->name + "-data";
+  y.Get(root, "data", "data", &data, "a path");
+  s->data = Resolved(data, path);
+  if (y.Get(root, "trials", "trials", &s->trials, "an integer") && (s->trials < 1 || s->trials > 99))
+    y.Error(root["trials"], "trials", "must be in 1..99");
+  if (y.Get(root, "duration", "duration", &s->duration_s, "a number of seconds") && !(s->duration_s >= 0))
+    y.Error(root["duration"], "duration", "must be >= 0 (0: until the experimenter stops the trial)");
+  y.Get(root, "blind", "blind", &s->blind, "true or false");
+  y.Get(root, "consent_required", "consent_required", &s->consent_required, "true or false");
+  if (y.Get(root, "self_reports", "self_reports", &s->self_reports, "a word") && s->self_reports != "after_event" &&
+      s->self_reports != "after_trial" && s->self_reports != "off")
+    y.Error(root["self_reports"], "self_reports", "must be after_event, after_trial or off");
+}
+
+void ReadParticipants(StrictYaml& y, const YAML::Node& root, Study* s) {
+  const YAML::Node list = root["participants"];
+  if (!list) return y.Error(root, "participants", "required key missing");
+  if (!list.IsSequence() || list.size() == 0) return y.Error(list, "participants", "must be a non-empty list of IDs");
+  static const std::regex pseudonym("[A-Za-z]{1,4}[0-9]{1,4}");
+  std::map<std::string, YAML::Node> seen;
+  for (size_t i = 0; i < list.size(); ++i) {
+    const std::string key = "participants[" + std::to_string(i) + "]";
+    std::string id;
+    if (!y.Get(list[i], key, &id, "an ID")) continue;
+    if (!std::regex_match(id, pseudonym)) {
+      y.Error(list[i], key, "'" + id + "' is not a pseudonymous ID: 1-4 letters then 1-4 digits, such as P01 (never a name)");
+    } else if (auto it = seen.find(id); it != seen.end()) {
+      y.Error(list[i], key, "participant " + id + " is listed twice (first at line " + std::to_string(it->second.Mark().line + 1) + ")");
+    } else {
+      seen.emplace(id, list[i]);
+      s->participants.push_back(id);
+    }
+  }
+}
+
+// The conditions; each override is checked against the graph at its line, then each condition whole.
+void ReadConditions(StrictYaml& y, const YAML::Node& root, const std::vector<std::string>& plugins, Study* s) {
+  const YAML::Node conditions = root["conditions"];
+  if (!conditions) return y.Error(root, "conditions", "required key missing");
+  if (!y.Map(conditions, "conditions", {})) return;
+  if (conditions.size() == 0) return y.Error(conditions, "conditions", "name at least one condition and its overrides");
+  for (const auto& kv : conditions) {
+    const std::string name = kv.first.Scalar(), where = "conditions." + name;
+    if (!IsName(name)) y.Error(kv.first, where, "a condition's name is letters, digits, '_' and '-'");
+    if (!y.Map(kv.second, where, {})) continue;
+    if (kv.second.size() == 0) y.Error(kv.second, where, "overrides nothing: name the keys it changes");
+    Condition c{name, "", {}};
+    bool bad = false;
+    for (const auto& o : kv.second) {
+      const std::string set = o.first.Scalar() + "=" + tools::SetText(o.second);
+      if (s->graph.empty()) continue;
+      if (std::string why = tools::GraphProblems(s->graph, {"clock=stepped", set}, plugins); !why.empty()) {
+        y.Error(o.second, where + "." + o.first.Scalar(), "does not validate:\n" + why);
+        bad = true;
+      }
+      c.sets.push_back(set);
+    }
+    if (!bad && !s->graph.empty() && c.sets.size() > 1)
+      if (std::string why = tools::GraphProblems(s->graph, c.sets, plugins); !why.empty())
+        y.Error(kv.second, where, "its overrides together do not validate:\n" + why);
+    s->conditions.push_back(std::move(c));
+  }
+}
+
+// Labels A, B, ... in an order drawn from the study's name (FNV-1a: the same on every machine).
+void GiveLabels(Study* s) {
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char ch : s->name) h = (h ^ ch) * 1099511628211ull;
+  std::vector<size_t> order(s->conditions.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  for (size_t i = order.size(); i > 1; --i) {
+    h = h * 6364136223846793005ull + 1442695040888963407ull;
+    std::swap(order[i - 1], order[(h >> 33) % i]);
+  }
+  for (size_t i = 0; i < order.size(); ++i) s->conditions[order[i]].label = std::string(1, static_cast<char>('A' + i));
+}
+
+}  // namespace
+
+std::vector<Trial> Study::TrialsOf(const std::string& participant) const {
+  const auto it = std::find(participants.begin(), participants.end(), participant);
+  if (it == participants.end() || conditions.empty()) return {};
+  const auto rows = BalancedLatinSquare(static_cast<int>(conditions.size()));
+  const auto& row = rows[static_cast<size_t>(it - participants.begin()) % rows.size()];
+  std::vector<Trial> out;
+  for (int c : row)
+    for (int r = 1; r <= trials; ++r) {
+      Trial t;
+      t.number = static_cast<int>(out.size()) + 1;
+      t.condition = c;
+      t.repetition = r;
+      char nn[16];
+      std::snprintf(nn, sizeof nn, "%02d", t.number);
+      const Condition& cond = conditions[static_cast<size_t>(c)];
+      t.file = (fs::path(data) / participant / (std::string(nn) + "-" + (blind ? cond.label : cond.name) + ".mcap")).string();
+      out.push_back(std::move(t));
+    }
+  return out;
+}
+
+Study LoadStudy(const std::string& path, const std::vector<std::string>& plugins, std::vector<Diagnostic>* problems) {
+  Study s;
+  s.file = path;
+  YAML::Node root;
+  if (!tools::LoadYamlFile(path, "study", &root, problems)) return s;
+  StrictYaml y(StrictYaml::InFile(path, {}), problems);
+  if (!y.Map(root, "", {"study", "graph", "data", "participants", "conditions", "trials", "duration", "blind", "consent_required",
+                        "self_reports"}))
+    return s;
+  ReadScalars(y, root, path, &s);
+  ReadParticipants(y, root, &s);
+  ReadConditions(y, root, plugins, &s);  // checked against the graph when it was found
+  GiveLabels(&s);
+  s.square_rows = static_cast<int>(BalancedLatinSquare(std::max(1, static_cast<int>(s.conditions.size()))).size());
+  return s;
+}
+
+}  // namespace dyad::study

@@ -1,0 +1,66 @@
+// tools/study/study_file.hpp: a study file, read and checked, and the plan it fixes: who does
+// which condition when (docs/study.md).
+//
+//   study: gain                          # its name (letters, digits, _ and -)
+//   graph: ../configs/interactive.yaml   # the base graph, relative to this file
+//   data: gain-data                      # where recordings go (default <name>-data beside this file)
+//   participants: [P01, P02, P03, P04]   # pseudonymous IDs only: 1-4 letters then 1-4 digits
+//   conditions:                          # each a set of overrides, as `dyad run --set` takes them
+//     assist: {mixer.gain: 0.3}
+//     follow: {mixer.gain: 0.9}
+//   trials: 2                            # per condition and participant (default 1)
+//   duration: 120                        # seconds per trial (default 0: until the experimenter stops it)
+//   blind: true                          # the experimenter sees "condition A", not its name (default false)
+//   consent_required: true               # no trial records before consent is marked (default true)
+//   self_reports: after_event            # after_event | after_trial | off (default after_event)
+//
+// Contract of LoadStudy:
+//   - Every problem of the file at once, each "file:line:col: key: message": unknown keys, wrong
+//     types, a participant ID that is not pseudonymous or is used twice (naming the first), no
+//     conditions, a condition that overrides nothing, an override the graph refuses (checked as
+//     `dyad validate --set` would, at the line of that value, and each condition as a whole).
+//   - The plan is a function of the file alone, fixed before the first participant comes:
+//     participant i (file order) does the conditions in row i of a balanced Latin square
+//     (latin_square.hpp), each as `trials` consecutive trials; blind labels A, B, ... are given
+//     to the conditions in an order drawn from the study's name (the same every time).
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "dyad/diagnostic.hpp"
+
+namespace dyad::study {
+
+struct Condition {
+  std::string name, label;  // label: "A", "B", ... (what a blind experimenter sees)
+  std::vector<std::string> sets;  // "KEY=VALUE", as `dyad run --set` takes them
+};
+
+struct Trial {
+  int number = 1;      // 1.. within the participant's session
+  int condition = 0;   // index in Study::conditions
+  int repetition = 1;  // 1..trials within its condition
+  std::string file;    // the recording: DATA/PARTICIPANT/NN-CONDITION.mcap (the label when blind)
+};
+
+struct Study {
+  std::string name, file, graph, data;  // graph and data absolute
+  std::vector<std::string> participants;
+  std::vector<Condition> conditions;
+  int trials = 1;
+  double duration_s = 0;
+  bool blind = false, consent_required = true;
+  std::string self_reports = "after_event";
+  int square_rows = 1;  // rows of the Latin square: participants in multiples of it are balanced
+
+  // The trials of `participant` (one of `participants`) in their order.
+  std::vector<Trial> TrialsOf(const std::string& participant) const;
+  // What the experimenter is shown of a condition: its label when blind, else its name.
+  std::string Shown(const Condition& c) const { return blind ? "condition " + c.label : c.name; }
+};
+
+Study LoadStudy(const std::string& path, const std::vector<std::string>& plugins, std::vector<Diagnostic>* problems);
+
+}  // namespace dyad::study

@@ -1,0 +1,26 @@
+#include "yaml_file.hpp"
+
+namespace dyad::tools {
+
+bool LoadYamlFile(const std::string& path, const std::string& what, YAML::Node* root, std::vector<Diagnostic>* problems) {
+  try {
+    *root = YAML::LoadFile(path);
+    return true;
+  } catch (const YAML::BadFile&) {
+    problems->push_back({SourceMark{path, 0, 0}, "", "cannot read the " + what + " file"});
+  } catch (const YAML::Exception& e) {
+    problems->push_back({SourceMark{path, e.mark.line + 1, e.mark.column + 1}, "", e.msg});
+  }
+  return false;
+}
+
+std::string SetText(const YAML::Node& node) {
+  if (node.IsScalar()) return node.Scalar();
+  YAML::Emitter e;
+  e.SetSeqFormat(YAML::Flow);
+  e.SetMapFormat(YAML::Flow);
+  e << node;
+  return e.c_str();
+}
+
+}  // namespace dyad::tools
