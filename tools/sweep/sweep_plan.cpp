@@ -14,6 +14,7 @@
 #include "dyad/pvrnn/train_config.hpp"
 #include "dyad/strict_yaml.hpp"
 #include "graph_check.hpp"
+#include "study_file.hpp"
 #include "yaml_file.hpp"
 
 namespace dyad::sweep {
@@ -72,22 +73,53 @@ void ReadTrain(StrictYaml& y, const YAML::Node& t, const std::string& path, Swee
   if (t["grid"]) ReadGrid(y, t["grid"], "train.grid", "train.", &plan->parameters, grid);
 }
 
+// The base: `graph:`, or a study's `condition:` (the study's graph with that condition's
+// overrides first, so the sweep varies around what the participants get).
+void ReadBase(StrictYaml& y, const YAML::Node& root, const std::string& path, const std::vector<std::string>& plugins,
+              SweepPlan* plan, std::vector<std::string>* base_sets, std::vector<Diagnostic>* problems) {
+  const YAML::Node study_node = root["study"], condition_node = root["condition"];
+  if (root["graph"] && study_node) return y.Error(study_node, "study", "give graph or study (with its condition), not both");
+  if (!study_node) {
+    if (condition_node) y.Error(condition_node, "condition", "a condition is a study's: give study too");
+    std::string graph;
+    if (!y.Get(root, "graph", "graph", &graph, "a path", true)) return;
+    fs::path g(graph);
+    if (g.is_relative()) g = fs::absolute(fs::path(path).parent_path()) / g;
+    std::error_code ec;
+    if (!fs::is_regular_file(g, ec)) y.Error(root["graph"], "graph", "no such file: " + g.lexically_normal().string());
+    plan->graph = g.lexically_normal().string();
+    return;
+  }
+  std::string file, condition;
+  const bool named = y.Get(study_node, "study", &file, "a path");
+  if (!y.Get(root, "condition", "condition", &condition, "a condition of the study", true) || !named) return;
+  fs::path f(file);
+  if (f.is_relative()) f = fs::absolute(fs::path(path).parent_path()) / f;
+  std::error_code ec;
+  if (!fs::is_regular_file(f, ec)) return y.Error(study_node, "study", "no such file: " + f.lexically_normal().string());
+  const size_t before = problems->size();
+  const study::Study st = study::LoadStudy(f.lexically_normal().string(), plugins, problems);  // its problems at its lines
+  if (problems->size() > before) return;
+  std::string known;
+  for (const auto& c : st.conditions) {
+    if (c.name == condition) {
+      plan->graph = st.graph;
+      base_sets->insert(base_sets->begin(), c.sets.begin(), c.sets.end());
+      return;
+    }
+    known += (known.empty() ? "" : ", ") + c.name;
+  }
+  y.Error(condition_node, "condition", "the study " + st.name + " has no condition '" + condition + "' (it has: " + known + ")");
+}
+
 // Reads the parts of the file; the overrides it names go to *swept (grid) or *listed (runs).
-void ReadFile(StrictYaml& y, const YAML::Node& root, const std::string& path, SweepPlan* plan,
+void ReadFile(StrictYaml& y, const YAML::Node& root, SweepPlan* plan,
               std::vector<std::string>* base_sets, std::vector<std::vector<SweptValue>>* grid,
               std::vector<std::vector<SweptValue>>* listed, std::vector<int64_t>* seeds) {
   if (y.Get(root, "sweep", "sweep", &plan->name, "a name", true) &&
       (plan->name.empty() || plan->name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") !=
                                  std::string::npos))
     y.Error(root["sweep"], "sweep", "a name is letters, digits, '_' and '-'");
-  std::string graph;
-  if (y.Get(root, "graph", "graph", &graph, "a path", true)) {
-    fs::path g(graph);
-    if (g.is_relative()) g = fs::absolute(fs::path(path).parent_path()) / g;
-    std::error_code ec;
-    if (!fs::is_regular_file(g, ec)) y.Error(root["graph"], "graph", "no such file: " + g.lexically_normal().string());
-    plan->graph = g.lexically_normal().string();
-  }
   if (y.Get(root, "duration", "duration", &plan->duration_s, "a number of seconds", true) && !(plan->duration_s > 0))
     y.Error(root["duration"], "duration", "must be > 0");
   y.Get(root, "recorder", "recorder", &plan->recorder, "a component name");
@@ -256,17 +288,25 @@ SweepPlan LoadSweep(const std::string& path, const std::vector<std::string>& plu
   YAML::Node root;
   if (!tools::LoadYamlFile(path, "sweep", &root, problems)) return plan;
   StrictYaml y(StrictYaml::InFile(path, {}), problems);
-  if (!y.Map(root, "", {"sweep", "graph", "duration", "recorder", "set", "grid", "runs", "seeds", "train"})) return plan;
+  if (!y.Map(root, "", {"sweep", "graph", "study", "condition", "duration", "recorder", "set", "grid", "runs", "seeds", "train"}))
+    return plan;
   std::vector<std::string> base, train_base;
   std::vector<std::vector<SweptValue>> grid, listed, train_grid;
   std::vector<int64_t> seeds;
   if (root["train"]) ReadTrain(y, root["train"], path, &plan, &train_base, &train_grid);
-  ReadFile(y, root, path, &plan, &base, &grid, &listed, &seeds);
+  ReadFile(y, root, &plan, &base, &grid, &listed, &seeds);
+  ReadBase(y, root, path, plugins, &plan, &base, problems);
   if (!problems->empty()) return plan;
 
   // Hermetic and deterministic: stepped, and the recording where the sweep says.
   base.push_back("clock=stepped");
   base.push_back(plan.recorder + ".overwrite=true");
+  // The trainings first: they do not depend on the graph validating (its own model, which every
+  // run replaces, may not exist yet), and a typo in train: is then said whatever else is wrong.
+  if (root["train"]) {
+    CheckModelKey(y, root["train"], plan.graph, base, plan);
+    PlanTrainings(y, root["train"], train_base, train_grid, &plan);
+  }
   const std::string replaced = root["train"] ? tools::ValidatorKey(plan.model_key) : "";
   if (std::string why = tools::GraphProblems(plan.graph, base, plugins, replaced); !why.empty()) {
     y.Error(root["set"] ? root["set"] : root, root["set"] ? "set" : "graph", "the graph with these overrides does not validate:\n" + why);
@@ -285,10 +325,6 @@ SweepPlan LoadSweep(const std::string& path, const std::vector<std::string>& plu
     for (const auto& o : values) check(o);
   for (const auto& run : listed)
     for (const auto& o : run) check(o);
-  if (root["train"]) {
-    CheckModelKey(y, root["train"], plan.graph, base, plan);
-    PlanTrainings(y, root["train"], train_base, train_grid, &plan);
-  }
   if (!problems->empty()) return plan;
 
   const std::vector<std::vector<const SweptValue*>> combos = Combinations(grid, listed);

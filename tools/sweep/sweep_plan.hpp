@@ -1,7 +1,9 @@
 // tools/sweep/sweep_plan.hpp: a sweep file, read and checked, as the list of runs it asks for.
 //
 //   sweep: gain                      # its name
-//   graph: ../configs/demo.yaml      # the base graph, relative to this file
+//   graph: ../configs/demo.yaml      # the base graph, relative to this file, or instead:
+//   study: ../studies/gain.yaml      #   a study's graph...
+//   condition: follow                #   ...with this condition's overrides first
 //   duration: 30                     # experiment seconds per run (runs are stepped: as fast as they go)
 //   recorder: recorder               # the graph's recorder component (default "recorder")
 //   set: {mind.model: m.yaml}        # overrides of every run, as `dyad run --set` takes them
@@ -19,7 +21,8 @@
 //
 // Contract of LoadSweep:
 //   - Every problem of the file at once, each "file:line:col: key: message" (strict YAML: unknown
-//     keys, wrong types, an empty grid or list, both grid and runs).
+//     keys, wrong types, an empty grid or list, both grid and runs, both graph and study, a
+//     condition the study lacks; a study file's own problems at its lines).
 //   - Every override (each value of each key) is checked against the graph, as `dyad validate
 //     --set` would: a key the graph lacks, a value its component refuses. Its problems are
 //     reported at the sweep file's line of that value.

@@ -112,6 +112,32 @@ TEST_F(SweepTest, AFailingRunIsRecordedTheRestRunAndARerunResumes) {
   EXPECT_EQ(ReadFile(dir_ / "o" / "sweep.csv").find("failed"), std::string::npos);
 }
 
+// A study's condition as the base: the study's graph with the condition's overrides first (the
+// sweep's own set: and grid after them), and the bad ways to name it.
+TEST_F(SweepTest, AStudysConditionIsTheBase) {
+  Write("study: st\ngraph: g.yaml\nparticipants: [P01, P02]\nconditions:\n  high: {src.start: 100}\n  low: {src.start: 0}\n",
+        "st.yaml");
+  const fs::path file = Write("sweep: s\nstudy: st.yaml\ncondition: high\nduration: 1\ngrid: {src.noise: [0, 1]}\n");
+  std::string out;
+  ASSERT_EQ(Sweep({file.string(), "--dry-run"}, &out), 0) << out;
+  EXPECT_NE(out.find(" --set src.start=100 --set clock=stepped --set recorder.overwrite=true --set src.noise=0 --set seed=1\n"),
+            std::string::npos)
+      << out;
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--no-plots"}, &out), 0) << out;
+  EXPECT_NE(out.find("2 ran, 0 done before, 0 failed"), std::string::npos) << out;
+  const std::string head = "sweep: s\nduration: 1\ngrid: {src.noise: [0]}\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {head + "study: st.yaml\ncondition: middle\n", "s.yaml:5:12: condition: the study st has no condition 'middle' (it has: high, low)"},
+      {head + "graph: g.yaml\nstudy: st.yaml\ncondition: high\n", "s.yaml:5:8: study: give graph or study (with its condition), not both"},
+      {head + "graph: g.yaml\ncondition: high\n", "s.yaml:5:12: condition: a condition is a study's: give study too"},
+      {head + "study: nowhere.yaml\ncondition: high\n", "s.yaml:4:8: study: no such file"},
+  };
+  for (const auto& [text, expected] : cases) {
+    EXPECT_EQ(Sweep({Write(text).string(), "--dry-run"}, &out), 2) << text;
+    EXPECT_NE(out.find(expected), std::string::npos) << "for\n" << text << "expected '" << expected << "' in:\n" << out;
+  }
+}
+
 // The demo graph with models the sweep trains (20 epochs: a fraction of a second each).
 class TrainingSweepTest : public SweepTest {
  protected:
