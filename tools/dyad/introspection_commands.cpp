@@ -49,13 +49,19 @@ std::string MachineName() {
 
 // A secured graph's watcher joins with the identity of this machine's host (`--host`, else the
 // machine's name; dyad/security.hpp).
+// *watched (if given) receives the graph: what `status` and `topics` wait to have seen.
 bool LoadWatcherCatalog(const std::string& graph_path, std::vector<std::string> plugins, Catalog* catalog,
-                        IntrospectOptions* options = nullptr, bool domain_given = false, const std::string& host = "") {
+                        IntrospectOptions* options = nullptr, bool domain_given = false, const std::string& host = "",
+                        std::optional<Graph>* watched = nullptr) {
   if (!graph_path.empty()) {
     std::vector<Diagnostic> diagnostics;
     const Graph graph = LoadGraph(graph_path, {}, &diagnostics);
     for (const Diagnostic& d : diagnostics) std::cerr << d.ToString() << "\n";
     if (!diagnostics.empty()) return false;
+    if (graph.clock == ClockMode::kStepped)
+      std::cerr << "warning: " << graph_path << ": clock: stepped: a stepped run keeps its DDS inside its process; watchers see "
+                   "only a run with --set clock=wall\n";
+    if (watched != nullptr) *watched = graph;
     plugins.insert(plugins.end(), graph.plugins.begin(), graph.plugins.end());
     if (options != nullptr) {
       options->network = graph.network;
@@ -75,16 +81,6 @@ bool LoadWatcherCatalog(const std::string& graph_path, std::vector<std::string> 
   return true;
 }
 
-// The --graph a watcher expects to see (LoadWatcherCatalog has said its problems already).
-std::optional<Graph> WatchedGraph(const std::string& path) {
-  if (path.empty()) return std::nullopt;
-  std::vector<Diagnostic> ignored;
-  Graph graph = LoadGraph(path, {}, &ignored);
-  if (graph.clock == ClockMode::kStepped)
-    std::cerr << "warning: " << path << ": clock: stepped: a stepped run keeps its DDS inside its process; watchers see "
-                 "only a run with --set clock=wall\n";
-  return graph;
-}
 
 }  // namespace
 
@@ -113,29 +109,35 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
     c->add_option("--wait", st->opts.wait_s, "Seconds of discovery before answering (topics) or giving up on a topic (echo, hz); default 5")->check(CLI::NonNegativeNumber);
   };
 
+  // The catalog, domain and network a watcher joins with, and the --graph it watches; false
+  // (exit 2) when the graph cannot be read, having said why.
+  auto join = [st](Catalog* catalog, std::optional<Graph>* graph = nullptr) {
+    return LoadWatcherCatalog(st->graph, st->plugins, catalog, &st->opts, st->domain_given(), st->host, graph);
+  };
+
   auto* topics = app.add_subcommand("topics", "List the topics on the DDS domain with their types and endpoints");
   add_common(topics);
   topics->add_option("--graph", st->graph, "The graph (its domain and network); ends as soon as its topics and processes are found");
-  topics->callback([st, &exit_code] {
+  topics->callback([st, join, &exit_code] {
     Catalog catalog;
-    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given(), st->host)) {
+    std::optional<Graph> graph;
+    if (!join(&catalog, &graph)) {
       exit_code = 2;
       return;
     }
-    const std::optional<Graph> graph = WatchedGraph(st->graph);
     exit_code = ListTopics(st->opts, std::cout, graph ? &*graph : nullptr);
   });
 
   auto* status = app.add_subcommand("status", "Every process of a running graph: host, pid, state, restarts, clock offsets, step stats");
   add_common(status);
   status->add_option("--graph", st->graph, "The graph (its name, domain and network); default: every graph on the domain. Ends as soon as it has heard all of it");
-  status->callback([st, &exit_code] {
+  status->callback([st, join, &exit_code] {
     Catalog catalog;
-    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given(), st->host)) {
+    std::optional<Graph> graph;
+    if (!join(&catalog, &graph)) {
       exit_code = 2;
       return;
     }
-    const std::optional<Graph> graph = WatchedGraph(st->graph);
     exit_code = ShowStatus(st->opts, graph ? &*graph : nullptr, std::cout, std::cerr);
   });
 
@@ -146,9 +148,9 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   echo->add_option("--duration", st->duration, "Stop after this many seconds");
   echo->add_option("--plugins", st->plugins, "Plugin file or folder whose message types to know (repeatable)");
   echo->add_option("--graph", st->graph, "Know the message types of this graph's plugins");
-  echo->callback([st, &exit_code] {
+  echo->callback([st, join, &exit_code] {
     Catalog catalog;
-    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given(), st->host)) {
+    if (!join(&catalog)) {
       exit_code = 2;
       return;
     }
@@ -161,9 +163,9 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   hz->add_option("--duration", st->duration, "Stop after this many seconds (0: until Ctrl-C)");
   hz->add_option("--plugins", st->plugins, "Plugin file or folder whose message types to know (repeatable)");
   hz->add_option("--graph", st->graph, "Know the message types of this graph's plugins");
-  hz->callback([st, &exit_code] {
+  hz->callback([st, join, &exit_code] {
     Catalog catalog;
-    if (!LoadWatcherCatalog(st->graph, st->plugins, &catalog, &st->opts, st->domain_given(), st->host)) {
+    if (!join(&catalog)) {
       exit_code = 2;
       return;
     }

@@ -22,25 +22,20 @@ bool IsName(const std::string& s) {
   return !s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-") == std::string::npos;
 }
 
-std::string Resolved(const std::string& path, const std::string& relative_to_file) {
-  fs::path p(path);
-  if (p.is_relative()) p = fs::absolute(fs::path(relative_to_file).parent_path()) / p;
-  return p.lexically_normal().string();
-}
 
 void ReadScalars(StrictYaml& y, const YAML::Node& root, const std::string& path, Study* s) {
   if (y.Get(root, "study", "study", &s->name, "a name", true) && !IsName(s->name))
     y.Error(root["study"], "study", "a name is letters, digits, '_' and '-'");
   std::string graph;
   if (y.Get(root, "graph", "graph", &graph, "a path", true)) {
-    const std::string g = Resolved(graph, path);
+    const std::string g = tools::PathBeside(path, graph);
     std::error_code ec;
     if (fs::is_regular_file(g, ec)) s->graph = g;
     else y.Error(root["graph"], "graph", "no such file: " + g);
   }
   std::string data = s->name + "-data";
   y.Get(root, "data", "data", &data, "a path");
-  s->data = Resolved(data, path);
+  s->data = tools::PathBeside(path, data);
   if (y.Get(root, "trials", "trials", &s->trials, "an integer") && (s->trials < 1 || s->trials > 99))
     y.Error(root["trials"], "trials", "must be in 1..99");
   if (y.Get(root, "duration", "duration", &s->duration_s, "a number of seconds") && !(s->duration_s >= 0))
@@ -102,10 +97,9 @@ void ReadConditions(StrictYaml& y, const YAML::Node& root, const std::vector<std
   }
 }
 
-// Labels A, B, ... in an order drawn from the study's name (FNV-1a: the same on every machine).
+// Labels A, B, ... in an order drawn from the study's name (the same on every machine).
 void GiveLabels(Study* s) {
-  uint64_t h = 1469598103934665603ull;
-  for (unsigned char ch : s->name) h = (h ^ ch) * 1099511628211ull;
+  uint64_t h = tools::Fnv1a(s->name);
   std::vector<size_t> order(s->conditions.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   for (size_t i = order.size(); i > 1; --i) {

@@ -1,5 +1,7 @@
 #include "yaml_file.hpp"
 
+#include <filesystem>
+
 namespace dyad::tools {
 
 bool LoadYamlFile(const std::string& path, const std::string& what, YAML::Node* root, std::vector<Diagnostic>* problems) {
@@ -21,6 +23,12 @@ std::string SetText(const YAML::Node& node) {
   e.SetMapFormat(YAML::Flow);
   e << node;
   return e.c_str();
+}
+
+std::string PathBeside(const std::string& file, const std::string& path) {
+  std::filesystem::path p(path);
+  if (p.is_relative()) p = std::filesystem::absolute(std::filesystem::path(file).parent_path()) / p;
+  return p.lexically_normal().string();
 }
 
 }  // namespace dyad::tools

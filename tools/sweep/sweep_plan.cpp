@@ -22,16 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-
-// FNV-1a: stable across builds and machines (a run's id names its folder).
-uint64_t Fnv1a(const std::string& s, uint64_t h = 1469598103934665603ull) {
-  for (unsigned char c : s) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 struct SweptValue {
   std::string key, value;
   YAML::Node node;  // where the sweep file wrote the value
@@ -61,11 +51,9 @@ void ReadTrain(StrictYaml& y, const YAML::Node& t, const std::string& path, Swee
   if (!y.Map(t, "train", {"config", "model", "set", "grid"})) return;
   std::string config;
   if (y.Get(t, "config", "train.config", &config, "a path", true)) {
-    fs::path c(config);
-    if (c.is_relative()) c = fs::absolute(fs::path(path).parent_path()) / c;
+    plan->train_config = tools::PathBeside(path, config);
     std::error_code ec;
-    if (!fs::is_regular_file(c, ec)) y.Error(t["config"], "train.config", "no such file: " + c.lexically_normal().string());
-    plan->train_config = c.lexically_normal().string();
+    if (!fs::is_regular_file(plan->train_config, ec)) y.Error(t["config"], "train.config", "no such file: " + plan->train_config);
   }
   y.Get(t, "model", "train.model", &plan->model_key, "a graph key (COMPONENT.PARAM)");
   if (const YAML::Node set = t["set"]; set && y.Map(set, "train.set", {}))
@@ -83,22 +71,19 @@ void ReadBase(StrictYaml& y, const YAML::Node& root, const std::string& path, co
     if (condition_node) y.Error(condition_node, "condition", "a condition is a study's: give study too");
     std::string graph;
     if (!y.Get(root, "graph", "graph", &graph, "a path", true)) return;
-    fs::path g(graph);
-    if (g.is_relative()) g = fs::absolute(fs::path(path).parent_path()) / g;
+    plan->graph = tools::PathBeside(path, graph);
     std::error_code ec;
-    if (!fs::is_regular_file(g, ec)) y.Error(root["graph"], "graph", "no such file: " + g.lexically_normal().string());
-    plan->graph = g.lexically_normal().string();
+    if (!fs::is_regular_file(plan->graph, ec)) y.Error(root["graph"], "graph", "no such file: " + plan->graph);
     return;
   }
   std::string file, condition;
   const bool named = y.Get(study_node, "study", &file, "a path");
   if (!y.Get(root, "condition", "condition", &condition, "a condition of the study", true) || !named) return;
-  fs::path f(file);
-  if (f.is_relative()) f = fs::absolute(fs::path(path).parent_path()) / f;
+  const std::string study_file = tools::PathBeside(path, file);
   std::error_code ec;
-  if (!fs::is_regular_file(f, ec)) return y.Error(study_node, "study", "no such file: " + f.lexically_normal().string());
+  if (!fs::is_regular_file(study_file, ec)) return y.Error(study_node, "study", "no such file: " + study_file);
   const size_t before = problems->size();
-  const study::Study st = study::LoadStudy(f.lexically_normal().string(), plugins, problems);  // its problems at its lines
+  const study::Study st = study::LoadStudy(study_file, plugins, problems);  // its problems at its lines
   if (problems->size() > before) return;
   std::string known;
   for (const auto& c : st.conditions) {
@@ -198,7 +183,7 @@ uint64_t HashFolder(const std::string& dir, uint64_t h) {
   for (fs::recursive_directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
     if (it->is_regular_file(ec)) files.push_back(it->path());
   std::sort(files.begin(), files.end());
-  for (const auto& f : files) h = Fnv1a(ReadText(f.string()), Fnv1a(fs::relative(f, dir, ec).string() + "\n", h));
+  for (const auto& f : files) h = tools::Fnv1a(ReadText(f.string()), tools::Fnv1a(fs::relative(f, dir, ec).string() + "\n", h));
   return h;
 }
 
@@ -236,7 +221,7 @@ void PlanTrainings(StrictYaml& y, const YAML::Node& t, const std::vector<std::st
   if (bad) return;
   std::vector<std::vector<const SweptValue*>> combos = Combinations(grid, {});
   if (combos.empty()) combos.emplace_back();  // no grid: one model
-  const uint64_t config_hash = Fnv1a(ReadText(plan->train_config));
+  const uint64_t config_hash = tools::Fnv1a(ReadText(plan->train_config));
   for (const auto& combo : combos) {
     SweepTraining training;
     training.sets = base;
@@ -247,8 +232,8 @@ void PlanTrainings(StrictYaml& y, const YAML::Node& t, const std::vector<std::st
     std::string dataset;
     CheckTraining(plan->train_config, training.sets, &dataset);
     uint64_t h = HashFolder(dataset, config_hash);
-    for (const auto& s : training.sets) h = Fnv1a(s + "\n", h);
-    training.id = Hex(Fnv1a(DYAD_VERSION, h));
+    for (const auto& s : training.sets) h = tools::Fnv1a(s + "\n", h);
+    training.id = Hex(tools::Fnv1a(DYAD_VERSION, h));
     plan->trainings.push_back(std::move(training));
   }
 }
@@ -343,10 +328,10 @@ SweepPlan LoadSweep(const std::string& path, const std::vector<std::string>& plu
           run.sets.push_back(o->key + "=" + o->value);
         }
         run.sets.push_back("seed=" + std::to_string(seed));
-        uint64_t h = Fnv1a(graph_text);
-        for (const auto& s : run.sets) h = Fnv1a(s + "\n", h);
-        if (t >= 0) h = Fnv1a("model " + plan.trainings[static_cast<size_t>(t)].id + "\n", h);
-        run.id = Hex(Fnv1a(DYAD_VERSION, h));
+        uint64_t h = tools::Fnv1a(graph_text);
+        for (const auto& s : run.sets) h = tools::Fnv1a(s + "\n", h);
+        if (t >= 0) h = tools::Fnv1a("model " + plan.trainings[static_cast<size_t>(t)].id + "\n", h);
+        run.id = Hex(tools::Fnv1a(DYAD_VERSION, h));
         plan.runs.push_back(std::move(run));
       }
   return plan;

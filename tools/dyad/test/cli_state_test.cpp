@@ -26,6 +26,26 @@ TEST(CliState, ASecondInvocationDoesNotInheritTheFirstsOptions) {
   std::filesystem::remove(graph);
 }
 
+// A run that fails before any step says why, and prints no timing table of zeros above it; a
+// run that stepped keeps its table even when it fails.
+TEST(CliRun, ARunThatNeverSteppedPrintsNoTableOfZeros) {
+  const auto graph = std::filesystem::temp_directory_path() / ("dyad_cli_zeros_" + std::to_string(getpid()) + ".yaml");
+  std::ofstream(graph) << "graph: z\nclock: stepped\ncomponents:\n"
+                          "  src: {type: counter_source, rate_hz: 10, outputs: {out: count}}\n"
+                          "  sink: {type: counter_sink, trigger: in, inputs: {in: count}, params: {file: /nonexistent/dir/x.txt}}\n";
+  auto failed = dyad::testing::RunCommand(AddRuntimeCommands, {"run", graph.string(), "--steps", "3"});
+  EXPECT_NE(failed.code, 0);
+  EXPECT_NE(failed.err.find("sink: activate failed"), std::string::npos) << failed.err;
+  EXPECT_EQ(failed.out.find("timing (process"), std::string::npos) << failed.out;
+  std::ofstream(graph) << "graph: z\nclock: stepped\ncomponents:\n"
+                          "  src: {type: counter_source, rate_hz: 10, outputs: {out: count}}\n"
+                          "  sink: {type: counter_sink, trigger: in, inputs: {in: count}}\n";
+  auto ran = dyad::testing::RunCommand(AddRuntimeCommands, {"run", graph.string(), "--steps", "3"});
+  EXPECT_EQ(ran.code, 0) << ran.err;
+  EXPECT_NE(ran.out.find("timing (process main)"), std::string::npos) << ran.out;
+  std::filesystem::remove(graph);
+}
+
 TEST(CliState, IntrospectionOptionsArePerInvocation) {
   // --domain 231 (nothing there) first; the second invocation's default wait must not be 0.3 s.
   auto first = dyad::testing::RunCommand(AddIntrospectionCommands, {"topics", "--domain", "231", "--wait", "0.3"});
