@@ -411,12 +411,7 @@ StatusOr<const StructDef*> Prepare(const Schema& schema, const std::string& root
                                    size_t size, bool* swap) {
   const SchemaImpl& impl = *ImplOf(schema);
   const StructDef* def = impl.FindStruct(root_type);
-  if (!def) {
-    std::string known;
-    for (const StructDef& s : impl.structs) known += (known.empty() ? "" : ", ") + s.name;
-    return Status::NotFound("unknown type '" + root_type + "' (" +
-                            (known.empty() ? "the schema defines no structs" : "the schema defines: " + known) + ")");
-  }
+  if (!def) return impl.UnknownStruct(root_type);
   if (size < kEncapsulationSize || data == nullptr) {
     return Status::DataLoss("sample of " + std::to_string(size) + " bytes is shorter than the 4-byte encapsulation header");
   }

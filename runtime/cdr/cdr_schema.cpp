@@ -44,6 +44,13 @@ const StructDef* SchemaImpl::FindStruct(const std::string& name) const {
   return it == struct_index.end() ? nullptr : &structs[it->second];
 }
 
+Status SchemaImpl::UnknownStruct(const std::string& name) const {
+  std::string known;
+  for (const StructDef& s : structs) known += (known.empty() ? "" : ", ") + s.name;
+  return Status::NotFound("unknown type '" + name + "' (" +
+                          (known.empty() ? "the schema defines no structs" : "the schema defines: " + known) + ")");
+}
+
 namespace {
 
 // Thrown inside the parser only; Parse turns it into "line N: message".

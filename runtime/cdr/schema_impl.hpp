@@ -92,6 +92,9 @@ struct SchemaImpl {
 
   // The struct named `name` ("a::B", "::a::B" or "a::B#hash"), or null.
   const StructDef* FindStruct(const std::string& name) const;
+  // NotFound for a `name` FindStruct does not know, listing the structs there are (the error of
+  // Decode and EncodeYaml alike).
+  Status UnknownStruct(const std::string& name) const;
 };
 
 }  // namespace dyad::cdr::internal

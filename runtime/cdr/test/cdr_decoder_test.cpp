@@ -5,12 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <optional>
 #include <random>
@@ -21,13 +19,14 @@
 #if DYAD_CDR_WITH_FASTCDR
 #include <fastcdr/Cdr.h>
 #include <fastcdr/FastBuffer.h>
-#include <fastdds/rtps/common/SerializedPayload.h>
 
 #include <dyad/msg/types.hpp>
 
 #include "cdr_test_types.h"
 #include "cdr_test_typesPubSubTypes.h"
 #endif
+
+#include "cdr_test_support.hpp"
 
 namespace dyad::cdr {
 namespace {
@@ -82,17 +81,6 @@ void ExpectFields(const std::vector<Field>& got, const std::vector<Want>& want) 
       EXPECT_EQ(std::memcmp(&w, &g, sizeof w), 0) << got[i].value << " vs " << w;
     }
   }
-}
-
-::testing::AssertionResult IsOk(const dyad::Status& s) {
-  if (s.ok()) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << s.ToString();
-}
-
-Schema ParseOk(const std::string& idl) {
-  dyad::StatusOr<Schema> s = Schema::Parse(idl);
-  EXPECT_TRUE(IsOk(s.status()));
-  return s.ok() ? *s : Schema();
 }
 
 std::string ParseError(const std::string& idl) { return Schema::Parse(idl).status().message(); }
@@ -169,61 +157,7 @@ void ExpectRowMatchesFields(const Schema& schema, const std::string& type,
 // ---------------------------------------------------------------------------------------------
 // Hand-built samples
 
-// Appends values to a CDR body with natural alignment, in either byte order.
-class Writer {
- public:
-  explicit Writer(bool little) : little_(little) {
-    bytes_ = {0x00, static_cast<uint8_t>(little ? 0x01 : 0x00), 0x00, 0x00};
-  }
-  template <class T>
-  Writer& Put(T v) {
-    while ((bytes_.size() - 4) % sizeof(T) != 0) bytes_.push_back(0);
-    uint8_t raw[sizeof(T)];
-    std::memcpy(raw, &v, sizeof(T));
-    const bool host_little = std::endian::native == std::endian::little;
-    for (size_t i = 0; i < sizeof(T); ++i) {
-      bytes_.push_back(raw[little_ == host_little ? i : sizeof(T) - 1 - i]);
-    }
-    return *this;
-  }
-  Writer& Str(const std::string& s) {
-    Put(static_cast<uint32_t>(s.size() + 1));
-    bytes_.insert(bytes_.end(), s.begin(), s.end());
-    bytes_.push_back(0);
-    return *this;
-  }
-  std::vector<uint8_t> bytes() const { return bytes_; }
-
- private:
-  bool little_;
-  std::vector<uint8_t> bytes_;
-};
-
-const char* kSmallIdl = R"(
-// A small schema for hand-built samples.
-module m {
-  enum Mode { OFF, ON };
-  struct P { float x; double y; };
-  struct S {
-    string name;
-    double v;
-    boolean flag;
-    Mode mode;
-    sequence<P> ps;
-    short grid[2][2];
-    uint64 big;
-  };
-};
-)";
-
-std::vector<uint8_t> SmallSample(bool little) {
-  Writer w(little);
-  w.Str("abc").Put(2.5).Put(uint8_t{1}).Put(uint32_t{1});
-  w.Put(uint32_t{2}).Put(1.5f).Put(-0.25).Put(0.0f).Put(1e300);
-  w.Put(int16_t{1}).Put(int16_t{-2}).Put(int16_t{3}).Put(int16_t{-4});
-  w.Put(std::numeric_limits<uint64_t>::max());
-  return w.bytes();
-}
+// Writer, kSmallIdl and SmallSample() are in cdr_test_support.hpp.
 
 std::vector<Want> SmallWant() {
   return {S("name", "abc"), D("v", 2.5), B("flag", true), S("mode", "ON"), Seq("ps", 2),
@@ -515,22 +449,16 @@ TEST(CdrSchema, SurvivesRandomlyMangledText) {
   }
 }
 
-struct BadIdl {
-  const char* idl;
-  const char* error;
-};
-// Names each case by its expected error in the test output and in CTest (stable across runs,
-// unlike gtest's default byte dump of the two pointers).
-void PrintTo(const BadIdl& bad, std::ostream* os) { *os << bad.error; }
+using BadIdl = BadText;  // an IDL text and its error
 
 class CdrSchemaError : public testing::TestWithParam<BadIdl> {};
 
 TEST_P(CdrSchemaError, NamesTheLine) {
-  EXPECT_EQ(ParseError(GetParam().idl), GetParam().error);
+  EXPECT_EQ(ParseError(GetParam().text), GetParam().error);
   // Valid IDL this reader does not support is Unimplemented; anything else InvalidArgument.
   const bool unsupported = std::string(GetParam().error).find("not supported") != std::string::npos ||
                            std::string(GetParam().error).find("too large to decode") != std::string::npos;
-  EXPECT_EQ(Schema::Parse(GetParam().idl).status().code(),
+  EXPECT_EQ(Schema::Parse(GetParam().text).status().code(),
             unsupported ? dyad::Status::Code::kUnimplemented : dyad::Status::Code::kInvalidArgument);
 }
 
@@ -568,15 +496,6 @@ INSTANTIATE_TEST_SUITE_P(
 
 #if DYAD_CDR_WITH_FASTCDR
 
-// The bytes Fast DDS puts on the wire: the type support's serialize() (little endian here).
-template <class PubSub, class T>
-std::vector<uint8_t> SerializeLikeFastDds(T msg) {
-  PubSub type;
-  eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(&msg)());
-  EXPECT_TRUE(type.serialize(&msg, &payload));
-  return std::vector<uint8_t>(payload.data, payload.data + payload.length);
-}
-
 // The same serialization (fastcdr, DDS_CDR, encapsulation first) in big-endian byte order.
 template <class T>
 std::vector<uint8_t> SerializeBigEndian(const T& msg) {
@@ -594,7 +513,7 @@ void CheckRoundTrip(const T& msg, const std::string& idl, const std::string& typ
                     const std::vector<Want>& want) {
   Schema schema = ParseOk(idl);
   ASSERT_TRUE(schema.HasType(type));
-  const auto little = SerializeLikeFastDds<typename MessageTraits<T>::PubSubType>(msg);
+  const auto little = FastCdrBytes(msg);
   const auto big = SerializeBigEndian(msg);
   ASSERT_EQ(little[1], 0x01);
   ASSERT_EQ(big[1], 0x00);
@@ -617,14 +536,6 @@ void CheckDyadMessage(const T& msg, const std::vector<Want>& want) {
   CheckRoundTrip(msg, MessageTraits<T>::kIdl, MessageTraits<T>::kName, want);
 }
 
-msg::Header MakeHeader(const std::string& source, uint64_t seq, int64_t stamp) {
-  msg::Header h;
-  h.source(source);
-  h.sequence_number(seq);
-  h.stamp_ns(stamp);
-  return h;
-}
-
 std::vector<Want> HeaderWant(const std::string& source, uint64_t seq, int64_t stamp) {
   return {S("header.source", source), N("header.sequence_number", seq), N("header.stamp_ns", stamp)};
 }
@@ -636,9 +547,7 @@ std::vector<Want> Cat(std::vector<Want> a, const V&... rest) {
 }
 
 TEST(CdrRoundTrip, EveryDyadMessageTypeParses) {
-  const auto types = msg::AllTypes();
-  EXPECT_GE(types.size(), 9u);
-  for (const TypeInfo* info : types) {
+  for (const TypeInfo* info : DyadTypes(9u)) {
     SCOPED_TRACE(info->name);
     Schema schema = ParseOk(info->idl);
     EXPECT_TRUE(schema.HasType(info->name));
@@ -653,12 +562,8 @@ TEST(CdrRoundTrip, Header) {
 }
 
 TEST(CdrRoundTrip, HumanInput) {
-  msg::HumanInput m;
-  m.header(MakeHeader("ab", 1, -5));  // 7-byte string: one byte of padding before the u64
-  m.x(-12.5);
-  m.y(0.1);
-  m.engaged(true);
-  CheckDyadMessage(m, Cat(HeaderWant("ab", 1, -5), std::vector<Want>{D("x", -12.5), D("y", 0.1), B("engaged", true)}));
+  CheckDyadMessage(HumanInputSample(),
+                   Cat(HeaderWant("ab", 1, -5), std::vector<Want>{D("x", -12.5), D("y", 0.1), B("engaged", true)}));
 }
 
 TEST(CdrRoundTrip, Intention) {
@@ -729,23 +634,13 @@ TEST(CdrRoundTrip, CartesianState) {
 }
 
 TEST(CdrRoundTrip, ComponentStats) {
-  msg::ComponentStats m;
-  m.header(MakeHeader("runtime", 4, 5));
-  m.component_name("mind");        // 5 bytes with NUL, then another string
-  m.process_name("dyad-run");      // 9 bytes with NUL, then a u64
-  m.steps(123456789012345ull);
-  m.step_mean_s(0.001);
-  m.step_p99_s(0.002);
-  m.step_max_s(0.01);
-  m.jitter_mean_s(1e-6);
-  m.jitter_max_s(2e-5);
-  m.deadline_misses(3);
-  CheckDyadMessage(m, Cat(HeaderWant("runtime", 4, 5),
-                          std::vector<Want>{S("component_name", "mind"), S("process_name", "dyad-run"),
-                                            N("steps", 123456789012345ull), D("step_mean_s", 0.001),
-                                            D("step_p99_s", 0.002), D("step_max_s", 0.01),
-                                            D("jitter_mean_s", 1e-6), D("jitter_max_s", 2e-5),
-                                            N("deadline_misses", 3)}));
+  CheckDyadMessage(ComponentStatsSample(),
+                   Cat(HeaderWant("runtime", 4, 5),
+                       std::vector<Want>{S("component_name", "mind"), S("process_name", "dyad-run"),
+                                         N("steps", 123456789012345ull), D("step_mean_s", 0.001),
+                                         D("step_p99_s", 0.002), D("step_max_s", 0.01),
+                                         D("jitter_mean_s", 1e-6), D("jitter_max_s", 2e-5),
+                                         N("deadline_misses", 3)}));
 }
 
 TEST(CdrRoundTrip, Counter) {
@@ -756,14 +651,10 @@ TEST(CdrRoundTrip, Counter) {
 }
 
 TEST(CdrRoundTrip, PingPongWithPayload) {
-  msg::PingPong m;
-  m.header(MakeHeader("ping", 2, 3));
-  m.id(99);
-  m.t0_ns(-1);
-  m.payload({0, 255, 7});
-  CheckDyadMessage(m, Cat(HeaderWant("ping", 2, 3),
-                          std::vector<Want>{N("id", 99), N("t0_ns", -1), Seq("payload", 3),
-                                            N("payload[0]", 0), N("payload[1]", 255), N("payload[2]", 7)}));
+  CheckDyadMessage(PingPongSample(),
+                   Cat(HeaderWant("ping", 2, 3),
+                       std::vector<Want>{N("id", 99), N("t0_ns", -1), Seq("payload", 3),
+                                         N("payload[0]", 0), N("payload[1]", 255), N("payload[2]", 7)}));
 }
 
 TEST(CdrRoundTrip, PingPongWithEmptyPayload) {
@@ -773,13 +664,6 @@ TEST(CdrRoundTrip, PingPongWithEmptyPayload) {
   m.t0_ns(2);
   CheckDyadMessage(m, Cat(HeaderWant("pong", 2, 3),
                           std::vector<Want>{N("id", 1), N("t0_ns", 2), Seq("payload", 0)}));
-}
-
-std::string ReadFile(const char* path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 }  // namespace
@@ -795,57 +679,9 @@ struct dyad::MessageTraits<dyad_cdr_test::Everything> {
 namespace dyad::cdr {
 namespace {
 
-dyad_cdr_test::inner::Point Point(char tag, float x, double y) {
-  dyad_cdr_test::inner::Point p;
-  p.tag(tag);
-  p.x(x);
-  p.y(y);
-  return p;
-}
-
 TEST(CdrRoundTrip, EverythingTheSubsetSupports) {
-  using namespace dyad_cdr_test;
-  Everything m;
-  m.b1(true);
-  m.d1(-1.25);
-  m.o(200);
-  m.c('Q');
-  m.s(-300);
-  m.us(65535);
-  m.l(-2000000000);
-  m.ul(4000000000u);
-  m.ll(std::numeric_limits<int64_t>::min());
-  m.ull(std::numeric_limits<uint64_t>::max());
-  m.f(0.1f);
-  m.i8(-128);
-  m.u8(255);
-  m.i16(-32768);
-  m.u16(1);
-  m.i32(std::numeric_limits<int32_t>::min());
-  m.u32(7);
-  m.i64(-1);
-  m.u64(1ull << 63);
-  m.odd("xyz");
-  m.d2(6.02214076e23);
-  m.bounded("12345678");
-  m.color(BLUE);
-  m.point(Point('p', 1.5f, -2.5));
-  m.points({Point('a', 1, 2), Point('b', 3, 4)});
-  m.bounded_points({Point('c', 5, 6)});
-  m.names({"", "one", "three"});
-  m.nested({{1, 2, 3}, {}, {-4}});
-  m.flags({true, false, true});
-  m.color_seq({GREEN, RED});
-  m.b2(false);
-  m.after_empty(123);
-  m.matrix({{{1, 2, 3}, {4, 5, 6}}});
-  m.corners({Point('x', -1, -2), Point('\0', 0, 0)});
-  m.colors({RED, GREEN});
-  m.v({0.5, 1.5, 2.5});
-  m.ls({-1, 0, 1});
-  m.tail(9);
   CheckRoundTrip(
-      m, ReadFile(DYAD_CDR_TEST_IDL), "dyad_cdr_test::Everything",
+      EverythingSample(), ReadFile(DYAD_CDR_TEST_IDL), "dyad_cdr_test::Everything",
       {B("b1", true), D("d1", -1.25), N("o", 200), S("c", "Q"), N("s", -300), N("us", 65535),
        N("l", -2000000000), N("ul", 4000000000u), N("ll", std::numeric_limits<int64_t>::min()),
        N("ull", std::numeric_limits<uint64_t>::max()), F("f", 0.1f), N("i8", -128), N("u8", 255),
@@ -878,7 +714,7 @@ TEST(CdrRoundTrip, EverythingWithEmptySequencesAndStrings) {
   m.u8(1);
   const std::string idl = ReadFile(DYAD_CDR_TEST_IDL);
   Schema schema = ParseOk(idl);
-  const auto little = SerializeLikeFastDds<EverythingPubSubType>(m);
+  const auto little = FastCdrBytes(m);
   const auto big = SerializeBigEndian(m);
   std::vector<Field> a = DecodeOk(schema, "dyad_cdr_test::Everything", little);
   std::vector<Field> b = DecodeOk(schema, "dyad_cdr_test::Everything", big);

@@ -1,6 +1,7 @@
 // dyad/cdr_decoder.hpp — turns serialized DDS samples into named field values, driven by the IDL
 // text of their type: no compiled (fastddsgen) types needed. `dyad echo` prints samples with it;
-// `dyad bag export --csv` turns recorded samples into CSV columns with it.
+// `dyad bag export --csv` turns recorded samples into CSV columns with it. The reverse, samples
+// from YAML values, is dyad/cdr_encoder.hpp.
 //
 // INPUT
 //   A sample exactly as Fast DDS 2.9 puts it on the wire and an MCAP recording stores it: the
