@@ -4,6 +4,8 @@
 
 #include <signal.h>
 
+#include <cstring>
+
 namespace {
 
 using namespace dyad::testing;
@@ -56,6 +58,18 @@ TEST_F(ProcessTest, IntrospectionSeesARunningGraph) {
   ASSERT_EQ(std::sscanf(hz.out().c_str(), "rate %lf Hz", &rate), 1) << hz.out();
   EXPECT_NEAR(rate, 50.0, 5.0) << hz.out();
 
+  // The running graph as discovered (`dyad graph --live`): its process with its components, the
+  // topic between them with its type and measured rate.
+  Child live(Dyad({"graph", "--live", g.string(), "--wait", "20", "--listen", "2"}), dir_, "live");
+  ASSERT_EQ(live.Wait(60), 0) << live.err();
+  EXPECT_NE(live.out().find("label=\"process main\\nsrc (counter_source)\\nsink (counter_sink)\""), std::string::npos) << live.out();
+  const size_t at = live.out().find("label=\"count\\nCounter\\n");
+  ASSERT_NE(at, std::string::npos) << live.out();
+  double live_rate = 0;
+  EXPECT_EQ(std::sscanf(live.out().c_str() + at + std::strlen("label=\"count\\nCounter\\n"), "%lf Hz", &live_rate), 1) << live.out();
+  EXPECT_NEAR(live_rate, 50.0, 5.0) << live.out();
+  EXPECT_NE(live.out().find("\"p:dyad/intro/main\" -> \"t:count\""), std::string::npos) << live.out();
+
   // Domain 231 is outside the tests' 1..200: nothing there, and `topics` says so.
   Child empty(Dyad({"topics", "--domain", "231", "--wait", "0.3"}), dir_, "empty");
   EXPECT_EQ(empty.Wait(30), 1);
@@ -68,6 +82,52 @@ TEST_F(ProcessTest, IntrospectionSeesARunningGraph) {
   run.Signal(SIGINT);
   EXPECT_EQ(run.Wait(15), 130) << run.err();
   EXPECT_NE(run.err().find("dyad run: interrupted (SIGINT)"), std::string::npos) << run.err();
+}
+
+// `dyad pub` publishes into a running graph as a guest: its fields as YAML, its type the graph's
+// (or named), a dyad header filled in; the graph's input and `dyad echo` get the samples. A bad
+// field is named at its column and nothing is published.
+TEST_F(ProcessTest, PubReachesTheGraphAndEcho) {
+  const std::string domain = std::to_string(domain_);
+  const fs::path heard = dir_ / "heard.txt";
+  const fs::path g = Write("g.yaml", "graph: pub\ndomain_id: " + domain +
+                                         "\ntopics:\n  count: {type: Counter}\n"
+                                         "components:\n"
+                                         "  sink: {type: counter_sink, trigger: in, params: {file: " + heard.string() +
+                                         ", expect: 5}, inputs: {in: count}}\n");
+  Child run(Dyad({"run", g.string(), "--duration", "30", "--quiet"}), dir_, "run");
+  Child echo(Dyad({"echo", "count", "--domain", domain, "-n", "3", "--wait", "20"}), dir_, "echo");
+  Child bad(Dyad({"pub", "count", "{value: 1, stamp: 2}", "--graph", g.string()}), dir_, "bad");
+  EXPECT_EQ(bad.Wait(30), 2);
+  EXPECT_NE(bad.err().find("dyad pub: the fields: line 1, column 12: stamp: unknown member of dyad::msg::Counter (members: header, value)"),
+            std::string::npos)
+      << bad.err();
+  // Three at 20 Hz with the graph's type, then two more with the type named and a header given.
+  Child pub(Dyad({"pub", "count", "{value: 42}", "--graph", g.string(), "--rate", "20", "--count", "3", "--wait", "20"}), dir_, "pub");
+  ASSERT_EQ(pub.Wait(60), 0) << pub.err();
+  EXPECT_NE(pub.out().find("dyad pub: 3 samples of dyad::msg::Counter on count"), std::string::npos) << pub.out();
+  Child named(Dyad({"pub", "count", "{header: {source: me, sequence_number: 9}, value: -7}", "--domain", domain, "--type", "Counter",
+                    "--count", "2", "--wait", "20"}),
+              dir_, "named");
+  ASSERT_EQ(named.Wait(60), 0) << named.err();
+  ASSERT_EQ(run.Wait(60), 0) << run.err();  // the sink ends the run at its fifth sample
+  ASSERT_EQ(echo.Wait(30), 0) << echo.err();
+  EXPECT_NE(echo.out().find("{\"header\":{\"source\":\"dyad/pub\",\"sequence_number\":1,"), std::string::npos) << echo.out();
+  EXPECT_NE(echo.out().find("\"value\":42}"), std::string::npos) << echo.out();
+
+  const std::vector<Received> got = ReadSink(heard);
+  ASSERT_EQ(got.size(), 5u) << ReadFile(heard);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(got[i].value, 42);
+    EXPECT_EQ(got[i].source, "dyad/pub");
+    EXPECT_EQ(got[i].sequence, i + 1);
+    EXPECT_GT(got[i].stamp_ns, 0);
+  }
+  for (size_t i = 3; i < 5; ++i) {
+    EXPECT_EQ(got[i].value, -7);
+    EXPECT_EQ(got[i].source, "me");
+    EXPECT_EQ(got[i].sequence, 9u);
+  }
 }
 
 // `dyad status` on a split graph whose second process's clock is 25 ms ahead (the test-only

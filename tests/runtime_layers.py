@@ -21,7 +21,7 @@ PUBLIC = {
     "on_demand_subscription.hpp": "graph",
     "decode_sample.hpp": "dds",
     "interrupt.hpp": "exec", "private_file.hpp": "exec",
-    "run.hpp": "hosts", "introspect.hpp": "hosts", "discovery_server.hpp": "hosts",
+    "run.hpp": "hosts", "introspect.hpp": "hosts", "guest.hpp": "hosts", "discovery_server.hpp": "hosts",
 }
 FASTDDS_ALLOWED = {"hosts/discovery_server.cpp"}
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]([^>"]+)[>"]')

@@ -10,8 +10,8 @@ namespace dyad::mixer {
 void ComplianceMixer::Describe(ComponentSpec& spec) {
   spec.Summary("Blends human and robot positions into the driver's command (g*human + (1-g)*robot while engaged), "
                "saturates its change per step and per second, holds it when inputs go stale.");
-  spec.Param("gain", 0.9).Range(0, 1).Doc("weight of the human while engaged (the study: 0.9)");
-  spec.Param("max_step", 5.0).Min(0).Unit("workspace units").Doc(
+  spec.Param("gain", 0.9).Range(0, 1).Live().Doc("weight of the human while engaged (the study: 0.9)");
+  spec.Param("max_step", 5.0).Min(0).Live().Unit("workspace units").Doc(
       "max change of the command per step, vector norm (the study: 5; 0: no limit)");
   spec.Param("max_speed", 50.0).Min(0).Unit("workspace units/s").Doc(
       "max speed of the command, vector norm, on the runtime clock's time between commands: a burst of "
@@ -77,6 +77,8 @@ Status ComplianceMixer::Step(const StepInfo& info) {
   }
   if (const msg::CartesianState* s = state_->latest()) in.state = {{s->x(), s->y()}, received_at(state_)};
 
+  const Params& p = ctx_->params();  // live: a change takes effect at this step
+  core_->SetGainAndMaxStep(p.Double("gain"), p.Double("max_step"));
   const MixerCore::Result r = core_->Update(in, info.now_ns);
   if (first_step_ns_ < 0) first_step_ns_ = info.now_ns;
   const int64_t timeout = core_->options().stale_timeout_ns;

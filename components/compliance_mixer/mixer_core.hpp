@@ -92,6 +92,12 @@ class MixerCore {
   Result Update(const Inputs& in, int64_t now_ns);
 
   const MixerOptions& options() const { return options_; }
+  // Live changes between updates (the component's live params). REQUIRES: gain in [0, 1],
+  // max_step >= 0 (their declarations say so; the runtime validated them).
+  void SetGainAndMaxStep(double gain, double max_step) {
+    options_.gain = gain;
+    options_.max_step = max_step;
+  }
   Vec2 integral() const { return integral_; }
 
  private:

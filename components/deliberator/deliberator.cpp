@@ -59,12 +59,12 @@ void Deliberator::Describe(ComponentSpec& spec) {
       .Doc("vcbot: W 5, 15 it, Adam lr 0.3 b1 0.1 b2 0.95, w 1e-5; reference: W 15, 15 it, Adam lr 0.1; "
            "the params below override it");
   spec.Param("window", int64_t{0}).Range(0, 1000).Unit("steps").Doc("sliding window W (0: the preset's)");
-  spec.Param("iterations", int64_t{0}).Range(0, 100000).Doc("optimiser iterations per step (0: the preset's)");
+  spec.Param("iterations", int64_t{0}).Range(0, 100000).Live().Doc("optimiser iterations per step (0: the preset's)");
   spec.Param("optimizer", "adam").OneOf({"adam", "ceres"}).Doc("adam or ceres (LBFGS, Wolfe line search)");
   spec.YamlParam("adam", "{}").Doc("Adam settings overriding the preset: lr, beta1, beta2, epsilon");
   spec.YamlParam("ceres", "{}").Doc("Ceres settings: lbfgs_rank, function_tolerance, gradient_tolerance, "
                                      "parameter_tolerance, max_line_search_iterations");
-  spec.Param("meta_prior", std::vector<double>{}).Min(0).Doc("online meta-prior w per layer, bottom first ([]: the preset's)");
+  spec.Param("meta_prior", std::vector<double>{}).Min(0).Live().Doc("online meta-prior w per layer, bottom first ([]: the preset's)");
   spec.Param("a_init", "prior").OneOf({"zero", "copy", "prior"}).Doc("A of the newest window step");
   spec.Param("noise", "off").OneOf({"off", "fixed", "resample"}).Doc("eps of the window: off (means), fixed per step, resampled each step");
   spec.Param("a_steps", int64_t{3}).Range(0, 1000).Unit("steps").Doc("first steps on the start primitive's trained A");
@@ -85,6 +85,18 @@ Status Deliberator::Configure(Context& ctx) {
     return Status::InvalidArgument("params.model: " + path + " has " + std::to_string(model->spec.num_dofs()) +
                                    " DOFs; the deliberator needs 2 (x, y)");
   ErrorRegressionOptions o = ErrorRegressionOptions::Preset(p.String("preset")).value();
+  preset_iterations_ = o.iterations;
+  preset_meta_prior_ = o.meta_prior;
+  live_iterations_ = p.Int("iterations");
+  live_meta_prior_ = p.DoubleList("meta_prior");
+  const size_t layers = static_cast<size_t>(model->spec.num_layers());
+  ctx.CheckLiveParam("meta_prior", [layers](const ParamValue& v) {
+    const auto& w = std::get<std::vector<double>>(v);
+    if (!w.empty() && w.size() != layers)
+      return Status::InvalidArgument("needs " + std::to_string(layers) + " values (one per layer of the model, bottom first), got " +
+                                     std::to_string(w.size()));
+    return Status::OK();
+  });
   if (p.Int("window") > 0) o.window = static_cast<int>(p.Int("window"));
   if (p.Int("iterations") > 0) o.iterations = static_cast<int>(p.Int("iterations"));
   o.optimizer = pvrnn::ParseOptimizerKind(p.String("optimizer")).value();
@@ -141,7 +153,19 @@ Status Deliberator::Configure(Context& ctx) {
   return Status::OK();
 }
 
+// The live params (iterations, meta_prior) as they are now: the regression retuned when changed.
+Status Deliberator::FollowLiveParams() {
+  const Params& p = ctx_->params();
+  if (p.Int("iterations") == live_iterations_ && p.DoubleList("meta_prior") == live_meta_prior_) return Status::OK();
+  live_iterations_ = p.Int("iterations");
+  live_meta_prior_ = p.DoubleList("meta_prior");
+  Status s = er_->Retune(live_iterations_ > 0 ? static_cast<int>(live_iterations_) : preset_iterations_,
+                         live_meta_prior_.empty() ? preset_meta_prior_ : live_meta_prior_);
+  return s.ok() ? s : Status::InvalidArgument("live params: " + s.message());  // checked before applied: not expected
+}
+
 Status Deliberator::Step(const StepInfo&) {
+  if (Status s = FollowLiveParams(); !s.ok()) return s;
   // Under the stepped clock the step takes no simulated time however long it runs: a wall-time
   // cap would only make the result depend on the machine's load, so the iteration cap alone
   // applies and a stepped run stays deterministic.

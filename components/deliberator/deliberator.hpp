@@ -68,6 +68,11 @@ class Deliberator final : public Component {
   bool stepped_ = false;  // stepped clock: no wall-time cap (see Step)
   uint64_t deadline_misses_ = 0, without_executed_ = 0, steps_ = 0;
   msg::Intention out_;
+  // Live params (iterations, meta_prior) as last applied, and the preset's for their "0" / "[]".
+  Status FollowLiveParams();
+  int64_t live_iterations_ = 0;
+  std::vector<double> live_meta_prior_, preset_meta_prior_;
+  int preset_iterations_ = 15;
 };
 
 }  // namespace dyad::deliberator

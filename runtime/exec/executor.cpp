@@ -95,6 +95,9 @@ struct Executor::Instance {
   std::atomic<bool> busy{false};
   std::atomic<bool> pending{false};
   uint64_t index = 0;
+  size_t slot = 0;  // in instances_ (and LiveParams' targets)
+  Params params;    // the component's ctx.params(): live ones change at step boundaries
+  LiveParams::Target live;
   bool configured = false;
   bool activated = false;
   std::thread thread;
@@ -106,7 +109,10 @@ class Executor::ContextImpl final : public Context, public detail::ContextExtens
   ContextImpl(Executor* ex, Instance* inst)
       : ex_(ex), inst_(inst), logger_(inst->name()), seed_(ComponentSeed(ex->graph_.seed, inst->name())) {}
   const std::string& name() const override { return inst_->name(); }
-  const Params& params() const override { return inst_->rc->params; }
+  const Params& params() const override { return inst_->params; }
+  void CheckLiveParam(const std::string& name, LiveParamCheck check) override {
+    if (inst_->configuring) inst_->live.checks[name] = std::move(check);
+  }
   const Clock& clock() const override { return *ex_->clock_; }
   Logger& log() override { return logger_; }
   uint64_t seed() const override { return seed_; }
@@ -256,6 +262,8 @@ Status Executor::Setup() {
     if (graph_.ProcessOf(*rc.config) != options_.process) continue;
     auto inst = std::make_unique<Instance>();
     inst->rc = &rc;
+    inst->slot = instances_.size();
+    inst->params = rc.params;
     if (Status s = BindPorts(*inst); !s.ok()) return s;
     inst->ctx = std::make_unique<ContextImpl>(this, inst.get());
     inst->component = rc.entry->type.create();
@@ -263,11 +271,23 @@ Status Executor::Setup() {
   }
   if (instances_.empty()) return Status::InvalidArgument("no component is placed in process '" + options_.process + "'");
 
+  if (!options_.guest) {
+    std::vector<LiveParams::Target*> targets;
+    for (auto& inst : instances_) {
+      inst->live = {inst->name(), &inst->rc->entry->spec, &inst->params, &inst->index, &inst->ctx->log(), {}};
+      targets.push_back(&inst->live);
+    }
+    live_params_ = std::make_unique<LiveParams>();
+    if (Status s = live_params_->Open(transport_.get(), graph_.name, options_.process, clock_.get(), std::move(targets)); !s.ok())
+      return s;
+  }
   // The runtime's own output: timing of this process's components.
-  auto w = CreateRuntimeWriter(transport_.get(), runtime_topics::kStats);
-  if (!w.ok()) return w.status();
-  stats_output_ = std::make_unique<Output<msg::ComponentStats>>();
-  stats_output_->Bind("stats", runtime_topics::kStats.name, "dyad/" + options_.process, w.value(), clock_.get());
+  if (!options_.guest) {
+    auto w = CreateRuntimeWriter(transport_.get(), runtime_topics::kStats);
+    if (!w.ok()) return w.status();
+    stats_output_ = std::make_unique<Output<msg::ComponentStats>>();
+    stats_output_->Bind("stats", runtime_topics::kStats.name, "dyad/" + options_.process, w.value(), clock_.get());
+  }
 
   if (options_.session) session_ = options_.session();
   if (session_)
@@ -355,6 +375,7 @@ Status Executor::BindPorts(Instance& inst) {
 Status Executor::StepOnce(Instance& inst, int64_t scheduled_steady_ns, bool periodic) {
   NestedTimer timer;
   const int64_t t0 = timer.start_ns();
+  if (live_params_) live_params_->BeforeStep(inst.slot);
   const int64_t now = clock_->now_ns();
   for (auto& in : inst.inputs) in->Poll(now);
   Status s = inst.component->Step(StepInfo{now, inst.index++, inst.rc->period_ns});

@@ -55,6 +55,7 @@
 #include <dyad/validate.hpp>
 
 #include "dds/transport.hpp"
+#include "exec/live_params.hpp"
 #include "exec/process_session.hpp"
 #include "exec/step_stats.hpp"
 
@@ -68,6 +69,9 @@ class Executor {
     double duration_s = 0;  // > 0: stop after this long (wall time, or simulated time when stepped)
     uint64_t steps = 0;     // > 0: stop after the fastest periodic component ran this many steps
     double stats_period_s = 1.0;
+    // A guest (dyad/guest.hpp) is none of the graph's processes: no writer on dyad/stats (`dyad
+    // status` must not list its components as the graph's), no answers to live parameter requests.
+    bool guest = false;
     // Makes the transport (participant name, stepped). Empty: a Fast DDS participant on the
     // graph's domain (hermetic to this process when stepped). Tests pass an in-memory one.
     std::function<StatusOr<std::unique_ptr<Transport>>(const std::string& name, bool stepped)> transport;
@@ -125,6 +129,7 @@ class Executor {
   std::unique_ptr<ClockImpl> clock_;
   std::vector<std::unique_ptr<Instance>> instances_;
   std::unique_ptr<OutputBase> stats_output_;
+  std::unique_ptr<LiveParams> live_params_;  // null in a guest
   // Graphs of several processes, wall clock: all start together. Closed before the transport goes.
   std::unique_ptr<ProcessSession> session_;
   int64_t start_steady_ns_ = 0;  // when periodic components take their first step

@@ -45,8 +45,8 @@ std::vector<TopicInfo> GraphTopics(const Graph& graph, const ResolvedGraph& reso
     t.writers_local = !t.writers.empty() && all_here;
     topics.push_back(std::move(t));
   }
-  // The runtime's own topics a recorder keeps: every process's timing, and in a graph of several
-  // wall-clock processes their announcements and clock offsets.
+  // The runtime's own topics a recorder keeps: every process's timing and live parameter changes,
+  // and in a graph of several wall-clock processes their announcements and clock offsets.
   auto add_runtime_topic = [&](const RuntimeTopic& rt, bool writers_local) {
     if (resolved.topics.count(rt.name)) return;
     TopicInfo t;
@@ -60,6 +60,7 @@ std::vector<TopicInfo> GraphTopics(const Graph& graph, const ResolvedGraph& reso
   };
   const bool one_process = graph.ProcessNames().size() == 1;
   add_runtime_topic(runtime_topics::kStats, one_process);  // every process's runtime writes it
+  add_runtime_topic(runtime_topics::kParams, one_process);  // live parameter changes, as answered
   if (!one_process && graph.clock == ClockMode::kWall) {
     add_runtime_topic(runtime_topics::kProcesses, false);
     add_runtime_topic(runtime_topics::kClockOffsets, false);

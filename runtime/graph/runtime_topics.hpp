@@ -10,6 +10,9 @@
 //   dyad/clock_offsets  each process's measured offsets to the others (TRANSIENT_LOCAL)
 //   dyad/stats          every component's timing, once per stats period (TRANSIENT_LOCAL)
 //   dyad/health         what a process did about endpoints discovery lost (hosts/endpoint_health)
+//   dyad/param_requests live parameter changes asked for (`dyad param`, the experimenter's page,
+//                       a param_script's output): every process reads them, the component's answers
+//   dyad/params         the answers: applied (old and new value), refused (why), a value asked for
 //
 // `reader` is for the runtime's and the recorder's readers, which must not lose a sample;
 // `watcher` for guests (`dyad status`, `hz`), which may drop samples but never slow a writer.
@@ -82,6 +85,25 @@ inline const RuntimeTopic kHealth{
     .writer = {.reliability = Reliability::kReliable, .depth = 32},
     .reader = {.reliability = Reliability::kReliable, .depth = 32},
     .watcher = {.reliability = Reliability::kBestEffort, .depth = 256},
+};
+
+// Reliable both ways and deep: a request lost is a change silently not made, an answer lost is a
+// change the recording does not show. Volatile: an old request must not be applied again by a
+// process that joins later (a restarted one starts from the graph's values, and says so).
+inline const RuntimeTopic kParamRequests{
+    .name = "dyad/param_requests",
+    .type = &TypeInfoOf<msg::ParamChange>,
+    .writer = {.reliability = Reliability::kReliable, .depth = 64},
+    .reader = {.reliability = Reliability::kReliable, .depth = 64},
+    .watcher = {.reliability = Reliability::kReliable, .depth = 64},
+};
+
+inline const RuntimeTopic kParams{
+    .name = "dyad/params",
+    .type = &TypeInfoOf<msg::ParamChange>,
+    .writer = {.reliability = Reliability::kReliable, .depth = 64},
+    .reader = {.reliability = Reliability::kReliable, .depth = 64},
+    .watcher = {.reliability = Reliability::kReliable, .depth = 64},
 };
 
 }  // namespace runtime_topics

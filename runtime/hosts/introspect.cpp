@@ -21,9 +21,9 @@
 
 #include "hosts/clock_sync.hpp"
 #include "dds/dds_participant.hpp"
-#include "graph/run_partition.hpp"
 #include "graph/graph_topics.hpp"
 #include "hosts/start_barrier.hpp"
+#include "hosts/watcher_join.hpp"
 #include "dyad/interrupt.hpp"
 
 namespace dyad {
@@ -32,45 +32,7 @@ namespace {
 using Steady = std::chrono::steady_clock;
 
 std::unique_ptr<DdsParticipant> Join(const IntrospectOptions& o, std::ostream& err) {
-  DdsParticipant::Options po;
-  po.scope = DdsParticipant::Scope::kWatcher;
-  po.network = o.network;
-  po.security = o.security;
-  po.partitions = {o.run_id.empty() || o.graph_name.empty() ? WatchPartition(o.graph_name) : RunPartition(o.graph_name, o.run_id)};
-  auto p = DdsParticipant::Create(o.domain_id, "dyad/introspect", std::move(po));
-  if (!p.ok()) {
-    err << p.status().message() << "\n";
-    return nullptr;
-  }
-  return std::move(p.value());
-}
-
-// Waits until some writer of `topic` is discovered; returns its DDS type name or "".
-std::string DiscoverType(DdsParticipant& p, const std::string& topic, double wait_s, const InterruptWatcher& interrupt) {
-  const auto end = Steady::now() + std::chrono::duration<double>(wait_s);
-  while (Steady::now() < end && !interrupt.interrupted()) {
-    for (const auto& e : p.Discovered())
-      if (e.writer && e.topic == topic) return e.type;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return "";
-}
-
-const TypeInfo* ResolveType(const Catalog& catalog, const std::string& dds_type, const std::string& topic, std::ostream& err) {
-  for (const TypeInfo* t : catalog.MessageTypes()) {
-    if (t->dds_name() == dds_type) return t;
-  }
-  const std::string base = dds_type.substr(0, dds_type.find('#'));
-  for (const TypeInfo* t : catalog.MessageTypes())
-    if (t->name == base) {
-      err << "topic '" << topic << "' carries " << dds_type << " but this dyad knows " << t->dds_name()
-          << " (same IDL name, different definition): rebuild from the same idl/\n";
-      return nullptr;
-    }
-  err << "topic '" << topic << "' carries " << dds_type
-      << ", a type this dyad does not know: name the plugin that defines it (--graph GRAPH.yaml, --plugins FILE,"
-         " or DYAD_PLUGIN_PATH)\n";
-  return nullptr;
+  return JoinAsWatcher(o, "dyad/introspect", err);
 }
 
 // A watcher's reader: the participant's serialized subscription (BEST_EFFORT: it matches every
@@ -235,6 +197,46 @@ int ListTopics(const IntrospectOptions& o, std::ostream& out, const Graph* graph
                  " private to its process and never seen here)\n";
     return 1;
   }
+  return 0;
+}
+
+int DiscoverLiveGraph(const IntrospectOptions& o, const Catalog& catalog, const Graph* graph, double listen_s, LiveGraph* live,
+                      std::ostream& err) {
+  InterruptWatcher interrupt;  // before the participant: its threads inherit the blocked signals
+  // Before the participant, so that it (whose subscriptions call into them) goes first.
+  std::vector<std::pair<std::string, std::unique_ptr<RawReader>>> readers;
+  auto p = Join(o, err);
+  if (!p) return 1;
+  Steady::time_point end = Steady::now() + std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(o.wait_s));
+  while (Steady::now() < end && !interrupt.interrupted()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    if (graph && DiscoveredAll(*graph, p->Discovered())) end = std::min(end, Steady::now() + std::chrono::milliseconds(200));
+  }
+  std::map<std::string, std::string> types;  // topic -> a writer's type
+  for (const auto& e : p->Discovered()) {
+    if (e.participant == p->name() || e.topic.rfind("dyad/", 0) == 0) continue;
+    live->endpoints.push_back({e.participant, e.topic, e.type, e.writer});
+    if (e.writer) types.emplace(e.topic, e.type);
+  }
+  if (live->endpoints.empty()) {
+    err << "dyad graph --live: no endpoint discovered on domain " << o.domain_id << " within " << o.wait_s
+        << " s (a stepped run is private to its process and never seen here)\n";
+    return 1;
+  }
+  // Rates: one reader per written topic of a known type, counting for listen_s.
+  std::ostringstream unknown;  // types this dyad does not know: no rate, said once
+  for (const auto& [topic, dds_type] : types)
+    if (const TypeInfo* type = ResolveType(catalog, dds_type, topic, unknown))
+      readers.emplace_back(topic, std::make_unique<RawReader>(*p, *type, topic));
+  std::map<std::string, uint64_t> counts;
+  const auto listen_end = Steady::now() + std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(listen_s));
+  std::vector<uint8_t> bytes;
+  while (Steady::now() < listen_end && !interrupt.interrupted()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    for (auto& [topic, reader] : readers)
+      while (reader->Next(&bytes)) ++counts[topic];
+  }
+  for (const auto& [topic, reader] : readers) live->rates_hz[topic] = static_cast<double>(counts[topic]) / std::max(listen_s, 1e-3);
   return 0;
 }
 

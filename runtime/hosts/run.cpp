@@ -24,12 +24,10 @@
 #include "graph/run_partition.hpp"
 #include "hosts/graph_session.hpp"
 #include "hosts/launcher.hpp"
+#include "hosts/process_run.hpp"
 
 namespace dyad {
 namespace {
-
-// How long a stopping process may take to end cleanly after SIGINT/SIGTERM.
-constexpr double kStopGraceS = 20;
 
 struct Loaded {
   Graph graph;
@@ -165,56 +163,6 @@ bool CheckRunOptions(const RunOptions& options, std::ostream& err) {
   return true;
 }
 
-// How one process's run ended.
-struct ProcessRun {
-  Status result;
-  std::vector<Executor::Row> rows;
-  int mismatches = 0;
-  int signal = 0;  // the signal that stopped it; 0: none
-};
-
-// Runs the components of `eo.process` until the run ends. SIGINT/SIGTERM stop it cleanly; a
-// process that cannot stop (a component or the DDS stack stuck) must not outlive its launcher
-// unseen: kStopGraceS after a signal it exits anyway, saying so, unless the run has ended by then
-// (the guard is cancelled before this returns).
-ProcessRun RunProcess(Loaded& l, const Executor::Options& eo) {
-  ProcessRun run;
-  std::atomic<Executor*> current{nullptr};
-  std::mutex guard_mutex;
-  std::condition_variable guard_cv;
-  bool run_over = false;
-  std::thread guard;
-  {
-    InterruptWatcher interrupt([&](int sig) {
-      if (Executor* ex = current.load()) ex->RequestStop(SignalName(sig));
-      std::lock_guard<std::mutex> lock(guard_mutex);
-      if (guard.joinable() || run_over) return;
-      guard = std::thread([&, sig] {
-        std::unique_lock<std::mutex> lock(guard_mutex);
-        if (guard_cv.wait_for(lock, std::chrono::duration<double>(kStopGraceS), [&] { return run_over; })) return;
-        std::fprintf(stderr, "dyad run: did not stop within %g s of %s: exiting without a clean shutdown\n", kStopGraceS,
-                     SignalName(sig));
-        std::_Exit(ExitCodeForSignal(sig));
-      });
-    });
-    Executor ex(l.graph, l.resolved, &l.catalog, eo);
-    current.store(&ex);
-    if (interrupt.signal() != 0) ex.RequestStop(SignalName(interrupt.signal()));  // before `current` was set
-    run.result = ex.Run();
-    run.rows = ex.Report();
-    run.mismatches = ex.wiring_problems();
-    current.store(nullptr);
-    run.signal = interrupt.signal();
-    {
-      std::lock_guard<std::mutex> lock(guard_mutex);
-      run_over = true;
-    }
-    guard_cv.notify_all();
-  }  // the signal thread has ended: `guard` is no longer written
-  if (guard.joinable()) guard.join();
-  return run;
-}
-
 // The timing table and what went wrong; the exit code of the run (run.hpp).
 int ReportRun(const ProcessRun& run, const Graph& g, const std::string& process, const RunOptions& options,
               std::ostream& out, std::ostream& err) {
@@ -300,7 +248,7 @@ int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
   // The launcher tells a child how often it restarted it (announced on dyad/processes).
   const auto restarts = static_cast<uint32_t>(options.restart_count);
   eo.session = [&graph = l.graph, process, host = eo.host, restarts] { return MakeGraphSession(graph, process, host, restarts); };
-  const ProcessRun run = RunProcess(l, eo);
+  const ProcessRun run = RunProcess(l.graph, l.resolved, l.catalog, eo);
   return ReportRun(run, l.graph, process, options, out, err);
 }
 

@@ -23,13 +23,17 @@ StatusOr<Report> BuildReport(const std::string& recording, std::ostream& warning
   if (const std::string folder = GraphMetadata(*reader, "folder");
       !folder.empty() && !report.plan.dataset.empty() && std::filesystem::path(report.plan.dataset).is_relative())
     report.plan.dataset = (std::filesystem::path(folder) / report.plan.dataset).lexically_normal().string();
-  auto tables = ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels", "dyad/clock_offsets"});
+  auto tables = ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels",
+                                     "dyad/clock_offsets", "dyad/params"});
   if (!tables.ok()) return tables.status();
   auto corrections = ClockCorrections(*tables, report.plan);
   if (!corrections.ok()) return corrections.status().WithContext(recording);
   auto timeline = BuildTimeline(*tables, report.plan, *corrections);
   if (!timeline.ok()) return timeline.status().WithContext(recording);
   report.timeline = std::move(*timeline);
+  auto changes = AppliedParamChanges(*tables, report.plan, report.timeline);
+  if (!changes.ok()) return changes.status().WithContext(recording);
+  report.param_changes = std::move(*changes);
   if (auto losses = bag::FindLosses(*reader); losses.ok()) report.transport = bag::FormatLosses(*losses);
   else warnings << "dyad analyze: " << recording << ": losses not read: " << losses.status().message() << "\n";
   const auto events = Events(report.timeline, report.plan);

@@ -2,7 +2,8 @@
 //
 // Contract of BuildReport(recording, warnings):
 //   - Reads the MCAP file (a cut-short one too: what it recovers is said on `warnings`), the
-//     graph recorded with it, the experiment's topics, the clock offsets between processes and
+//     graph recorded with it, the experiment's topics, the clock offsets between processes, the
+//     live parameter changes applied (dyad/params; none recorded: an empty list, no warning) and
 //     the transport's losses (a loss table that cannot be read is a warning, not a failure).
 //   - Fails (InvalidArgument / IOError / DataLoss) naming the file: not an MCAP file, a graph
 //     that does not parse, tables that do not decode.

@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
+#include <tuple>
 
 namespace dyad::analyze {
 namespace {
@@ -60,6 +60,99 @@ class Cells {
   const TopicTable& table_;
   std::map<std::string, int> index_;
 };
+
+const char* const kTimelineTopics[] = {"human/input", "robot/intention", "robot/state", "observer/labels"};
+
+// A stamp of `process`'s clock moved onto the recorder's process's clock; a process without a
+// measured offset (or the recorder's own) keeps its stamps.
+double OnRecorderClock(const std::map<std::string, int64_t>& corrections, const std::string& process, double stamp) {
+  auto c = corrections.find(process);
+  return c == corrections.end() ? stamp : stamp - static_cast<double>(c->second);
+}
+
+// The columns ComponentStamp reads: the writer's name only when there is a clock to correct.
+std::vector<std::string> StampColumns(const std::map<std::string, int64_t>& corrections) {
+  if (corrections.empty()) return {"header.stamp_ns"};
+  return {"header.stamp_ns", "header.source"};
+}
+
+// A row's stamp on the recorder's process's clock; its writer is the component header.source
+// names (one the graph does not have: the stamp as it is).
+StatusOr<double> ComponentStamp(const Cells& cells, size_t row, const ExperimentPlan& plan,
+                                const std::map<std::string, int64_t>& corrections) {
+  auto stamp = cells.Number(row, "header.stamp_ns");
+  if (!stamp.ok() || corrections.empty()) return stamp;
+  auto p = plan.process_of.find(cells.Text(row, "header.source"));
+  return p == plan.process_of.end() ? *stamp : OnRecorderClock(corrections, p->second, *stamp);
+}
+
+// The process that wrote a dyad/params answer: its source is "dyad/<process>" (runtime/exec/
+// live_params.hpp); else the process of the component it names (the one that answers for it).
+std::string WriterProcess(const Cells& cells, size_t row, const ExperimentPlan& plan) {
+  const std::string& source = cells.Text(row, "header.source");
+  if (source.rfind("dyad/", 0) == 0) return source.substr(5);
+  auto p = plan.process_of.find(cells.Text(row, "component_name"));
+  return p == plan.process_of.end() ? std::string() : p->second;
+}
+
+int64_t StepOf(double stamp, int64_t t0_ns, int64_t period_ns) {
+  return std::llround((stamp - static_cast<double>(t0_ns)) / static_cast<double>(period_ns));
+}
+
+// t0: the first human sample, else the first sample of any topic; none when no topic has one.
+StatusOr<std::optional<int64_t>> StepZero(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
+                                          const std::map<std::string, int64_t>& corrections,
+                                          const std::vector<std::string>& stamp_columns) {
+  std::optional<int64_t> t0;
+  for (const char* t : kTimelineTopics) {
+    auto it = tables.find(t);
+    if (it == tables.end() || it->second.size() == 0) continue;
+    Cells cells(t, it->second);
+    if (Status s = cells.Need(stamp_columns); !s.ok()) return s;
+    auto stamp = ComponentStamp(cells, 0, plan, corrections);
+    if (!stamp.ok()) return stamp.status();
+    const auto first = static_cast<int64_t>(*stamp);
+    if (std::string(t) == "human/input") return std::optional<int64_t>(first);
+    t0 = t0 ? std::min(*t0, first) : first;
+  }
+  return t0;
+}
+
+Status FillHuman(const Cells& c, size_t r, StepSample& s) {
+  auto x = c.Number(r, "x"); auto y = c.Number(r, "y"); auto e = c.Bool(r, "engaged");
+  if (!x.ok()) return x.status();
+  if (!y.ok()) return y.status();
+  if (!e.ok()) return e.status();
+  s.human_x = *x; s.human_y = *y; s.engaged = *e;
+  return Status::OK();
+}
+
+Status FillIntention(const Cells& c, size_t r, StepSample& s) {
+  double* dst[] = {&s.robot_x, &s.robot_y, &s.nelbo, &s.reconstruction, &s.regulation, &s.optimisation_s};
+  const char* names[] = {"x", "y", "nelbo", "reconstruction", "regulation", "optimisation_s"};
+  for (int i = 0; i < 6; ++i) {
+    auto v = c.Number(r, names[i]);
+    if (!v.ok()) return v.status();
+    *dst[i] = *v;
+  }
+  return Status::OK();
+}
+
+Status FillState(const Cells& c, size_t r, StepSample& s) {
+  auto x = c.Number(r, "x"); auto y = c.Number(r, "y");
+  if (!x.ok()) return x.status();
+  if (!y.ok()) return y.status();
+  s.executed_x = *x; s.executed_y = *y;
+  return Status::OK();
+}
+
+Status FillLabels(const Cells& c, size_t r, StepSample& s) {
+  auto g = c.Number(r, "congruence");
+  if (!g.ok()) return g.status();
+  s.congruence = *g;
+  if (Status st = c.List(r, "human", &s.p_human); !st.ok()) return st;
+  return c.List(r, "robot", &s.p_robot);
+}
 
 }  // namespace
 
@@ -134,102 +227,83 @@ StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables
                                  const std::map<std::string, int64_t>& corrections) {
   Timeline timeline;
   timeline.clock_corrections_ns = corrections;
-  // A row's stamp on the recorder's process's clock.
-  auto corrected = [&](const Cells& cells, size_t row, double stamp) {
-    if (corrections.empty()) return stamp;
-    auto p = plan.process_of.find(cells.Text(row, "header.source"));
-    if (p == plan.process_of.end()) return stamp;
-    auto c = corrections.find(p->second);
-    return c == corrections.end() ? stamp : stamp - static_cast<double>(c->second);
-  };
-  const std::vector<std::string> stamp_columns =
-      corrections.empty() ? std::vector<std::string>{"header.stamp_ns"} : std::vector<std::string>{"header.stamp_ns", "header.source"};
-  const char* const kTopics[] = {"human/input", "robot/intention", "robot/state", "observer/labels"};
-  for (const char* t : kTopics) {
+  const std::vector<std::string> stamp_columns = StampColumns(corrections);
+  for (const char* t : kTimelineTopics) {
     auto it = tables.find(t);
     if (it == tables.end() || it->second.size() == 0) timeline.missing_topics.push_back(t);
   }
-  // t0: the first human sample, else the first sample of any topic.
-  int64_t t0 = std::numeric_limits<int64_t>::max();
-  for (const char* t : kTopics) {
-    auto it = tables.find(t);
-    if (it == tables.end() || it->second.size() == 0) continue;
-    Cells cells(t, it->second);
-    if (Status s = cells.Need(stamp_columns); !s.ok()) return s;
-    auto stamp = cells.Number(0, "header.stamp_ns");
-    if (!stamp.ok()) return stamp.status();
-    const auto first = static_cast<int64_t>(corrected(cells, 0, *stamp));
-    if (std::string(t) == "human/input") { t0 = first; break; }
-    t0 = std::min(t0, first);
-  }
-  if (t0 == std::numeric_limits<int64_t>::max()) return timeline;
+  auto t0 = StepZero(tables, plan, corrections, stamp_columns);
+  if (!t0.ok()) return t0.status();
+  if (!t0->has_value()) return timeline;
+  timeline.t0_ns = *t0;
 
   auto at = [&](double stamp) -> StepSample* {
-    const int64_t step = std::llround((stamp - static_cast<double>(t0)) / static_cast<double>(plan.period_ns));
+    const int64_t step = StepOf(stamp, **t0, plan.period_ns);
     if (step < 0) return nullptr;
     while (static_cast<int64_t>(timeline.steps.size()) <= step) {
       timeline.steps.push_back(EmptyStep(static_cast<int64_t>(timeline.steps.size())));
     }
     return &timeline.steps[step];
   };
-  // Each topic fills its fields; `fill` gets the row's cells and the step's sample.
-  auto each = [&](const char* topic, const std::vector<std::string>& fields,
-                  const std::function<Status(const Cells&, size_t, StepSample&)>& fill) -> Status {
+  // Each topic fills its fields of the step its row's stamp falls on.
+  using Fill = Status (*)(const Cells&, size_t, StepSample&);
+  const std::tuple<const char*, std::vector<std::string>, Fill> topics[] = {
+      {"human/input", {"x", "y", "engaged"}, FillHuman},
+      {"robot/intention", {"x", "y", "nelbo", "reconstruction", "regulation", "optimisation_s"}, FillIntention},
+      {"robot/state", {"x", "y"}, FillState},
+      {"observer/labels", {"human", "robot", "congruence"}, FillLabels},
+  };
+  for (const auto& [topic, fields, fill] : topics) {
     auto it = tables.find(topic);
-    if (it == tables.end()) return Status::OK();
+    if (it == tables.end()) continue;
     Cells cells(topic, it->second);
     std::vector<std::string> need = fields;
     need.insert(need.end(), stamp_columns.begin(), stamp_columns.end());
     if (Status s = cells.Need(need); !s.ok()) return s;
     for (size_t r = 0; r < it->second.size(); ++r) {
-      auto stamp = cells.Number(r, "header.stamp_ns");
+      auto stamp = ComponentStamp(cells, r, plan, corrections);
       if (!stamp.ok()) return stamp.status();
-      StepSample* s = at(corrected(cells, r, *stamp));
+      StepSample* s = at(*stamp);
       if (s == nullptr) continue;
       if (Status st = fill(cells, r, *s); !st.ok()) return st;
     }
-    return Status::OK();
-  };
-  Status s = each("human/input", {"x", "y", "engaged"}, [](const Cells& c, size_t r, StepSample& s) -> Status {
-    auto x = c.Number(r, "x"); auto y = c.Number(r, "y"); auto e = c.Bool(r, "engaged");
-    if (!x.ok()) return x.status();
-    if (!y.ok()) return y.status();
-    if (!e.ok()) return e.status();
-    s.human_x = *x; s.human_y = *y; s.engaged = *e;
-    return Status::OK();
-  });
-  if (!s.ok()) return s;
-  s = each("robot/intention", {"x", "y", "nelbo", "reconstruction", "regulation", "optimisation_s"},
-           [](const Cells& c, size_t r, StepSample& s) -> Status {
-             double* dst[] = {&s.robot_x, &s.robot_y, &s.nelbo, &s.reconstruction, &s.regulation, &s.optimisation_s};
-             const char* names[] = {"x", "y", "nelbo", "reconstruction", "regulation", "optimisation_s"};
-             for (int i = 0; i < 6; ++i) {
-               auto v = c.Number(r, names[i]);
-               if (!v.ok()) return v.status();
-               *dst[i] = *v;
-             }
-             return Status::OK();
-           });
-  if (!s.ok()) return s;
-  s = each("robot/state", {"x", "y"}, [](const Cells& c, size_t r, StepSample& s) -> Status {
-    auto x = c.Number(r, "x"); auto y = c.Number(r, "y");
-    if (!x.ok()) return x.status();
-    if (!y.ok()) return y.status();
-    s.executed_x = *x; s.executed_y = *y;
-    return Status::OK();
-  });
-  if (!s.ok()) return s;
-  s = each("observer/labels", {"human", "robot", "congruence"}, [&](const Cells& c, size_t r, StepSample& s) -> Status {
-    auto g = c.Number(r, "congruence");
-    if (!g.ok()) return g.status();
-    s.congruence = *g;
-    if (Status st = c.List(r, "human", &s.p_human); !st.ok()) return st;
-    if (Status st = c.List(r, "robot", &s.p_robot); !st.ok()) return st;
+  }
+  for (const StepSample& s : timeline.steps)
     timeline.classes = std::max<int>(timeline.classes, static_cast<int>(std::max(s.p_human.size(), s.p_robot.size())));
-    return Status::OK();
-  });
-  if (!s.ok()) return s;
   return timeline;
+}
+
+StatusOr<std::vector<ParamChangeEvent>> AppliedParamChanges(const std::map<std::string, TopicTable>& tables,
+                                                            const ExperimentPlan& plan, const Timeline& timeline) {
+  std::vector<ParamChangeEvent> out;
+  auto it = tables.find("dyad/params");
+  if (it == tables.end()) return out;
+  Cells cells("dyad/params", it->second);
+  if (Status s = cells.Need({"header.source", "header.stamp_ns", "graph_name", "component_name", "param_name", "op",
+                             "value", "old_value", "who"});
+      !s.ok())
+    return s;
+  std::optional<int64_t> t0 = timeline.t0_ns;
+  const double period_s = static_cast<double>(plan.period_ns) * 1e-9;
+  for (size_t r = 0; r < it->second.size(); ++r) {
+    if (cells.Text(r, "op") != "applied") continue;  // refusals changed nothing; "value" answers a get
+    const std::string& graph = cells.Text(r, "graph_name");
+    if (!plan.graph_name.empty() && !graph.empty() && graph != plan.graph_name) continue;
+    auto stamp = cells.Number(r, "header.stamp_ns");
+    if (!stamp.ok()) return stamp.status();
+    const double on_recorder = OnRecorderClock(timeline.clock_corrections_ns, WriterProcess(cells, r, plan), *stamp);
+    if (!t0) t0 = static_cast<int64_t>(on_recorder);
+    ParamChangeEvent e;
+    e.step = StepOf(on_recorder, *t0, plan.period_ns);
+    e.time_s = static_cast<double>(e.step) * period_s;
+    e.component = cells.Text(r, "component_name");
+    e.param = cells.Text(r, "param_name");
+    e.old_value = cells.Text(r, "old_value");
+    e.value = cells.Text(r, "value");
+    e.who = cells.Text(r, "who");
+    out.push_back(std::move(e));
+  }
+  return out;
 }
 
 int MostLikelyClass(const std::vector<double>& p) {

@@ -5,6 +5,7 @@
 //   robot/intention  Intention       -> robot intention, N-ELBO and its terms
 //   robot/state      CartesianState  -> executed position
 //   observer/labels  IntentionLabel  -> class probabilities of human and robot, congruence P(C_t)
+//   dyad/params      ParamChange     -> live parameter changes applied during the run
 //
 // Samples are put on one step grid: step = round((stamp - t0) / period), t0 the first human
 // sample's stamp, period from the graph (the human source's rate_hz; 100 ms if unknown). A topic
@@ -22,6 +23,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,11 +72,34 @@ struct Timeline {
   std::vector<std::string> missing_topics;
   int classes = 0;  // length of the observer's probability vectors (0: no observer)
   std::map<std::string, int64_t> clock_corrections_ns;  // applied, per process (see above)
+  // The stamp of step 0 (recorder's process's clock): what other samples are placed against
+  // (AppliedParamChanges). Empty when no topic of the timeline has a sample.
+  std::optional<int64_t> t0_ns;
 };
 
 // `corrections`: ClockCorrections(); stamps of components of other processes are used as they are.
 StatusOr<Timeline> BuildTimeline(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
                                  const std::map<std::string, int64_t>& corrections = {});
+
+// A live parameter change the component's process applied (idl/param.idl, op "applied"). It
+// took effect at the component's step boundary: its Step() used `value` from then on.
+struct ParamChangeEvent {
+  int64_t step = 0;     // on the timeline's grid (see below); negative: before step 0
+  double time_s = 0;    // step * period, as timeline.csv's time_s
+  std::string component, param;
+  std::string old_value, value;  // YAML flow text, before and after
+  std::string who;               // who asked, e.g. "dyad param set (ana@lab-pc)"
+};
+
+// The applied changes of dyad/params, in recording order, on `timeline`'s step grid the way
+// BuildTimeline places samples: the answer's stamp moved onto the recorder's process's clock by
+// timeline.clock_corrections_ns (the writer's process: header.source "dyad/<process>", else the
+// component's), then step = round((stamp - t0_ns) / period). Answers naming another graph than
+// the plan's (a recorder on a shared domain) are left out. Without t0_ns (no experiment topic
+// recorded) the first change's stamp is step 0. No dyad/params: empty. Fails (DataLoss) on a
+// table without ParamChange's fields or with a stamp that is not a number.
+StatusOr<std::vector<ParamChangeEvent>> AppliedParamChanges(const std::map<std::string, TopicTable>& tables,
+                                                            const ExperimentPlan& plan, const Timeline& timeline);
 
 // Events of the plan, or engaged runs of the timeline when the plan has none. Planned events are
 // limited to the recorded steps: one starting after the last recorded step is left out (the run

@@ -3,7 +3,8 @@
 
 usage: plot_report.py REPORT_DIR [--dataset DATASET_DIR]
 
-Reads REPORT_DIR/timeline.csv and events.csv (written by `dyad analyze`) and, when given, the
+Reads REPORT_DIR/timeline.csv and events.csv (written by `dyad analyze`), params.csv when the
+run had live parameter changes (drawn as dotted lines on the time axes) and, when given, the
 data set's primitive_<id>_0.csv files (NRL layout) as a grey watermark. Writes
 workspace.png, nelbo.png and congruence.png into REPORT_DIR. Needs python3-matplotlib only.
 """
@@ -65,6 +66,30 @@ def column(rows, name):
     return [number(r[name]) for r in rows]
 
 
+def read_changes(report_dir):
+    """The live parameter changes of params.csv; none when the report has no such file."""
+    path = os.path.join(report_dir, "params.csv")
+    return read_csv(path) if os.path.exists(path) else []
+
+
+def change_label(change, limit=40):
+    """The line's label, e.g. mixer.gain 0.9→0.2; a long value (a list) cut, a '$' kept out of mathtext."""
+    text = f"{change['component']}.{change['param']} {change['old_value']}\u2192{change['value']}"
+    if len(text) > limit:
+        text = text[:limit - 1] + "\u2026"
+    return text.replace("$", r"\$")
+
+
+def mark_changes(ax, changes):
+    """Each change as a dotted vertical line at its step, its label rotated along it near the top."""
+    for i, c in enumerate(changes):
+        t = number(c["time_s"])
+        ax.axvline(t, color="0.3", ls=":", lw=1.0, zorder=3, label="parameter change" if i == 0 else None)
+        # x in data, y in axes fractions: the label stays near the top whatever the y scale.
+        ax.text(t, 0.97, change_label(c), transform=ax.get_xaxis_transform(), rotation=90, fontsize=6.5,
+                ha="right", va="top", color="0.25", zorder=4)
+
+
 def plot_workspace(rows, shapes, out):
     fig, ax = plt.subplots(figsize=(7, 7))
     for i, (xs, ys) in enumerate(shapes):
@@ -95,13 +120,14 @@ def shade(ax, spans):
         ax.axvspan(a, b, color="tab:red", alpha=0.12, lw=0, label="human engaged" if i == 0 else None)
 
 
-def plot_nelbo(rows, out):
+def plot_nelbo(rows, changes, out):
     t = column(rows, "time_s")
     fig, ax = plt.subplots(figsize=(10, 3.5))
     shade(ax, engaged_spans(rows))
     ax.plot(t, column(rows, "nelbo"), color="tab:purple", lw=0.8, label="N-ELBO")
     ax.plot(t, column(rows, "reconstruction"), color="tab:green", lw=0.6, alpha=0.7, label="reconstruction")
     ax.set_yscale("symlog", linthresh=1e-3)
+    mark_changes(ax, changes)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("free energy of the window")
     ax.set_title("Robot's N-ELBO after each step's error regression")
@@ -111,12 +137,13 @@ def plot_nelbo(rows, out):
     plt.close(fig)
 
 
-def plot_congruence(rows, events, out):
+def plot_congruence(rows, events, changes, out):
     t = column(rows, "time_s")
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(10, 6), gridspec_kw={"height_ratios": [2, 1]})
     shade(top, engaged_spans(rows))
     top.plot(t, column(rows, "congruence"), color="tab:orange", lw=0.9, label="P(C_t)")
     top.set_ylim(-0.02, 1.02)
+    mark_changes(top, changes)
     top.set_xlabel("time (s)")
     top.set_ylabel("intention congruence")
     top.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
@@ -145,6 +172,7 @@ def main():
     try:
         rows = read_csv(os.path.join(args.report_dir, "timeline.csv"))
         events = read_csv(os.path.join(args.report_dir, "events.csv"))
+        changes = read_changes(args.report_dir)
     except (OSError, csv.Error, KeyError) as e:
         print(f"plot_report.py: {e}", file=sys.stderr)
         return 2
@@ -153,8 +181,8 @@ def main():
         return 2
     shapes = load_dataset(args.dataset) if args.dataset else []
     plot_workspace(rows, shapes, os.path.join(args.report_dir, "workspace.png"))
-    plot_nelbo(rows, os.path.join(args.report_dir, "nelbo.png"))
-    plot_congruence(rows, events, os.path.join(args.report_dir, "congruence.png"))
+    plot_nelbo(rows, changes, os.path.join(args.report_dir, "nelbo.png"))
+    plot_congruence(rows, events, changes, os.path.join(args.report_dir, "congruence.png"))
     return 0
 
 

@@ -62,6 +62,47 @@ std::string TimelineCsv(const Report& r) {
   return s.str();
 }
 
+// A CSV cell, quoted when it holds a separator, a quote or a line break (RFC 4180; as
+// tools/bag/csv_export.cpp writes them). Values are YAML flow text: "[0.1, 0.2]" has commas.
+std::string CsvCell(const std::string& cell) {
+  if (cell.find_first_of(",\"\r\n") == std::string::npos) return cell;
+  std::string quoted = "\"";
+  for (char c : cell) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+std::string ParamsCsv(const Report& r) {
+  std::ostringstream s;
+  s << "step,time_s,component,param,old_value,value,who\n";
+  for (const ParamChangeEvent& c : r.param_changes) {
+    s << c.step << ',' << Num(c.time_s, 3) << ',' << CsvCell(c.component) << ',' << CsvCell(c.param) << ','
+      << CsvCell(c.old_value) << ',' << CsvCell(c.value) << ',' << CsvCell(c.who) << '\n';
+  }
+  return s.str();
+}
+
+// Text for a Markdown table cell: a '|' would end the cell, a line break the row.
+std::string MdCell(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '|') out += "\\|";
+    else out += (c == '\n' || c == '\r') ? ' ' : c;
+  }
+  return out;
+}
+
+void ParamChangesSection(const Report& r, std::ostream& s) {
+  if (r.param_changes.empty()) return;
+  s << "\n## Live parameter changes\n\n";
+  s << "| time | component.param | old -> new | who |\n|---|---|---|---|\n";
+  for (const ParamChangeEvent& c : r.param_changes) {
+    s << "| " << Num(c.time_s, 3) << " s (step " << c.step << ") | " << MdCell(c.component + "." + c.param) << " | "
+      << MdCell(c.old_value) << " -> " << MdCell(c.value) << " | " << MdCell(c.who) << " |\n";
+  }
+  s << "\nEach change was applied at the component's step boundary (between two of its steps, never mid-step): "
+       "its steps from then on used the new value (params.csv).\n";
+}
+
 double Percentile(std::vector<double> v, double q) {
   if (v.empty()) return std::nan("");
   std::sort(v.begin(), v.end());
@@ -96,39 +137,8 @@ std::string MetricsJson(const Report& r) {
   return s.str();
 }
 
-}  // namespace
-
-std::vector<std::pair<std::string, double>> RunMetrics(const Report& r) {
-  std::vector<double> congruence, final_congruence, accuracy, follows, switch_s, switched, nelbo;
-  const double period_s = static_cast<double>(r.plan.period_ns) * 1e-9;
-  for (const EventSummary& e : r.events) {
-    congruence.push_back(e.mean_congruence);
-    final_congruence.push_back(e.final_congruence);
-    accuracy.push_back(e.human_accuracy);
-    follows.push_back(e.robot_follows);
-    switched.push_back(e.robot_switch_after >= 0 ? 1.0 : 0.0);
-    if (e.robot_switch_after >= 0) switch_s.push_back(static_cast<double>(e.robot_switch_after) * period_s);
-  }
-  int64_t engaged = 0;
-  for (const StepSample& x : r.timeline.steps) {
-    nelbo.push_back(x.nelbo);
-    engaged += x.engaged ? 1 : 0;
-  }
-  const double steps = static_cast<double>(r.timeline.steps.size());
-  return {{"steps", steps},
-          {"engaged_fraction", steps > 0 ? static_cast<double>(engaged) / steps : std::nan("")},
-          {"events", static_cast<double>(r.events.size())},
-          {"mean_congruence", FiniteMean(congruence)},
-          {"final_congruence", FiniteMean(final_congruence)},
-          {"observer_accuracy", FiniteMean(accuracy)},
-          {"robot_follows", FiniteMean(follows)},
-          {"switched_fraction", FiniteMean(switched)},
-          {"switch_latency_s", FiniteMean(switch_s)},
-          {"nelbo_mean", FiniteMean(nelbo)}};
-}
-
-std::string FormatMarkdown(const Report& r) {
-  std::ostringstream s;
+// The run's header and the bullets that summarise it.
+void SummarySection(const Report& r, std::ostream& s) {
   s << "# Experiment report\n\n";
   s << "- recording: `" << r.recording << "`\n";
   if (!r.plan.graph_name.empty()) s << "- graph: `" << r.plan.graph_name << "`\n";
@@ -179,6 +189,9 @@ std::string FormatMarkdown(const Report& r) {
     const size_t n = r.plan.events.size() - r.events.size();
     s << "- " << n << " planned event" << (n == 1 ? "" : "s") << " after the end of the recording (not scored)\n";
   }
+}
+
+void EventsSection(const Report& r, std::ostream& s) {
   s << "\n## Events\n\n";
   if (r.events.empty()) {
     s << "No interventions (the human never engaged).\n\n";
@@ -203,6 +216,9 @@ std::string FormatMarkdown(const Report& r) {
          "\"robot switched after\": steps from the event's start to the first step where the robot's intention is "
          "classified as the human's primitive (\"never\": not within the event).\n\n";
   }
+}
+
+void ConfusionSection(const Report& r, std::ostream& s) {
   s << "## Observer confusion on the human's traces\n\n";
   if (r.confusion.empty()) {
     s << "Not available: the recording has no observer labels during events with a known primitive.\n";
@@ -222,6 +238,46 @@ std::string FormatMarkdown(const Report& r) {
       s << "\n";
     }
   }
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, double>> RunMetrics(const Report& r) {
+  std::vector<double> congruence, final_congruence, accuracy, follows, switch_s, switched, nelbo;
+  const double period_s = static_cast<double>(r.plan.period_ns) * 1e-9;
+  for (const EventSummary& e : r.events) {
+    congruence.push_back(e.mean_congruence);
+    final_congruence.push_back(e.final_congruence);
+    accuracy.push_back(e.human_accuracy);
+    follows.push_back(e.robot_follows);
+    switched.push_back(e.robot_switch_after >= 0 ? 1.0 : 0.0);
+    if (e.robot_switch_after >= 0) switch_s.push_back(static_cast<double>(e.robot_switch_after) * period_s);
+  }
+  int64_t engaged = 0;
+  for (const StepSample& x : r.timeline.steps) {
+    nelbo.push_back(x.nelbo);
+    engaged += x.engaged ? 1 : 0;
+  }
+  const double steps = static_cast<double>(r.timeline.steps.size());
+  return {{"steps", steps},
+          {"engaged_fraction", steps > 0 ? static_cast<double>(engaged) / steps : std::nan("")},
+          {"events", static_cast<double>(r.events.size())},
+          {"mean_congruence", FiniteMean(congruence)},
+          {"final_congruence", FiniteMean(final_congruence)},
+          {"observer_accuracy", FiniteMean(accuracy)},
+          {"robot_follows", FiniteMean(follows)},
+          {"switched_fraction", FiniteMean(switched)},
+          {"switch_latency_s", FiniteMean(switch_s)},
+          {"nelbo_mean", FiniteMean(nelbo)}};
+}
+
+std::string FormatMarkdown(const Report& r) {
+  std::ostringstream s;
+  SummarySection(r, s);
+  // Before the scores: a change of a parameter during the run may explain them.
+  ParamChangesSection(r, s);
+  EventsSection(r, s);
+  ConfusionSection(r, s);
   s << "\n## Plots\n\n![workspace](workspace.png)\n\n![N-ELBO](nelbo.png)\n\n![congruence](congruence.png)\n";
   return s.str();
 }
@@ -237,6 +293,11 @@ Status WriteReport(const Report& r, const std::string& dir) {
   for (const auto& [name, text] : files) {
     if (Status s = WriteFile(dir + "/" + name, text); !s.ok()) return s;
   }
+  // The plots draw whatever params.csv the folder holds: one of an earlier report must go.
+  const std::string params = dir + "/params.csv";
+  if (!r.param_changes.empty()) return WriteFile(params, ParamsCsv(r));
+  std::filesystem::remove(params, ec);
+  if (ec) return Status::IOError(params, "cannot remove the previous report's: " + ec.message());
   return Status::OK();
 }
 

@@ -4,9 +4,12 @@
 //   events.csv     one row per event (EventSummary)
 //   confusion.csv  observer confusion on the human's traces: true,predicted,count
 //   timeline.csv   one row per step: positions, engagement, N-ELBO terms, congruence, argmaxes
+//   params.csv     the live parameter changes applied (only when there were some; an old one goes):
+//                  step,time_s,component,param,old_value,value,who (cells quoted as RFC 4180 says)
 //   graph.yaml     the recorded graph (when the recording has it)
 //   metrics.json   the run in numbers (RunMetrics): what `dyad sweep` tabulates
-// The PNG plots are drawn from timeline.csv and events.csv by tools/analyze/plot_report.py.
+// The PNG plots are drawn from timeline.csv, events.csv and params.csv by
+// tools/analyze/plot_report.py.
 #pragma once
 
 #include <string>
@@ -25,6 +28,7 @@ struct Report {
   Timeline timeline;
   std::vector<EventSummary> events;
   std::vector<std::vector<int64_t>> confusion;
+  std::vector<ParamChangeEvent> param_changes;  // applied during the run, in recording order
   // What the recording lost in transport and what the runtime healed: `dyad bag info`'s losses:
   // and health: sections (tools/bag/losses.hpp); empty: not read.
   std::string transport;

@@ -9,9 +9,11 @@ namespace dyad::cli {
 namespace {
 
 // The runtime's own topics a process writes and reads (runtime/graph/runtime_topics.hpp).
-const std::set<std::string> kProcessWrites = {"dyad/processes", "dyad/stats", "dyad/health", "dyad/clock", "dyad/clock_offsets"};
-const std::set<std::string> kProcessReads = {"dyad/processes", "dyad/clock"};
-const std::set<std::string> kLauncherWrites = {"dyad/launchers", "dyad/processes"};
+const std::set<std::string> kProcessWrites = {"dyad/processes", "dyad/stats", "dyad/health", "dyad/clock", "dyad/clock_offsets",
+                                               "dyad/params"};
+const std::set<std::string> kProcessReads = {"dyad/processes", "dyad/clock", "dyad/param_requests"};
+// A host's identity also asks for live parameter changes (`dyad param set` on a lab machine).
+const std::set<std::string> kLauncherWrites = {"dyad/launchers", "dyad/processes", "dyad/param_requests"};
 
 std::string Escaped(const std::string& s) {
   std::string out;

@@ -94,4 +94,62 @@ std::string GraphDot(const Graph& graph, const ResolvedGraph& resolved) {
   return out.str();
 }
 
+namespace {
+
+// "process mind" (+ its components) for a process of `graph`; else the participant's name.
+std::string ParticipantLabel(const std::string& participant, const Graph* graph, bool* of_graph) {
+  *of_graph = false;
+  if (graph == nullptr) return participant;
+  const std::string prefix = "dyad/" + graph->name + "/";
+  if (participant.rfind(prefix, 0) != 0) return participant;
+  const std::string process = participant.substr(prefix.size());
+  if (!graph->ProcessNames().count(process)) return participant;
+  *of_graph = true;
+  std::string label = "process " + process;
+  for (const auto& c : graph->components)
+    if (graph->ProcessOf(c) == process) label += "\n" + c.name + " (" + c.type + ")";
+  return label;
+}
+
+std::string RateText(const LiveGraph& live, const std::string& topic) {
+  auto r = live.rates_hz.find(topic);
+  if (r == live.rates_hz.end()) return "rate not measured";
+  if (r->second <= 0) return "no samples";
+  std::ostringstream text;
+  text.setf(std::ios::fixed);
+  text.precision(1);
+  text << r->second << " Hz";
+  return text.str();
+}
+
+}  // namespace
+
+std::string LiveGraphDot(const LiveGraph& live, const Graph* graph) {
+  std::ostringstream out;
+  out << "digraph " << Quoted(graph ? graph->name + " (live)" : "live") << " {\n"
+      << "  rankdir=LR;\n  fontname=\"Helvetica\";\n  node [fontname=\"Helvetica\", fontsize=11];\n"
+      << "  edge [fontname=\"Helvetica\", fontsize=9, color=\"#555555\"];\n";
+  std::set<std::string> participants;
+  std::map<std::string, std::string> types;  // topic -> type (short name)
+  std::set<std::pair<std::string, std::string>> writes, reads;  // (participant, topic)
+  for (const auto& e : live.endpoints) {
+    participants.insert(e.participant);
+    const std::string type = e.type.substr(0, e.type.find('#'));
+    types.emplace(e.topic, type.substr(type.rfind(':') == std::string::npos ? 0 : type.rfind(':') + 1));
+    (e.writer ? writes : reads).insert({e.participant, e.topic});
+  }
+  for (const auto& p : participants) {
+    bool of_graph = false;
+    const std::string label = ParticipantLabel(p, graph, &of_graph);
+    out << "  " << Quoted("p:" + p) << " [shape=box, style=" << (of_graph ? "\"rounded,filled\", fillcolor=\"#dde8f5\"" : "dashed")
+        << ", label=" << Quoted(label) << "];\n";
+  }
+  for (const auto& [topic, type] : types)
+    out << "  " << TopicId(topic) << " [shape=ellipse, label=" << Quoted(topic + "\n" + type + "\n" + RateText(live, topic)) << "];\n";
+  for (const auto& [p, topic] : writes) out << "  " << Quoted("p:" + p) << " -> " << TopicId(topic) << ";\n";
+  for (const auto& [p, topic] : reads) out << "  " << TopicId(topic) << " -> " << Quoted("p:" + p) << ";\n";
+  out << "}\n";
+  return out.str();
+}
+
 }  // namespace dyad::cli

@@ -14,10 +14,21 @@
 #include <string>
 
 #include <dyad/graph.hpp>
+#include <dyad/introspect.hpp>
 #include <dyad/validate.hpp>
 
 namespace dyad::cli {
 
 std::string GraphDot(const Graph& graph, const ResolvedGraph& resolved);
+
+// Contract of LiveGraphDot(live, graph) (`dyad graph --live`): the running graph as discovered.
+//   - One box per participant: a graph process's ("dyad/<graph>/<process>") labelled "process P"
+//     with, when `graph` is that graph, the components placed there; any other (a watcher, a
+//     guest, another program) by its participant name, dashed.
+//   - One ellipse per topic: its name, its type's short name and its measured rate ("49.8 Hz",
+//     "no samples", or "rate not measured" for a type this dyad does not know). Edges run writer
+//     participant -> topic -> reader participant, one per pair however many endpoints.
+//   - Quoting and order as GraphDot's: the same discovery gives the same text.
+std::string LiveGraphDot(const LiveGraph& live, const Graph* graph);
 
 }  // namespace dyad::cli

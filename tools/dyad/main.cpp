@@ -12,6 +12,7 @@
 #include "analyze_commands.hpp"
 #include "bag_commands.hpp"
 #include "introspection_commands.hpp"
+#include "guest_commands.hpp"
 #include "observer_commands.hpp"
 #include "pvrnn_commands.hpp"
 #include "runtime_commands.hpp"
@@ -61,6 +62,7 @@ int main(int argc, char** argv) {
   dyad::cli::AddIntrospectionCommands(app, exit_code);
   dyad::cli::AddSecurityCommands(app, exit_code);
   dyad::cli::AddBagCommands(app, exit_code);
+  dyad::cli::AddGuestCommands(app, exit_code);  // after bag: it adds `bag play`
   dyad::cli::AddPvrnnCommands(app, exit_code);
   dyad::cli::AddObserverCommands(app, exit_code);
   dyad::cli::AddAnalyzeCommands(app, exit_code);

@@ -122,6 +122,7 @@ std::string ComponentReferenceMarkdown(const std::string& name, const CatalogEnt
     for (const auto& p : spec.params()) {
       std::string type = ToString(p.type);
       if (p.path) type += " (path)";
+      if (p.live) type += " (live)";
       if (p.min || p.max) type += ", " + ParamRangeText(p);
       if (!p.unit.empty()) type += " [" + p.unit + "]";
       if (!p.choices.empty()) {

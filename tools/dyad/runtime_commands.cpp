@@ -12,11 +12,13 @@
 
 #include <dyad/catalog.hpp>
 #include <dyad/discovery_server.hpp>
+#include <dyad/introspect.hpp>
 #include <dyad/run.hpp>
 
 #include <dyad/validate.hpp>
 
 #include "graph_dot.hpp"
+#include "watcher_catalog.hpp"
 #include "reference_markdown.hpp"
 #include "run_process.hpp"
 
@@ -43,7 +45,7 @@ void PrintType(const std::string& name, const CatalogEntry& e, std::ostream& out
   for (const auto& p : e.spec.outputs())
     out << "  output " << p.name << ": " << p.type->short_name() << (p.doc.empty() ? "" : "  # " + p.doc) << "\n";
   for (const auto& p : e.spec.params()) {
-    out << "  param  " << p.name << ": " << ToString(p.type) << (p.path ? " path" : "");
+    out << "  param  " << p.name << ": " << ToString(p.type) << (p.path ? " path" : "") << (p.live ? " live" : "");
     out << (p.default_value ? " = " + ToYamlText(*p.default_value) : " (required)");
     if (!p.unit.empty()) out << " [" << p.unit << "]";
     if (p.min || p.max) out << " range " << ParamRangeText(p);
@@ -54,6 +56,28 @@ void PrintType(const std::string& name, const CatalogEntry& e, std::ostream& out
     if (!p.doc.empty()) out << "  # " << p.doc;
     out << "\n";
   }
+}
+
+// The DOT text on stdout, or rendered into `svg` by Graphviz's dot.
+int EmitDot(const std::string& dot, const std::string& svg) {
+  if (svg.empty()) {
+    std::cout << dot;
+    return 0;
+  }
+  const std::string dot_file = svg + ".dot";
+  std::ofstream(dot_file) << dot;
+  const int rc = tools::RunProcess({"dot", "-Tsvg", "-o", svg, dot_file});
+  if (rc == 127) {
+    std::cerr << "dyad graph --svg: Graphviz's dot is not on PATH (Debian: apt install graphviz); the DOT text is in " << dot_file << "\n";
+    return 1;
+  }
+  if (rc != 0) {
+    std::cerr << "dyad graph --svg: dot -Tsvg " << dot_file << " failed (exit " << rc << ")\n";
+    return 1;
+  }
+  std::filesystem::remove(dot_file);
+  std::cout << "wrote " << svg << "\n";
+  return 0;
 }
 
 // `dyad graph`: the graph checked against the component types (not configured: a picture needs
@@ -75,25 +99,50 @@ int DrawGraph(const std::string& path, const std::vector<std::string>& sets, con
     std::cerr << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", nothing was drawn\n";
     return 2;
   }
-  const std::string dot = GraphDot(graph, resolved);
-  if (svg.empty()) {
-    std::cout << dot;
-    return 0;
-  }
-  const std::string dot_file = svg + ".dot";
-  std::ofstream(dot_file) << dot;
-  const int rc = tools::RunProcess({"dot", "-Tsvg", "-o", svg, dot_file});
-  if (rc == 127) {
-    std::cerr << "dyad graph --svg: Graphviz's dot is not on PATH (Debian: apt install graphviz); the DOT text is in " << dot_file << "\n";
-    return 1;
-  }
-  if (rc != 0) {
-    std::cerr << "dyad graph --svg: dot -Tsvg " << dot_file << " failed (exit " << rc << ")\n";
-    return 1;
-  }
-  std::filesystem::remove(dot_file);
-  std::cout << "wrote " << svg << "\n";
-  return 0;
+  return EmitDot(GraphDot(graph, resolved), svg);
+}
+
+// `dyad graph --live`: the graphs on the domain as discovered, with measured rates.
+int DrawLiveGraph(const std::string& path, IntrospectOptions options, bool domain_given, double listen_s, const std::string& svg) {
+  Catalog catalog;
+  std::optional<Graph> graph;
+  if (!LoadWatcherCatalog(path, {}, &catalog, &options, domain_given, "", &graph)) return 2;
+  LiveGraph live;
+  if (int rc = DiscoverLiveGraph(options, catalog, graph ? &*graph : nullptr, listen_s, &live, std::cerr); rc != 0) return rc;
+  return EmitDot(LiveGraphDot(live, graph ? &*graph : nullptr), svg);
+}
+
+// `dyad graph`: the graph file's picture, or (--live) the running graph's.
+void AddGraphCommand(CLI::App& app, int& exit_code) {
+  struct State {
+    std::string graph_path, svg;
+    std::vector<std::string> sets, plugins;
+    bool dot = false, live = false;
+    IntrospectOptions watch;
+    double listen_s = 2;
+  };
+  auto st = std::make_shared<State>();
+  auto* graph = app.add_subcommand("graph", "Draw a graph: components, topics, processes and hosts (Graphviz DOT, or SVG)");
+  graph->add_option("graph", st->graph_path, "Graph YAML file (with --live: optional, its domain and processes)");
+  graph->add_flag("--live", st->live, "The running graph as discovered on the domain, with each topic's measured rate");
+  auto* domain = graph->add_option("--domain", st->watch.domain_id, "--live: DDS domain id (default: the graph's, else 0)")->check(CLI::Range(0, 232));
+  graph->add_option("--wait", st->watch.wait_s, "--live: seconds of discovery at most (default 5; with a graph it ends once all is found)")
+      ->check(CLI::NonNegativeNumber);
+  graph->add_option("--listen", st->listen_s, "--live: seconds to measure the rates (default 2)")->check(CLI::PositiveNumber);
+  graph->add_option("--set", st->sets, kSetHelp);
+  graph->add_option("--plugins", st->plugins, "Extra plugin file or folder (repeatable)");
+  auto* svg = graph->add_option("--svg", st->svg, "Render into this SVG file with Graphviz's dot (Debian: graphviz)");
+  graph->add_flag("--dot", st->dot, "Print the DOT text (the default)")->excludes(svg);
+  graph->callback([st, domain, &exit_code] {
+    if (st->live) {
+      exit_code = DrawLiveGraph(st->graph_path, st->watch, domain->count() > 0, st->listen_s, st->svg);
+    } else if (st->graph_path.empty()) {
+      std::cerr << "dyad graph: name the graph file (or --live for the running graph as discovered)\n";
+      exit_code = 2;
+    } else {
+      exit_code = DrawGraph(st->graph_path, st->sets, st->plugins, st->svg);
+    }
+  });
 }
 
 }  // namespace
@@ -106,8 +155,6 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
     std::vector<std::string> sets, plugins, type_names;
     bool markdown = false, messages = false, no_plugins = false;
     std::string listen;  // discovery-server --listen
-    std::string svg;     // graph --svg
-    bool dot = false;    // graph --dot
   };
   auto st = std::make_shared<State>();
   RunOptions& run = st->run;
@@ -129,13 +176,7 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
 
   AddRunCommand(app, [&exit_code](const RunOptions& options) { exit_code = RunGraph(options, std::cout, std::cerr); });
 
-  auto* graph = app.add_subcommand("graph", "Draw a graph: components, topics, processes and hosts (Graphviz DOT, or SVG)");
-  graph->add_option("graph", run.graph_path, "Graph YAML file")->required();
-  graph->add_option("--set", sets, kSetHelp);
-  graph->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
-  auto* svg = graph->add_option("--svg", st->svg, "Render into this SVG file with Graphviz's dot (Debian: graphviz)");
-  graph->add_flag("--dot", st->dot, "Print the DOT text (the default)")->excludes(svg);
-  graph->callback([st, &exit_code] { exit_code = DrawGraph(st->run.graph_path, st->sets, st->plugins, st->svg); });
+  AddGraphCommand(app, exit_code);
 
   auto* ds = app.add_subcommand("discovery-server", "Run a Fast DDS discovery server for graphs with network.discovery: server");
   ds->add_option("--listen", st->listen, "ADDRESS:PORT to listen on (UDP)")->required();

@@ -124,6 +124,19 @@ StatusOr<std::unique_ptr<ErrorRegression<Scalar>>> ErrorRegression<Scalar>::Crea
 }
 
 template <typename Scalar>
+Status ErrorRegression<Scalar>::Retune(int iterations, const std::vector<double>& meta_prior) {
+  ErrorRegressionOptions o = options_;
+  o.iterations = iterations;
+  o.meta_prior = meta_prior;
+  if (Status s = o.Validate(spec_.num_layers()); !s.ok()) return s;
+  options_ = o;
+  meta_prior_ = meta_prior;
+  if (meta_prior_.empty())
+    for (const auto& layer : spec_.layers) meta_prior_.push_back(layer.w);
+  return Status::OK();
+}
+
+template <typename Scalar>
 ErrorRegression<Scalar>::ErrorRegression(const Model& model, const ErrorRegressionOptions& options)
     : spec_(model.spec),
       options_(options),

@@ -23,6 +23,8 @@ void Replay::Describe(ComponentSpec& spec) {
   spec.Param("topics", std::vector<std::string>{}).Doc("recorded topics, names or regexes; empty: all but dyad/stats");
   spec.YamlParam("remap", "{}").Doc("recorded topic -> topic to publish on, e.g. {human/input: replay/human}");
   spec.Param("speed", 1.0).Min(1e-6).Doc("wall clock: time scale (2 = twice as fast)");
+  spec.Param("start_s", 0.0).Min(0).Unit("s").Doc("skip the first seconds of the recording (counted from its first chosen message)");
+  spec.Param("loop", false).Doc("start over after the last message, until the run ends (no stop request)");
 }
 
 Status Replay::Configure(Context& ctx) {
@@ -30,6 +32,7 @@ Status Replay::Configure(Context& ctx) {
   const Params& p = ctx.params();
   path_ = p.String("file");
   speed_ = p.Double("speed");
+  loop_ = p.Bool("loop");
   auto reader = mcap::Reader::Open(path_);
   if (!reader.ok()) return Status::InvalidArgument("params.file = '" + path_ + "': " + Detail(reader.status().message(), path_));
   if (reader->recovery().truncated) ctx.log().Warn(reader->recovery().Describe());
@@ -100,12 +103,25 @@ Status Replay::Configure(Context& ctx) {
   });
   if (!s.ok()) return Status::DataLoss("params.file = '" + path_ + "': " + Detail(s.message(), path_));
   if (bytes_.size() >= UINT32_MAX / 2) return Status::Unimplemented("params.file = '" + path_ + "': more than 2 GiB of chosen messages");
+  if (Status s = SkipStart(p.Double("start_s")); !s.ok()) return s;
   ctx.log().Info("replaying " + std::to_string(messages_.size()) + " messages on " + std::to_string(topics_.size()) + " topic(s) from " + path_);
   return Status::OK();
 }
 
+// The first message played: the first `start_s` seconds of the recording are skipped.
+Status Replay::SkipStart(double start_s) {
+  begin_ = 0;
+  if (messages_.empty()) return Status::OK();
+  const double skip_ns = start_s * 1e9;
+  const uint64_t first = messages_.front().log_time;
+  while (begin_ < messages_.size() && static_cast<double>(messages_[begin_].log_time - first) < skip_ns) ++begin_;
+  if (begin_ == messages_.size())
+    return Status::InvalidArgument("params.start_s: " + std::to_string(start_s) + " s is past the last chosen message of '" + path_ + "'");
+  return Status::OK();
+}
+
 Status Replay::Activate() {
-  next_ = 0;
+  next_ = begin_;
   start_ns_ = -1;
   done_ = false;
   return Status::OK();
@@ -132,11 +148,15 @@ Status Replay::Step(const StepInfo& info) {
   } else {
     if (start_ns_ < 0) start_ns_ = info.now_ns;
     const double elapsed = static_cast<double>(info.now_ns - start_ns_) * speed_;
-    const uint64_t first = messages_.empty() ? 0 : messages_.front().log_time;
+    const uint64_t first = messages_.empty() ? 0 : messages_[begin_].log_time;
     while (end < messages_.size() && static_cast<double>(messages_[end].log_time - first) <= elapsed) ++end;
   }
   if (Status s = PublishUpTo(end); !s.ok()) return s;
-  if (next_ >= messages_.size()) {
+  if (next_ >= messages_.size() && loop_) {
+    // The next pass starts at the next step (its first message then, as the first pass's did).
+    next_ = begin_;
+    start_ns_ = -1;
+  } else if (next_ >= messages_.size()) {
     done_ = true;
     ctx_->RequestStop("replayed " + std::to_string(messages_.size()) + " messages from " + path_);
   }

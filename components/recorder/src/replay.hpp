@@ -10,13 +10,15 @@
 ///   topics (string list, []): recorded topics, names or regexes; empty: all but dyad/stats.
 ///   remap (yaml, {}): recorded topic -> topic to publish on, e.g. {human/input: replay/human}.
 ///   speed (double, 1.0, > 0): wall clock: time scale (2 = twice as fast).
+///   start_s (double, 0, >= 0): skip the first seconds of the recording (from its first chosen message).
+///   loop (bool, false): start over after the last message until the run ends (never asks it to stop).
 /// @endcomponent
 ///
 /// Messages are published in log-time order as recorded, bytes unchanged (headers keep their
 /// source, sequence and stamp), with the DDS source timestamp set to the recorded publish_time.
 /// Each topic's type must be known to this process with the recorded definition (the channel's
 /// dds_type "name#hash", else the IDL text, must match); otherwise Configure fails naming the topic.
-/// When the last message has been published the component asks the run to stop.
+/// When the last message has been published the component asks the run to stop (unless `loop`).
 /// The chosen messages are loaded into memory in Configure (their uncompressed size).
 #pragma once
 
@@ -44,10 +46,13 @@ class Replay final : public Component {
     uint32_t offset = 0, size = 0;  // in bytes_
   };
   Status PublishUpTo(size_t end);
+  Status SkipStart(double start_s);
 
   Context* ctx_ = nullptr;
   std::string path_;
   double speed_ = 1.0;
+  bool loop_ = false;
+  size_t begin_ = 0;   // the first message played (start_s)
   std::vector<std::string> topics_;  // recorded topic per writer
   std::vector<SerializedWriter*> writers_;  // owned by the runtime
   std::vector<Message> messages_;

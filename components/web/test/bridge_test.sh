@@ -46,7 +46,7 @@ node -e '
 const r = JSON.parse(require("fs").readFileSync("client.json", "utf8"));
 const fail = (m) => { console.error("FAIL: " + m); process.exit(1); };
 const topics = r.channels.map((c) => c.topic).sort().join(",");
-if (topics !== "dyad/stats,robot/command,robot/state") fail("advertised " + topics);
+if (topics !== "dyad/params,dyad/stats,robot/command,robot/state") fail("advertised " + topics);
 for (const c of r.channels) if (c.encoding !== "cdr" || c.schemaEncoding !== "omgidl" || !c.schemaName.startsWith("dyad::msg::")) fail(JSON.stringify(c));
 if (r.samples.length < 100) fail("only " + r.samples.length + " samples in 3 s at 50 Hz");
 if (!r.statuses.some((s) => s.level === 2 && s.message.includes("not writable"))) fail("publish on robot/state was not refused: " + JSON.stringify(r.statuses));

@@ -115,7 +115,9 @@ namespace dyad {
 // 3: ParamSpec::path (relative paths resolved against the graph file), Context::graph_folder().
 // 4: input health (InputBase::writers_alive, writers_gone, deadline_misses).
 // 5: ParamSpec::secret (redacted from Context::graph_yaml()).
-inline constexpr uint32_t kPluginAbiVersion = 5;
+// 6: live parameters: ParamSpec::live, Params::Set, Context::CheckLiveParam; a live param's value
+//    in ctx.params() changes between steps.
+inline constexpr uint32_t kPluginAbiVersion = 6;
 
 // The runtime clock: wall time (ns since the Unix epoch) in `clock: wall` graphs, simulated time
 // (ns since start) in `clock: stepped` graphs. Thread-safe.
@@ -403,6 +405,14 @@ class Context {
   // A writer of `type` on `topic`, with the topic's graph QoS (defaults if not a graph topic).
   // Fails: InvalidArgument (the topic carries another type in this process), Internal (DDS).
   virtual StatusOr<SerializedWriter*> AdvertiseSerialized(const std::string& topic, const TypeInfo& type);
+
+  // Live parameters (params.hpp; ABI 6). In Configure(): a check of new values of the live param
+  // `name` that its declaration cannot express (e.g. a list as long as the model has layers). The
+  // runtime runs it on the step thread at the step boundary, after the declaration's checks and
+  // before the value takes effect; an error refuses the change with its message, and the old
+  // value stays. The default (test fakes of Context) keeps no check.
+  using LiveParamCheck = std::function<Status(const ParamValue& value)>;
+  virtual void CheckLiveParam(const std::string& /*name*/, LiveParamCheck /*check*/) {}
 
   // The port declared under `name` with type T. Asking for an undeclared port or another type is
   // a programming error: it aborts naming the component and port.

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,22 @@ struct IntrospectOptions {
 // a component writes it) and a reader (when one reads it), and every process's participant was
 // discovered, plus 0.2 s for the rest of that discovery burst.
 int ListTopics(const IntrospectOptions& options, std::ostream& out, const Graph* graph = nullptr);
+
+// `dyad graph --live`: the running graphs as discovered (every other participant's writers and
+// readers; the runtime's own dyad/... topics left out) and each topic's rate measured over
+// `listen_s` seconds by a best-effort reader (topics whose type this dyad knows). Discovery ends
+// as ListTopics' does: with `graph`, once its topics and processes are found (`wait_s` at most).
+// Returns 0, or 1 when nothing was found.
+struct LiveGraph {
+  struct Endpoint {
+    std::string participant, topic, type;
+    bool writer = false;
+  };
+  std::vector<Endpoint> endpoints;
+  std::map<std::string, double> rates_hz;  // per topic; absent: not measured (type unknown)
+};
+int DiscoverLiveGraph(const IntrospectOptions& options, const Catalog& catalog, const Graph* graph, double listen_s,
+                      LiveGraph* live, std::ostream& err);
 
 // Turns one serialized sample (CDR with encapsulation) of `type` into text.
 using SamplePrinter = std::function<std::string(const TypeInfo& type, const uint8_t* data, size_t size)>;

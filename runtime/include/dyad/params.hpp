@@ -21,6 +21,14 @@
 // recording) has each secret's value replaced by "<redacted>", and dyad prints it nowhere.
 // (Secret() on any other type is refused when the plugin is loaded.)
 //
+// Live parameters: a parameter marked Live() may be changed while the graph runs (`dyad param
+// set`, the experimenter's page, a param_script; docs/runtime.md "Live parameters"). The new value
+// is validated against the same declaration (type, range, choices) and replaces the old one at a
+// step boundary of the component: between two of its Step() calls, on its step thread, so a
+// component that reads it from ctx.params() in Step() (a map lookup) sees each change at its next
+// step and never mid-step. A value read once in Configure() does not change: mark Live() only what
+// Step() reads. Paths, secrets and kYaml values cannot be live (refused when the plugin is loaded).
+//
 // Values reach the component only after validation, so getters never fail on user input; asking
 // for an undeclared name or the wrong type is a programming error and aborts with a message.
 #pragma once
@@ -59,6 +67,7 @@ struct ParamSpec {
   std::string doc;
   bool path = false;                         // a file or folder (see the file comment)
   bool secret = false;                       // redacted from the graph text (see the file comment)
+  bool live = false;                         // may change while the component runs (see the file comment)
 
   // Builder-style setters used in Describe().
   ParamSpec& Range(double lo, double hi) { min = lo; max = hi; return *this; }
@@ -69,6 +78,7 @@ struct ParamSpec {
   ParamSpec& Doc(std::string d) { doc = std::move(d); return *this; }
   ParamSpec& Path() { path = true; return *this; }
   ParamSpec& Secret() { secret = true; return *this; }
+  ParamSpec& Live() { live = true; return *this; }
 };
 
 // Validated values of one component instance, defaults filled in.
@@ -84,6 +94,8 @@ class Params {
   const std::vector<double>& DoubleList(const std::string& name) const;
   const std::vector<std::string>& StringList(const std::string& name) const;
   bool Has(const std::string& name) const { return values_.count(name) != 0; }
+  // The runtime's, for a live parameter's new (validated) value; components only read.
+  void Set(const std::string& name, ParamValue value) { values_[name] = std::move(value); }
   const std::map<std::string, ParamValue>& values() const { return values_; }
 
  private:

@@ -1,6 +1,6 @@
 // `dyad analyze`: step alignment, event scores and confusion against hand-computed values on a
-// synthetic recording written with the real IDL schemas and CDR; the CLI's report folder (PNG
-// files checked by their magic bytes) and its errors.
+// synthetic recording written with the real IDL schemas and CDR; live parameter changes on the
+// same step grid; the CLI's report folder (PNG files checked by their magic bytes) and its errors.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,6 +15,7 @@
 #include <dyad/msg/types.hpp>
 
 #include "analyze_commands.hpp"
+#include "build_report.hpp"
 #include "dyad/testing/cli.hpp"
 #include "dyad/mcap/writer.hpp"
 #include "demonstrations.hpp"
@@ -393,6 +394,124 @@ TEST(AnalyzeCli, BadInputExitsTwoNamingTheFile) {
   const std::string rec = WriteExperiment(TempPath("exp.mcap"));
   EXPECT_EQ(RunCli({"analyze", rec, "-o", TempPath("r"), "--dataset", TempPath("nope")}, &err), 2);
   EXPECT_NE(err.find("--dataset"), std::string::npos) << err;
+}
+
+// Live parameter changes: human/input at 10 Hz for 20 steps; on dyad/params, mixer.gain applied
+// 1.0 s after the first human sample (the mixer had made 9 steps: the answer's own step count is
+// not the timeline's step) and a refusal, which changed nothing.
+std::string WriteParamChanges(const std::string& path) {
+  auto writer = mcap::Writer::Open(path);
+  EXPECT_TRUE(writer.ok());
+  EXPECT_TRUE(writer->AddMetadata("dyad.graph", {{"yaml", kGraph}}).ok());
+  Channel<msg::HumanInput> human(*writer, "human/input");
+  Channel<msg::ParamChange> params(*writer, "dyad/params");
+  auto answer = [](const std::string& op, const std::string& value, uint64_t step) {
+    msg::ParamChange a;
+    a.header().source("dyad/main");
+    a.graph_name("unit"); a.component_name("mixer"); a.param_name("gain"); a.op(op); a.value(value);
+    a.request_id(op); a.step(step);
+    return a;
+  };
+  for (int t = 0; t < 20; ++t) {
+    msg::HumanInput h; h.x(t); h.y(-t);
+    human.Write(h, t);
+    if (t == 10) {
+      msg::ParamChange applied = answer("applied", "0.2", 9);
+      applied.old_value("0.9"); applied.who("dyad param set (ana@lab-pc)");
+      params.Write(applied, t);
+    }
+    if (t == 14) {
+      msg::ParamChange refused = answer("refused", "7", 13);
+      refused.who("experimenter page"); refused.reason("7 is above the maximum 1");
+      params.Write(refused, t);
+    }
+  }
+  EXPECT_TRUE(writer->Close().ok());
+  return path;
+}
+
+std::vector<std::string> Lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(AnalyzeParams, AnAppliedChangeIsPlacedOnTheTimelinesStepGrid) {
+  std::ostringstream warnings;
+  auto r = BuildReport(WriteParamChanges(TempPath("p.mcap")), warnings);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(warnings.str(), "");
+  ASSERT_EQ(r->param_changes.size(), 1u);  // the refusal is not a change
+  const ParamChangeEvent& c = r->param_changes[0];
+  EXPECT_EQ(c.step, 10);
+  EXPECT_DOUBLE_EQ(c.time_s, 1.0);
+  EXPECT_EQ(c.component, "mixer");
+  EXPECT_EQ(c.param, "gain");
+  EXPECT_EQ(c.old_value, "0.9");
+  EXPECT_EQ(c.value, "0.2");
+  EXPECT_EQ(c.who, "dyad param set (ana@lab-pc)");
+  ASSERT_TRUE(r->timeline.t0_ns.has_value());
+  EXPECT_EQ(*r->timeline.t0_ns, 1'000'000'000);
+
+  const std::string dir = TempPath("report");
+  ASSERT_TRUE(WriteReport(*r, dir).ok());
+  EXPECT_EQ(Lines(dir + "/params.csv"), (std::vector<std::string>{"step,time_s,component,param,old_value,value,who",
+                                                                    "10,1.000,mixer,gain,0.9,0.2,dyad param set (ana@lab-pc)"}));
+  const std::string md = FormatMarkdown(*r);
+  const auto section = md.find("## Live parameter changes\n\n| time | component.param | old -> new | who |\n");
+  ASSERT_NE(section, std::string::npos) << md;
+  EXPECT_NE(md.find("| 1.000 s (step 10) | mixer.gain | 0.9 -> 0.2 | dyad param set (ana@lab-pc) |\n", section),
+            std::string::npos) << md;
+  EXPECT_NE(md.find("applied at the component's step boundary", section), std::string::npos) << md;
+  EXPECT_EQ(md.find("| 7"), std::string::npos) << md;  // refused: not shown
+}
+
+// The answer is stamped by its writer's process ("dyad/main"): when the timeline moves stamps of
+// that process onto the recorder's clock, the change moves with them.
+TEST(AnalyzeParams, AChangeGetsTheClockCorrectionOfItsWritersProcess) {
+  auto reader = mcap::Reader::Open(WriteParamChanges(TempPath("p.mcap")));
+  ASSERT_TRUE(reader.ok());
+  auto tables = ReadTables(*reader, {});
+  ASSERT_TRUE(tables.ok()) << tables.status().ToString();
+  auto plan = PlanFromGraphYaml(kGraph);
+  ASSERT_TRUE(plan.ok());
+  auto timeline = BuildTimeline(*tables, *plan, {{"main", 200'000'000}});  // main's clock 2 steps ahead
+  ASSERT_TRUE(timeline.ok()) << timeline.status().ToString();
+  auto changes = AppliedParamChanges(*tables, *plan, *timeline);
+  ASSERT_TRUE(changes.ok()) << changes.status().ToString();
+  ASSERT_EQ(changes->size(), 1u);
+  EXPECT_EQ((*changes)[0].step, 8);
+  EXPECT_DOUBLE_EQ((*changes)[0].time_s, 0.8);
+}
+
+// No dyad/params: no list, no warning, no file, no section; a params.csv of an earlier report in
+// the same folder is removed (the plots would draw it). Cells with commas and quotes are quoted.
+TEST(AnalyzeParams, WithoutChangesThereIsNoTableAndCellsAreQuoted) {
+  std::ostringstream warnings;
+  auto r = BuildReport(WriteExperiment(TempPath("a.mcap")), warnings);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_TRUE(r->param_changes.empty());
+  EXPECT_EQ(warnings.str(), "");
+  EXPECT_EQ(FormatMarkdown(*r).find("Live parameter changes"), std::string::npos);
+  const std::string dir = TempPath("report");
+  Report with = *r;
+  with.param_changes.push_back({12, 1.2, "mind", "meta_prior", "[1, 1]", "[0.5, 2]", "page \"lab\""});
+  ASSERT_TRUE(WriteReport(with, dir).ok());
+  EXPECT_EQ(Lines(dir + "/params.csv").at(1), "12,1.200,mind,meta_prior,\"[1, 1]\",\"[0.5, 2]\",\"page \"\"lab\"\"\"");
+  ASSERT_TRUE(WriteReport(*r, dir).ok());
+  EXPECT_FALSE(std::filesystem::exists(dir + "/params.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/report.md"));
+}
+
+// `dyad analyze` end to end with a change: params.csv is written and plot_report.py draws it.
+TEST(AnalyzeCli, DrawsThePlotsWithParameterChanges) {
+  const std::string rec = WriteParamChanges(TempPath("p.mcap"));
+  const std::string out = TempPath("report");
+  const std::string cmd = std::string(DYAD_BIN_DIR) + "/dyad analyze " + rec + " -o " + out + " > " + out + ".log 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << Head(out + ".log", 4000);
+  EXPECT_EQ(Lines(out + "/params.csv").size(), 2u);
+  for (const char* f : {"nelbo.png", "congruence.png"}) EXPECT_EQ(Head(out + "/" + f, 8), "\x89PNG\r\n\x1a\n") << f;
 }
 
 }  // namespace

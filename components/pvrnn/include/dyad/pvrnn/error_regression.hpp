@@ -128,6 +128,11 @@ class ErrorRegression {
   const StepResult& Step(const double* executed,
                          SteadyClock::time_point deadline = SteadyClock::time_point::max());
 
+  // Changes the optimiser's iterations per step and the online meta-prior between two steps (a
+  // deliberator's live parameters); empty `meta_prior`: the model's training w. Checked as
+  // Create checks them (the error names the field); on error nothing changes.
+  Status Retune(int iterations, const std::vector<double>& meta_prior);
+
   const double* intention() const { return intention_.data(); }
   const StepResult& last() const { return result_; }
   const ErrorRegressionOptions& options() const { return options_; }

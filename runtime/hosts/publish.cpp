@@ -1,0 +1,137 @@
+// `dyad pub` (dyad/guest.hpp): one topic's samples, published by a guest.
+#include <unistd.h>
+
+#include <chrono>
+#include <ostream>
+#include <set>
+#include <thread>
+
+#include "dyad/guest.hpp"
+#include "dyad/interrupt.hpp"
+#include "dyad/join_list.hpp"
+#include "dyad/validate.hpp"
+#include "exec/wall_clock.hpp"
+#include "graph/graph_topics.hpp"
+#include "hosts/watcher_join.hpp"
+
+namespace dyad {
+namespace {
+
+class WallClock final : public Clock {
+ public:
+  int64_t now_ns() const override { return WallNowNs(); }
+};
+
+// The topic's type (and QoS) from the graph, the name given or its discovered endpoints; null
+// after saying why.
+const TypeInfo* TopicType(const PublishOptions& o, const Catalog& catalog, DdsParticipant& participant, TopicQos* qos,
+                          const InterruptWatcher& interrupt, std::ostream& err) {
+  if (o.watched != nullptr) {
+    std::vector<Diagnostic> diags;
+    const ResolvedGraph resolved = ValidateGraph(*o.watched, catalog, &diags);
+    for (const auto& d : diags) err << d.ToString() << "\n";
+    if (!diags.empty()) return nullptr;
+    auto it = resolved.topics.find(o.topic);
+    if (it == resolved.topics.end()) {
+      std::vector<std::string> names;
+      for (const auto& [name, t] : resolved.topics) names.push_back(name);
+      err << "dyad pub: graph '" << o.watched->name << "' has no topic '" << o.topic << "' (its topics: " << JoinList(names) << ")\n";
+      return nullptr;
+    }
+    *qos = QosOf(it->second);
+    return it->second.type;
+  }
+  if (!o.type_name.empty()) {
+    const TypeInfo* type = catalog.FindMessageType(o.type_name);
+    if (type == nullptr) err << "dyad pub: --type " << o.type_name << ": no message type of that name (dyad types --messages lists them)\n";
+    return type;
+  }
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.watch.wait_s);
+  while (std::chrono::steady_clock::now() < end && !interrupt.interrupted()) {
+    for (const auto& e : participant.Discovered())
+      if (e.topic == o.topic) return ResolveType(catalog, e.type, o.topic, err);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (!interrupt.interrupted())
+    err << "dyad pub: no endpoint of topic '" << o.topic << "' found on domain " << o.watch.domain_id << " within " << o.watch.wait_s
+        << " s to take its type from: give --graph or --type\n";
+  return nullptr;
+}
+
+// The participants whose readers the first sample waits for: with the graph, its processes that
+// read the topic (named ".../<graph>/<process>"); without, anyone's ("": any reader).
+std::set<std::string> ExpectedReaders(const PublishOptions& o) {
+  if (o.watched == nullptr) return {""};
+  std::set<std::string> names;
+  for (const auto& c : o.watched->components)
+    for (const auto& port : c.inputs)
+      if (port.topic == o.topic) names.insert("/" + o.watched->name + "/" + o.watched->ProcessOf(c));
+  return names.empty() ? std::set<std::string>{""} : names;
+}
+
+// Waits up to wait_s for those readers of the topic, then for matching.
+void AwaitReaders(const PublishOptions& o, DdsParticipant& participant, const InterruptWatcher& interrupt, std::ostream& err) {
+  std::set<std::string> missing = ExpectedReaders(o);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.watch.wait_s);
+  while (!missing.empty() && std::chrono::steady_clock::now() < end && !interrupt.interrupted()) {
+    for (const auto& e : participant.Discovered())
+      if (!e.writer && e.topic == o.topic)
+        std::erase_if(missing, [&](const std::string& suffix) { return e.participant.ends_with(suffix); });
+    if (!missing.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (interrupt.interrupted()) return;
+  if (missing.empty())
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  else
+    err << "warning: dyad pub: no reader of '" << o.topic << "'" << (missing.count("") ? "" : " in the graph's processes (" + JoinList(missing) + ")")
+        << " discovered within " << o.watch.wait_s << " s; publishing anyway\n";
+}
+
+}  // namespace
+
+int PublishTopic(const PublishOptions& o, const Catalog& catalog, const SampleMaker& make_sample, std::ostream& out,
+                 std::ostream& err) {
+  InterruptWatcher interrupt;
+  std::unique_ptr<DdsParticipant> participant = JoinAsWatcher(o.watch, "dyad/guest/pub/" + std::to_string(getpid()), err);
+  if (!participant) return 1;
+  TopicQos qos;
+  const TypeInfo* type = TopicType(o, catalog, *participant, &qos, interrupt, err);
+  if (interrupt.interrupted()) return ExitCodeForSignal(interrupt.signal());
+  if (type == nullptr) return 2;
+  StatusOr<std::vector<uint8_t>> sample = make_sample(*type, 0);
+  if (!sample.ok()) {
+    err << "dyad pub: " << sample.status().message() << "\n";
+    return 2;
+  }
+  WallClock clock;
+  auto writer = participant->CreateSerializedWriter(o.topic, *type, qos, &clock);
+  if (!writer.ok()) {
+    err << "dyad pub: " << writer.status().message() << "\n";
+    return 1;
+  }
+  AwaitReaders(o, *participant, interrupt, err);
+  const auto period = std::chrono::duration<double>(o.rate_hz > 0 ? 1.0 / o.rate_hz : 0.0);
+  const auto start = std::chrono::steady_clock::now();
+  uint64_t written = 0;
+  for (; (o.count == 0 || written < o.count) && !interrupt.interrupted(); ++written) {
+    if (written > 0) {
+      sample = make_sample(*type, written);
+      if (!sample.ok()) {
+        err << "dyad pub: sample " << written << ": " << sample.status().message() << "\n";
+        return 2;
+      }
+      std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period * written));
+      if (interrupt.interrupted()) break;
+    }
+    if (Status s = (*writer)->Write(*sample, -1); !s.ok()) {
+      err << "dyad pub: " << s.message() << "\n";
+      return 1;
+    }
+  }
+  out << "dyad pub: " << written << " sample" << (written == 1 ? "" : "s") << " of " << type->name << " on " << o.topic << "\n";
+  participant.reset();  // its writer waits for the readers' acknowledgements first (0.5 s at most)
+  if (interrupt.interrupted() && o.count != 0) return ExitCodeForSignal(interrupt.signal());
+  return 0;
+}
+
+}  // namespace dyad
