@@ -12,6 +12,7 @@
 #include <set>
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -22,6 +23,7 @@
 #include <dyad/pvrnn/dataset.hpp>
 #include <dyad/topic_select.hpp>
 
+#include "encode_sample.hpp"
 #include "pages.hpp"
 #include "web_human.hpp"
 
@@ -104,6 +106,15 @@ void AddEvent(RunEvents& events, const SerializedSample& sample) {
   events.Add(m, std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
 }
 
+namespace {
+// A sample of dyad/params into the experimenter's list of answers.
+void AddAnswer(ParamAnswers& answers, const SerializedSample& sample) {
+  msg::ParamChange m;
+  if (!DecodeSample(sample.cdr, &m).ok()) return;
+  answers.Add(m, std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
+}
+}  // namespace
+
 void WebComponent::Describe(ComponentSpec& spec) {
   spec.Summary("Embedded web server with a live Foxglove WebSocket bridge over the graph's topics.");
   spec.Param("address", "127.0.0.1").Doc("address to bind; anything but loopback needs tls_certificate (or plain_http)");
@@ -150,7 +161,15 @@ Status WebComponent::Configure(Context& ctx) {
   if (Status s = ChooseTokens(p); !s.ok()) return s;
   if (Status s = ChooseTls(p); !s.ok()) return s;
   port_file_ = p.String("port_file");
+  if (Status s = ConfigureBridge(ctx, p); !s.ok()) return s;
+  if (Status s = ConfigureSubject(ctx, p); !s.ok()) return s;
+  if (Status s = ConfigureExperimenter(ctx); !s.ok()) return s;
+  ConfigurePages();
+  return Status::OK();
+}
 
+// The Foxglove bridge: the advertised topics (read while a client subscribes) and the writable ones.
+Status WebComponent::ConfigureBridge(Context& ctx, const Params& p) {
   std::vector<std::string> names;
   for (const auto& t : ctx.graph_topics()) names.push_back(t.name);
   auto chosen = SelectTopics(p.StringList("topics"), names, "params.topics");
@@ -176,7 +195,19 @@ Status WebComponent::Configure(Context& ctx) {
   }
 
   bridge_ = std::make_unique<FoxgloveBridge>("dyad/" + ctx.graph_name(), channels, std::move(writers));
+  // Read only while a client subscribes (the bridge starts and stops them).
+  FoxgloveBridge* bridge = bridge_.get();
+  for (const auto& c : channels) {
+    const uint32_t id = c.id;
+    auto sub = SubscribeSerializedOnDemand(ctx, c.topic, [bridge, id](const SerializedSample& sample) { bridge->OnSample(id, sample); });
+    if (!sub.ok()) return sub.status().WithContext("params.topics: '" + c.topic + "'");
+    bridge_->SetSubscription(id, *sub);
+  }
+  return Status::OK();
+}
 
+// The subject's page: the robot's state to it, its pointer to `pointer`.
+Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
   SubjectChannel::Options so;
   so.engage_key = p.String("engage_key");
   so.half_width = p.Double("half_width");
@@ -200,18 +231,29 @@ Status WebComponent::Configure(Context& ctx) {
     // Serialised by SubjectChannel (component.hpp: one Output's Publish calls must not overlap).
     if (Status s = pointer_->Publish(pointer_sample_); !s.ok()) ctx_->log().Warn("pointer: " + s.ToString());
   });
+  return Status::OK();
+}
 
+// The experimenter's page: series, notes, live parameters, stats, run events.
+Status WebComponent::ConfigureExperimenter(Context& ctx) {
   intention_ = &ctx.input<msg::Intention>("intention");
   labels_ = &ctx.input<msg::IntentionLabel>("labels");
   notes_ = &ctx.output<msg::Annotation>("notes");
-  experimenter_ = std::make_unique<ExperimenterChannel>([this](const std::string& text) {
-    note_.author("experimenter");
-    note_.text(text);
-    // Serialised by ExperimenterChannel.
-    if (Status s = notes_->Publish(note_); !s.ok()) ctx_->log().Warn("notes: experimenter's note lost: " + s.ToString());
-  });
+  // Requests are written as the page asks (a generic writer: the runtime's topic, not a port to bind).
+  auto requests = ctx.AdvertiseSerialized("dyad/param_requests", TypeInfoOf<msg::ParamChange>());
+  if (!requests.ok()) return requests.status().WithContext("live parameters");
+  param_requests_ = *requests;
+  experimenter_ = std::make_unique<ExperimenterChannel>(
+      [this](const std::string& text) {
+        note_.author("experimenter");
+        note_.text(text);
+        // Serialised by ExperimenterChannel.
+        if (Status s = notes_->Publish(note_); !s.ok()) ctx_->log().Warn("notes: experimenter's note lost: " + s.ToString());
+      },
+      [this](const ParamRequest& request) { return PublishParamRequest(request); });
   stats_ = std::make_shared<StatsTable>(GraphsComponents(ctx));
   events_ = std::make_shared<RunEvents>();
+  answers_ = std::make_shared<ParamAnswers>(ctx.graph_name());
   for (const auto& t : ctx.graph_topics()) {
     Status s;
     if (t.name == "dyad/stats") {
@@ -221,10 +263,15 @@ Status WebComponent::Configure(Context& ctx) {
       s = ctx.SubscribeSerialized(t.name, [events = events_](const SerializedSample& sample) { AddEvent<msg::ProcessState>(*events, sample); });
     } else if (t.name == "dyad/health") {
       s = ctx.SubscribeSerialized(t.name, [events = events_](const SerializedSample& sample) { AddEvent<msg::HealthEvent>(*events, sample); });
+    } else if (t.name == "dyad/params") {
+      s = ctx.SubscribeSerialized(t.name, [answers = answers_](const SerializedSample& sample) { AddAnswer(*answers, sample); });
     }
     if (!s.ok()) return s;
   }
+  return Status::OK();
+}
 
+void WebComponent::ConfigurePages() {
   const std::set<Role> everyone = {Role::kViewer, Role::kSubject, Role::kExperimenter};
   const std::set<Role> watchers = {Role::kViewer, Role::kExperimenter};  // not the subject: no stats, no notes
   const std::string html = "text/html; charset=utf-8";
@@ -237,15 +284,32 @@ Status WebComponent::Configure(Context& ctx) {
       WebServer::Endpoint{"/subject/ws", {}, subject_.get(), everyone, /*viewers=*/false},
       WebServer::Endpoint{"/experimenter/ws", {}, experimenter_.get(), watchers},
   };
-  // Read only while a client subscribes (the bridge starts and stops them).
-  FoxgloveBridge* bridge = bridge_.get();
-  for (const auto& c : channels) {
-    const uint32_t id = c.id;
-    auto sub = SubscribeSerializedOnDemand(ctx, c.topic, [bridge, id](const SerializedSample& sample) { bridge->OnSample(id, sample); });
-    if (!sub.ok()) return sub.status().WithContext("params.topics: '" + c.topic + "'");
-    bridge_->SetSubscription(id, *sub);
+}
+
+// On a web server thread, one at a time (ExperimenterChannel serialises its sinks).
+StatusOr<std::string> WebComponent::PublishParamRequest(const ParamRequest& r) {
+  const uint64_t n = param_request_.header().sequence_number() + 1;
+  const int64_t now = ctx_->clock().now_ns();
+  param_request_.header().source(ctx_->name());
+  param_request_.header().sequence_number(n);
+  param_request_.header().stamp_ns(now);
+  param_request_.graph_name(ctx_->graph_name());
+  param_request_.component_name(r.component);
+  param_request_.param_name(r.param);
+  param_request_.op(r.set ? "set" : "get");
+  param_request_.value(r.set ? r.value : "");
+  param_request_.who("experimenter page");
+  // Unique across runs and processes: this process, its clock, its count.
+  param_request_.request_id("experimenter page/" + std::to_string(getpid()) + "/" + std::to_string(now) + "/" + std::to_string(n));
+  const std::vector<uint8_t> cdr = EncodeSample(param_request_);
+  if (cdr.empty()) return Status::Internal("the request did not encode");
+  if (Status s = param_requests_->Write(cdr, now); !s.ok()) {
+    ctx_->log().Warn("live parameters: " + r.component + "." + r.param + ": request not published: " + s.ToString());
+    return s;
   }
-  return Status::OK();
+  ctx_->log().Info("live parameters: asked " + r.component + "." + r.param + (r.set ? " = " + r.value : " (get)") +
+                   " (experimenter page, " + param_request_.request_id() + ")");
+  return param_request_.request_id();
 }
 
 Status WebComponent::Activate() {
@@ -292,6 +356,7 @@ Status WebComponent::Step(const StepInfo& info) {
     last_stats_ns_ = info.now_ns;
     experimenter_->Broadcast(2, stats_->Json());
     if (std::string events = events_->Json(); !events.empty()) experimenter_->Broadcast(3, std::move(events));
+    if (std::string answers = answers_->Json(); !answers.empty()) experimenter_->Broadcast(4, std::move(answers));
   }
   bridge_->ReportDrops();
   return Status::OK();

@@ -7,7 +7,8 @@
 /// (then it speaks TLS with `tls_certificate`). Every page and WebSocket needs a token, one per
 /// role: the subject's opens the subject's page and steers; the viewer's watches (subject's page,
 /// experimenter's page without notes, Foxglove read-only); the experimenter's opens everything,
-/// writes notes and publishes on `writable` topics. Its Step (its own rate, the
+/// writes notes, changes live parameters (dyad/param_requests, answers from dyad/params) and
+/// publishes on `writable` topics. Its Step (its own rate, the
 /// pages' display rate, <= 60 Hz) sends the robot's newest position to the subject's pages and
 /// reports dropped samples to Foxglove clients; samples reach the bridge through serialized
 /// subscriptions and pointer samples leave on `pointer` as they come: nothing here ever waits
@@ -25,6 +26,7 @@
 
 #include "src/experimenter_channel.hpp"
 #include "src/foxglove_bridge.hpp"
+#include "src/param_answers.hpp"
 #include "src/run_events.hpp"
 #include "src/stats_table.hpp"
 #include "src/subject_channel.hpp"
@@ -42,6 +44,11 @@ class WebComponent final : public Component {
 
  private:
   void LogPointerDelays();
+  Status ConfigureBridge(Context& ctx, const Params& p);
+  Status ConfigureSubject(Context& ctx, const Params& p);
+  Status ConfigureExperimenter(Context& ctx);
+  void ConfigurePages();
+  StatusOr<std::string> PublishParamRequest(const ParamRequest& request);  // ExperimenterChannel's param sink
   Context* ctx_ = nullptr;
   WebServer::Options options_;
   std::string port_file_;
@@ -60,6 +67,9 @@ class WebComponent final : public Component {
   std::unique_ptr<ExperimenterChannel> experimenter_;
   std::shared_ptr<StatsTable> stats_;  // filled by the dyad/stats subscription
   std::shared_ptr<RunEvents> events_;  // filled by the dyad/processes and dyad/health subscriptions
+  std::shared_ptr<ParamAnswers> answers_;  // filled by the dyad/params subscription
+  SerializedWriter* param_requests_ = nullptr;  // dyad/param_requests; owned by the runtime
+  msg::ParamChange param_request_;              // the last request (its header's sequence number)
   int64_t last_stats_ns_ = 0;
   msg::Annotation note_;
   std::unique_ptr<FoxgloveBridge> bridge_;

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Live parameters from the experimenter's page, in Debian's Chromium (playwright-core): the page
+# sets the mixer's gain (applied, 0.9 -> 0.25), asks for 7 (refused by the mixer's process), gets
+# it, and a viewer's page that asks is closed (components/web/test/node/experimenter_params.mjs);
+# the recording then holds the change, who made it, and the mixer's commands before and after it.
+#   experimenter_params_test.sh BUILD_DIR WORK_DIR FIXED_INPUTS_PLUGIN
+set -euo pipefail
+build=$1
+work=$2
+plugin=$3
+node_dir=$(cd "$(dirname "$0")" && pwd)/node
+if [ ! -d "$node_dir/node_modules" ] || [ ! -x /usr/bin/chromium ]; then
+  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
+fi
+rm -rf "$work"; mkdir -p "$work"; cd "$work"
+# The mixer between fixed inputs (human at x = 10, robot at x = 0): its command's x is 10 * gain.
+cat > graph.yaml <<YAML
+graph: experimenter_params
+clock: wall
+domain_id: $(( 1 + $$ % 200 ))
+plugins: [$plugin]
+components:
+  web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port, token: experimenter-token-0001, subject_token: subject-token-000001, viewer_token: viewer-token-0000001}, outputs: {pointer: web/pointer}}
+  inputs: {type: fixed_inputs, rate_hz: 10, outputs: {human: human/input, robot: robot/intention}}
+  mixer: {type: compliance_mixer, rate_hz: 10, params: {max_step: 0, max_speed: 0}, inputs: {human: human/input, robot: robot/intention}, outputs: {command: robot/command}}
+  rec: {type: recorder, rate_hz: 10, params: {file: rec.mcap}}
+YAML
+"$build/bin/dyad" run graph.yaml --duration 30 > run.out 2> run.err &
+pid=$!
+for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
+[ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
+node "$node_dir/experimenter_params.mjs" "http://127.0.0.1:$(cat web.port)" "$work" || { kill -INT $pid; wait $pid || true; cat run.err; exit 1; }
+kill -INT $pid
+wait $pid || true
+"$build/bin/dyad" bag export rec.mcap --csv csv > csv.out 2>&1 || { cat csv.out; echo "FAIL: dyad bag export"; exit 1; }
+# The recording: the applied change (and the refusal, and the get), each from the page; the
+# mixer's commands at 9 (gain 0.9), then at 2.5.
+python3 - csv <<'PY'
+import csv, sys
+d = sys.argv[1]
+rows = list(csv.DictReader(open(d + "/dyad_params.csv")))
+got = [(r["op"], r["component_name"] + "." + r["param_name"], r["old_value"], r["value"], r["reason"], r["who"]) for r in rows]
+want = [("applied", "mixer.gain", "0.9", "0.25", "", "experimenter page"),
+        ("refused", "mixer.gain", "", "7", "must be <= 1, got 7", "experimenter page"),
+        ("value", "mixer.gain", "", "0.25", "", "experimenter page")]
+if got != want:
+    sys.exit("FAIL: dyad_params.csv holds %s, expected %s" % (got, want))
+xs = [float(r["x"]) for r in csv.DictReader(open(d + "/robot_command.csv"))]
+if not xs or xs[0] != 9.0 or xs[-1] != 2.5:
+    sys.exit("FAIL: the mixer's commands went from %s to %s, expected 9 then 2.5" % (xs[:1], xs[-1:]))
+print("recorded: %s; commands %g -> %g" % (got[0], xs[0], xs[-1]))
+PY
