@@ -156,8 +156,6 @@ void SummarySection(const Report& r, std::ostream& s) {
     for (const std::string& t : r.timeline.missing_topics) s << " `" << t << "`";
     s << "\n";
   }
-  // A partition or a stalled writer shows here before it skews a number below.
-  if (!r.transport.empty()) s << "\n## Transport: what the recording lost, what the runtime healed\n\n```\n" << r.transport << "```\n\n";
   std::vector<double> opt_ms, c_engaged, c_free, nelbo;
   int64_t engaged_steps = 0;
   for (const StepSample& x : r.timeline.steps) {
@@ -189,6 +187,9 @@ void SummarySection(const Report& r, std::ostream& s) {
     const size_t n = r.plan.events.size() - r.events.size();
     s << "- " << n << " planned event" << (n == 1 ? "" : "s") << " after the end of the recording (not scored)\n";
   }
+  // A partition or a stalled writer shows here, before the tables whose numbers it would skew
+  // (after the bullets: a heading between them put the last bullets under it).
+  if (!r.transport.empty()) s << "\n## Transport: what the recording lost, what the runtime healed\n\n```\n" << r.transport << "```\n";
 }
 
 void EventsSection(const Report& r, std::ostream& s) {

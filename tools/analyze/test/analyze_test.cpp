@@ -324,6 +324,9 @@ TEST(Analyze, TheTransportSectionComesBeforeTheScores) {
   ASSERT_NE(at, std::string::npos) << md;
   EXPECT_NE(md.find("3 missing\n```\n"), std::string::npos) << md;
   EXPECT_LT(at, md.find("| ")) << md;
+  // After the summary's bullets, not among them (a heading there put the last bullets under it).
+  EXPECT_LT(md.find("- congruence P(C_t): "), at) << md;
+  EXPECT_LT(md.find("- engaged steps: "), at) << md;
 }
 
 TEST(Analyze, CellParsersRejectWhatIsNotANumber) {
