@@ -84,7 +84,8 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
   }
   void on_publisher_discovery(fdds::DomainParticipant*, rtps::WriterDiscoveryInfo&& info) override {
     const bool gone = info.status == rtps::WriterDiscoveryInfo::REMOVED_WRITER;
-    Track(true, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid());
+    Track(true, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid(),
+          PartitionsMatch(owner_->partitions_, info.info.m_qos.m_partition.names()));
     if (info.status != rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) return;
     const std::string topic = info.info.topicName().to_string();
     if (!PartitionsMatch(owner_->partitions_, info.info.m_qos.m_partition.names())) {
@@ -95,7 +96,8 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
   }
   void on_subscriber_discovery(fdds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override {
     const bool gone = info.status == rtps::ReaderDiscoveryInfo::REMOVED_READER;
-    Track(false, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid());
+    Track(false, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid(),
+          PartitionsMatch(owner_->partitions_, info.info.m_qos.m_partition.names()));
     if (info.status != rtps::ReaderDiscoveryInfo::DISCOVERED_READER) return;
     if (!PartitionsMatch(owner_->partitions_, info.info.m_qos.m_partition.names())) return;
     Check("reader", info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid().guidPrefix);
@@ -167,7 +169,8 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
                 PartitionText(owner_->partitions_));
   }
 
-  void Track(bool writer, bool gone, const std::string& topic, const std::string& type, const rtps::GUID_t& guid) {
+  void Track(bool writer, bool gone, const std::string& topic, const std::string& type, const rtps::GUID_t& guid,
+             bool same_partition) {
     std::ostringstream os;
     os << guid;
     std::lock_guard<std::mutex> lock(mutex_);
@@ -175,7 +178,7 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
       endpoints_.erase(os.str());
       return;
     }
-    endpoints_[os.str()] = DiscoveredEndpoint{writer, topic, type, GuidPrefixString(guid.guidPrefix), os.str()};
+    endpoints_[os.str()] = DiscoveredEndpoint{writer, topic, type, GuidPrefixString(guid.guidPrefix), os.str(), same_partition};
   }
 
   DdsParticipant* owner_;
@@ -1034,6 +1037,27 @@ StatusOr<SerializedWriter*> DdsParticipant::CreateSerializedWriter(const std::st
   if (w->writer_ == nullptr) return Status::Internal("cannot create writer on topic '" + topic + "'" + SecurityHint("publish"));
   serialized_writers_.push_back(std::move(w));
   return serialized_writers_.back().get();
+}
+
+int DdsParticipant::MatchedReadersOf(const std::string& topic) const {
+  int most = 0;
+  for (const auto& w : writers_)
+    if (w->topic_ == topic) most = std::max(most, w->matched());
+  for (const auto& w : serialized_writers_)
+    if (w->topic_ == topic) {
+      std::lock_guard<std::mutex> lock(w->mutex_);
+      most = std::max(most, WriterMatched(w->writer_));
+    }
+  return most;
+}
+
+int DdsParticipant::MatchedWritersOf(const std::string& topic) const {
+  int most = 0;
+  for (const auto& r : readers_)
+    if (r->topic() == topic) most = std::max(most, r->Matched());
+  for (const auto& r : serialized_readers_)
+    if (r->topic() == topic && r->exists()) most = std::max(most, r->Matched());
+  return most;
 }
 
 }  // namespace dyad

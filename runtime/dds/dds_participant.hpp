@@ -207,6 +207,7 @@ struct DiscoveredEndpoint {
   std::string type;         // DDS type name ("name#hash" for dyad types)
   std::string participant;  // its participant's name
   std::string guid;
+  bool same_partition = true;  // shares a partition with this participant: DDS may match it with ours
 };
 
 class DdsParticipant final : public Transport {
@@ -279,6 +280,12 @@ class DdsParticipant final : public Transport {
   const std::string& name() const { return name_; }
   // Every remote (or local) endpoint discovered so far that is still alive.
   std::vector<DiscoveredEndpoint> Discovered() const;
+  // The most readers one of this participant's writers of `topic` is matched with, and the most
+  // writers one of its readers of `topic` is matched with; 0 when it has none there. Discovery
+  // comes before matching: a guest waits on these before its first sample (from the thread that
+  // creates the endpoints).
+  int MatchedReadersOf(const std::string& topic) const;
+  int MatchedWritersOf(const std::string& topic) const;
 
  private:
   class DiscoveryListener;

@@ -7,9 +7,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <ostream>
-#include <set>
 #include <thread>
 
 #include "dyad/interrupt.hpp"
@@ -41,7 +41,7 @@ class GuestSession final : public ProcessSession {
       std::fprintf(stderr, "warning: %s: not discovered within %g s: %s; going on\n", o_.label.c_str(), o_.watch.wait_s,
                    JoinList(missing).c_str());
     else
-      std::this_thread::sleep_for(std::chrono::milliseconds(250));  // the rest of the discovery burst: matching
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the rest of that burst: another reader, say
     start_ns_ = WallNowNs();
     return start_ns_;
   }
@@ -53,15 +53,18 @@ class GuestSession final : public ProcessSession {
   bool shared_start() const override { return false; }
 
  private:
-  // "a writer of T" / "a reader of T" for every awaited endpoint not discovered yet.
+  // "a writer of T" / "a reader of T" for every awaited endpoint not matched yet with the
+  // guest's own (discovered is not enough: a sample written between the two is lost to it).
+  // Every endpoint discovered in the guest's partitions counts (at least one per topic).
   std::vector<std::string> Missing() const {
-    std::set<std::pair<std::string, bool>> seen;  // (topic, writer)
-    for (const auto& e : participant_->Discovered()) seen.insert({e.topic, e.writer});
+    std::map<std::pair<std::string, bool>, int> discovered;  // (topic, writer) -> endpoints
+    for (const auto& e : participant_->Discovered())
+      if (e.same_partition && e.participant != participant_->name()) ++discovered[{e.topic, e.writer}];
     std::vector<std::string> missing;
     for (const auto& t : o_.await_writers)
-      if (!seen.count({t, true})) missing.push_back("a writer of " + t);
+      if (participant_->MatchedWritersOf(t) < std::max(1, discovered[{t, true}])) missing.push_back("a writer of " + t);
     for (const auto& t : o_.await_readers)
-      if (!seen.count({t, false})) missing.push_back("a reader of " + t);
+      if (participant_->MatchedReadersOf(t) < std::max(1, discovered[{t, false}])) missing.push_back("a reader of " + t);
     return missing;
   }
   const DdsParticipant* participant_;

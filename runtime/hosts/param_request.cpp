@@ -64,7 +64,8 @@ std::string CheckAgainstGraph(const ParamRequest& r, const Catalog& catalog, std
   return r.watched->ProcessOf(*rc->config);
 }
 
-// Waits until the process's reader of the requests and writer of the answers are discovered.
+// Waits until the process's reader of the requests and writer of the answers are discovered and
+// matched with this participant's writer and reader.
 bool AwaitProcess(DdsParticipant& participant, const std::string& suffix, double wait_s, const InterruptWatcher& interrupt) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_s);
   while (std::chrono::steady_clock::now() < end && !interrupt.interrupted()) {
@@ -74,10 +75,10 @@ bool AwaitProcess(DdsParticipant& participant, const std::string& suffix, double
       reader = reader || (!e.writer && e.topic == runtime_topics::kParamRequests.name);
       writer = writer || (e.writer && e.topic == runtime_topics::kParams.name);
     }
-    if (reader && writer) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(250));  // the rest of the burst: matching
+    // Discovered, then matched with ours (a request written before the match would be lost).
+    if (reader && writer && participant.MatchedReadersOf(runtime_topics::kParamRequests.name) > 0 &&
+        participant.MatchedWritersOf(runtime_topics::kParams.name) > 0)
       return true;
-    }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   return false;

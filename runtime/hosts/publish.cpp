@@ -69,22 +69,34 @@ std::set<std::string> ExpectedReaders(const PublishOptions& o) {
   return names.empty() ? std::set<std::string>{""} : names;
 }
 
-// Waits up to wait_s for those readers of the topic, then for matching.
+// Waits up to wait_s for those readers of the topic, then until this participant's writer has
+// matched every reader of the topic discovered in its partitions (discovered is not enough: a
+// sample written before the match is lost to a volatile reader).
 void AwaitReaders(const PublishOptions& o, DdsParticipant& participant, const InterruptWatcher& interrupt, std::ostream& err) {
   std::set<std::string> missing = ExpectedReaders(o);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.watch.wait_s);
-  while (!missing.empty() && std::chrono::steady_clock::now() < end && !interrupt.interrupted()) {
+  auto readers = [&] {
+    int n = 0;
     for (const auto& e : participant.Discovered())
-      if (!e.writer && e.topic == o.topic)
+      if (!e.writer && e.topic == o.topic && e.same_partition && e.participant != participant.name()) {
+        ++n;
         std::erase_if(missing, [&](const std::string& suffix) { return e.participant.ends_with(suffix); });
-    if (!missing.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    return n;
+  };
+  int discovered = readers();
+  while ((!missing.empty() || participant.MatchedReadersOf(o.topic) < discovered) && std::chrono::steady_clock::now() < end &&
+         !interrupt.interrupted()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    discovered = readers();
   }
   if (interrupt.interrupted()) return;
-  if (missing.empty())
-    std::this_thread::sleep_for(std::chrono::milliseconds(250));
-  else
+  if (!missing.empty())
     err << "warning: dyad pub: no reader of '" << o.topic << "'" << (missing.count("") ? "" : " in the graph's processes (" + JoinList(missing) + ")")
         << " discovered within " << o.watch.wait_s << " s; publishing anyway\n";
+  else if (participant.MatchedReadersOf(o.topic) < discovered)
+    err << "warning: dyad pub: " << participant.MatchedReadersOf(o.topic) << " of the " << discovered << " readers of '" << o.topic
+        << "' matched within " << o.watch.wait_s << " s; publishing anyway\n";
 }
 
 }  // namespace

@@ -12,11 +12,11 @@
 // no step statistics on dyad/stats. Its clock is the wall clock (stepped runs keep their DDS to
 // their own process: there is nothing to visit).
 //
-// Before its components are activated, the guest waits, up to `watch.wait_s`, until every topic
-// of `await_writers` has a discovered writer and every topic of `await_readers` a discovered
-// reader (then 0.25 s for the rest of that discovery burst), so that what it records or plays
-// starts with the graph's first sample, not with a discovery race; what it has not seen by then
-// is said, and the run goes on.
+// Before its components are activated, the guest waits, up to `watch.wait_s`, until its readers
+// of every topic of `await_writers` are matched with that topic's writers, and its writers of
+// every topic of `await_readers` with that topic's readers (every one discovered in its
+// partitions, at least one), so that what it records or plays starts with the graph's first
+// sample, not with a discovery race; what it has not matched by then is said, and it goes on.
 //
 // Returns as RunGraph does (run.hpp): 0 at a clean end (a component's RequestStop, `duration_s`,
 // SIGINT/SIGTERM: 0 too, since that is how a recording ends), 2 for a bad guest graph or a topic
@@ -59,8 +59,9 @@ int RunGuest(const GuestOptions& options, const Catalog& catalog, std::ostream& 
 // graph's; without a graph, `type_name` names it ("HumanInput" or "dyad::msg::HumanInput"), else
 // it is the type of the topic's discovered endpoints (readers or writers, up to watch.wait_s).
 // Sample 0 is made before anything is published: a bad sample publishes nothing. The first
-// sample waits, up to watch.wait_s, for a reader of the topic (then 0.25 s for matching);
-// without one it is published anyway, with a warning. At the end each sample has been
+// sample waits, up to watch.wait_s, for the topic's readers in the graph's processes that read it
+// (with a graph; else any reader) and until the writer has matched every reader discovered in
+// its partitions; then it is published anyway, with a warning. At the end each sample has been
 // acknowledged by the reliable readers, or 0.5 s has passed.
 // Returns 0, 2 for bad input (an unknown topic or type, a bad sample: said on `err`), 1 when a
 // write fails, 128 + signal when a signal ended a run with a `count` it did not reach.
