@@ -96,25 +96,40 @@ TEST_F(ProcessTest, PubReachesTheGraphAndEcho) {
                                          "  sink: {type: counter_sink, trigger: in, params: {file: " + heard.string() +
                                          ", expect: 5}, inputs: {in: count}}\n");
   Child run(Dyad({"run", g.string(), "--duration", "30", "--quiet"}), dir_, "run");
-  Child echo(Dyad({"echo", "count", "--domain", domain, "-n", "3", "--wait", "20", "--duration", "20"}), dir_, "echo");
   Child bad(Dyad({"pub", "count", "{value: 1, stamp: 2}", "--graph", g.string()}), dir_, "bad");
   EXPECT_EQ(bad.Wait(30), 2);
   EXPECT_NE(bad.err().find("dyad pub: the fields: line 1, column 12: stamp: unknown member of dyad::msg::Counter (members: header, value)"),
             std::string::npos)
       << bad.err();
-  // Three at 20 Hz with the graph's type, then two more with the type named and a header given.
+  // Three at 20 Hz with the graph's type, then two more with a header given. With the graph, pub
+  // waits for the graph's own readers: without it, for whichever readers it found first.
   Child pub(Dyad({"pub", "count", "{value: 42}", "--graph", g.string(), "--rate", "20", "--count", "3", "--wait", "20"}), dir_, "pub");
   ASSERT_EQ(pub.Wait(60), 0) << pub.err();
   EXPECT_NE(pub.out().find("dyad pub: 3 samples of dyad::msg::Counter on count"), std::string::npos) << pub.out();
-  Child named(Dyad({"pub", "count", "{header: {source: me, sequence_number: 9}, value: -7}", "--domain", domain, "--type", "Counter",
-                    "--count", "2", "--wait", "20"}),
+  Child named(Dyad({"pub", "count", "{header: {source: me, sequence_number: 9}, value: -7}", "--graph", g.string(), "--count", "2",
+                    "--wait", "20"}),
               dir_, "named");
   ASSERT_EQ(named.Wait(60), 0) << named.err();
+  // Without a graph, the type named: on a topic nobody reads, published anyway, saying so.
+  Child typed(Dyad({"pub", "nobody/reads", "{x: 0.5, engaged: true}", "--domain", domain, "--type", "HumanInput", "--wait", "0.5"}),
+              dir_, "typed");
+  ASSERT_EQ(typed.Wait(30), 0) << typed.err();
+  EXPECT_NE(typed.out().find("dyad pub: 1 sample of dyad::msg::HumanInput on nobody/reads"), std::string::npos) << typed.out();
+  EXPECT_NE(typed.err().find("warning: dyad pub: no reader of 'nobody/reads' discovered within 0.5 s; publishing anyway"),
+            std::string::npos)
+      << typed.err();
   ASSERT_EQ(run.Wait(60), 0) << run.err();  // the sink ends the run at its fifth sample
-  ASSERT_EQ(echo.Wait(30), 0) << echo.err();
-  // A watcher joined beside the graph: it hears what was published once it matched (3 of the 5).
+  // `dyad echo` hears `dyad pub`: echo opens its reader once it has found a writer (for its type),
+  // so pub publishes at a rate for long enough, after a short wait for readers.
+  Child echo(Dyad({"echo", "pub/echoed", "--domain", domain, "-n", "2", "--wait", "30", "--duration", "40"}), dir_, "echo");
+  Child echoed(Dyad({"pub", "pub/echoed", "{value: 7}", "--domain", domain, "--type", "Counter", "--rate", "10", "--count", "60",
+                     "--wait", "0.5"}),
+               dir_, "echoed");
+  ASSERT_EQ(echo.Wait(60), 0) << echo.err();
+  echoed.Signal(SIGINT);
+  EXPECT_EQ(echoed.Wait(30), 130) << echoed.err();  // stopped before its count: 128 + SIGINT
   EXPECT_NE(echo.out().find("{\"header\":{\"source\":\"dyad/pub\",\"sequence_number\":"), std::string::npos) << echo.out();
-  EXPECT_NE(echo.out().find("\"value\":42}"), std::string::npos) << echo.out();
+  EXPECT_NE(echo.out().find("\"value\":7}"), std::string::npos) << echo.out();
 
   const std::vector<Received> got = ReadSink(heard);
   ASSERT_EQ(got.size(), 5u) << ReadFile(heard);

@@ -90,6 +90,16 @@ void AwaitReaders(const PublishOptions& o, DdsParticipant& participant, const In
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     discovered = readers();
   }
+  // Without the graph nothing says how many readers there are: the rest of the discovery burst
+  // that brought the first (0.5 s), and they are matched too.
+  if (o.watched == nullptr && missing.empty()) {
+    const auto settle = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+    while (std::chrono::steady_clock::now() < settle && std::chrono::steady_clock::now() < end && !interrupt.interrupted())
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    discovered = readers();
+    while (participant.MatchedReadersOf(o.topic) < discovered && std::chrono::steady_clock::now() < end && !interrupt.interrupted())
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   if (interrupt.interrupted()) return;
   if (!missing.empty())
     err << "warning: dyad pub: no reader of '" << o.topic << "'" << (missing.count("") ? "" : " in the graph's processes (" + JoinList(missing) + ")")
