@@ -127,4 +127,21 @@ TEST_F(ProcessTest, ParamGetAndSetChangeARunningGraphAndAreRecorded) {
   EXPECT_DOUBLE_EQ(std::stod(commands.back().at("x")), 2.5);
 }
 
+// A param_script's schedule is checked before anything runs: the element and what is wrong.
+TEST_F(ProcessTest, ABadParamScriptIsRefusedNamingTheElement) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"{at_s: -1, set: {src.start: 1}}", "g.yaml:6:107: components.script.params.changes[0].at_s: must be a number of seconds >= 0"},
+      {"{at_s: 1, set: {mix.gain: 1}}", "components.script.params.changes[0].set.mix.gain: no component 'mix' in the graph (components: script, src)"},
+      {"{at_s: 1, set: {gain: 1}}", "components.script.params.changes[0].set.gain: must be COMPONENT.PARAM"}};
+  for (const auto& [change, expected] : cases) {
+    const fs::path g = Write("g.yaml", "graph: ps\nclock: stepped\ndomain_id: " + std::to_string(domain_) +
+                                           "\ncomponents:\n  src: {type: counter_source, rate_hz: 10, outputs: {out: c}}\n"
+                                           "  script: {type: param_script, rate_hz: 10, outputs: {requests: dyad/param_requests}, "
+                                           "params: {changes: [" + change + "]}}\n");
+    Child c(Dyad({"validate", g.string()}), dir_, "validate");
+    EXPECT_EQ(c.Wait(30), 2) << change;
+    EXPECT_NE(c.err().find(expected), std::string::npos) << change << ":\n" << c.err();
+  }
+}
+
 }  // namespace
