@@ -58,6 +58,7 @@ std::string Replace(std::string s, const std::string& from, const std::string& t
 
 std::vector<BadCase> BadCases() {
   const std::string v = kValid;
+  const std::string wall = Replace(v, "clock: stepped", "clock: wall ");  // same columns
   return {
       {"YamlSyntax", "components: {a: [1, 2}\n", "g.yaml:1:", "", "YAML syntax error"},
       {"UnknownTopLevelKey", Replace(v, "clock: stepped", "clock: stepped\nspeed: 3"), "g.yaml:3:1", "speed", "unknown key"},
@@ -110,6 +111,34 @@ std::vector<BadCase> BadCases() {
       {"BothRateAndTrigger", Replace(v, "    trigger: in", "    trigger: in\n    rate_hz: 5"), "g.yaml:11:14",
        "components.sink.trigger", "either rate_hz or trigger"},
       {"ComponentsNotAMap", "graph: x\ncomponents: [a, b]\n", "g.yaml:2:13", "components", "must be a mapping"},
+      // ROS 2 topics (dyad/ros2_names.hpp): each rule a bad name breaks is said.
+      {"Ros2NameRelative", wall + "topics:\n  arm: {ros2: servo/cmd, type: geometry_msgs/msg/Twist}\n", "g.yaml:14:15",
+       "topics.arm.ros2", "must be fully qualified (start with '/')"},
+      {"Ros2NameRepeatedSlash", wall + "topics:\n  arm: {ros2: /a//b, type: geometry_msgs/msg/Twist}\n", "g.yaml:14:15",
+       "topics.arm.ros2", "must not contain repeated '/'"},
+      {"Ros2NameDigitToken", wall + "topics:\n  arm: {ros2: /arm/2d, type: geometry_msgs/msg/Twist}\n", "g.yaml:14:15",
+       "topics.arm.ros2", "must not start with a digit ('2d')"},
+      {"Ros2NameBadCharacter", wall + "topics:\n  arm: {ros2: /arm-1, type: geometry_msgs/msg/Twist}\n", "g.yaml:14:15",
+       "topics.arm.ros2", "not '-'"},
+      {"Ros2NameTrailingSlash", wall + "topics:\n  arm: {ros2: /arm/, type: geometry_msgs/msg/Twist}\n", "g.yaml:14:15",
+       "topics.arm.ros2", "must not end with '/'"},
+      {"UnknownRos2Type", wall + "topics:\n  arm: {ros2: /a, type: geometry_msgs/msg/Wrench}\n", "g.yaml:14:25",
+       "topics.arm.type", "unknown message type 'geometry_msgs/msg/Wrench'"},
+      {"DyadTypeOnARos2Topic", wall + "topics:\n  arm: {ros2: /a, type: HumanInput}\n", "g.yaml:14:25", "topics.arm.type",
+       "is a dyad type; ROS 2 topic '/a' needs a ROS 2 type"},
+      {"Ros2TopicWithoutType", wall + "topics:\n  arm: {ros2: /a}\n", "g.yaml:14:15", "topics.arm.type",
+       "a ROS 2 topic needs its type"},
+      {"UnknownRos2Qos", wall + "topics:\n  arm: {ros2: /a, type: geometry_msgs/msg/Twist, qos: fast}\n", "g.yaml:14:55",
+       "topics.arm.qos", "unknown ROS 2 QoS profile 'fast' (known: default, sensor_data"},
+      {"QosOnADyadTopic", v + "topics:\n  count: {qos: default}\n", "g.yaml:14:16", "topics.count.qos",
+       "only a ROS 2 topic"},
+      {"Ros2TopicInASteppedRun", v + "topics:\n  arm: {ros2: /a, type: geometry_msgs/msg/Twist}\n", "g.yaml:2:8", "clock",
+       "ROS 2 topic /a, which programs outside the graph share"},
+      {"TwoTopicsOneRos2Name",
+       wall + "topics:\n  a: {ros2: /x, type: geometry_msgs/msg/Twist}\n  b: {ros2: /x, type: geometry_msgs/msg/Twist}\n",
+       "g.yaml:15:13", "topics.b.ros2", "is also topics.a.ros2"},
+      {"SlashTopicName", Replace(Replace(v, "outputs: {out: count}", "outputs: {out: /count}"), "inputs: {in: count}", "inputs: {in: /count}"),
+       "g.yaml:8:20", "topics./count", "a ROS 2 name: declare a topic of the graph with ros2: /count"},
       // Tried by hand while fuzzing graphs: yaml-cpp stops deep nesting but said only "bad file".
       {"NestedTooDeep", "graph: x\ncomponents: " + std::string(3000, '[') + "\n", "g.yaml:3:", "",
        "YAML syntax error: nested too deeply (500 levels)"},

@@ -17,7 +17,7 @@ LAYERS = ["graph", "dds", "exec", "hosts"]
 PUBLIC = {
     "component.hpp": None, "join_list.hpp": None, "message_traits.hpp": None, "status.hpp": None, "params.hpp": None,
     "graph.hpp": "graph", "validate.hpp": "graph", "catalog.hpp": "graph", "topic_select.hpp": "graph",
-    "diagnostic.hpp": "graph", "strict_yaml.hpp": "graph", "security.hpp": "graph",
+    "diagnostic.hpp": "graph", "strict_yaml.hpp": "graph", "security.hpp": "graph", "ros2_names.hpp": "graph",
     "on_demand_subscription.hpp": "graph",
     "decode_sample.hpp": "dds",
     "interrupt.hpp": "exec", "private_file.hpp": "exec",

@@ -4,6 +4,7 @@
 #include "dds/security_qos.hpp"
 
 #include <dyad/decode_sample.hpp>
+#include <dyad/ros2_names.hpp>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -82,53 +83,91 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
     std::lock_guard<std::mutex> lock(mutex_);
     names_[GuidPrefixString(info.info.m_guid.guidPrefix)] = info.info.m_participantName.to_string();
   }
+  // Remote endpoints are named by their DDS topic; ours by the graph's topic (a ROS 2 topic's
+  // DDS topic is "rt/...", in the default partition): compare in the graph's names.
   void on_publisher_discovery(fdds::DomainParticipant*, rtps::WriterDiscoveryInfo&& info) override {
     const bool gone = info.status == rtps::WriterDiscoveryInfo::REMOVED_WRITER;
-    Track(true, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid(),
-          PartitionsMatch(owner_->partitions_, info.info.m_qos.m_partition.names()));
+    const std::string dds_topic = info.info.topicName().to_string();
+    const bool same_partition = SharesPartition(dds_topic, info.info.m_qos.m_partition.names());
+    Track(true, gone, dds_topic, info.info.typeName().to_string(), info.info.guid(), same_partition);
     if (info.status != rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) return;
-    const std::string topic = info.info.topicName().to_string();
-    if (!PartitionsMatch(owner_->partitions_, info.info.m_qos.m_partition.names())) {
-      Foreign(topic, info.info.m_qos.m_partition.names(), info.info.guid());
+    if (!same_partition) {
+      Foreign(dds_topic, info.info.m_qos.m_partition.names(), info.info.guid());
       return;  // another run's: its type is not ours to check
     }
-    Check("writer", topic, info.info.typeName().to_string(), info.info.guid().guidPrefix);
+    Check("writer", dds_topic, info.info.typeName().to_string(), info.info.guid().guidPrefix);
   }
   void on_subscriber_discovery(fdds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override {
     const bool gone = info.status == rtps::ReaderDiscoveryInfo::REMOVED_READER;
-    Track(false, gone, info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid(),
-          PartitionsMatch(owner_->partitions_, info.info.m_qos.m_partition.names()));
+    const std::string dds_topic = info.info.topicName().to_string();
+    const bool same_partition = SharesPartition(dds_topic, info.info.m_qos.m_partition.names());
+    Track(false, gone, dds_topic, info.info.typeName().to_string(), info.info.guid(), same_partition);
     if (info.status != rtps::ReaderDiscoveryInfo::DISCOVERED_READER) return;
-    if (!PartitionsMatch(owner_->partitions_, info.info.m_qos.m_partition.names())) return;
-    Check("reader", info.info.topicName().to_string(), info.info.typeName().to_string(), info.info.guid().guidPrefix);
+    if (!same_partition) return;
+    Check("reader", dds_topic, info.info.typeName().to_string(), info.info.guid().guidPrefix);
   }
 
+  // Endpoints by the names this participant uses: a ROS 2 topic of ours by its graph name, any
+  // other ROS 2 topic by its ROS 2 name ("rt/a/b" -> "/a/b").
   std::vector<DiscoveredEndpoint> Snapshot() {
+    std::map<std::string, std::string> ours;
+    {
+      std::lock_guard<std::mutex> lock(owner_->mutex_);
+      ours = owner_->ros2_topics_;
+    }
     std::lock_guard<std::mutex> lock(mutex_);
     std::vector<DiscoveredEndpoint> out;
     for (auto [guid, e] : endpoints_) {
       auto it = names_.find(e.participant);
       if (it != names_.end()) e.participant = it->second;
+      if (auto our = ours.find(e.topic); our != ours.end()) e.topic = our->second;
+      else if (std::string ros2 = Ros2NameOfDdsTopic(e.topic); !ros2.empty()) e.topic = ros2;
       out.push_back(e);
     }
     return out;
   }
   void on_requested_incompatible_qos(fdds::DataReader* reader, const fdds::RequestedIncompatibleQosStatus& status) override {
     if (on_problem_)
-      on_problem_("topic '" + reader->get_topicdescription()->get_name() + "': a writer offers an incompatible " +
+      on_problem_("topic " + TopicText(reader->get_topicdescription()->get_name()) + ": a writer offers an incompatible " +
                   QosPolicyName(status.last_policy_id) + " QoS; no data will flow to this reader");
   }
   void on_offered_incompatible_qos(fdds::DataWriter* writer, const fdds::OfferedIncompatibleQosStatus& status) override {
     if (on_problem_)
-      on_problem_("topic '" + writer->get_topic()->get_name() + "': a reader requests an incompatible " +
+      on_problem_("topic " + TopicText(writer->get_topic()->get_name()) + ": a reader requests an incompatible " +
                   QosPolicyName(status.last_policy_id) + " QoS; this writer's data will not reach it");
   }
 
  private:
-  void Check(const char* kind, const std::string& topic, const std::string& type, const rtps::GuidPrefix_t& prefix) {
-    std::string ours;
+  // A ROS 2 topic (ours, or any "rt/..." that is not a dyad topic of ours) is in the default
+  // partition, where ROS 2 peers and our ROS 2 endpoints are.
+  // "'arm/pose'", or "'arm/pose' (ROS 2 topic /arm/pose)" for one of our ROS 2 topics.
+  std::string TopicText(const std::string& dds_topic) {
+    std::lock_guard<std::mutex> lock(owner_->mutex_);
+    const std::string topic = owner_->TopicOfDds(dds_topic);
+    return topic == dds_topic ? "'" + topic + "'" : "'" + topic + "' (ROS 2 topic " + Ros2NameOfDdsTopic(dds_topic) + ")";
+  }
+  // A remote participant's name; one without (not a dyad process: another vendor's, ROS 2's)
+  // by its GUID prefix. REQUIRES: mutex_ held.
+  std::string RemoteName(const rtps::GuidPrefix_t& prefix) {
+    auto it = names_.find(GuidPrefixString(prefix));
+    if (it != names_.end() && !it->second.empty()) return "'" + it->second + "'";
+    return "participant " + GuidPrefixString(prefix) + (it != names_.end() ? " (unnamed: not a dyad process)" : "");
+  }
+
+  bool SharesPartition(const std::string& dds_topic, const std::vector<std::string>& remote) {
+    static const std::vector<std::string> kDefault;
+    std::lock_guard<std::mutex> lock(owner_->mutex_);
+    const std::string topic = owner_->TopicOfDds(dds_topic);
+    const bool ros2 = owner_->dds_topics_.count(topic) > 0 ||
+                      (!owner_->topic_types_.count(topic) && !Ros2NameOfDdsTopic(dds_topic).empty());
+    return PartitionsMatch(ros2 ? kDefault : owner_->partitions_, remote);
+  }
+
+  void Check(const char* kind, const std::string& dds_topic, const std::string& type, const rtps::GuidPrefix_t& prefix) {
+    std::string ours, topic;
     {
       std::lock_guard<std::mutex> lock(owner_->mutex_);
+      topic = owner_->TopicOfDds(dds_topic);
       auto it = owner_->topic_types_.find(topic);
       if (it == owner_->topic_types_.end()) return;
       ours = it->second;
@@ -137,12 +176,11 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
     std::string remote;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      auto it = names_.find(GuidPrefixString(prefix));
-      remote = it != names_.end() ? it->second : "participant " + GuidPrefixString(prefix);
+      remote = RemoteName(prefix);
     }
     const bool same_idl_name = ours.substr(0, ours.find('#')) == type.substr(0, type.find('#'));
-    on_problem_("type mismatch on topic '" + topic + "': '" + owner_->name_ + "' uses " + ours + ", a " + kind + " of '" +
-                remote + "' uses " + type +
+    on_problem_("type mismatch on topic " + TopicText(dds_topic) + ": '" + owner_->name_ + "' uses " + ours + ", a " + kind + " of " +
+                remote + " uses " + type +
                 (same_idl_name ? " (same IDL name, different definition: rebuild both from the same idl/)"
                                : " (different types)") +
                 "; no samples will flow between them");
@@ -150,9 +188,11 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
 
   // A writer of a topic this participant uses, in another run's partition: DDS does not match
   // them, so nothing of it is delivered (or recorded) here; say so once per writer.
-  void Foreign(const std::string& topic, const std::vector<std::string>& partitions, const rtps::GUID_t& guid) {
+  void Foreign(const std::string& dds_topic, const std::vector<std::string>& partitions, const rtps::GUID_t& guid) {
+    std::string topic;
     {
       std::lock_guard<std::mutex> lock(owner_->mutex_);
+      topic = owner_->TopicOfDds(dds_topic);
       if (!owner_->topic_types_.count(topic)) return;
     }
     std::ostringstream os;
@@ -161,10 +201,9 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!foreign_reported_.insert(os.str()).second || !on_foreign_) return;
-      auto it = names_.find(GuidPrefixString(guid.guidPrefix));
-      remote = it != names_.end() ? it->second : "participant " + GuidPrefixString(guid.guidPrefix);
+      remote = RemoteName(guid.guidPrefix);
     }
-    on_foreign_("topic '" + topic + "' is also written by '" + remote + "' in " + PartitionText(partitions) +
+    on_foreign_("topic '" + topic + "' is also written by " + remote + " in " + PartitionText(partitions) +
                 ", another run on this domain: ignored (not delivered, not recorded); this run is in " +
                 PartitionText(owner_->partitions_));
   }
@@ -731,13 +770,16 @@ StatusOr<DdsParticipant::Generation> DdsParticipant::MakeGeneration() {
   }
   g.publisher = g.participant->create_publisher(pub_qos);
   g.subscriber = g.participant->create_subscriber(sub_qos);
-  Status st = g.publisher != nullptr && g.subscriber != nullptr
+  g.ros2_publisher = g.participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+  g.ros2_subscriber = g.participant->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  Status st = g.publisher != nullptr && g.subscriber != nullptr && g.ros2_publisher != nullptr && g.ros2_subscriber != nullptr
                   ? Status::OK()
                   : Status::Internal("cannot create DDS publisher/subscriber for '" + name_ + "'");
   // The topics of the generation it replaces (a renewal), with their types.
   for (const auto& [topic, type] : topic_infos_) {
     if (!st.ok()) break;
-    st = AddTopic(g, topic, *type);
+    auto dds = dds_topics_.find(topic);
+    st = AddTopic(g, topic, dds == dds_topics_.end() ? topic : dds->second, *type);
   }
   if (!st.ok()) {
     DeleteGeneration(g);
@@ -746,18 +788,24 @@ StatusOr<DdsParticipant::Generation> DdsParticipant::MakeGeneration() {
   return g;
 }
 
-Status DdsParticipant::AddTopic(Generation& g, const std::string& topic, const TypeInfo& type) {
+Status DdsParticipant::AddTopic(Generation& g, const std::string& topic, const std::string& dds_topic, const TypeInfo& type) {
   const std::string dds_type = type.dds_name();
   if (g.participant->find_type(dds_type).empty()) {
     fdds::TypeSupport support(type.make_type_support());
     if (support.register_type(g.participant, dds_type) != ReturnCode_t::RETCODE_OK)
       return Status::Internal("cannot register type " + dds_type);
   }
-  fdds::Topic* t = g.participant->create_topic(topic, dds_type, fdds::TOPIC_QOS_DEFAULT);
-  if (t == nullptr) return Status::Internal("cannot create topic '" + topic + "' of type " + dds_type);
+  fdds::Topic* t = g.participant->create_topic(dds_topic, dds_type, fdds::TOPIC_QOS_DEFAULT);
+  if (t == nullptr) return Status::Internal("cannot create topic '" + dds_topic + "' of type " + dds_type);
   g.topics[topic] = t;
   return Status::OK();
 }
+
+std::string DdsParticipant::TopicOfDds(const std::string& dds_topic) const {
+  auto it = ros2_topics_.find(dds_topic);
+  return it == ros2_topics_.end() ? dds_topic : it->second;
+}
+
 
 void DdsParticipant::DeleteGeneration(Generation& g) {
   if (g.participant == nullptr) return;
@@ -774,7 +822,7 @@ fdds::DataReader* DdsParticipant::NewReader(const std::string& topic, const fdds
   fdds::Topic* t = nullptr;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    sub = gen_.subscriber;
+    sub = dds_topics_.count(topic) ? gen_.ros2_subscriber : gen_.subscriber;
     t = gen_.topics.at(topic);
   }
   return sub->create_datareader(t, qos, nullptr, fdds::StatusMask::none());
@@ -785,7 +833,7 @@ fdds::DataWriter* DdsParticipant::NewWriter(const std::string& topic, const fdds
   fdds::Topic* t = nullptr;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    pub = gen_.publisher;
+    pub = dds_topics_.count(topic) ? gen_.ros2_publisher : gen_.publisher;
     t = gen_.topics.at(topic);
   }
   return pub->create_datawriter(t, qos);
@@ -888,17 +936,29 @@ DdsParticipant::~DdsParticipant() {
   DeleteGeneration(gen_);
 }
 
-Status DdsParticipant::GetTopic(const std::string& topic, const TypeInfo& type) {
+Status DdsParticipant::GetTopic(const std::string& topic, const TypeInfo& type, const std::string& given_ros2_name) {
   std::lock_guard<std::mutex> lock(mutex_);
   const std::string dds_type = type.dds_name();
+  // A name starting with '/' is a ROS 2 topic's own (a watcher's `dyad echo /arm/pose`); graph
+  // topics never start with '/' (validation).
+  const std::string ros2_name = given_ros2_name.empty() && !topic.empty() && topic[0] == '/' ? topic : given_ros2_name;
+  const std::string dds_topic = ros2_name.empty() ? topic : Ros2DdsTopic(ros2_name);
   if (auto it = topic_types_.find(topic); it != topic_types_.end()) {
     if (it->second != dds_type)
       return Status::InvalidArgument("topic '" + topic + "' already carries " + it->second + ", not " + dds_type);
+    auto dds = dds_topics_.find(topic);
+    if ((dds == dds_topics_.end() ? topic : dds->second) != dds_topic)
+      return Status::InvalidArgument("topic '" + topic + "' is already DDS topic '" +
+                                     (dds == dds_topics_.end() ? topic : dds->second) + "', not '" + dds_topic + "'");
     return Status::OK();
   }
-  if (Status s = AddTopic(gen_, topic, type); !s.ok()) return s;
+  if (Status s = AddTopic(gen_, topic, dds_topic, type); !s.ok()) return s;
   topic_types_[topic] = dds_type;
   topic_infos_[topic] = &type;
+  if (!ros2_name.empty()) {
+    dds_topics_[topic] = dds_topic;
+    ros2_topics_[dds_topic] = topic;
+  }
   return Status::OK();
 }
 
@@ -924,7 +984,7 @@ void ApplyQos(Q& q, const TopicQos& qos) {
 
 StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
                                                     std::function<void()> on_data) {
-  if (Status st = GetTopic(topic, type); !st.ok()) return st;
+  if (Status st = GetTopic(topic, type, qos.ros2_name); !st.ok()) return st;
   fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
   ApplyQos(rq, qos);
   std::unique_ptr<DdsReader> r(new DdsReader());
@@ -951,7 +1011,7 @@ StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, co
 }
 
 StatusOr<TypedWriter*> DdsParticipant::CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos) {
-  if (Status st = GetTopic(topic, type); !st.ok()) return st;
+  if (Status st = GetTopic(topic, type, qos.ros2_name); !st.ok()) return st;
   fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
   ApplyQos(wq, qos);
   std::unique_ptr<DdsWriter> w(new DdsWriter());
@@ -983,7 +1043,7 @@ StatusOr<OnDemandReader*> DdsParticipant::CreateOnDemandReader(const std::string
 StatusOr<DdsSerializedReader*> DdsParticipant::MakeSerializedReader(const std::string& topic, const TypeInfo& type,
                                                                     const TopicQos& qos, const Clock* clock,
                                                                     SerializedCallback callback, bool on_demand) {
-  if (Status st = GetTopic(topic, type); !st.ok()) return st;
+  if (Status st = GetTopic(topic, type, qos.ros2_name); !st.ok()) return st;
   fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
   ApplyQos(rq, qos);
   if (qos.keep_all) {
@@ -1023,7 +1083,7 @@ StatusOr<SerializedWriter*> DdsParticipant::CreateSerializedWriter(const std::st
                                                                                       const TypeInfo& type,
                                                                                       const TopicQos& qos,
                                                                                       const Clock* clock) {
-  if (Status st = GetTopic(topic, type); !st.ok()) return st;
+  if (Status st = GetTopic(topic, type, qos.ros2_name); !st.ok()) return st;
   fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
   ApplyQos(wq, qos);
   std::unique_ptr<DdsSerializedWriter> w(new DdsSerializedWriter());

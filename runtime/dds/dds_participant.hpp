@@ -291,19 +291,27 @@ class DdsParticipant final : public Transport {
   class DiscoveryListener;
   // A DDS participant with its publisher, subscriber and topics (one per name). A renewal makes
   // a new one and retires the old until its endpoints are gone.
+  // ROS 2 topics' endpoints (TopicQos::ros2_name) go with the second publisher and subscriber,
+  // which are in the default partition, where ROS 2 peers are.
   struct Generation {
     eprosima::fastdds::dds::DomainParticipant* participant = nullptr;
     eprosima::fastdds::dds::Publisher* publisher = nullptr;
     eprosima::fastdds::dds::Subscriber* subscriber = nullptr;
-    std::map<std::string, eprosima::fastdds::dds::Topic*> topics;
+    eprosima::fastdds::dds::Publisher* ros2_publisher = nullptr;
+    eprosima::fastdds::dds::Subscriber* ros2_subscriber = nullptr;
+    std::map<std::string, eprosima::fastdds::dds::Topic*> topics;  // by graph topic name
   };
   DdsParticipant();
   StatusOr<Generation> MakeGeneration();
   // What a refused endpoint's error adds on a secured participant ("" otherwise).
   std::string SecurityHint(const std::string& verb) const;
-  static Status AddTopic(Generation& g, const std::string& topic, const TypeInfo& type);
+  static Status AddTopic(Generation& g, const std::string& topic, const std::string& dds_topic, const TypeInfo& type);
   static void DeleteGeneration(Generation& g);
-  Status GetTopic(const std::string& topic, const TypeInfo& type);  // on the current generation
+  // On the current generation; `ros2_name`: a ROS 2 topic's (TopicQos::ros2_name).
+  Status GetTopic(const std::string& topic, const TypeInfo& type, const std::string& ros2_name);
+  // The graph topic a discovered DDS topic is ("rt/a" -> the graph's name for ROS 2 topic /a).
+  // REQUIRES: mutex_ held.
+  std::string TopicOfDds(const std::string& dds_topic) const;
   eprosima::fastdds::dds::DataReader* NewReader(const std::string& topic, const eprosima::fastdds::dds::DataReaderQos& qos);
   eprosima::fastdds::dds::DataWriter* NewWriter(const std::string& topic, const eprosima::fastdds::dds::DataWriterQos& qos);
   // A serialized reader, started (plain) or stopped with no DDS reader yet (on demand).
@@ -320,6 +328,8 @@ class DdsParticipant final : public Transport {
   std::vector<Generation> retired_gens_;
   std::map<std::string, std::string> topic_types_;     // topic -> dds type name
   std::map<std::string, const TypeInfo*> topic_infos_;  // topic -> its type
+  std::map<std::string, std::string> dds_topics_;       // topic -> DDS topic, for ROS 2 topics only
+  std::map<std::string, std::string> ros2_topics_;      // DDS topic "rt/..." -> the graph's topic
   Scope scope_ = Scope::kNetwork;
   bool secured_ = false;  // DDS Security on (Options::security)
   std::vector<std::string> partitions_;

@@ -192,6 +192,8 @@ class Executor::ContextImpl final : public Context, public detail::ContextExtens
     const bool reliable = info->reliable && !info->writers_local;
     TopicQos qos{reliable ? Reliability::kReliable : Reliability::kBestEffort,
                  on_demand ? std::max(info->depth, 1) : info->depth, 0, !on_demand};
+    if (auto rt = ex_->resolved_.topics.find(topic); rt != ex_->resolved_.topics.end())
+      qos.ros2_name = QosOf(rt->second).ros2_name;  // a ROS 2 topic is read where ROS 2 writes it
     // The callback's time is the subscriber's, not that of the step whose Publish() delivers it.
     StepStats* stats = &inst_->stats;
     SerializedCallback timed = [cb = std::move(callback), stats](const SerializedSample& sample) {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include <dyad/msg/ros2_types.hpp>
 #include <dyad/msg/types.hpp>
 
 namespace fs = std::filesystem;
@@ -29,6 +30,7 @@ class Catalog::Registry final : public PluginRegistry {
 
 Catalog::Catalog() {
   for (const TypeInfo* t : msg::AllTypes()) AddMessageType(t);
+  for (const TypeInfo* t : ros2::AllTypes()) AddMessageType(t);
 }
 
 Catalog::~Catalog() {
@@ -159,7 +161,8 @@ void Catalog::AddMessageType(const TypeInfo* type) {
 
 const TypeInfo* Catalog::FindMessageType(const std::string& name) const {
   for (const TypeInfo* t : MessageTypes())
-    if (t->name == name || t->short_name() == name || t->dds_name() == name) return t;
+    if (t->name == name || t->short_name() == name || t->dds_name() == name || (t->ros2() && t->ros2_name == name))
+      return t;
   return nullptr;
 }
 

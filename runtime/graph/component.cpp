@@ -9,6 +9,7 @@
 namespace dyad {
 
 std::string TypeInfo::short_name() const {
+  if (ros2()) return ros2_name;
   const auto pos = name.rfind("::");
   return pos == std::string::npos ? name : name.substr(pos + 2);
 }

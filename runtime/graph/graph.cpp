@@ -1,6 +1,7 @@
 // Reads an experiment graph from YAML, keeping every node's position for error messages.
 #include "dyad/graph.hpp"
 #include "dyad/join_list.hpp"
+#include "dyad/ros2_names.hpp"
 #include "dyad/strict_yaml.hpp"
 
 #include <algorithm>
@@ -145,6 +146,30 @@ void ResolveScope(StrictYaml& r, const YAML::Node& network, Graph* g) {
   }
 }
 
+// `ros2:` and `qos:` (dyad/ros2_names.hpp): the profile's reliability and depth first, so that
+// the entry's own `reliability:` and `depth:` override them.
+void ReadRos2Topic(StrictYaml& r, const YAML::Node& spec, const std::string& key, TopicConfig* t) {
+  if (spec["ros2"] && r.String(spec["ros2"], key + ".ros2", &t->ros2)) {
+    t->ros2_mark = r.Mark(spec["ros2"], key + ".ros2");
+    if (std::string why = Ros2TopicNameProblem(t->ros2); !why.empty())
+      r.Error(spec["ros2"], key + ".ros2", "'" + t->ros2 + "' is not a ROS 2 topic name: it " + why);
+  }
+  if (!spec["qos"]) {
+    if (!t->ros2.empty()) t->ros2_qos = "default";
+  } else if (r.String(spec["qos"], key + ".qos", &t->ros2_qos)) {
+    Ros2Qos profile;
+    if (t->ros2.empty())
+      r.Error(spec["qos"], key + ".qos", "names a ROS 2 QoS profile: only a ROS 2 topic (with ros2:) has one");
+    else if (!Ros2QosProfile(t->ros2_qos, &profile))
+      r.Error(spec["qos"], key + ".qos", "unknown ROS 2 QoS profile '" + t->ros2_qos + "' (known: " + JoinList(Ros2QosProfiles()) + ")");
+  }
+  Ros2Qos profile;
+  if (!t->ros2.empty() && Ros2QosProfile(t->ros2_qos, &profile)) {
+    t->reliability = profile.reliable ? Reliability::kReliable : Reliability::kBestEffort;
+    t->depth = profile.depth;
+  }
+}
+
 void ReadTopics(StrictYaml& r, const YAML::Node& node, Graph* g) {
   if (!r.Map(node, "topics", {})) return;
   for (const auto& kv : node) {
@@ -162,6 +187,7 @@ void ReadTopics(StrictYaml& r, const YAML::Node& node, Graph* g) {
       r.String(spec["type"], key + ".type", &t.type);
       t.type_mark = r.Mark(spec["type"], key + ".type");
     }
+    ReadRos2Topic(r, spec, key, &t);
     if (spec["reliability"]) {
       std::string rel;
       if (r.String(spec["reliability"], key + ".reliability", &rel)) {

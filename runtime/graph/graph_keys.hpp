@@ -17,7 +17,7 @@ inline const std::set<std::string> kNetwork = {"scope", "discovery", "hosts",   
                                                "transport", "interfaces", "lease_s",       "start_timeout_s",
                                                "max_clock_offset_ms", "launcher_tcp_port"};
 inline const std::set<std::string> kProcess = {"host", "restart", "max_restarts", "backoff_s", "required", "tcp_port"};
-inline const std::set<std::string> kTopic = {"type", "reliability", "depth", "deadline_ms", "liveliness_ms"};
+inline const std::set<std::string> kTopic = {"type", "reliability", "depth", "deadline_ms", "liveliness_ms", "ros2", "qos"};
 // A component's scalars (`--set mixer.rate_hz=20`); its params, inputs and outputs are maps.
 inline const std::set<std::string> kComponentScalars = {"type", "rate_hz", "trigger", "process"};
 inline const std::set<std::string> kComponent = {"type", "rate_hz", "trigger", "process", "params", "inputs", "outputs"};

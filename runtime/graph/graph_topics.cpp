@@ -22,6 +22,7 @@ TopicQos QosOf(const ResolvedTopic& topic) {
   if (topic.config == nullptr) return TopicQos{};
   TopicQos q{topic.config->reliability, topic.config->depth, topic.config->deadline_ms, false};
   q.liveliness_ms = topic.config->liveliness_ms;
+  q.ros2_name = topic.config->ros2;
   return q;
 }
 

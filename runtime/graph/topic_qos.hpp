@@ -4,6 +4,8 @@
 // the tests ignores what it cannot model.
 #pragma once
 
+#include <string>
+
 #include <dyad/graph.hpp>
 
 namespace dyad {
@@ -15,6 +17,9 @@ struct TopicQos {
   bool keep_all = false;         // KEEP_ALL history (recorders); depth then sizes resource limits only
   bool transient_local = false;  // a late-joining reader gets the writer's history (dyad/processes)
   double liveliness_ms = 0;      // > 0: AUTOMATIC liveliness with this lease
+  // A ROS 2 topic's name (dyad/ros2_names.hpp): the endpoint is DDS topic "rt<name>" in the
+  // default partition. Empty: a dyad topic, under its own name in the run's partition.
+  std::string ros2_name{};
 };
 
 }  // namespace dyad

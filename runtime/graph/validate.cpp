@@ -275,19 +275,41 @@ class Validation {
       writers_[b.topic].push_back({ps->type, key + ".outputs." + b.port, b.mark});
     }
     for (const auto& ps : spec.outputs())
-      if (!bound_outputs.count(ps.name))
+      if (!bound_outputs.count(ps.name) && !ps.optional)
         warn(c.mark, key + ".outputs." + ps.name, "output is bound to no topic: what it writes goes nowhere (and is not recorded)");
   }
 
-  // Declared topic types must exist.
+  // Declared topic types must exist; a ROS 2 topic names a ROS 2 type.
   void CheckDeclaredTypes() {
     for (const auto& t : graph_.topics) {
-      if (!t.type.empty() && catalog_.FindMessageType(t.type) == nullptr) {
+      const TypeInfo* type = t.type.empty() ? nullptr : catalog_.FindMessageType(t.type);
+      if (!t.type.empty() && type == nullptr) {
         std::vector<std::string> known;
-        for (const auto* ti : catalog_.MessageTypes()) known.push_back(ti->short_name());
+        for (const auto* ti : catalog_.MessageTypes()) known.push_back(ti->ros2() ? ti->ros2_name : ti->short_name());
         error(t.type_mark, "topics." + t.name + ".type", "unknown message type '" + t.type + "' (known: " + JoinList(known) + ")");
       }
+      if (!t.ros2.empty()) CheckRos2Topic(t, type);
     }
+  }
+
+  void CheckRos2Topic(const TopicConfig& t, const TypeInfo* type) {
+    const std::string key = "topics." + t.name;
+    if (t.type.empty())
+      error(t.ros2_mark, key + ".type", "a ROS 2 topic needs its type, e.g. type: geometry_msgs/msg/TwistStamped");
+    else if (type != nullptr && !type->ros2()) {
+      std::vector<std::string> known;
+      for (const auto* ti : catalog_.MessageTypes())
+        if (ti->ros2()) known.push_back(ti->ros2_name);
+      error(t.type_mark, key + ".type", "'" + t.type + "' is a dyad type; ROS 2 topic '" + t.ros2 +
+                                            "' needs a ROS 2 type (known: " + JoinList(known) + ")");
+    }
+    if (graph_.clock == ClockMode::kStepped)
+      error(graph_.clock_mark.file.empty() ? t.ros2_mark : graph_.clock_mark, "clock",
+            "topic '" + t.name + "' is ROS 2 topic " + t.ros2 + ", which programs outside the graph share: a stepped "
+            "run sees no other process (use clock: wall)");
+    for (const auto& other : graph_.topics)
+      if (&other != &t && other.ros2 == t.ros2 && &other < &t)
+        error(t.ros2_mark, key + ".ros2", "ROS 2 topic " + t.ros2 + " is also topics." + other.name + ".ros2");
   }
 
   // Topic types agree; every read topic has a writer.
@@ -300,6 +322,12 @@ class Validation {
     for (const auto& t : graph_.topics)
       if (!t.type.empty() && catalog_.FindMessageType(t.type) != nullptr) all_topics.insert(t.name);
     for (const auto& name : all_topics) {
+      if (!name.empty() && name[0] == '/') {
+        const SourceMark mark = graph_.FindTopic(name) ? graph_.FindTopic(name)->mark : FirstUse(name);
+        error(mark, "topics." + name, "a topic name starting with '/' is a ROS 2 name: declare a topic of the graph with "
+                                      "ros2: " + name + " (and its type) instead");
+        continue;
+      }
       ResolvedTopic rt;
       rt.name = name;
       rt.config = graph_.FindTopic(name);
@@ -318,10 +346,16 @@ class Validation {
       if (writers_[name].empty() && declared == nullptr)
         for (const auto& u : readers_[name])
           error(u.mark, u.who, "nothing publishes topic '" + name + "' (no component output is bound to it)");
-      if (writers_[name].empty() && declared != nullptr)
+      if (writers_[name].empty() && declared != nullptr && rt.config->ros2.empty())  // ROS 2: the robot's side writes it
         warn(rt.config->mark, "topics." + name, "no component of the graph writes this topic: it must come from outside (a replay, another program)");
       out_.topics[name] = rt;
     }
+  }
+
+  SourceMark FirstUse(const std::string& topic) {
+    if (!writers_[topic].empty()) return writers_[topic].front().mark;
+    if (!readers_[topic].empty()) return readers_[topic].front().mark;
+    return SourceMark{graph_.file, 1, 1};
   }
 
   // The stepped clock runs the graph in one process.

@@ -142,11 +142,16 @@ bool DiscoveredAll(const Graph& graph, const std::vector<DiscoveredEndpoint>& fo
   std::set<std::pair<std::string, bool>> seen;  // (topic, writer)
   std::set<std::string> participants;
   for (const auto& e : found) seen.insert({e.topic, e.writer}), participants.insert(e.participant);
+  // A watcher sees a ROS 2 topic under its ROS 2 name.
+  auto seen_as = [&](const std::string& topic, bool writer) {
+    const TopicConfig* t = graph.FindTopic(topic);
+    return seen.count({t && !t->ros2.empty() ? t->ros2 : topic, writer}) > 0;
+  };
   for (const auto& c : graph.components) {
     for (const auto& port : c.outputs)
-      if (!port.topic.empty() && !seen.count({port.topic, true})) return false;
+      if (!port.topic.empty() && !seen_as(port.topic, true)) return false;
     for (const auto& port : c.inputs)
-      if (!port.topic.empty() && !seen.count({port.topic, false})) return false;
+      if (!port.topic.empty() && !seen_as(port.topic, false)) return false;
   }
   for (const std::string& process : graph.ProcessNames()) {
     const std::string suffix = "/" + graph.name + "/" + process;

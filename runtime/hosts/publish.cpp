@@ -74,6 +74,7 @@ std::set<std::string> ExpectedReaders(const PublishOptions& o) {
 // sample written before the match is lost to a volatile reader).
 void AwaitReaders(const PublishOptions& o, DdsParticipant& participant, const InterruptWatcher& interrupt, std::ostream& err) {
   std::set<std::string> missing = ExpectedReaders(o);
+  const bool any_reader = missing.count("") > 0;
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.watch.wait_s);
   auto readers = [&] {
     int n = 0;
@@ -90,9 +91,13 @@ void AwaitReaders(const PublishOptions& o, DdsParticipant& participant, const In
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     discovered = readers();
   }
-  // Without the graph nothing says how many readers there are: the rest of the discovery burst
-  // that brought the first (0.5 s), and they are matched too.
-  if (o.watched == nullptr && missing.empty()) {
+  // When the graph does not say who reads the topic (none given, or none of its components: a
+  // ROS 2 topic the robot's side reads), nothing says how many readers there are: the rest of the
+  // discovery burst that brought the first (0.5 s), and they are matched too. The wait also lets
+  // a reader of another vendor match this writer from its side (seen with Cyclone DDS: a volatile
+  // reader ignores samples of a writer it has not matched yet, and a reliable writer's match says
+  // nothing about the reader's).
+  if (any_reader && missing.empty()) {
     const auto settle = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
     while (std::chrono::steady_clock::now() < settle && std::chrono::steady_clock::now() < end && !interrupt.interrupted())
       std::this_thread::sleep_for(std::chrono::milliseconds(10));

@@ -66,6 +66,13 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
     return LoadWatcherCatalog(st->graph, st->plugins, catalog, &st->opts, st->domain_given(), st->host, graph);
   };
 
+  // The topic a watcher reads: a ROS 2 topic of the --graph by its ROS 2 name (what it is on the
+  // wire, where every ROS 2 program sees it).
+  auto watched_topic = [st](const std::optional<Graph>& graph) {
+    const TopicConfig* t = graph ? graph->FindTopic(st->topic) : nullptr;
+    return t && !t->ros2.empty() ? t->ros2 : st->topic;
+  };
+
   auto* topics = app.add_subcommand("topics", "List the topics on the DDS domain with their types and endpoints");
   add_common(topics);
   topics->add_option("--graph", st->graph, "The graph (its domain and network); ends as soon as its topics and processes are found");
@@ -99,13 +106,14 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   echo->add_option("--duration", st->duration, "Stop after this many seconds");
   echo->add_option("--plugins", st->plugins, "Plugin file or folder whose message types to know (repeatable)");
   echo->add_option("--graph", st->graph, "Know the message types of this graph's plugins");
-  echo->callback([st, join, &exit_code] {
+  echo->callback([st, join, watched_topic, &exit_code] {
     Catalog catalog;
-    if (!join(&catalog)) {
+    std::optional<Graph> graph;
+    if (!join(&catalog, &graph)) {
       exit_code = 2;
       return;
     }
-    exit_code = EchoTopic(st->opts, catalog, st->topic, st->count, st->duration, JsonPrinter(), std::cout, std::cerr);
+    exit_code = EchoTopic(st->opts, catalog, watched_topic(graph), st->count, st->duration, JsonPrinter(), std::cout, std::cerr);
   });
 
   auto* hz = app.add_subcommand("hz", "Measure the publication rate of a topic");
@@ -114,13 +122,14 @@ void AddIntrospectionCommands(CLI::App& app, int& exit_code) {
   hz->add_option("--duration", st->duration, "Stop after this many seconds (0: until Ctrl-C)");
   hz->add_option("--plugins", st->plugins, "Plugin file or folder whose message types to know (repeatable)");
   hz->add_option("--graph", st->graph, "Know the message types of this graph's plugins");
-  hz->callback([st, join, &exit_code] {
+  hz->callback([st, join, watched_topic, &exit_code] {
     Catalog catalog;
-    if (!join(&catalog)) {
+    std::optional<Graph> graph;
+    if (!join(&catalog, &graph)) {
       exit_code = 2;
       return;
     }
-    exit_code = TopicHz(st->opts, catalog, st->topic, st->duration, std::cout, std::cerr);
+    exit_code = TopicHz(st->opts, catalog, watched_topic(graph), st->duration, std::cout, std::cerr);
   });
 }
 

@@ -154,10 +154,18 @@ std::string MessageReferenceMarkdown(const Catalog& catalog) {
          "Every sample starts with a `Header` (source component, sequence number, stamp). Types are\n"
          "OMG IDL (`idl/*.idl`), compiled by fastddsgen at build time; on the wire a type is named\n"
          "`<IDL name>#<hash of its definition>` (docs/runtime.md). Graphs name them by their short name\n"
-         "(`topics: {robot/state: {type: CartesianState}}`).\n\n";
-  for (const TypeInfo* t : catalog.MessageTypes()) out << "- [" << t->short_name() << "](#" << Anchor(t->short_name()) << ")\n";
-  for (const TypeInfo* t : catalog.MessageTypes()) {
-    const StructText s = FindStruct(t->idl, t->short_name());
+         "(`topics: {robot/state: {type: CartesianState}}`).\n\n"
+         "ROS 2 message types (`idl/ros2/`, docs/ros2.md) follow dyad's: named as ROS 2 names them\n"
+         "(`geometry_msgs/msg/TwistStamped`), on the wire as ROS 2's middlewares do\n"
+         "(`geometry_msgs::msg::dds_::TwistStamped_`, no hash), with no dyad `Header`.\n\n";
+  // dyad's own types first, then the ROS 2 ones.
+  std::vector<const TypeInfo*> types;
+  for (bool ros2 : {false, true})
+    for (const TypeInfo* t : catalog.MessageTypes())
+      if (t->ros2() == ros2) types.push_back(t);
+  for (const TypeInfo* t : types) out << "- [" << t->short_name() << "](#" << Anchor(t->short_name()) << ")\n";
+  for (const TypeInfo* t : types) {
+    const StructText s = FindStruct(t->idl, t->name.substr(t->name.rfind("::") + 2));
     out << "\n## " << t->short_name() << "\n\n`" << t->name << "`";
     if (!s.doc.empty()) out << ": " << s.doc;
     out << "\n\n";

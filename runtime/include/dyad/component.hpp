@@ -117,7 +117,8 @@ namespace dyad {
 // 5: ParamSpec::secret (redacted from Context::graph_yaml()).
 // 6: live parameters: ParamSpec::live, Params::Set, Context::CheckLiveParam; a live param's value
 //    in ctx.params() changes between steps.
-inline constexpr uint32_t kPluginAbiVersion = 6;
+// 7: TypeInfo::ros2_name (ROS 2 message types, no dyad Header: Publish stamps nothing in them).
+inline constexpr uint32_t kPluginAbiVersion = 7;
 
 // The runtime clock: wall time (ns since the Unix epoch) in `clock: wall` graphs, simulated time
 // (ns since start) in `clock: stepped` graphs. Thread-safe.
@@ -261,14 +262,18 @@ class OutputBase {
 template <class T>
 class Output final : public OutputBase {
  public:
-  // Fills sample.header() (source, next sequence number, clock stamp) and publishes it.
-  // Unbound outputs accept and drop samples.
+  // Fills sample.header() (source, next sequence number, clock stamp) and publishes it; a ROS 2
+  // type's header is the component's to fill (message_traits.hpp). Unbound outputs accept and
+  // drop samples.
   Status Publish(T& sample) {
-    auto& h = sample.header();
-    h.source(source_);
-    h.sequence_number(++sequence_);
     const int64_t now = clock_ ? clock_->now_ns() : 0;
-    h.stamp_ns(now);
+    ++sequence_;
+    if constexpr (MessageTraits<T>::kDyadHeader) {
+      auto& h = sample.header();
+      h.source(source_);
+      h.sequence_number(sequence_);
+      h.stamp_ns(now);
+    }
     if (endpoint_ == nullptr) return Status::OK();
     return endpoint_->WriteStamped(&sample, now);
   }
@@ -279,7 +284,7 @@ struct PortSpec {
   std::string name;
   const TypeInfo* type = nullptr;  // static storage
   std::string doc;
-  bool optional = false;  // inputs: may be left unbound in the graph
+  bool optional = false;  // may be left unbound in the graph (an output: without a warning)
   std::function<std::unique_ptr<InputBase>()> make_input;
   std::function<std::unique_ptr<OutputBase>()> make_output;
 

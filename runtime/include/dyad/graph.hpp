@@ -67,8 +67,14 @@ struct TopicConfig {
   int depth = 1;             // KEEP_LAST history depth
   double deadline_ms = 0;    // 0: none
   double liveliness_ms = 0;  // 0: the network's lease_s; else a writer silent this long is not alive
+  // A ROS 2 topic (dyad/ros2_names.hpp): its fully qualified ROS 2 name; empty for a dyad topic.
+  // `qos:` names its ROS 2 QoS profile (default "default"), which sets reliability and depth
+  // unless the entry sets them too.
+  std::string ros2;
+  std::string ros2_qos;
   SourceMark mark;
   SourceMark type_mark;
+  SourceMark ros2_mark;
 };
 
 enum class Discovery { kMulticast, kPeers, kServer };

@@ -11,7 +11,13 @@
 // different-layout types and drop every sample silently).
 //
 // A message type T must have a member `dyad::msg::Header& header()` (every dyad IDL struct
-// starts with `Header header;`).
+// starts with `Header header;`), which Output<T>::Publish stamps.
+//
+// ROS 2 message types (idl/ros2/, docs/ros2.md) are the exception: named as ROS 2's middlewares
+// name them on the wire ("geometry_msgs::msg::dds_::TwistStamped_", also known by their ROS 2
+// name "geometry_msgs/msg/TwistStamped"), their DDS type name carries no hash (ROS 2 peers
+// match on the plain name), and they have no dyad Header: the component fills their
+// std_msgs/Header (stamp, frame_id) itself.
 #pragma once
 
 #include <functional>
@@ -27,11 +33,14 @@ struct TypeInfo {
   std::string name;  // IDL name, e.g. "dyad::msg::HumanInput"
   std::string hash;  // 16 hex digits of the definition's SHA-256
   std::string idl;   // IDL text, includes inlined
+  std::string ros2_name;  // "geometry_msgs/msg/Twist" for a ROS 2 type; empty for dyad's own
   // Returns a new Fast DDS type support for T, already renamed to dds_name(). Caller owns it.
   std::function<eprosima::fastdds::dds::TopicDataType*()> make_type_support;
 
-  std::string dds_name() const { return name + "#" + hash; }
-  // "HumanInput": the name after the last "::".
+  bool ros2() const { return !ros2_name.empty(); }
+  // The DDS type name: "<name>#<hash>", or the plain IDL name for a ROS 2 type.
+  std::string dds_name() const { return ros2() ? name : name + "#" + hash; }
+  // "HumanInput": the name after the last "::"; a ROS 2 type's ROS 2 name.
   std::string short_name() const;
 };
 
@@ -48,6 +57,7 @@ const TypeInfo& TypeInfoOf() {
     i.name = MessageTraits<T>::kName;
     i.hash = MessageTraits<T>::kHash;
     i.idl = MessageTraits<T>::kIdl;
+    i.ros2_name = MessageTraits<T>::kRos2Name;
     std::string dds_name = i.dds_name();
     i.make_type_support = [dds_name]() -> eprosima::fastdds::dds::TopicDataType* {
       auto* t = new typename MessageTraits<T>::PubSubType();
@@ -69,4 +79,19 @@ const TypeInfo& TypeInfoOf() {
     static constexpr const char* kName = #NS "::" #NAME;         \
     static constexpr const char* kHash = HASH;                   \
     static constexpr const char* kIdl = IDL;                     \
+    static constexpr const char* kRos2Name = "";                 \
+    static constexpr bool kDyadHeader = true;                    \
+  }
+
+// Declares MessageTraits for the ROS 2 type NS::NAME ("<pkg>::msg::dds_", "<Type>_"), known as
+// ROS2_NAME ("<pkg>/msg/<Type>"): no dyad Header, a plain DDS type name.
+#define DYAD_ROS2_MESSAGE_TYPE(NS, NAME, ROS2_NAME, HASH, IDL)    \
+  template <>                                                    \
+  struct dyad::MessageTraits<NS::NAME> {                         \
+    using PubSubType = NS::NAME##PubSubType;                     \
+    static constexpr const char* kName = #NS "::" #NAME;         \
+    static constexpr const char* kHash = HASH;                   \
+    static constexpr const char* kIdl = IDL;                     \
+    static constexpr const char* kRos2Name = ROS2_NAME;          \
+    static constexpr bool kDyadHeader = false;                   \
   }
