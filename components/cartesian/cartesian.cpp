@@ -1,4 +1,5 @@
 #include "cartesian.hpp"
+#include "ros2_cartesian.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -406,4 +407,5 @@ DYAD_PLUGIN(registry) {
   registry.Add<dyad::cartesian::VirtualCartesian>("virtual_cartesian");
   registry.Add<dyad::cartesian::UdpCartesian>("udp_cartesian");
   registry.Add<dyad::cartesian::CartesianPattern>("cartesian_pattern");
+  registry.Add<dyad::cartesian::Ros2Cartesian>("ros2_cartesian");
 }
