@@ -1,10 +1,14 @@
 // bench_pvrnn_train: ms per training epoch and achieved GFLOP/s (2 x multiply-adds of the
 // posterior pass + BPTT) for the study's model (d=40,10; z=4,1; tau=2,10) on the Macaw set
 // (or the built-in analytic set when ../shared/data is absent), beside the GFLOP/s of a large
-// Eigen GEMM in the same scalar, measured in the same run. One thread.
+// Eigen GEMM (one thread) in the same scalar, measured in the same run. Per scalar three rows:
+// 1 chunk on 1 thread, 2 chunks (the default) on 1 thread and on --threads (default 2), with
+// the speed-up over the first row.
 //
-//   bench_pvrnn_train [--epochs N] [--full]   (--full: run 50,000 epochs in float and report
-//                                              wall time and final loss)
+//   bench_pvrnn_train [--epochs N] [--threads N] [--full] [--curve N]
+//     --full: run 50,000 epochs in float (default options) and report wall time and final loss
+//     --curve N: train N epochs (seed 1) and print the loss every 1000 epochs to 17 digits, in
+//                float and double (to compare the loss curve before and after an engine change)
 #include <Eigen/Core>
 #include <chrono>
 #include <cstdio>
@@ -38,28 +42,52 @@ double GemmGflops() {
 }
 
 template <typename Scalar>
-void Row(const char* name, const Model& init, const Dataset& data, int epochs) {
-  auto trainer = Trainer<Scalar>::Create(init, data, TrainerOptions{}).value();
+double MsPerEpoch(const Model& init, const Dataset& data, const TrainerOptions& o, int epochs, double* gflops) {
+  auto trainer = Trainer<Scalar>::Create(init, data, o).value();
   for (int e = 0; e < 20; ++e) trainer->Epoch();  // warm up
   const auto t0 = Clock::now();
-  LossTerms last;
-  for (int e = 0; e < epochs; ++e) last = trainer->Epoch();
+  for (int e = 0; e < epochs; ++e) trainer->Epoch();
   const double secs = std::chrono::duration<double>(Clock::now() - t0).count();
-  const double ms = 1e3 * secs / epochs;
-  const double gflops = 2.0 * trainer->pass().MultiplyAddsPerIteration() / (secs / epochs) / 1e9;
+  *gflops = 2.0 * trainer->MultiplyAddsPerEpoch() / (secs / epochs) / 1e9;
+  return 1e3 * secs / epochs;
+}
+
+// One row per configuration; the last column is the speed-up over the first row of the scalar.
+template <typename Scalar>
+void Rows(const char* name, const Model& init, const Dataset& data, int epochs, int threads) {
   const double gemm = GemmGflops<Scalar>();
-  std::printf("%-7s %10.3f %10.2f %12.2f %9.1f%% %14.1f s\n", name, ms, gflops, gemm, 100 * gflops / gemm,
-              ms * 50000 / 1e3);
+  double first = 0;
+  for (auto [chunks, n_threads] : {std::pair{1, 1}, std::pair{2, 1}, std::pair{2, threads}}) {
+    TrainerOptions o;
+    o.chunks = chunks;
+    o.threads = n_threads;
+    double gflops = 0;
+    const double ms = MsPerEpoch<Scalar>(init, data, o, epochs, &gflops);
+    if (first == 0) first = ms;
+    std::printf("%-7s %6d %7d %10.3f %10.2f %12.2f %9.1f%% %12.1f s %8.2fx\n", name, chunks, n_threads, ms, gflops,
+                gemm, 100 * gflops / gemm, ms * 50000 / 1e3, first / ms);
+  }
+}
+
+template <typename Scalar>
+void Curve(const char* name, const Model& init, const Dataset& data, int epochs) {
+  auto trainer = Trainer<Scalar>::Create(init, data, TrainerOptions{}).value();
+  for (int e = 1; e <= epochs; ++e) {
+    const LossTerms& l = trainer->Epoch();
+    if (e % 1000 == 0 || e == 1) std::printf("curve %s %d %.17g\n", name, e, l.loss);
+  }
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  int epochs = 2000;
+  int epochs = 2000, curve = 0, threads = 2;
   bool full = false;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--epochs") && i + 1 < argc) epochs = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--full")) full = true;
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) threads = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--curve") && i + 1 < argc) curve = std::atoi(argv[++i]);
   }
   Eigen::setNbThreads(1);
   const std::string macaw = std::string(DYAD_SHARED_DATA_DIR) + "/vcbot/dataset/Macaw";
@@ -70,12 +98,17 @@ int main(int argc, char** argv) {
     data = MakeAnalyticDataset();
   }
   const Model init = Model::Initialize(ModelSpec::MacawBot(), data.steps(), data.size(), 1);
+  if (curve > 0) {
+    Curve<float>("float", init, data, curve);
+    Curve<double>("double", init, data, curve);
+    return 0;
+  }
   std::printf("PV-RNN training, model d=40,10 z=4,1 tau=2,10 on '%s' (%d sequences x %d steps), %d epochs\n",
               data.name.c_str(), data.size(), data.steps(), epochs);
-  std::printf("%-7s %10s %10s %12s %10s %16s\n", "scalar", "ms/epoch", "GFLOP/s", "GEMM GFLOP/s", "of GEMM",
-              "50k epochs");
-  Row<float>("float", init, data, epochs);
-  Row<double>("double", init, data, epochs);
+  std::printf("%-7s %6s %7s %10s %10s %12s %10s %14s %9s\n", "scalar", "chunks", "threads", "ms/epoch", "GFLOP/s",
+              "GEMM GFLOP/s", "of GEMM", "50k epochs", "speed-up");
+  Rows<float>("float", init, data, epochs, threads);
+  Rows<double>("double", init, data, epochs, threads);
   if (full) {
     auto trainer = Trainer<float>::Create(init, data, TrainerOptions{}).value();
     const auto t0 = Clock::now();

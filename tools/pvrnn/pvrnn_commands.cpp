@@ -66,6 +66,7 @@ int RunTraining(const TrainConfig& c, const std::string& config_path, const Data
   opts.adam = c.adam;
   opts.seed = c.seed;
   opts.sample_noise = c.noise;
+  opts.threads = static_cast<int>(c.threads);
   auto made = Trainer<Scalar>::Create(init, data, opts);
   if (!made.ok()) return Fail(kBadInput, made.status().message());
   Trainer<Scalar>& trainer = *made.value();

@@ -146,6 +146,8 @@ Outcome Train(const SweepPlan& plan, const SweepTraining& training, const Runner
   std::vector<std::string> args = {o.dyad, "train", plan.train_config};
   for (const auto& s : training.sets) args.insert(args.end(), {"--set", s});
   args.insert(args.end(), {"--set", "output=" + model});
+  // Workers already fill the cores: one thread per training (same bits whatever the count).
+  if (o.workers > 1) args.insert(args.end(), {"--set", "threads=1"});
   const std::string log = (dir / (training.id + ".log")).string();
   const int rc = tools::RunProcess(args, log);
   if (rc == 0 && fs::exists(model)) return Outcome::kOk;

@@ -188,7 +188,7 @@ void ReadAdam(StrictYaml& r, const YAML::Node& root, AdamOptions* adam) {
 TrainConfig Read(StrictYaml& r, const std::string& file, const YAML::Node& root) {
   TrainConfig c;
   if (!r.Map(root, "", {"dataset", "loops", "layers", "encoding", "epochs", "adam", "seed", "scalar", "noise",
-                        "log_every", "checkpoint_every", "output", "checkpoint", "log_csv"}))
+                        "threads", "log_every", "checkpoint_every", "output", "checkpoint", "log_csv"}))
     return c;
   ReadPath(r, file, root, "dataset", &c.dataset, true);
   if (r.Get(root, "loops", "loops", &c.loops, "an integer"))
@@ -202,6 +202,8 @@ TrainConfig Read(StrictYaml& r, const std::string& file, const YAML::Node& root)
   if (r.Get(root, "scalar", "scalar", &c.scalar, "a string"))
     Check(r, c.scalar == "float" || c.scalar == "double", root, "scalar", "must be float or double", c.scalar);
   r.Get(root, "noise", "noise", &c.noise, "true or false");
+  if (r.Get(root, "threads", "threads", &c.threads, "an integer"))
+    Check(r, c.threads >= 0 && c.threads <= 256, root, "threads", "must be in 0..256", c.threads);
   if (r.Get(root, "log_every", "log_every", &c.log_every, "an integer"))
     Check(r, c.log_every > 0, root, "log_every", "must be > 0", c.log_every);
   if (r.Get(root, "checkpoint_every", "checkpoint_every", &c.checkpoint_every, "an integer"))

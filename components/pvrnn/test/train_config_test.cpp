@@ -88,6 +88,18 @@ TEST(TrainConfig, LoopsDefaultsToOneAndIsRangeChecked) {
   EXPECT_EQ(zero.status().message(), "--set loops=0: loops: must be in 1..100, got 0");
 }
 
+TEST(TrainConfig, ThreadsDefaultToTheCoresAndAreRangeChecked) {
+  auto c = LoadTrainConfig(kDir + "/valid_train.yaml");
+  ASSERT_TRUE(c.ok()) << c.status().message();
+  EXPECT_EQ(c->threads, 0);
+  auto one = LoadTrainConfig(kDir + "/valid_train.yaml", {"threads=1"});
+  ASSERT_TRUE(one.ok()) << one.status().message();
+  EXPECT_EQ(one->threads, 1);
+  auto bad = LoadTrainConfig(kDir + "/valid_train.yaml", {"threads=-1"});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().message(), "--set threads=-1: threads: must be in 0..256, got -1");
+}
+
 TEST(TrainConfig, BadOverrideIsNamed) {
   auto c = LoadTrainConfig(kDir + "/valid_train.yaml", {"epochs=-3"});
   ASSERT_FALSE(c.ok());

@@ -79,6 +79,7 @@ class PosteriorPass {
   double MultiplyAddsPerIteration() const;
 
  private:
+  void WeightGradients(Weights<Scalar>* grad_w) const;
   NetworkLayout layout_;
   int steps_, sequences_, cols_;
   // Inputs of the last Forward.
@@ -87,9 +88,9 @@ class PosteriorPass {
   const MatrixT<Scalar>* targets_ = nullptr;
   LossTerms terms_;  // kl_per_layer sized once: Forward allocates nothing
   bool weights_frozen_ = false;
-  const Weights<Scalar>* transposed_ = nullptr;  // weights whose transposes r_t_, wz_t_, wx_t_ hold
+  const Weights<Scalar>* transposed_ = nullptr;  // weights whose transposes r_t_, wx_t_ hold
   VectorT<Scalar> rate_, keep_, kl_coef_;
-  MatrixT<Scalar> r_t_, wz_t_, wx_t_;      // transposed copies for the backward products
+  MatrixT<Scalar> r_t_, wx_t_;             // transposed copies for the backward products
   MatrixT<Scalar> r_maskf_, wz_maskf_;
   // Trajectory: h_, d_ have (steps+1)*sequences columns (block 0 = start).
   MatrixT<Scalar> h_, d_;
@@ -98,8 +99,9 @@ class PosteriorPass {
   MatrixT<Scalar> x_, log_x_;                                      // output_units x cols
   // Backward buffers.
   MatrixT<Scalar> g_pre_;          // recurrent_rows x cols
-  MatrixT<Scalar> g_out_, g_d0_;   // output_units x cols, d0 x cols
-  MatrixT<Scalar> g_d_, g_h_, g_h_next_, g_z_;
+  MatrixT<Scalar> g_out_, g_d0_;   // output_units x cols; total_d x cols (rows below d0 zero)
+  MatrixT<Scalar> g_h_, g_h_next_, g_z_;
+  MatrixT<Scalar> keep_tile_;      // 1 - a for every row and sequence (total_d x sequences)
   MatrixT<Scalar> g_start_h_, g_start_d_;
 };
 

@@ -10,6 +10,7 @@
 //   adam: {lr: 0.001, beta1: 0.9, beta2: 0.999, epsilon: 1.0e-8}
 //   seed: 1
 //   scalar: float                              # float | double
+//   threads: 0                                 # 0: the hardware's cores (same result for any)
 //   noise: true                                # sample eps during training
 //   log_every: 100                             # progress line + CSV row
 //   checkpoint_every: 5000                     # 0 = only at the end / on Ctrl-C
@@ -45,6 +46,9 @@ struct TrainConfig {
   uint64_t seed = 1;
   std::string scalar = "float";    // "float" | "double"
   bool noise = true;
+  // Threads of the trainer (TrainerOptions::threads): the result is the same for any; 1 is
+  // faster when other processes keep every core busy.
+  int64_t threads = 0;             // REQUIRES 0..256 (0: the hardware's cores)
   int64_t log_every = 100;         // REQUIRES > 0
   int64_t checkpoint_every = 5000; // REQUIRES >= 0
   std::string output;              // REQUIRED
