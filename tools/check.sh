@@ -2,7 +2,8 @@
 # Sanitizer builds of the test suite, and the fuzz corpus replay (CI runs `sanitize`).
 #
 #   bash tools/check.sh sanitize   asan without the `e2e` label, then tsan (below); CI runs this.
-#                                  e2e (the demos, the watcher stress, the pages in Chromium) are whole-program timings
+#                                  e2e (the demos, the watcher stress, the pages in Chromium, the ROS 2 driver against
+#                                  its fake arm) are whole-program timings
 #                                  the Release suite runs; under ASan they cost CI ~4 minutes and
 #                                  cover code the unit tests already run under ASan
 #   bash tools/check.sh asan       ./build-san: clang 14, ASan + UBSan (-fno-sanitize-recover=all:

@@ -10,6 +10,6 @@ repo=$(cd "$(dirname "$0")/../.." && pwd)
 build=$(cd "${1:-$repo/build}" && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-bash "$repo/tests/watcher_stress_test.sh" "$build/bin/dyad" "$work/run" > "$work/out.txt" 2>&1 ||
+bash "$repo/tests/watcher_stress_test.sh" "$build/bin/dyad" "$work/run" --timing > "$work/out.txt" 2>&1 ||
   { cat "$work/out.txt"; echo "bench_watchers: the scenario's functional checks failed" >&2; exit 1; }
 cat "$work/run/timing.txt"
