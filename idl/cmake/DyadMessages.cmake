@@ -13,13 +13,25 @@
 #
 #   Each struct must start with `dyad::msg::Header header;` (the runtime stamps it).
 #
+# dyad_add_messages(<target> ROS2 FILES <pkg>/msg/<Type>.idl... [IDL_DIR <dir>])
+#
+#   More ROS 2 message types (docs/ros2.md), laid out as dyad's idl/ros2/: each file holds struct
+#   <Type>_ in module <pkg>::msg::dds_ and may include dyad's ROS 2 types
+#   (`#include "std_msgs/msg/Header.idl"`: their code lives in dyad::msgs). Headers land as
+#   <pkg>/msg/<Type>.h, the traits as <target>/msg/types.hpp (INCLUDE_PREFIX), the types named
+#   by their ROS 2 names, with no dyad Header and no hash on the wire. Example:
+#   tests/out_of_tree/ros2_messages/.
+#
 # Needs DYAD_IDL_DIR (dyad's IDL files) and DYAD_MSG_INCLUDE_DIR (the folder holding dyad's
 # generated header.h): find_package(dyad) sets both; dyad's own build sets them in idl/.
 
 find_program(FASTDDSGEN fastddsgen)
 
 function(dyad_add_messages target)
-  cmake_parse_arguments(A "" "NAMESPACE;IDL_DIR;INCLUDE_PREFIX" "FILES" ${ARGN})
+  cmake_parse_arguments(A "ROS2" "NAMESPACE;IDL_DIR;INCLUDE_PREFIX" "FILES" ${ARGN})
+  if(A_ROS2 AND NOT A_NAMESPACE)
+    set(A_NAMESPACE ${target}::ros2)  # holds only AllTypes()
+  endif()
   if(NOT A_NAMESPACE OR NOT A_FILES)
     message(FATAL_ERROR "dyad_add_messages(${target}): NAMESPACE and FILES are required")
   endif()
@@ -38,22 +50,38 @@ function(dyad_add_messages target)
   set(_idl_paths "")
   set(_outputs "")
   set(_own_files "")
+  set(_copies "")
+  set(_dest_dirs ${_out})
   foreach(_idl IN LISTS A_FILES)
     get_filename_component(_stem ${_idl} NAME_WE)
     list(APPEND _idl_paths ${A_IDL_DIR}/${_idl})
+    # A ROS 2 type's C++ goes where its generated includes look for it: <pkg>/msg/.
+    set(_dest ${_out})
+    if(A_ROS2)
+      get_filename_component(_pkg_dir ${_idl} DIRECTORY)
+      set(_dest ${_root}/include/${_pkg_dir})
+      list(APPEND _dest_dirs ${_dest})
+    endif()
     foreach(_suffix .h .cxx PubSubTypes.h PubSubTypes.cxx)
-      list(APPEND _own_files ${_scratch}/${_stem}${_suffix})
-      list(APPEND _outputs ${_out}/${_stem}${_suffix})
+      list(APPEND _copies COMMAND ${CMAKE_COMMAND} -E copy ${_scratch}/${_stem}${_suffix} ${_dest}/${_stem}${_suffix})
+      list(APPEND _outputs ${_dest}/${_stem}${_suffix})
     endforeach()
   endforeach()
+  set(_include_path -I ${A_IDL_DIR} -I ${DYAD_IDL_DIR})
+  set(_traits_path ${DYAD_IDL_DIR})
+  if(A_ROS2)
+    set(_include_path -I ${A_IDL_DIR} -I ${DYAD_IDL_DIR}/ros2)
+    set(_traits_path ${DYAD_IDL_DIR}/ros2)
+    set(_traits_mode ROS2)
+  endif()
   # fastddsgen also writes C++ for every included file (a second dyad::msg::Header): it goes to a
   # scratch folder, and only the files of FILES are kept.
   add_custom_command(
     OUTPUT ${_outputs}
     COMMAND ${CMAKE_COMMAND} -E rm -rf ${_scratch}
-    COMMAND ${CMAKE_COMMAND} -E make_directory ${_scratch} ${_out}
-    COMMAND ${FASTDDSGEN} -cs -replace -d ${_scratch} -I ${A_IDL_DIR} -I ${DYAD_IDL_DIR} ${_idl_paths}
-    COMMAND ${CMAKE_COMMAND} -E copy ${_own_files} ${_out}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${_scratch} ${_dest_dirs}
+    COMMAND ${FASTDDSGEN} -cs -replace -d ${_scratch} ${_include_path} ${_idl_paths}
+    ${_copies}
     DEPENDS ${_idl_paths}
     WORKING_DIRECTORY ${A_IDL_DIR}
     COMMENT "fastddsgen: C++ for ${A_FILES} (${target})"
@@ -63,15 +91,18 @@ function(dyad_add_messages target)
     NAMESPACE ${A_NAMESPACE}
     INCLUDE_PREFIX ${A_INCLUDE_PREFIX}
     IDL_DIR ${A_IDL_DIR}
-    IDL_PATH ${DYAD_IDL_DIR}
+    IDL_PATH ${_traits_path}
+    ${_traits_mode}
     FILES ${A_FILES})
   set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${_idl_paths})
   set(_sources ${_outputs})
   list(FILTER _sources INCLUDE REGEX "\\.cxx$")
   target_sources(${target} PRIVATE ${_sources})
   set_source_files_properties(${_sources} PROPERTIES COMPILE_OPTIONS -w)  # fastddsgen's code is not ours to fix
-  # ${_out}: our generated "x.h" includes; DYAD_MSG_INCLUDE_DIR: their "header.h"
-  target_include_directories(${target} PRIVATE ${_root}/include ${_out} ${DYAD_MSG_INCLUDE_DIR})
+  # ${_out}: our generated "x.h" includes; DYAD_MSG_INCLUDE_DIR: their "header.h"; two levels up
+  # from it (gen/ in dyad's build, include/ installed): dyad's ROS 2 headers, "std_msgs/msg/Header.h".
+  get_filename_component(_ros2_include "${DYAD_MSG_INCLUDE_DIR}/../.." ABSOLUTE)
+  target_include_directories(${target} PRIVATE ${_root}/include ${_out} ${DYAD_MSG_INCLUDE_DIR} ${_ros2_include})
   if(TARGET dyad::msgs)
     target_link_libraries(${target} PRIVATE dyad::msgs)
   else()

@@ -87,3 +87,34 @@ grep -q "does not know: name the plugin" "$work/echo-unknown.err" || { cat "$wor
 kill $run_pid; wait $run_pid 2>/dev/null || true
 trap - EXIT
 echo "plugin with its own message type: recorded, exported, echoed"
+
+# A plugin bringing ROS 2 types dyad does not ship (dyad_add_messages ... ROS2), from the
+# installed example: known by their ROS 2 names, recorded and exported with their fields.
+example="$work/prefix/share/dyad/examples/ros2_messages"
+cmake -S "$example" -B "$work/ros2-build" -DCMAKE_PREFIX_PATH="$work/prefix" -DCMAKE_BUILD_TYPE=Release > "$work/ros2-configure.log"
+cmake --build "$work/ros2-build" -j2 > "$work/ros2-build.log" || { cat "$work/ros2-build.log"; exit 1; }
+sensor="$work/ros2-build/force_sensor.so"
+"$work/prefix/bin/dyad" types --messages --plugins "$sensor" | grep '^geometry_msgs/msg/WrenchStamped ' > /dev/null
+cat > "$work/ros2.yaml" <<YAML
+graph: force
+clock: stepped
+domain_id: $domain
+plugins: [$sensor]
+topics:
+  wrench: {type: geometry_msgs/msg/WrenchStamped}
+components:
+  src: {type: counter_source, rate_hz: 10, params: {start: 1}, outputs: {out: count}}
+  sensor: {type: force_sensor, trigger: in, params: {newtons_per_count: 0.5}, inputs: {in: count}, outputs: {out: wrench}}
+  rec: {type: recorder, rate_hz: 1, params: {file: "$work/ros2.mcap", topics: [wrench]}}
+YAML
+"$work/prefix/bin/dyad" run "$work/ros2.yaml" --steps 3 --quiet
+"$work/prefix/bin/dyad" bag export "$work/ros2.mcap" --csv "$work/ros2-csv" > /dev/null
+actual=$(cut -d, -f4- "$work/ros2-csv/wrench.csv")
+expected='header.stamp.sec,header.stamp.nanosec,header.frame_id,wrench.force.x,wrench.force.y,wrench.force.z,wrench.torque.x,wrench.torque.y,wrench.torque.z
+0,0,tool0,0.5,0,0,0,0,0
+0,100000000,tool0,1,0,0,0,0,0
+0,200000000,tool0,1.5,0,0,0,0,0'
+if [ "$actual" != "$expected" ]; then
+  echo "unexpected export of the plugin's ROS 2 type:"; echo "$actual"; exit 1
+fi
+echo "plugin with ROS 2 types of its own: known by their ROS 2 names, recorded, exported"
