@@ -43,6 +43,17 @@ std::string Ros2NameOfDdsTopic(std::string_view dds_topic) {
   return std::string(dds_topic.substr(2));
 }
 
+std::string Ros2TypeOfDdsType(std::string_view dds_type) {
+  constexpr std::string_view kMiddle = "::msg::dds_::";
+  const size_t m = dds_type.find(kMiddle);
+  if (m == std::string_view::npos || m == 0 || dds_type.size() < m + kMiddle.size() + 2 || dds_type.back() != '_')
+    return "";
+  const std::string_view pkg = dds_type.substr(0, m);
+  const std::string_view type = dds_type.substr(m + kMiddle.size(), dds_type.size() - m - kMiddle.size() - 1);
+  if (pkg.find(':') != std::string_view::npos || type.find(':') != std::string_view::npos) return "";
+  return std::string(pkg) + "/msg/" + std::string(type);
+}
+
 bool Ros2QosProfile(std::string_view name, Ros2Qos* qos) {
   // rmw/qos_profiles.h: default (reliable, volatile, keep last 10), sensor_data (best effort,
   // volatile, keep last 5), parameters and services_default (reliable, volatile, 1000 / 10).

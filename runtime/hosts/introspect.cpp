@@ -1,5 +1,7 @@
 #include "dyad/introspect.hpp"
 
+#include <dyad/ros2_names.hpp>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -184,7 +186,8 @@ int ListTopics(const IntrospectOptions& o, std::ostream& out, const Graph* graph
   for (const auto& e : p->Discovered()) {
     if (e.participant == p->name()) continue;
     Row& r = rows[e.topic];
-    r.types.insert(e.type);
+    const std::string ros2_type = Ros2TypeOfDdsType(e.type);  // a ROS 2 type by its ROS 2 name
+    r.types.insert(ros2_type.empty() ? e.type : ros2_type);
     r.participants.insert(e.participant);
     (e.writer ? r.writers : r.readers)++;
   }

@@ -28,6 +28,10 @@ std::string Ros2DdsTopic(std::string_view ros2_name);
 // The ROS 2 topic a DDS topic stands for: "rt/a/b" -> "/a/b"; "" for any other DDS topic.
 std::string Ros2NameOfDdsTopic(std::string_view dds_topic);
 
+// The ROS 2 type a DDS type name stands for: "geometry_msgs::msg::dds_::Twist_" ->
+// "geometry_msgs/msg/Twist"; "" for any other name.
+std::string Ros2TypeOfDdsType(std::string_view dds_type);
+
 // A ROS 2 QoS profile by its rclcpp name: reliable or not, KEEP_LAST depth (every profile here is
 // volatile). False for a name not listed by Ros2QosProfiles().
 struct Ros2Qos {
