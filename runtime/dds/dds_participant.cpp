@@ -95,7 +95,7 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
       Foreign(dds_topic, info.info.m_qos.m_partition.names(), info.info.guid());
       return;  // another run's: its type is not ours to check
     }
-    Check("writer", dds_topic, info.info.typeName().to_string(), info.info.guid().guidPrefix);
+    Check("writer", dds_topic, info.info.typeName().to_string(), GuidPrefixString(info.info.guid().guidPrefix));
   }
   void on_subscriber_discovery(fdds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override {
     const bool gone = info.status == rtps::ReaderDiscoveryInfo::REMOVED_READER;
@@ -104,7 +104,7 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
     Track(false, gone, dds_topic, info.info.typeName().to_string(), info.info.guid(), same_partition);
     if (info.status != rtps::ReaderDiscoveryInfo::DISCOVERED_READER) return;
     if (!same_partition) return;
-    Check("reader", dds_topic, info.info.typeName().to_string(), info.info.guid().guidPrefix);
+    Check("reader", dds_topic, info.info.typeName().to_string(), GuidPrefixString(info.info.guid().guidPrefix));
   }
 
   // Endpoints by the names this participant uses: a ROS 2 topic of ours by its graph name, any
@@ -125,6 +125,17 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
       out.push_back(e);
     }
     return out;
+  }
+  // A topic this participant has just begun to use: the endpoints discovered on it before (their
+  // discovery found no topic of ours to check them against) are checked now.
+  void CheckDiscovered(const std::string& dds_topic) {
+    std::vector<DiscoveredEndpoint> known;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (const auto& [guid, e] : endpoints_)
+        if (e.topic == dds_topic && e.same_partition) known.push_back(e);
+    }
+    for (const auto& e : known) Check(e.writer ? "writer" : "reader", dds_topic, e.type, e.participant);
   }
   void on_requested_incompatible_qos(fdds::DataReader* reader, const fdds::RequestedIncompatibleQosStatus& status) override {
     if (on_problem_)
@@ -148,11 +159,13 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
   }
   // A remote participant's name; one without (not a dyad process: another vendor's, ROS 2's)
   // by its GUID prefix. REQUIRES: mutex_ held.
-  std::string RemoteName(const rtps::GuidPrefix_t& prefix) {
-    auto it = names_.find(GuidPrefixString(prefix));
+  std::string RemoteName(const std::string& prefix) {
+    auto it = names_.find(prefix);
     if (it != names_.end() && !it->second.empty()) return "'" + it->second + "'";
-    return "participant " + GuidPrefixString(prefix) + (it != names_.end() ? " (unnamed: not a dyad process)" : "");
+    return "participant " + prefix + (it != names_.end() ? " (unnamed: not a dyad process)" : "");
   }
+
+
 
   bool SharesPartition(const std::string& dds_topic, const std::vector<std::string>& remote) {
     static const std::vector<std::string> kDefault;
@@ -163,7 +176,7 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
     return PartitionsMatch(ros2 ? kDefault : owner_->partitions_, remote);
   }
 
-  void Check(const char* kind, const std::string& dds_topic, const std::string& type, const rtps::GuidPrefix_t& prefix) {
+  void Check(const char* kind, const std::string& dds_topic, const std::string& type, const std::string& prefix) {
     std::string ours, topic;
     {
       std::lock_guard<std::mutex> lock(owner_->mutex_);
@@ -201,7 +214,7 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!foreign_reported_.insert(os.str()).second || !on_foreign_) return;
-      remote = RemoteName(guid.guidPrefix);
+      remote = RemoteName(GuidPrefixString(guid.guidPrefix));
     }
     on_foreign_("topic '" + topic + "' is also written by " + remote + " in " + PartitionText(partitions) +
                 ", another run on this domain: ignored (not delivered, not recorded); this run is in " +
@@ -937,6 +950,15 @@ DdsParticipant::~DdsParticipant() {
 }
 
 Status DdsParticipant::GetTopic(const std::string& topic, const TypeInfo& type, const std::string& given_ros2_name) {
+  std::string added;  // the DDS topic, when this call made it
+  Status s = AddTopicOnce(topic, type, given_ros2_name, &added);
+  // Outside mutex_: the check takes it. Endpoints of the topic discovered before it existed here.
+  if (s.ok() && !added.empty()) listener_->CheckDiscovered(added);
+  return s;
+}
+
+Status DdsParticipant::AddTopicOnce(const std::string& topic, const TypeInfo& type, const std::string& given_ros2_name,
+                                    std::string* added) {
   std::lock_guard<std::mutex> lock(mutex_);
   const std::string dds_type = type.dds_name();
   // A name starting with '/' is a ROS 2 topic's own (a watcher's `dyad echo /arm/pose`); graph
@@ -959,6 +981,7 @@ Status DdsParticipant::GetTopic(const std::string& topic, const TypeInfo& type, 
     dds_topics_[topic] = dds_topic;
     ros2_topics_[dds_topic] = topic;
   }
+  *added = dds_topic;
   return Status::OK();
 }
 

@@ -309,6 +309,8 @@ class DdsParticipant final : public Transport {
   static void DeleteGeneration(Generation& g);
   // On the current generation; `ros2_name`: a ROS 2 topic's (TopicQos::ros2_name).
   Status GetTopic(const std::string& topic, const TypeInfo& type, const std::string& ros2_name);
+  // GetTopic's part under mutex_; *added: the DDS topic when this call created it.
+  Status AddTopicOnce(const std::string& topic, const TypeInfo& type, const std::string& ros2_name, std::string* added);
   // The graph topic a discovered DDS topic is ("rt/a" -> the graph's name for ROS 2 topic /a).
   // REQUIRES: mutex_ held.
   std::string TopicOfDds(const std::string& dds_topic) const;

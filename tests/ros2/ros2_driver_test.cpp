@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <thread>
 #include <nlohmann/json.hpp>
 
 #include "dyad/cdr_decoder.hpp"
@@ -175,9 +176,12 @@ TEST_F(Ros2DriverTest, NanPosesFromTheArmStopTheDriver) {
 TEST_F(Ros2DriverTest, IncompatibleQosAndWrongTypesAreNamed) {
   ChildProcess arm(Arm("twist", {"--pose-qos", "sensor_data"}), dir_, "arm");
   ASSERT_TRUE(arm.WaitForOutput("ready", 10)) << arm.err();
-  ChildProcess wrong({DYAD_ROS2_WIRE_PEER, "command", "--mode", "twist", "--to", "0,0,0", "--for-s", "4", "--topic",
+  ChildProcess wrong({DYAD_ROS2_WIRE_PEER, "command", "--mode", "twist", "--to", "0,0,0", "--for-s", "6", "--topic",
                       "/arm/pose", "--domain", std::to_string(domain_)},
                      dir_, "wrong");
+  // Up before the run: discovered before the run's participant has the topic, so the mismatch is
+  // found when the topic is made (CheckDiscovered), not by the discovery callback.
+  std::this_thread::sleep_for(std::chrono::seconds(1));
   ChildProcess run({DYAD_EXE, "run", Graph("ros2_servo.yaml"), "--duration", "3"}, dir_, "run");
   ASSERT_EQ(run.Wait(30), 1) << run.err();  // a run with mismatches fails, saying how many
   EXPECT_NE(run.err().find("topic 'arm/pose' (ROS 2 topic /arm/pose): a writer offers an incompatible reliability QoS"),
