@@ -34,9 +34,9 @@ Status ArmPlaneOptions::Validate() const {
   for (int i = 0; i < 3; ++i)
     if (!(box_min[i] < box_max[i]))
       return Status::InvalidArgument("box_min " + Text(box_min) + " must be below box_max " + Text(box_max) + " on every axis");
-  bool clamped = false;
-  for (int i = 0; i < 3; ++i) clamped = clamped || origin[i] < box_min[i] || origin[i] > box_max[i];
-  if (clamped) return Status::InvalidArgument("origin " + Text(origin) + " lies outside the box");
+  bool outside = false;
+  for (int i = 0; i < 3; ++i) outside = outside || origin[i] < box_min[i] || origin[i] > box_max[i];
+  if (outside) return Status::InvalidArgument("origin " + Text(origin) + " lies outside the box");
   return Status::OK();
 }
 

@@ -88,25 +88,21 @@ Status Ros2Cartesian::Configure(Context& ctx) {
   return Status::OK();
 }
 
-void Ros2Cartesian::WarnOnce(bool* logged, const std::string& message) {
-  if (*logged) return;
-  *logged = true;
-  ctx_->log().Warn(message + " (logged once)");
-}
-
 void Ros2Cartesian::TakePoses(int64_t now_ns) {
   for (size_t i = arm_pose_->received().size() - arm_pose_->new_count(); i < arm_pose_->received().size(); ++i) {
     const Vec3 p = PositionOf(arm_pose_->received()[i]);
     if (!Finite(p)) {
       ++nonfinite_poses_;
-      WarnOnce(&nonfinite_pose_logged_, "the arm reported a pose with NaN or infinite coordinates: ignored");
+      WarnOnce(&nonfinite_pose_logged_,
+               [] { return std::string("the arm reported a pose with NaN or infinite coordinates: ignored"); });
       continue;
     }
     if (!plane_->Inside(p)) {
       ++outside_poses_;
-      WarnOnce(&outside_logged_, "the arm reported a pose outside the workspace box (" + std::to_string(p[0]) + ", " +
-                                     std::to_string(p[1]) + ", " + std::to_string(p[2]) +
-                                     "): it is only ever sent back into the box");
+      WarnOnce(&outside_logged_, [&] {
+        return "the arm reported a pose outside the workspace box (" + std::to_string(p[0]) + ", " +
+               std::to_string(p[1]) + ", " + std::to_string(p[2]) + "): it is only ever sent back into the box";
+      });
     }
     pose_ = p;
     last_pose_ns_ = now_ns;
@@ -119,7 +115,8 @@ void Ros2Cartesian::TakeCommand(int64_t now_ns) {
   const msg::CartesianCommand& c = command_->received().back();
   if (!std::isfinite(c.x()) || !std::isfinite(c.y())) {
     ++nonfinite_commands_;
-    WarnOnce(&nonfinite_command_logged_, "a command with NaN or infinite coordinates: rejected, the goal is kept");
+    WarnOnce(&nonfinite_command_logged_,
+             [] { return std::string("a command with NaN or infinite coordinates: rejected, the goal is kept"); });
     return;
   }
   last_command_ns_ = now_ns;  // a hold feeds the watchdog and keeps the goal
@@ -128,8 +125,10 @@ void Ros2Cartesian::TakeCommand(int64_t now_ns) {
   goal_ = plane_->Clamp(plane_->ToRobot(c.x(), c.y()), &clamped);
   if (clamped) {
     ++clamped_;
-    WarnOnce(&clamp_logged_, "target (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) +
-                                 ") lies outside the workspace box: clamped into it");
+    WarnOnce(&clamp_logged_, [&] {
+      return "target (" + std::to_string(c.x()) + ", " + std::to_string(c.y()) +
+             ") lies outside the workspace box: clamped into it";
+    });
   }
 }
 
@@ -141,9 +140,11 @@ Status Ros2Cartesian::Step(const StepInfo& info) {
   TakeCommand(now);
   const bool stale_pose = last_pose_ns_ < 0 || now - last_pose_ns_ > pose_timeout_ns_;
   const bool stale_command = last_command_ns_ < 0 || now - last_command_ns_ > watchdog_ns_;
-  if (stale_pose && last_pose_ns_ >= 0) WarnOnce(&stale_logged_, "no pose from the arm for pose_timeout_s: stopped");
+  if (stale_pose && last_pose_ns_ >= 0)
+    WarnOnce(&stale_logged_, [] { return std::string("no pose from the arm for pose_timeout_s: stopped"); });
   if (!stale_pose) stale_logged_ = false;
-  if (stale_command && last_command_ns_ >= 0) WarnOnce(&watchdog_logged_, "no command for watchdog_s: holding");
+  if (stale_command && last_command_ns_ >= 0)
+    WarnOnce(&watchdog_logged_, [] { return std::string("no command for watchdog_s: holding"); });
   if (!stale_command) watchdog_logged_ = false;
   const bool move = !stale_pose && !stale_command && goal_.has_value();
   Status s;

@@ -43,7 +43,14 @@ class Ros2Cartesian final : public Component {
   Status SendTwist(const Vec3& v, int64_t now_ns);
   Status SendPose(const Vec3& p, int64_t now_ns);
   Status PublishState(int64_t now_ns, bool stopped);
-  void WarnOnce(bool* logged, const std::string& message);
+  // Logs message() the first time *logged is false; the text is built only then (steps at
+  // 100 Hz allocate nothing while a warned condition lasts).
+  template <class Message>
+  void WarnOnce(bool* logged, Message message) {
+    if (*logged) return;
+    *logged = true;
+    ctx_->log().Warn(message() + " (logged once)");
+  }
 
   Context* ctx_ = nullptr;
   Input<msg::CartesianCommand>* command_ = nullptr;                // owned by the runtime

@@ -13,10 +13,9 @@
 #include <thread>
 #include <nlohmann/json.hpp>
 
-#include "dyad/cdr_decoder.hpp"
-#include "dyad/mcap/reader.hpp"
 #include "dyad/testing/child_process.hpp"
 #include "dyad/testing/dds_domain.hpp"
+#include "recording_json.hpp"
 
 namespace fs = std::filesystem;
 using dyad::testing::ChildProcess;
@@ -61,19 +60,8 @@ class Ros2DriverTest : public ::testing::Test {
   // Every message of `topic` in the run's recording, decoded.
   std::vector<Sample> Read(const std::string& topic) {
     std::vector<Sample> out;
-    auto reader = dyad::mcap::Reader::Open((dir_ / "run.mcap").string());
-    EXPECT_TRUE(reader.ok()) << reader.status().message();
-    if (!reader.ok()) return out;
-    dyad::mcap::ReadOptions options;
-    options.topics = {topic};
-    EXPECT_TRUE(reader->ReadMessages(options, [&](const dyad::mcap::MessageView& m) {
-                        const auto& schema = reader->schemas().at(m.channel->schema_id);
-                        auto parsed = dyad::cdr::Schema::Parse(schema.data);
-                        std::vector<dyad::cdr::Field> fields;
-                        if (parsed.ok() && dyad::cdr::Decode(*parsed, schema.name, m.data.data(), m.data.size(), &fields).ok())
-                          out.push_back({static_cast<int64_t>(m.log_time), json::parse(dyad::cdr::ToJson(fields))});
-                        return true;
-                      }).ok());
+    for (auto& m : dyad::testing::ReadRecordingJson((dir_ / "run.mcap").string(), {topic}))
+      out.push_back({m.t_ns, std::move(m.value)});
     return out;
   }
   fs::path dir_;

@@ -13,10 +13,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "dyad/cdr_decoder.hpp"
-#include "dyad/mcap/reader.hpp"
 #include "dyad/testing/child_process.hpp"
 #include "dyad/testing/dds_domain.hpp"
+#include "recording_json.hpp"
 
 namespace fs = std::filesystem;
 using dyad::testing::ChildProcess;
@@ -77,19 +76,8 @@ TEST_F(Ros2WireTest, CycloneSamplesDecodeInDyadAndDyadSamplesDecodeInCyclone) {
   const std::map<std::string, json> sent = ByType(pub.out());
   ASSERT_EQ(sent.size(), kTypes.size()) << pub.out();
 
-  auto reader = dyad::mcap::Reader::Open((dir_ / "wire.mcap").string());
-  ASSERT_TRUE(reader.ok()) << reader.status().message();
   std::map<std::string, json> recorded;  // by topic
-  ASSERT_TRUE(reader->ReadMessages({}, [&](const dyad::mcap::MessageView& m) {
-                      const dyad::mcap::Schema& schema = reader->schemas().at(m.channel->schema_id);
-                      auto parsed = dyad::cdr::Schema::Parse(schema.data);
-                      EXPECT_TRUE(parsed.ok()) << schema.name;
-                      std::vector<dyad::cdr::Field> fields;
-                      dyad::Status s = dyad::cdr::Decode(*parsed, schema.name, m.data.data(), m.data.size(), &fields);
-                      EXPECT_TRUE(s.ok()) << m.channel->topic << ": " << s.message();
-                      recorded[m.channel->topic] = json::parse(dyad::cdr::ToJson(fields));
-                      return true;
-                    }).ok());
+  for (const auto& m : dyad::testing::ReadRecordingJson((dir_ / "wire.mcap").string())) recorded[m.topic] = m.value;
   for (const auto& t : kTypes) {
     SCOPED_TRACE(t);
     ASSERT_TRUE(recorded.count(TopicOf(t))) << "nothing recorded on " << TopicOf(t);

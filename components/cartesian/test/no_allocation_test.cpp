@@ -14,6 +14,7 @@
 #include <dyad/msg/types.hpp>
 
 #include "cartesian.hpp"
+#include "ros2_cartesian.hpp"
 
 
 namespace dyad::cartesian {
@@ -262,6 +263,106 @@ TEST(UdpWorkspace, LimitsMustBeAnOrderedFinitePair) {
     EXPECT_FALSE(s.ok());
     EXPECT_NE(s.message().find("params.y_limits: must be [min, max], finite, min < max"), std::string::npos) << s.message();
   }
+}
+
+// ros2_cartesian at 100 Hz: commands and arm poses in, a twist and the state out, through its
+// own ports (two inputs, three outputs of three types). Its steps allocate nothing, also while
+// its warnings' conditions last (targets clamped, poses outside the box: said once, built once).
+class Ros2Context final : public Context {
+ public:
+  explicit Ros2Context(std::map<std::string, ParamValue> params) : params_(std::move(params)) {
+    command_.Bind("command", "robot/command", &commands);
+    pose_.Bind("arm_pose", "arm/pose", &poses);
+    state_.Bind("state", "robot/state", "driver", &sink, &time);
+    twist_.Bind("twist", "arm/twist", "driver", &sink, &time);
+    target_.Bind("pose_target", "arm/target", "driver", &sink, &time);
+  }
+  const std::string& name() const override { return name_; }
+  const Params& params() const override { return params_; }
+  const Clock& clock() const override { return time; }
+  Logger& log() override { return logger; }
+  uint64_t seed() const override { return 1; }
+  int64_t period_ns() const override { return 10'000'000; }
+  void RequestStop(std::string) override {}
+  Status StepOnce(Component& c, uint64_t index) {
+    command_.Poll(time.now);
+    pose_.Poll(time.now);
+    StepInfo info;
+    info.now_ns = time.now;
+    info.index = index;
+    return c.Step(info);
+  }
+
+  template <class T>
+  class Queue final : public detail::ReaderEndpoint {
+   public:
+    bool TakeNext(void* sample) override {
+      if (queue.empty()) return false;
+      *static_cast<T*>(sample) = queue.front();
+      queue.pop_front();
+      return true;
+    }
+    std::deque<T> queue;
+  };
+  class Sink final : public detail::WriterEndpoint {
+   public:
+    Status Write(const void*) override {
+      ++written;
+      return Status::OK();
+    }
+    int written = 0;
+  };
+  FakeClock time;
+  FakeLogger logger;
+  Queue<msg::CartesianCommand> commands;
+  Queue<geometry_msgs::msg::dds_::PoseStamped_> poses;
+  Sink sink;
+
+ protected:
+  InputBase* FindInput(std::string_view port, const TypeInfo&) override {
+    return port == "command" ? static_cast<InputBase*>(&command_) : &pose_;
+  }
+  OutputBase* FindOutput(std::string_view port, const TypeInfo&) override {
+    if (port == "state") return &state_;
+    return port == "twist" ? static_cast<OutputBase*>(&twist_) : &target_;
+  }
+
+ private:
+  std::string name_ = "driver";
+  Params params_;
+  Input<msg::CartesianCommand> command_;
+  Input<geometry_msgs::msg::dds_::PoseStamped_> pose_;
+  Output<msg::CartesianState> state_;
+  Output<geometry_msgs::msg::dds_::TwistStamped_> twist_;
+  Output<geometry_msgs::msg::dds_::PoseStamped_> target_;
+};
+
+TEST(NoAllocation, Ros2CartesianStepAllocatesNothingWhileItsWarningsLast) {
+  Ros2Context ctx({{"mode", std::string("twist")}, {"frame_id", std::string("base_link")},
+                   {"origin", std::vector<double>{0.4, 0, 0.3}}, {"x_axis", std::vector<double>{0, -1, 0}},
+                   {"y_axis", std::vector<double>{0, 0, 1}}, {"scale", 0.002},
+                   {"box_min", std::vector<double>{0.2, -0.3, 0.1}}, {"box_max", std::vector<double>{0.6, 0.3, 0.5}},
+                   {"orientation", std::vector<double>{0, 0, 0, 1}}, {"max_velocity", 0.25},
+                   {"max_acceleration", 2.0}, {"watchdog_s", 0.5}, {"pose_timeout_s", 0.5}});
+  Ros2Cartesian driver;
+  ASSERT_TRUE(driver.Configure(ctx).ok());
+  ASSERT_TRUE(driver.Activate().ok());
+  geometry_msgs::msg::dds_::PoseStamped_ pose;
+  pose.header().frame_id("base_link");
+  pose.pose().position().x(0.9);  // outside the box (x <= 0.6): warned once
+  pose.pose().position().z(0.3);
+  for (uint64_t k = 0; k < 300; ++k) {
+    ctx.time.now = static_cast<int64_t>(k) * 10'000'000;
+    ctx.commands.queue.push_back(Command(1000));  // far outside the box: clamped, warned once
+    ctx.poses.queue.push_back(pose);
+    const long before = dyad::testing::AllocationCount();
+    ASSERT_TRUE(ctx.StepOnce(driver, k).ok());
+    if (k >= 2) {
+      ASSERT_EQ(dyad::testing::AllocationCount() - before, 0) << "step " << k;
+    }
+  }
+  EXPECT_EQ(ctx.logger.lines.size(), 2u);  // the clamp and the pose outside the box, once each
+  EXPECT_EQ(ctx.sink.written, 600);         // a twist and a state per step
 }
 
 }  // namespace
