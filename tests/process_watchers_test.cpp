@@ -91,7 +91,7 @@ TEST_F(ProcessTest, PubReachesTheGraphAndEcho) {
   const std::string domain = std::to_string(domain_);
   const fs::path heard = dir_ / "heard.txt";
   const fs::path g = Write("g.yaml", "graph: pub\ndomain_id: " + domain +
-                                         "\ntopics:\n  count: {type: Counter}\n"
+                                         "\ntopics:\n  count: {type: Counter, depth: 8}\n"
                                          "components:\n"
                                          "  sink: {type: counter_sink, trigger: in, params: {file: " + heard.string() +
                                          ", expect: 5}, inputs: {in: count}}\n");
@@ -101,7 +101,8 @@ TEST_F(ProcessTest, PubReachesTheGraphAndEcho) {
   EXPECT_NE(bad.err().find("dyad pub: the fields: line 1, column 12: stamp: unknown member of dyad::msg::Counter (members: header, value)"),
             std::string::npos)
       << bad.err();
-  // Three at 20 Hz with the graph's type, then two more with a header given. With the graph, pub
+  // Three at 20 Hz with the graph's type, then two more with a header given, back to back (the
+  // topic keeps 8: with depth 1 a slow sink rightly hears only the newer). With the graph, pub
   // waits for the graph's own readers: without it, for whichever readers it found first.
   Child pub(Dyad({"pub", "count", "{value: 42}", "--graph", g.string(), "--rate", "20", "--count", "3", "--wait", "20"}), dir_, "pub");
   ASSERT_EQ(pub.Wait(60), 0) << pub.err();
