@@ -130,7 +130,82 @@ class Probe : public Component {
   OnDemandSubscription* on_demand_ = nullptr;  // owned by the runtime
 };
 
-void RegisterProbe(PluginRegistry& r) { r.Add<Probe>("probe"); }
+// A component with a live param whose preparation takes `prepare_ms` (refusing 13) and a plain
+// live param: logs each step's values and whether a preparation was running meanwhile.
+class Slow : public Component {
+ public:
+  static void Describe(ComponentSpec& spec) {
+    spec.Param("level", 0).Live();
+    spec.Param("other", 0).Live();
+    spec.Param("prepare_ms", 300.0);
+  }
+  Status Configure(Context& ctx) override {
+    ctx_ = &ctx;
+    const auto prepare = std::chrono::duration<double, std::milli>(ctx.params().Double("prepare_ms"));
+    ctx.PrepareLiveParam("level", [this, prepare](const ParamValue& v) {
+      preparing_.store(true);
+      std::this_thread::sleep_for(prepare);
+      preparing_.store(false);
+      return std::get<int64_t>(v) == 13 ? Status::InvalidArgument("unlucky") : Status::OK();
+    });
+    return Status::OK();
+  }
+  Status Step(const StepInfo& info) override {
+    g_log->Add("slow step " + std::to_string(info.index) + " level " + std::to_string(ctx_->params().Int("level")) + " other " +
+               std::to_string(ctx_->params().Int("other")) + (preparing_.load() ? " while preparing" : ""));
+    return Status::OK();
+  }
+
+ private:
+  Context* ctx_ = nullptr;
+  std::atomic<bool> preparing_{false};
+};
+
+// Asks for live changes of `slow` at its steps: level 5 then other 7 at step 2, level 13 at
+// step 4, level 9 at step `last` (the run stops before it is prepared).
+class Asker : public Component {
+ public:
+  static void Describe(ComponentSpec& spec) {
+    spec.Param("last", 1000);
+    spec.Output<msg::ParamChange>("requests");
+  }
+  Status Configure(Context& ctx) override {
+    graph_ = ctx.graph_name();
+    last_ = static_cast<uint64_t>(ctx.params().Int("last"));
+    out_ = &ctx.output<msg::ParamChange>("requests");
+    return Status::OK();
+  }
+  Status Step(const StepInfo& info) override {
+    auto ask = [&](const std::string& param, const std::string& value) {
+      msg::ParamChange r;
+      r.graph_name(graph_);
+      r.component_name("slow");
+      r.param_name(param);
+      r.op("set");
+      r.value(value);
+      r.request_id(param + value);
+      return out_->Publish(r);
+    };
+    if (info.index == 2) {
+      if (Status s = ask("level", "5"); !s.ok()) return s;
+      return ask("other", "7");
+    }
+    if (info.index == 4) return ask("level", "13");
+    if (info.index == last_) return ask("level", "9");
+    return Status::OK();
+  }
+
+ private:
+  std::string graph_;
+  uint64_t last_ = 1000;
+  Output<msg::ParamChange>* out_ = nullptr;
+};
+
+void RegisterProbe(PluginRegistry& r) {
+  r.Add<Probe>("probe");
+  r.Add<Slow>("slow");
+  r.Add<Asker>("asker");
+}
 
 class ExecutorTest : public ::testing::Test {
  protected:
@@ -333,6 +408,33 @@ components:
   // a publishes before the viewer steps at each instant: samples 4, 5 and 6 only.
   EXPECT_EQ(Stats("viewer").deliveries, 3u);
   EXPECT_EQ(log_.Matching("viewer deactivate"), (std::vector<std::string>{"viewer deactivate (tapped 3)"}));
+}
+
+// A prepared live param on the wall clock: its preparation runs while the component steps on, the
+// value takes effect at a step boundary after it ended, the component's next request waits for
+// it (answered in order), a refused preparation leaves the old value, and a run that stops
+// during one ends without waiting for a step that never comes.
+TEST_F(ExecutorTest, APreparedLiveParamIsPreparedOffTheStepThreadAndAppliedInOrder) {
+  ASSERT_TRUE(Run(R"(graph: t
+clock: wall
+components:
+  asker: {type: asker, rate_hz: 20, params: {last: 29}, outputs: {requests: dyad/param_requests}}
+  slow: {type: slow, rate_hz: 20, params: {prepare_ms: 300}}
+)", 0, 1.6).ok());
+  const std::vector<std::string> steps = log_.Matching("slow step");
+  ASSERT_GE(steps.size(), 20u);
+  int while_preparing = 0, first_five = -1, first_seven = -1;
+  for (size_t i = 0; i < steps.size(); ++i) {
+    while_preparing += steps[i].ends_with("while preparing");
+    if (first_five < 0 && steps[i].find("level 5") != std::string::npos) first_five = static_cast<int>(i);
+    if (first_seven < 0 && steps[i].find("other 7") != std::string::npos) first_seven = static_cast<int>(i);
+    EXPECT_EQ(steps[i].find("level 13"), std::string::npos) << steps[i] << ": a refused value took effect";
+    EXPECT_EQ(steps[i].find("level 9"), std::string::npos) << steps[i] << ": the run stopped before it was prepared";
+  }
+  EXPECT_GE(while_preparing, 4) << "300 ms of preparation at 20 Hz: the component stepped on meanwhile";
+  ASSERT_GE(first_five, 3) << "level 5 applied after its 300 ms preparation";
+  EXPECT_GE(first_seven, first_five) << "other 7 came after level 5: it waited for it";
+  EXPECT_NE(steps.back().find("level 5 other 7"), std::string::npos) << steps.back();
 }
 
 TEST(SubscribeSerializedOnDemand, IsUnimplementedOnAContextOfTheTests) {

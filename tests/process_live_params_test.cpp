@@ -3,6 +3,8 @@
 // reads and changes it in a running wall-clock graph.
 #include "process_fixture.hpp"
 
+#include "dyad/testing/csv.hpp"
+
 #include <signal.h>
 
 #include <map>
@@ -10,38 +12,6 @@
 namespace {
 
 using namespace dyad::testing;
-
-// One CSV line's cells (RFC 4180 quoting: "a, b" and "say ""hi""").
-std::vector<std::string> CsvCells(const std::string& line) {
-  std::vector<std::string> cells(1);
-  bool quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') cells.back() += '"', ++i;
-    else if (c == '"') quoted = !quoted;
-    else if (c == ',' && !quoted) cells.emplace_back();
-    else cells.back() += c;
-  }
-  return cells;
-}
-
-// One CSV file of `dyad bag export --csv` as rows of column -> text (no line breaks in cells).
-std::vector<std::map<std::string, std::string>> ReadCsv(const fs::path& file) {
-  std::istringstream lines(ReadFile(file));
-  std::vector<std::string> columns;
-  std::vector<std::map<std::string, std::string>> rows;
-  for (std::string line; std::getline(lines, line);) {
-    const std::vector<std::string> cells = CsvCells(line);
-    if (columns.empty()) {
-      columns = cells;
-      continue;
-    }
-    std::map<std::string, std::string> row;
-    for (size_t i = 0; i < columns.size() && i < cells.size(); ++i) row[columns[i]] = cells[i];
-    rows.push_back(std::move(row));
-  }
-  return rows;
-}
 
 // The mixer between fixed inputs (human at x = 10, robot at x = 0): its command's x is 10 * gain.
 std::string MixerGraph(const std::string& clock, int domain, const fs::path& recording, const std::string& extra = "") {

@@ -2,7 +2,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <openssl/evp.h>
+
+#include <chrono>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include <dyad/join_list.hpp>
@@ -48,12 +53,37 @@ Status ApplyMap(const std::string& param, const std::string& yaml_text,
   return Status::OK();
 }
 
+// The SHA-256 of a file's bytes in hex, as sha256sum prints it.
+StatusOr<std::string> FileSha256(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) return Status::IOError(path + ": cannot read");
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  if (EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) != 1)
+    return Status::Internal("SHA-256 of " + path + " failed");
+  static const char kHex[] = "0123456789abcdef";
+  std::string hex;
+  for (unsigned int i = 0; i < length; ++i) hex += {kHex[digest[i] >> 4], kHex[digest[i] & 15]};
+  return hex;
+}
+
+// A model file loaded for the deliberator: 2 DOFs. Errors start with the path.
+StatusOr<pvrnn::Model> LoadTwoDofModel(const std::string& path) {
+  auto model = pvrnn::LoadModel(path);
+  if (!model.ok()) return model.status();
+  if (model->spec.num_dofs() != 2)
+    return Status::InvalidArgument(path + " has " + std::to_string(model->spec.num_dofs()) + " DOFs; the deliberator needs 2 (x, y)");
+  return model;
+}
+
 }  // namespace
 
 void Deliberator::Describe(ComponentSpec& spec) {
   spec.Summary("The robot's PV-RNN mind: online error regression over a sliding window of executed "
                "positions, publishing the next intended position each step.");
-  spec.RequiredParam("model", ParamType::kString).Path().Doc(".dpvrnn model file (2 DOF: x, y)");
+  spec.RequiredParam("model", ParamType::kString).Path().Live()
+      .Doc(".dpvrnn model file (2 DOF: x, y); set live, swapped in at a step boundary once loaded and checked");
   spec.Param("start_primitive", int64_t{0}).Min(0).Doc("primitive the robot starts drawing");
   spec.Param("preset", "vcbot").OneOf({"vcbot", "reference"})
       .Doc("vcbot: W 5, 15 it, Adam lr 0.3 b1 0.1 b2 0.95, w 1e-5; reference: W 15, 15 it, Adam lr 0.1; "
@@ -72,31 +102,30 @@ void Deliberator::Describe(ComponentSpec& spec) {
       .Doc("wall clock: optimisation cap per step (0: 20% of the period, 20 ms when triggered); stepped: none");
   spec.Param("seed", int64_t{-1}).Min(-1).Doc("noise seed (-1: the graph's seed for this instance)");
   spec.Input<msg::CartesianState>("executed").Optional().Doc("executed robot position s_{t-1}");
+  spec.Output<msg::ModelInfo>("model").Optional().Doc("the model in force: at step 0 and at every swap (path, SHA-256, first step)");
   spec.Output<msg::Intention>("intention").Doc("intended position r_t and the window's N-ELBO");
 }
 
 Status Deliberator::Configure(Context& ctx) {
   ctx_ = &ctx;
   const Params& p = ctx.params();
-  const std::string& path = p.String("model");
-  auto model = pvrnn::LoadModel(path);
+  model_path_ = p.String("model");
+  auto model = LoadTwoDofModel(model_path_);
   if (!model.ok()) return Status::InvalidArgument("params.model: " + model.status().message());
-  if (model->spec.num_dofs() != 2)
-    return Status::InvalidArgument("params.model: " + path + " has " + std::to_string(model->spec.num_dofs()) +
-                                   " DOFs; the deliberator needs 2 (x, y)");
   ErrorRegressionOptions o = ErrorRegressionOptions::Preset(p.String("preset")).value();
   preset_iterations_ = o.iterations;
   preset_meta_prior_ = o.meta_prior;
   live_iterations_ = p.Int("iterations");
   live_meta_prior_ = p.DoubleList("meta_prior");
-  const size_t layers = static_cast<size_t>(model->spec.num_layers());
-  ctx.CheckLiveParam("meta_prior", [layers](const ParamValue& v) {
+  layers_ = model->spec.num_layers();
+  ctx.CheckLiveParam("meta_prior", [this](const ParamValue& v) {  // on the step thread: layers_ is the model's in force
     const auto& w = std::get<std::vector<double>>(v);
-    if (!w.empty() && w.size() != layers)
-      return Status::InvalidArgument("needs " + std::to_string(layers) + " values (one per layer of the model, bottom first), got " +
+    if (!w.empty() && w.size() != static_cast<size_t>(layers_))
+      return Status::InvalidArgument("needs " + std::to_string(layers_) + " values (one per layer of the model, bottom first), got " +
                                      std::to_string(w.size()));
     return Status::OK();
   });
+  ctx.PrepareLiveParam("model", [this](const ParamValue& v) { return PrepareModel(std::get<std::string>(v)); });
   if (p.Int("window") > 0) o.window = static_cast<int>(p.Int("window"));
   if (p.Int("iterations") > 0) o.iterations = static_cast<int>(p.Int("iterations"));
   o.optimizer = pvrnn::ParseOptimizerKind(p.String("optimizer")).value();
@@ -128,23 +157,34 @@ Status Deliberator::Configure(Context& ctx) {
   o.a_steps = static_cast<int>(p.Int("a_steps"));
   if (auto problems = o.Problems(model->spec.num_layers()); !problems.empty())
     return Status::InvalidArgument("params." + problems.front().ToString());
+  options_ = o;
+  start_primitive_ = static_cast<int>(p.Int("start_primitive"));
+  seed_ = p.Int("seed") >= 0 ? static_cast<uint64_t>(p.Int("seed")) : ctx.seed();
+  if (start_primitive_ >= model->sequences())
+    return Status::InvalidArgument("params.start_primitive: " + std::to_string(start_primitive_) + ": " + model_path_ +
+                                   " has primitives 0.." + std::to_string(model->sequences() - 1));
   auto er = pvrnn::ErrorRegression<float>::Create(model.value(), o);
   if (!er.ok()) return Status::InvalidArgument("params." + er.status().message());
   er_ = std::move(er.value());
-  const int64_t start = p.Int("start_primitive");
-  const uint64_t seed = p.Int("seed") >= 0 ? static_cast<uint64_t>(p.Int("seed")) : ctx.seed();
-  if (start >= model->sequences())
-    return Status::InvalidArgument("params.start_primitive: " + std::to_string(start) + ": " + path + " has primitives 0.." +
-                                   std::to_string(model->sequences() - 1));
-  if (Status s = er_->Reset(static_cast<int>(start), seed); !s.ok()) return Status::InvalidArgument("params." + s.message());
+  if (Status s = er_->Reset(start_primitive_, seed_); !s.ok()) return Status::InvalidArgument("params." + s.message());
+  history_.assign(static_cast<size_t>(o.window), {0.0, 0.0});
+  auto hash = FileSha256(model_path_);
+  if (!hash.ok()) return Status::InvalidArgument("params.model: " + hash.status().message());
+  first_info_.path(model_path_);
+  first_info_.sha256(*hash);
+  first_info_.primitives(static_cast<uint32_t>(model->sequences()));
+  first_info_.layers(static_cast<uint32_t>(layers_));
+  first_info_.step(0);
+  first_info_.prepare_s(0);
   const double budget_ms = p.Double("time_budget_ms");
   budget_s_ = budget_ms > 0 ? budget_ms * 1e-3 : (ctx.period_ns() > 0 ? 0.2 * ctx.period_ns() * 1e-9 : 0.02);
   stepped_ = ctx.stepped();
   executed_ = &ctx.input<msg::CartesianState>("executed");
   intention_ = &ctx.output<msg::Intention>("intention");
+  model_info_ = &ctx.output<msg::ModelInfo>("model");
   std::ostringstream info;
-  info << "model " << path << ", start primitive " << start << ", window " << o.window << ", " << o.iterations
-       << " iterations of " << pvrnn::ToString(o.optimizer);
+  info << "model " << model_path_ << " (sha256 " << hash->substr(0, 12) << "), start primitive " << start_primitive_ << ", window "
+       << o.window << ", " << o.iterations << " iterations of " << pvrnn::ToString(o.optimizer);
   if (stepped_)
     info << ", no time cap (stepped clock: simulated time stands still during a step)";
   else
@@ -153,9 +193,82 @@ Status Deliberator::Configure(Context& ctx) {
   return Status::OK();
 }
 
+// Off the step thread (LiveParams' preparer; at the boundary when stepped). The live params are
+// stable meanwhile: the runtime holds this component's other changes until this returns.
+Status Deliberator::PrepareModel(const std::string& path) {
+  const auto start = std::chrono::steady_clock::now();
+  auto model = LoadTwoDofModel(path);
+  if (!model.ok()) return model.status();
+  if (start_primitive_ >= model->sequences())
+    return Status::InvalidArgument(path + " has primitives 0.." + std::to_string(model->sequences() - 1) +
+                                   "; the run started on primitive " + std::to_string(start_primitive_));
+  auto hash = FileSha256(path);
+  if (!hash.ok()) return hash.status();
+  ErrorRegressionOptions o = options_;  // as configured; then the live params in force
+  o.meta_prior.clear();  // the model's own w unless given: checked against its layers below
+  auto er = pvrnn::ErrorRegression<float>::Create(model.value(), o);
+  if (!er.ok()) return er.status();
+  const Params& p = ctx_->params();
+  const int iterations = p.Int("iterations") > 0 ? static_cast<int>(p.Int("iterations")) : preset_iterations_;
+  const std::vector<double>& meta_prior = p.DoubleList("meta_prior").empty() ? preset_meta_prior_ : p.DoubleList("meta_prior");
+  if (!meta_prior.empty() && meta_prior.size() != static_cast<size_t>(model->spec.num_layers()))
+    return Status::InvalidArgument(path + " has " + std::to_string(model->spec.num_layers()) + " layers; meta_prior has " +
+                                   std::to_string(meta_prior.size()) + " values (set meta_prior: [] or one per layer first)");
+  if (Status s = (*er)->Retune(iterations, meta_prior); !s.ok()) return s;
+  if (Status s = (*er)->Reset(start_primitive_, seed_); !s.ok()) return s;
+  // Warm it on the executed positions in the window: it starts where the robot is.
+  std::vector<std::array<double, 2>> window;
+  uint64_t fed = 0;
+  {
+    std::lock_guard<std::mutex> lock(swap_mutex_);
+    fed = history_fed_;
+    for (uint64_t k = fed > history_.size() ? fed - history_.size() : 0; k < fed; ++k) window.push_back(history_[k % history_.size()]);
+  }
+  for (const auto& xy : window) (*er)->Step(xy.data(), pvrnn::SteadyClock::time_point::max());
+  Prepared prepared;
+  prepared.er = std::move(er.value());
+  prepared.fed = fed;
+  prepared.info.path(path);
+  prepared.info.sha256(*hash);
+  prepared.info.primitives(static_cast<uint32_t>(model->sequences()));
+  prepared.info.layers(static_cast<uint32_t>(model->spec.num_layers()));
+  // Wall time, so none under the stepped clock: its recordings are the same in every run.
+  prepared.info.prepare_s(stepped_ ? 0.0 : std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  std::lock_guard<std::mutex> lock(swap_mutex_);
+  prepared_ = std::move(prepared);
+  return Status::OK();
+}
+
+// At the step boundary after the runtime applied a new `model`: the prepared regression takes
+// over. The positions executed since it was warmed get one evaluation each (cheap: the step's
+// own solve comes after), so its window matches the old one's.
+Status Deliberator::SwapModel() {
+  Prepared p;
+  {
+    std::lock_guard<std::mutex> lock(swap_mutex_);
+    p = std::move(prepared_);
+    prepared_ = Prepared{};
+  }
+  if (!p.er || p.info.path() != ctx_->params().String("model"))
+    return Status::Internal("model " + ctx_->params().String("model") + " applied without its preparation");
+  const uint64_t from = std::max(p.fed, history_fed_ > history_.size() ? history_fed_ - history_.size() : 0);
+  for (uint64_t k = from; k < history_fed_; ++k) p.er->Step(history_[k % history_.size()].data(), pvrnn::SteadyClock::now());
+  er_ = std::move(p.er);
+  layers_ = static_cast<int>(p.info.layers());
+  std::ostringstream info;
+  info << "step " << steps_ << ": model " << model_path_ << " -> " << p.info.path() << " (sha256 " << p.info.sha256().substr(0, 12)
+       << ", prepared in " << p.info.prepare_s() * 1e3 << " ms off the step thread)";
+  ctx_->log().Info(info.str());
+  model_path_ = p.info.path();
+  p.info.step(steps_);
+  return model_info_->Publish(p.info);
+}
+
 // The live params (iterations, meta_prior) as they are now: the regression retuned when changed.
 Status Deliberator::FollowLiveParams() {
   const Params& p = ctx_->params();
+  if (p.String("model") != model_path_)
+    if (Status s = SwapModel(); !s.ok()) return s;
   if (p.Int("iterations") == live_iterations_ && p.DoubleList("meta_prior") == live_meta_prior_) return Status::OK();
   live_iterations_ = p.Int("iterations");
   live_meta_prior_ = p.DoubleList("meta_prior");
@@ -175,6 +288,8 @@ Status Deliberator::Step(const StepInfo&) {
   double optimisation_s = 0;
   bool missed = false;
   const pvrnn::StepResult* r = nullptr;
+  if (steps_ == 0)
+    if (Status s = model_info_->Publish(first_info_); !s.ok()) return s;
   if (steps_ > 0) {  // step 0 publishes r_0: nothing executed yet
     double xy[2];
     const msg::CartesianState* s = executed_->received().empty() ? nullptr : &executed_->received().back();
@@ -187,6 +302,10 @@ Status Deliberator::Step(const StepInfo&) {
       ++without_executed_;
     }
     r = &er_->Step(xy, deadline);
+    {
+      std::lock_guard<std::mutex> lock(swap_mutex_);  // uncontended but while a model is prepared
+      history_[history_fed_++ % history_.size()] = {xy[0], xy[1]};
+    }
     optimisation_s = r->optimisation_s;
     missed = !stepped_ && (r->stopped_by_deadline || optimisation_s > budget_s_);
     if (missed && (deadline_misses_++ % 100) == 0) {

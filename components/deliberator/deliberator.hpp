@@ -10,13 +10,19 @@
 ///     late driver) or with a non-finite x or y, the robot's own last intention is taken
 ///     instead, and counted.
 /// outputs:
+///   model (ModelInfo, optional): the model in force: published at step 0 and at every swap, with
+///     its path, SHA-256, first step and preparation time (the recording's account of the swaps)
 ///   intention (Intention): r_t with nelbo/reconstruction/regulation of the best iterate,
 ///     optimisation_s, iterations and deadline_missed. Published every step, on time: the solve
 ///     stops before `time_budget_ms` with the best iterate so far (deadline_missed = true).
 ///     Under the stepped clock there is no time cap (only `iterations`): simulated time does not
 ///     pass during a step, and a wall-time cap would make the run depend on the machine's load.
 /// params:
-///   model (string, required): .dpvrnn model file (2 DOF: x, y)
+///   model (string, required, live): .dpvrnn model file (2 DOF: x, y). Set while the graph runs
+///     (`dyad param set deliberator.model new.dpvrnn`, the experimenter's page) it is swapped in
+///     without stopping: loaded, checked (2 DOFs, as many layers as a set meta_prior has values,
+///     the start primitive) and warmed by replaying the window's executed positions off the step
+///     thread, then switched at a step boundary; a bad file is refused and the old model steers on.
 ///   start_primitive (int, 0): the primitive the robot starts drawing
 ///   preset (string, vcbot): vcbot (W 5, 15 it, Adam 0.3/0.1/0.95, w 1e-5) | reference (W 15,
 ///     15 it, Adam 0.1/0.9/0.999, w = the model's training meta-prior); the params below override it
@@ -37,7 +43,11 @@
 /// Example (configs): see components/deliberator/example.yaml.
 #pragma once
 
+#include <array>
 #include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
 
 #include <dyad/component.hpp>
 #include <dyad/msg/types.hpp>
@@ -63,7 +73,32 @@ class Deliberator final : public Component {
   Context* ctx_ = nullptr;
   Input<msg::CartesianState>* executed_ = nullptr;  // owned by the runtime
   Output<msg::Intention>* intention_ = nullptr;     // owned by the runtime
+  Output<msg::ModelInfo>* model_info_ = nullptr;    // owned by the runtime
   std::unique_ptr<pvrnn::ErrorRegression<float>> er_;
+  pvrnn::ErrorRegressionOptions options_;  // as created, retuned by the live params
+  int start_primitive_ = 0;
+  uint64_t seed_ = 0;
+
+  // Model swaps (the live `model`). PrepareModel runs off the step thread (LiveParams) and leaves
+  // the new regression in `prepared_`; Step swaps it in when ctx.params() shows the new path
+  // (the runtime applies the value only after PrepareModel returned OK, and holds this
+  // component's other live changes until then, so options_ does not change meanwhile).
+  Status PrepareModel(const std::string& path);
+  Status SwapModel();
+  struct Prepared {
+    std::unique_ptr<pvrnn::ErrorRegression<float>> er;
+    msg::ModelInfo info;
+    uint64_t fed = 0;  // executed positions it was warmed with (history_fed_ when prepared)
+  };
+  std::mutex swap_mutex_;  // prepared_ and the history
+  Prepared prepared_;
+  std::string model_path_;  // in force
+  // The last executed positions fed to er_ (a ring of the window's size), and how many were fed
+  // since its Reset: a prepared model replays them, so it starts where the robot is.
+  std::vector<std::array<double, 2>> history_;
+  uint64_t history_fed_ = 0;
+  int layers_ = 0;             // of the model in force
+  msg::ModelInfo first_info_;  // published at step 0
   double budget_s_ = 0.02;
   bool stepped_ = false;  // stepped clock: no wall-time cap (see Step)
   uint64_t deadline_misses_ = 0, without_executed_ = 0, steps_ = 0;

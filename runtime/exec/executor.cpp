@@ -113,6 +113,9 @@ class Executor::ContextImpl final : public Context, public detail::ContextExtens
   void CheckLiveParam(const std::string& name, LiveParamCheck check) override {
     if (inst_->configuring) inst_->live.checks[name] = std::move(check);
   }
+  void PrepareLiveParam(const std::string& name, LiveParamCheck prepare) override {
+    if (inst_->configuring) inst_->live.prepares[name] = std::move(prepare);
+  }
   const Clock& clock() const override { return *ex_->clock_; }
   Logger& log() override { return logger_; }
   uint64_t seed() const override { return seed_; }
@@ -236,6 +239,7 @@ Executor::~Executor() {
     inst->active.store(false, std::memory_order_release);
     if (inst->thread.joinable()) inst->thread.join();
   }
+  if (live_params_) live_params_->Stop();  // its preparer may be inside a component
   // The transport first (no callback after it), then components and ports (member order).
   if (session_) session_->Close();  // its threads write on the transport's endpoints
   transport_.reset();
@@ -276,11 +280,12 @@ Status Executor::Setup() {
   if (!options_.guest) {
     std::vector<LiveParams::Target*> targets;
     for (auto& inst : instances_) {
-      inst->live = {inst->name(), &inst->rc->entry->spec, &inst->params, &inst->index, &inst->ctx->log(), {}};
+      inst->live = {inst->name(), &inst->rc->entry->spec, &inst->params, &inst->index, &inst->ctx->log(), {}, {}};
       targets.push_back(&inst->live);
     }
     live_params_ = std::make_unique<LiveParams>();
-    if (Status s = live_params_->Open(transport_.get(), graph_.name, options_.process, clock_.get(), std::move(targets)); !s.ok())
+    if (Status s = live_params_->Open(transport_.get(), graph_.name, options_.process, clock_.get(), graph_.folder,
+                                         clock_->stepped(), std::move(targets)); !s.ok())
       return s;
   }
   // The runtime's own output: timing of this process's components.
@@ -585,6 +590,7 @@ Status Executor::Run() {
     if (inst->thread.joinable()) inst->thread.join();
     while (inst->busy.load(std::memory_order_acquire)) std::this_thread::yield();
   }
+  if (live_params_) live_params_->Stop();  // no preparation runs inside a component deactivating
   // The last stats, while every subscriber (a recorder) still listens.
   if (stats_output_) PublishStats();
   for (auto it = instances_.rbegin(); it != instances_.rend(); ++it) {

@@ -9,10 +9,13 @@
 namespace dyad {
 
 Status LiveParams::Open(Transport* transport, const std::string& graph_name, const std::string& process, const Clock* clock,
-                        std::vector<Target*> targets) {
+                        const std::string& graph_folder, bool stepped, std::vector<Target*> targets) {
   graph_name_ = graph_name;
+  graph_folder_ = graph_folder;
+  stepped_ = stepped;
   targets_ = std::move(targets);
   queues_.resize(targets_.size());
+  preparations_.resize(targets_.size());
   auto r = CreateRuntimeReader(transport, runtime_topics::kParamRequests,
                                [this] { arrived_.store(true, std::memory_order_release); });
   if (!r.ok()) return r.status();
@@ -39,55 +42,143 @@ void LiveParams::Take() {
 }
 
 void LiveParams::Apply(size_t index) {
-  std::vector<msg::ParamChange> mine;
+  Target& target = *targets_[index];
+  Preparation& preparation = preparations_[index];
+  std::optional<msg::ParamChange> finished;
+  std::deque<msg::ParamChange> mine;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     Take();
+    if (preparation.state == Preparation::State::kRunning) return;  // the requests after it wait
+    if (preparation.state == Preparation::State::kDone) {
+      finished = Finish(target, preparation);
+      preparation = {};
+      prepared_.fetch_sub(1, std::memory_order_release);
+    }
     mine.swap(queues_[index]);
     queued_.fetch_sub(static_cast<int>(mine.size()), std::memory_order_release);
   }
-  for (const auto& request : mine) Publish(Answer(*targets_[index], request));
+  if (finished) Publish(std::move(*finished));
+  while (!mine.empty()) {
+    const msg::ParamChange request = std::move(mine.front());
+    mine.pop_front();
+    Preparation p;
+    if (std::optional<msg::ParamChange> answer = Answer(target, request, &p)) {
+      Publish(std::move(*answer));
+      continue;
+    }
+    if (stepped_) {  // at the boundary: the same step in every run
+      p.result = target.prepares.at(request.param_name())(p.value);
+      Publish(Finish(target, p));
+      continue;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    queued_.fetch_add(static_cast<int>(mine.size()), std::memory_order_release);
+    queues_[index].insert(queues_[index].begin(), std::make_move_iterator(mine.begin()), std::make_move_iterator(mine.end()));
+    p.state = Preparation::State::kRunning;
+    preparation = std::move(p);
+    to_prepare_.push_back(index);
+    if (!preparer_.joinable()) preparer_ = std::thread([this] { RunPreparations(); });
+    prepare_cv_.notify_one();
+    return;
+  }
 }
 
-msg::ParamChange LiveParams::Answer(Target& target, const msg::ParamChange& request) {
-  msg::ParamChange a = request;
+void LiveParams::RunPreparations() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    prepare_cv_.wait(lock, [this] { return stopping_ || !to_prepare_.empty(); });
+    if (to_prepare_.empty()) return;  // stopping, nothing left
+    const size_t index = to_prepare_.front();
+    to_prepare_.pop_front();
+    // Running: only this thread touches the preparation until it is marked done.
+    Preparation& p = preparations_[index];
+    const Context::LiveParamCheck& prepare = targets_[index]->prepares.at(p.request.param_name());
+    lock.unlock();
+    Status result = prepare(p.value);
+    lock.lock();
+    p.result = std::move(result);
+    p.state = Preparation::State::kDone;
+    prepared_.fetch_add(1, std::memory_order_release);
+  }
+}
+
+void LiveParams::Stop() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  prepare_cv_.notify_all();
+  if (preparer_.joinable()) preparer_.join();
+  if (!answers_) return;  // never opened
+  for (size_t i = 0; i < preparations_.size(); ++i)
+    if (preparations_[i].state != Preparation::State::kNone) {
+      Publish(Refused(*targets_[i], preparations_[i].request, "the run stopped before the change took effect"));
+      preparations_[i] = {};
+    }
+}
+
+msg::ParamChange LiveParams::Refused(Target& target, msg::ParamChange a, const std::string& why) {
   a.step(*target.steps);
   a.old_value("");
-  a.reason("");
-  auto refuse = [&](const std::string& why) {
-    a.op("refused");
-    a.reason(why);
-    target.log->Warn("param " + request.param_name() + " = " + request.value() + " (" + request.who() + "): refused: " + why);
-    return a;
-  };
+  a.op("refused");
+  a.reason(why);
+  target.log->Warn("param " + a.param_name() + " = " + a.value() + " (" + a.who() + "): refused: " + why);
+  return a;
+}
+
+std::optional<msg::ParamChange> LiveParams::Answer(Target& target, const msg::ParamChange& request, Preparation* prepare) {
   const ParamSpec* spec = target.spec->FindParam(request.param_name());
   std::vector<std::string> live;
   for (const auto& p : target.spec->params())
     if (p.live) live.push_back(p.name);
-  if (spec == nullptr) return refuse("no parameter '" + request.param_name() + "' (live: " + (live.empty() ? "none" : JoinList(live)) + ")");
+  if (spec == nullptr)
+    return Refused(target, request, "no parameter '" + request.param_name() + "' (live: " + (live.empty() ? "none" : JoinList(live)) + ")");
   if (!spec->live)
-    return refuse("'" + request.param_name() + "' is not live: read once, at configure (live: " + (live.empty() ? "none" : JoinList(live)) + ")");
-  const std::string old = ToYamlText(target.params->values().at(request.param_name()));
+    return Refused(target, request,
+                   "'" + request.param_name() + "' is not live: read once, at configure (live: " + (live.empty() ? "none" : JoinList(live)) + ")");
   if (request.op() == "get") {
+    msg::ParamChange a = request;
+    a.step(*target.steps);
+    a.old_value("");
+    a.reason("");
     a.op("value");
-    a.value(old);
+    a.value(ToYamlText(target.params->values().at(request.param_name())));
     return a;
   }
   YAML::Node node;
   try {
     node = YAML::Load(request.value());
   } catch (const YAML::Exception& e) {
-    return refuse("not YAML: " + std::string(e.what()));
+    return Refused(target, request, "not YAML: " + std::string(e.what()));
   }
   StatusOr<ParamValue> value = ParamFromYaml(*spec, node);
-  if (!value.ok()) return refuse(value.status().message());
+  if (!value.ok()) return Refused(target, request, value.status().message());
+  if (spec->path) ResolvePaths(graph_folder_, &value.value());
   if (auto check = target.checks.find(request.param_name()); check != target.checks.end())
-    if (Status s = check->second(*value); !s.ok()) return refuse(s.message());
+    if (Status s = check->second(*value); !s.ok()) return Refused(target, request, s.message());
+  Preparation p;
+  p.request = request;
+  p.value = std::move(value).value();
+  if (target.prepares.count(request.param_name())) {
+    *prepare = std::move(p);
+    return std::nullopt;
+  }
+  return Finish(target, p);
+}
+
+// Applies a set that passed every check (and its preparation, if any) at this step boundary.
+msg::ParamChange LiveParams::Finish(Target& target, const Preparation& p) {
+  if (!p.result.ok()) return Refused(target, p.request, p.result.message());
+  msg::ParamChange a = p.request;
+  const std::string old = ToYamlText(target.params->values().at(p.request.param_name()));
+  a.step(*target.steps);
+  a.reason("");
   a.op("applied");
   a.old_value(old);
-  a.value(ToYamlText(*value));
-  target.params->Set(request.param_name(), std::move(value).value());
-  target.log->Info("param " + request.param_name() + ": " + old + " -> " + a.value() + " (" + request.who() + ")");
+  a.value(ToYamlText(p.value));
+  target.params->Set(p.request.param_name(), p.value);
+  target.log->Info("param " + p.request.param_name() + ": " + old + " -> " + a.value() + " (" + p.request.who() + ")");
   return a;
 }
 

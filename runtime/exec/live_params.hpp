@@ -10,16 +10,28 @@
 // delivered as they are written, and are taken at the next step boundary of their component: the
 // same run gives the same changes at the same steps.
 //
+// Prepared params (Context::PrepareLiveParam: a check that takes longer than a step, such as
+// loading a model): on the wall clock a set that passed the quick checks goes to one preparer
+// thread; the step thread carries on, and the first step boundary after the preparation ended
+// applies or refuses it (answered then, with that step). Requests for the same component that
+// came after it wait for it, so each component's requests are answered in the order they came.
+// Under the stepped clock the preparation runs at the boundary itself: a run is reproducible.
+//
 // Threads: BeforeStep(i) runs on target i's step thread (several targets, several threads);
-// the request reader's callback only raises a flag. Cost when nothing is asked: two atomic loads.
+// the request reader's callback only raises a flag. Cost when nothing is asked: three atomic
+// loads (also while a preparation runs).
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <dyad/component.hpp>
@@ -37,23 +49,48 @@ class LiveParams {
     Params* params = nullptr;           // the component's (its ctx.params())
     const uint64_t* steps = nullptr;    // its steps so far
     Logger* log = nullptr;
-    std::map<std::string, Context::LiveParamCheck> checks;  // CheckLiveParam()
+    std::map<std::string, Context::LiveParamCheck> checks;    // CheckLiveParam()
+    std::map<std::string, Context::LiveParamCheck> prepares;  // PrepareLiveParam()
   };
 
+  LiveParams() = default;
+  LiveParams(const LiveParams&) = delete;
+  LiveParams& operator=(const LiveParams&) = delete;
+  ~LiveParams() { Stop(); }
+
   // Opens the request reader and the answer writer on `transport`; answers are stamped by
-  // `clock` and sourced "dyad/<process>".
+  // `clock` and sourced "dyad/<process>". Relative live paths resolve against `graph_folder`.
+  // `stepped`: preparations run at the step boundary (above).
   Status Open(Transport* transport, const std::string& graph_name, const std::string& process, const Clock* clock,
-              std::vector<Target*> targets);
+              const std::string& graph_folder, bool stepped, std::vector<Target*> targets);
   // At a step boundary of targets[index], on its step thread.
   void BeforeStep(size_t index) {
-    if (!arrived_.load(std::memory_order_acquire) && queued_.load(std::memory_order_acquire) == 0) return;
+    if (!arrived_.load(std::memory_order_acquire) && queued_.load(std::memory_order_acquire) == 0 &&
+        prepared_.load(std::memory_order_acquire) == 0)
+      return;
     Apply(index);
   }
+  // When the steps have ended, before the components deactivate: waits for a preparation under
+  // way and refuses the sets not applied ("the run stopped ..."), so none goes unanswered.
+  void Stop();
 
  private:
+  // A set being prepared for one target: it passed the quick checks; `result` once done.
+  struct Preparation {
+    enum class State { kNone, kRunning, kDone } state = State::kNone;
+    msg::ParamChange request;
+    ParamValue value;
+    Status result;
+  };
+
   void Apply(size_t index);
   void Take();  // REQUIRES: mutex_ held
-  msg::ParamChange Answer(Target& target, const msg::ParamChange& request);
+  // The answer to `request`, or nullopt when it passed the quick checks of a prepared param:
+  // then `*prepare` holds it, to be prepared and then Finish()ed.
+  std::optional<msg::ParamChange> Answer(Target& target, const msg::ParamChange& request, Preparation* prepare);
+  msg::ParamChange Finish(Target& target, const Preparation& p);
+  msg::ParamChange Refused(Target& target, msg::ParamChange answer, const std::string& why);
+  void RunPreparations();  // the preparer thread
   void Publish(msg::ParamChange answer);
 
   std::string graph_name_;
@@ -63,7 +100,16 @@ class LiveParams {
   std::atomic<bool> arrived_{false};
   std::atomic<int> queued_{0};
   std::mutex mutex_;  // the reader and the queues
-  std::vector<std::vector<msg::ParamChange>> queues_;
+  std::vector<std::deque<msg::ParamChange>> queues_;
+  std::string graph_folder_;
+  bool stepped_ = false;
+  // Preparations (prepared_: how many are done and not yet applied), guarded by mutex_.
+  std::vector<Preparation> preparations_;
+  std::atomic<int> prepared_{0};
+  std::deque<size_t> to_prepare_;  // target indices
+  bool stopping_ = false;
+  std::condition_variable prepare_cv_;
+  std::thread preparer_;  // started by the first preparation
   std::mutex publish_mutex_;  // answers_ (its sequence numbers)
 };
 

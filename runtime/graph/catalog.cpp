@@ -86,9 +86,9 @@ Status Catalog::Register(const std::string& origin, void (*register_types)(Plugi
                   << ToString(p.type) << " (only string and list of strings can be paths)\n";
         bad_spec = true;
       }
-      if (p.live && (p.path || p.secret || p.type == ParamType::kYaml)) {
+      if (p.live && (p.secret || p.type == ParamType::kYaml)) {
         conflicts << file << ": component type '" << t.name << "': param '" << p.name << "' is marked Live() but is "
-                  << (p.path ? "a path" : p.secret ? "a secret" : "yaml") << " (those are read once, in Configure)\n";
+                  << (p.secret ? "a secret" : "yaml") << " (those are read once, in Configure)\n";
         bad_spec = true;
       }
       if (p.secret && p.type != ParamType::kString) {

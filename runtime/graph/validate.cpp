@@ -39,8 +39,8 @@ std::string RangeError(const ParamSpec& spec, double v) {
   return os.str();
 }
 
-// A path param's value made absolute against `base` (Graph::FolderOf); absolute and empty
-// values are kept.
+}  // namespace
+
 void ResolvePaths(const std::filesystem::path& base, ParamValue* value) {
   auto resolve = [&](std::string& p) {
     if (p.empty() || std::filesystem::path(p).is_absolute()) return;
@@ -50,8 +50,6 @@ void ResolvePaths(const std::filesystem::path& base, ParamValue* value) {
   if (auto* list = std::get_if<std::vector<std::string>>(value))
     for (std::string& p : *list) resolve(p);
 }
-
-}  // namespace
 
 StatusOr<ParamValue> ParamFromYaml(const ParamSpec& spec, const YAML::Node& node) {
   const std::string got = node.IsScalar() ? "'" + node.Scalar() + "'" : node.IsSequence() ? "a list" : node.IsMap() ? "a mapping" : "null";

@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <ostream>
 #include <thread>
 
@@ -19,8 +20,9 @@ namespace dyad {
 namespace {
 
 // The graph's process of the component, after checking the request against the graph file; ""
-// after saying what is wrong.
-std::string CheckAgainstGraph(const ParamRequest& r, const Catalog& catalog, std::ostream& err) {
+// after saying what is wrong. `*value`: the value to ask for (a relative path made absolute
+// against the working folder, as `--set` does: the process may run elsewhere).
+std::string CheckAgainstGraph(const ParamRequest& r, const Catalog& catalog, std::string* value, std::ostream& err) {
   const std::string what = "dyad param: " + r.component + "." + r.param;
   std::vector<Diagnostic> diags;
   const ResolvedGraph resolved = ValidateGraph(*r.watched, catalog, &diags);
@@ -56,6 +58,11 @@ std::string CheckAgainstGraph(const ParamRequest& r, const Catalog& catalog, std
         err << what << " = " << r.value << ": " << v.status().message() << "\n";
         return "";
       }
+      *value = r.value;
+      if (spec->path) {
+        ResolvePaths(std::filesystem::current_path(), &v.value());
+        *value = ToYamlText(*v);
+      }
     } catch (const YAML::Exception& e) {
       err << what << " = " << r.value << ": not YAML: " << e.what() << "\n";
       return "";
@@ -88,7 +95,8 @@ bool AwaitProcess(DdsParticipant& participant, const std::string& suffix, double
 
 int RequestParam(const ParamRequest& r, const Catalog& catalog, std::ostream& out, std::ostream& err) {
   const std::string what = r.component + "." + r.param;
-  const std::string process = CheckAgainstGraph(r, catalog, err);
+  std::string value;
+  const std::string process = CheckAgainstGraph(r, catalog, &value, err);
   if (process.empty()) return 2;
   InterruptWatcher interrupt;
   std::unique_ptr<DdsParticipant> participant = JoinAsWatcher(r.watch, "dyad/guest/param/" + std::to_string(getpid()), err);
@@ -114,7 +122,7 @@ int RequestParam(const ParamRequest& r, const Catalog& catalog, std::ostream& ou
   q.component_name(r.component);
   q.param_name(r.param);
   q.op(r.set ? "set" : "get");
-  q.value(r.set ? r.value : "");
+  q.value(r.set ? value : "");
   q.who(r.who);
   q.request_id(r.who + "/" + std::to_string(getpid()) + "/" + std::to_string(WallNowNs()));
   if (Status s = (*requests)->Write(&q); !s.ok()) {

@@ -14,7 +14,14 @@ namespace {
 struct WriterState {
   WriterLosses losses;
   std::int64_t last_stamp = 0, first_stamp = 0;
+  bool events = false;  // speaks only when something happens: silence is no loss
 };
+
+// Topics that carry events, not a stream: dyad/health, and these types (a live param's answer,
+// the deliberator's model at start and at each swap).
+bool CarriesEvents(const std::string& topic, const std::string& type) {
+  return topic == "dyad/health" || type == "dyad::msg::ParamChange" || type == "dyad::msg::ModelInfo";
+}
 
 const std::string* FieldValue(const std::vector<cdr::Field>& fields, const char* path) {
   for (const auto& f : fields)
@@ -72,6 +79,7 @@ StatusOr<Losses> FindLosses(const mcap::Reader& reader) {
       s.losses.writer = *source;
       s.losses.first = s.losses.last = n;
       s.first_stamp = t;
+      s.events = CarriesEvents(m.channel->topic, type);
     } else if (n > s.losses.last + 1) {
       s.losses.gaps.push_back({n - s.losses.last - 1, s.last_stamp, t});
     }
@@ -88,8 +96,7 @@ StatusOr<Losses> FindLosses(const mcap::Reader& reader) {
     const double span = (s.last_stamp - s.first_stamp) * 1e-9;
     const double usual = s.losses.samples > 1 ? span / static_cast<double>(s.losses.samples - 1) : 0;
     const double silent = (end_ns - s.last_stamp) * 1e-9;
-    // dyad/health speaks only when something happens.
-    if (silent > 2 && silent > 10 * usual && s.losses.topic != "dyad/health") s.losses.silent_at_end_s = silent;
+    if (silent > 2 && silent > 10 * usual && !s.events) s.losses.silent_at_end_s = silent;
     out.writers.push_back(std::move(s.losses));
   }
   return out;

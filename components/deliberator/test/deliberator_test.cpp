@@ -4,14 +4,17 @@
 
 #include <gtest/gtest.h>
 
+#include "dyad/testing/csv.hpp"
 #include "dyad/testing/dds_domain.hpp"
 #include "dyad/testing/fake_context.hpp"
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "dyad/pvrnn/model_file.hpp"
@@ -203,6 +206,97 @@ TEST(Deliberator, RunsInASteppedGraphAndPublishesEveryStep) {
   }
   EXPECT_GE(lines, 39);
   EXPECT_GE(optimised, 38);
+  fs::remove_all(dir);
+}
+
+// The first word `sha256sum` prints for `file` (an implementation independent of dyad's).
+std::string Sha256sum(const fs::path& file) {
+  std::string out;
+  if (FILE* p = popen(("sha256sum " + file.string()).c_str(), "r")) {
+    char buf[256];
+    while (std::fgets(buf, sizeof buf, p)) out += buf;
+    pclose(p);
+  }
+  return out.substr(0, out.find(' '));
+}
+
+// A live `model` swaps the robot's mind mid-run: in a stepped run at the step boundary after the
+// request, the same in every run; recorded (the param's answer; the model topic with each model's
+// SHA-256 and first step); a broken file is refused and the model in force steers on.
+TEST(Deliberator, ALiveModelIsSwappedAtAStepBoundaryRecordedAndABadOneRefused) {
+  const fs::path dir = fs::temp_directory_path() / ("dyad_deliberator_swap_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path a = RandomModelFile(), b = dir / "b.dpvrnn", bad = dir / "bad.dpvrnn";
+  ASSERT_TRUE(pvrnn::SaveModel(pvrnn::Model::Initialize(pvrnn::ModelSpec::MacawBot(), 72, 7, 11), b.string()).ok());
+  {  // b, truncated: its checksum cannot match
+    std::ifstream in(b, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(bad, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  }
+  auto run = [&](const std::string& name, const std::string& changes) {
+    const fs::path rec = dir / (name + ".mcap"), graph = dir / (name + ".yaml"), csv = dir / name;
+    std::ofstream(graph) << "graph: swap\nclock: stepped\nseed: 3\ndomain_id: " << dyad::testing::DomainForThisProcess()
+                         << "\nplugins: [" << DYAD_DELIBERATOR_TEST_PLUGIN << "]\ncomponents:\n"
+                         << "  driver: {type: executed_script, rate_hz: 10, outputs: {state: robot/state}}\n"
+                         << "  mind:\n    type: deliberator\n    rate_hz: 10\n    params: {model: " << a.string()
+                         << ", start_primitive: 1}\n"
+                         << "    inputs: {executed: robot/state}\n    outputs: {intention: robot/intention, model: mind/model}\n"
+                         << "  script: {type: param_script, rate_hz: 10, outputs: {requests: dyad/param_requests}, params: {changes: ["
+                         << changes << "]}}\n"
+                         << "  rec: {type: recorder, rate_hz: 10, params: {file: " << rec.string() << "}}\n";
+    const std::string cmd = std::string(DYAD_EXE) + " run " + graph.string() + " --steps 40 > " + (dir / (name + ".log")).string() +
+                            " 2>&1 && " + DYAD_EXE + " bag export " + rec.string() + " --csv " + csv.string() + " >> " +
+                            (dir / (name + ".log")).string() + " 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << std::ifstream(dir / (name + ".log")).rdbuf();
+    return csv;
+  };
+  const std::string swaps = "{at_s: 2.0, set: {mind.model: " + b.string() + "}}, {at_s: 3.0, set: {mind.model: " + bad.string() + "}}";
+  const fs::path first = run("first", swaps), again = run("again", swaps), none = run("none", "");
+
+  const auto changes = dyad::testing::ReadCsv(first / "dyad_params.csv");
+  ASSERT_EQ(changes.size(), 2u) << std::ifstream(first / "dyad_params.csv").rdbuf();
+  EXPECT_EQ(changes[0].at("op"), "applied");
+  EXPECT_EQ(changes[0].at("old_value"), "\"" + a.string() + "\"");  // YAML text
+  EXPECT_EQ(changes[0].at("value"), "\"" + b.string() + "\"");
+  const uint64_t swap_step = std::stoull(changes[0].at("step"));
+  EXPECT_EQ(swap_step, 21u);  // asked at 2.0 s, after step 20 ran: the mind's step 21 is B's first
+  EXPECT_EQ(changes[1].at("op"), "refused");
+  EXPECT_NE(changes[1].at("reason").find(bad.string()), std::string::npos) << changes[1].at("reason");
+
+  const auto models = dyad::testing::ReadCsv(first / "mind_model.csv");
+  ASSERT_EQ(models.size(), 2u) << "the model at the start and the one swap: the bad file never steered";
+  EXPECT_EQ(models[0].at("path"), a.string());
+  EXPECT_EQ(models[0].at("sha256"), Sha256sum(a));
+  EXPECT_EQ(models[0].at("step"), "0");
+  EXPECT_EQ(models[1].at("path"), b.string());
+  EXPECT_EQ(models[1].at("sha256"), Sha256sum(b));
+  EXPECT_EQ(models[1].at("step"), std::to_string(swap_step));
+  EXPECT_EQ(models[1].at("primitives"), "7");
+
+  auto read = [](const fs::path& csv) { return dyad::testing::ReadCsv(csv / "robot_intention.csv"); };
+  const auto with = read(first), without = read(none);
+  ASSERT_EQ(with.size(), 40u);
+  ASSERT_EQ(without.size(), 40u);
+  for (size_t i = 0; i < with.size(); ++i) {
+    if (i < swap_step)
+      EXPECT_EQ(with[i].at("x"), without[i].at("x")) << "step " << i << ": A steers until the swap";
+    else
+      EXPECT_NE(with[i].at("x"), without[i].at("x")) << "step " << i << ": B steers from the swap on";
+    EXPECT_EQ(with[i].at("iterations"), i == 0 ? "0" : "15") << "step " << i;
+  }
+  // The same in every run (but optimisation_s: the wall time the solves took).
+  const auto again_with = read(again);
+  ASSERT_EQ(again_with.size(), with.size());
+  for (size_t i = 0; i < with.size(); ++i)
+    for (const char* column : {"x", "y", "nelbo", "iterations"})
+      EXPECT_EQ(with[i].at(column), again_with[i].at(column)) << "step " << i << ": two runs of one stepped graph swapped differently";
+  for (const std::string f : {"mind_model.csv", "dyad_params.csv"}) {
+    std::ostringstream x, y;
+    x << std::ifstream(first / f).rdbuf();
+    y << std::ifstream(again / f).rdbuf();
+    EXPECT_EQ(x.str(), y.str()) << f << ": two runs of one stepped graph swapped differently";
+  }
   fs::remove_all(dir);
 }
 

@@ -118,7 +118,8 @@ namespace dyad {
 // 6: live parameters: ParamSpec::live, Params::Set, Context::CheckLiveParam; a live param's value
 //    in ctx.params() changes between steps.
 // 7: TypeInfo::ros2_name (ROS 2 message types, no dyad Header: Publish stamps nothing in them).
-inline constexpr uint32_t kPluginAbiVersion = 7;
+// 8: Context::PrepareLiveParam (prepared off the step thread); a live param may be a Path().
+inline constexpr uint32_t kPluginAbiVersion = 8;
 
 // The runtime clock: wall time (ns since the Unix epoch) in `clock: wall` graphs, simulated time
 // (ns since start) in `clock: stepped` graphs. Thread-safe.
@@ -418,6 +419,16 @@ class Context {
   // value stays. The default (test fakes of Context) keeps no check.
   using LiveParamCheck = std::function<Status(const ParamValue& value)>;
   virtual void CheckLiveParam(const std::string& /*name*/, LiveParamCheck /*check*/) {}
+  // Live parameters (ABI 8). In Configure(): like CheckLiveParam, for a check that takes longer
+  // than a step allows, typically preparing what the value names (load and check a model file,
+  // build what Step() will swap in). On the wall clock it runs on a runtime thread, off the step
+  // thread, while the component keeps stepping; the value takes effect at the first step
+  // boundary after it returned OK (the answer carries that step), or is refused with its message.
+  // The component's requests that came after it wait for it (answered in order). Under the
+  // stepped clock it runs at the step boundary, so a run is reproducible. `prepare` may run
+  // concurrently with Step(): what it shares with Step() is the component's to guard; Step() sees
+  // the new value in ctx.params() only after `prepare` returned, and never mid-step.
+  virtual void PrepareLiveParam(const std::string& /*name*/, LiveParamCheck /*prepare*/) {}
 
   // The port declared under `name` with type T. Asking for an undeclared port or another type is
   // a programming error: it aborts naming the component and port.

@@ -27,7 +27,9 @@
 // step boundary of the component: between two of its Step() calls, on its step thread, so a
 // component that reads it from ctx.params() in Step() (a map lookup) sees each change at its next
 // step and never mid-step. A value read once in Configure() does not change: mark Live() only what
-// Step() reads. Paths, secrets and kYaml values cannot be live (refused when the plugin is loaded).
+// Step() reads. A live path given relative resolves against the graph file's folder; what it names
+// is typically loaded off the step thread (Context::PrepareLiveParam). Secrets and kYaml values
+// cannot be live (refused when the plugin is loaded).
 //
 // Values reach the component only after validation, so getters never fail on user input; asking
 // for an undeclared name or the wrong type is a programming error and aborts with a message.

@@ -11,6 +11,7 @@
 // Configure() would reject.
 #pragma once
 
+#include <filesystem>
 #include <map>
 #include <set>
 #include <string>
@@ -82,5 +83,9 @@ std::string RedactedGraphYaml(const Graph& graph, const ResolvedGraph& resolved)
 // Converts a YAML value to a param of `spec`'s type; InvalidArgument (message without location)
 // when it is not one.
 StatusOr<ParamValue> ParamFromYaml(const ParamSpec& spec, const YAML::Node& node);
+
+// A path param's value (a string or a list of strings) made absolute against `base` (the graph
+// file's folder); absolute and empty values are kept.
+void ResolvePaths(const std::filesystem::path& base, ParamValue* value);
 
 }  // namespace dyad
