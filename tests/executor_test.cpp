@@ -9,6 +9,7 @@
 #include <mutex>
 #include <thread>
 
+#include <dyad/decode_sample.hpp>
 #include <dyad/msg/types.hpp>
 #include <dyad/on_demand_subscription.hpp>
 
@@ -130,8 +131,9 @@ class Probe : public Component {
   OnDemandSubscription* on_demand_ = nullptr;  // owned by the runtime
 };
 
-// A component with a live param whose preparation takes `prepare_ms` (refusing 13) and a plain
-// live param: logs each step's values and whether a preparation was running meanwhile.
+// A component with a live param whose preparation takes `prepare_ms` (1.5 s for 9, refusing 13)
+// and a plain live param: logs each step's values, whether a preparation was running meanwhile,
+// and each commit.
 class Slow : public Component {
  public:
   static void Describe(ComponentSpec& spec) {
@@ -142,12 +144,17 @@ class Slow : public Component {
   Status Configure(Context& ctx) override {
     ctx_ = &ctx;
     const auto prepare = std::chrono::duration<double, std::milli>(ctx.params().Double("prepare_ms"));
-    ctx.PrepareLiveParam("level", [this, prepare](const ParamValue& v) {
-      preparing_.store(true);
-      std::this_thread::sleep_for(prepare);
-      preparing_.store(false);
-      return std::get<int64_t>(v) == 13 ? Status::InvalidArgument("unlucky") : Status::OK();
-    });
+    ctx.PrepareLiveParam(
+        "level",
+        [this, prepare](const ParamValue& v) {
+          preparing_.store(true);
+          const int64_t other = ctx_->params().Int("other");  // held still while this runs
+          std::this_thread::sleep_for(std::get<int64_t>(v) == 9 ? std::chrono::duration<double, std::milli>(1500) : prepare);
+          preparing_.store(false);
+          if (ctx_->params().Int("other") != other) return Status::Internal("other changed during the preparation");
+          return std::get<int64_t>(v) == 13 ? Status::InvalidArgument("unlucky") : Status::OK();
+        },
+        [this](const ParamValue& v) { g_log->Add("slow commit " + std::to_string(std::get<int64_t>(v))); });
     return Status::OK();
   }
   Status Step(const StepInfo& info) override {
@@ -162,7 +169,7 @@ class Slow : public Component {
 };
 
 // Asks for live changes of `slow` at its steps: level 5 then other 7 at step 2, level 13 at
-// step 4, level 9 at step `last` (the run stops before it is prepared).
+// step 4, level 9 at step `last` (prepared for longer than the run lasts); logs the answers.
 class Asker : public Component {
  public:
   static void Describe(ComponentSpec& spec) {
@@ -173,7 +180,12 @@ class Asker : public Component {
     graph_ = ctx.graph_name();
     last_ = static_cast<uint64_t>(ctx.params().Int("last"));
     out_ = &ctx.output<msg::ParamChange>("requests");
-    return Status::OK();
+    // Every answer, also those given after the last step (until just before Deactivate).
+    return ctx.SubscribeSerialized("dyad/params", [](const SerializedSample& sample) {
+      msg::ParamChange a;
+      if (!DecodeSample(sample.cdr, &a).ok()) return g_log->Add("answer undecodable");
+      g_log->Add("answer " + a.op() + " " + a.param_name() + " " + a.value() + (a.reason().empty() ? "" : " (" + a.reason() + ")"));
+    });
   }
   Status Step(const StepInfo& info) override {
     auto ask = [&](const std::string& param, const std::string& value) {
@@ -410,15 +422,16 @@ components:
   EXPECT_EQ(log_.Matching("viewer deactivate"), (std::vector<std::string>{"viewer deactivate (tapped 3)"}));
 }
 
-// A prepared live param on the wall clock: its preparation runs while the component steps on, the
-// value takes effect at a step boundary after it ended, the component's next request waits for
-// it (answered in order), a refused preparation leaves the old value, and a run that stops
-// during one ends without waiting for a step that never comes.
+// A prepared live param on the wall clock: its preparation runs while the component steps on
+// (its other live params held still), the value takes effect at a step boundary after it ended
+// (committed there), the component's next request waits for it (answered in order), a refused
+// preparation leaves the old value, and a run that stops during one refuses it without waiting
+// for a step that never comes.
 TEST_F(ExecutorTest, APreparedLiveParamIsPreparedOffTheStepThreadAndAppliedInOrder) {
   ASSERT_TRUE(Run(R"(graph: t
 clock: wall
 components:
-  asker: {type: asker, rate_hz: 20, params: {last: 29}, outputs: {requests: dyad/param_requests}}
+  asker: {type: asker, rate_hz: 20, params: {last: 24}, outputs: {requests: dyad/param_requests}}
   slow: {type: slow, rate_hz: 20, params: {prepare_ms: 300}}
 )", 0, 1.6).ok());
   const std::vector<std::string> steps = log_.Matching("slow step");
@@ -432,9 +445,13 @@ components:
     EXPECT_EQ(steps[i].find("level 9"), std::string::npos) << steps[i] << ": the run stopped before it was prepared";
   }
   EXPECT_GE(while_preparing, 4) << "300 ms of preparation at 20 Hz: the component stepped on meanwhile";
-  ASSERT_GE(first_five, 3) << "level 5 applied after its 300 ms preparation";
+  ASSERT_GE(first_five, 6) << "level 5 applied after its 300 ms preparation (asked at step 2)";
   EXPECT_GE(first_seven, first_five) << "other 7 came after level 5: it waited for it";
   EXPECT_NE(steps.back().find("level 5 other 7"), std::string::npos) << steps.back();
+  EXPECT_EQ(log_.Matching("slow commit"), (std::vector<std::string>{"slow commit 5"}));
+  EXPECT_EQ(log_.Matching("answer "),
+            (std::vector<std::string>{"answer applied level 5", "answer applied other 7", "answer refused level 13 (unlucky)",
+                                      "answer refused level 9 (the run stopped before the change took effect)"}));
 }
 
 TEST(SubscribeSerializedOnDemand, IsUnimplementedOnAContextOfTheTests) {

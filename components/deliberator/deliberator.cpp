@@ -12,6 +12,7 @@
 
 #include <dyad/join_list.hpp>
 
+#include "dyad/pvrnn/checked_file.hpp"
 #include "dyad/pvrnn/model_file.hpp"
 
 namespace dyad::deliberator {
@@ -55,12 +56,11 @@ Status ApplyMap(const std::string& param, const std::string& yaml_text,
 
 // The SHA-256 of a file's bytes in hex, as sha256sum prints it.
 StatusOr<std::string> FileSha256(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in.good() && !in.eof()) return Status::IOError(path + ": cannot read");
+  StatusOr<std::string> bytes = pvrnn::ReadWholeFile(path, "model file");
+  if (!bytes.ok()) return bytes.status();
   unsigned char digest[EVP_MAX_MD_SIZE];
   unsigned int length = 0;
-  if (EVP_Digest(bytes.data(), bytes.size(), digest, &length, EVP_sha256(), nullptr) != 1)
+  if (EVP_Digest(bytes->data(), bytes->size(), digest, &length, EVP_sha256(), nullptr) != 1)
     return Status::Internal("SHA-256 of " + path + " failed");
   static const char kHex[] = "0123456789abcdef";
   std::string hex;
@@ -125,7 +125,11 @@ Status Deliberator::Configure(Context& ctx) {
                                      std::to_string(w.size()));
     return Status::OK();
   });
-  ctx.PrepareLiveParam("model", [this](const ParamValue& v) { return PrepareModel(std::get<std::string>(v)); });
+  ctx.PrepareLiveParam(
+      "model", [this](const ParamValue& v) { return PrepareModel(std::get<std::string>(v)); },
+      [this](const ParamValue&) {
+        if (Status s = SwapModel(); !s.ok()) ctx_->log().Error("model swap: " + s.message());
+      });
   if (p.Int("window") > 0) o.window = static_cast<int>(p.Int("window"));
   if (p.Int("iterations") > 0) o.iterations = static_cast<int>(p.Int("iterations"));
   o.optimizer = pvrnn::ParseOptimizerKind(p.String("optimizer")).value();
@@ -212,8 +216,10 @@ Status Deliberator::PrepareModel(const std::string& path) {
   const int iterations = p.Int("iterations") > 0 ? static_cast<int>(p.Int("iterations")) : preset_iterations_;
   const std::vector<double>& meta_prior = p.DoubleList("meta_prior").empty() ? preset_meta_prior_ : p.DoubleList("meta_prior");
   if (!meta_prior.empty() && meta_prior.size() != static_cast<size_t>(model->spec.num_layers()))
-    return Status::InvalidArgument(path + " has " + std::to_string(model->spec.num_layers()) + " layers; meta_prior has " +
-                                   std::to_string(meta_prior.size()) + " values (set meta_prior: [] or one per layer first)");
+    return Status::InvalidArgument(path + " has " + std::to_string(model->spec.num_layers()) + " layers; the meta_prior in force has " +
+                                   std::to_string(meta_prior.size()) + " values (" +
+                                   (p.DoubleList("meta_prior").empty() ? "the preset's" : "as set") +
+                                   "): a model with another number of layers needs a restart");
   if (Status s = (*er)->Retune(iterations, meta_prior); !s.ok()) return s;
   if (Status s = (*er)->Reset(start_primitive_, seed_); !s.ok()) return s;
   // Warm it on the executed positions in the window: it starts where the robot is.
@@ -239,9 +245,10 @@ Status Deliberator::PrepareModel(const std::string& path) {
   return Status::OK();
 }
 
-// At the step boundary after the runtime applied a new `model`: the prepared regression takes
-// over. The positions executed since it was warmed get one evaluation each (cheap: the step's
-// own solve comes after), so its window matches the old one's.
+// The commit of a new `model`: at the step boundary where the runtime applied it, on the step
+// thread, before Step(). The prepared regression takes over; the positions executed since it was
+// warmed get one evaluation each (cheap: the step's own solve comes after), so its window
+// matches the old one's.
 Status Deliberator::SwapModel() {
   Prepared p;
   {
@@ -249,26 +256,24 @@ Status Deliberator::SwapModel() {
     p = std::move(prepared_);
     prepared_ = Prepared{};
   }
-  if (!p.er || p.info.path() != ctx_->params().String("model"))
-    return Status::Internal("model " + ctx_->params().String("model") + " applied without its preparation");
+  if (!p.er) return Status::Internal("model " + ctx_->params().String("model") + " applied without its preparation");
   const uint64_t from = std::max(p.fed, history_fed_ > history_.size() ? history_fed_ - history_.size() : 0);
   for (uint64_t k = from; k < history_fed_; ++k) p.er->Step(history_[k % history_.size()].data(), pvrnn::SteadyClock::now());
   er_ = std::move(p.er);
   layers_ = static_cast<int>(p.info.layers());
   std::ostringstream info;
-  info << "step " << steps_ << ": model " << model_path_ << " -> " << p.info.path() << " (sha256 " << p.info.sha256().substr(0, 12)
-       << ", prepared in " << p.info.prepare_s() * 1e3 << " ms off the step thread)";
-  ctx_->log().Info(info.str());
+  info << "step " << steps_ << ": model " << model_path_ << " -> " << p.info.path() << " (sha256 " << p.info.sha256().substr(0, 12);
+  if (!stepped_) info << ", prepared in " << p.info.prepare_s() * 1e3 << " ms off the step thread";
+  ctx_->log().Info(info.str() + ")");
   model_path_ = p.info.path();
   p.info.step(steps_);
+  model_published_ = true;  // at step 0: the configured model never steered
   return model_info_->Publish(p.info);
 }
 
 // The live params (iterations, meta_prior) as they are now: the regression retuned when changed.
 Status Deliberator::FollowLiveParams() {
   const Params& p = ctx_->params();
-  if (p.String("model") != model_path_)
-    if (Status s = SwapModel(); !s.ok()) return s;
   if (p.Int("iterations") == live_iterations_ && p.DoubleList("meta_prior") == live_meta_prior_) return Status::OK();
   live_iterations_ = p.Int("iterations");
   live_meta_prior_ = p.DoubleList("meta_prior");
@@ -288,8 +293,10 @@ Status Deliberator::Step(const StepInfo&) {
   double optimisation_s = 0;
   bool missed = false;
   const pvrnn::StepResult* r = nullptr;
-  if (steps_ == 0)
+  if (!model_published_) {
+    model_published_ = true;
     if (Status s = model_info_->Publish(first_info_); !s.ok()) return s;
+  }
   if (steps_ > 0) {  // step 0 publishes r_0: nothing executed yet
     double xy[2];
     const msg::CartesianState* s = executed_->received().empty() ? nullptr : &executed_->received().back();

@@ -19,7 +19,7 @@
 ///     pass during a step, and a wall-time cap would make the run depend on the machine's load.
 /// params:
 ///   model (string, required, live): .dpvrnn model file (2 DOF: x, y). Set while the graph runs
-///     (`dyad param set deliberator.model new.dpvrnn`, the experimenter's page) it is swapped in
+///     (`dyad param set mind.model=new.dpvrnn --graph G`, the experimenter's page) it is swapped in
 ///     without stopping: loaded, checked (2 DOFs, as many layers as a set meta_prior has values,
 ///     the start primitive) and warmed by replaying the window's executed positions off the step
 ///     thread, then switched at a step boundary; a bad file is refused and the old model steers on.
@@ -75,14 +75,14 @@ class Deliberator final : public Component {
   Output<msg::Intention>* intention_ = nullptr;     // owned by the runtime
   Output<msg::ModelInfo>* model_info_ = nullptr;    // owned by the runtime
   std::unique_ptr<pvrnn::ErrorRegression<float>> er_;
-  pvrnn::ErrorRegressionOptions options_;  // as created, retuned by the live params
+  pvrnn::ErrorRegressionOptions options_;  // as configured (the live params: from ctx.params())
   int start_primitive_ = 0;
   uint64_t seed_ = 0;
 
-  // Model swaps (the live `model`). PrepareModel runs off the step thread (LiveParams) and leaves
-  // the new regression in `prepared_`; Step swaps it in when ctx.params() shows the new path
-  // (the runtime applies the value only after PrepareModel returned OK, and holds this
-  // component's other live changes until then, so options_ does not change meanwhile).
+  // Model swaps (the live `model`). PrepareModel runs off the step thread (Context::
+  // PrepareLiveParam) and leaves the new regression in `prepared_`; SwapModel, the commit, swaps
+  // it in at the step boundary where the runtime applies the value. ctx.params() does not change
+  // while PrepareModel runs (the runtime holds this component's other live changes).
   Status PrepareModel(const std::string& path);
   Status SwapModel();
   struct Prepared {
@@ -98,7 +98,8 @@ class Deliberator final : public Component {
   std::vector<std::array<double, 2>> history_;
   uint64_t history_fed_ = 0;
   int layers_ = 0;             // of the model in force
-  msg::ModelInfo first_info_;  // published at step 0
+  msg::ModelInfo first_info_;  // published at step 0 (unless a swap came first)
+  bool model_published_ = false;
   double budget_s_ = 0.02;
   bool stepped_ = false;  // stepped clock: no wall-time cap (see Step)
   uint64_t deadline_misses_ = 0, without_executed_ = 0, steps_ = 0;

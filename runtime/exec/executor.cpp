@@ -113,8 +113,8 @@ class Executor::ContextImpl final : public Context, public detail::ContextExtens
   void CheckLiveParam(const std::string& name, LiveParamCheck check) override {
     if (inst_->configuring) inst_->live.checks[name] = std::move(check);
   }
-  void PrepareLiveParam(const std::string& name, LiveParamCheck prepare) override {
-    if (inst_->configuring) inst_->live.prepares[name] = std::move(prepare);
+  void PrepareLiveParam(const std::string& name, LiveParamPrepare prepare, LiveParamCommit commit) override {
+    if (inst_->configuring) inst_->live.prepares[name] = {std::move(prepare), std::move(commit)};
   }
   const Clock& clock() const override { return *ex_->clock_; }
   Logger& log() override { return logger_; }

@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <exception>
+
 #include "dyad/join_list.hpp"
 #include "dyad/validate.hpp"
 #include "graph/runtime_topics.hpp"
@@ -41,24 +43,37 @@ void LiveParams::Take() {
   }
 }
 
+namespace {
+// Runs a component's preparation; a throw refuses the value instead of ending the process.
+Status RunPrepare(const Context::LiveParamPrepare& prepare, const ParamValue& value) {
+  try {
+    return prepare(value);
+  } catch (const std::exception& e) {
+    return Status::Internal(std::string("the preparation threw: ") + e.what());
+  } catch (...) {
+    return Status::Internal("the preparation threw");
+  }
+}
+}  // namespace
+
 void LiveParams::Apply(size_t index) {
   Target& target = *targets_[index];
-  Preparation& preparation = preparations_[index];
-  std::optional<msg::ParamChange> finished;
+  std::optional<Preparation> done;
   std::deque<msg::ParamChange> mine;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     Take();
+    Preparation& preparation = preparations_[index];
     if (preparation.state == Preparation::State::kRunning) return;  // the requests after it wait
     if (preparation.state == Preparation::State::kDone) {
-      finished = Finish(target, preparation);
+      done = std::move(preparation);
       preparation = {};
       prepared_.fetch_sub(1, std::memory_order_release);
     }
     mine.swap(queues_[index]);
     queued_.fetch_sub(static_cast<int>(mine.size()), std::memory_order_release);
   }
-  if (finished) Publish(std::move(*finished));
+  if (done) Publish(ApplyOrRefuse(target, *done));  // commits first: the requests below see it
   while (!mine.empty()) {
     const msg::ParamChange request = std::move(mine.front());
     mine.pop_front();
@@ -68,15 +83,15 @@ void LiveParams::Apply(size_t index) {
       continue;
     }
     if (stepped_) {  // at the boundary: the same step in every run
-      p.result = target.prepares.at(request.param_name())(p.value);
-      Publish(Finish(target, p));
+      p.result = RunPrepare(target.prepares.at(request.param_name()).prepare, p.value);
+      Publish(ApplyOrRefuse(target, p));
       continue;
     }
     std::lock_guard<std::mutex> lock(mutex_);
     queued_.fetch_add(static_cast<int>(mine.size()), std::memory_order_release);
     queues_[index].insert(queues_[index].begin(), std::make_move_iterator(mine.begin()), std::make_move_iterator(mine.end()));
     p.state = Preparation::State::kRunning;
-    preparation = std::move(p);
+    preparations_[index] = std::move(p);
     to_prepare_.push_back(index);
     if (!preparer_.joinable()) preparer_ = std::thread([this] { RunPreparations(); });
     prepare_cv_.notify_one();
@@ -88,14 +103,13 @@ void LiveParams::RunPreparations() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
     prepare_cv_.wait(lock, [this] { return stopping_ || !to_prepare_.empty(); });
-    if (to_prepare_.empty()) return;  // stopping, nothing left
+    if (stopping_) return;  // Stop() refuses what was not prepared
     const size_t index = to_prepare_.front();
     to_prepare_.pop_front();
-    // Running: only this thread touches the preparation until it is marked done.
-    Preparation& p = preparations_[index];
-    const Context::LiveParamCheck& prepare = targets_[index]->prepares.at(p.request.param_name());
+    Preparation& p = preparations_[index];  // kRunning: this thread's until marked done
+    const Context::LiveParamPrepare& prepare = targets_[index]->prepares.at(p.request.param_name()).prepare;
     lock.unlock();
-    Status result = prepare(p.value);
+    Status result = RunPrepare(prepare, p.value);
     lock.lock();
     p.result = std::move(result);
     p.state = Preparation::State::kDone;
@@ -106,16 +120,31 @@ void LiveParams::RunPreparations() {
 void LiveParams::Stop() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    stopping_ = true;
+    if (stopped_) return;
+    stopped_ = stopping_ = true;
   }
   prepare_cv_.notify_all();
   if (preparer_.joinable()) preparer_.join();
-  if (!answers_) return;  // never opened
-  for (size_t i = 0; i < preparations_.size(); ++i)
-    if (preparations_[i].state != Preparation::State::kNone) {
-      Publish(Refused(*targets_[i], preparations_[i].request, "the run stopped before the change took effect"));
+  if (!answers_ || reader_ == nullptr) return;  // never opened
+  std::vector<msg::ParamChange> answers;
+  const std::string why = "the run stopped before the change took effect";
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    Take();
+    for (size_t i = 0; i < targets_.size(); ++i) {
+      if (preparations_[i].state != Preparation::State::kNone) answers.push_back(Refused(*targets_[i], preparations_[i].request, why));
       preparations_[i] = {};
+      for (const msg::ParamChange& request : queues_[i]) {
+        Preparation unused;
+        std::optional<msg::ParamChange> get = request.op() == "get" ? Answer(*targets_[i], request, &unused) : std::nullopt;
+        answers.push_back(get ? *get : Refused(*targets_[i], request, why));
+      }
+      queues_[i].clear();
     }
+    queued_.store(0, std::memory_order_release);
+    prepared_.store(0, std::memory_order_release);
+  }
+  for (auto& a : answers) Publish(std::move(a));
 }
 
 msg::ParamChange LiveParams::Refused(Target& target, msg::ParamChange a, const std::string& why) {
@@ -164,11 +193,12 @@ std::optional<msg::ParamChange> LiveParams::Answer(Target& target, const msg::Pa
     *prepare = std::move(p);
     return std::nullopt;
   }
-  return Finish(target, p);
+  return ApplyOrRefuse(target, p);
 }
 
-// Applies a set that passed every check (and its preparation, if any) at this step boundary.
-msg::ParamChange LiveParams::Finish(Target& target, const Preparation& p) {
+// At this step boundary, on the target's step thread: applies a set that passed every check and
+// its preparation (then the component's commit), or refuses it with the preparation's error.
+msg::ParamChange LiveParams::ApplyOrRefuse(Target& target, const Preparation& p) {
   if (!p.result.ok()) return Refused(target, p.request, p.result.message());
   msg::ParamChange a = p.request;
   const std::string old = ToYamlText(target.params->values().at(p.request.param_name()));
@@ -178,6 +208,8 @@ msg::ParamChange LiveParams::Finish(Target& target, const Preparation& p) {
   a.old_value(old);
   a.value(ToYamlText(p.value));
   target.params->Set(p.request.param_name(), p.value);
+  if (auto prepared = target.prepares.find(p.request.param_name()); prepared != target.prepares.end() && prepared->second.commit)
+    prepared->second.commit(p.value);
   target.log->Info("param " + p.request.param_name() + ": " + old + " -> " + a.value() + " (" + p.request.who() + ")");
   return a;
 }

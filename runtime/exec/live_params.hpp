@@ -13,13 +13,14 @@
 // Prepared params (Context::PrepareLiveParam: a check that takes longer than a step, such as
 // loading a model): on the wall clock a set that passed the quick checks goes to one preparer
 // thread; the step thread carries on, and the first step boundary after the preparation ended
-// applies or refuses it (answered then, with that step). Requests for the same component that
-// came after it wait for it, so each component's requests are answered in the order they came.
-// Under the stepped clock the preparation runs at the boundary itself: a run is reproducible.
+// applies it and calls the component's commit, or refuses it (answered then, with that step).
+// Requests for the same component that came after it wait for it, so each component's requests
+// are answered in the order they came. Under the stepped clock the preparation runs at the
+// boundary itself: a run is reproducible. Stop() answers whatever is left: nothing goes unanswered.
 //
 // Threads: BeforeStep(i) runs on target i's step thread (several targets, several threads);
 // the request reader's callback only raises a flag. Cost when nothing is asked: three atomic
-// loads (also while a preparation runs).
+// loads. While a request waits behind a preparation, every target's boundary takes the mutex.
 #pragma once
 
 #include <atomic>
@@ -50,7 +51,11 @@ class LiveParams {
     const uint64_t* steps = nullptr;    // its steps so far
     Logger* log = nullptr;
     std::map<std::string, Context::LiveParamCheck> checks;    // CheckLiveParam()
-    std::map<std::string, Context::LiveParamCheck> prepares;  // PrepareLiveParam()
+    struct Prepared {
+      Context::LiveParamPrepare prepare;
+      Context::LiveParamCommit commit;
+    };
+    std::map<std::string, Prepared> prepares;  // PrepareLiveParam()
   };
 
   LiveParams() = default;
@@ -71,11 +76,14 @@ class LiveParams {
     Apply(index);
   }
   // When the steps have ended, before the components deactivate: waits for a preparation under
-  // way and refuses the sets not applied ("the run stopped ..."), so none goes unanswered.
+  // way (one at most is started), refuses the sets not applied ("the run stopped ...") and
+  // answers the gets still waiting, so no request goes unanswered. Idempotent; REQUIRES the
+  // transport alive the first time.
   void Stop();
 
  private:
-  // A set being prepared for one target: it passed the quick checks; `result` once done.
+  // A set being prepared for one target: it passed the quick checks; `result` once done. While
+  // kRunning only the preparer thread touches it.
   struct Preparation {
     enum class State { kNone, kRunning, kDone } state = State::kNone;
     msg::ParamChange request;
@@ -88,7 +96,7 @@ class LiveParams {
   // The answer to `request`, or nullopt when it passed the quick checks of a prepared param:
   // then `*prepare` holds it, to be prepared and then Finish()ed.
   std::optional<msg::ParamChange> Answer(Target& target, const msg::ParamChange& request, Preparation* prepare);
-  msg::ParamChange Finish(Target& target, const Preparation& p);
+  msg::ParamChange ApplyOrRefuse(Target& target, const Preparation& p);
   msg::ParamChange Refused(Target& target, msg::ParamChange answer, const std::string& why);
   void RunPreparations();  // the preparer thread
   void Publish(msg::ParamChange answer);
@@ -99,7 +107,7 @@ class LiveParams {
   std::unique_ptr<Output<msg::ParamChange>> answers_;
   std::atomic<bool> arrived_{false};
   std::atomic<int> queued_{0};
-  std::mutex mutex_;  // the reader and the queues
+  std::mutex mutex_;  // the reader, the queues, the preparations and the preparer's state
   std::vector<std::deque<msg::ParamChange>> queues_;
   std::string graph_folder_;
   bool stepped_ = false;
@@ -107,7 +115,7 @@ class LiveParams {
   std::vector<Preparation> preparations_;
   std::atomic<int> prepared_{0};
   std::deque<size_t> to_prepare_;  // target indices
-  bool stopping_ = false;
+  bool stopping_ = false, stopped_ = false;
   std::condition_variable prepare_cv_;
   std::thread preparer_;  // started by the first preparation
   std::mutex publish_mutex_;  // answers_ (its sequence numbers)

@@ -419,16 +419,20 @@ class Context {
   // value stays. The default (test fakes of Context) keeps no check.
   using LiveParamCheck = std::function<Status(const ParamValue& value)>;
   virtual void CheckLiveParam(const std::string& /*name*/, LiveParamCheck /*check*/) {}
-  // Live parameters (ABI 8). In Configure(): like CheckLiveParam, for a check that takes longer
-  // than a step allows, typically preparing what the value names (load and check a model file,
-  // build what Step() will swap in). On the wall clock it runs on a runtime thread, off the step
-  // thread, while the component keeps stepping; the value takes effect at the first step
-  // boundary after it returned OK (the answer carries that step), or is refused with its message.
-  // The component's requests that came after it wait for it (answered in order). Under the
-  // stepped clock it runs at the step boundary, so a run is reproducible. `prepare` may run
-  // concurrently with Step(): what it shares with Step() is the component's to guard; Step() sees
-  // the new value in ctx.params() only after `prepare` returned, and never mid-step.
-  virtual void PrepareLiveParam(const std::string& /*name*/, LiveParamCheck /*prepare*/) {}
+  // Live parameters (ABI 8). In Configure(): for a live param whose check takes longer than a
+  // step allows, typically preparing what the value names (load and check a model file, build
+  // what Step() will use). `prepare` runs, on the wall clock, on a runtime thread while the
+  // component keeps stepping; under the stepped clock at the step boundary (a run is
+  // reproducible). It may read ctx.params(): none of the component's live params changes while it
+  // runs (its later requests wait, answered in order). It must not throw (a throw refuses the
+  // value, saying so). Once it returned OK, the first step boundary applies the value (the answer
+  // carries that step) and calls `commit` there, on the step thread, before the next Step() (also
+  // when the value equals the old one): where the component switches to what `prepare` made. An
+  // error of `prepare` refuses the value with its message; a run that stops before the boundary
+  // refuses it too, without `commit`. What `prepare` shares with Step() is the component's to guard.
+  using LiveParamPrepare = std::function<Status(const ParamValue& value)>;
+  using LiveParamCommit = std::function<void(const ParamValue& value)>;
+  virtual void PrepareLiveParam(const std::string& /*name*/, LiveParamPrepare /*prepare*/, LiveParamCommit /*commit*/) {}
 
   // The port declared under `name` with type T. Asking for an undeclared port or another type is
   // a programming error: it aborts naming the component and port.
