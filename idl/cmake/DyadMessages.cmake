@@ -75,12 +75,13 @@ function(dyad_add_messages target)
     set(_traits_mode ROS2)
   endif()
   # fastddsgen also writes C++ for every included file (a second dyad::msg::Header): it goes to a
-  # scratch folder, and only the files of FILES are kept.
+  # scratch folder, and only the files of FILES are kept. -t: its preprocessed files go to a
+  # folder of this call's, not /tmp, where another build's fastddsgen would overwrite them.
   add_custom_command(
     OUTPUT ${_outputs}
     COMMAND ${CMAKE_COMMAND} -E rm -rf ${_scratch}
-    COMMAND ${CMAKE_COMMAND} -E make_directory ${_scratch} ${_dest_dirs}
-    COMMAND ${FASTDDSGEN} -cs -replace -d ${_scratch} ${_include_path} ${_idl_paths}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${_scratch} ${_scratch}_tmp ${_dest_dirs}
+    COMMAND ${FASTDDSGEN} -cs -replace -t ${_scratch}_tmp -d ${_scratch} ${_include_path} ${_idl_paths}
     ${_copies}
     DEPENDS ${_idl_paths}
     WORKING_DIRECTORY ${A_IDL_DIR}
