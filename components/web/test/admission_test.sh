@@ -28,6 +28,7 @@ for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
 status=0
 node "$node_dir/admission.mjs" "ws://127.0.0.1:$(cat web.port)" $experimenter $subject $viewer || status=1
 kill -INT $pid; wait $pid || true
+[ $status -eq 0 ] || { echo "the graph's log:"; tail -30 run.err; }
 grep -q "/subject?token=<params.subject_token>" run.err && grep -q "/experimenter?token=<params.token>" run.err &&
   ! grep -q s3cret run.err || { echo "FAIL: the URLs printed do not say where the tokens are, or print them"; status=1; }
 exit $status
