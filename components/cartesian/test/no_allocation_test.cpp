@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "dyad/testing/allocation_counter.hpp"
+#include "dyad/testing/fake_context.hpp"
 
 #include <cmath>
 #include <cstdlib>
@@ -30,18 +31,6 @@ class FakeLogger final : public Logger {
  public:
   void Write(Level, std::string_view m) override { lines.emplace_back(m); }
   std::vector<std::string> lines;
-};
-
-// Hands out queued commands (copied into the runtime's scratch sample).
-class CommandQueue final : public detail::ReaderEndpoint {
- public:
-  bool TakeNext(void* sample) override {
-    if (queue.empty()) return false;
-    *static_cast<msg::CartesianCommand*>(sample) = queue.front();
-    queue.pop_front();
-    return true;
-  }
-  std::deque<msg::CartesianCommand> queue;
 };
 
 class CountingWriter final : public detail::WriterEndpoint {
@@ -80,7 +69,7 @@ class FakeContext final : public Context {
 
   FakeClock time;
   FakeLogger logger;
-  CommandQueue commands;
+  dyad::testing::QueueReader<msg::CartesianCommand> commands;  // copied into the runtime's scratch sample
   CountingWriter states;
 
  protected:
@@ -293,17 +282,6 @@ class Ros2Context final : public Context {
     return c.Step(info);
   }
 
-  template <class T>
-  class Queue final : public detail::ReaderEndpoint {
-   public:
-    bool TakeNext(void* sample) override {
-      if (queue.empty()) return false;
-      *static_cast<T*>(sample) = queue.front();
-      queue.pop_front();
-      return true;
-    }
-    std::deque<T> queue;
-  };
   class Sink final : public detail::WriterEndpoint {
    public:
     Status Write(const void*) override {
@@ -314,8 +292,8 @@ class Ros2Context final : public Context {
   };
   FakeClock time;
   FakeLogger logger;
-  Queue<msg::CartesianCommand> commands;
-  Queue<geometry_msgs::msg::dds_::PoseStamped_> poses;
+  dyad::testing::QueueReader<msg::CartesianCommand> commands;
+  dyad::testing::QueueReader<geometry_msgs::msg::dds_::PoseStamped_> poses;
   Sink sink;
 
  protected:
