@@ -6,8 +6,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <sstream>
 
 #include <dyad/join_list.hpp>
