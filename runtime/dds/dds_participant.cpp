@@ -1003,6 +1003,18 @@ void ApplyQos(Q& q, const TopicQos& qos) {
     q.liveliness().announcement_period = eprosima::fastrtps::Duration_t(qos.liveliness_ms * 1e-3 / 3);
   }
 }
+
+// A guest's (kWatcher's) reliable writer keeps its last 100 samples, whatever the topic's depth.
+// Discovery is not symmetric: the guest's writer may match a graph reader (and the guest start
+// writing) a moment before that reader matches the writer; the reader then learns the writer's
+// first sequence number from its first heartbeat and asks for what it missed, which a depth-1
+// history has already dropped (`dyad bag play` lost its first sample that way in CI). Readers
+// still keep their own depth; writers with KEEP_LAST never wait for them.
+constexpr int32_t kGuestWriterDepth = 100;
+void KeepForLateMatches(fdds::DataWriterQos& q) {
+  if (q.reliability().kind == fdds::RELIABLE_RELIABILITY_QOS && q.history().kind == fdds::KEEP_LAST_HISTORY_QOS)
+    q.history().depth = std::max(q.history().depth, kGuestWriterDepth);
+}
 }  // namespace
 
 StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, const TypeInfo& type, const TopicQos& qos,
@@ -1037,6 +1049,7 @@ StatusOr<TypedWriter*> DdsParticipant::CreateWriter(const std::string& topic, co
   if (Status st = GetTopic(topic, type, qos.ros2_name); !st.ok()) return st;
   fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
   ApplyQos(wq, qos);
+  if (scope_ == Scope::kWatcher) KeepForLateMatches(wq);
   std::unique_ptr<DdsWriter> w(new DdsWriter());
   w->topic_ = topic;
   w->make_ = [this, topic, wq] { return NewWriter(topic, wq); };
@@ -1109,6 +1122,7 @@ StatusOr<SerializedWriter*> DdsParticipant::CreateSerializedWriter(const std::st
   if (Status st = GetTopic(topic, type, qos.ros2_name); !st.ok()) return st;
   fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
   ApplyQos(wq, qos);
+  if (scope_ == Scope::kWatcher) KeepForLateMatches(wq);
   std::unique_ptr<DdsSerializedWriter> w(new DdsSerializedWriter());
   w->topic_ = topic;
   w->type_ = &type;
