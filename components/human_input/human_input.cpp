@@ -9,7 +9,11 @@ void HumanSynthetic::Describe(ComponentSpec& spec) {
       .Doc("list of {start, end, primitive}: steps start..end-1 engaged tracing that primitive; sorted, not overlapping");
   spec.Param("noise_std", 0.0).Min(0).Unit("workspace units").Doc("Gaussian noise per axis while engaged (seeded)");
   spec.Param("lag", int64_t{0}).Min(0).Unit("steps").Doc("the trace runs this many steps behind the event's clock");
+  spec.Param("self_report_error", 0.0).Min(0).Max(1).Doc("probability that a self-report names another primitive (uniformly)");
+  spec.Param("self_report_delay", 1.5).Min(0).Unit("s").Doc("from a release to its self-report");
   spec.Output<msg::HumanInput>("out").Doc("position and engaged flag, one sample per step");
+  spec.Output<msg::SelfReport>("self_report").Optional().Doc(
+      "after each event's release (and the delay): the primitive the human says it drew, as a study's subject answers");
 }
 
 Status HumanSynthetic::Configure(Context& ctx) {
@@ -24,8 +28,11 @@ Status HumanSynthetic::Configure(Context& ctx) {
   o.noise_std = ctx.params().Double("noise_std");
   o.lag = ctx.params().Int("lag");
   o.seed = ctx.seed();
+  o.report_error = ctx.params().Double("self_report_error");
+  report_delay_ns_ = static_cast<int64_t>(ctx.params().Double("self_report_delay") * 1e9);
   human_ = std::make_unique<SyntheticHuman>(std::move(data.value()), std::move(events.value()), o);
   out_ = &ctx.output<msg::HumanInput>("out");
+  reports_ = &ctx.output<msg::SelfReport>("self_report");
   return Status::OK();
 }
 
@@ -34,7 +41,33 @@ Status HumanSynthetic::Step(const StepInfo& info) {
   sample_.x(s.x);
   sample_.y(s.y);
   sample_.engaged(s.engaged);
-  return out_->Publish(sample_);
+  if (Status st = out_->Publish(sample_); !st.ok()) return st;
+  QueueReports(s, info.now_ns);
+  return PublishDueReports(info.now_ns);
+}
+
+void HumanSynthetic::QueueReports(const HumanSample& s, int64_t now_ns) {
+  for (const ReleasedEvent& r : s.released) {
+    PendingReport p{.report = {}, .due_ns = now_ns + report_delay_ns_};
+    p.report.choice(r.answer);
+    p.report.segment_start_ns(r.event == segment_event_ ? segment_start_ns_ : now_ns);
+    p.report.segment_end_ns(now_ns);
+    pending_.push_back(std::move(p));
+  }
+  if (s.event >= 0 && s.event != segment_event_) {
+    segment_event_ = s.event;
+    segment_start_ns_ = now_ns;
+  }
+}
+
+Status HumanSynthetic::PublishDueReports(int64_t now_ns) {
+  while (!pending_.empty() && pending_.front().due_ns <= now_ns) {
+    msg::SelfReport& r = pending_.front().report;
+    r.response_s(static_cast<double>(now_ns - r.segment_end_ns()) * 1e-9);
+    if (Status st = reports_->Publish(r); !st.ok()) return st;
+    pending_.pop_front();
+  }
+  return Status::OK();
 }
 
 void HumanReplay::Describe(ComponentSpec& spec) {

@@ -18,9 +18,10 @@ struct WriterState {
 };
 
 // Topics that carry events, not a stream: dyad/health, and these types (a live param's answer,
-// the deliberator's model at start and at each swap).
+// the deliberator's model at start and at each swap, a person's answer after a release).
 bool CarriesEvents(const std::string& topic, const std::string& type) {
-  return topic == "dyad/health" || type == "dyad::msg::ParamChange" || type == "dyad::msg::ModelInfo";
+  return topic == "dyad/health" || type == "dyad::msg::ParamChange" || type == "dyad::msg::ModelInfo" ||
+         type == "dyad::msg::SelfReport";
 }
 
 const std::string* FieldValue(const std::vector<cdr::Field>& fields, const char* path) {

@@ -6,7 +6,11 @@ namespace dyad::human_input {
 
 SyntheticHuman::SyntheticHuman(pvrnn::Dataset data, std::vector<InterventionEvent> events,
                                const SyntheticHumanOptions& options)
-    : data_(std::move(data)), events_(std::move(events)), options_(options), rng_(options.seed) {
+    : data_(std::move(data)),
+      events_(std::move(events)),
+      options_(options),
+      rng_(options.seed),
+      answers_(options.seed ^ 0x5e1f'4e90'7b3c'11d5ULL) {
   if (!events_.empty()) {
     const Eigen::MatrixXd& first = data_.sequences[static_cast<size_t>(events_.front().primitive)];
     last_x_ = first(0, 0);
@@ -15,8 +19,8 @@ SyntheticHuman::SyntheticHuman(pvrnn::Dataset data, std::vector<InterventionEven
 }
 
 HumanSample SyntheticHuman::Step(int64_t k) {
-  while (next_event_ < events_.size() && events_[next_event_].end <= k) ++next_event_;
   HumanSample s;
+  while (next_event_ < events_.size() && events_[next_event_].end <= k) s.released.push_back(Release(next_event_++));
   if (next_event_ < events_.size() && events_[next_event_].start <= k) {
     const InterventionEvent& e = events_[next_event_];
     const Eigen::MatrixXd& seq = data_.sequences[static_cast<size_t>(e.primitive)];
@@ -36,6 +40,19 @@ HumanSample SyntheticHuman::Step(int64_t k) {
     s.y = last_y_;
   }
   return s;
+}
+
+ReleasedEvent SyntheticHuman::Release(size_t event) {
+  ReleasedEvent r;
+  r.event = static_cast<int>(event);
+  r.primitive = events_[event].primitive;
+  r.answer = r.primitive;
+  const int n = data_.size();
+  if (n > 1 && std::uniform_real_distribution<double>(0.0, 1.0)(answers_) < options_.report_error) {
+    const int other = std::uniform_int_distribution<int>(0, n - 2)(answers_);  // one of the n - 1 others
+    r.answer = other < r.primitive ? other : other + 1;
+  }
+  return r;
 }
 
 }  // namespace dyad::human_input

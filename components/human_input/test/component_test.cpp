@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "dyad/pvrnn/analytic_dataset.hpp"
+#include "dyad/testing/csv.hpp"
 #include "dyad/testing/fake_context.hpp"
 #include "human_input.hpp"
 
@@ -60,6 +61,35 @@ TEST(HumanSyntheticComponent, PublishesTheTraceOfTheDataSetDuringEvents) {
   EXPECT_EQ(s[19].header().sequence_number(), 20u);
 }
 
+// Steps are 100 ms apart: event 5..14 is released at step 15 (1.5 s); with a delay of 0.25 s its
+// self-report comes at the first step from 1.75 s on (step 18: a response of 0.3 s).
+TEST(HumanSyntheticComponent, ReportsWhatItDrewAfterEachReleaseWithTheSegmentsTimes) {
+  testing::FakeContext ctx(&HumanSynthetic::Describe,
+                           {{"dataset", AnalyticDir()},
+                            {"events", std::string("[{start: 5, end: 15, primitive: 3}, {start: 30, end: 40, primitive: 1}]")},
+                            {"self_report_delay", 0.25}});
+  ctx.Capture<msg::HumanInput>("out");
+  auto& reports = ctx.Capture<msg::SelfReport>("self_report");
+  HumanSynthetic c;
+  ASSERT_TRUE(c.Configure(ctx).ok());
+  std::vector<uint64_t> published_at;
+  for (uint64_t k = 0; k < 45; ++k) {
+    const size_t before = reports.samples.size();
+    ASSERT_TRUE(c.Step({.now_ns = static_cast<int64_t>(k) * 100'000'000LL, .index = k}).ok());
+    if (reports.samples.size() > before) published_at.push_back(k);
+  }
+  ASSERT_EQ(reports.samples.size(), 2u);
+  EXPECT_EQ(published_at, (std::vector<uint64_t>{18, 43}));
+  const msg::SelfReport& r = reports.samples[0];
+  EXPECT_EQ(r.choice(), 3);
+  EXPECT_EQ(r.segment_start_ns(), 500'000'000LL);
+  EXPECT_EQ(r.segment_end_ns(), 1'500'000'000LL);
+  EXPECT_NEAR(r.response_s(), 0.3, 1e-12);
+  EXPECT_EQ(reports.samples[1].choice(), 1);
+  EXPECT_EQ(reports.samples[1].segment_start_ns(), 3'000'000'000LL);
+  EXPECT_EQ(reports.samples[1].header().sequence_number(), 2u);
+}
+
 TEST(HumanSyntheticComponent, SameSeedSameTrackOtherSeedOtherNoise) {
   const std::string ev = "[{start: 0, end: 50, primitive: 1}]";
   const auto a = RunSynthetic(ev, 1.0, 2, 11, 50), b = RunSynthetic(ev, 1.0, 2, 11, 50), c = RunSynthetic(ev, 1.0, 2, 12, 50);
@@ -107,10 +137,10 @@ TEST(HumanReplayComponent, PublishesOneRowPerStepAndStopsAtTheEnd) {
 
 // `dyad run` with the plugin found by type name: replay ends the run by itself; a synthetic human
 // with bad events stops it before the first step with the event named.
-int RunDyad(const fs::path& dir, const std::string& graph, std::string* err) {
+int RunDyad(const fs::path& dir, const std::string& graph, std::string* err, const std::string& args = "") {
   const fs::path g = dir / "g.yaml", e = dir / "err.txt";
   std::ofstream(g) << graph;
-  const std::string cmd = std::string(DYAD_EXE) + " run " + g.string() + " --quiet > /dev/null 2> " + e.string();
+  const std::string cmd = std::string(DYAD_EXE) + " run " + g.string() + " --quiet " + args + " > /dev/null 2> " + e.string();
   const int rc = std::system(cmd.c_str());
   std::ifstream in(e);
   err->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
@@ -141,6 +171,34 @@ TEST(HumanInputPlugin, LoadsByTypeNameAndRunsInDyad) {
                     &err),
             0);
   EXPECT_NE(err.find("events[0].primitive = 9"), std::string::npos) << err;
+}
+
+// A stepped rehearsal at 10 Hz: the event of steps 2..9 is released at step 10 (1.0 s) and
+// answered 0.3 s later; the graph's recorder keeps the answer, read back through
+// `dyad bag export --csv`.
+TEST(HumanInputPlugin, ARecorderKeepsTheSelfReportsOfARun) {
+  const fs::path dir = TempDir("self_report");
+  const fs::path mcap = dir / "run.mcap", csv = dir / "csv";
+  std::string err;
+  ASSERT_EQ(RunDyad(dir,
+                    "graph: rehearsal\nclock: stepped\ndomain_id: " + std::to_string(dyad::testing::DomainForThisProcess()) +
+                        "\ncomponents:\n"
+                        "  synth: {type: human_synthetic, rate_hz: 10, params: {dataset: " + AnalyticDir() +
+                        ", events: [{start: 2, end: 10, primitive: 4}], self_report_delay: 0.3},\n"
+                        "          outputs: {out: human/input, self_report: human/self_report}}\n"
+                        "  rec: {type: recorder, rate_hz: 10, params: {file: " + mcap.string() + ", topics: [human/self_report]}}\n",
+                    &err, "--steps 20"),
+            0)
+      << err;
+  const std::string cmd = std::string(DYAD_EXE) + " bag export " + mcap.string() + " --csv " + csv.string() + " > /dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const auto rows = dyad::testing::ReadCsv(csv / "human_self_report.csv");
+  ASSERT_EQ(rows.size(), 1u) << "in " << csv;
+  EXPECT_EQ(rows[0].at("choice"), "4");
+  EXPECT_EQ(rows[0].at("segment_start_ns"), "200000000");
+  EXPECT_EQ(rows[0].at("segment_end_ns"), "1000000000");
+  EXPECT_NEAR(std::stod(rows[0].at("response_s")), 0.3, 1e-9);
+  EXPECT_EQ(rows[0].at("header.source"), "synth");
 }
 
 }  // namespace

@@ -1,5 +1,8 @@
-// The scripted human: tracing, disengagement, lag, noise determinism.
+// The scripted human: tracing, disengagement, lag, noise determinism, self-reports.
 #include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
 
 #include "dyad/human_input/synthetic_human.hpp"
 
@@ -87,6 +90,66 @@ TEST(SyntheticHuman, NoiseIsDeterministicPerSeedWithTheRequestedSpread) {
   for (double d : a) v += (d - m) * (d - m);
   EXPECT_NEAR(std::sqrt(v / a.size()), 2.0, 0.1);
   EXPECT_NEAR(m, 0.0, 0.15);
+}
+
+// Seven primitives (as the study's data set has) of 4 steps each.
+pvrnn::Dataset Seven() {
+  pvrnn::Dataset d;
+  for (int p = 0; p < 7; ++p) d.sequences.push_back(Eigen::MatrixXd::Constant(2, 4, p));
+  return d;
+}
+
+TEST(SyntheticHuman, ReleasesEachEventAtItsEndAndReportsItsPrimitive) {
+  // Back to back: event 1 ends where event 2 starts, at step 16.
+  SyntheticHuman h(Tiny(), {{3, 9, 1}, {12, 16, 0}, {16, 18, 1}}, {});
+  std::vector<std::pair<int64_t, ReleasedEvent>> released;
+  for (int64_t k = 0; k < 25; ++k)
+    for (const ReleasedEvent& r : h.Step(k).released) released.push_back({k, r});
+  ASSERT_EQ(released.size(), 3u);
+  const std::vector<std::array<int64_t, 4>> want = {{9, 0, 1, 1}, {16, 1, 0, 0}, {18, 2, 1, 1}};  // step, event, truth, answer
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(released[i].first, want[i][0]) << i;
+    EXPECT_EQ(released[i].second.event, want[i][1]) << i;
+    EXPECT_EQ(released[i].second.primitive, want[i][2]) << i;
+    EXPECT_EQ(released[i].second.answer, want[i][3]) << i;
+  }
+}
+
+// 4000 one-step events: the wrong answers' share is the configured probability (within 4 standard
+// deviations of the binomial), a wrong answer is never the truth, and the six others are about
+// equally likely.
+TEST(SyntheticHuman, WrongSelfReportsComeAtTheConfiguredRateSpreadOverTheOtherPrimitives) {
+  std::vector<InterventionEvent> events;
+  for (int i = 0; i < 4000; ++i) events.push_back({2 * i, 2 * i + 1, i % 7});
+  for (const double p : {0.0, 0.2, 1.0}) {
+    SyntheticHuman h(Seven(), events, {.noise_std = 0, .lag = 0, .seed = 3, .report_error = p});
+    int reports = 0, wrong = 0;
+    std::array<int, 7> offset{};  // (answer - truth) mod 7 of the wrong answers
+    for (int64_t k = 0; k <= 8000; ++k)
+      for (const ReleasedEvent& r : h.Step(k).released) {
+        ++reports;
+        if (r.answer == r.primitive) continue;
+        ++wrong;
+        ASSERT_GE(r.answer, 0);
+        ASSERT_LT(r.answer, 7);
+        ++offset[static_cast<size_t>((r.answer - r.primitive + 7) % 7)];
+      }
+    ASSERT_EQ(reports, 4000);
+    EXPECT_NEAR(wrong / 4000.0, p, 4 * std::sqrt(p * (1 - p) / 4000)) << p;
+    EXPECT_EQ(offset[0], 0);
+    for (int o = 1; o < 7 && wrong > 0; ++o) EXPECT_NEAR(offset[static_cast<size_t>(o)], wrong / 6.0, wrong / 6.0 * 0.3) << p << " offset " << o;
+  }
+}
+
+TEST(SyntheticHuman, AskingForWrongReportsLeavesTheTrackAsItWas) {
+  SyntheticHuman a(Tiny(), Events(), {.noise_std = 1.0, .lag = 1, .seed = 9});
+  SyntheticHuman b(Tiny(), Events(), {.noise_std = 1.0, .lag = 1, .seed = 9, .report_error = 0.7});
+  for (int64_t k = 0; k < 40; ++k) {
+    const HumanSample x = a.Step(k), y = b.Step(k);
+    EXPECT_EQ(x.x, y.x) << k;
+    EXPECT_EQ(x.y, y.y) << k;
+    EXPECT_EQ(x.released.size(), y.released.size()) << k;
+  }
 }
 
 }  // namespace
