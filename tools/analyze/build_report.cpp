@@ -24,7 +24,7 @@ StatusOr<Report> BuildReport(const std::string& recording, std::ostream& warning
       !folder.empty() && !report.plan.dataset.empty() && std::filesystem::path(report.plan.dataset).is_relative())
     report.plan.dataset = (std::filesystem::path(folder) / report.plan.dataset).lexically_normal().string();
   auto tables = ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels",
-                                     "dyad/clock_offsets", "dyad/params"});
+                                     "dyad/clock_offsets", "dyad/params", "human/self_report"});
   if (!tables.ok()) return tables.status();
   auto corrections = ClockCorrections(*tables, report.plan);
   if (!corrections.ok()) return corrections.status().WithContext(recording);
@@ -36,9 +36,13 @@ StatusOr<Report> BuildReport(const std::string& recording, std::ostream& warning
   report.param_changes = std::move(*changes);
   if (auto losses = bag::FindLosses(*reader); losses.ok()) report.transport = bag::FormatLosses(*losses);
   else warnings << "dyad analyze: " << recording << ": losses not read: " << losses.status().message() << "\n";
-  const auto events = Events(report.timeline, report.plan);
+  auto events = Events(report.timeline, report.plan);
+  auto reports = SelfReports(*tables, report.plan, report.timeline);
+  if (!reports.ok()) return reports.status().WithContext(recording);
+  AttachSelfReports(*reports, &events);
   report.events = SummariseEvents(report.timeline, events);
   report.confusion = HumanConfusion(report.timeline, events);
+  report.reported_confusion = ReportedConfusion(report.timeline, events);
   return report;
 }
 

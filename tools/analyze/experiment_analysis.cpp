@@ -306,6 +306,53 @@ StatusOr<std::vector<ParamChangeEvent>> AppliedParamChanges(const std::map<std::
   return out;
 }
 
+StatusOr<std::vector<SelfReportEvent>> SelfReports(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
+                                                   const Timeline& timeline) {
+  std::vector<SelfReportEvent> out;
+  auto it = tables.find("human/self_report");
+  if (it == tables.end()) return out;
+  Cells cells("human/self_report", it->second);
+  if (Status s = cells.Need({"header.source", "choice", "response_s", "segment_start_ns", "segment_end_ns"}); !s.ok()) return s;
+  auto writer = [&](size_t r) {
+    auto p = plan.process_of.find(cells.Text(r, "header.source"));
+    return p == plan.process_of.end() ? std::string() : p->second;
+  };
+  std::optional<int64_t> t0 = timeline.t0_ns;
+  for (size_t r = 0; r < it->second.size(); ++r) {
+    auto start = cells.Number(r, "segment_start_ns");
+    if (!start.ok()) return start.status();
+    auto end = cells.Number(r, "segment_end_ns");
+    if (!end.ok()) return end.status();
+    auto choice = cells.Number(r, "choice");
+    if (!choice.ok()) return choice.status();
+    auto response = cells.Number(r, "response_s");
+    if (!response.ok()) return response.status();
+    const double from = OnRecorderClock(timeline.clock_corrections_ns, writer(r), *start);
+    if (!t0) t0 = static_cast<int64_t>(from);
+    SelfReportEvent e;
+    e.start_step = StepOf(from, *t0, plan.period_ns);
+    e.end_step = StepOf(OnRecorderClock(timeline.clock_corrections_ns, writer(r), *end), *t0, plan.period_ns);
+    e.choice = static_cast<int>(*choice);
+    e.response_s = *response;
+    out.push_back(e);
+  }
+  return out;
+}
+
+void AttachSelfReports(const std::vector<SelfReportEvent>& reports, std::vector<PlannedEvent>* events) {
+  for (const SelfReportEvent& r : reports) {
+    PlannedEvent* best = nullptr;
+    int64_t best_overlap = 0;
+    for (PlannedEvent& e : *events) {
+      const int64_t overlap = std::min(e.end_step, r.end_step) - std::max(e.start_step, r.start_step);
+      if (overlap > best_overlap) best = &e, best_overlap = overlap;
+    }
+    if (best == nullptr || best->reported != kNotReported) continue;
+    best->reported = r.choice;
+    if (best->primitive < 0 && r.choice >= 0) best->primitive = r.choice;
+  }
+}
+
 int MostLikelyClass(const std::vector<double>& p) {
   if (p.empty()) return -1;
   return static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin());
@@ -369,23 +416,36 @@ std::vector<EventSummary> SummariseEvents(const Timeline& timeline, const std::v
   return out;
 }
 
-std::vector<std::vector<int64_t>> HumanConfusion(const Timeline& timeline, const std::vector<PlannedEvent>& events) {
+namespace {
+// counts[truth(e)][argmax p_human] over the labelled steps of events whose truth is a class.
+template <class Truth>
+std::vector<std::vector<int64_t>> Confusion(const Timeline& timeline, const std::vector<PlannedEvent>& events, Truth truth) {
   std::vector<std::vector<int64_t>> counts;
   if (timeline.classes == 0) return counts;
   counts.assign(timeline.classes, std::vector<int64_t>(timeline.classes, 0));
   bool any = false;
   for (const PlannedEvent& e : events) {
-    if (e.primitive < 0 || e.primitive >= timeline.classes) continue;
+    const int row = truth(e);
+    if (row < 0 || row >= timeline.classes) continue;
     const int64_t end = std::min<int64_t>(e.end_step, static_cast<int64_t>(timeline.steps.size()));
     for (int64_t t = std::max<int64_t>(e.start_step, 0); t < end; ++t) {
       const int predicted = MostLikelyClass(timeline.steps[t].p_human);
       if (predicted < 0 || predicted >= timeline.classes) continue;
-      ++counts[e.primitive][predicted];
+      ++counts[row][predicted];
       any = true;
     }
   }
   if (!any) counts.clear();
   return counts;
+}
+}  // namespace
+
+std::vector<std::vector<int64_t>> HumanConfusion(const Timeline& timeline, const std::vector<PlannedEvent>& events) {
+  return Confusion(timeline, events, [](const PlannedEvent& e) { return e.primitive; });
+}
+
+std::vector<std::vector<int64_t>> ReportedConfusion(const Timeline& timeline, const std::vector<PlannedEvent>& events) {
+  return Confusion(timeline, events, [](const PlannedEvent& e) { return e.reported; });
 }
 
 }  // namespace dyad::analyze

@@ -32,10 +32,14 @@
 
 namespace dyad::analyze {
 
+// An event's self-report when it has none (a SelfReport's choice -1 is "something else").
+constexpr int kNotReported = -2;
+
 struct PlannedEvent {
   int64_t start_step = 0;  // first engaged step
   int64_t end_step = 0;    // one past the last
   int primitive = -1;      // traced primitive; -1 unknown
+  int reported = kNotReported;  // what the person said they drew (AttachSelfReports)
 };
 
 // What the graph YAML says about the experiment; every field has a usable default.
@@ -106,6 +110,25 @@ StatusOr<std::vector<ParamChangeEvent>> AppliedParamChanges(const std::map<std::
 // ended before it), one running past it ends there.
 std::vector<PlannedEvent> Events(const Timeline& timeline, const ExperimentPlan& plan);
 
+// A person's answer after a release (idl/human.idl SelfReport, topic human/self_report), its
+// segment on the timeline's grid as AppliedParamChanges places stamps (the writer's process is
+// that of the component header.source names).
+struct SelfReportEvent {
+  int64_t start_step = 0;  // the segment's first engaged step
+  int64_t end_step = 0;    // its release
+  int choice = -1;         // a primitive; -1: "something else"
+  double response_s = 0;
+};
+// No human/self_report: empty. Fails (DataLoss) on a table without SelfReport's fields or with a
+// cell that is not a number.
+StatusOr<std::vector<SelfReportEvent>> SelfReports(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
+                                                   const Timeline& timeline);
+
+// Gives each report to the event its segment overlaps most (the earlier on ties; a report that
+// overlaps none is left out, and an event keeps its first report). An event of unknown primitive
+// (a person's) takes a reported primitive as its primitive: what the observer is judged against.
+void AttachSelfReports(const std::vector<SelfReportEvent>& reports, std::vector<PlannedEvent>* events);
+
 // Index of the largest probability (the first on ties); -1 for an empty vector (no label).
 int MostLikelyClass(const std::vector<double>& p);
 
@@ -124,5 +147,8 @@ std::vector<EventSummary> SummariseEvents(const Timeline& timeline, const std::v
 // Confusion of the observer on the human's traces: counts[true primitive][argmax p_human] over
 // the labelled steps of events with a known primitive. Empty when there are none.
 std::vector<std::vector<int64_t>> HumanConfusion(const Timeline& timeline, const std::vector<PlannedEvent>& events);
+// The same against what the person said: counts[reported primitive][argmax p_human] over the
+// labelled steps of events with a reported primitive ("something else" is left out).
+std::vector<std::vector<int64_t>> ReportedConfusion(const Timeline& timeline, const std::vector<PlannedEvent>& events);
 
 }  // namespace dyad::analyze

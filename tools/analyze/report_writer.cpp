@@ -29,20 +29,21 @@ Status WriteFile(const std::string& path, const std::string& text) {
 std::string EventsCsv(const Report& r) {
   std::ostringstream s;
   s << "event,start_step,end_step,primitive,mean_congruence,final_congruence,human_accuracy,robot_follows,"
-       "robot_switch_after\n";
+       "robot_switch_after,self_report\n";
   for (const EventSummary& e : r.events) {
     s << e.index << ',' << e.event.start_step << ',' << e.event.end_step << ',' << e.event.primitive << ','
       << Num(e.mean_congruence, 6) << ',' << Num(e.final_congruence, 6) << ',' << Num(e.human_accuracy, 6) << ','
-      << Num(e.robot_follows, 6) << ',' << e.robot_switch_after << '\n';
+      << Num(e.robot_follows, 6) << ',' << e.robot_switch_after << ','
+      << (e.event.reported == kNotReported ? std::string() : std::to_string(e.event.reported)) << '\n';
   }
   return s.str();
 }
 
-std::string ConfusionCsv(const Report& r) {
+std::string ConfusionCsv(const std::vector<std::vector<int64_t>>& m) {
   std::ostringstream s;
   s << "true,predicted,count\n";
-  for (size_t t = 0; t < r.confusion.size(); ++t) {
-    for (size_t p = 0; p < r.confusion[t].size(); ++p) s << t << ',' << p << ',' << r.confusion[t][p] << '\n';
+  for (size_t t = 0; t < m.size(); ++t) {
+    for (size_t p = 0; p < m[t].size(); ++p) s << t << ',' << p << ',' << m[t][p] << '\n';
   }
   return s.str();
 }
@@ -192,6 +193,15 @@ void SummarySection(const Report& r, std::ostream& s) {
   if (!r.transport.empty()) s << "\n## Transport: what the recording lost, what the runtime healed\n\n```\n" << r.transport << "```\n";
 }
 
+// The event's primitive, and what the person said when it differs: "3", "3 (said 5)",
+// "3 (said: something else)"; "unknown" when neither the plan nor a self-report names it.
+std::string PrimitiveCell(const PlannedEvent& e) {
+  std::string cell = e.primitive < 0 ? std::string("unknown") : std::to_string(e.primitive);
+  if (e.reported == -1) cell += " (said: something else)";
+  else if (e.reported >= 0 && e.reported != e.primitive) cell += " (said " + std::to_string(e.reported) + ")";
+  return cell;
+}
+
 void EventsSection(const Report& r, std::ostream& s) {
   s << "\n## Events\n\n";
   if (r.events.empty()) {
@@ -206,7 +216,7 @@ void EventsSection(const Report& r, std::ostream& s) {
         if (p.start_step == e.event.start_step && p.end_step > e.event.end_step)
           cut = " (cut off by the end of the recording; planned to " + std::to_string(p.end_step - 1) + ")";
       s << "| " << e.index << " | " << e.event.start_step << "-" << e.event.end_step - 1 << cut << " | "
-        << (e.event.primitive < 0 ? std::string("?") : std::to_string(e.event.primitive)) << " | "
+        << PrimitiveCell(e.event) << " | "
         << Num(e.mean_congruence) << " | " << Num(e.final_congruence) << " | " << Num(e.human_accuracy) << " | "
         << Num(e.robot_follows) << " | "
         << (e.robot_switch_after < 0 ? std::string("never") : std::to_string(e.robot_switch_after) + " steps")
@@ -219,26 +229,37 @@ void EventsSection(const Report& r, std::ostream& s) {
   }
 }
 
+// A row-normalised confusion matrix as a markdown table (rows with no count left out).
+void ConfusionTable(const std::vector<std::vector<int64_t>>& m, std::ostream& s) {
+  s << "|   |";
+  for (size_t p = 0; p < m.size(); ++p) s << ' ' << p << " |";
+  s << "\n|---|";
+  for (size_t p = 0; p < m.size(); ++p) s << "---|";
+  s << "\n";
+  for (size_t t = 0; t < m.size(); ++t) {
+    int64_t total = 0;
+    for (int64_t c : m[t]) total += c;
+    if (total == 0) continue;
+    s << "| **" << t << "** |";
+    for (int64_t c : m[t]) s << ' ' << Num(static_cast<double>(c) / static_cast<double>(total), 2) << " |";
+    s << "\n";
+  }
+}
+
 void ConfusionSection(const Report& r, std::ostream& s) {
   s << "## Observer confusion on the human's traces\n\n";
   if (r.confusion.empty()) {
     s << "Not available: the recording has no observer labels during events with a known primitive.\n";
   } else {
     s << "Rows: primitive the human traced; columns: the observer's most likely class; row-normalised "
-         "(counts in confusion.csv).\n\n|   |";
-    for (size_t p = 0; p < r.confusion.size(); ++p) s << ' ' << p << " |";
-    s << "\n|---|";
-    for (size_t p = 0; p < r.confusion.size(); ++p) s << "---|";
-    s << "\n";
-    for (size_t t = 0; t < r.confusion.size(); ++t) {
-      int64_t total = 0;
-      for (int64_t c : r.confusion[t]) total += c;
-      if (total == 0) continue;
-      s << "| **" << t << "** |";
-      for (int64_t c : r.confusion[t]) s << ' ' << Num(static_cast<double>(c) / static_cast<double>(total), 2) << " |";
-      s << "\n";
-    }
+         "(counts in confusion.csv).\n\n";
+    ConfusionTable(r.confusion, s);
   }
+  if (r.reported_confusion.empty()) return;
+  s << "\n## Observer confusion against the self-reports\n\n"
+       "Rows: the primitive the person said they drew when they released; columns: the observer's most likely "
+       "class over that event's steps; row-normalised (counts in reported_confusion.csv).\n\n";
+  ConfusionTable(r.reported_confusion, s);
 }
 
 }  // namespace
@@ -288,11 +309,17 @@ Status WriteReport(const Report& r, const std::string& dir) {
   std::filesystem::create_directories(dir, ec);
   if (ec) return Status::IOError(dir, "cannot create the report folder: " + ec.message());
   const std::pair<const char*, std::string> files[] = {
-      {"report.md", FormatMarkdown(r)}, {"events.csv", EventsCsv(r)},     {"confusion.csv", ConfusionCsv(r)},
+      {"report.md", FormatMarkdown(r)}, {"events.csv", EventsCsv(r)},     {"confusion.csv", ConfusionCsv(r.confusion)},
       {"timeline.csv", TimelineCsv(r)}, {"graph.yaml", r.graph_yaml},    {"metrics.json", MetricsJson(r)},
   };
   for (const auto& [name, text] : files) {
     if (Status s = WriteFile(dir + "/" + name, text); !s.ok()) return s;
+  }
+  const std::string reported = dir + "/reported_confusion.csv";  // as params.csv below: no stale one
+  if (!r.reported_confusion.empty()) {
+    if (Status s = WriteFile(reported, ConfusionCsv(r.reported_confusion)); !s.ok()) return s;
+  } else {
+    std::filesystem::remove(reported, ec);
   }
   // The plots draw whatever params.csv the folder holds: one of an earlier report must go.
   const std::string params = dir + "/params.csv";

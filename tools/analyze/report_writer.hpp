@@ -28,6 +28,7 @@ struct Report {
   Timeline timeline;
   std::vector<EventSummary> events;
   std::vector<std::vector<int64_t>> confusion;
+  std::vector<std::vector<int64_t>> reported_confusion;  // against the self-reports; empty: none
   std::vector<ParamChangeEvent> param_changes;  // applied during the run, in recording order
   // What the recording lost in transport and what the runtime healed: `dyad bag info`'s losses:
   // and health: sections (tools/bag/losses.hpp); empty: not read.

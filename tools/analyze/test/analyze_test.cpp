@@ -3,10 +3,13 @@
 // same step grid; the CLI's report folder (PNG files checked by their magic bytes) and its errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
@@ -34,6 +37,13 @@ std::string TempPath(const std::string& name) {
   std::string path = ::testing::TempDir() + "dyad_analyze_" + info->name() + "_" + name;
   std::filesystem::remove_all(path);
   return path;
+}
+
+std::vector<std::string> Lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
 }
 
 const char* kGraph = R"(graph: unit
@@ -85,8 +95,10 @@ std::vector<double> OneHot(int k, int n = 7) {
 // 40 steps. Human engaged during the graph's two events. Observer: the human's class is right
 // except at steps 12 and 13 (says 3); the robot's class is 1 until step 15, then 2 until 25,
 // then 1. Congruence = step / 100.
+// `reports`: self-reports {first step, release step, choice} written 2 steps after the release.
 std::string WriteExperiment(const std::string& path, bool with_observer = true,
-                            const std::map<std::string, std::string>& graph = {{"yaml", kGraph}}) {
+                            const std::map<std::string, std::string>& graph = {{"yaml", kGraph}},
+                            const std::vector<std::array<int64_t, 3>>& reports = {}) {
   auto writer = mcap::Writer::Open(path);
   EXPECT_TRUE(writer.ok());
   EXPECT_TRUE(writer->AddMetadata("dyad.graph", graph).ok());
@@ -94,7 +106,19 @@ std::string WriteExperiment(const std::string& path, bool with_observer = true,
   Channel<msg::Intention> robot(*writer, "robot/intention");
   Channel<msg::CartesianState> state(*writer, "robot/state");
   Channel<msg::IntentionLabel> labels(*writer, "observer/labels");
+  std::optional<Channel<msg::SelfReport>> said;
+  if (!reports.empty()) said.emplace(*writer, "human/self_report");
   for (int t = 0; t < 40; ++t) {
+    for (const auto& [first, release, choice] : reports) {
+      if (release + 2 != t) continue;
+      msg::SelfReport r;
+      r.header().source("human");
+      r.choice(static_cast<int32_t>(choice));
+      r.response_s(0.2);
+      r.segment_start_ns(1'000'000'000 + first * kPeriod);
+      r.segment_end_ns(1'000'000'000 + release * kPeriod);
+      said->Write(r, t);
+    }
     const bool engaged = (t >= 10 && t < 20) || (t >= 30 && t < 34);
     msg::HumanInput h; h.x(t); h.y(-t); h.engaged(engaged);
     human.Write(h, t);
@@ -297,10 +321,59 @@ TEST(Analyze, AnInteractiveRunHasItsEngagedRunsAsEventsAndSaysWhatWasNotRecorded
   EXPECT_EQ(events[1].primitive, -1);
   r.events = SummariseEvents(r.timeline, events);
   const std::string md = FormatMarkdown(r);
-  EXPECT_NE(md.find("| 1 | 20-22 | ? |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 1 | 20-22 | unknown |"), std::string::npos) << md;
   EXPECT_NE(md.find("- N-ELBO: not recorded"), std::string::npos) << md;
   EXPECT_NE(md.find("- deliberation time per step: not recorded"), std::string::npos) << md;
   EXPECT_EQ(md.find("mean , median"), std::string::npos) << md;
+}
+
+// The synthetic human's two events (steps 10..19 primitive 2, 30..33 primitive 5), reported as
+// 2 and, wrongly, 4: each event keeps its traced primitive and gets its report; the observer is
+// judged against the reports in a second matrix (event 1's 4 steps, all classified 5, in row 4).
+TEST(Analyze, SelfReportsJoinTheirEventsAndJudgeTheObserverInASecondMatrix) {
+  const std::string path = WriteExperiment(TempPath("s.mcap"), true, {{"yaml", kGraph}}, {{10, 20, 2}, {30, 34, 4}});
+  std::ostringstream warnings;
+  auto r = BuildReport(path, warnings);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->events.size(), 2u);
+  EXPECT_EQ(r->events[0].event.primitive, 2);
+  EXPECT_EQ(r->events[0].event.reported, 2);
+  EXPECT_EQ(r->events[1].event.primitive, 5);
+  EXPECT_EQ(r->events[1].event.reported, 4);
+  EXPECT_EQ(r->confusion[5][5], 4);
+  ASSERT_EQ(r->reported_confusion.size(), 7u);
+  EXPECT_EQ(r->reported_confusion[2][2], 8);
+  EXPECT_EQ(r->reported_confusion[2][3], 2);
+  EXPECT_EQ(r->reported_confusion[4][5], 4);
+  EXPECT_EQ(r->reported_confusion[5][5], 0);
+  const std::string md = FormatMarkdown(*r);
+  EXPECT_NE(md.find("| 1 | 30-33 | 5 (said 4) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("## Observer confusion against the self-reports"), std::string::npos) << md;
+  EXPECT_NE(md.find("| **4** | 0.00 | 0.00 | 0.00 | 0.00 | 0.00 | 1.00 | 0.00 |"), std::string::npos) << md;
+  const std::string dir = TempPath("s_report");
+  ASSERT_TRUE(WriteReport(*r, dir).ok());
+  const auto events = Lines(dir + "/events.csv");
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[0].substr(events[0].rfind(',') + 1), "self_report");
+  EXPECT_EQ(events[2].substr(events[2].rfind(',') + 1), "4");
+  const auto counts = Lines(dir + "/reported_confusion.csv");
+  EXPECT_NE(std::find(counts.begin(), counts.end(), "4,5,4"), counts.end());
+}
+
+// A person (no planned events): the engaged runs are the events and what the person said is their
+// primitive; "something else" leaves it unknown.
+TEST(Analyze, APersonsSelfReportsNameTheirEngagedRuns) {
+  const std::string path = WriteExperiment(TempPath("p.mcap"), true, {{"yaml", "graph: unit\nclock: stepped\n"}}, {{10, 20, 2}, {30, 34, -1}});
+  std::ostringstream warnings;
+  auto r = BuildReport(path, warnings);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->events.size(), 2u);
+  EXPECT_EQ(r->events[0].event.primitive, 2);
+  EXPECT_NEAR(r->events[0].human_accuracy, 0.8, 1e-12);
+  EXPECT_EQ(r->events[1].event.primitive, -1);
+  EXPECT_EQ(r->events[1].event.reported, -1);
+  const std::string md = FormatMarkdown(*r);
+  EXPECT_NE(md.find("| 1 | 30-33 | unknown (said: something else) |"), std::string::npos) << md;
 }
 
 TEST(Analyze, WithoutObserverTheReportSaysWhatIsMissing) {
@@ -431,13 +504,6 @@ std::string WriteParamChanges(const std::string& path) {
   }
   EXPECT_TRUE(writer->Close().ok());
   return path;
-}
-
-std::vector<std::string> Lines(const std::string& path) {
-  std::ifstream in(path);
-  std::vector<std::string> lines;
-  for (std::string line; std::getline(in, line);) lines.push_back(line);
-  return lines;
 }
 
 TEST(AnalyzeParams, AnAppliedChangeIsPlacedOnTheTimelinesStepGrid) {
