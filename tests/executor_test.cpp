@@ -154,7 +154,7 @@ class Slow : public Component {
           if (ctx_->params().Int("other") != other) return Status::Internal("other changed during the preparation");
           return std::get<int64_t>(v) == 13 ? Status::InvalidArgument("unlucky") : Status::OK();
         },
-        [this](const ParamValue& v) { g_log->Add("slow commit " + std::to_string(std::get<int64_t>(v))); });
+        [](const ParamValue& v) { g_log->Add("slow commit " + std::to_string(std::get<int64_t>(v))); });
     return Status::OK();
   }
   Status Step(const StepInfo& info) override {
