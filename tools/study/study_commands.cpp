@@ -4,12 +4,22 @@
 #include <iostream>
 #include <memory>
 
+#include "study_analysis.hpp"
 #include "study_file.hpp"
 
 namespace dyad::cli {
 namespace {
 
 constexpr int kOk = 0, kBadInput = 2;
+
+// The study file, or false after listing its problems.
+bool Load(const std::string& file, const std::vector<std::string>& plugins, study::Study* s) {
+  std::vector<Diagnostic> problems;
+  *s = study::LoadStudy(file, plugins, &problems);
+  for (const auto& p : problems) std::cerr << p.ToString() << "\n";
+  if (!problems.empty()) std::cerr << file << ": " << problems.size() << " problem" << (problems.size() == 1 ? "" : "s") << "\n";
+  return problems.empty();
+}
 
 struct PlanOptions {
   std::string file;
@@ -19,13 +29,8 @@ struct PlanOptions {
 
 // `dyad study plan`: the study checked, and who does which condition when.
 int Plan(const PlanOptions& o) {
-  std::vector<Diagnostic> problems;
-  const study::Study s = study::LoadStudy(o.file, o.plugins, &problems);
-  if (!problems.empty()) {
-    for (const auto& p : problems) std::cerr << p.ToString() << "\n";
-    std::cerr << o.file << ": " << problems.size() << " problem" << (problems.size() == 1 ? "" : "s") << "\n";
-    return kBadInput;
-  }
+  study::Study s;
+  if (!Load(o.file, o.plugins, &s)) return kBadInput;
   const size_t n = s.participants.size();
   std::cout << "study " << s.name << ": " << n << " participant" << (n == 1 ? "" : "s") << " x " << s.conditions.size()
             << " conditions x " << s.trials << " trial" << (s.trials == 1 ? "" : "s") << ", on " << s.graph << "\n";
@@ -56,6 +61,28 @@ int Plan(const PlanOptions& o) {
   return kOk;
 }
 
+struct AnalyzeOptions {
+  std::string file, out;
+  std::vector<std::string> plugins;
+};
+
+// `dyad study analyze`: every recording of the plan, one table across everyone.
+int Analyze(const AnalyzeOptions& o) {
+  study::Study s;
+  if (!Load(o.file, o.plugins, &s)) return kBadInput;
+  const study::StudyAnalysis a = study::AnalyzeStudy(s, std::cerr);
+  const std::string dir = o.out.empty() ? s.data + "/analysis" : o.out;
+  if (Status st = study::WriteStudyAnalysis(s, a, dir); !st.ok()) {
+    std::cerr << "dyad study analyze: " << st.ToString() << "\n";
+    return 1;
+  }
+  std::cout << "study " << s.name << ": " << a.trials.size() << " trial" << (a.trials.size() == 1 ? "" : "s") << " analysed, "
+            << a.missing.size() << " missing\n";
+  for (const auto& m : a.missing) std::cout << "  missing: " << m << "\n";
+  std::cout << "analysis: " << dir << "/report.md (trials.csv, events.csv, summary.csv)\n";
+  return kOk;
+}
+
 }  // namespace
 
 void AddStudyCommands(CLI::App& app, int& exit_code) {
@@ -67,6 +94,13 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   plan->add_option("--plugins", o->plugins, "Extra plugin file or folder (repeatable)");
   plan->add_flag("--unblind", o->unblind, "Name the conditions of a blind study (not for the experimenter's eyes)");
   plan->callback([o, &exit_code] { exit_code = Plan(*o); });
+  auto a = std::make_shared<AnalyzeOptions>();
+  auto* analyze = study->add_subcommand(
+      "analyze", "Analyse every recording of a study: one row per trial and per event, per condition a mean with a 95% bootstrap interval");
+  analyze->add_option("study", a->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
+  analyze->add_option("-o,--out", a->out, "Output folder (default: the study's data folder/analysis)");
+  analyze->add_option("--plugins", a->plugins, "Extra plugin file or folder (repeatable)");
+  analyze->callback([a, &exit_code] { exit_code = Analyze(*a); });
 }
 
 }  // namespace dyad::cli

@@ -13,13 +13,12 @@
 #include <sstream>
 #include <tuple>
 
-#include <fastdds/rtps/common/SerializedPayload.h>
-
 #include <dyad/msg/types.hpp>
 
 #include "analyze_commands.hpp"
 #include "build_report.hpp"
 #include "dyad/testing/cli.hpp"
+#include "dyad/testing/mcap_channel.hpp"
 #include "dyad/mcap/writer.hpp"
 #include "demonstrations.hpp"
 #include "dyad/pvrnn/dataset.hpp"
@@ -59,32 +58,9 @@ components:
         - {start: 30, end: 34, primitive: 5}
 )";
 
+// Stamped at 1 s + step * kPeriod (t0 != 0: alignment subtracts it).
 template <class T>
-class Channel {
- public:
-  Channel(mcap::Writer& w, const std::string& topic) : w_(w) {
-    auto schema = w.AddSchema(MessageTraits<T>::kName, "omgidl", MessageTraits<T>::kIdl);
-    EXPECT_TRUE(schema.ok());
-    auto channel = w.AddChannel(topic, "cdr", *schema);
-    EXPECT_TRUE(channel.ok());
-    id_ = *channel;
-  }
-  // `clock_offset_ns`: the writer's clock is that far ahead (a process on another host).
-  void Write(T& m, int64_t step, int64_t clock_offset_ns = 0) {
-    m.header().stamp_ns(1'000'000'000 + step * kPeriod + clock_offset_ns);  // t0 != 0: alignment subtracts it
-    m.header().sequence_number(++seq_);
-    eprosima::fastrtps::rtps::SerializedPayload_t payload(type_.getSerializedSizeProvider(&m)());
-    ASSERT_TRUE(type_.serialize(&m, &payload));
-    const auto t = static_cast<uint64_t>(m.header().stamp_ns());
-    ASSERT_TRUE(w_.Write(id_, static_cast<uint32_t>(seq_), t, t, {payload.data, payload.length}).ok());
-  }
-
- private:
-  mcap::Writer& w_;
-  mcap::ChannelId id_ = 0;
-  uint64_t seq_ = 0;
-  typename MessageTraits<T>::PubSubType type_;
-};
+using Channel = testing::McapChannel<T>;
 
 std::vector<double> OneHot(int k, int n = 7) {
   std::vector<double> p(n, 0.02);

@@ -1,0 +1,189 @@
+#include "study_analysis.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "bootstrap.hpp"
+#include "build_report.hpp"
+
+namespace dyad::study {
+namespace {
+
+// FNV-1a: a seed from names that is the same on every machine (std::hash is not).
+uint64_t SeedOf(const std::string& text) {
+  uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
+  return h;
+}
+
+std::string Num(double v) {
+  if (std::isnan(v)) return "";
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+
+std::string Csv(const std::string& cell) {
+  if (cell.find_first_of(",\"\n") == std::string::npos) return cell;
+  std::string q = "\"";
+  for (char c : cell) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+Status WriteFile(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) return Status::IOError(path.string(), "cannot write");
+  return Status::OK();
+}
+
+void AddConfusion(const std::vector<std::vector<int64_t>>& m, std::vector<std::vector<int64_t>>* sum) {
+  if (m.empty()) return;
+  if (sum->size() < m.size()) sum->resize(m.size());
+  for (auto& row : *sum) row.resize(std::max(row.size(), m.size()), 0);
+  for (size_t t = 0; t < m.size(); ++t)
+    for (size_t p = 0; p < m[t].size(); ++p) (*sum)[t][p] += m[t][p];
+}
+
+std::string TrialsCsv(const Study& s, const StudyAnalysis& a) {
+  std::ostringstream out;
+  out << "participant,condition,label,trial,repetition,file";
+  if (!a.trials.empty())
+    for (const auto& [name, value] : a.trials.front().metrics) out << ',' << name;
+  out << '\n';
+  for (const TrialResult& r : a.trials) {
+    const Condition& c = s.conditions[static_cast<size_t>(r.trial.condition)];
+    out << r.participant << ',' << c.name << ',' << c.label << ',' << r.trial.number << ',' << r.trial.repetition << ','
+        << Csv(r.trial.file);
+    for (const auto& [name, value] : r.metrics) out << ',' << Num(value);
+    out << '\n';
+  }
+  return out.str();
+}
+
+std::string EventsCsv(const Study& s, const StudyAnalysis& a) {
+  std::ostringstream out;
+  out << "participant,condition,trial,event,start_step,end_step,primitive,self_report,mean_congruence,final_congruence,"
+         "human_accuracy,robot_follows,robot_switch_after\n";
+  for (const TrialResult& r : a.trials)
+    for (const analyze::EventSummary& e : r.events) {
+      out << r.participant << ',' << s.conditions[static_cast<size_t>(r.trial.condition)].name << ',' << r.trial.number << ','
+          << e.index << ',' << e.event.start_step << ',' << e.event.end_step << ','
+          << (e.event.primitive < 0 ? std::string() : std::to_string(e.event.primitive)) << ','
+          << (e.event.reported == analyze::kNotReported ? std::string() : std::to_string(e.event.reported)) << ','
+          << Num(e.mean_congruence) << ',' << Num(e.final_congruence) << ',' << Num(e.human_accuracy) << ','
+          << Num(e.robot_follows) << ',' << (e.robot_switch_after < 0 ? std::string() : std::to_string(e.robot_switch_after))
+          << '\n';
+    }
+  return out.str();
+}
+
+// Per condition and measure: the trials' values and their interval.
+std::vector<std::pair<const Condition*, std::vector<std::pair<std::string, MeanInterval>>>> Summary(const Study& s,
+                                                                                                   const StudyAnalysis& a) {
+  std::vector<std::pair<const Condition*, std::vector<std::pair<std::string, MeanInterval>>>> out;
+  for (size_t c = 0; c < s.conditions.size(); ++c) {
+    std::vector<std::pair<std::string, MeanInterval>> measures;
+    for (const std::string& m : SummaryMeasures()) {
+      std::vector<double> values;
+      for (const TrialResult& r : a.trials) {
+        if (static_cast<size_t>(r.trial.condition) != c) continue;
+        for (const auto& [name, value] : r.metrics)
+          if (name == m) values.push_back(value);
+      }
+      measures.emplace_back(m, BootstrapMean(values, SeedOf(s.name + "/" + s.conditions[c].name + "/" + m)));
+    }
+    out.emplace_back(&s.conditions[c], std::move(measures));
+  }
+  return out;
+}
+
+std::string SummaryCsv(const Study& s, const StudyAnalysis& a) {
+  std::ostringstream out;
+  out << "condition,label,measure,trials,mean,ci_low,ci_high\n";
+  for (const auto& [c, measures] : Summary(s, a))
+    for (const auto& [m, ci] : measures)
+      out << c->name << ',' << c->label << ',' << m << ',' << ci.n << ',' << Num(ci.mean) << ',' << Num(ci.low) << ','
+          << Num(ci.high) << '\n';
+  return out.str();
+}
+
+std::string ReportMd(const Study& s, const StudyAnalysis& a) {
+  std::ostringstream out;
+  out << "# Study " << s.name << "\n\n" << a.trials.size() << " trial" << (a.trials.size() == 1 ? "" : "s") << " analysed";
+  if (!a.missing.empty()) out << ", " << a.missing.size() << " missing (below)";
+  out << ". Per condition: the mean over its trials and a 95% bootstrap interval (percentile, resampling trials); "
+         "\"trials\" counts those that have the measure.\n\n| condition | measure | trials | mean | 95% interval |\n|---|---|---|---|---|\n";
+  for (const auto& [c, measures] : Summary(s, a))
+    for (const auto& [m, ci] : measures)
+      out << "| " << c->name << " (" << c->label << ") | " << m << " | " << ci.n << " | " << (ci.n > 0 ? Num(ci.mean) : "unknown")
+          << " | " << (ci.n > 0 ? Num(ci.low) + " to " + Num(ci.high) : "unknown") << " |\n";
+  out << "\nmean_congruence: P(C_t), the observer's belief that human and robot intend the same primitive, averaged over "
+         "each event; observer_accuracy: share of engaged steps where the observer names the human's primitive; "
+         "robot_follows: the same for the robot's intention; switch_latency_s: from an event's start to the robot's "
+         "first step on the human's primitive; nelbo_mean: the deliberator's free energy (negative ELBO) of its window, "
+         "lower when its model explains what it perceived.\n";
+  if (!a.missing.empty()) {
+    out << "\n## Missing trials\n\n";
+    for (const std::string& m : a.missing) out << "- " << m << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace
+
+const std::vector<std::string>& SummaryMeasures() {
+  static const std::vector<std::string> m = {"mean_congruence", "observer_accuracy", "robot_follows", "switch_latency_s",
+                                             "nelbo_mean"};
+  return m;
+}
+
+StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings) {
+  StudyAnalysis a;
+  for (const std::string& p : study.participants)
+    for (const Trial& t : study.TrialsOf(p)) {
+      const std::string name = p + " trial " + std::to_string(t.number) + " (" + t.file + ")";
+      if (!std::filesystem::exists(t.file)) {
+        a.missing.push_back(name + ": not recorded");
+        continue;
+      }
+      auto report = analyze::BuildReport(t.file, warnings);
+      if (!report.ok()) {
+        a.missing.push_back(name + ": " + report.status().message());
+        continue;
+      }
+      a.trials.push_back({p, t, analyze::RunMetrics(*report), report->events});
+      AddConfusion(report->reported_confusion, &a.reported_confusion);
+    }
+  return a;
+}
+
+Status WriteStudyAnalysis(const Study& study, const StudyAnalysis& a, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return Status::IOError(dir, "cannot create the analysis folder: " + ec.message());
+  const std::filesystem::path d(dir);
+  const std::pair<const char*, std::string> files[] = {{"trials.csv", TrialsCsv(study, a)},
+                                                       {"events.csv", EventsCsv(study, a)},
+                                                       {"summary.csv", SummaryCsv(study, a)},
+                                                       {"report.md", ReportMd(study, a)}};
+  for (const auto& [name, text] : files)
+    if (Status s = WriteFile(d / name, text); !s.ok()) return s;
+  const std::filesystem::path confusion = d / "reported_confusion.csv";
+  if (a.reported_confusion.empty()) {
+    std::filesystem::remove(confusion, ec);
+    return Status::OK();
+  }
+  std::ostringstream out;
+  out << "reported,predicted,count\n";
+  for (size_t t = 0; t < a.reported_confusion.size(); ++t)
+    for (size_t p = 0; p < a.reported_confusion[t].size(); ++p) out << t << ',' << p << ',' << a.reported_confusion[t][p] << '\n';
+  return WriteFile(confusion, out.str());
+}
+
+}  // namespace dyad::study
