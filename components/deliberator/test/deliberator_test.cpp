@@ -229,6 +229,10 @@ TEST(Deliberator, ALiveModelIsSwappedAtAStepBoundaryRecordedAndABadOneRefused) {
   fs::create_directories(dir);
   const fs::path a = RandomModelFile(), b = dir / "b.dpvrnn", bad = dir / "bad.dpvrnn";
   ASSERT_TRUE(pvrnn::SaveModel(pvrnn::Model::Initialize(pvrnn::ModelSpec::MacawBot(), 72, 7, 11), b.string()).ok());
+  const fs::path one = dir / "one.dpvrnn";  // a model of 1 layer: the preset's meta-prior has 2 values
+  pvrnn::ModelSpec one_layer = pvrnn::ModelSpec::MacawBot();
+  one_layer.layers.resize(1);
+  ASSERT_TRUE(pvrnn::SaveModel(pvrnn::Model::Initialize(one_layer, 72, 7, 11), one.string()).ok());
   {  // b, truncated: its checksum cannot match
     std::ifstream in(b, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -251,11 +255,12 @@ TEST(Deliberator, ALiveModelIsSwappedAtAStepBoundaryRecordedAndABadOneRefused) {
     EXPECT_EQ(std::system(cmd.c_str()), 0) << std::ifstream(dir / (name + ".log")).rdbuf();
     return csv;
   };
-  const std::string swaps = "{at_s: 2.0, set: {mind.model: " + b.string() + "}}, {at_s: 3.0, set: {mind.model: " + bad.string() + "}}";
+  const std::string swaps = "{at_s: 2.0, set: {mind.model: " + b.string() + "}}, {at_s: 3.0, set: {mind.model: " + bad.string() +
+                            "}}, {at_s: 3.5, set: {mind.model: " + one.string() + "}}";
   const fs::path first = run("first", swaps), again = run("again", swaps), none = run("none", "");
 
   const auto changes = dyad::testing::ReadCsv(first / "dyad_params.csv");
-  ASSERT_EQ(changes.size(), 2u) << std::ifstream(first / "dyad_params.csv").rdbuf();
+  ASSERT_EQ(changes.size(), 3u) << std::ifstream(first / "dyad_params.csv").rdbuf();
   EXPECT_EQ(changes[0].at("op"), "applied");
   EXPECT_EQ(changes[0].at("old_value"), "\"" + a.string() + "\"");  // YAML text
   EXPECT_EQ(changes[0].at("value"), "\"" + b.string() + "\"");
@@ -263,9 +268,13 @@ TEST(Deliberator, ALiveModelIsSwappedAtAStepBoundaryRecordedAndABadOneRefused) {
   EXPECT_EQ(swap_step, 21u);  // asked at 2.0 s, after step 20 ran: the mind's step 21 is B's first
   EXPECT_EQ(changes[1].at("op"), "refused");
   EXPECT_NE(changes[1].at("reason").find(bad.string()), std::string::npos) << changes[1].at("reason");
+  EXPECT_EQ(changes[2].at("op"), "refused");
+  EXPECT_NE(changes[2].at("reason").find(one.string() + " has 1 layers; the meta_prior in force has 2 values (the preset's)"),
+            std::string::npos)
+      << changes[2].at("reason");
 
   const auto models = dyad::testing::ReadCsv(first / "mind_model.csv");
-  ASSERT_EQ(models.size(), 2u) << "the model at the start and the one swap: the bad file never steered";
+  ASSERT_EQ(models.size(), 2u) << "the model at the start and the one swap: the bad files never steered";
   EXPECT_EQ(models[0].at("path"), a.string());
   EXPECT_EQ(models[0].at("sha256"), Sha256sum(a));
   EXPECT_EQ(models[0].at("step"), "0");
