@@ -1,5 +1,7 @@
 #include "human_input.hpp"
 
+#include <cmath>
+
 namespace dyad::human_input {
 
 void HumanSynthetic::Describe(ComponentSpec& spec) {
@@ -10,7 +12,7 @@ void HumanSynthetic::Describe(ComponentSpec& spec) {
   spec.Param("noise_std", 0.0).Min(0).Unit("workspace units").Doc("Gaussian noise per axis while engaged (seeded)");
   spec.Param("lag", int64_t{0}).Min(0).Unit("steps").Doc("the trace runs this many steps behind the event's clock");
   spec.Param("self_report_error", 0.0).Min(0).Max(1).Doc("probability that a self-report names another primitive (uniformly)");
-  spec.Param("self_report_delay", 1.5).Min(0).Unit("s").Doc("from a release to its self-report");
+  spec.Param("self_report_delay", 1.5).Range(0, 3600).Unit("s").Doc("from a release to its self-report");
   spec.Output<msg::HumanInput>("out").Doc("position and engaged flag, one sample per step");
   spec.Output<msg::SelfReport>("self_report").Optional().Doc(
       "after each event's release (and the delay): the primitive the human says it drew, as a study's subject answers");
@@ -29,7 +31,7 @@ Status HumanSynthetic::Configure(Context& ctx) {
   o.lag = ctx.params().Int("lag");
   o.seed = ctx.seed();
   o.report_error = ctx.params().Double("self_report_error");
-  report_delay_ns_ = static_cast<int64_t>(ctx.params().Double("self_report_delay") * 1e9);
+  report_delay_ns_ = std::llround(ctx.params().Double("self_report_delay") * 1e9);
   human_ = std::make_unique<SyntheticHuman>(std::move(data.value()), std::move(events.value()), o);
   out_ = &ctx.output<msg::HumanInput>("out");
   reports_ = &ctx.output<msg::SelfReport>("self_report");

@@ -1004,15 +1004,18 @@ void ApplyQos(Q& q, const TopicQos& qos) {
   }
 }
 
-// A guest's (kWatcher's) reliable writer keeps its last 100 samples, whatever the topic's depth.
-// Discovery is not symmetric: the guest's writer may match a graph reader (and the guest start
-// writing) a moment before that reader matches the writer; the reader then learns the writer's
-// first sequence number from its first heartbeat and asks for what it missed, which a depth-1
-// history has already dropped (`dyad bag play` lost its first sample that way in CI). Readers
-// still keep their own depth; writers with KEEP_LAST never wait for them.
+// A guest's (kWatcher's) reliable volatile writer keeps its last 100 samples, whatever the
+// topic's depth. Discovery is not symmetric: the guest's writer may match a graph reader (and the
+// guest start writing) a moment before that reader matches the writer; the reader then learns
+// the writer's first sequence number from its first heartbeat and asks for what it missed, which
+// a depth-1 history has already dropped (`dyad bag play` lost its first sample that way in CI);
+// up to 100 written before the match are now repaired. Readers keep their own depth; writers
+// with KEEP_LAST never wait for them. Not TRANSIENT_LOCAL writers (the launchers' latched
+// dyad/processes state): a late joiner must get their last sample, not their last 100.
 constexpr int32_t kGuestWriterDepth = 100;
 void KeepForLateMatches(fdds::DataWriterQos& q) {
-  if (q.reliability().kind == fdds::RELIABLE_RELIABILITY_QOS && q.history().kind == fdds::KEEP_LAST_HISTORY_QOS)
+  if (q.reliability().kind == fdds::RELIABLE_RELIABILITY_QOS && q.durability().kind == fdds::VOLATILE_DURABILITY_QOS &&
+      q.history().kind == fdds::KEEP_LAST_HISTORY_QOS)
     q.history().depth = std::max(q.history().depth, kGuestWriterDepth);
 }
 }  // namespace

@@ -327,6 +327,9 @@ StatusOr<std::vector<SelfReportEvent>> SelfReports(const std::map<std::string, T
     if (!choice.ok()) return choice.status();
     auto response = cells.Number(r, "response_s");
     if (!response.ok()) return response.status();
+    if (!(*choice >= -1 && *choice <= 1e6) || *choice != std::floor(*choice))
+      return Status::DataLoss("topic human/self_report message " + std::to_string(r + 1),
+                              "field \"choice\" holds " + cells.Text(r, "choice") + ": not a primitive index or -1");
     const double from = OnRecorderClock(timeline.clock_corrections_ns, writer(r), *start);
     if (!t0) t0 = static_cast<int64_t>(from);
     SelfReportEvent e;

@@ -39,9 +39,10 @@ std::string EventsCsv(const Report& r) {
   return s.str();
 }
 
-std::string ConfusionCsv(const std::vector<std::vector<int64_t>>& m) {
+// `truth`: the first column's name ("true": the traced primitive; "reported": the self-report).
+std::string ConfusionCsv(const std::vector<std::vector<int64_t>>& m, const char* truth) {
   std::ostringstream s;
-  s << "true,predicted,count\n";
+  s << truth << ",predicted,count\n";
   for (size_t t = 0; t < m.size(); ++t) {
     for (size_t p = 0; p < m[t].size(); ++p) s << t << ',' << p << ',' << m[t][p] << '\n';
   }
@@ -309,7 +310,7 @@ Status WriteReport(const Report& r, const std::string& dir) {
   std::filesystem::create_directories(dir, ec);
   if (ec) return Status::IOError(dir, "cannot create the report folder: " + ec.message());
   const std::pair<const char*, std::string> files[] = {
-      {"report.md", FormatMarkdown(r)}, {"events.csv", EventsCsv(r)},     {"confusion.csv", ConfusionCsv(r.confusion)},
+      {"report.md", FormatMarkdown(r)}, {"events.csv", EventsCsv(r)},     {"confusion.csv", ConfusionCsv(r.confusion, "true")},
       {"timeline.csv", TimelineCsv(r)}, {"graph.yaml", r.graph_yaml},    {"metrics.json", MetricsJson(r)},
   };
   for (const auto& [name, text] : files) {
@@ -317,7 +318,7 @@ Status WriteReport(const Report& r, const std::string& dir) {
   }
   const std::string reported = dir + "/reported_confusion.csv";  // as params.csv below: no stale one
   if (!r.reported_confusion.empty()) {
-    if (Status s = WriteFile(reported, ConfusionCsv(r.reported_confusion)); !s.ok()) return s;
+    if (Status s = WriteFile(reported, ConfusionCsv(r.reported_confusion, "reported")); !s.ok()) return s;
   } else {
     std::filesystem::remove(reported, ec);
   }

@@ -53,8 +53,7 @@ void AddConfusion(const std::vector<std::vector<int64_t>>& m, std::vector<std::v
 std::string TrialsCsv(const Study& s, const StudyAnalysis& a) {
   std::ostringstream out;
   out << "participant,condition,label,trial,repetition,file";
-  if (!a.trials.empty())
-    for (const auto& [name, value] : a.trials.front().metrics) out << ',' << name;
+  for (const auto& [name, value] : analyze::RunMetrics(analyze::Report{})) out << ',' << name;  // the same names for every trial
   out << '\n';
   for (const TrialResult& r : a.trials) {
     const Condition& c = s.conditions[static_cast<size_t>(r.trial.condition)];
@@ -83,20 +82,36 @@ std::string EventsCsv(const Study& s, const StudyAnalysis& a) {
   return out.str();
 }
 
-// Per condition and measure: the trials' values and their interval.
-std::vector<std::pair<const Condition*, std::vector<std::pair<std::string, MeanInterval>>>> Summary(const Study& s,
-                                                                                                   const StudyAnalysis& a) {
-  std::vector<std::pair<const Condition*, std::vector<std::pair<std::string, MeanInterval>>>> out;
+struct ConditionMeasure {
+  std::string measure;
+  int trials = 0;        // with the measure
+  MeanInterval interval;  // over participants: n counts those with the measure
+};
+
+// Per condition and measure: each participant's mean over their trials of it (trials of one
+// person are not independent), then the mean over participants and its bootstrap interval,
+// resampling participants.
+std::vector<std::pair<const Condition*, std::vector<ConditionMeasure>>> Summary(const Study& s, const StudyAnalysis& a) {
+  std::vector<std::pair<const Condition*, std::vector<ConditionMeasure>>> out;
   for (size_t c = 0; c < s.conditions.size(); ++c) {
-    std::vector<std::pair<std::string, MeanInterval>> measures;
+    std::vector<ConditionMeasure> measures;
     for (const std::string& m : SummaryMeasures()) {
-      std::vector<double> values;
+      ConditionMeasure cm;
+      cm.measure = m;
+      std::map<std::string, std::pair<double, int>> by_participant;  // sum, count
       for (const TrialResult& r : a.trials) {
         if (static_cast<size_t>(r.trial.condition) != c) continue;
         for (const auto& [name, value] : r.metrics)
-          if (name == m) values.push_back(value);
+          if (name == m && !std::isnan(value)) {
+            by_participant[r.participant].first += value;
+            ++by_participant[r.participant].second;
+            ++cm.trials;
+          }
       }
-      measures.emplace_back(m, BootstrapMean(values, SeedOf(s.name + "/" + s.conditions[c].name + "/" + m)));
+      std::vector<double> means;
+      for (const auto& [p, sum] : by_participant) means.push_back(sum.first / sum.second);
+      cm.interval = BootstrapMean(means, SeedOf(s.name + "/" + s.conditions[c].name + "/" + m));
+      measures.push_back(std::move(cm));
     }
     out.emplace_back(&s.conditions[c], std::move(measures));
   }
@@ -105,11 +120,11 @@ std::vector<std::pair<const Condition*, std::vector<std::pair<std::string, MeanI
 
 std::string SummaryCsv(const Study& s, const StudyAnalysis& a) {
   std::ostringstream out;
-  out << "condition,label,measure,trials,mean,ci_low,ci_high\n";
+  out << "condition,label,measure,participants,trials,mean,ci_low,ci_high\n";
   for (const auto& [c, measures] : Summary(s, a))
-    for (const auto& [m, ci] : measures)
-      out << c->name << ',' << c->label << ',' << m << ',' << ci.n << ',' << Num(ci.mean) << ',' << Num(ci.low) << ','
-          << Num(ci.high) << '\n';
+    for (const ConditionMeasure& m : measures)
+      out << c->name << ',' << c->label << ',' << m.measure << ',' << m.interval.n << ',' << m.trials << ',' << Num(m.interval.mean)
+          << ',' << Num(m.interval.low) << ',' << Num(m.interval.high) << '\n';
   return out.str();
 }
 
@@ -117,17 +132,21 @@ std::string ReportMd(const Study& s, const StudyAnalysis& a) {
   std::ostringstream out;
   out << "# Study " << s.name << "\n\n" << a.trials.size() << " trial" << (a.trials.size() == 1 ? "" : "s") << " analysed";
   if (!a.missing.empty()) out << ", " << a.missing.size() << " missing (below)";
-  out << ". Per condition: the mean over its trials and a 95% bootstrap interval (percentile, resampling trials); "
-         "\"trials\" counts those that have the measure.\n\n| condition | measure | trials | mean | 95% interval |\n|---|---|---|---|---|\n";
+  out << ". Per condition: each participant's mean over their trials, then the mean over participants and a 95% "
+         "bootstrap interval (percentile, resampling participants); \"participants\" and \"trials\" count those that "
+         "have the measure.\n\n| condition | measure | participants | trials | mean | 95% interval |\n|---|---|---|---|---|---|\n";
   for (const auto& [c, measures] : Summary(s, a))
-    for (const auto& [m, ci] : measures)
-      out << "| " << c->name << " (" << c->label << ") | " << m << " | " << ci.n << " | " << (ci.n > 0 ? Num(ci.mean) : "unknown")
-          << " | " << (ci.n > 0 ? Num(ci.low) + " to " + Num(ci.high) : "unknown") << " |\n";
+    for (const ConditionMeasure& m : measures) {
+      const MeanInterval& ci = m.interval;
+      out << "| " << c->name << " (" << c->label << ") | " << m.measure << " | " << ci.n << " | " << m.trials << " | "
+          << (ci.n > 0 ? Num(ci.mean) : "unknown") << " | " << (ci.n > 0 ? Num(ci.low) + " to " + Num(ci.high) : "unknown") << " |\n";
+    }
   out << "\nmean_congruence: P(C_t), the observer's belief that human and robot intend the same primitive, averaged over "
-         "each event; observer_accuracy: share of engaged steps where the observer names the human's primitive; "
-         "robot_follows: the same for the robot's intention; switch_latency_s: from an event's start to the robot's "
-         "first step on the human's primitive; nelbo_mean: the deliberator's free energy (negative ELBO) of its window, "
-         "lower when its model explains what it perceived.\n";
+         "each event, then over events; observer_accuracy: per event, the share of its labelled steps where the observer "
+         "names the human's primitive, averaged over events; robot_follows: the same for the robot's intention; "
+         "switch_latency_s: from an event's start to the robot's first step on the human's primitive (events where it "
+         "switched); nelbo_mean: the deliberator's free energy (negative ELBO) of its window, lower when its model "
+         "explains what it perceived.\n";
   if (!a.missing.empty()) {
     out << "\n## Missing trials\n\n";
     for (const std::string& m : a.missing) out << "- " << m << "\n";

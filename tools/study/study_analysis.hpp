@@ -9,8 +9,9 @@
 //     condition, label, trial, repetition, file, then RunMetrics' measures), events.csv (one row
 //     per event of every trial: participant, condition, trial, the event's steps, primitive,
 //     self-report, congruence, the observer's accuracy on the human, whether the robot follows,
-//     its switch latency), summary.csv (per condition and measure: trials with the measure, mean,
-//     95% percentile-bootstrap interval, seeded from the study, condition and measure names),
+//     its switch latency), summary.csv (per condition and measure: each participant's mean over
+//     their trials, then the mean over participants with a 95% percentile-bootstrap interval that
+//     resamples participants, seeded from the study, condition and measure names),
 //     reported_confusion.csv (the observer against the self-reports, summed over trials; only
 //     when there are some) and report.md (the summary, the missing trials). Conditions are named
 //     (the analysis is the unblinded step) with their labels beside them.
@@ -37,7 +38,7 @@ struct TrialResult {
 
 struct StudyAnalysis {
   std::vector<TrialResult> trials;  // in the plan's order
-  std::vector<std::string> missing;  // "P02 trial 03 (FILE): not recorded" and the like
+  std::vector<std::string> missing;  // "P02 trial 3 (FILE): not recorded" and the like
   std::vector<std::vector<int64_t>> reported_confusion;  // empty: no self-report with labels
 };
 

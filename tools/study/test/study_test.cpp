@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -162,6 +163,24 @@ TEST(Bootstrap, TwoValuesSpanTheirInterval) {
   EXPECT_DOUBLE_EQ(ci.high, 0.8);
 }
 
+// The documented draw (indices rng() % n of one mt19937_64) and type-1 quantiles, replayed here:
+// with 40 resamples the 95% interval is the smallest and the 39th smallest of the 40 means.
+TEST(Bootstrap, TheIntervalIsTheType1QuantilesOfTheDocumentedResamples) {
+  const std::vector<double> x = {1, 2, 3, 4, 5, 6, 7};
+  std::mt19937_64 rng(11);
+  std::vector<double> means(40);
+  for (double& m : means) {
+    double s = 0;
+    for (size_t i = 0; i < x.size(); ++i) s += x[static_cast<size_t>(rng() % x.size())];
+    m = s / 7;
+  }
+  std::sort(means.begin(), means.end());
+  const MeanInterval ci = BootstrapMean(x, 11, 40);
+  EXPECT_EQ(ci.low, means[0]);
+  EXPECT_EQ(ci.high, means[38]);
+  EXPECT_EQ(BootstrapMean(x, 11, 40, /*level=*/7.0).low, ci.low) << "a level outside (0, 1) is 0.95";
+}
+
 // 600 samples of 25 draws from N(1, 2^2): the 95% interval covers the true mean in about 95% of
 // them (the percentile bootstrap undercovers a little at this size: 92% measured), and the same values
 // and seed give the same interval.
@@ -222,61 +241,70 @@ void WriteTrial(const fs::path& file, double c, int switch_after, int said) {
   ASSERT_TRUE(w->Close().ok());
 }
 
-// Two participants x two conditions; P02's second trial was never recorded. Per condition the
-// numbers are computed by hand from what each trial holds.
+// Two participants x two conditions x two trials; P02's two trials of `low` were never recorded.
+// Per condition the numbers are computed by hand from what each trial holds: a participant's
+// trials are averaged first, then the participants (the interval resamples participants).
 TEST_F(StudyFile, AnalyzeMakesOneTableAcrossEveryoneAndSaysWhatIsMissing) {
   const std::string f = Write("study: gain\ngraph: g.yaml\nparticipants: [P01, P02]\n"
-                              "conditions:\n  low: {src.start: 1}\n  high: {src.start: 3}\n");
+                              "conditions:\n  low: {src.start: 1}\n  high: {src.start: 3}\ntrials: 2\n");
   std::vector<Diagnostic> problems;
   const Study s = LoadStudy(f, {}, &problems);
   ASSERT_TRUE(problems.empty()) << problems.front().ToString();
-  std::map<std::string, const Trial*> file_of;  // "P01/low" -> its trial
-  const auto p1 = s.TrialsOf("P01"), p2 = s.TrialsOf("P02");
-  for (const auto* trials : {&p1, &p2})
-    for (const Trial& t : *trials) file_of[(trials == &p1 ? "P01/" : "P02/") + s.conditions[static_cast<size_t>(t.condition)].name] = &t;
-  WriteTrial(file_of.at("P01/low")->file, 0.2, 4, 4);   // said 4, drew 2
-  WriteTrial(file_of.at("P01/high")->file, 0.6, 2, 2);
-  WriteTrial(file_of.at("P02/high")->file, 0.8, 6, 2);
-  const Trial& never = *file_of.at("P02/low");
+  std::map<std::string, Trial> trial_of;  // "P01/low/1" -> its trial
+  for (const std::string p : {"P01", "P02"})
+    for (const Trial& t : s.TrialsOf(p))
+      trial_of[p + "/" + s.conditions[static_cast<size_t>(t.condition)].name + "/" + std::to_string(t.repetition)] = t;
+  WriteTrial(trial_of.at("P01/low/1").file, 0.2, 4, 4);  // said 4, drew 2
+  WriteTrial(trial_of.at("P01/low/2").file, 0.4, 4, 2);
+  WriteTrial(trial_of.at("P01/high/1").file, 0.6, 2, 2);
+  WriteTrial(trial_of.at("P01/high/2").file, 0.6, 2, 2);
+  WriteTrial(trial_of.at("P02/high/1").file, 0.8, 6, 2);
+  WriteTrial(trial_of.at("P02/high/2").file, 1.0, 8, 2);
 
   auto r = dyad::testing::RunCommand(dyad::cli::AddStudyCommands, {"study", "analyze", f});
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("3 trials analysed, 1 missing"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("6 trials analysed, 2 missing"), std::string::npos) << r.out;
+  const Trial& never = trial_of.at("P02/low/2");
   EXPECT_NE(r.out.find("P02 trial " + std::to_string(never.number) + " (" + never.file + "): not recorded"), std::string::npos) << r.out;
   const fs::path out = fs::path(s.data) / "analysis";
   std::map<std::string, std::map<std::string, std::string>> summary;  // "low/measure" -> row
   for (const auto& row : dyad::testing::ReadCsv(out / "summary.csv")) summary[row.at("condition") + "/" + row.at("measure")] = row;
   ASSERT_EQ(summary.size(), 10u);
   auto num = [&](const std::string& key, const std::string& col) { return std::stod(summary.at(key).at(col)); };
-  EXPECT_EQ(summary.at("low/mean_congruence").at("trials"), "1");
-  EXPECT_DOUBLE_EQ(num("low/mean_congruence", "mean"), 0.2);
-  EXPECT_DOUBLE_EQ(num("low/mean_congruence", "ci_low"), 0.2);
-  EXPECT_DOUBLE_EQ(num("low/mean_congruence", "ci_high"), 0.2);
-  EXPECT_EQ(summary.at("high/mean_congruence").at("trials"), "2");
-  EXPECT_NEAR(num("high/mean_congruence", "mean"), 0.7, 1e-9);
+  EXPECT_EQ(summary.at("low/mean_congruence").at("participants"), "1");
+  EXPECT_EQ(summary.at("low/mean_congruence").at("trials"), "2");
+  EXPECT_NEAR(num("low/mean_congruence", "mean"), 0.3, 1e-9);
+  EXPECT_NEAR(num("low/mean_congruence", "ci_low"), 0.3, 1e-9);
+  EXPECT_NEAR(num("low/mean_congruence", "ci_high"), 0.3, 1e-9);
+  // high: P01 0.6 and P02 0.9, so the interval spans 0.6..0.9 (resampling the four trials would
+  // reach 1.0).
+  EXPECT_EQ(summary.at("high/mean_congruence").at("participants"), "2");
+  EXPECT_EQ(summary.at("high/mean_congruence").at("trials"), "4");
+  EXPECT_NEAR(num("high/mean_congruence", "mean"), 0.75, 1e-9);
   EXPECT_NEAR(num("high/mean_congruence", "ci_low"), 0.6, 1e-9);
-  EXPECT_NEAR(num("high/mean_congruence", "ci_high"), 0.8, 1e-9);
+  EXPECT_NEAR(num("high/mean_congruence", "ci_high"), 0.9, 1e-9);
   // The robot follows from step 10 + k of the 10-step event: (10 - k) / 10; switch latency k * 0.1 s.
   EXPECT_NEAR(num("low/robot_follows", "mean"), 0.6, 1e-9);
-  EXPECT_NEAR(num("high/robot_follows", "mean"), (0.8 + 0.4) / 2, 1e-9);
-  EXPECT_NEAR(num("high/switch_latency_s", "mean"), (0.2 + 0.6) / 2, 1e-9);
+  EXPECT_NEAR(num("high/robot_follows", "mean"), (0.8 + (0.4 + 0.2) / 2) / 2, 1e-9);
+  EXPECT_NEAR(num("high/switch_latency_s", "mean"), (0.2 + (0.6 + 0.8) / 2) / 2, 1e-9);
   EXPECT_NEAR(num("low/observer_accuracy", "mean"), 1.0, 1e-9);
   const auto trials = dyad::testing::ReadCsv(out / "trials.csv");
-  ASSERT_EQ(trials.size(), 3u);
+  ASSERT_EQ(trials.size(), 6u);
+  EXPECT_EQ(trials[0].count("nelbo_mean"), 1u);
   const auto events = dyad::testing::ReadCsv(out / "events.csv");
-  ASSERT_EQ(events.size(), 3u);
+  ASSERT_EQ(events.size(), 6u);
   int said_four = 0;
   for (const auto& e : events) said_four += e.at("self_report") == "4" && e.at("participant") == "P01" && e.at("condition") == "low";
   EXPECT_EQ(said_four, 1);
-  // Against the self-reports: 10 steps of the event said to be 4 (the observer: 2), 20 said 2.
+  // Against the self-reports: 10 steps of the event said to be 4 (the observer: 2), 50 said 2.
   std::map<std::string, std::string> confusion;
   for (const auto& row : dyad::testing::ReadCsv(out / "reported_confusion.csv"))
     confusion[row.at("reported") + "," + row.at("predicted")] = row.at("count");
   EXPECT_EQ(confusion.at("4,2"), "10");
-  EXPECT_EQ(confusion.at("2,2"), "20");
+  EXPECT_EQ(confusion.at("2,2"), "50");
   std::ifstream md(out / "report.md");
   const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
-  EXPECT_NE(report.find("| high (" + s.conditions[1].label + ") | mean_congruence | 2 | 0.7 | 0.6 to 0.8 |"), std::string::npos) << report;
+  EXPECT_NE(report.find("| high (" + s.conditions[1].label + ") | mean_congruence | 2 | 4 | 0.75 | 0.6 to 0.9 |"), std::string::npos) << report;
   EXPECT_NE(report.find("## Missing trials"), std::string::npos) << report;
 }
 
