@@ -76,11 +76,11 @@ std::vector<std::string> StampColumns(const std::map<std::string, int64_t>& corr
   return {"header.stamp_ns", "header.source"};
 }
 
-// A row's stamp on the recorder's process's clock; its writer is the component header.source
-// names (one the graph does not have: the stamp as it is).
+// A row's stamp (`column`, a stamp of its writer's clock) on the recorder's process's clock; its
+// writer is the component header.source names (one the graph does not have: the stamp as it is).
 StatusOr<double> ComponentStamp(const Cells& cells, size_t row, const ExperimentPlan& plan,
-                                const std::map<std::string, int64_t>& corrections) {
-  auto stamp = cells.Number(row, "header.stamp_ns");
+                                const std::map<std::string, int64_t>& corrections, const char* column = "header.stamp_ns") {
+  auto stamp = cells.Number(row, column);
   if (!stamp.ok() || corrections.empty()) return stamp;
   auto p = plan.process_of.find(cells.Text(row, "header.source"));
   return p == plan.process_of.end() ? *stamp : OnRecorderClock(corrections, p->second, *stamp);
@@ -313,15 +313,12 @@ StatusOr<std::vector<SelfReportEvent>> SelfReports(const std::map<std::string, T
   if (it == tables.end()) return out;
   Cells cells("human/self_report", it->second);
   if (Status s = cells.Need({"header.source", "choice", "response_s", "segment_start_ns", "segment_end_ns"}); !s.ok()) return s;
-  auto writer = [&](size_t r) {
-    auto p = plan.process_of.find(cells.Text(r, "header.source"));
-    return p == plan.process_of.end() ? std::string() : p->second;
-  };
+  const auto& corrections = timeline.clock_corrections_ns;
   std::optional<int64_t> t0 = timeline.t0_ns;
   for (size_t r = 0; r < it->second.size(); ++r) {
-    auto start = cells.Number(r, "segment_start_ns");
+    auto start = ComponentStamp(cells, r, plan, corrections, "segment_start_ns");
     if (!start.ok()) return start.status();
-    auto end = cells.Number(r, "segment_end_ns");
+    auto end = ComponentStamp(cells, r, plan, corrections, "segment_end_ns");
     if (!end.ok()) return end.status();
     auto choice = cells.Number(r, "choice");
     if (!choice.ok()) return choice.status();
@@ -330,11 +327,10 @@ StatusOr<std::vector<SelfReportEvent>> SelfReports(const std::map<std::string, T
     if (!(*choice >= -1 && *choice <= 1e6) || *choice != std::floor(*choice))
       return Status::DataLoss("topic human/self_report message " + std::to_string(r + 1),
                               "field \"choice\" holds " + cells.Text(r, "choice") + ": not a primitive index or -1");
-    const double from = OnRecorderClock(timeline.clock_corrections_ns, writer(r), *start);
-    if (!t0) t0 = static_cast<int64_t>(from);
+    if (!t0) t0 = static_cast<int64_t>(*start);
     SelfReportEvent e;
-    e.start_step = StepOf(from, *t0, plan.period_ns);
-    e.end_step = StepOf(OnRecorderClock(timeline.clock_corrections_ns, writer(r), *end), *t0, plan.period_ns);
+    e.start_step = StepOf(*start, *t0, plan.period_ns);
+    e.end_step = StepOf(*end, *t0, plan.period_ns);
     e.choice = static_cast<int>(*choice);
     e.response_s = *response;
     out.push_back(e);

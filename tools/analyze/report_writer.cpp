@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
+
+#include "text_output.hpp"
 
 namespace dyad::analyze {
 namespace {
@@ -16,14 +17,6 @@ std::string Num(double v, int precision = 3) {
   s.precision(precision);
   s << v;
   return s.str();
-}
-
-Status WriteFile(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) return Status::IOError(path, "cannot write");
-  return Status::OK();
 }
 
 std::string EventsCsv(const Report& r) {
@@ -64,21 +57,12 @@ std::string TimelineCsv(const Report& r) {
   return s.str();
 }
 
-// A CSV cell, quoted when it holds a separator, a quote or a line break (RFC 4180; as
-// tools/bag/csv_export.cpp writes them). Values are YAML flow text: "[0.1, 0.2]" has commas.
-std::string CsvCell(const std::string& cell) {
-  if (cell.find_first_of(",\"\r\n") == std::string::npos) return cell;
-  std::string quoted = "\"";
-  for (char c : cell) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return quoted + "\"";
-}
-
 std::string ParamsCsv(const Report& r) {
   std::ostringstream s;
   s << "step,time_s,component,param,old_value,value,who\n";
   for (const ParamChangeEvent& c : r.param_changes) {
-    s << c.step << ',' << Num(c.time_s, 3) << ',' << CsvCell(c.component) << ',' << CsvCell(c.param) << ','
-      << CsvCell(c.old_value) << ',' << CsvCell(c.value) << ',' << CsvCell(c.who) << '\n';
+    s << c.step << ',' << Num(c.time_s, 3) << ',' << tools::CsvCell(c.component) << ',' << tools::CsvCell(c.param) << ','
+      << tools::CsvCell(c.old_value) << ',' << tools::CsvCell(c.value) << ',' << tools::CsvCell(c.who) << '\n';
   }
   return s.str();
 }
@@ -314,17 +298,17 @@ Status WriteReport(const Report& r, const std::string& dir) {
       {"timeline.csv", TimelineCsv(r)}, {"graph.yaml", r.graph_yaml},    {"metrics.json", MetricsJson(r)},
   };
   for (const auto& [name, text] : files) {
-    if (Status s = WriteFile(dir + "/" + name, text); !s.ok()) return s;
+    if (Status s = tools::WriteTextFile(dir + "/" + name, text); !s.ok()) return s;
   }
   const std::string reported = dir + "/reported_confusion.csv";  // as params.csv below: no stale one
   if (!r.reported_confusion.empty()) {
-    if (Status s = WriteFile(reported, ConfusionCsv(r.reported_confusion, "reported")); !s.ok()) return s;
+    if (Status s = tools::WriteTextFile(reported, ConfusionCsv(r.reported_confusion, "reported")); !s.ok()) return s;
   } else {
     std::filesystem::remove(reported, ec);
   }
   // The plots draw whatever params.csv the folder holds: one of an earlier report must go.
   const std::string params = dir + "/params.csv";
-  if (!r.param_changes.empty()) return WriteFile(params, ParamsCsv(r));
+  if (!r.param_changes.empty()) return tools::WriteTextFile(params, ParamsCsv(r));
   std::filesystem::remove(params, ec);
   if (ec) return Status::IOError(params, "cannot remove the previous report's: " + ec.message());
   return Status::OK();

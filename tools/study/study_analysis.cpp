@@ -2,12 +2,12 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <sstream>
 
 #include "bootstrap.hpp"
 #include "build_report.hpp"
+#include "text_output.hpp"
 
 namespace dyad::study {
 namespace {
@@ -27,21 +27,6 @@ std::string Num(double v) {
   return s.str();
 }
 
-std::string Csv(const std::string& cell) {
-  if (cell.find_first_of(",\"\n") == std::string::npos) return cell;
-  std::string q = "\"";
-  for (char c : cell) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
-Status WriteFile(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) return Status::IOError(path.string(), "cannot write");
-  return Status::OK();
-}
-
 void AddConfusion(const std::vector<std::vector<int64_t>>& m, std::vector<std::vector<int64_t>>* sum) {
   if (m.empty()) return;
   if (sum->size() < m.size()) sum->resize(m.size());
@@ -58,7 +43,7 @@ std::string TrialsCsv(const Study& s, const StudyAnalysis& a) {
   for (const TrialResult& r : a.trials) {
     const Condition& c = s.conditions[static_cast<size_t>(r.trial.condition)];
     out << r.participant << ',' << c.name << ',' << c.label << ',' << r.trial.number << ',' << r.trial.repetition << ','
-        << Csv(r.trial.file);
+        << tools::CsvCell(r.trial.file);
     for (const auto& [name, value] : r.metrics) out << ',' << Num(value);
     out << '\n';
   }
@@ -91,8 +76,9 @@ struct ConditionMeasure {
 // Per condition and measure: each participant's mean over their trials of it (trials of one
 // person are not independent), then the mean over participants and its bootstrap interval,
 // resampling participants.
-std::vector<std::pair<const Condition*, std::vector<ConditionMeasure>>> Summary(const Study& s, const StudyAnalysis& a) {
-  std::vector<std::pair<const Condition*, std::vector<ConditionMeasure>>> out;
+using Summaries = std::vector<std::pair<const Condition*, std::vector<ConditionMeasure>>>;
+Summaries Summary(const Study& s, const StudyAnalysis& a) {
+  Summaries out;
   for (size_t c = 0; c < s.conditions.size(); ++c) {
     std::vector<ConditionMeasure> measures;
     for (const std::string& m : SummaryMeasures()) {
@@ -118,24 +104,24 @@ std::vector<std::pair<const Condition*, std::vector<ConditionMeasure>>> Summary(
   return out;
 }
 
-std::string SummaryCsv(const Study& s, const StudyAnalysis& a) {
+std::string SummaryCsv(const Summaries& summary) {
   std::ostringstream out;
   out << "condition,label,measure,participants,trials,mean,ci_low,ci_high\n";
-  for (const auto& [c, measures] : Summary(s, a))
+  for (const auto& [c, measures] : summary)
     for (const ConditionMeasure& m : measures)
       out << c->name << ',' << c->label << ',' << m.measure << ',' << m.interval.n << ',' << m.trials << ',' << Num(m.interval.mean)
           << ',' << Num(m.interval.low) << ',' << Num(m.interval.high) << '\n';
   return out.str();
 }
 
-std::string ReportMd(const Study& s, const StudyAnalysis& a) {
+std::string ReportMd(const Study& s, const StudyAnalysis& a, const Summaries& summary) {
   std::ostringstream out;
   out << "# Study " << s.name << "\n\n" << a.trials.size() << " trial" << (a.trials.size() == 1 ? "" : "s") << " analysed";
   if (!a.missing.empty()) out << ", " << a.missing.size() << " missing (below)";
   out << ". Per condition: each participant's mean over their trials, then the mean over participants and a 95% "
          "bootstrap interval (percentile, resampling participants); \"participants\" and \"trials\" count those that "
          "have the measure.\n\n| condition | measure | participants | trials | mean | 95% interval |\n|---|---|---|---|---|---|\n";
-  for (const auto& [c, measures] : Summary(s, a))
+  for (const auto& [c, measures] : summary)
     for (const ConditionMeasure& m : measures) {
       const MeanInterval& ci = m.interval;
       out << "| " << c->name << " (" << c->label << ") | " << m.measure << " | " << ci.n << " | " << m.trials << " | "
@@ -187,12 +173,13 @@ Status WriteStudyAnalysis(const Study& study, const StudyAnalysis& a, const std:
   std::filesystem::create_directories(dir, ec);
   if (ec) return Status::IOError(dir, "cannot create the analysis folder: " + ec.message());
   const std::filesystem::path d(dir);
+  const Summaries summary = Summary(study, a);  // the bootstrap, once for both files
   const std::pair<const char*, std::string> files[] = {{"trials.csv", TrialsCsv(study, a)},
                                                        {"events.csv", EventsCsv(study, a)},
-                                                       {"summary.csv", SummaryCsv(study, a)},
-                                                       {"report.md", ReportMd(study, a)}};
+                                                       {"summary.csv", SummaryCsv(summary)},
+                                                       {"report.md", ReportMd(study, a, summary)}};
   for (const auto& [name, text] : files)
-    if (Status s = WriteFile(d / name, text); !s.ok()) return s;
+    if (Status s = tools::WriteTextFile((d / name).string(), text); !s.ok()) return s;
   const std::filesystem::path confusion = d / "reported_confusion.csv";
   if (a.reported_confusion.empty()) {
     std::filesystem::remove(confusion, ec);
@@ -202,7 +189,7 @@ Status WriteStudyAnalysis(const Study& study, const StudyAnalysis& a, const std:
   out << "reported,predicted,count\n";
   for (size_t t = 0; t < a.reported_confusion.size(); ++t)
     for (size_t p = 0; p < a.reported_confusion[t].size(); ++p) out << t << ',' << p << ',' << a.reported_confusion[t][p] << '\n';
-  return WriteFile(confusion, out.str());
+  return tools::WriteTextFile(confusion.string(), out.str());
 }
 
 }  // namespace dyad::study

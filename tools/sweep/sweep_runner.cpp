@@ -16,6 +16,7 @@
 
 #include "build_report.hpp"
 #include "run_process.hpp"
+#include "text_output.hpp"
 
 namespace dyad::sweep {
 namespace {
@@ -85,13 +86,6 @@ std::string Duration(double s) {
   if (s >= 3600) std::snprintf(buf, sizeof buf, "%dh%02dm", static_cast<int>(s / 3600), static_cast<int>(s / 60) % 60);
   else std::snprintf(buf, sizeof buf, "%dm%02ds", static_cast<int>(s / 60), static_cast<int>(s) % 60);
   return buf;
-}
-
-std::string CsvField(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
 }
 
 // What Pool runs: job i, what it is (for the log), and the file that says why it failed.
@@ -200,9 +194,9 @@ Status WriteSweepCsv(const SweepPlan& plan, const std::string& out) {
   }
   std::ostringstream csv;
   csv << "run,status";
-  for (const auto& p : plan.parameters) csv << ',' << CsvField(p);
+  for (const auto& p : plan.parameters) csv << ',' << tools::CsvCell(p);
   csv << ",seed";
-  for (const auto& m : metric_names) csv << ',' << CsvField(m);
+  for (const auto& m : metric_names) csv << ',' << tools::CsvCell(m);
   csv << '\n';
   for (size_t i = 0; i < plan.runs.size(); ++i) {
     const SweepRun& run = plan.runs[i];
@@ -211,7 +205,7 @@ Status WriteSweepCsv(const SweepPlan& plan, const std::string& out) {
       std::string v;
       for (const auto& [k, value] : run.params)
         if (k == p) v = value;
-      csv << ',' << CsvField(v);
+      csv << ',' << tools::CsvCell(v);
     }
     csv << ',' << run.seed;
     for (const auto& m : metric_names) {

@@ -336,6 +336,17 @@ TEST(Analyze, SelfReportsJoinTheirEventsAndJudgeTheObserverInASecondMatrix) {
   EXPECT_NE(std::find(counts.begin(), counts.end(), "4,5,4"), counts.end());
 }
 
+// A self-report whose choice is neither a primitive nor -1 fails the analysis, naming the message.
+TEST(Analyze, ASelfReportWithABadChoiceIsRefusedNamingTheMessage) {
+  const std::string path = WriteExperiment(TempPath("bad_report.mcap"), true, {{"yaml", kGraph}}, {{10, 20, 2}, {30, 34, -5}});
+  std::ostringstream warnings;
+  auto r = BuildReport(path, warnings);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), Status::Code::kDataLoss);
+  EXPECT_NE(r.status().message().find("topic human/self_report message 2"), std::string::npos) << r.status().ToString();
+  EXPECT_NE(r.status().message().find("field \"choice\" holds -5"), std::string::npos) << r.status().ToString();
+}
+
 // A person (no planned events): the engaged runs are the events and what the person said is their
 // primitive; "something else" leaves it unknown.
 TEST(Analyze, APersonsSelfReportsNameTheirEngagedRuns) {

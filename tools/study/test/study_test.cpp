@@ -260,12 +260,18 @@ TEST_F(StudyFile, AnalyzeMakesOneTableAcrossEveryoneAndSaysWhatIsMissing) {
   WriteTrial(trial_of.at("P01/high/2").file, 0.6, 2, 2);
   WriteTrial(trial_of.at("P02/high/1").file, 0.8, 6, 2);
   WriteTrial(trial_of.at("P02/high/2").file, 1.0, 8, 2);
+  const Trial& broken = trial_of.at("P02/low/1");  // a file that is no recording: listed with the reason
+  fs::create_directories(fs::path(broken.file).parent_path());
+  std::ofstream(broken.file) << "not an MCAP file";
 
   auto r = dyad::testing::RunCommand(dyad::cli::AddStudyCommands, {"study", "analyze", f});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("6 trials analysed, 2 missing"), std::string::npos) << r.out;
   const Trial& never = trial_of.at("P02/low/2");
   EXPECT_NE(r.out.find("P02 trial " + std::to_string(never.number) + " (" + never.file + "): not recorded"), std::string::npos) << r.out;
+  const std::string broken_line = "P02 trial " + std::to_string(broken.number) + " (" + broken.file + "): ";
+  ASSERT_NE(r.out.find(broken_line), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(broken_line + "not recorded"), std::string::npos) << "the reason, not 'not recorded':\n" << r.out;
   const fs::path out = fs::path(s.data) / "analysis";
   std::map<std::string, std::map<std::string, std::string>> summary;  // "low/measure" -> row
   for (const auto& row : dyad::testing::ReadCsv(out / "summary.csv")) summary[row.at("condition") + "/" + row.at("measure")] = row;
