@@ -18,9 +18,9 @@
 // partitions, at least one), so that what it records or plays starts with the graph's first
 // sample, not with a discovery race; what it has not matched by then is said, and it goes on.
 // Discovery is not symmetric (a graph reader may match the guest's writer a moment after the
-// writer matched it): the guest's reliable writers keep their last 100 samples whatever the
-// topic's depth (volatile ones), so such a reader gets up to 100 first samples by repair instead
-// of losing them.
+// writer matched it): a guest with writers waits 0.5 s more before its first sample, and its
+// reliable volatile writers keep their last 100 samples whatever the topic's depth, so a reader
+// later still gets up to 100 first samples by repair (late) instead of losing them.
 //
 // Returns as RunGraph does (run.hpp): 0 at a clean end (a component's RequestStop, `duration_s`,
 // SIGINT/SIGTERM: 0 too, since that is how a recording ends), 2 for a bad guest graph or a topic
