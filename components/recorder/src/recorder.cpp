@@ -47,6 +47,9 @@ void Recorder::Describe(ComponentSpec& spec) {
   spec.Param("overwrite", false).Doc(
       "replace an existing file (false: an existing file is an error, nothing is recorded over it); either way the "
       "file is created 0600 and never through a symlink");
+  spec.Param("metadata", std::vector<std::string>{}).Doc(
+      "KEY=VALUE entries kept in the file as its \"dyad.run\" metadata (who ran it and why: `dyad study run` names the "
+      "study, participant, condition and trial)");
   spec.Param("topics", std::vector<std::string>{}).Doc("topic names or regexes (whole-name match); empty: every graph topic");
   spec.Param("chunk_size", int64_t{256 * 1024}).Range(1024, 1024.0 * 1024 * 1024).Unit("bytes").Doc("uncompressed bytes per chunk");
   spec.Param("compression", "zstd").OneOf({"zstd", "none"}).Doc("chunk compression");
@@ -79,6 +82,15 @@ Status Recorder::Configure(Context& ctx) {
   options_.library = "dyad recorder";
   if (Status s = options_.Validate(); !s.ok()) return Status::InvalidArgument("params: " + s.message());
   flush_period_s_ = ctx.stepped() ? 0.0 : p.Double("flush_period_s");
+  run_metadata_.clear();
+  for (const std::string& entry : p.StringList("metadata")) {
+    const size_t eq = entry.find('=');
+    if (eq == std::string::npos || eq == 0)
+      return Status::InvalidArgument("params.metadata: '" + entry + "' is not KEY=VALUE");
+    const std::string key = entry.substr(0, eq);
+    if (run_metadata_.count(key)) return Status::InvalidArgument("params.metadata: key '" + key + "' is given twice");
+    run_metadata_[key] = entry.substr(eq + 1);
+  }
 
   std::vector<std::string> names;
   for (const auto& t : ctx.graph_topics()) names.push_back(t.name);
@@ -142,6 +154,8 @@ Status Recorder::OpenFile() {
                                                      {"folder", ctx_->graph_folder()}});
       !s.ok())
     return s;
+  if (!run_metadata_.empty())
+    if (Status s = writer_->AddMetadata("dyad.run", run_metadata_); !s.ok()) return s;
   thread_ = std::thread([this] { WriterLoop(); });
   const std::string list = JoinList(channels_, [](const auto& c) -> const std::string& { return c->topic->name; });
   ctx_->log().Info("recording " + std::to_string(channels_.size()) + " topic(s) into " + path_ + ": " + list);

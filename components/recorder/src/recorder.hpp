@@ -7,6 +7,9 @@
 /// params:
 ///   file (string, "{graph}-{time}.mcap"): output path; {graph} = graph name, {time} = local
 ///        start time YYYYMMDD-HHMMSS. Missing parent folders are created.
+///   metadata (string list, []): KEY=VALUE entries written as the file's "dyad.run" metadata
+///        record (who ran it and why: `dyad study run` names study, participant, condition,
+///        trial); a malformed entry or a key given twice is an error.
 ///   topics (string list, []): topic names or regular expressions (whole-name match); empty:
 ///        every topic of the graph, dyad/stats included.
 ///   chunk_size (int, 262144 bytes, 1 KiB .. 1 GiB): uncompressed bytes per MCAP chunk.
@@ -24,7 +27,7 @@
 /// timestamp (= its header stamp for dyad writers; both Unix ns under the wall clock, simulated
 /// ns under the stepped clock), sequence = the writer's sequence number (low 32 bits); zstd
 /// chunks; a summary section; metadata "dyad.graph" {name, clock, yaml} with the graph file as
-/// run (--set overrides applied).
+/// run (--set overrides applied); metadata "dyad.run" with the `metadata` param's entries, when any.
 ///
 /// Threads: samples are copied into a RecordQueue on the delivering thread (a lock and a memcpy);
 /// one writer thread owned by the recorder writes and compresses chunks. Deactivate() (normal end,
@@ -39,6 +42,7 @@
 #pragma once
 
 #include <atomic>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -78,6 +82,7 @@ class Recorder final : public Component {
   std::string path_;
   mcap::WriterOptions options_;
   double flush_period_s_ = 1.0;
+  std::map<std::string, std::string> run_metadata_;  // params.metadata
   std::vector<std::unique_ptr<Channel>> channels_;  // channel id = index + 1
   std::unique_ptr<RecordQueue> queue_;
   std::unique_ptr<mcap::Writer> writer_;

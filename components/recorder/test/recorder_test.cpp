@@ -244,7 +244,8 @@ class RecorderTest : public ::testing::Test {
 };
 
 TEST_F(RecorderTest, SteppedGraphRecordsEverySampleOfThreePublishersReadBackByMcapCore) {
-  const fs::path graph = Write("g.yaml", ThreePublishers("stepped", 100, 100, 50, "file: '" + (dir_ / "{graph}.mcap").string() + "'"));
+  const fs::path graph = Write("g.yaml", ThreePublishers("stepped", 100, 100, 50, "file: '" + (dir_ / "{graph}.mcap").string() +
+                                                                       "', metadata: [study=gain, participant=P01, 'note=a=b, c']"));
   ASSERT_EQ(Run({"run", graph.string(), "--steps", "300", "--quiet"}), 0);
   const fs::path file = dir_ / "rec3.mcap";  // {graph} substituted
   ASSERT_TRUE(fs::exists(file));
@@ -287,6 +288,11 @@ TEST_F(RecorderTest, SteppedGraphRecordsEverySampleOfThreePublishersReadBackByMc
       EXPECT_EQ(md.entries.at("folder"), std::filesystem::absolute(graph).parent_path().lexically_normal().string());
     }
   EXPECT_TRUE(has_graph);
+  // What the launcher said about the run (params.metadata; `dyad study run` gives it by --set).
+  std::map<std::string, std::string> run;
+  for (const auto& md : r.metadata)
+    if (md.name == "dyad.run") run = md.entries;
+  EXPECT_EQ(run, (std::map<std::string, std::string>{{"study", "gain"}, {"participant", "P01"}, {"note", "a=b, c"}}));
   EXPECT_EQ(CheckWithNode(file, r, false), "");
   EXPECT_EQ(CheckWithNode(file, r, true), "");
   EXPECT_EQ(DecodeWithFoxglove(file), "") << "every message decodes with its omgidl schema, header sequence = MCAP sequence";
@@ -598,6 +604,10 @@ INSTANTIATE_TEST_SUITE_P(
                  "x: activate failed: params.file = '/proc/dyad/x.mcap'"},
         BadParam{"ExistingFileNotOverwritten", "{type: recorder, rate_hz: 1, params: {file: DIR/not.mcap}}",
                  "params.file = '"},
+        BadParam{"MetadataWithoutEquals", "{type: recorder, rate_hz: 1, params: {file: DIR/x.mcap, metadata: [study]}}",
+                 "params.metadata: 'study' is not KEY=VALUE"},
+        BadParam{"MetadataKeyTwice", "{type: recorder, rate_hz: 1, params: {file: DIR/x.mcap, metadata: [a=1, a=2]}}",
+                 "params.metadata: key 'a' is given twice"},
         BadParam{"UnknownCompression", "{type: recorder, rate_hz: 1, params: {compression: lz4}}",
                  "components.x.params.compression: must be one of: zstd, none"},
         BadParam{"ChunkTooSmall", "{type: recorder, rate_hz: 1, params: {chunk_size: 10}}",
