@@ -1,31 +1,56 @@
 #include "run_process.hpp"
 
+#include <errno.h>
 #include <fcntl.h>
-#include <spawn.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <unistd.h>
 #include <sys/wait.h>
 
-extern char** environ;
 
 namespace dyad::tools {
 
-int RunProcess(const std::vector<std::string>& args, const std::string& log) {
-  if (args.empty()) return 127;
+int StartProcess(const std::vector<std::string>& args, const std::string& log, bool own_group) {
+  if (args.empty()) return -1;
   std::vector<char*> argv;
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid != 0) return pid;  // -1: not started
+  // The child, until exec: async-signal-safe calls only.
   if (!log.empty()) {
-    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (fd < 0 || dup2(fd, 1) < 0 || dup2(fd, 2) < 0) _exit(127);
   }
-  pid_t pid = 0;
-  const int started = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (started != 0) return 127;
+  if (own_group) {
+    setpgid(0, 0);
+    // Its caller manages its end: when the caller dies, the child is stopped as by Ctrl-C.
+    prctl(PR_SET_PDEATHSIG, SIGINT);
+    if (getppid() != parent) _exit(127);  // the caller died before prctl
+  }
+  execvp(argv[0], argv.data());
+  _exit(127);
+}
+
+int WaitProcess(int pid) {
   int status = 0;
-  if (waitpid(pid, &status, 0) < 0) return 127;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return 127;  // a signal handled meanwhile (a study's Ctrl-C) is not the child's end
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+bool ProcessEnded(int pid, int* code) {
+  int status = 0;
+  const pid_t r = waitpid(pid, &status, WNOHANG);
+  if (r == 0 || (r < 0 && errno == EINTR)) return false;
+  *code = r < 0 ? 127 : WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return true;
+}
+
+int RunProcess(const std::vector<std::string>& args, const std::string& log) {
+  const int pid = StartProcess(args, log, false);
+  return pid < 0 ? 127 : WaitProcess(pid);
 }
 
 std::string ShellQuoted(const std::vector<std::string>& args) {

@@ -7,6 +7,12 @@
 //     (created 0600, or truncated).
 //   - Returns the child's exit status, 128 + N when signal N ended it, 127 when it could not be
 //     started. Thread-safe (each call waits for its own child only).
+// StartProcess(args, log, own_group) and WaitProcess(pid): the same in two halves, for a caller
+// that signals the child meanwhile; own_group puts the child in a process group of its own, so a
+// terminal's Ctrl-C reaches only the caller (which decides what the child gets), and the child
+// gets SIGINT when the caller dies (a graph is never left running unsupervised). StartProcess
+// returns -1 when no child could be made (127 from WaitProcess when the program could not be
+// started); WaitProcess returns as RunProcess does.
 // ShellQuoted(args): the command line a POSIX shell turns back into exactly `args` (arguments
 // with anything but [A-Za-z0-9_./=:,+@%-] in single quotes), for logs and generated scripts.
 #pragma once
@@ -17,6 +23,9 @@
 namespace dyad::tools {
 
 int RunProcess(const std::vector<std::string>& args, const std::string& log = "");
+int StartProcess(const std::vector<std::string>& args, const std::string& log, bool own_group);
+int WaitProcess(int pid);
+bool ProcessEnded(int pid, int* status);  // without waiting: true (and *status as above) once it has
 std::string ShellQuoted(const std::vector<std::string>& args);
 
 }  // namespace dyad::tools

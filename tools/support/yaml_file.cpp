@@ -27,7 +27,8 @@ std::string SetText(const YAML::Node& node) {
 
 std::string PathBeside(const std::string& file, const std::string& path) {
   std::filesystem::path p(path);
-  if (p.is_relative()) p = std::filesystem::absolute(std::filesystem::path(file).parent_path()) / p;
+  // absolute(file) first: a bare "s.yaml" has an empty parent, which absolute() refuses.
+  if (p.is_relative()) p = std::filesystem::absolute(file).parent_path() / p;
   return p.lexically_normal().string();
 }
 
