@@ -8,7 +8,6 @@
 #include <fstream>
 #include <mutex>
 #include <optional>
-#include <random>
 #include <set>
 
 #include <sys/stat.h>
@@ -78,14 +77,6 @@ StatusOr<std::map<Role, std::string>> ReadTokenFile(const std::string& path) {
   return tokens;
 }
 
-std::string RandomToken() {
-  std::random_device rd;
-  static const char* hex = "0123456789abcdef";
-  std::string t;
-  for (int i = 0; i < 32; ++i) t.push_back(hex[rd() % 16]);
-  return t;
-}
-
 // Every (process, component) of the graph as run, placed as the runtime places them.
 std::set<std::pair<std::string, std::string>> GraphsComponents(const Context& ctx) {
   std::vector<Diagnostic> diags;  // the runtime parsed this text before: none
@@ -140,12 +131,18 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Param("engage_key", "Space").Doc("subject's page: the key (KeyboardEvent.code) that engages while held, besides the mouse button");
   spec.Param("half_width", 50.0).Min(1e-6).Doc("subject's page: the workspace drawn is [-half_width, half_width]^2 (the study's 50)");
   spec.Param("show_primitives", false).Doc("subject's page: draw the data set's primitives as a faint watermark");
-  spec.Param("dataset", "").Path().Doc("subject's page: NRL data set folder of the primitives (with show_primitives)");
+  spec.Param("dataset", "").Path().Doc("subject's page: NRL data set folder of the primitives (the watermark, the question's thumbnails)");
+  spec.Param("self_reports", "after_event").OneOf({"after_event", "off"}).Doc(
+      "subject's page: with `self_report` bound, ask \"What were you drawing?\" after each release (the data set's "
+      "primitives as thumbnails, and \"something else\")");
+  spec.Param("self_report_min_hold_s", 1.0).Min(0).Unit("s").Doc("subject's page: ask only after a hold at least this long");
   spec.Input<msg::CartesianState>("robot").Optional().Doc("robot state shown on the subject's page");
   spec.Input<msg::Intention>("intention").Optional().Doc("experimenter's page: the deliberator's N-ELBO");
   spec.Input<msg::IntentionLabel>("labels").Optional().Doc("experimenter's page: the observer's P(C_t) and labels");
   spec.Output<msg::Annotation>("notes").Doc("experimenter's notes (record this topic to align them with the run)");
   spec.Output<msg::HumanInput>("pointer").Doc("the steering page's pointer, at the browser's event rate (to web_human)");
+  spec.Output<msg::SelfReport>("self_report").Optional().Doc(
+      "the subject's answers: choice, response time from the release, the hold's start and end (runtime clock)");
 }
 
 Status WebComponent::Configure(Context& ctx) {
@@ -211,8 +208,13 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
   SubjectChannel::Options so;
   so.engage_key = p.String("engage_key");
   so.half_width = p.Double("half_width");
-  if (p.Bool("show_primitives")) {
-    if (p.String("dataset").empty()) return Status::InvalidArgument("params.show_primitives: needs params.dataset (an NRL data set folder)");
+  reports_ = &ctx.output<msg::SelfReport>("self_report");
+  so.watermark = p.Bool("show_primitives");
+  so.ask = reports_->bound() && p.String("self_reports") == "after_event";
+  so.ask_after_hold_s = p.Double("self_report_min_hold_s");
+  if (so.watermark || so.ask) {
+    const std::string why = so.watermark ? "params.show_primitives" : "params.self_reports (the question's thumbnails)";
+    if (p.String("dataset").empty()) return Status::InvalidArgument(why + ": needs params.dataset (an NRL data set folder)");
     auto data = pvrnn::LoadNrlDataset(p.String("dataset"));
     if (!data.ok()) return data.status().WithContext("params.dataset");
     for (const auto& seq : data->sequences) {
@@ -224,13 +226,35 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
   }
   robot_ = &ctx.input<msg::CartesianState>("robot");
   pointer_ = &ctx.output<msg::HumanInput>("pointer");
-  subject_ = std::make_unique<SubjectChannel>(so, [this](double x, double y, bool engaged) {
-    pointer_sample_.x(x);
-    pointer_sample_.y(y);
-    pointer_sample_.engaged(engaged);
-    // Serialised by SubjectChannel (component.hpp: one Output's Publish calls must not overlap).
-    if (Status s = pointer_->Publish(pointer_sample_); !s.ok()) ctx_->log().Warn("pointer: " + s.ToString());
-  });
+  // Both sinks are serialised by SubjectChannel (component.hpp: one Output's Publish calls must
+  // not overlap), so the hold they share needs no lock of its own.
+  subject_ = std::make_unique<SubjectChannel>(
+      so,
+      [this](double x, double y, bool engaged) {
+        const int64_t now = ctx_->clock().now_ns();
+        if (engaged && !holding_) hold_start_ns_ = now;
+        if (!engaged && holding_) hold_end_ns_ = now, answerable_ = true;
+        holding_ = engaged;
+        pointer_sample_.x(x);
+        pointer_sample_.y(y);
+        pointer_sample_.engaged(engaged);
+        if (Status s = pointer_->Publish(pointer_sample_); !s.ok()) ctx_->log().Warn("pointer: " + s.ToString());
+      },
+      [this](int choice) { return PublishSelfReport(choice); });
+  return Status::OK();
+}
+
+// The answer about the last hold, once (a second click, or an answer while holding again, is ignored).
+Status WebComponent::PublishSelfReport(int choice) {
+  if (!answerable_ || holding_) return Status::OK();
+  answerable_ = false;
+  const int64_t now = ctx_->clock().now_ns();
+  msg::SelfReport r;
+  r.choice(choice);
+  r.response_s(static_cast<double>(now - hold_end_ns_) * 1e-9);
+  r.segment_start_ns(hold_start_ns_);
+  r.segment_end_ns(hold_end_ns_);
+  if (Status s = reports_->Publish(r); !s.ok()) ctx_->log().Warn("self_report: the subject's answer was lost: " + s.ToString());
   return Status::OK();
 }
 

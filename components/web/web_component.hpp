@@ -1,5 +1,8 @@
 /// The `web` component: one embedded web server per process (civetweb) with
-///   - `/subject`: the subject's page (steer the robot with the mouse; see web_human.hpp),
+///   - `/subject`: the subject's page (steer the robot with the mouse; see web_human.hpp; after
+///     each release of a hold of at least `self_report_min_hold_s`, when `self_report` is bound,
+///     it asks "What were you drawing?" and the answer leaves on `self_report` with the hold's
+///     start and end on the runtime clock),
 ///   - `/experimenter`: the experimenter's page,
 ///   - `/`: an index page, and the Foxglove WebSocket bridge over the graph's topics for
 ///     Foxglove ("Foxglove WebSocket" connection to ws://ADDRESS:PORT).
@@ -49,6 +52,7 @@ class WebComponent final : public Component {
   Status ConfigureExperimenter(Context& ctx);
   void ConfigurePages();
   StatusOr<std::string> PublishParamRequest(const ParamRequest& request);  // ExperimenterChannel's param sink
+  Status PublishSelfReport(int choice);                                    // SubjectChannel's report sink
   Context* ctx_ = nullptr;
   WebServer::Options options_;
   std::string port_file_;
@@ -76,6 +80,11 @@ class WebComponent final : public Component {
   std::unique_ptr<SubjectChannel> subject_;
   std::unique_ptr<WebServer> server_;
   msg::HumanInput pointer_sample_;
+  Output<msg::SelfReport>* reports_ = nullptr;  // owned by the runtime; may be unbound
+  // The steering page's last hold (runtime clock), for its self-report; touched only by the
+  // subject channel's sinks, which it serialises.
+  bool holding_ = false, answerable_ = false;
+  int64_t hold_start_ns_ = 0, hold_end_ns_ = 0;
 };
 
 }  // namespace dyad::web

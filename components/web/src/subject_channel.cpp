@@ -70,7 +70,10 @@ void SubjectChannel::OnOpen(ClientId client, Role role) {
                                 {"half_width", options_.half_width},
                                 {"engage_key", options_.engage_key},
                                 {"role", RoleName(role)},
-                                {"primitives", prims}}
+                                {"primitives", prims},
+                                {"watermark", options_.watermark},
+                                {"ask", options_.ask && static_cast<bool>(report_)},
+                                {"ask_after_hold_s", options_.ask_after_hold_s}}
                                .dump());
 }
 
@@ -124,6 +127,17 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
     if (previous != 0) SendRole(previous, false);
     SendRole(client, true);
     return Status::OK();
+  }
+  if (*op == "self_report") {
+    auto choice = j.find("choice");
+    const int last = static_cast<int>(options_.primitives.size()) - 1;
+    if (choice == j.end() || !choice->is_number_integer() || choice->get<int64_t>() < -1 || choice->get<int64_t>() > last)
+      return Status::InvalidArgument("self_report: needs an integer \"choice\" in -1.." + std::to_string(last) +
+                                     " (a primitive, or -1: something else)");
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("self_report: a viewer's token may not answer");
+    if (client != steering_ || !report_ || !options_.ask) return Status::OK();  // nobody asked this page
+    return report_(static_cast<int>(choice->get<int64_t>()));
   }
   return Status::InvalidArgument("unknown op");
 }

@@ -3,8 +3,11 @@
 ///
 /// Page -> server (JSON text): {"op":"pointer","x":..,"y":..,"engaged":bool,"t":ms} on every
 /// pointer or key event and every 50 ms while engaged (a keepalive); {"op":"steer"} to take the
-/// steering role. Server -> page: {"op":"hello",...} (role, steering, workspace, engage key,
-/// primitives for the watermark), {"op":"role","steering":bool}, {"op":"state","x","y"} (newest
+/// steering role; {"op":"self_report","choice":k} the subject's answer to "What were you
+/// drawing?" (k: a primitive's index, -1 "something else"; from the steering page only, a viewer's
+/// is refused). Server -> page: {"op":"hello",...} (role, steering, workspace, engage key,
+/// primitives, whether they are a watermark, whether and after how long a hold to ask),
+/// {"op":"role","steering":bool}, {"op":"state","x","y"} (newest
 /// only: a slow page never builds a backlog), {"op":"ack","t":ms} after each pointer sample was
 /// published (the page measures the round trip). A pointer sample may carry "wall" (the event's
 /// time, ms since the epoch): the channel then keeps the event-to-publication delay.
@@ -33,12 +36,19 @@ class SubjectChannel final : public ClientHandler {
   struct Options {
     std::string engage_key = "Space";  // KeyboardEvent.code; the mouse button always engages
     double half_width = 50;            // the workspace is [-half_width, half_width]^2
-    std::vector<std::vector<std::array<double, 2>>> primitives;  // watermark; empty: none
+    std::vector<std::vector<std::array<double, 2>>> primitives;  // for the watermark and the question
+    bool watermark = true;          // draw the primitives faintly behind the workspace
+    bool ask = false;               // ask "What were you drawing?" after each release
+    double ask_after_hold_s = 1.0;  // ... of a hold at least this long (a tap is no event)
   };
   // Publishes one pointer sample on the graph (called on civetweb threads, serialised here).
   using PointerSink = std::function<void(double x, double y, bool engaged)>;
 
-  SubjectChannel(Options options, PointerSink sink) : options_(std::move(options)), sink_(std::move(sink)) {}
+  // Publishes the steering page's answer (called like PointerSink); its Status goes back to the page.
+  using ReportSink = std::function<Status(int choice)>;
+
+  SubjectChannel(Options options, PointerSink sink, ReportSink report = {})
+      : options_(std::move(options)), sink_(std::move(sink)), report_(std::move(report)) {}
   void SetServer(WebServer* server);
   // Sends the robot's position to every page (newest only).
   void BroadcastState(double x, double y);
@@ -63,6 +73,7 @@ class SubjectChannel final : public ClientHandler {
   void SendRole(ClientId client, bool steering);
   const Options options_;
   const PointerSink sink_;
+  const ReportSink report_;
   std::atomic<WebServer*> server_{nullptr};
   mutable std::mutex mutex_;  // guards the members below and serialises sink_ calls
   std::vector<ClientId> pages_;  // in connection order

@@ -18,8 +18,18 @@
 #include <deque>
 #include <cstring>
 #include <filesystem>
+#include <random>
 
 namespace dyad::web {
+
+std::string RandomToken() {
+  std::random_device rd;
+  static const char* hex = "0123456789abcdef";
+  std::string t;
+  for (int i = 0; i < 32; ++i) t.push_back(hex[rd() % 16]);
+  return t;
+}
+
 namespace {
 
 constexpr int kCloseTooBig = 1009, kCloseUnsupported = 1003, kClosePolicy = 1008;
@@ -280,6 +290,8 @@ StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
     page.uri = uri;
     mg_set_request_handler(s->ctx_, uri.c_str(), &WebServer::OnPage, &page);
   }
+  // Every other path is ours to answer too: civetweb's own 404 (no document root) crashes.
+  if (!s->options_.pages.count("/")) mg_set_request_handler(s->ctx_, "/", &WebServer::OnPage, &s->not_found_);
   for (const auto& e : s->options_.endpoints) {
     auto st = std::make_unique<EndpointState>();
     st->server = s.get();

@@ -65,6 +65,9 @@ const char* RoleName(Role role);
 // nothing.
 bool TokenMatches(std::string_view given, std::string_view expected);
 
+// A new token: 32 hex digits from std::random_device.
+std::string RandomToken();
+
 // The URLs' host for a server bound to `address`: itself, or for a wildcard (0.0.0.0, ::) this
 // machine's IPv4 addresses other than loopback (loopback when it has none).
 std::vector<std::string> UrlHosts(const std::string& address);
@@ -163,6 +166,7 @@ class WebServer {
   std::shared_ptr<Client> Find(ClientId id) const;
 
   Options options_;
+  Page not_found_{"", "", {}, "\n"};  // "/" when no page is: its URI matches no request (404)
   std::unique_ptr<HandlerThread> handler_thread_;  // runs OnText/OnBinary (see web_server.cpp)
   int64_t message_received_ns_ = 0;                 // written and read on the handler thread only
   mg_context* ctx_ = nullptr;

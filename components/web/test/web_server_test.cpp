@@ -133,6 +133,18 @@ TEST(WebServer, APageNeedsATokenOfARoleItAdmits) {
   EXPECT_NE(ok.find("X-Frame-Options: DENY"), std::string::npos);
 }
 
+// A server without a "/" page (the study page's) answers 404 for any other path; civetweb's own
+// error path (no document root) crashed on the browser's /favicon.ico.
+TEST(WebServer, AnyOtherPathIsNotFound) {
+  RecordingHandler handler;
+  auto server = WebServer::Start(TestOptions(&handler));
+  ASSERT_TRUE(server.ok()) << server.status().ToString();
+  const int port = (*server)->port();
+  for (const std::string& path : std::vector<std::string>{"/favicon.ico", "/", "/watch/more?token=" + kViewer, "/nope?token=" + kViewer})
+    EXPECT_EQ(Get(port, path).rfind("HTTP/1.1 404", 0), 0u) << path;
+  EXPECT_EQ(Get(port, "/watch?token=" + kViewer).rfind("HTTP/1.1 200", 0), 0u) << "the server survived";
+}
+
 TEST(WebServer, AWebSocketNeedsATokenOfARoleItsEndpointAdmits) {
   RecordingHandler handler;
   auto server = WebServer::Start(TestOptions(&handler));

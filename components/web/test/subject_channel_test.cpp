@@ -1,0 +1,62 @@
+// SubjectChannel's answers to "What were you drawing?": only the steering page's, only when
+// asked, only a primitive of the data set or -1, and a viewer's refused (it closes the page).
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "subject_channel.hpp"
+
+namespace dyad::web {
+namespace {
+
+struct Answers {
+  std::vector<int> choices;
+  SubjectChannel Channel(bool ask) {
+    SubjectChannel::Options o;
+    o.primitives.assign(7, {{0.0, 0.0}, {1.0, 1.0}});
+    o.ask = ask;
+    return SubjectChannel(o, [](double, double, bool) {}, [this](int c) {
+      choices.push_back(c);
+      return Status::OK();
+    });
+  }
+};
+
+TEST(SubjectChannel, TheSteeringPagesAnswerReachesTheGraph) {
+  Answers a;
+  SubjectChannel ch = a.Channel(true);
+  ch.OnOpen(1, Role::kSubject);  // steers: the first subject page
+  ch.OnOpen(2, Role::kSubject);  // watches
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":6})").ok());
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":-1})").ok());
+  ASSERT_TRUE(ch.OnText(2, R"({"op":"self_report","choice":3})").ok()) << "a watching page is ignored, not closed";
+  EXPECT_EQ(a.choices, (std::vector<int>{6, -1}));
+}
+
+TEST(SubjectChannel, ABadAnswerOrAViewersIsRefused) {
+  Answers a;
+  SubjectChannel ch = a.Channel(true);
+  ch.OnOpen(1, Role::kSubject);
+  ch.OnOpen(3, Role::kViewer);
+  for (const char* bad : {R"({"op":"self_report","choice":7})", R"({"op":"self_report","choice":-2})",
+                          R"({"op":"self_report","choice":1.5})", R"({"op":"self_report"})", R"({"op":"self_report","choice":"2"})"}) {
+    const Status s = ch.OnText(1, bad);
+    EXPECT_EQ(s.code(), Status::Code::kInvalidArgument) << bad;
+    EXPECT_NE(s.message().find("needs an integer \"choice\" in -1..6"), std::string::npos) << s.message();
+  }
+  const Status viewer = ch.OnText(3, R"({"op":"self_report","choice":1})");
+  EXPECT_EQ(viewer.code(), Status::Code::kFailedPrecondition);
+  EXPECT_NE(viewer.message().find("a viewer's token may not answer"), std::string::npos) << viewer.message();
+  EXPECT_TRUE(a.choices.empty());
+}
+
+TEST(SubjectChannel, AnAnswerNobodyAskedForIsIgnored) {
+  Answers a;
+  SubjectChannel ch = a.Channel(false);  // the graph records no answers
+  ch.OnOpen(1, Role::kSubject);
+  EXPECT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":2})").ok());
+  EXPECT_TRUE(a.choices.empty());
+}
+
+}  // namespace
+}  // namespace dyad::web
