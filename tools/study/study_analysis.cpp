@@ -1,11 +1,16 @@
 #include "study_analysis.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <set>
+#include <tuple>
 #include <filesystem>
 #include <map>
 #include <sstream>
 
 #include "bootstrap.hpp"
+#include "dyad/mcap/reader.hpp"
+#include "study_session.hpp"
 #include "build_report.hpp"
 #include "text_output.hpp"
 
@@ -37,13 +42,13 @@ void AddConfusion(const std::vector<std::vector<int64_t>>& m, std::vector<std::v
 
 std::string TrialsCsv(const Study& s, const StudyAnalysis& a) {
   std::ostringstream out;
-  out << "participant,condition,label,trial,repetition,file";
+  out << "participant,condition,label,trial,repetition,attempt,file";
   for (const auto& [name, value] : analyze::RunMetrics(analyze::Report{})) out << ',' << name;  // the same names for every trial
   out << '\n';
   for (const TrialResult& r : a.trials) {
     const Condition& c = s.conditions[static_cast<size_t>(r.trial.condition)];
     out << r.participant << ',' << c.name << ',' << c.label << ',' << r.trial.number << ',' << r.trial.repetition << ','
-        << tools::CsvCell(r.trial.file);
+        << r.attempt << ',' << tools::CsvCell(r.trial.file);
     for (const auto& [name, value] : r.metrics) out << ',' << Num(value);
     out << '\n';
   }
@@ -137,6 +142,26 @@ std::string ReportMd(const Study& s, const StudyAnalysis& a, const Summaries& su
     out << "\n## Missing trials\n\n";
     for (const std::string& m : a.missing) out << "- " << m << "\n";
   }
+  if (!a.reports_vs_plan.empty()) {
+    int64_t all = 0, wrong = 0;
+    for (const auto& [pair, n] : a.reports_vs_plan) all += n, wrong += pair.first != pair.second ? n : 0;
+    out << "\n## Self-reports against the plan (synthetic participants)\n\n" << wrong << " of " << all
+        << " self-reports name another primitive than the one traced (" << Num(100.0 * static_cast<double>(wrong) / static_cast<double>(all))
+        << "%; -1: \"something else\"); reports_vs_plan.csv has every pair.\n\n| traced | reported | events |\n|---|---|---|\n";
+    for (const auto& [pair, n] : a.reports_vs_plan)
+      if (pair.first != pair.second) out << "| " << pair.first << " | " << pair.second << " | " << n << " |\n";
+  }
+  bool any_repeated = false;
+  for (const TrialResult& r : a.trials) {
+    if (r.repeated.empty()) continue;
+    if (!any_repeated) out << "\n## Repeated trials\n\n";
+    any_repeated = true;
+    out << "- " << r.participant << " trial " << r.trial.number << ": " << r.repeated << "\n";
+  }
+  if (!a.unplanned.empty()) {
+    out << "\n## Files not in the plan (not analysed)\n\n";
+    for (const std::string& f : a.unplanned) out << "- " << f << "\n";
+  }
   return out.str();
 }
 
@@ -148,23 +173,100 @@ const std::vector<std::string>& SummaryMeasures() {
   return m;
 }
 
-StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings) {
+std::string NotThisTrial(const std::string& file, const Study& study, const std::string& participant, const Trial& trial,
+                         bool rehearsal) {
+  auto reader = mcap::Reader::Open(file);
+  if (!reader.ok()) return reader.status().message();
+  const std::map<std::string, std::string>* run = nullptr;
+  for (const auto& md : reader->metadata())
+    if (md.name == "dyad.run") run = &md.entries;
+  if (!run) return "no study metadata (\"dyad.run\"): not recorded by dyad study run";
+  auto get = [&](const char* key) {
+    const auto it = run->find(key);
+    return it == run->end() ? std::string("(none)") : it->second;
+  };
+  if (get("study") != study.name) return "a recording of study " + get("study") + ", not " + study.name;
+  if (get("participant") != participant) return "a recording of participant " + get("participant");
+  if (get("trial") != std::to_string(trial.number)) return "a recording of trial " + get("trial");
+  if ((get("rehearsal") == "true") != rehearsal)
+    return rehearsal ? "a recording of a participant, not of the rehearsal" : "a rehearsal's recording (synthetic participant)";
+  return "";
+}
+
+namespace {
+
+// The attempt of `t` to analyse, or the reason there is none (session: the participant's log).
+struct Chosen {
+  std::string file, why_not, repeated;
+  int attempt = 1;
+};
+Chosen ChooseAttempt(const Session& session, const Trial& t) {
+  Chosen c;
+  c.file = t.file;
+  const Attempt* done = session.Complete(t.number);
+  auto add = [&c](const Attempt& a, const std::string& fate) {
+    c.repeated += (c.repeated.empty() ? "" : "; ") + ("attempt " + std::to_string(a.attempt) + " " + fate) +
+                  (a.reason.empty() ? "" : ", repeated because: " + a.reason);
+  };
+  for (const Attempt& a : session.attempts) {
+    if (a.trial != t.number) continue;
+    if (&a == done) add(a, "analysed");
+    else add(a, a.outcome.empty() ? "ended with the session" : a.outcome);
+  }
+  if (done) {
+    c.file = done->file;
+    c.attempt = done->attempt;
+    if (done->attempt == 1 && c.repeated == "attempt 1 analysed") c.repeated.clear();
+  } else if (session.Last(t.number)) {
+    c.why_not = "incomplete (" + c.repeated + ")";
+  }
+  return c;
+}
+
+}  // namespace
+
+StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehearsal) {
   StudyAnalysis a;
-  for (const std::string& p : study.participants)
+  namespace fs = std::filesystem;
+  for (const std::string& p : study.participants) {
+    const Session session = ReadSession(study, p);
+    for (const std::string& problem : session.problems) warnings << "warning: " << problem << "\n";
+    std::set<std::string> planned;
     for (const Trial& t : study.TrialsOf(p)) {
-      const std::string name = p + " trial " + std::to_string(t.number) + " (" + t.file + ")";
-      if (!std::filesystem::exists(t.file)) {
+      for (int k = 1; k <= 99; ++k) planned.insert(fs::path(AttemptFile(t, k)).filename().string());
+      const Chosen c = ChooseAttempt(session, t);
+      const std::string name = p + " trial " + std::to_string(t.number) + " (" + c.file + ")";
+      if (!c.why_not.empty()) {
+        a.missing.push_back(name + ": " + c.why_not);
+        continue;
+      }
+      if (!fs::exists(c.file)) {
         a.missing.push_back(name + ": not recorded");
         continue;
       }
-      auto report = analyze::BuildReport(t.file, warnings);
+      if (std::string why = NotThisTrial(c.file, study, p, t, rehearsal); !why.empty()) {
+        a.missing.push_back(name + ": " + why);
+        continue;
+      }
+      auto report = analyze::BuildReport(c.file, warnings);
       if (!report.ok()) {
         a.missing.push_back(name + ": " + report.status().message());
         continue;
       }
-      a.trials.push_back({p, t, analyze::RunMetrics(*report), report->events});
+      TrialResult r{p, t, c.attempt, !report->plan.events.empty(), c.repeated, analyze::RunMetrics(*report), report->events};
+      r.trial.file = c.file;
+      if (r.planned)
+        for (const analyze::EventSummary& e : r.events)
+          if (e.event.primitive >= 0 && e.event.reported != analyze::kNotReported) ++a.reports_vs_plan[{e.event.primitive, e.event.reported}];
+      a.trials.push_back(std::move(r));
       AddConfusion(report->reported_confusion, &a.reported_confusion);
     }
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(fs::path(study.data) / p, ec))
+      if (entry.path().extension() == ".mcap" && !planned.count(entry.path().filename().string()))
+        a.unplanned.push_back(entry.path().string());
+  }
+  std::sort(a.unplanned.begin(), a.unplanned.end());
   return a;
 }
 
@@ -180,16 +282,21 @@ Status WriteStudyAnalysis(const Study& study, const StudyAnalysis& a, const std:
                                                        {"report.md", ReportMd(study, a, summary)}};
   for (const auto& [name, text] : files)
     if (Status s = tools::WriteTextFile((d / name).string(), text); !s.ok()) return s;
-  const std::filesystem::path confusion = d / "reported_confusion.csv";
-  if (a.reported_confusion.empty()) {
-    std::filesystem::remove(confusion, ec);
-    return Status::OK();
-  }
-  std::ostringstream out;
-  out << "reported,predicted,count\n";
+  // The two matrices exist only when there is something in them (an old file goes).
+  std::ostringstream confusion, vs_plan;
+  confusion << "reported,predicted,count\n";
   for (size_t t = 0; t < a.reported_confusion.size(); ++t)
-    for (size_t p = 0; p < a.reported_confusion[t].size(); ++p) out << t << ',' << p << ',' << a.reported_confusion[t][p] << '\n';
-  return tools::WriteTextFile(confusion.string(), out.str());
+    for (size_t p = 0; p < a.reported_confusion[t].size(); ++p) confusion << t << ',' << p << ',' << a.reported_confusion[t][p] << '\n';
+  vs_plan << "planned,reported,events\n";
+  for (const auto& [pair, n] : a.reports_vs_plan) vs_plan << pair.first << ',' << pair.second << ',' << n << '\n';
+  const std::tuple<const char*, bool, std::string> optional[] = {
+      {"reported_confusion.csv", !a.reported_confusion.empty(), confusion.str()},
+      {"reports_vs_plan.csv", !a.reports_vs_plan.empty(), vs_plan.str()}};
+  for (const auto& [name, present, text] : optional) {
+    if (!present) std::filesystem::remove(d / name, ec);
+    else if (Status s = tools::WriteTextFile((d / name).string(), text); !s.ok()) return s;
+  }
+  return Status::OK();
 }
 
 }  // namespace dyad::study

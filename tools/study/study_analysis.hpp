@@ -2,9 +2,15 @@
 // table across everyone (docs/study.md).
 //
 // Contract:
-//   - AnalyzeStudy reads each planned trial's recording (Trial::file) with `dyad analyze`'s
-//     BuildReport. A trial without its file, or with one that cannot be analysed, is listed as
-//     missing with the reason; the analysis goes on with what exists.
+//   - AnalyzeStudy reads each planned trial's recording with `dyad analyze`'s BuildReport: the
+//     last complete attempt the participant's session log names (study_session.hpp), or
+//     Trial::file when the log knows nothing of the trial. Listed as missing with the reason, and
+//     left out, while the analysis goes on with what exists: a trial not recorded; one whose
+//     attempts all ended incomplete (stopped early, failed, or the session ended mid-trial); a
+//     file that cannot be analysed; a recording whose "dyad.run" metadata does not say it is this
+//     trial of this participant of this study (another study's file, a rehearsal's among the
+//     participants' or the reverse, or a file without that metadata).
+//   - Every other .mcap file in a participant's folder is listed as not part of the plan.
 //   - WriteStudyAnalysis writes into `dir` (created): trials.csv (one row per trial: participant,
 //     condition, label, trial, repetition, file, then RunMetrics' measures), events.csv (one row
 //     per event of every trial: participant, condition, trial, the event's steps, primitive,
@@ -13,11 +19,13 @@
 //     their trials, then the mean over participants with a 95% percentile-bootstrap interval that
 //     resamples participants, seeded from the study, condition and measure names),
 //     reported_confusion.csv (the observer against the self-reports, summed over trials; only
-//     when there are some) and report.md (the summary, the missing trials). Conditions are named
+//     when there are some), reports_vs_plan.csv (synthetic participants: the primitive each traced
+//     against the one it reported, per event; only when there are some) and report.md (the summary, the missing trials). Conditions are named
 //     (the analysis is the unblinded step) with their labels beside them.
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -32,6 +40,9 @@ namespace dyad::study {
 struct TrialResult {
   std::string participant;
   Trial trial;
+  int attempt = 1;       // the attempt analysed (its file: Trial::file for attempt 1)
+  bool planned = false;  // a synthetic human's trial: each event's primitive is the one it traced
+  std::string repeated;  // the earlier attempts' fate and reasons, for the report
   std::vector<std::pair<std::string, double>> metrics;  // analyze::RunMetrics
   std::vector<analyze::EventSummary> events;
 };
@@ -39,10 +50,19 @@ struct TrialResult {
 struct StudyAnalysis {
   std::vector<TrialResult> trials;  // in the plan's order
   std::vector<std::string> missing;  // "P02 trial 3 (FILE): not recorded" and the like
+  std::vector<std::string> unplanned;  // .mcap files in a participant's folder that are no attempt of the plan
   std::vector<std::vector<int64_t>> reported_confusion;  // empty: no self-report with labels
+  // Planned trials only: (traced primitive, reported choice) -> events; how wrong the reports are.
+  std::map<std::pair<int, int>, int64_t> reports_vs_plan;
 };
 
-StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings);
+// `rehearsal`: the recordings `dyad study rehearse` made (their metadata says so), in study.data.
+StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehearsal = false);
+
+// Empty when `file`'s "dyad.run" metadata names this study, participant and trial (and
+// rehearsal flag); else why not.
+std::string NotThisTrial(const std::string& file, const Study& study, const std::string& participant, const Trial& trial,
+                         bool rehearsal);
 Status WriteStudyAnalysis(const Study& study, const StudyAnalysis& analysis, const std::string& dir);
 
 // The measures summarised per condition (names of RunMetrics).

@@ -1,11 +1,15 @@
 #include "study_commands.hpp"
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "study_analysis.hpp"
 #include "study_file.hpp"
+#include "study_page.hpp"
+#include "study_session.hpp"
+#include "yaml_file.hpp"
 
 namespace dyad::cli {
 namespace {
@@ -61,16 +65,207 @@ int Plan(const PlanOptions& o) {
   return kOk;
 }
 
+std::string ThisExecutable() {
+  std::error_code ec;
+  return std::filesystem::read_symlink("/proc/self/exe", ec).string();
+}
+
+std::string TrialLine(const study::Study& s, const study::Trial& t, size_t of) {
+  return "trial " + std::to_string(t.number) + " of " + std::to_string(of) + ": " +
+         s.Shown(s.conditions[static_cast<size_t>(t.condition)]);
+}
+
+std::string Ended(const study::Attempt& a) {
+  char secs[32];
+  std::snprintf(secs, sizeof secs, "%.1f s", a.seconds);
+  if (a.outcome == "complete") return std::string("complete (") + secs + ")";
+  if (a.outcome == "stopped") return std::string("stopped after ") + secs + ": incomplete";
+  return "failed: the graph exited " + std::to_string(a.exit) + " after " + secs;
+}
+
+// One line from the experimenter (empty at the end of input).
+std::string Ask(const std::string& prompt) {
+  std::cout << prompt << std::flush;
+  std::string line;
+  if (!std::getline(std::cin, line)) return "";
+  return line;
+}
+
+struct RunOptions {
+  std::string file, participant, reason;
+  std::vector<std::string> plugins;
+  bool consent = false, yes = false, page = false;
+  int trial = 0;  // --trial: run this one again (with --reason), then stop
+  study::PageOptions page_options;
+};
+
+// Consent before the first trial records: marked on the command line or at the prompt.
+bool HaveConsent(const study::Study& s, const RunOptions& o) {
+  if (!s.consent_required || study::ReadSession(s, o.participant).consent) return true;
+  std::string how = "--consent";
+  if (!o.consent) {
+    if (o.yes || Ask("Has " + o.participant + " given informed consent? Type yes to mark it: ") != "yes") {
+      std::cerr << "dyad study run: consent is required (consent_required in " << s.file << ") and not marked for "
+                << o.participant << ": nothing was recorded (--consent marks it)\n";
+      return false;
+    }
+    how = "marked at the prompt";
+  }
+  if (Status st = study::MarkConsent(s, o.participant, how); !st.ok()) {
+    std::cerr << "dyad study run: " << st.ToString() << "\n";
+    return false;
+  }
+  std::cout << "consent marked for " << o.participant << " (" << how << ")\n";
+  return true;
+}
+
+// Runs one attempt at `t` and says how it ended; false when it could not start.
+bool RunOne(const study::Study& s, const RunOptions& o, const study::Trial& t, size_t of, const std::string& reason,
+            study::Attempt* out) {
+  const study::Session session = study::ReadSession(s, o.participant);
+  const study::Attempt* last = session.Last(t.number);
+  study::AttemptRequest r;
+  r.dyad = ThisExecutable();
+  r.participant = o.participant;
+  r.trial = t;
+  r.attempt = last ? last->attempt + 1 : 1;
+  while (std::filesystem::exists(study::AttemptFile(t, r.attempt))) ++r.attempt;  // a file the log does not know
+  r.reason = reason;
+  std::cout << TrialLine(s, t, of) << (r.attempt > 1 ? ", attempt " + std::to_string(r.attempt) : "") << " -> "
+            << study::AttemptFile(t, r.attempt) << "\n"
+            << (s.duration_s > 0 ? "  running for " + std::to_string(static_cast<int>(s.duration_s)) + " s (Ctrl-C stops it early)"
+                                 : std::string("  running (Ctrl-C ends it)"))
+            << std::endl;
+  auto a = study::RunAttempt(s, r);
+  if (!a.ok()) {
+    std::cerr << "dyad study run: " << a.status().ToString() << "\n";
+    return false;
+  }
+  std::cout << "  trial " << t.number << ": " << Ended(*a) << "\n";
+  *out = *a;
+  return true;
+}
+
+// `dyad study run`: the participant's trials in their order, from the first not yet complete.
+int RunSession(const RunOptions& o) {
+  study::Study s;
+  if (!Load(o.file, o.plugins, &s)) return kBadInput;
+  const std::vector<study::Trial> trials = s.TrialsOf(o.participant);
+  if (trials.empty()) {
+    std::cerr << "dyad study run: --participant " << o.participant << " is not a participant of " << s.file << "\n";
+    return kBadInput;
+  }
+  if (o.trial > static_cast<int>(trials.size())) {
+    std::cerr << "dyad study run: --trial " << o.trial << ": " << o.participant << " has " << trials.size() << " trials\n";
+    return kBadInput;
+  }
+  const study::Session before = study::ReadSession(s, o.participant);
+  for (const auto& p : before.problems) std::cerr << "warning: " << p << "\n";
+  std::cout << "study " << s.name << ", participant " << o.participant << ": " << trials.size() << " trials\n";
+  if (o.page) {  // the experimenter's study page instead of the terminal
+    if (Status st = o.consent ? study::MarkConsent(s, o.participant, "--consent") : Status::OK(); !st.ok()) {
+      std::cerr << "dyad study run: " << st.ToString() << "\n";
+      return 1;
+    }
+    study::PageOptions po = o.page_options;
+    po.dyad = ThisExecutable();
+    return study::RunStudyPage(s, o.participant, po);
+  }
+  if (!HaveConsent(s, o)) return kBadInput;
+  study::Attempt a;
+  if (o.trial > 0) {  // a repetition, asked for on the command line
+    if (o.reason.empty()) {
+      std::cerr << "dyad study run: --trial " << o.trial << " needs --reason (why the trial is repeated)\n";
+      return kBadInput;
+    }
+    if (!RunOne(s, o, trials[static_cast<size_t>(o.trial - 1)], trials.size(), o.reason, &a)) return 1;
+    return a.outcome == "complete" ? kOk : 1;
+  }
+  // A trial that did not complete is run again, with the experimenter's reason, before the next.
+  auto why_again = [&](const study::Attempt& last) {
+    if (o.yes) {
+      std::cerr << "dyad study run: trial " << last.trial << " is incomplete (" << Ended(last) << "); repeat it with --trial "
+                << last.trial << " --reason TEXT\n";
+      return std::string();
+    }
+    return Ask("Trial " + std::to_string(last.trial) + " was " + Ended(last) + ". Why is it repeated (empty: stop here)? ");
+  };
+  for (const study::Trial& t : trials) {
+    const study::Session now = study::ReadSession(s, o.participant);
+    if (now.Complete(t.number)) continue;
+    std::string reason;
+    if (const study::Attempt* last = now.Last(t.number); last && (reason = why_again(*last)).empty()) return 1;
+    if (!o.yes && Ask(TrialLine(s, t, trials.size()) + ". Enter starts it, q stops here: ") == "q") return kOk;
+    if (!RunOne(s, o, t, trials.size(), reason, &a)) return 1;
+    while (a.outcome != "complete") {
+      if ((reason = why_again(a)).empty()) return 1;
+      if (!RunOne(s, o, t, trials.size(), reason, &a)) return 1;
+    }
+  }
+  std::cout << o.participant << ": every trial complete (session log " << study::SessionLogPath(s, o.participant) << ")\n";
+  return kOk;
+}
+
 struct AnalyzeOptions {
   std::string file, out;
   std::vector<std::string> plugins;
+  bool rehearsal = false;
 };
+
+// The study as `dyad study rehearse` runs it: its rehearsal graph, recordings in DATA/rehearsal.
+study::Study AsRehearsal(study::Study s) {
+  s.data = (std::filesystem::path(s.data) / "rehearsal").string();
+  return s;
+}
+
+// `dyad study rehearse`: every participant's trials, a synthetic human each, then the analysis.
+int Rehearse(const AnalyzeOptions& o) {
+  study::Study s;
+  if (!Load(o.file, o.plugins, &s)) return kBadInput;
+  const study::Study r = AsRehearsal(s);
+  int failed = 0, ran = 0;
+  for (const std::string& p : r.participants)
+    for (const study::Trial& t : r.TrialsOf(p)) {
+      const study::Session session = study::ReadSession(r, p);
+      if (session.Complete(t.number)) continue;
+      const study::Attempt* last = session.Last(t.number);
+      study::AttemptRequest req;
+      req.dyad = ThisExecutable();
+      req.participant = p;
+      req.trial = t;
+      req.attempt = last ? last->attempt + 1 : 1;
+      req.reason = last ? "the rehearsal was resumed" : "";
+      req.rehearsal = true;
+      // Each synthetic participant and trial its own random streams, the same on every machine.
+      req.extra_sets = {"seed=" + std::to_string(tools::Fnv1a(s.name + "/" + p + "/" + std::to_string(t.number)) % 1000000 + 1)};
+      req.run_log = std::filesystem::path(study::AttemptFile(t, req.attempt)).replace_extension(".log").string();
+      auto a = study::RunAttempt(r, req);
+      ++ran;
+      if (!a.ok() || a->outcome != "complete") {
+        ++failed;
+        std::cerr << p << " " << TrialLine(r, t, r.TrialsOf(p).size()) << ": "
+                  << (a.ok() ? Ended(*a) + " (see " + req.run_log + ")" : a.status().ToString()) << "\n";
+        continue;
+      }
+      std::cout << p << " " << TrialLine(r, t, r.TrialsOf(p).size()) << ": " << Ended(*a) << std::endl;
+    }
+  std::cout << "rehearsal of " << s.name << ": " << ran << " trial" << (ran == 1 ? "" : "s") << " run, " << failed << " failed\n";
+  const study::StudyAnalysis a = study::AnalyzeStudy(r, std::cerr, true);
+  const std::string dir = o.out.empty() ? r.data + "/analysis" : o.out;
+  if (Status st = study::WriteStudyAnalysis(r, a, dir); !st.ok()) {
+    std::cerr << "dyad study rehearse: " << st.ToString() << "\n";
+    return 1;
+  }
+  std::cout << "analysis: " << dir << "/report.md (" << a.trials.size() << " trials analysed, " << a.missing.size() << " missing)\n";
+  return failed == 0 ? kOk : 1;
+}
 
 // `dyad study analyze`: every recording of the plan, one table across everyone.
 int Analyze(const AnalyzeOptions& o) {
   study::Study s;
   if (!Load(o.file, o.plugins, &s)) return kBadInput;
-  const study::StudyAnalysis a = study::AnalyzeStudy(s, std::cerr);
+  if (o.rehearsal) s = AsRehearsal(s);
+  const study::StudyAnalysis a = study::AnalyzeStudy(s, std::cerr, o.rehearsal);
   const std::string dir = o.out.empty() ? s.data + "/analysis" : o.out;
   if (Status st = study::WriteStudyAnalysis(s, a, dir); !st.ok()) {
     std::cerr << "dyad study analyze: " << st.ToString() << "\n";
@@ -100,7 +295,29 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   analyze->add_option("study", a->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
   analyze->add_option("-o,--out", a->out, "Output folder (default: the study's data folder/analysis)");
   analyze->add_option("--plugins", a->plugins, "Extra plugin file or folder (repeatable)");
+  analyze->add_flag("--rehearsal", a->rehearsal, "Analyse the rehearsal's recordings (DATA/rehearsal) instead of the participants'");
   analyze->callback([a, &exit_code] { exit_code = Analyze(*a); });
+  auto r = std::make_shared<RunOptions>();
+  auto* run = study->add_subcommand("run", "Run a participant's trials in their planned order, recording each with the study's metadata");
+  run->add_option("study", r->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
+  run->add_option("--participant", r->participant, "The participant's ID (as the study file lists it)")->required();
+  run->add_flag("--consent", r->consent, "Mark that the participant has given informed consent (logged)");
+  run->add_flag("--yes", r->yes, "Ask nothing: run the remaining trials one after another; stop at one that does not complete");
+  run->add_option("--trial", r->trial, "Run this trial again (a new attempt beside the earlier ones), then stop")->check(CLI::Range(1, 9999));
+  run->add_option("--reason", r->reason, "Why --trial is repeated (kept in the session log)");
+  run->add_option("--plugins", r->plugins, "Extra plugin file or folder (repeatable)");
+  auto* page = run->add_flag("--page", r->page, "Run the session from the experimenter's study page (its URL is printed) instead of the terminal");
+  run->add_option("--page-port", r->page_options.port, "The study page's port (0: any free one)")->check(CLI::Range(0, 65535))->needs(page);
+  run->add_option("--page-port-file", r->page_options.port_file, "Write the study page's port here")->needs(page);
+  page->excludes("--yes")->excludes("--trial");
+  run->callback([r, &exit_code] { exit_code = RunSession(*r); });
+  auto h = std::make_shared<AnalyzeOptions>();
+  auto* rehearse = study->add_subcommand(
+      "rehearse", "Run the whole study stepped with synthetic participants (the rehearsal graph), then analyse it, into DATA/rehearsal");
+  rehearse->add_option("study", h->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
+  rehearse->add_option("-o,--out", h->out, "Analysis folder (default: DATA/rehearsal/analysis)");
+  rehearse->add_option("--plugins", h->plugins, "Extra plugin file or folder (repeatable)");
+  rehearse->callback([h, &exit_code] { exit_code = Rehearse(*h); });
 }
 
 }  // namespace dyad::cli

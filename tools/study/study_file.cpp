@@ -7,6 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "dyad/graph.hpp"
 #include "dyad/strict_yaml.hpp"
 #include "graph_check.hpp"
 #include "yaml_file.hpp"
@@ -43,8 +44,10 @@ void ReadScalars(StrictYaml& y, const YAML::Node& root, const std::string& path,
   y.Get(root, "blind", "blind", &s->blind, "true or false");
   y.Get(root, "consent_required", "consent_required", &s->consent_required, "true or false");
   if (y.Get(root, "self_reports", "self_reports", &s->self_reports, "a word") && s->self_reports != "after_event" &&
-      s->self_reports != "after_trial" && s->self_reports != "off")
-    y.Error(root["self_reports"], "self_reports", "must be after_event, after_trial or off");
+      s->self_reports != "off")
+    y.Error(root["self_reports"], "self_reports",
+            s->self_reports == "after_trial" ? "after_trial is not asked by the subject's page yet: after_event or off"
+                                             : "must be after_event or off");
 }
 
 void ReadParticipants(StrictYaml& y, const YAML::Node& root, Study* s) {
@@ -97,6 +100,48 @@ void ReadConditions(StrictYaml& y, const YAML::Node& root, const std::vector<std
   }
 }
 
+// `recorder` and `rehearsal`, after the conditions: the rehearsal graph is checked against each.
+void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& path, const std::vector<std::string>& plugins,
+                   Study* s) {
+  y.Get(root, "recorder", "recorder", &s->recorder, "a component name");
+  if (!s->graph.empty())
+    if (std::string why = tools::GraphProblems(s->graph, {"clock=stepped", s->recorder + ".metadata=[study=" + s->name + "]"}, plugins);
+        !why.empty())
+      y.Error(root["recorder"] ? root["recorder"] : root, "recorder", "the graph's recorder '" + s->recorder + "' cannot record a trial:\n" + why);
+  // Whether the subject's page asks: each `web` component of the graph is told.
+  if (!s->graph.empty()) {
+    std::vector<Diagnostic> ignored;  // the graph's own problems were said above
+    for (const ComponentConfig& c : LoadGraph(s->graph, {}, &ignored).components)
+      if (c.type == "web") {
+        s->page_sets.push_back(c.name + ".self_reports=" + s->self_reports);
+        // The same tokens for every trial, so the pages reconnect to the next trial's graph.
+        if (!c.params || !c.params["token_file"])
+          s->page_sets.push_back(c.name + ".token_file=" + (fs::path(s->data) / (c.name + "-tokens")).string());
+      }
+  }
+  s->rehearsal_graph = s->graph;
+  const YAML::Node r = root["rehearsal"];
+  if (!r) return;
+  if (!y.Map(r, "rehearsal", {"graph", "set"})) return;
+  std::string graph;
+  if (y.Get(r, "graph", "rehearsal.graph", &graph, "a path")) {
+    const std::string g = tools::PathBeside(path, graph);
+    std::error_code ec;
+    if (!fs::is_regular_file(g, ec)) return y.Error(r["graph"], "rehearsal.graph", "no such file: " + g);
+    s->rehearsal_graph = g;
+  }
+  if (const YAML::Node set = r["set"]; set && y.Map(set, "rehearsal.set", {}))
+    for (const auto& kv : set) s->rehearsal_sets.push_back(kv.first.Scalar() + "=" + tools::SetText(kv.second));
+  if (s->rehearsal_graph.empty()) return;
+  for (const Condition& c : s->conditions) {
+    std::vector<std::string> sets = {"clock=stepped"};
+    sets.insert(sets.end(), c.sets.begin(), c.sets.end());
+    sets.insert(sets.end(), s->rehearsal_sets.begin(), s->rehearsal_sets.end());
+    if (std::string why = tools::GraphProblems(s->rehearsal_graph, sets, plugins); !why.empty())
+      y.Error(r, "rehearsal", "condition " + c.name + " does not validate on the rehearsal graph " + s->rehearsal_graph + ":\n" + why);
+  }
+}
+
 // Labels A, B, ... in an order drawn from the study's name (the same on every machine).
 void GiveLabels(Study* s) {
   uint64_t h = tools::Fnv1a(s->name);
@@ -139,11 +184,12 @@ Study LoadStudy(const std::string& path, const std::vector<std::string>& plugins
   if (!tools::LoadYamlFile(path, "study", &root, problems)) return s;
   StrictYaml y(StrictYaml::InFile(path, {}), problems);
   if (!y.Map(root, "", {"study", "graph", "data", "participants", "conditions", "trials", "duration", "blind", "consent_required",
-                        "self_reports"}))
+                        "self_reports", "recorder", "rehearsal"}))
     return s;
   ReadScalars(y, root, path, &s);
   ReadParticipants(y, root, &s);
   ReadConditions(y, root, plugins, &s);  // checked against the graph when it was found
+  ReadRehearsal(y, root, path, plugins, &s);
   GiveLabels(&s);
   s.square_rows = static_cast<int>(BalancedLatinSquare(std::max(1, static_cast<int>(s.conditions.size()))).size());
   return s;

@@ -12,13 +12,19 @@
 //   duration: 120                        # seconds per trial (default 0: until the experimenter stops it)
 //   blind: true                          # the experimenter sees "condition A", not its name (default false)
 //   consent_required: true               # no trial records before consent is marked (default true)
-//   self_reports: after_event            # after_event | after_trial | off (default after_event)
+//   self_reports: after_event            # after_event | off: the subject's page asks after each release (default after_event)
+//   recorder: recorder                   # the graph's recorder component (default recorder)
+//   rehearsal:                           # `dyad study rehearse`: synthetic participants instead of people
+//     graph: ../demo.yaml                # the graph they are run on, stepped (default: the study's graph)
+//     set: {human.self_report_error: 0.2}   # its own overrides, under each condition's
 //
 // Contract of LoadStudy:
 //   - Every problem of the file at once, each "file:line:col: key: message": unknown keys, wrong
 //     types, a participant ID that is not pseudonymous or is used twice (naming the first), no
 //     conditions, a condition that overrides nothing, an override the graph refuses (checked as
 //     `dyad validate --set` would, at the line of that value, and each condition as a whole).
+//   - The rehearsal graph, with its overrides, is checked against every condition like the
+//     study's graph (a condition must mean the same keys in both).
 //   - The plan is a function of the file alone, fixed before the first participant comes:
 //     participant i (file order) does the conditions in row i of a balanced Latin square
 //     (latin_square.hpp), each as `trials` consecutive trials; blind labels A, B, ... are given
@@ -53,6 +59,10 @@ struct Study {
   double duration_s = 0;
   bool blind = false, consent_required = true;
   std::string self_reports = "after_event";
+  std::string recorder = "recorder";  // the component whose `file` and `metadata` each trial sets
+  std::vector<std::string> page_sets;  // "WEB.self_reports=MODE" for each `web` component of the graph
+  std::string rehearsal_graph;        // absolute; the study's graph unless the file names another
+  std::vector<std::string> rehearsal_sets;
   int square_rows = 1;  // rows of the Latin square: participants in multiples of it are balanced
 
   // The trials of `participant` (one of `participants`) in their order.

@@ -11,6 +11,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <sstream>
 #include <vector>
 
 #include <dyad/msg/types.hpp>
@@ -23,6 +24,7 @@
 #include "study_commands.hpp"
 #include "study_analysis.hpp"
 #include "study_file.hpp"
+#include "study_session.hpp"
 
 namespace dyad::study {
 namespace {
@@ -63,7 +65,8 @@ class StudyFile : public ::testing::Test {
     fs::create_directories(dir_);
     std::ofstream(dir_ / "g.yaml") << "graph: g\nclock: stepped\ncomponents:\n"
                                       "  src: {type: counter_source, rate_hz: 10, outputs: {out: c}}\n"
-                                      "  sink: {type: counter_sink, rate_hz: 10, inputs: {in: c}}\n";
+                                      "  sink: {type: counter_sink, rate_hz: 10, inputs: {in: c}}\n"
+                                      "  recorder: {type: recorder, rate_hz: 1}\n";
   }
   void TearDown() override {
     if (!HasFailure()) fs::remove_all(dir_);
@@ -122,9 +125,23 @@ TEST_F(StudyFile, EveryBadInputIsSaidAtItsLine) {
   for (const std::string expected :
        {"s.yaml:3:21: participants[1]: 'Jane Doe' is not a pseudonymous ID", "s.yaml:3:31: participants[2]: participant P01 is listed twice (first at line 3)",
         "s.yaml:5:19: conditions.low.src.nope: does not validate:", "s.yaml:6:9: conditions.high: overrides nothing",
-        "s.yaml:7:9: trials: must be in 1..99", "s.yaml:8:15: self_reports: must be after_event, after_trial or off",
+        "s.yaml:7:9: trials: must be in 1..99", "s.yaml:8:15: self_reports: must be after_event or off",
         "s.yaml:9:1: colour: unknown key"})
     EXPECT_NE(all.find(expected), std::string::npos) << "no '" << expected << "' in\n" << all;
+}
+
+// `dyad study plan s.yaml` in the file's own folder: a bare file name has no parent folder (it
+// used to throw from std::filesystem::absolute("")).
+TEST_F(StudyFile, AFileNamedWithoutItsFolderIsReadInTheWorkingFolder) {
+  Write("study: gain\ngraph: g.yaml\nparticipants: [P01]\nconditions:\n  low: {src.start: 1}\n");
+  const fs::path before = fs::current_path();
+  fs::current_path(dir_);
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy("s.yaml", {}, &problems);
+  fs::current_path(before);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  EXPECT_EQ(s.graph, (dir_ / "g.yaml").string());
+  EXPECT_EQ(s.data, (dir_ / "gain-data").string());
 }
 
 TEST_F(StudyFile, PlanCommandPrintsOrdersAndKeepsTheBlind) {
@@ -204,13 +221,22 @@ TEST(Bootstrap, CoversTheTrueMeanAboutAsOftenAsItSays) {
   EXPECT_LE(covered, 588) << "coverage " << covered / 600.0;  // 98%
 }
 
+std::map<std::string, std::string> RunOf(const std::string& study, const std::string& participant, const Trial& t,
+                                         const std::string& rehearsal = "false") {
+  return {{"study", study}, {"participant", participant}, {"trial", std::to_string(t.number)}, {"rehearsal", rehearsal}};
+}
+
 // A recording of one trial as `dyad analyze` reads it: a synthetic human's event at steps 10..19
 // (primitive 2), 30 steps; the observer names the human's primitive throughout, the robot's from
 // step 10 + `switch_after`; congruence `c` at every step; the human's self-report `said`.
-void WriteTrial(const fs::path& file, double c, int switch_after, int said) {
+// `run`: its "dyad.run" metadata, as `dyad study run` has the recorder write it.
+void WriteTrial(const fs::path& file, double c, int switch_after, int said, const std::map<std::string, std::string>& run) {
   fs::create_directories(file.parent_path());
   auto w = mcap::Writer::Open(file.string());
   ASSERT_TRUE(w.ok());
+  if (!run.empty()) {
+    ASSERT_TRUE(w->AddMetadata("dyad.run", run).ok());
+  }
   ASSERT_TRUE(w->AddMetadata("dyad.graph", {{"yaml", "graph: t\nclock: stepped\ncomponents:\n  human:\n    type: human_synthetic\n"
                                                      "    rate_hz: 10\n    params:\n      events: [{start: 10, end: 20, primitive: 2}]\n"}})
                   .ok());
@@ -254,12 +280,12 @@ TEST_F(StudyFile, AnalyzeMakesOneTableAcrossEveryoneAndSaysWhatIsMissing) {
   for (const std::string p : {"P01", "P02"})
     for (const Trial& t : s.TrialsOf(p))
       trial_of[p + "/" + s.conditions[static_cast<size_t>(t.condition)].name + "/" + std::to_string(t.repetition)] = t;
-  WriteTrial(trial_of.at("P01/low/1").file, 0.2, 4, 4);  // said 4, drew 2
-  WriteTrial(trial_of.at("P01/low/2").file, 0.4, 4, 2);
-  WriteTrial(trial_of.at("P01/high/1").file, 0.6, 2, 2);
-  WriteTrial(trial_of.at("P01/high/2").file, 0.6, 2, 2);
-  WriteTrial(trial_of.at("P02/high/1").file, 0.8, 6, 2);
-  WriteTrial(trial_of.at("P02/high/2").file, 1.0, 8, 2);
+  WriteTrial(trial_of.at("P01/low/1").file, 0.2, 4, 4, RunOf("gain", "P01", trial_of.at("P01/low/1")));  // said 4, drew 2
+  WriteTrial(trial_of.at("P01/low/2").file, 0.4, 4, 2, RunOf("gain", "P01", trial_of.at("P01/low/2")));
+  WriteTrial(trial_of.at("P01/high/1").file, 0.6, 2, 2, RunOf("gain", "P01", trial_of.at("P01/high/1")));
+  WriteTrial(trial_of.at("P01/high/2").file, 0.6, 2, 2, RunOf("gain", "P01", trial_of.at("P01/high/2")));
+  WriteTrial(trial_of.at("P02/high/1").file, 0.8, 6, 2, RunOf("gain", "P02", trial_of.at("P02/high/1")));
+  WriteTrial(trial_of.at("P02/high/2").file, 1.0, 8, 2, RunOf("gain", "P02", trial_of.at("P02/high/2")));
   const Trial& broken = trial_of.at("P02/low/1");  // a file that is no recording: listed with the reason
   fs::create_directories(fs::path(broken.file).parent_path());
   std::ofstream(broken.file) << "not an MCAP file";
@@ -308,10 +334,74 @@ TEST_F(StudyFile, AnalyzeMakesOneTableAcrossEveryoneAndSaysWhatIsMissing) {
     confusion[row.at("reported") + "," + row.at("predicted")] = row.at("count");
   EXPECT_EQ(confusion.at("4,2"), "10");
   EXPECT_EQ(confusion.at("2,2"), "50");
+  // The synthetic humans traced 2 every time; one of the six said 4.
+  std::map<std::string, std::string> vs_plan;
+  for (const auto& row : dyad::testing::ReadCsv(out / "reports_vs_plan.csv")) vs_plan[row.at("planned") + "," + row.at("reported")] = row.at("events");
+  EXPECT_EQ(vs_plan, (std::map<std::string, std::string>{{"2,2", "5"}, {"2,4", "1"}}));
   std::ifstream md(out / "report.md");
   const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_NE(report.find("| high (" + s.conditions[1].label + ") | mean_congruence | 2 | 4 | 0.75 | 0.6 to 0.9 |"), std::string::npos) << report;
   EXPECT_NE(report.find("## Missing trials"), std::string::npos) << report;
+  EXPECT_NE(report.find("1 of 6 self-reports name another primitive than the one traced (16.6667%"), std::string::npos) << report;
+}
+
+// What the analysis takes from a folder: the last complete attempt of a trial (the session log
+// says which), never a recording of another study, another trial, or a rehearsal; every file it
+// left out is said.
+TEST_F(StudyFile, AnalyzeTakesTheLastCompleteAttemptAndRefusesOtherRecordings) {
+  const std::string f = Write("study: gain\ngraph: g.yaml\nparticipants: [P01, P02]\n"
+                              "conditions:\n  low: {src.start: 1}\n  high: {src.start: 3}\n");
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy(f, {}, &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  const auto p1 = s.TrialsOf("P01"), p2 = s.TrialsOf("P02");
+  // P01 trial 1: attempt 1 stopped early, attempt 2 complete (the one analysed: congruence 0.5).
+  ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"consent","how":"test"})").ok());
+  ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"start","trial":1,"attempt":1,"file":")" + p1[0].file + R"("})").ok());
+  ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"end","trial":1,"attempt":1,"outcome":"stopped","seconds":40})").ok());
+  const std::string second = AttemptFile(p1[0], 2);
+  EXPECT_EQ(fs::path(second).filename().string(), fs::path(p1[0].file).stem().string() + ".try2.mcap");
+  ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"start","trial":1,"attempt":2,"file":")" + second +
+                                               R"(","reason":"fire alarm"})").ok());
+  ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"end","trial":1,"attempt":2,"outcome":"complete","seconds":120})").ok());
+  WriteTrial(p1[0].file, 0.1, 2, 2, RunOf("gain", "P01", p1[0]));
+  WriteTrial(second, 0.5, 2, 2, RunOf("gain", "P01", p1[0]));
+  // P01 trial 2: started, and the session ended during it (no end in the log).
+  ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"start","trial":2,"attempt":1,"file":")" + p1[1].file + R"("})").ok());
+  WriteTrial(p1[1].file, 0.9, 2, 2, RunOf("gain", "P01", p1[1]));
+  // P02: a recording of another study, and one of the rehearsal, at its planned paths.
+  WriteTrial(p2[0].file, 0.9, 2, 2, RunOf("other", "P02", p2[0]));
+  WriteTrial(p2[1].file, 0.9, 2, 2, RunOf("gain", "P02", p2[1], "true"));
+  WriteTrial(fs::path(s.data) / "P02" / "copy.mcap", 0.9, 2, 2, RunOf("gain", "P02", p2[1]));
+  std::ofstream(fs::path(s.data) / "P01" / "session.log", std::ios::app) << "not json\n";
+
+  std::ostringstream warnings;
+  const StudyAnalysis a = AnalyzeStudy(s, warnings);
+  ASSERT_EQ(a.trials.size(), 1u);
+  EXPECT_EQ(a.trials[0].attempt, 2);
+  EXPECT_EQ(a.trials[0].trial.file, second);
+  EXPECT_EQ(a.trials[0].repeated, "attempt 1 stopped; attempt 2 analysed, repeated because: fire alarm");
+  for (const auto& [name, value] : a.trials[0].metrics)
+    if (name == "mean_congruence") {
+      EXPECT_NEAR(value, 0.5, 1e-9) << "not the analysed attempt's";
+    }
+  ASSERT_EQ(a.missing.size(), 3u);
+  EXPECT_EQ(a.missing[0], "P01 trial 2 (" + p1[1].file + "): incomplete (attempt 1 ended with the session)");
+  EXPECT_EQ(a.missing[1], "P02 trial 1 (" + p2[0].file + "): a recording of study other, not gain");
+  EXPECT_EQ(a.missing[2], "P02 trial 2 (" + p2[1].file + "): a rehearsal's recording (synthetic participant)");
+  EXPECT_EQ(a.unplanned, (std::vector<std::string>{(fs::path(s.data) / "P02" / "copy.mcap").string()}));
+  EXPECT_NE(warnings.str().find("session.log:7: not a session event"), std::string::npos) << warnings.str();
+  // A file without the study's metadata is not taken for a trial either.
+  WriteTrial(p2[0].file.substr(0, p2[0].file.size() - 5) + ".try9.mcap", 0.9, 2, 2, {});
+  EXPECT_EQ(NotThisTrial(p2[0].file.substr(0, p2[0].file.size() - 5) + ".try9.mcap", s, "P02", p2[0], false),
+            "no study metadata (\"dyad.run\"): not recorded by dyad study run");
+  ASSERT_TRUE(WriteStudyAnalysis(s, a, (dir_ / "out").string()).ok());
+  std::ifstream md(dir_ / "out" / "report.md");
+  const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("## Repeated trials\n\n- P01 trial 1: attempt 1 stopped; attempt 2 analysed, repeated because: fire alarm"),
+            std::string::npos) << report;
+  EXPECT_NE(report.find("## Files not in the plan (not analysed)"), std::string::npos) << report;
+  EXPECT_EQ(dyad::testing::ReadCsv(dir_ / "out" / "trials.csv").at(0).at("attempt"), "2");
 }
 
 }  // namespace

@@ -1,0 +1,228 @@
+#include "study_page.hpp"
+
+#include <signal.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "study_session.hpp"
+#include "web_server.hpp"
+
+namespace dyad::study {
+
+extern const char* const kStudyPageHtml;  // study_page.html, embedded at configure time
+
+namespace {
+
+using Json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+volatile sig_atomic_t g_quit = 0;
+extern "C" void OnQuitSignal(int) { g_quit = 1; }
+
+class StudyChannel final : public web::ClientHandler {
+ public:
+  StudyChannel(const Study& s, std::string participant, std::string dyad)
+      : study_(s), participant_(std::move(participant)), dyad_(std::move(dyad)), trials_(s.TrialsOf(participant_)) {}
+  ~StudyChannel() override { Join(); }
+
+  void SetServer(web::WebServer* server) { server_.store(server); }
+  bool running() const { return running_.load(); }
+  void StopTrial() { stop_.store(true); }
+  void Join() {
+    if (worker_.joinable()) worker_.join();
+  }
+
+  // Every page gets the state (from the session log, so it is what the terminal would say).
+  void Broadcast() {
+    web::WebServer* server = server_.load();
+    if (server == nullptr) return;
+    const std::string text = StateJson().dump();
+    for (web::ClientId c : server->clients()) server->SendText(c, text);
+  }
+
+  void OnOpen(web::ClientId client, web::Role) override {
+    if (web::WebServer* server = server_.load()) server->SendText(client, StateJson().dump());
+  }
+  Status OnBinary(web::ClientId, std::span<const uint8_t>) override { return Status::InvalidArgument("text frames only"); }
+  void OnClose(web::ClientId) override {}
+
+  Status OnText(web::ClientId client, std::string_view text) override {
+    const Json j = Json::parse(text.begin(), text.end(), nullptr, false);
+    if (j.is_discarded() || !j.is_object() || !j.contains("op") || !j["op"].is_string())
+      return Status::InvalidArgument("not a JSON object with an \"op\"");
+    const std::string op = j["op"];
+    std::string refused;
+    if (op == "consent") refused = Consent();
+    else if (op == "stop") stop_.store(true);
+    else if (op == "start") {
+      if (!j.contains("trial") || !j["trial"].is_number_integer()) return Status::InvalidArgument("start: needs an integer \"trial\"");
+      refused = Start(j["trial"].get<int>(), j.contains("reason") && j["reason"].is_string() ? j["reason"].get<std::string>() : "");
+    } else {
+      return Status::InvalidArgument("unknown op '" + op + "'");
+    }
+    if (!refused.empty())
+      if (web::WebServer* server = server_.load()) server->SendText(client, Json{{"op", "error"}, {"message", refused}}.dump());
+    Broadcast();
+    return Status::OK();
+  }
+
+ private:
+  std::string Consent() {
+    if (ReadSession(study_, participant_).consent) return "";
+    if (Status s = MarkConsent(study_, participant_, "marked on the study page"); !s.ok()) return s.ToString();
+    std::cout << "consent marked for " << participant_ << " (on the study page)" << std::endl;
+    return "";
+  }
+
+  // Why trial `k` may not start now, or "" once it has.
+  std::string Start(int k, const std::string& reason) {
+    if (running_.load()) return "trial " + std::to_string(current_trial_) + " is running: stop it first";
+    if (k < 1 || k > static_cast<int>(trials_.size())) return "there is no trial " + std::to_string(k);
+    const Session session = ReadSession(study_, participant_);
+    if (study_.consent_required && !session.consent) return "consent is required and not marked: nothing was recorded";
+    int next = 0;  // the first trial not complete
+    for (const Trial& t : trials_)
+      if (!session.Complete(t.number)) {
+        next = t.number;
+        break;
+      }
+    const Attempt* last = session.Last(k);
+    if (last && reason.empty()) return "trial " + std::to_string(k) + " was run before: say why it is repeated";
+    if (!last && k != next) return "trial " + std::to_string(next) + " comes first (the plan's order)";
+    AttemptRequest r;
+    r.dyad = dyad_;
+    r.participant = participant_;
+    r.trial = trials_[static_cast<size_t>(k - 1)];
+    r.attempt = last ? last->attempt + 1 : 1;
+    while (std::filesystem::exists(AttemptFile(r.trial, r.attempt))) ++r.attempt;
+    r.reason = reason;
+    r.stop = &stop_;
+    Join();
+    stop_.store(false);
+    running_.store(true);
+    current_trial_ = k;
+    current_attempt_ = r.attempt;
+    started_ = Clock::now();
+    std::cout << "trial " << k << " of " << trials_.size() << ": " << study_.Shown(study_.conditions[static_cast<size_t>(r.trial.condition)])
+              << (r.attempt > 1 ? ", attempt " + std::to_string(r.attempt) : "") << " -> " << AttemptFile(r.trial, r.attempt) << std::endl;
+    worker_ = std::thread([this, r] {
+      auto a = RunAttempt(study_, r);
+      std::cout << "  trial " << r.trial.number << ": "
+                << (a.ok() ? a->outcome + " (" + std::to_string(static_cast<int>(std::lround(a->seconds))) + " s)" : a.status().ToString())
+                << std::endl;
+      {
+        std::lock_guard<std::mutex> lock(error_mutex_);
+        last_error_ = a.ok() ? "" : a.status().ToString();
+      }
+      running_.store(false);
+      Broadcast();
+    });
+    return "";
+  }
+
+  Json StateJson() {
+    const Session session = ReadSession(study_, participant_);
+    Json trials = Json::array();
+    bool done = true;
+    for (const Trial& t : trials_) {
+      int attempts = 0;
+      for (const Attempt& a : session.attempts) attempts += a.trial == t.number;
+      const Attempt* last = session.Last(t.number);
+      std::string status = "to do";
+      if (session.Complete(t.number)) status = "complete";
+      else if (last) status = last->outcome.empty() ? "running" : last->outcome;
+      done = done && session.Complete(t.number);
+      trials.push_back({{"number", t.number},
+                        {"shown", study_.Shown(study_.conditions[static_cast<size_t>(t.condition)])},
+                        {"file", std::filesystem::path(t.file).filename().string()},
+                        {"status", status},
+                        {"attempts", attempts}});
+    }
+    Json running = nullptr;
+    if (running_.load())
+      running = {{"trial", current_trial_.load()},
+                 {"attempt", current_attempt_.load()},
+                 {"elapsed_s", std::chrono::duration<double>(Clock::now() - started_.load()).count()}};
+    std::string error;
+    {
+      std::lock_guard<std::mutex> lock(error_mutex_);
+      error = last_error_;
+    }
+    return {{"op", "state"},
+            {"study", study_.name},
+            {"participant", participant_},
+            {"blind", study_.blind},
+            {"consent_required", study_.consent_required},
+            {"consent", session.consent},
+            {"duration_s", study_.duration_s},
+            {"trials", trials},
+            {"running", running},
+            {"done", done},
+            {"error", error.empty() ? Json(nullptr) : Json(error)}};
+  }
+
+  const Study& study_;
+  const std::string participant_, dyad_;
+  const std::vector<Trial> trials_;
+  std::atomic<web::WebServer*> server_{nullptr};
+  std::atomic<bool> running_{false}, stop_{false};
+  std::atomic<int> current_trial_{0}, current_attempt_{0};
+  std::atomic<Clock::time_point> started_{Clock::time_point{}};
+  std::mutex error_mutex_;
+  std::string last_error_;  // why the last attempt could not run (guarded by error_mutex_)
+  std::thread worker_;
+};
+
+}  // namespace
+
+int RunStudyPage(const Study& study, const std::string& participant, const PageOptions& o) {
+  StudyChannel channel(study, participant, o.dyad);
+  web::WebServer::Options so;
+  so.address = o.address;
+  so.port = o.port;
+  const std::string token = web::RandomToken();
+  so.tokens = {{web::Role::kExperimenter, token}};
+  so.pages["/study"] = web::WebServer::Page{"text/html; charset=utf-8", kStudyPageHtml, {web::Role::kExperimenter}, ""};
+  so.endpoints.push_back(web::WebServer::Endpoint{"/study/ws", {}, &channel, {web::Role::kExperimenter}, false});
+  auto server = web::WebServer::Start(so);
+  if (!server.ok()) {
+    std::cerr << "dyad study run: the study page: " << server.status().ToString() << "\n";
+    return 1;
+  }
+  channel.SetServer(server->get());
+  if (!o.port_file.empty()) std::ofstream(o.port_file) << (*server)->port() << "\n";
+  for (const std::string& host : web::UrlHosts(o.address))
+    std::cout << "study page: http://" << host << ":" << (*server)->port() << "/study?token=" << token << std::endl;
+  struct sigaction sa {}, old_int {}, old_term {};
+  sa.sa_handler = OnQuitSignal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &old_int);
+  sigaction(SIGTERM, &sa, &old_term);
+  // A signal during a trial stops the trial (RunAttempt's own handlers); between trials it ends here.
+  for (auto next = Clock::now(); !(g_quit && !channel.running()); std::this_thread::sleep_for(std::chrono::milliseconds(50))) {
+    if (g_quit && channel.running()) channel.StopTrial();
+    if (channel.running() && Clock::now() >= next) {
+      channel.Broadcast();
+      next = Clock::now() + std::chrono::seconds(1);
+    }
+  }
+  channel.Join();
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
+  channel.SetServer(nullptr);
+  server->reset();
+  std::cout << "study page closed" << std::endl;
+  return 0;
+}
+
+}  // namespace dyad::study

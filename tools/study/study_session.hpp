@@ -1,0 +1,82 @@
+// tools/study/study_session.hpp: one participant's session of a study: consent, the attempts at
+// each planned trial, and the log that keeps them (docs/study.md, "Running a session").
+//
+// The session log, DATA/PARTICIPANT/session.log, one JSON object per line, only ever appended
+// (created 0600):
+//   {"time":"2026-11-26T20:31:05Z","event":"consent","how":"..."}
+//   {"time":...,"event":"start","trial":3,"attempt":2,"file":"/abs/03-B.try2.mcap","reason":"..."}
+//   {"time":...,"event":"end","trial":3,"attempt":2,"outcome":"complete","seconds":120.0,"exit":0}
+// outcome: complete | stopped (the experimenter ended a timed trial early) | failed (the graph
+// exited non-zero or was killed). A start without its end: the session itself ended mid-trial.
+//
+// Contract:
+//   - AttemptFile: attempt 1 of a trial records into Trial::file (DATA/P01/03-B.mcap), attempt k
+//     into DATA/P01/03-B.try<k>.mcap. A repetition never replaces the earlier attempt.
+//   - ReadSession never fails: lines it cannot read are listed in `problems` (file:line) and
+//     skipped; a missing log is a session that has not started.
+//   - RunAttempt refuses (nothing started, nothing logged) a trial when consent is required and
+//     not marked, or when the attempt's file exists. Otherwise it logs the start, runs
+//     `dyad run` on the graph with the condition's overrides, the recorder's file and the
+//     metadata below, and logs the end. While it runs, SIGINT (Ctrl-C) stops the trial: the
+//     graph gets one SIGINT (it is in a process group of its own) and finishes its recording.
+//   - Recording metadata ("dyad.run" in the MCAP file): study, participant, condition (its label
+//     when the study is blind: the file must not unblind whoever reads it), trial, attempt,
+//     rehearsal (true|false), dyad_version, graph_hash (FNV-1a of the graph file's text and the
+//     run's overrides, hex).
+#pragma once
+
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include "dyad/status.hpp"
+#include "study_file.hpp"
+
+namespace dyad::study {
+
+struct Attempt {
+  int trial = 0, attempt = 0;
+  std::string file, reason;  // reason: why this attempt repeats the trial (empty for the first)
+  std::string outcome;       // complete | stopped | failed | "" (started, never ended)
+  double seconds = 0;
+  int exit = 0;
+};
+
+struct Session {
+  std::string log;  // its path
+  bool consent = false;
+  std::vector<Attempt> attempts;  // in the order they started
+  std::vector<std::string> problems;
+
+  // The last attempt at `trial`, or null; the last complete one, or null.
+  const Attempt* Last(int trial) const;
+  const Attempt* Complete(int trial) const;
+};
+
+std::string AttemptFile(const Trial& t, int attempt);
+std::string SessionLogPath(const Study& s, const std::string& participant);
+Session ReadSession(const Study& s, const std::string& participant);
+
+// Appends one event (its "time" is added) to the participant's log.
+Status AppendSessionEvent(const Study& s, const std::string& participant, const std::string& json_object);
+Status MarkConsent(const Study& s, const std::string& participant, const std::string& how);
+
+struct AttemptRequest {
+  std::string dyad;         // the dyad executable
+  std::string participant;
+  Trial trial;
+  int attempt = 1;
+  std::string reason;       // required for attempt > 1
+  bool rehearsal = false;   // the rehearsal graph and its overrides, no consent needed
+  std::vector<std::string> extra_sets;  // after the condition's (a rehearsal's seed)
+  std::string run_log;      // the graph's output; empty: the terminal
+  const std::atomic<bool>* stop = nullptr;  // set: stop the trial as SIGINT does (the study page's Stop)
+};
+
+// Runs one attempt (see the contract); the returned attempt says how it ended.
+StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r);
+
+// The `dyad run` command line of an attempt (for RunAttempt and its tests).
+std::vector<std::string> AttemptCommand(const Study& s, const AttemptRequest& r);
+
+}  // namespace dyad::study

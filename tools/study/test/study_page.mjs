@@ -1,0 +1,61 @@
+#!/usr/bin/env node
+// The experimenter's study page in Debian's Chromium (headless, playwright-core):
+//   node study_page.mjs STUDY_PAGE_URL SCREENSHOT_DIR
+// Marks consent (confirming the dialog), starts trial 1 and waits for it to complete, repeats it
+// with a reason, starts trial 2 and stops it early, sees that it must be repeated, repeats it with
+// a reason, and sees the session complete. Fails (exit 1) at the first step the page gets wrong.
+import { chromium } from "playwright-core";
+
+const [url, shotDir] = process.argv.slice(2);
+const browser = await chromium.launch({
+  executablePath: process.env.DYAD_CHROMIUM ?? "/usr/bin/chromium",
+  args: ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking"],
+});
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+try {
+  const page = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+  page.on("dialog", (d) => d.accept());
+  await page.goto(url);
+  const text = (sel) => page.textContent(sel);
+  const status = (k) => text(`tr[data-trial="${k}"] td:nth-child(4)`);
+  const attempts = (k) => text(`tr[data-trial="${k}"] td:nth-child(5)`);
+  const waitStatus = (k, s, ms = 20000) =>
+    page.waitForFunction(([k, s]) => document.querySelector(`tr[data-trial="${k}"] td:nth-child(4)`)?.textContent === s, [k, s], { timeout: ms });
+  await page.waitForSelector('tr[data-trial="1"]');
+  if ((await text("#consent")) !== "consent required, not given") throw new Error("consent shown as: " + (await text("#consent")));
+  if (!(await page.isDisabled("#start"))) throw new Error("Start is enabled before consent");
+  await page.click("#mark-consent");
+  await page.waitForFunction(() => document.getElementById("consent").textContent === "consent given");
+  const shown = await text('tr[data-trial="1"] td:nth-child(2)');
+  if (!/^condition [AB]$/.test(shown)) throw new Error("a blind study's condition shown as: " + shown);
+  if (!(await text("#start")).startsWith("Start trial 1 of 2")) throw new Error("Start says: " + (await text("#start")));
+  await page.click("#start");
+  await waitStatus(1, "running", 5000);
+  await page.screenshot({ path: `${shotDir}/study_page_running.png` });
+  await waitStatus(1, "complete");
+  // A repetition needs its reason.
+  await page.click('tr[data-trial="1"] button.repeat');
+  if (!(await text("#message")).includes("Say why trial 1 is repeated")) throw new Error("a repeat without a reason: " + (await text("#message")));
+  await page.fill("#reason", "the participant sneezed");
+  await page.click('tr[data-trial="1"] button.repeat');
+  await waitStatus(1, "running", 5000);
+  await waitStatus(1, "complete");
+  if ((await attempts(1)) !== "2") throw new Error("trial 1 attempts: " + (await attempts(1)));
+  // Trial 2 stopped early: incomplete, and Start refuses to go on without a repetition.
+  await page.click("#start");
+  await waitStatus(2, "running", 5000);
+  await sleep(700);
+  await page.click("#stop");
+  await waitStatus(2, "stopped");
+  if (!(await page.isDisabled("#start"))) throw new Error("Start is enabled after an incomplete trial");
+  if (!(await text("#message")).includes("Trial 2 did not complete")) throw new Error("message: " + (await text("#message")));
+  await page.fill("#reason", "stopped by mistake");
+  await page.click('tr[data-trial="2"] button.repeat');
+  await waitStatus(2, "running", 5000);
+  await waitStatus(2, "complete");
+  await page.waitForFunction(() => document.getElementById("elapsed").textContent === "session complete");
+  await page.screenshot({ path: `${shotDir}/study_page_done.png` });
+  console.log("page: consent, trial 1 twice, trial 2 stopped and repeated, session complete (" + (await status(2)) + ")");
+} finally {
+  await browser.close();
+}

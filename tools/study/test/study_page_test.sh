@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# `dyad study run --page`: a participant's session driven from the experimenter's study page in
+# Debian's Chromium (tools/study/test/study_page.mjs says what the browser does); then the session
+# log and the recordings are read back here.
+#   study_page_test.sh REPO BUILD_DIR WORK_DIR
+set -euo pipefail
+repo=$1 build=$2 work=$3
+node_modules=$repo/components/web/test/node/node_modules
+if [ ! -d "$node_modules" ] || [ ! -x /usr/bin/chromium ]; then
+  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
+fi
+fail() { echo "FAIL: $*" >&2; exit 1; }
+rm -rf "$work"; mkdir -p "$work"; cd "$work"
+ln -s "$node_modules" node_modules  # the script imports playwright-core from beside itself
+cp "$(dirname "$0")/study_page.mjs" .
+cat > g.yaml <<YAML
+graph: g
+clock: wall
+domain_id: $(( 1 + $$ % 200 ))
+components:
+  src: {type: counter_source, rate_hz: 20, outputs: {out: c}}
+  sink: {type: counter_sink, rate_hz: 20, inputs: {in: c}}
+  recorder: {type: recorder, rate_hz: 1}
+YAML
+cat > s.yaml <<YAML
+study: page_test
+graph: g.yaml
+participants: [P01]
+conditions:
+  low: {src.start: 1}
+  high: {src.start: 3}
+duration: 2
+blind: true
+YAML
+"$build/bin/dyad" study run s.yaml --participant P01 --page --page-port 0 > runner.out 2> runner.err &
+pid=$!
+for _ in $(seq 100); do grep -q "study page: " runner.out && break; sleep 0.1; done
+url=$(grep -o "http://[^ ]*" runner.out | head -1)
+[ -n "$url" ] || { kill $pid; cat runner.out runner.err; fail "no study page URL"; }
+node study_page.mjs "$url" "$work" || { kill $pid; cat runner.out runner.err; fail "the page"; }
+kill -INT $pid
+wait $pid || fail "the runner exited $? after SIGINT between trials: $(cat runner.err)"
+python3 - page_test-data/P01/session.log <<'PY'
+import json, sys
+lines = [json.loads(l) for l in open(sys.argv[1])]
+def fail(why): sys.exit("FAIL: " + why + "\n" + "\n".join(map(str, lines)))
+if lines[0].get("event") != "consent" or lines[0].get("how") != "marked on the study page": fail("consent first, from the page")
+ends = [(l["trial"], l["attempt"], l["outcome"]) for l in lines if l["event"] == "end"]
+if ends != [(1, 1, "complete"), (1, 2, "complete"), (2, 1, "stopped"), (2, 2, "complete")]: fail("attempts %s" % ends)
+reasons = [(l["trial"], l.get("reason")) for l in lines if l["event"] == "start" and l["attempt"] == 2]
+if reasons != [(1, "the participant sneezed"), (2, "stopped by mistake")]: fail("reasons %s" % reasons)
+print("PASS: session log as the page drove it")
+PY
+n=$(ls page_test-data/P01/*.mcap | wc -l)
+[ "$n" = 4 ] || fail "$n recordings (want 4: two attempts of each trial): $(ls page_test-data/P01)"

@@ -1,0 +1,192 @@
+// `dyad study run` as an experimenter uses it, with real processes: consent before anything
+// records, each trial's recording with the study's metadata, nothing overwritten, a repetition
+// beside the first attempt with its reason, a trial stopped early or a session killed mid-trial
+// marked incomplete while the analysis goes on.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "dyad/mcap/reader.hpp"
+#include "dyad/testing/child_process.hpp"
+#include "study_analysis.hpp"
+#include "study_file.hpp"
+#include "study_session.hpp"
+
+namespace dyad::study {
+namespace {
+
+namespace fs = std::filesystem;
+using dyad::testing::ChildProcess;
+
+std::vector<nlohmann::json> LogLines(const std::string& path) {
+  std::vector<nlohmann::json> out;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) out.push_back(nlohmann::json::parse(line));
+  return out;
+}
+
+std::map<std::string, std::string> RunMetadata(const std::string& file) {
+  auto r = mcap::Reader::Open(file);
+  EXPECT_TRUE(r.ok()) << r.status().message();
+  if (!r.ok()) return {};
+  for (const auto& md : r->metadata())
+    if (md.name == "dyad.run") return md.entries;
+  return {};
+}
+
+class StudySession : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("dyad_session_" + std::to_string(getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  // A study of two blind conditions on a counter graph with a recorder, on `clock`.
+  Study Make(const std::string& clock, double duration_s) {
+    std::ofstream(dir_ / "g.yaml") << "graph: g\nclock: " << clock << "\ncomponents:\n"
+                                      "  src: {type: counter_source, rate_hz: 20, outputs: {out: c}}\n"
+                                      "  sink: {type: counter_sink, rate_hz: 20, inputs: {in: c}}\n"
+                                      "  recorder: {type: recorder, rate_hz: 1}\n";
+    std::ofstream(dir_ / "s.yaml") << "study: gain\ngraph: g.yaml\nparticipants: [P01, P02]\n"
+                                      "conditions:\n  low: {src.start: 1}\n  high: {src.start: 3}\n"
+                                      "duration: " << duration_s << "\nblind: true\n";
+    std::vector<Diagnostic> problems;
+    Study s = LoadStudy((dir_ / "s.yaml").string(), {}, &problems);
+    EXPECT_TRUE(problems.empty()) << problems.front().ToString();
+    return s;
+  }
+  std::vector<std::string> Command(std::vector<std::string> args) {
+    args.insert(args.begin(), {DYAD_EXE, "study", "run", (dir_ / "s.yaml").string(), "--participant", "P01"});
+    return args;
+  }
+  fs::path dir_;
+};
+
+TEST_F(StudySession, ConsentComesFirstThenEveryTrialRecordsItsMetadataAndNothingIsOverwritten) {
+  const Study s = Make("stepped", 2);
+  const auto trials = s.TrialsOf("P01");
+  // Consent required and not marked: refused, nothing recorded, nothing logged.
+  ChildProcess refused(Command({"--yes"}), dir_, "refused");
+  ASSERT_EQ(refused.Wait(60), 2) << refused.err();
+  EXPECT_NE(refused.err().find("consent is required (consent_required in " + (dir_ / "s.yaml").string() +
+                               ") and not marked for P01: nothing was recorded"),
+            std::string::npos)
+      << refused.err();
+  EXPECT_FALSE(fs::exists(fs::path(s.data) / "P01")) << "a refused session left files";
+
+  ChildProcess run(Command({"--consent", "--yes"}), dir_, "run");
+  ASSERT_EQ(run.Wait(120), 0) << run.out() << run.err();
+  EXPECT_NE(run.out().find("trial 1 of 2: condition " + s.conditions[static_cast<size_t>(trials[0].condition)].label),
+            std::string::npos) << run.out();
+  EXPECT_EQ(run.out().find("low"), std::string::npos) << "a blind session named a condition:\n" << run.out();
+  const auto log = LogLines(SessionLogPath(s, "P01"));
+  ASSERT_EQ(log.size(), 5u);
+  EXPECT_EQ(log[0]["event"], "consent");
+  EXPECT_EQ(log[0]["how"], "--consent");
+  for (size_t i = 0; i < trials.size(); ++i) {
+    const Trial& t = trials[i];
+    const auto& start = log[1 + 2 * i];
+    const auto& end = log[2 + 2 * i];
+    EXPECT_EQ(start["event"], "start");
+    EXPECT_EQ(start["trial"], t.number);
+    EXPECT_EQ(start["file"], t.file);
+    EXPECT_EQ(end["event"], "end");
+    EXPECT_EQ(end["outcome"], "complete");
+    EXPECT_EQ(end["exit"], 0);
+    const auto md = RunMetadata(t.file);
+    EXPECT_EQ(md.at("study"), "gain");
+    EXPECT_EQ(md.at("participant"), "P01");
+    EXPECT_EQ(md.at("condition"), s.conditions[static_cast<size_t>(t.condition)].label) << "the label, never the name";
+    EXPECT_EQ(md.at("trial"), std::to_string(t.number));
+    EXPECT_EQ(md.at("attempt"), "1");
+    EXPECT_EQ(md.at("rehearsal"), "false");
+    EXPECT_EQ(md.at("dyad_version"), DYAD_VERSION);
+    EXPECT_EQ(md.at("graph_hash").size(), 16u);
+    EXPECT_EQ(fs::status(t.file).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write);
+  }
+  EXPECT_NE(RunMetadata(trials[0].file).at("graph_hash"), RunMetadata(trials[1].file).at("graph_hash"))
+      << "the conditions' overrides are part of the graph's hash";
+  // Again: every trial is complete, nothing runs and nothing is touched.
+  const auto first_time = fs::last_write_time(trials[0].file);
+  ChildProcess again(Command({"--yes"}), dir_, "again");
+  ASSERT_EQ(again.Wait(60), 0) << again.err();
+  EXPECT_NE(again.out().find("P01: every trial complete"), std::string::npos) << again.out();
+  EXPECT_EQ(fs::last_write_time(trials[0].file), first_time);
+  EXPECT_EQ(LogLines(SessionLogPath(s, "P01")).size(), 5u);
+  // A repetition needs a reason, and records beside the first attempt.
+  ChildProcess no_reason(Command({"--trial", "1"}), dir_, "no_reason");
+  EXPECT_EQ(no_reason.Wait(60), 2);
+  EXPECT_NE(no_reason.err().find("--trial 1 needs --reason"), std::string::npos) << no_reason.err();
+  ChildProcess repeat(Command({"--trial", "1", "--reason", "the participant sneezed"}), dir_, "repeat");
+  ASSERT_EQ(repeat.Wait(60), 0) << repeat.err();
+  const std::string second = AttemptFile(trials[0], 2);
+  EXPECT_EQ(RunMetadata(second).at("attempt"), "2");
+  EXPECT_EQ(fs::last_write_time(trials[0].file), first_time) << "the first attempt was touched";
+  const auto after = LogLines(SessionLogPath(s, "P01"));
+  ASSERT_EQ(after.size(), 7u);
+  EXPECT_EQ(after[5]["reason"], "the participant sneezed");
+  const StudyAnalysis a = AnalyzeStudy(s, std::cerr);
+  for (const std::string& m : a.missing) EXPECT_EQ(m.find("P01"), std::string::npos) << m;
+  // P02 never came: their trials are missing, and said so.
+  EXPECT_EQ(a.missing.size(), 2u);
+}
+
+// A timed trial stopped early (Ctrl-C) is incomplete; a session killed mid-trial stops its graph
+// (which finishes its recording) and leaves the trial incomplete; the analysis goes on.
+TEST_F(StudySession, AStoppedOrKilledTrialIsIncompleteAndItsRecordingStaysReadable) {
+  const Study s = Make("wall", 30);
+  const auto trials = s.TrialsOf("P01");
+  ChildProcess stopped(Command({"--consent", "--yes"}), dir_, "stopped");
+  ASSERT_TRUE(stopped.WaitForOutput("Ctrl-C stops it early", 30)) << stopped.err();
+  for (int i = 0; i < 500 && !fs::exists(trials[0].file); ++i) usleep(10000);
+  usleep(1'500'000);
+  stopped.Signal(SIGINT);
+  ASSERT_EQ(stopped.Wait(30), 1) << stopped.out() << stopped.err();
+  EXPECT_NE(stopped.err().find("trial 1 is incomplete (stopped after"), std::string::npos) << stopped.err();
+  auto log = LogLines(SessionLogPath(s, "P01"));
+  ASSERT_EQ(log.size(), 3u);
+  EXPECT_EQ(log[2]["outcome"], "stopped");
+  EXPECT_LT(log[2]["seconds"].get<double>(), 20);
+  auto first = mcap::Reader::Open(trials[0].file);
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  EXPECT_FALSE(first->recovery().truncated) << "the graph got one SIGINT and finished its file";
+
+  // The session itself killed during the repetition: its graph is stopped, not orphaned.
+  ChildProcess killed(Command({"--trial", "1", "--reason", "stopped by mistake"}), dir_, "killed");
+  ASSERT_TRUE(killed.WaitForOutput("Ctrl-C stops it early", 30)) << killed.err();
+  const std::string second = AttemptFile(trials[0], 2);
+  for (int i = 0; i < 500 && !fs::exists(second); ++i) usleep(10000);
+  usleep(1'000'000);
+  killed.Signal(SIGKILL);
+  killed.Wait(10);
+  for (int i = 0; i < 1000; ++i, usleep(10000)) {  // the graph ends on its own SIGINT, within seconds
+    auto r = mcap::Reader::Open(second);
+    if (r.ok() && !r->recovery().truncated) break;
+  }
+  auto r = mcap::Reader::Open(second);
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  EXPECT_FALSE(r->recovery().truncated) << "the graph outlived its session, or was killed instead of stopped";
+  log = LogLines(SessionLogPath(s, "P01"));
+  ASSERT_EQ(log.size(), 4u) << "a start without its end";
+  const StudyAnalysis a = AnalyzeStudy(s, std::cerr);
+  ASSERT_FALSE(a.missing.empty());
+  EXPECT_EQ(a.missing[0], "P01 trial 1 (" + trials[0].file +
+                              "): incomplete (attempt 1 stopped; attempt 2 ended with the session, repeated because: stopped by mistake)");
+}
+
+}  // namespace
+}  // namespace dyad::study
