@@ -8,7 +8,9 @@
 // Exit code (stored in `exit_code`): 0 success, 1 runtime failure (plots), 2 bad input.
 #pragma once
 
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;  // <CLI/CLI.hpp> is costly to compile: only the command files include it
+}  // namespace CLI
 
 namespace dyad::cli {
 

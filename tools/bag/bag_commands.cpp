@@ -1,5 +1,7 @@
 #include "bag_commands.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <dyad/cdr_decoder.hpp>
 
 #include <iostream>

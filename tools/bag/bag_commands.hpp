@@ -17,7 +17,9 @@
 // file, unknown --topic). Errors go to stderr as "dyad bag: FILE: what is wrong".
 #pragma once
 
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;  // <CLI/CLI.hpp> is costly to compile: only the command files include it
+}  // namespace CLI
 
 namespace dyad::cli {
 

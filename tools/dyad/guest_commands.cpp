@@ -1,5 +1,7 @@
 #include "guest_commands.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <unistd.h>
 
 #include <algorithm>

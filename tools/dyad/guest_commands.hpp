@@ -2,7 +2,9 @@
 // (dyad/guest.hpp). `bag play` joins the `bag` command group, so this is added after it.
 #pragma once
 
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;  // <CLI/CLI.hpp> is costly to compile: only the command files include it
+}  // namespace CLI
 
 namespace dyad::cli {
 

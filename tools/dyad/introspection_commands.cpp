@@ -1,4 +1,6 @@
 #include "introspection_commands.hpp"
+
+#include <CLI/CLI.hpp>
 #include "watcher_catalog.hpp"
 
 #include <iomanip>

@@ -1,5 +1,7 @@
 #include "runtime_commands.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>

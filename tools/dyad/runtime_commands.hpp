@@ -3,9 +3,11 @@
 
 #include <functional>
 
-#include <CLI/CLI.hpp>
-
 #include <dyad/run.hpp>
+
+namespace CLI {
+class App;  // <CLI/CLI.hpp> is costly to compile: only the command files include it
+}  // namespace CLI
 
 namespace dyad::cli {
 

@@ -1,5 +1,7 @@
 #include "security_commands.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <iostream>
 #include <memory>

@@ -2,7 +2,9 @@
 // what a secured graph is: dyad/security.hpp, docs/security.md).
 #pragma once
 
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;  // <CLI/CLI.hpp> is costly to compile: only the command files include it
+}  // namespace CLI
 
 namespace dyad::cli {
 

@@ -1,5 +1,7 @@
 #include "observer_commands.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>

@@ -1,5 +1,7 @@
 #include "pvrnn_commands.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <unistd.h>
 
 #include <array>

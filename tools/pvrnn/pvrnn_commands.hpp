@@ -17,7 +17,9 @@
 // 1 runtime failure (I/O, training diverged), 2 bad input or usage.
 #pragma once
 
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;  // <CLI/CLI.hpp> is costly to compile: only the command files include it
+}  // namespace CLI
 
 namespace dyad::cli {
 

@@ -1,5 +1,7 @@
 #include "study_commands.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <cstdio>
 #include <filesystem>
 #include <iostream>

@@ -1,7 +1,9 @@
 // `dyad study ...`: a study with people: its plan (docs/study.md).
 #pragma once
 
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;  // <CLI/CLI.hpp> is costly to compile: only the command files include it
+}  // namespace CLI
 
 namespace dyad::cli {
 

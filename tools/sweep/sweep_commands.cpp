@@ -1,5 +1,7 @@
 #include "sweep_commands.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <unistd.h>
 
 #include <filesystem>

@@ -1,7 +1,9 @@
 // `dyad sweep SWEEP.yaml`: a grid of simulated experiments on every core (docs/sweep.md).
 #pragma once
 
-#include <CLI/CLI.hpp>
+namespace CLI {
+class App;  // <CLI/CLI.hpp> is costly to compile: only the command files include it
+}  // namespace CLI
 
 namespace dyad::cli {
 

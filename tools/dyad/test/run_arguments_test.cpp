@@ -4,12 +4,13 @@
 #include "hosts/run_arguments.hpp"
 
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <optional>
+
+#include <CLI/CLI.hpp>
 
 #include "dyad/testing/cli.hpp"
 #include "runtime_commands.hpp"

@@ -1,16 +1,17 @@
 // dyad/testing/cli.hpp: runs one command group of the `dyad` CLI in-process, capturing what it
-// prints (test code only; needs GoogleTest and CLI11).
+// prints (test code only; link dyad_test_cli). CLI11 stays out of this header: it costs seconds
+// of compile time in every file that includes it.
 //
 //   auto r = dyad::testing::RunCommand(dyad::cli::AddBagCommands, {"bag", "info", path});
 //   EXPECT_EQ(r.code, 2) << r.err;
 #pragma once
 
-#include <gtest/gtest.h>
-
-#include <CLI/CLI.hpp>
-
 #include <string>
 #include <vector>
+
+namespace CLI {
+class App;
+}  // namespace CLI
 
 namespace dyad::testing {
 
@@ -20,20 +21,6 @@ struct CliRun {
 };
 
 // `add_commands(app, exit_code)` registers the group, as tools/dyad/main.cpp does.
-template <class AddCommands>
-CliRun RunCommand(AddCommands add_commands, std::vector<std::string> args) {
-  CLI::App app{"dyad"};
-  CliRun r;
-  add_commands(app, r.code);
-  args.insert(args.begin(), "dyad");
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  ::testing::internal::CaptureStdout();
-  ::testing::internal::CaptureStderr();
-  app.parse(static_cast<int>(argv.size()), argv.data());
-  r.err = ::testing::internal::GetCapturedStderr();
-  r.out = ::testing::internal::GetCapturedStdout();
-  return r;
-}
+CliRun RunCommand(void (*add_commands)(CLI::App& app, int& exit_code), std::vector<std::string> args);
 
 }  // namespace dyad::testing
