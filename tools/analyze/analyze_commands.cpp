@@ -30,14 +30,6 @@ struct Options {
   bool plots = true;
 };
 
-// share/dyad/plot_report.py next to the executable's bin/ (build tree and installed tree alike).
-std::string PlotScript(const std::string& name = "plot_report.py") {
-  std::error_code ec;
-  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (ec) return {};
-  return (exe.parent_path().parent_path() / "share" / "dyad" / name).string();
-}
-
 int RunAnalyze(const Options& o) {
   if (!o.dataset.empty() && !std::filesystem::is_directory(o.dataset)) {
     std::cerr << "dyad analyze: --dataset " << o.dataset << ": not a folder\n";
@@ -64,14 +56,12 @@ int RunAnalyze(const Options& o) {
   std::cout << "report: " << out << "/report.md (" << report.timeline.steps.size() << " steps, "
             << report.events.size() << " events)\n";
   if (!o.plots) return kOk;
-  const std::string script = PlotScript();
-  if (script.empty() || !std::filesystem::exists(script)) {
+  const std::string script = tools::DyadScriptPath("plot_report.py");
+  if (!std::filesystem::exists(script)) {
     std::cerr << "dyad analyze: plot script not found at " << script << "\n";
     return kFailure;
   }
-  // Debian's interpreter first: python3-matplotlib is installed for it, whatever else is on PATH.
-  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  std::vector<std::string> args = {python, script, out};
+  std::vector<std::string> args = {out};
   std::string dataset = o.dataset.empty() ? report.plan.dataset : o.dataset;
   if (!dataset.empty()) {
     if (std::filesystem::is_directory(dataset)) {
@@ -82,7 +72,7 @@ int RunAnalyze(const Options& o) {
                 << " is not a folder from here; plots drawn without the watermark (pass --dataset)\n";
     }
   }
-  const int code = tools::RunProcess(args);
+  const int code = tools::RunDyadScript("plot_report.py", args);
   if (code != 0) {
     std::cerr << "dyad analyze: " << script << " failed (exit " << code
               << "); is python3-matplotlib installed (tools/setup.sh)?\n";
@@ -115,15 +105,14 @@ void SayWhatWasCut(const analyze::Demonstrations& d, std::ostream& out, std::ost
 
 // --preview: the primitives drawn, each titled with its segment (and its first warning).
 int DrawPreview(const FromRecordingOptions& o, const analyze::Demonstrations& d) {
-  const std::string python = std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  std::vector<std::string> args = {python, PlotScript("plot_dataset.py"), o.out, o.preview};
+  std::vector<std::string> args = {o.out, o.preview};
   for (size_t k = 0; k < d.chosen.size(); ++k) {
     std::string label = "primitive " + std::to_string(k) + " <- segment " + std::to_string(d.chosen[k]);
     const auto& s = d.segments[static_cast<size_t>(d.chosen[k])];
     if (s.laps > 1) label += "\n(" + std::to_string(s.laps) + " laps!)";
     args.insert(args.end(), {"--label", std::to_string(k) + "=" + label});
   }
-  if (int code = tools::RunProcess(args); code != 0) {
+  if (int code = tools::RunDyadScript("plot_dataset.py", args); code != 0) {
     std::cerr << "dyad dataset from-recording: the preview was not drawn (exit " << code << "; python3-matplotlib: tools/setup.sh)\n";
     return kFailure;
   }

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 
+#include "run_process.hpp"
 #include "study_analysis.hpp"
 #include "study_file.hpp"
 #include "study_page.hpp"
@@ -211,8 +212,21 @@ int RunSession(const RunOptions& o) {
 struct AnalyzeOptions {
   std::string file, out;
   std::vector<std::string> plugins;
-  bool rehearsal = false;
+  bool rehearsal = false, plots = true;
 };
+
+// The analysis of `s` into `dir`, with its plots; false (said) when it could not be written.
+bool WriteAnalysis(const study::Study& s, const study::StudyAnalysis& a, const std::string& dir, bool plots,
+                   const char* command) {
+  if (Status st = study::WriteStudyAnalysis(s, a, dir); !st.ok()) {
+    std::cerr << command << ": " << st.ToString() << "\n";
+    return false;
+  }
+  if (plots && !a.trials.empty())
+    if (int rc = tools::RunDyadScript("plot_study.py", {dir}); rc != 0)
+      std::cerr << command << ": warning: the plots were not drawn (python3 with matplotlib; exit " << rc << ")\n";
+  return true;
+}
 
 // The study as `dyad study rehearse` runs it: its rehearsal graph, recordings in DATA/rehearsal.
 study::Study AsRehearsal(study::Study s) {
@@ -254,10 +268,7 @@ int Rehearse(const AnalyzeOptions& o) {
   std::cout << "rehearsal of " << s.name << ": " << ran << " trial" << (ran == 1 ? "" : "s") << " run, " << failed << " failed\n";
   const study::StudyAnalysis a = study::AnalyzeStudy(r, std::cerr, true);
   const std::string dir = o.out.empty() ? r.data + "/analysis" : o.out;
-  if (Status st = study::WriteStudyAnalysis(r, a, dir); !st.ok()) {
-    std::cerr << "dyad study rehearse: " << st.ToString() << "\n";
-    return 1;
-  }
+  if (!WriteAnalysis(r, a, dir, o.plots, "dyad study rehearse")) return 1;
   std::cout << "analysis: " << dir << "/report.md (" << a.trials.size() << " trials analysed, " << a.missing.size() << " missing)\n";
   return failed == 0 ? kOk : 1;
 }
@@ -269,14 +280,11 @@ int Analyze(const AnalyzeOptions& o) {
   if (o.rehearsal) s = AsRehearsal(s);
   const study::StudyAnalysis a = study::AnalyzeStudy(s, std::cerr, o.rehearsal);
   const std::string dir = o.out.empty() ? s.data + "/analysis" : o.out;
-  if (Status st = study::WriteStudyAnalysis(s, a, dir); !st.ok()) {
-    std::cerr << "dyad study analyze: " << st.ToString() << "\n";
-    return 1;
-  }
+  if (!WriteAnalysis(s, a, dir, o.plots, "dyad study analyze")) return 1;
   std::cout << "study " << s.name << ": " << a.trials.size() << " trial" << (a.trials.size() == 1 ? "" : "s") << " analysed, "
             << a.missing.size() << " missing\n";
   for (const auto& m : a.missing) std::cout << "  missing: " << m << "\n";
-  std::cout << "analysis: " << dir << "/report.md (trials.csv, events.csv, summary.csv)\n";
+  std::cout << "analysis: " << dir << "/report.md (trials.csv, events.csv, summary.csv, plots/)\n";
   return kOk;
 }
 
@@ -297,6 +305,7 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   analyze->add_option("study", a->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
   analyze->add_option("-o,--out", a->out, "Output folder (default: the study's data folder/analysis)");
   analyze->add_option("--plugins", a->plugins, "Extra plugin file or folder (repeatable)");
+  analyze->add_flag("!--no-plots", a->plots, "Tables and report only");
   analyze->add_flag("--rehearsal", a->rehearsal, "Analyse the rehearsal's recordings (DATA/rehearsal) instead of the participants'");
   analyze->callback([a, &exit_code] { exit_code = Analyze(*a); });
   auto r = std::make_shared<RunOptions>();
@@ -319,6 +328,7 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   rehearse->add_option("study", h->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
   rehearse->add_option("-o,--out", h->out, "Analysis folder (default: DATA/rehearsal/analysis)");
   rehearse->add_option("--plugins", h->plugins, "Extra plugin file or folder (repeatable)");
+  rehearse->add_flag("!--no-plots", h->plots, "Tables and report only");
   rehearse->callback([h, &exit_code] { exit_code = Rehearse(*h); });
 }
 

@@ -7,6 +7,8 @@
 #include <unistd.h>
 #include <sys/wait.h>
 
+#include <filesystem>
+
 
 namespace dyad::tools {
 
@@ -51,6 +53,21 @@ bool ProcessEnded(int pid, int* code) {
 int RunProcess(const std::vector<std::string>& args, const std::string& log) {
   const int pid = StartProcess(args, log, false);
   return pid < 0 ? 127 : WaitProcess(pid);
+}
+
+std::string DyadScriptPath(const std::string& name) {
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return (exe.parent_path().parent_path() / "share" / "dyad" / name).string();
+}
+
+int RunDyadScript(const std::string& name, const std::vector<std::string>& args) {
+  const std::string script = DyadScriptPath(name);
+  if (!std::filesystem::exists(script)) return 127;
+  // Debian's interpreter first: python3-matplotlib is installed for it, whatever else is on PATH.
+  std::vector<std::string> all = {std::filesystem::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3", script};
+  all.insert(all.end(), args.begin(), args.end());
+  return RunProcess(all);
 }
 
 std::string ShellQuoted(const std::vector<std::string>& args) {

@@ -13,6 +13,10 @@
 // gets SIGINT when the caller dies (a graph is never left running unsupervised). StartProcess
 // returns -1 when no child could be made (127 from WaitProcess when the program could not be
 // started); WaitProcess returns as RunProcess does.
+// RunDyadScript(name, args): runs share/dyad/NAME (a Python script installed beside the `dyad`
+// executable's bin/, in the build tree and the installed tree alike) with Debian's python3 (which
+// has python3-matplotlib), arguments `args`; returns as RunProcess, 127 when the script is not
+// there. DyadScriptPath(name) is where it is looked for.
 // ShellQuoted(args): the command line a POSIX shell turns back into exactly `args` (arguments
 // with anything but [A-Za-z0-9_./=:,+@%-] in single quotes), for logs and generated scripts.
 #pragma once
@@ -26,6 +30,8 @@ int RunProcess(const std::vector<std::string>& args, const std::string& log = ""
 int StartProcess(const std::vector<std::string>& args, const std::string& log, bool own_group);
 int WaitProcess(int pid);
 bool ProcessEnded(int pid, int* status);  // without waiting: true (and *status as above) once it has
+std::string DyadScriptPath(const std::string& name);
+int RunDyadScript(const std::string& name, const std::vector<std::string>& args);
 std::string ShellQuoted(const std::vector<std::string>& args);
 
 }  // namespace dyad::tools

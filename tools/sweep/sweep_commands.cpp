@@ -30,18 +30,13 @@ struct Options {
   sweep::SlurmOptions slurm_options;
 };
 
-// <prefix>/share/dyad/plot_sweep.py next to the executable's bin/ (build and installed trees).
+// The dyad executable itself (the runs and Slurm's jobs run it).
 std::string Self() {
   std::error_code ec;
   return fs::read_symlink("/proc/self/exe", ec).string();
 }
 
-int Plot(const std::string& csv, const std::string& dir) {
-  const std::string script = (fs::path(Self()).parent_path().parent_path() / "share" / "dyad" / "plot_sweep.py").string();
-  // Debian's interpreter first: python3-matplotlib is installed for it, whatever else is on PATH.
-  const std::string python = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  return tools::RunProcess({python, script, csv, dir});
-}
+int Plot(const std::string& csv, const std::string& dir) { return tools::RunDyadScript("plot_sweep.py", {csv, dir}); }
 
 // Back to the folder it started in, whatever happens (the command may run inside a test binary).
 struct RestoreCwd {

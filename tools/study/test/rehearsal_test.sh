@@ -63,6 +63,11 @@ off=$(awk -F, 'NR > 1 && $1 != $2 { s += $3 } END { print s + 0 }' $out/reports_
 grep -q "$wrong of $events self-reports name another primitive" $out/report.md || fail "the report does not say $wrong of $events"
 off=$(awk -F, 'NR > 1 && $1 != $2 { s += $3 } END { print s + 0 }' $out/reported_confusion.csv)
 [ "$off" -gt 0 ] || fail "the confusion against the self-reports has nothing off its diagonal"
+if /usr/bin/python3 -c "import matplotlib" 2> /dev/null; then
+  for m in mean_congruence robot_follows; do
+    [ "$(head -c 8 $out/plots/$m.png | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || fail "no plot of $m per condition"
+  done
+fi
 cp $out/summary.csv summary.first
 "$dyad" study rehearse s.yaml > again.log 2>&1 || { cat again.log; fail "the second rehearse"; }
 grep -q "0 trials run, 0 failed" again.log || { cat again.log; fail "the second rehearse ran trials again"; }
