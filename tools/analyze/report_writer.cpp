@@ -148,7 +148,9 @@ void SummarySection(const Report& r, std::ostream& s) {
     engaged_steps += x.engaged;
     if (!std::isnan(x.optimisation_s)) opt_ms.push_back(x.optimisation_s * 1e3);
     if (!std::isnan(x.nelbo)) nelbo.push_back(x.nelbo);
-    if (!std::isnan(x.congruence)) (x.engaged ? c_engaged : c_free).push_back(x.congruence);
+    // The idle time before the first engagement (a participant settling in) is no part of the
+    // interaction: the disengaged mean starts with the first engagement.
+    if (!std::isnan(x.congruence) && engaged_steps > 0) (x.engaged ? c_engaged : c_free).push_back(x.congruence);
   }
   auto mean = [](const std::vector<double>& v) {
     double t = 0;
@@ -167,7 +169,11 @@ void SummarySection(const Report& r, std::ostream& s) {
     << (engaged_steps == 0       ? std::string("never engaged, so not measured while engaged")
         : std::isnan(engaged)    ? std::string("not measured while engaged (no observer labels)")
                                  : "mean " + Num(engaged) + " while engaged")
-    << ", " << (std::isnan(free) ? std::string("not measured") : Num(free)) << " otherwise\n";
+    << ", " << (std::isnan(free) ? std::string("not measured") : Num(free)) << " otherwise (from the first engagement on)\n";
+  s << "\nN-ELBO is the deliberator's free energy over its window of what it perceived (how badly its "
+       "model's reconstruction fits, plus how far its posterior moved from its prior): lower means its "
+       "model explains what happened. P(C_t), the congruence, is the observer's probability at step t that "
+       "the human and the robot intend the same primitive.\n";
 
   if (r.plan.events.size() > r.events.size()) {
     const size_t n = r.plan.events.size() - r.events.size();
@@ -187,6 +193,9 @@ std::string PrimitiveCell(const PlannedEvent& e) {
   return cell;
 }
 
+// A measure against the event's primitive: "unknown" when nobody knows what the human traced.
+std::string OrUnknown(const EventSummary& e, double v) { return e.event.primitive < 0 ? std::string("unknown") : Num(v); }
+
 void EventsSection(const Report& r, std::ostream& s) {
   s << "\n## Events\n\n";
   if (r.events.empty()) {
@@ -202,15 +211,18 @@ void EventsSection(const Report& r, std::ostream& s) {
           cut = " (cut off by the end of the recording; planned to " + std::to_string(p.end_step - 1) + ")";
       s << "| " << e.index << " | " << e.event.start_step << "-" << e.event.end_step - 1 << cut << " | "
         << PrimitiveCell(e.event) << " | "
-        << Num(e.mean_congruence) << " | " << Num(e.final_congruence) << " | " << Num(e.human_accuracy) << " | "
-        << Num(e.robot_follows) << " | "
-        << (e.robot_switch_after < 0 ? std::string("never") : std::to_string(e.robot_switch_after) + " steps")
+        << Num(e.mean_congruence) << " | " << Num(e.final_congruence) << " | " << OrUnknown(e, e.human_accuracy) << " | "
+        << OrUnknown(e, e.robot_follows) << " | "
+        << (e.event.primitive < 0        ? std::string("unknown")
+            : e.robot_switch_after < 0   ? std::string("never")
+                                         : std::to_string(e.robot_switch_after) + " steps")
         << " |\n";
     }
     s << "\n\"observer on human\": fraction of the event's steps where the observer's most likely class of the "
          "human's motion is the primitive the human traced; \"robot follows\": the same for the robot's intention; "
          "\"robot switched after\": steps from the event's start to the first step where the robot's intention is "
-         "classified as the human's primitive (\"never\": not within the event).\n\n";
+         "classified as the human's primitive (\"never\": not within the event; \"unknown\": the human's primitive is not "
+         "known, neither planned nor said).\n\n";
   }
 }
 

@@ -271,6 +271,30 @@ TEST(Analyze, EventsAfterTheEndOfTheRecordingAreNotScored) {
   EXPECT_NE(md.find("1 planned event after the end of the recording (not scored)"), std::string::npos) << md;
 }
 
+// The participant settling in before their first hold is no part of the interaction: the
+// disengaged congruence is averaged from the first engagement on. N-ELBO and P(C_t) are explained.
+TEST(Analyze, IdleTimeBeforeTheFirstEngagementIsLeftOutOfTheMeans) {
+  Report r = Analyse(WriteExperiment(TempPath("a.mcap")));
+  double sum = 0;
+  int n = 0;
+  bool seen = false;
+  for (auto& x : r.timeline.steps) {
+    seen = seen || x.engaged;
+    if (!seen) x.congruence = 0.99;  // idle: must not count
+    else if (!x.engaged && !std::isnan(x.congruence)) sum += x.congruence, ++n;
+  }
+  ASSERT_GT(n, 0);
+  ASSERT_FALSE(r.timeline.steps.front().engaged);
+  std::ostringstream expected;
+  expected.setf(std::ios::fixed);
+  expected.precision(3);
+  expected << ", " << sum / n << " otherwise (from the first engagement on)";
+  const std::string md = FormatMarkdown(r);
+  EXPECT_NE(md.find(expected.str()), std::string::npos) << expected.str() << "\n" << md;
+  EXPECT_NE(md.find("N-ELBO is the deliberator's free energy"), std::string::npos) << md;
+  EXPECT_NE(md.find("P(C_t), the congruence, is the observer's probability"), std::string::npos) << md;
+}
+
 TEST(Analyze, ANeverEngagedHumanIsSaidSoNotAnEmptyNumber) {
   Report r = Analyse(WriteExperiment(TempPath("a.mcap")));
   for (auto& x : r.timeline.steps) x.engaged = false;
@@ -297,7 +321,11 @@ TEST(Analyze, AnInteractiveRunHasItsEngagedRunsAsEventsAndSaysWhatWasNotRecorded
   EXPECT_EQ(events[1].primitive, -1);
   r.events = SummariseEvents(r.timeline, events);
   const std::string md = FormatMarkdown(r);
-  EXPECT_NE(md.find("| 1 | 20-22 | unknown |"), std::string::npos) << md;
+  // Nobody knows what the person traced in event 1: its measures against that primitive say so.
+  const size_t row = md.find("| 1 | 20-22 | unknown |");
+  ASSERT_NE(row, std::string::npos) << md;
+  const std::string line = md.substr(row, md.find('\n', row) - row);
+  EXPECT_EQ(line.substr(line.size() - 31), "| unknown | unknown | unknown |") << line;
   EXPECT_NE(md.find("- N-ELBO: not recorded"), std::string::npos) << md;
   EXPECT_NE(md.find("- deliberation time per step: not recorded"), std::string::npos) << md;
   EXPECT_EQ(md.find("mean , median"), std::string::npos) << md;
