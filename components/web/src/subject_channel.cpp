@@ -51,12 +51,23 @@ void SubjectChannel::SendRole(ClientId client, bool steering) {
 
 void SubjectChannel::OnOpen(ClientId client, Role role) {
   bool steering = false;
+  ClientId demoted = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     pages_.push_back(client);
     roles_[client] = role;
-    if (steering_ == 0 && role != Role::kViewer) steering_ = client, steering = true;
+    // The subject's page steers before the experimenter's: an experimenter who opened /subject
+    // first (to check it) must not keep the steering once the participant's page comes.
+    const bool experimenter_steers = steering_ != 0 && roles_[steering_] == Role::kExperimenter;
+    if (role != Role::kViewer && (steering_ == 0 || (role == Role::kSubject && experimenter_steers))) {
+      if (steering_ != 0) {
+        demoted = steering_;
+        sink_(last_x_, last_y_, false);  // the experimenter's hold ends now
+      }
+      steering_ = client, steering = true;
+    }
   }
+  if (demoted != 0) SendRole(demoted, false);
   json prims = json::array();
   for (const auto& p : options_.primitives) {
     json pts = json::array();
@@ -155,11 +166,9 @@ void SubjectChannel::OnClose(ClientId client) {
     if (client != steering_) return;
     sink_(last_x_, last_y_, false);  // the subject left: disengaged at once
     steering_ = 0;
-    for (ClientId page : pages_)
-      if (roles_[page] != Role::kViewer) {
-        steering_ = page;
-        break;
-      }
+    for (const Role preferred : {Role::kSubject, Role::kExperimenter})  // a subject's page first
+      for (ClientId page : pages_)
+        if (steering_ == 0 && roles_[page] == preferred) steering_ = page;
     promoted = steering_;
   }
   if (promoted != 0) SendRole(promoted, true);

@@ -13,8 +13,9 @@
 /// time, ms since the epoch): the channel then keeps the event-to-publication delay.
 ///
 /// Several pages may watch; one steers: the first to connect with the subject's or the
-/// experimenter's token, until it leaves (the oldest such page left then steers) or another such
-/// page asks to steer. A viewer's page only watches: a pointer sample or a steering request from
+/// experimenter's token, until it leaves (the oldest such page left then steers, a subject's
+/// before an experimenter's) or another such page asks to steer. A subject's page that connects
+/// while an experimenter's steers takes the steering (the experimenter opened /subject first). A viewer's page only watches: a pointer sample or a steering request from
 /// it closes it. Only the steering page's pointer reaches the graph; when it disconnects, a
 /// disengaged sample is published at once.
 #pragma once

@@ -58,5 +58,30 @@ TEST(SubjectChannel, AnAnswerNobodyAskedForIsIgnored) {
   EXPECT_TRUE(a.choices.empty());
 }
 
+// The experimenter opens /subject before the participant: the participant's page, once it
+// comes, steers; the experimenter's stops (its hold ends: one disengaged sample), and steers again
+// only when the participant's page leaves.
+TEST(SubjectChannel, TheSubjectsPageSteersBeforeTheExperimenters) {
+  std::vector<std::pair<int, bool>> published;  // (page whose pointer it was, engaged)
+  int sender = 0;
+  SubjectChannel ch(SubjectChannel::Options{}, [&](double, double, bool engaged) { published.push_back({sender, engaged}); });
+  auto pointer = [&](web::ClientId c) {
+    sender = static_cast<int>(c);
+    return ch.OnText(c, R"({"op":"pointer","x":1,"y":2,"engaged":true})");
+  };
+  ch.OnOpen(1, Role::kExperimenter);
+  ASSERT_TRUE(pointer(1).ok());
+  ch.OnOpen(2, Role::kSubject);
+  ch.OnOpen(3, Role::kSubject);  // a second subject page does not take over from the first
+  ASSERT_TRUE(pointer(1).ok());  // ignored: not the steering page any more
+  ASSERT_TRUE(pointer(3).ok());  // ignored
+  ASSERT_TRUE(pointer(2).ok());
+  EXPECT_EQ(published, (std::vector<std::pair<int, bool>>{{1, true}, {1, false}, {2, true}}));
+  ch.OnClose(2);  // the subject's other page steers, not the experimenter's
+  ASSERT_TRUE(pointer(3).ok());
+  ASSERT_TRUE(pointer(1).ok());
+  EXPECT_EQ(published.back(), (std::pair<int, bool>{3, true}));
+}
+
 }  // namespace
 }  // namespace dyad::web
