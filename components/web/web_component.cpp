@@ -381,6 +381,8 @@ Status WebComponent::Step(const StepInfo& info) {
     experimenter_->Broadcast(2, stats_->Json());
     if (std::string events = events_->Json(); !events.empty()) experimenter_->Broadcast(3, std::move(events));
     if (std::string answers = answers_->Json(); !answers.empty()) experimenter_->Broadcast(4, std::move(answers));
+    // Whether the participant's page is there and holding (the experimenter cannot see it).
+    experimenter_->Broadcast(5, nlohmann::json{{"op", "subject"}, {"pages", subject_->pages()}, {"engaged", holding_.load()}}.dump());
   }
   bridge_->ReportDrops();
   return Status::OK();

@@ -22,6 +22,7 @@
 /// YAML like every other part.
 #pragma once
 
+#include <atomic>
 #include <memory>
 
 #include <dyad/component.hpp>
@@ -83,7 +84,8 @@ class WebComponent final : public Component {
   Output<msg::SelfReport>* reports_ = nullptr;  // owned by the runtime; may be unbound
   // The steering page's last hold (runtime clock), for its self-report; touched only by the
   // subject channel's sinks, which it serialises.
-  bool holding_ = false, answerable_ = false;
+  std::atomic<bool> holding_{false};  // read by Step for the experimenter's page
+  bool answerable_ = false;
   int64_t hold_start_ns_ = 0, hold_end_ns_ = 0;
 };
 

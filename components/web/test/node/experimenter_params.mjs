@@ -37,6 +37,12 @@ try {
   const page = await context.newPage();
   await page.goto(base + "/experimenter?token=experimenter-token-0001");  // the test graph's tokens
   await page.waitForFunction(() => document.getElementById("conn").textContent === "live", null, { timeout: 10000 });
+  // No subject's page is open in this test: the header says so (sent once a second).
+  try {
+    await page.waitForFunction(() => document.getElementById("subject").textContent === "subject: no page", null, { timeout: 5000 });
+  } catch {
+    failures.push("the header's subject status: " + (await page.textContent("#subject")));
+  }
 
   await ask(page, "mixer.gain", "0.25");
   await expectListed(page, "applied", /^\d{1,2}:\d\d:\d\d.*  mixer\.gain 0\.9 \u2192 0\.25 \(experimenter page\)$/);
