@@ -212,6 +212,7 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
   so.watermark = p.Bool("show_primitives");
   so.ask = reports_->bound() && p.String("self_reports") == "after_event";
   so.ask_after_hold_s = p.Double("self_report_min_hold_s");
+  min_hold_ns_ = static_cast<int64_t>(std::llround(so.ask_after_hold_s * 1e9));
   if (so.watermark || so.ask) {
     const std::string why = so.watermark ? "params.show_primitives" : "params.self_reports (the question's thumbnails)";
     if (p.String("dataset").empty()) return Status::InvalidArgument(why + ": needs params.dataset (an NRL data set folder)");
@@ -246,7 +247,8 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
 
 // The answer about the last hold, once (a second click, or an answer while holding again, is ignored).
 Status WebComponent::PublishSelfReport(int choice) {
-  if (!answerable_ || holding_) return Status::OK();
+  // The server's own checks, whatever a page sends: a finished hold, long enough to be asked about.
+  if (!answerable_ || holding_ || hold_end_ns_ - hold_start_ns_ < min_hold_ns_) return Status::OK();
   answerable_ = false;
   const int64_t now = ctx_->clock().now_ns();
   msg::SelfReport r;

@@ -86,7 +86,7 @@ class WebComponent final : public Component {
   // subject channel's sinks, which it serialises.
   std::atomic<bool> holding_{false};  // read by Step for the experimenter's page
   bool answerable_ = false;
-  int64_t hold_start_ns_ = 0, hold_end_ns_ = 0;
+  int64_t hold_start_ns_ = 0, hold_end_ns_ = 0, min_hold_ns_ = 0;
 };
 
 }  // namespace dyad::web

@@ -70,7 +70,8 @@ def main():
             ax.errorbar([i + 0.12], [m], yerr=[[m - (lo if lo is not None else m)], [(hi if hi is not None else m) - m]],
                         fmt="D", color="#1f77b4", capsize=5, ms=7, zorder=3)
         ax.set_xticks(range(len(conditions)))
-        ax.set_xticklabels(["%s (%s)" % (c, labels[c]) for c in conditions])
+        # A blind analysis names a condition by its label already ("condition A").
+        ax.set_xticklabels([c if c == "condition " + labels[c] else "%s (%s)" % (c, labels[c]) for c in conditions])
         ax.set_xlim(-0.5, len(conditions) - 0.5)
         ax.set_ylabel(measure)
         ax.set_title("%s\ngrey: each participant; blue: mean, 95%% bootstrap interval" % measure, fontsize=9)

@@ -40,6 +40,9 @@ void AddConfusion(const std::vector<std::vector<int64_t>>& m, std::vector<std::v
     for (size_t p = 0; p < m[t].size(); ++p) (*sum)[t][p] += m[t][p];
 }
 
+// A condition as the analysis's files name it: by name once unblinded, else by its label only.
+std::string NameOf(const StudyAnalysis& a, const Condition& c) { return a.unblinded ? c.name : "condition " + c.label; }
+
 std::string TrialsCsv(const Study& s, const StudyAnalysis& a) {
   std::ostringstream out;
   out << "participant,condition,label,trial,repetition,attempt,file";
@@ -47,7 +50,7 @@ std::string TrialsCsv(const Study& s, const StudyAnalysis& a) {
   out << '\n';
   for (const TrialResult& r : a.trials) {
     const Condition& c = s.conditions[static_cast<size_t>(r.trial.condition)];
-    out << r.participant << ',' << c.name << ',' << c.label << ',' << r.trial.number << ',' << r.trial.repetition << ','
+    out << r.participant << ',' << NameOf(a, c) << ',' << c.label << ',' << r.trial.number << ',' << r.trial.repetition << ','
         << r.attempt << ',' << tools::CsvCell(r.trial.file);
     for (const auto& [name, value] : r.metrics) out << ',' << Num(value);
     out << '\n';
@@ -61,7 +64,7 @@ std::string EventsCsv(const Study& s, const StudyAnalysis& a) {
          "human_accuracy,robot_follows,robot_switch_after\n";
   for (const TrialResult& r : a.trials)
     for (const analyze::EventSummary& e : r.events) {
-      out << r.participant << ',' << s.conditions[static_cast<size_t>(r.trial.condition)].name << ',' << r.trial.number << ','
+      out << r.participant << ',' << NameOf(a, s.conditions[static_cast<size_t>(r.trial.condition)]) << ',' << r.trial.number << ','
           << e.index << ',' << e.event.start_step << ',' << e.event.end_step << ','
           << (e.event.primitive < 0 ? std::string() : std::to_string(e.event.primitive)) << ','
           << (e.event.reported == analyze::kNotReported ? std::string() : std::to_string(e.event.reported)) << ','
@@ -109,12 +112,12 @@ Summaries Summary(const Study& s, const StudyAnalysis& a) {
   return out;
 }
 
-std::string SummaryCsv(const Summaries& summary) {
+std::string SummaryCsv(const StudyAnalysis& a, const Summaries& summary) {
   std::ostringstream out;
   out << "condition,label,measure,participants,trials,mean,ci_low,ci_high\n";
   for (const auto& [c, measures] : summary)
     for (const ConditionMeasure& m : measures)
-      out << c->name << ',' << c->label << ',' << m.measure << ',' << m.interval.n << ',' << m.trials << ',' << Num(m.interval.mean)
+      out << NameOf(a, *c) << ',' << c->label << ',' << m.measure << ',' << m.interval.n << ',' << m.trials << ',' << Num(m.interval.mean)
           << ',' << Num(m.interval.low) << ',' << Num(m.interval.high) << '\n';
   return out.str();
 }
@@ -129,7 +132,7 @@ std::string ReportMd(const Study& s, const StudyAnalysis& a, const Summaries& su
   for (const auto& [c, measures] : summary)
     for (const ConditionMeasure& m : measures) {
       const MeanInterval& ci = m.interval;
-      out << "| " << c->name << " (" << c->label << ") | " << m.measure << " | " << ci.n << " | " << m.trials << " | "
+      out << "| " << (a.unblinded ? c->name + " (" + c->label + ")" : NameOf(a, *c)) << " | " << m.measure << " | " << ci.n << " | " << m.trials << " | "
           << (ci.n > 0 ? Num(ci.mean) : "unknown") << " | " << (ci.n > 0 ? Num(ci.low) + " to " + Num(ci.high) : "unknown") << " |\n";
     }
   out << "\nmean_congruence: P(C_t), the observer's belief that human and robot intend the same primitive, averaged over "
@@ -188,12 +191,28 @@ std::string NotThisTrial(const std::string& file, const Study& study, const std:
   if (get("study") != study.name) return "a recording of study " + get("study") + ", not " + study.name;
   if (get("participant") != participant) return "a recording of participant " + get("participant");
   if (get("trial") != std::to_string(trial.number)) return "a recording of trial " + get("trial");
+  const Condition& c = study.conditions[static_cast<size_t>(trial.condition)];
+  if (get("condition") != (study.blind ? c.label : c.name))
+    return "a recording of condition " + get("condition") + ", which the plan does not give this trial";
   if ((get("rehearsal") == "true") != rehearsal)
     return rehearsal ? "a recording of a participant, not of the rehearsal" : "a rehearsal's recording (synthetic participant)";
   return "";
 }
 
 namespace {
+
+// Empty when the file's "dyad.run" metadata says it is attempt `attempt`.
+std::string AttemptMismatch(const std::string& file, int attempt) {
+  auto reader = mcap::Reader::Open(file);
+  if (!reader.ok()) return reader.status().message();
+  for (const auto& md : reader->metadata())
+    if (md.name == "dyad.run") {
+      const auto it = md.entries.find("attempt");
+      const std::string said = it == md.entries.end() ? "(none)" : it->second;
+      return said == std::to_string(attempt) ? "" : "a recording of attempt " + said + ", not " + std::to_string(attempt);
+    }
+  return "";
+}
 
 // The attempt of `t` to analyse, or the reason there is none (session: the participant's log).
 struct Chosen {
@@ -211,10 +230,11 @@ Chosen ChooseAttempt(const Session& session, const Trial& t) {
   for (const Attempt& a : session.attempts) {
     if (a.trial != t.number) continue;
     if (&a == done) add(a, "analysed");
-    else add(a, a.outcome.empty() ? "ended with the session" : a.outcome);
+    else add(a, a.outcome.empty() ? "interrupted (the session ended during it)" : a.outcome);
   }
   if (done) {
-    c.file = done->file;
+    // The plan names the file (the log's path is what it was then: the folder may have moved).
+    c.file = AttemptFile(t, done->attempt);
     c.attempt = done->attempt;
     if (done->attempt == 1 && c.repeated == "attempt 1 analysed") c.repeated.clear();
   } else if (session.Last(t.number)) {
@@ -244,7 +264,9 @@ StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehe
         a.missing.push_back(name + ": not recorded");
         continue;
       }
-      if (std::string why = NotThisTrial(c.file, study, p, t, rehearsal); !why.empty()) {
+      std::string why = NotThisTrial(c.file, study, p, t, rehearsal);
+      if (why.empty() && c.attempt > 1) why = AttemptMismatch(c.file, c.attempt);
+      if (!why.empty()) {
         a.missing.push_back(name + ": " + why);
         continue;
       }
@@ -278,7 +300,7 @@ Status WriteStudyAnalysis(const Study& study, const StudyAnalysis& a, const std:
   const Summaries summary = Summary(study, a);  // the bootstrap, once for both files
   const std::pair<const char*, std::string> files[] = {{"trials.csv", TrialsCsv(study, a)},
                                                        {"events.csv", EventsCsv(study, a)},
-                                                       {"summary.csv", SummaryCsv(summary)},
+                                                       {"summary.csv", SummaryCsv(a, summary)},
                                                        {"report.md", ReportMd(study, a, summary)}};
   for (const auto& [name, text] : files)
     if (Status s = tools::WriteTextFile((d / name).string(), text); !s.ok()) return s;

@@ -12,7 +12,7 @@
 //     participants' or the reverse, or a file without that metadata).
 //   - Every other .mcap file in a participant's folder is listed as not part of the plan.
 //   - WriteStudyAnalysis writes into `dir` (created): trials.csv (one row per trial: participant,
-//     condition, label, trial, repetition, file, then RunMetrics' measures), events.csv (one row
+//     condition, label, trial, repetition, attempt, file, then RunMetrics' measures), events.csv (one row
 //     per event of every trial: participant, condition, trial, the event's steps, primitive,
 //     self-report, congruence, the observer's accuracy on the human, whether the robot follows,
 //     its switch latency), summary.csv (per condition and measure: each participant's mean over
@@ -51,6 +51,9 @@ struct StudyAnalysis {
   std::vector<TrialResult> trials;  // in the plan's order
   std::vector<std::string> missing;  // "P02 trial 3 (FILE): not recorded" and the like
   std::vector<std::string> unplanned;  // .mcap files in a participant's folder that are no attempt of the plan
+  // The files name the conditions (the unblinded step); false: "condition A" only (a blind
+  // study's rehearsal, seen by the experimenter before the study).
+  bool unblinded = true;
   std::vector<std::vector<int64_t>> reported_confusion;  // empty: no self-report with labels
   // Planned trials only: (traced primitive, reported choice) -> events; how wrong the reports are.
   std::map<std::pair<int, int>, int64_t> reports_vs_plan;
@@ -59,8 +62,8 @@ struct StudyAnalysis {
 // `rehearsal`: the recordings `dyad study rehearse` made (their metadata says so), in study.data.
 StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehearsal = false);
 
-// Empty when `file`'s "dyad.run" metadata names this study, participant and trial (and
-// rehearsal flag); else why not.
+// Empty when `file`'s "dyad.run" metadata names this study, participant, trial, condition (its
+// label when blind) and rehearsal flag; else why not.
 std::string NotThisTrial(const std::string& file, const Study& study, const std::string& participant, const Trial& trial,
                          bool rehearsal);
 Status WriteStudyAnalysis(const Study& study, const StudyAnalysis& analysis, const std::string& dir);

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "run_process.hpp"
 #include "study_analysis.hpp"
@@ -83,14 +84,15 @@ std::string Ended(const study::Attempt& a) {
   std::snprintf(secs, sizeof secs, "%.1f s", a.seconds);
   if (a.outcome == "complete") return std::string("complete (") + secs + ")";
   if (a.outcome == "stopped") return std::string("stopped after ") + secs + ": incomplete";
-  return "failed: the graph exited " + std::to_string(a.exit) + " after " + secs;
+  if (a.outcome.empty()) return "interrupted: the session ended during it";
+  return "failed: the graph exited " + std::to_string(a.exit) + " after " + secs + (a.exit == 0 ? " and left no whole recording" : "");
 }
 
-// One line from the experimenter (empty at the end of input).
-std::string Ask(const std::string& prompt) {
+// One line from the experimenter; nothing at the end of input (no answer is never a yes).
+std::optional<std::string> Ask(const std::string& prompt) {
   std::cout << prompt << std::flush;
   std::string line;
-  if (!std::getline(std::cin, line)) return "";
+  if (!std::getline(std::cin, line)) return std::nullopt;
   return line;
 }
 
@@ -102,24 +104,16 @@ struct RunOptions {
   study::PageOptions page_options;
 };
 
-// Consent before the first trial records: marked on the command line or at the prompt.
-bool HaveConsent(const study::Study& s, const RunOptions& o) {
-  if (!s.consent_required || study::ReadSession(s, o.participant).consent) return true;
-  std::string how = "--consent";
-  if (!o.consent) {
-    if (o.yes || Ask("Has " + o.participant + " given informed consent? Type yes to mark it: ") != "yes") {
-      std::cerr << "dyad study run: consent is required (consent_required in " << s.file << ") and not marked for "
-                << o.participant << ": nothing was recorded (--consent marks it)\n";
-      return false;
-    }
-    how = "marked at the prompt";
-  }
-  if (Status st = study::MarkConsent(s, o.participant, how); !st.ok()) {
-    std::cerr << "dyad study run: " << st.ToString() << "\n";
-    return false;
-  }
-  std::cout << "consent marked for " << o.participant << " (" << how << ")\n";
-  return true;
+// Consent before the first trial records: how it was given ("" when it is not needed or already
+// marked), or nothing when it was not (said). Asked before anything is written.
+std::optional<std::string> ConsentGiven(const study::Study& s, const RunOptions& o, const study::Session& before) {
+  if (!s.consent_required || before.consent) return std::string();
+  if (o.consent) return std::string("--consent");
+  if (!o.yes && Ask("Has " + o.participant + " given informed consent? Type yes to mark it: ").value_or("") == "yes")
+    return std::string("marked at the prompt");
+  std::cerr << "dyad study run: consent is required (consent_required in " << s.file << ") and not marked for " << o.participant
+            << ": nothing was recorded (--consent marks it)\n";
+  return std::nullopt;
 }
 
 // Runs one attempt at `t` and says how it ended; false when it could not start.
@@ -134,6 +128,13 @@ bool RunOne(const study::Study& s, const RunOptions& o, const study::Trial& t, s
   r.attempt = last ? last->attempt + 1 : 1;
   while (std::filesystem::exists(study::AttemptFile(t, r.attempt))) ++r.attempt;  // a file the log does not know
   r.reason = reason;
+  // The graph's output names what a blind experimenter must not see (its parameters): it goes to
+  // a file beside the recording then.
+  if (s.blind) r.run_log = std::filesystem::path(study::AttemptFile(t, r.attempt)).replace_extension(".log").string();
+  if (std::string why = study::WhyNotStart(session, s.TrialsOf(o.participant), t.number, reason); !why.empty()) {
+    std::cerr << "dyad study run: " << why << "\n";
+    return false;
+  }
   std::cout << TrialLine(s, t, of) << (r.attempt > 1 ? ", attempt " + std::to_string(r.attempt) : "") << " -> "
             << study::AttemptFile(t, r.attempt) << "\n"
             << (s.duration_s > 0 ? "  running for " + std::to_string(static_cast<int>(s.duration_s)) + " s (Ctrl-C stops it early)"
@@ -144,7 +145,7 @@ bool RunOne(const study::Study& s, const RunOptions& o, const study::Trial& t, s
     std::cerr << "dyad study run: " << a.status().ToString() << "\n";
     return false;
   }
-  std::cout << "  trial " << t.number << ": " << Ended(*a) << "\n";
+  std::cout << "  trial " << t.number << ": " << Ended(*a) << (r.run_log.empty() ? "" : " (its output: " + r.run_log + ")") << "\n";
   *out = *a;
   return true;
 }
@@ -162,11 +163,24 @@ int RunSession(const RunOptions& o) {
     std::cerr << "dyad study run: --trial " << o.trial << ": " << o.participant << " has " << trials.size() << " trials\n";
     return kBadInput;
   }
+  if (!o.reason.empty() && o.trial == 0) {
+    std::cerr << "dyad study run: --reason is the reason of a --trial repetition; give --trial N too\n";
+    return kBadInput;
+  }
+  // One runner per participant, from the first thing that writes (consent, the page) on; a
+  // session refused for want of consent leaves nothing behind.
+  auto lock = [&]() -> StatusOr<study::SessionLock> {
+    auto l = study::SessionLock::Acquire(s, o.participant);
+    if (!l.ok()) std::cerr << "dyad study run: " << l.status().ToString() << "\n";
+    return l;
+  };
   const study::Session before = study::ReadSession(s, o.participant);
   for (const auto& p : before.problems) std::cerr << "warning: " << p << "\n";
   std::cout << "study " << s.name << ", participant " << o.participant << ": " << trials.size() << " trials\n";
   if (o.page) {  // the experimenter's study page instead of the terminal
-    if (Status st = o.consent ? study::MarkConsent(s, o.participant, "--consent") : Status::OK(); !st.ok()) {
+    auto held = lock();
+    if (!held.ok()) return kBadInput;
+    if (Status st = o.consent && !before.consent ? study::MarkConsent(s, o.participant, "--consent") : Status::OK(); !st.ok()) {
       std::cerr << "dyad study run: " << st.ToString() << "\n";
       return 1;
     }
@@ -174,14 +188,24 @@ int RunSession(const RunOptions& o) {
     po.dyad = ThisExecutable();
     return study::RunStudyPage(s, o.participant, po);
   }
-  if (!HaveConsent(s, o)) return kBadInput;
+  const std::optional<std::string> consent = ConsentGiven(s, o, before);
+  if (!consent) return kBadInput;
+  auto held = lock();
+  if (!held.ok()) return kBadInput;
+  if (!consent->empty()) {
+    if (Status st = study::MarkConsent(s, o.participant, *consent); !st.ok()) {
+      std::cerr << "dyad study run: " << st.ToString() << "\n";
+      return 1;
+    }
+    std::cout << "consent marked for " << o.participant << " (" << *consent << ")\n";
+  }
   study::Attempt a;
   if (o.trial > 0) {  // a repetition, asked for on the command line
     if (o.reason.empty()) {
       std::cerr << "dyad study run: --trial " << o.trial << " needs --reason (why the trial is repeated)\n";
       return kBadInput;
     }
-    if (!RunOne(s, o, trials[static_cast<size_t>(o.trial - 1)], trials.size(), o.reason, &a)) return 1;
+    if (!RunOne(s, o, trials[static_cast<size_t>(o.trial - 1)], trials.size(), o.reason, &a)) return kBadInput;
     return a.outcome == "complete" ? kOk : 1;
   }
   // A trial that did not complete is run again, with the experimenter's reason, before the next.
@@ -191,16 +215,20 @@ int RunSession(const RunOptions& o) {
                 << last.trial << " --reason TEXT\n";
       return std::string();
     }
-    return Ask("Trial " + std::to_string(last.trial) + " was " + Ended(last) + ". Why is it repeated (empty: stop here)? ");
+    return Ask("Trial " + std::to_string(last.trial) + " was " + Ended(last) + ". Why is it repeated (empty: stop here)? ")
+        .value_or("");
   };
   for (const study::Trial& t : trials) {
     const study::Session now = study::ReadSession(s, o.participant);
     if (now.Complete(t.number)) continue;
     std::string reason;
     if (const study::Attempt* last = now.Last(t.number); last && (reason = why_again(*last)).empty()) return 1;
-    if (!o.yes && Ask(TrialLine(s, t, trials.size()) + ". Enter starts it, q stops here: ") == "q") return kOk;
+    if (!o.yes) {
+      const auto answer = Ask(TrialLine(s, t, trials.size()) + ". Enter starts it, q stops here: ");
+      if (!answer || *answer == "q") return kOk;  // the end of input starts nothing
+    }
     if (!RunOne(s, o, t, trials.size(), reason, &a)) return 1;
-    while (a.outcome != "complete") {
+    while (a.outcome != "complete") {  // with --yes (or Ctrl-C then no reason): stop here, not at the next trial
       if ((reason = why_again(a)).empty()) return 1;
       if (!RunOne(s, o, t, trials.size(), reason, &a)) return 1;
     }
@@ -212,7 +240,7 @@ int RunSession(const RunOptions& o) {
 struct AnalyzeOptions {
   std::string file, out;
   std::vector<std::string> plugins;
-  bool rehearsal = false, plots = true;
+  bool rehearsal = false, plots = true, unblind = false;
 };
 
 // The analysis of `s` into `dir`, with its plots; false (said) when it could not be written.
@@ -255,8 +283,17 @@ int Rehearse(const AnalyzeOptions& o) {
       // Each synthetic participant and trial its own random streams, the same on every machine.
       req.extra_sets = {"seed=" + std::to_string(tools::Fnv1a(s.name + "/" + p + "/" + std::to_string(t.number)) % 1000000 + 1)};
       req.run_log = std::filesystem::path(study::AttemptFile(t, req.attempt)).replace_extension(".log").string();
+      auto lock = study::SessionLock::Acquire(r, p);
+      if (!lock.ok()) {
+        std::cerr << "dyad study rehearse: " << lock.status().ToString() << "\n";
+        return kBadInput;
+      }
       auto a = study::RunAttempt(r, req);
       ++ran;
+      if (a.ok() && a->interrupted) {
+        std::cerr << "dyad study rehearse: interrupted during " << p << " trial " << t.number << " (a new rehearse resumes)\n";
+        return 1;
+      }
       if (!a.ok() || a->outcome != "complete") {
         ++failed;
         std::cerr << p << " " << TrialLine(r, t, r.TrialsOf(p).size()) << ": "
@@ -266,7 +303,9 @@ int Rehearse(const AnalyzeOptions& o) {
       std::cout << p << " " << TrialLine(r, t, r.TrialsOf(p).size()) << ": " << Ended(*a) << std::endl;
     }
   std::cout << "rehearsal of " << s.name << ": " << ran << " trial" << (ran == 1 ? "" : "s") << " run, " << failed << " failed\n";
-  const study::StudyAnalysis a = study::AnalyzeStudy(r, std::cerr, true);
+  study::StudyAnalysis a = study::AnalyzeStudy(r, std::cerr, true);
+  // Rehearsed before anyone comes, seen by the experimenter: a blind study's stays blind.
+  a.unblinded = !s.blind || o.unblind;
   const std::string dir = o.out.empty() ? r.data + "/analysis" : o.out;
   if (!WriteAnalysis(r, a, dir, o.plots, "dyad study rehearse")) return 1;
   std::cout << "analysis: " << dir << "/report.md (" << a.trials.size() << " trials analysed, " << a.missing.size() << " missing)\n";
@@ -278,7 +317,8 @@ int Analyze(const AnalyzeOptions& o) {
   study::Study s;
   if (!Load(o.file, o.plugins, &s)) return kBadInput;
   if (o.rehearsal) s = AsRehearsal(s);
-  const study::StudyAnalysis a = study::AnalyzeStudy(s, std::cerr, o.rehearsal);
+  study::StudyAnalysis a = study::AnalyzeStudy(s, std::cerr, o.rehearsal);
+  a.unblinded = !s.blind || !o.rehearsal || o.unblind;
   const std::string dir = o.out.empty() ? s.data + "/analysis" : o.out;
   if (!WriteAnalysis(s, a, dir, o.plots, "dyad study analyze")) return 1;
   std::cout << "study " << s.name << ": " << a.trials.size() << " trial" << (a.trials.size() == 1 ? "" : "s") << " analysed, "
@@ -306,6 +346,7 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   analyze->add_option("-o,--out", a->out, "Output folder (default: the study's data folder/analysis)");
   analyze->add_option("--plugins", a->plugins, "Extra plugin file or folder (repeatable)");
   analyze->add_flag("!--no-plots", a->plots, "Tables and report only");
+  analyze->add_flag("--unblind", a->unblind, "With --rehearsal: name a blind study's conditions (the participants' analysis always does)");
   analyze->add_flag("--rehearsal", a->rehearsal, "Analyse the rehearsal's recordings (DATA/rehearsal) instead of the participants'");
   analyze->callback([a, &exit_code] { exit_code = Analyze(*a); });
   auto r = std::make_shared<RunOptions>();
@@ -329,6 +370,7 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   rehearse->add_option("-o,--out", h->out, "Analysis folder (default: DATA/rehearsal/analysis)");
   rehearse->add_option("--plugins", h->plugins, "Extra plugin file or folder (repeatable)");
   rehearse->add_flag("!--no-plots", h->plots, "Tables and report only");
+  rehearse->add_flag("--unblind", h->unblind, "Name a blind study's conditions in the rehearsal's analysis (not for the experimenter's eyes)");
   rehearse->callback([h, &exit_code] { exit_code = Rehearse(*h); });
 }
 

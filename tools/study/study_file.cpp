@@ -114,9 +114,9 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
     for (const ComponentConfig& c : LoadGraph(s->graph, {}, &ignored).components)
       if (c.type == "web") {
         s->page_sets.push_back(c.name + ".self_reports=" + s->self_reports);
-        // The same tokens for every trial, so the pages reconnect to the next trial's graph.
-        if (!c.params || !c.params["token_file"])
-          s->page_sets.push_back(c.name + ".token_file=" + (fs::path(s->data) / (c.name + "-tokens")).string());
+        // The same tokens for every trial of a participant (each participant their own), so the
+        // pages reconnect to the next trial's graph.
+        if (!c.params || !c.params["token_file"]) s->token_file_webs.push_back(c.name);
       }
   }
   s->rehearsal_graph = s->graph;

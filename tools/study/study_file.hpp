@@ -61,6 +61,7 @@ struct Study {
   std::string self_reports = "after_event";
   std::string recorder = "recorder";  // the component whose `file` and `metadata` each trial sets
   std::vector<std::string> page_sets;  // "WEB.self_reports=MODE" for each `web` component of the graph
+  std::vector<std::string> token_file_webs;  // web components without a token_file: one per participant is given
   std::string rehearsal_graph;        // absolute; the study's graph unless the file names another
   std::vector<std::string> rehearsal_sets;
   int square_rows = 1;  // rows of the Latin square: participants in multiples of it are balanced

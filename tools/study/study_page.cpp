@@ -26,8 +26,8 @@ namespace {
 using Json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-volatile sig_atomic_t g_quit = 0;
-extern "C" void OnQuitSignal(int) { g_quit = 1; }
+std::atomic<int> g_quit{0};  // lock-free: set by the handler, read by the main loop
+extern "C" void OnQuitSignal(int) { g_quit.store(1); }
 
 class StudyChannel final : public web::ClientHandler {
  public:
@@ -36,6 +36,7 @@ class StudyChannel final : public web::ClientHandler {
   ~StudyChannel() override { Join(); }
 
   void SetServer(web::WebServer* server) { server_.store(server); }
+  void Close() { closing_.store(true); }  // no trial starts any more
   bool running() const { return running_.load(); }
   void StopTrial() { stop_.store(true); }
   void Join() {
@@ -86,19 +87,12 @@ class StudyChannel final : public web::ClientHandler {
 
   // Why trial `k` may not start now, or "" once it has.
   std::string Start(int k, const std::string& reason) {
+    if (closing_.load()) return "the study page is closing";
     if (running_.load()) return "trial " + std::to_string(current_trial_) + " is running: stop it first";
-    if (k < 1 || k > static_cast<int>(trials_.size())) return "there is no trial " + std::to_string(k);
     const Session session = ReadSession(study_, participant_);
     if (study_.consent_required && !session.consent) return "consent is required and not marked: nothing was recorded";
-    int next = 0;  // the first trial not complete
-    for (const Trial& t : trials_)
-      if (!session.Complete(t.number)) {
-        next = t.number;
-        break;
-      }
+    if (std::string why = WhyNotStart(session, trials_, k, reason); !why.empty()) return why;
     const Attempt* last = session.Last(k);
-    if (last && reason.empty()) return "trial " + std::to_string(k) + " was run before: say why it is repeated";
-    if (!last && k != next) return "trial " + std::to_string(next) + " comes first (the plan's order)";
     AttemptRequest r;
     r.dyad = dyad_;
     r.participant = participant_;
@@ -107,6 +101,8 @@ class StudyChannel final : public web::ClientHandler {
     while (std::filesystem::exists(AttemptFile(r.trial, r.attempt))) ++r.attempt;
     r.reason = reason;
     r.stop = &stop_;
+    // A blind experimenter must not read the graph's output (its parameters): a file beside the recording.
+    if (study_.blind) r.run_log = std::filesystem::path(AttemptFile(r.trial, r.attempt)).replace_extension(".log").string();
     Join();
     stop_.store(false);
     running_.store(true);
@@ -139,8 +135,10 @@ class StudyChannel final : public web::ClientHandler {
       for (const Attempt& a : session.attempts) attempts += a.trial == t.number;
       const Attempt* last = session.Last(t.number);
       std::string status = "to do";
+      const bool now_running = running_.load() && current_trial_.load() == t.number;
       if (session.Complete(t.number)) status = "complete";
-      else if (last) status = last->outcome.empty() ? "running" : last->outcome;
+      else if (now_running) status = "running";
+      else if (last) status = last->outcome.empty() ? "interrupted" : last->outcome;
       done = done && session.Complete(t.number);
       trials.push_back({{"number", t.number},
                         {"shown", study_.Shown(study_.conditions[static_cast<size_t>(t.condition)])},
@@ -175,7 +173,7 @@ class StudyChannel final : public web::ClientHandler {
   const std::string participant_, dyad_;
   const std::vector<Trial> trials_;
   std::atomic<web::WebServer*> server_{nullptr};
-  std::atomic<bool> running_{false}, stop_{false};
+  std::atomic<bool> running_{false}, stop_{false}, closing_{false};
   std::atomic<int> current_trial_{0}, current_attempt_{0};
   std::atomic<Clock::time_point> started_{Clock::time_point{}};
   std::mutex error_mutex_;
@@ -186,6 +184,13 @@ class StudyChannel final : public web::ClientHandler {
 }  // namespace
 
 int RunStudyPage(const Study& study, const std::string& participant, const PageOptions& o) {
+  // Before anything can start a trial: a trial's own handlers restore these when it ends.
+  struct sigaction sa {}, old_int {}, old_term {};
+  sa.sa_handler = OnQuitSignal;
+  sa.sa_flags = SA_RESTART;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &old_int);
+  sigaction(SIGTERM, &sa, &old_term);
   StudyChannel channel(study, participant, o.dyad);
   web::WebServer::Options so;
   so.address = o.address;
@@ -197,32 +202,33 @@ int RunStudyPage(const Study& study, const std::string& participant, const PageO
   auto server = web::WebServer::Start(so);
   if (!server.ok()) {
     std::cerr << "dyad study run: the study page: " << server.status().ToString() << "\n";
+    sigaction(SIGINT, &old_int, nullptr);
+    sigaction(SIGTERM, &old_term, nullptr);
     return 1;
   }
   channel.SetServer(server->get());
   if (!o.port_file.empty()) std::ofstream(o.port_file) << (*server)->port() << "\n";
   for (const std::string& host : web::UrlHosts(o.address))
     std::cout << "study page: http://" << host << ":" << (*server)->port() << "/study?token=" << token << std::endl;
-  struct sigaction sa {}, old_int {}, old_term {};
-  sa.sa_handler = OnQuitSignal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
   // A signal during a trial stops the trial (RunAttempt's own handlers); between trials it ends here.
-  for (auto next = Clock::now(); !(g_quit && !channel.running()); std::this_thread::sleep_for(std::chrono::milliseconds(50))) {
-    if (g_quit && channel.running()) channel.StopTrial();
+  for (auto next = Clock::now(); !(g_quit.load() && !channel.running()); std::this_thread::sleep_for(std::chrono::milliseconds(50))) {
+    if (g_quit.load() && channel.running()) channel.StopTrial();
     if (channel.running() && Clock::now() >= next) {
       channel.Broadcast();
       next = Clock::now() + std::chrono::seconds(1);
     }
   }
+  channel.Close();
+  channel.SetServer(nullptr);
+  server->reset();  // no request can come any more
   channel.Join();
   sigaction(SIGINT, &old_int, nullptr);
   sigaction(SIGTERM, &old_term, nullptr);
-  channel.SetServer(nullptr);
-  server->reset();
-  std::cout << "study page closed" << std::endl;
-  return 0;
+  bool done = true;
+  const Session session = ReadSession(study, participant);
+  for (const Trial& t : study.TrialsOf(participant)) done = done && session.Complete(t.number);
+  std::cout << "study page closed: " << (done ? "every trial complete" : "trials remain") << std::endl;
+  return done ? 0 : 1;  // as the terminal's session: 1 while trials remain
 }
 
 }  // namespace dyad::study

@@ -1,9 +1,13 @@
 #include "study_session.hpp"
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <thread>
 #include <ctime>
@@ -13,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dyad/mcap/reader.hpp"
 #include "dyad/private_file.hpp"
 #include "run_process.hpp"
 #include "yaml_file.hpp"
@@ -36,14 +41,36 @@ std::string UtcNow() {
   return buf;
 }
 
+// 'text' as a YAML single-quoted scalar ('' is a quote inside it): a --set value that stays a
+// string whatever it holds (" #", ": ", a leading '[').
+std::string YamlQuoted(const std::string& text) {
+  std::string q = "'";
+  for (char ch : text) q += ch == '\'' ? std::string("''") : std::string(1, ch);
+  return q + "'";
+}
+
+// JSON text of `j`; text that is not UTF-8 (a reason typed in another encoding) is replaced, not thrown.
+std::string Dump(const Json& j) { return j.dump(-1, ' ', false, Json::error_handler_t::replace); }
+
 const Condition& ConditionOf(const Study& s, const Trial& t) { return s.conditions[static_cast<size_t>(t.condition)]; }
 
-// The overrides of an attempt, after `clock=...` and before the recorder's.
-std::vector<std::string> RunSets(const Study& s, const AttemptRequest& r) {
+// The overrides that make the experiment (the graph hash covers these): the condition's, the
+// rehearsal's, the caller's (a seed).
+std::vector<std::string> ExperimentSets(const Study& s, const AttemptRequest& r) {
   std::vector<std::string> sets = ConditionOf(s, r.trial).sets;
   if (r.rehearsal) sets.insert(sets.end(), s.rehearsal_sets.begin(), s.rehearsal_sets.end());
-  else sets.insert(sets.end(), s.page_sets.begin(), s.page_sets.end());
   sets.insert(sets.end(), r.extra_sets.begin(), r.extra_sets.end());
+  return sets;
+}
+
+// All the overrides of an attempt, after `clock=...` and before the recorder's: with a person,
+// the pages' too (whether to ask, the participant's own tokens).
+std::vector<std::string> RunSets(const Study& s, const AttemptRequest& r) {
+  std::vector<std::string> sets = ExperimentSets(s, r);
+  if (r.rehearsal) return sets;
+  sets.insert(sets.end(), s.page_sets.begin(), s.page_sets.end());
+  for (const std::string& web : s.token_file_webs)
+    sets.push_back(web + ".token_file=" + YamlQuoted((fs::path(s.data) / r.participant / (web + "-tokens")).string()));
   return sets;
 }
 
@@ -58,16 +85,18 @@ std::string GraphHash(const std::string& graph, const std::vector<std::string>& 
   return hex;
 }
 
-volatile sig_atomic_t g_stop_requested = 0;
-extern "C" void OnStopSignal(int) { g_stop_requested = 1; }
+std::atomic<int> g_stop_signals{0};  // lock-free: safe in a handler and read by another thread
+static_assert(std::atomic<int>::is_always_lock_free);
+extern "C" void OnStopSignal(int) { g_stop_signals.fetch_add(1); }
 
-// SIGINT and SIGTERM only set a flag while an attempt runs (the previous handlers come back after).
+// SIGINT and SIGTERM only count while an attempt runs (the previous handlers come back after).
 class StopSignals {
  public:
   StopSignals() {
-    g_stop_requested = 0;
+    g_stop_signals.store(0);
     struct sigaction sa {};
     sa.sa_handler = OnStopSignal;
+    sa.sa_flags = SA_RESTART;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, &old_int_);
     sigaction(SIGTERM, &sa, &old_term_);
@@ -150,7 +179,7 @@ Session ReadSession(const Study& s, const std::string& participant) {
 }
 
 Status AppendSessionEvent(const Study& s, const std::string& participant, const std::string& json_object) {
-  Json j = Json::parse(json_object, nullptr, false);
+  Json j = Json::parse(json_object, nullptr, false);  // (our own events: valid JSON)
   if (!j.is_object()) return Status::Internal("session event is not a JSON object: " + json_object);
   Json line = {{"time", UtcNow()}};
   line.update(j);
@@ -158,7 +187,7 @@ Status AppendSessionEvent(const Study& s, const std::string& participant, const 
   if (Status st = CreatePrivateDirectories(fs::path(path).parent_path().string()); !st.ok()) return st;
   auto fd = OpenPrivateLog(path);
   if (!fd.ok()) return fd.status();
-  const std::string text = line.dump() + "\n";
+  const std::string text = Dump(line) + "\n";
   const ssize_t n = ::write(*fd, text.data(), text.size());
   ::close(*fd);
   if (n != static_cast<ssize_t>(text.size())) return Status::IOError(path, "cannot append to the session log");
@@ -166,7 +195,36 @@ Status AppendSessionEvent(const Study& s, const std::string& participant, const 
 }
 
 Status MarkConsent(const Study& s, const std::string& participant, const std::string& how) {
-  return AppendSessionEvent(s, participant, Json{{"event", "consent"}, {"how", how}}.dump());
+  return AppendSessionEvent(s, participant, Dump(Json{{"event", "consent"}, {"how", how}}));
+}
+
+std::string WhyNotStart(const Session& session, const std::vector<Trial>& trials, int k, const std::string& reason) {
+  if (k < 1 || k > static_cast<int>(trials.size())) return "there is no trial " + std::to_string(k);
+  int next = 0;  // the first trial not complete
+  for (const Trial& t : trials)
+    if (!session.Complete(t.number)) {
+      next = t.number;
+      break;
+    }
+  if (session.Last(k)) return reason.empty() ? "trial " + std::to_string(k) + " was run before: say why it is repeated" : "";
+  if (k != next) return "trial " + std::to_string(next) + " comes first (the plan's order)";
+  return "";
+}
+
+StatusOr<SessionLock> SessionLock::Acquire(const Study& s, const std::string& participant) {
+  const std::string dir = (fs::path(s.data) / participant).string(), path = dir + "/session.lock";
+  if (Status st = CreatePrivateDirectories(dir); !st.ok()) return st;
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0600);
+  if (fd < 0) return Status::IOError(path, std::strerror(errno));
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    ::close(fd);
+    return Status::FailedPrecondition(path, "another dyad study run holds " + participant + "'s session (one runner per participant)");
+  }
+  return SessionLock(fd);
+}
+
+SessionLock::~SessionLock() {
+  if (fd_ >= 0) ::close(fd_);  // releases the lock
 }
 
 std::vector<std::string> AttemptCommand(const Study& s, const AttemptRequest& r) {
@@ -186,14 +244,11 @@ std::vector<std::string> AttemptCommand(const Study& s, const AttemptRequest& r)
       {"attempt", std::to_string(r.attempt)},
       {"rehearsal", r.rehearsal ? "true" : "false"},
       {"dyad_version", DYAD_VERSION},
-      {"graph_hash", GraphHash(graph, sets)}};
-  std::string list;  // a YAML flow list of quoted scalars ('' is a quote inside one)
-  for (const auto& [key, value] : metadata) {
-    std::string entry = key + "=" + value, quoted;
-    for (char ch : entry) quoted += ch == '\'' ? std::string("''") : std::string(1, ch);
-    list += (list.empty() ? "['" : ", '") + quoted + "'";
-  }
-  args.insert(args.end(), {"--set", s.recorder + ".file=" + AttemptFile(r.trial, r.attempt), "--set", s.recorder + ".metadata=" + list + "]"});
+      {"graph_hash", GraphHash(graph, ExperimentSets(s, r))}};
+  std::string list;  // a YAML flow list of quoted scalars
+  for (const auto& [key, value] : metadata) list += (list.empty() ? "[" : ", ") + YamlQuoted(key + "=" + value);
+  args.insert(args.end(), {"--set", s.recorder + ".file=" + YamlQuoted(AttemptFile(r.trial, r.attempt)), "--set",
+                           s.recorder + ".metadata=" + list + "]"});
   return args;
 }
 
@@ -215,32 +270,40 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   if (Status st = CreatePrivateDirectories(fs::path(a.file).parent_path().string()); !st.ok()) return st;
   Json start = {{"event", "start"}, {"trial", a.trial}, {"attempt", a.attempt}, {"file", a.file}};
   if (!a.reason.empty()) start["reason"] = a.reason;
-  if (Status st = AppendSessionEvent(s, r.participant, start.dump()); !st.ok()) return st;
+  if (Status st = AppendSessionEvent(s, r.participant, Dump(start)); !st.ok()) return st;
 
   const auto t0 = std::chrono::steady_clock::now();
-  bool stopped = false;
+  int forwarded = 0;  // SIGINTs sent to the graph
   {
     StopSignals signals;
     const int pid = tools::StartProcess(AttemptCommand(s, r), r.run_log, true);
     a.exit = 127;
-    // A stop is forwarded once: a second SIGINT makes dyad exit at once, losing its last chunk.
+    // One stop is forwarded as one SIGINT: the graph finishes its recording. A second stop (a
+    // graph that hangs while ending) is forwarded too: dyad then exits at once, losing at most
+    // its last chunk.
     while (pid >= 0 && !tools::ProcessEnded(pid, &a.exit)) {
-      if ((g_stop_requested || (r.stop && r.stop->load())) && !stopped) {
-        stopped = true;
-        ::kill(pid, SIGINT);
-      }
+      const int signals_now = g_stop_signals.load();
+      const int wanted = std::min(2, signals_now + (r.stop && r.stop->load() ? 1 : 0));
+      a.interrupted = a.interrupted || signals_now > 0;
+      for (; forwarded < wanted; ++forwarded) ::kill(pid, SIGINT);
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }
   a.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // A trial without a duration ends when the experimenter stops it; a timed one stopped early is
-  // incomplete. The graph's exit status after a stop is its answer to the signal, not a failure.
-  if (stopped) a.outcome = s.duration_s > 0 ? "stopped" : "complete";
-  else a.outcome = a.exit == 0 ? "complete" : "failed";
-  if (a.outcome == "complete" && !fs::exists(a.file, ec)) a.outcome = "failed";
+  // A trial without a duration ends when the experimenter stops it (the graph then exits 0, or
+  // 130 for the signal); a timed one stopped early is incomplete. A recording cut short (a
+  // crash, a second stop) is never complete.
+  const bool stopped = forwarded > 0;
+  const bool ended_well = a.exit == 0 || (stopped && a.exit == 128 + SIGINT);
+  if (stopped && s.duration_s > 0) a.outcome = "stopped";
+  else a.outcome = ended_well ? "complete" : "failed";
+  if (a.outcome == "complete") {
+    auto recording = mcap::Reader::Open(a.file);
+    if (!recording.ok() || recording->recovery().truncated) a.outcome = "failed";
+  }
   Json end = {{"event", "end"}, {"trial", a.trial}, {"attempt", a.attempt}, {"outcome", a.outcome},
               {"seconds", std::round(a.seconds * 10) / 10}, {"exit", a.exit}};
-  if (Status st = AppendSessionEvent(s, r.participant, end.dump()); !st.ok()) return st;
+  if (Status st = AppendSessionEvent(s, r.participant, Dump(end)); !st.ok()) return st;
   return a;
 }
 

@@ -7,7 +7,8 @@
 //   {"time":...,"event":"start","trial":3,"attempt":2,"file":"/abs/03-B.try2.mcap","reason":"..."}
 //   {"time":...,"event":"end","trial":3,"attempt":2,"outcome":"complete","seconds":120.0,"exit":0}
 // outcome: complete | stopped (the experimenter ended a timed trial early) | failed (the graph
-// exited non-zero or was killed). A start without its end: the session itself ended mid-trial.
+// exited non-zero other than after a stop, was killed, or left a recording cut short or none).
+// A start without its end: the session itself ended mid-trial ("interrupted").
 //
 // Contract:
 //   - AttemptFile: attempt 1 of a trial records into Trial::file (DATA/P01/03-B.mcap), attempt k
@@ -18,11 +19,18 @@
 //     not marked, or when the attempt's file exists. Otherwise it logs the start, runs
 //     `dyad run` on the graph with the condition's overrides, the recorder's file and the
 //     metadata below, and logs the end. While it runs, SIGINT (Ctrl-C) stops the trial: the
-//     graph gets one SIGINT (it is in a process group of its own) and finishes its recording.
+//     graph gets one SIGINT (it is in a process group of its own) and finishes its recording; a
+//     second one is forwarded too (dyad then exits at once). Attempt::interrupted says a signal
+//     came, so a caller running several trials stops there.
 //   - Recording metadata ("dyad.run" in the MCAP file): study, participant, condition (its label
-//     when the study is blind: the file must not unblind whoever reads it), trial, attempt,
-//     rehearsal (true|false), dyad_version, graph_hash (FNV-1a of the graph file's text and the
-//     run's overrides, hex).
+//     when the study is blind), trial, attempt, rehearsal (true|false), dyad_version (the
+//     runner's), graph_hash (FNV-1a of the top graph file's text and the run's overrides, hex;
+//     not of the files it extends, its models or plugins). Blinding covers file names, this
+//     metadata and the runner's output, not the recording's contents: its "dyad.graph" record
+//     holds the graph as run, the condition's values included.
+//   - WhyNotStart: the plan's order, the same for every front end: a trial never run starts only
+//     when it is the first one not complete; one run before starts again only with a reason.
+//   - SessionLock: one runner per participant at a time (flock on DATA/P/session.lock).
 #pragma once
 
 #include <atomic>
@@ -40,6 +48,7 @@ struct Attempt {
   std::string outcome;       // complete | stopped | failed | "" (started, never ended)
   double seconds = 0;
   int exit = 0;
+  bool interrupted = false;  // RunAttempt: SIGINT/SIGTERM reached the runner (a person wants it all to stop)
 };
 
 struct Session {
@@ -75,6 +84,22 @@ struct AttemptRequest {
 
 // Runs one attempt (see the contract); the returned attempt says how it ended.
 StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r);
+
+// Why trial `k` (1-based) of `trials` may not start now ("" when it may).
+std::string WhyNotStart(const Session& session, const std::vector<Trial>& trials, int k, const std::string& reason);
+
+// Held for a whole session; refused (FailedPrecondition naming the lock) while another runner holds it.
+class SessionLock {
+ public:
+  static StatusOr<SessionLock> Acquire(const Study& s, const std::string& participant);
+  SessionLock(SessionLock&& o) noexcept : fd_(o.fd_) { o.fd_ = -1; }
+  SessionLock& operator=(SessionLock&&) = delete;
+  ~SessionLock();
+
+ private:
+  explicit SessionLock(int fd) : fd_(fd) {}
+  int fd_ = -1;
+};
 
 // The `dyad run` command line of an attempt (for RunAttempt and its tests).
 std::vector<std::string> AttemptCommand(const Study& s, const AttemptRequest& r);

@@ -2,6 +2,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <unistd.h>
@@ -18,13 +19,27 @@ int StartProcess(const std::vector<std::string>& args, const std::string& log, b
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
   const pid_t parent = getpid();
+  // SIGINT/SIGTERM blocked across fork: one arriving meanwhile waits for the caller's handler
+  // (restored below) instead of running that handler in the child, where it would be lost.
+  sigset_t stop_signals, old_mask;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, &old_mask);
   const pid_t pid = fork();
-  if (pid != 0) return pid;  // -1: not started
+  if (pid != 0) {
+    pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
+    return pid;  // -1: not started
+  }
   // The child, until exec: async-signal-safe calls only.
+  signal(SIGINT, SIG_DFL);
+  signal(SIGTERM, SIG_DFL);
+  pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
   if (!log.empty()) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0600);
     if (fd < 0 || dup2(fd, 1) < 0 || dup2(fd, 2) < 0) _exit(127);
   }
+  close_range(3, ~0U, 0);  // nothing of ours (a log being read, a socket) leaks into the child
   if (own_group) {
     setpgid(0, 0);
     // Its caller manages its end: when the caller dies, the child is stopped as by Ctrl-C.
@@ -58,6 +73,7 @@ int RunProcess(const std::vector<std::string>& args, const std::string& log) {
 std::string DyadScriptPath(const std::string& name) {
   std::error_code ec;
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec || exe.empty()) return "/nonexistent/share/dyad/" + name;  // never a script of the working folder
   return (exe.parent_path().parent_path() / "share" / "dyad" / name).string();
 }
 

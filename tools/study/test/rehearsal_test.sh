@@ -37,6 +37,9 @@ grep -q "12 trials run, 0 failed" rehearse.log || { cat rehearse.log; fail "not 
 out=data-study/rehearsal/analysis
 [ "$(tail -n +2 $out/trials.csv | wc -l)" = 12 ] || fail "trials.csv: $(cat $out/trials.csv)"
 [ ! -e data-study/S01/session.log ] || fail "the rehearsal wrote into the participants' folder"
+# A blind study's rehearsal names no condition (the experimenter reads it before the study).
+! grep -qE "(^|[,| ])(assist|follow)([,| ]|$)" $out/trials.csv $out/summary.csv $out/events.csv $out/report.md ||
+  fail "the blind rehearsal named a condition: $(grep -E "(^|[,| ])(assist|follow)([,| ]|$)" $out/*.csv $out/report.md | head -3)"
 # Per condition and measure, the mean over participants of each participant's mean over trials.
 for measure in mean_congruence robot_follows; do
   awk -F, -v m="$measure" '
@@ -72,6 +75,10 @@ cp $out/summary.csv summary.first
 "$dyad" study rehearse s.yaml > again.log 2>&1 || { cat again.log; fail "the second rehearse"; }
 grep -q "0 trials run, 0 failed" again.log || { cat again.log; fail "the second rehearse ran trials again"; }
 cmp summary.first $out/summary.csv || fail "the same recordings gave another table"
+# A rehearsal's recording put where a participant's trial belongs is refused by name.
+first=$(ls data-study/rehearsal/S01/01-*.mcap | head -1)
+mkdir -p data-study/S01 && cp "$first" data-study/S01/
 "$dyad" study analyze s.yaml > analyze.log 2>&1 || { cat analyze.log; fail "dyad study analyze"; }
 grep -q "0 trials analysed, 12 missing" analyze.log || { cat analyze.log; fail "the participants' analysis took rehearsal files"; }
+grep -q "a rehearsal's recording (synthetic participant)" analyze.log || { cat analyze.log; fail "the rehearsal's file was not named"; }
 echo "PASS: 12 rehearsal trials; $wrong of $events self-reports wrong; summary = the participants' means"

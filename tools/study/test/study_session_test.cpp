@@ -93,6 +93,9 @@ TEST_F(StudySession, ConsentComesFirstThenEveryTrialRecordsItsMetadataAndNothing
   EXPECT_NE(run.out().find("trial 1 of 2: condition " + s.conditions[static_cast<size_t>(trials[0].condition)].label),
             std::string::npos) << run.out();
   EXPECT_EQ(run.out().find("low"), std::string::npos) << "a blind session named a condition:\n" << run.out();
+  // Blind: the graph's own output (it names parameters) goes to a file beside each recording.
+  EXPECT_EQ(run.err().find("recorder:"), std::string::npos) << run.err();
+  EXPECT_NE(dyad::testing::ReadFile(fs::path(trials[0].file).replace_extension(".log")).find("recorder:"), std::string::npos);
   const auto log = LogLines(SessionLogPath(s, "P01"));
   ASSERT_EQ(log.size(), 5u);
   EXPECT_EQ(log[0]["event"], "consent");
@@ -128,6 +131,9 @@ TEST_F(StudySession, ConsentComesFirstThenEveryTrialRecordsItsMetadataAndNothing
   EXPECT_EQ(fs::last_write_time(trials[0].file), first_time);
   EXPECT_EQ(LogLines(SessionLogPath(s, "P01")).size(), 5u);
   // A repetition needs a reason, and records beside the first attempt.
+  ChildProcess reason_alone(Command({"--reason", "why"}), dir_, "reason_alone");
+  EXPECT_EQ(reason_alone.Wait(60), 2);
+  EXPECT_NE(reason_alone.err().find("--reason is the reason of a --trial repetition"), std::string::npos) << reason_alone.err();
   ChildProcess no_reason(Command({"--trial", "1"}), dir_, "no_reason");
   EXPECT_EQ(no_reason.Wait(60), 2);
   EXPECT_NE(no_reason.err().find("--trial 1 needs --reason"), std::string::npos) << no_reason.err();
@@ -153,7 +159,11 @@ TEST_F(StudySession, AStoppedOrKilledTrialIsIncompleteAndItsRecordingStaysReadab
   ChildProcess stopped(Command({"--consent", "--yes"}), dir_, "stopped");
   ASSERT_TRUE(stopped.WaitForOutput("Ctrl-C stops it early", 30)) << stopped.err();
   for (int i = 0; i < 500 && !fs::exists(trials[0].file); ++i) usleep(10000);
-  usleep(1'500'000);
+  // One runner per participant: a second one is refused while the first holds the session.
+  ChildProcess second_runner(Command({"--yes"}), dir_, "second_runner");
+  EXPECT_EQ(second_runner.Wait(30), 2);
+  EXPECT_NE(second_runner.err().find("another dyad study run holds P01's session"), std::string::npos) << second_runner.err();
+  usleep(1'000'000);
   stopped.Signal(SIGINT);
   ASSERT_EQ(stopped.Wait(30), 1) << stopped.out() << stopped.err();
   EXPECT_NE(stopped.err().find("trial 1 is incomplete (stopped after"), std::string::npos) << stopped.err();
@@ -165,6 +175,10 @@ TEST_F(StudySession, AStoppedOrKilledTrialIsIncompleteAndItsRecordingStaysReadab
   ASSERT_TRUE(first.ok()) << first.status().message();
   EXPECT_FALSE(first->recovery().truncated) << "the graph got one SIGINT and finished its file";
 
+  // The plan's order: trial 2 never ran and trial 1 is not complete, so it may not start.
+  ChildProcess out_of_order(Command({"--trial", "2", "--reason", "to go on"}), dir_, "out_of_order");
+  EXPECT_EQ(out_of_order.Wait(30), 2);
+  EXPECT_NE(out_of_order.err().find("trial 1 comes first (the plan's order)"), std::string::npos) << out_of_order.err();
   // The session itself killed during the repetition: its graph is stopped, not orphaned.
   ChildProcess killed(Command({"--trial", "1", "--reason", "stopped by mistake"}), dir_, "killed");
   ASSERT_TRUE(killed.WaitForOutput("Ctrl-C stops it early", 30)) << killed.err();
@@ -185,7 +199,7 @@ TEST_F(StudySession, AStoppedOrKilledTrialIsIncompleteAndItsRecordingStaysReadab
   const StudyAnalysis a = AnalyzeStudy(s, std::cerr);
   ASSERT_FALSE(a.missing.empty());
   EXPECT_EQ(a.missing[0], "P01 trial 1 (" + trials[0].file +
-                              "): incomplete (attempt 1 stopped; attempt 2 ended with the session, repeated because: stopped by mistake)");
+                              "): incomplete (attempt 1 stopped; attempt 2 interrupted (the session ended during it), repeated because: stopped by mistake)");
 }
 
 }  // namespace

@@ -221,9 +221,16 @@ TEST(Bootstrap, CoversTheTrueMeanAboutAsOftenAsItSays) {
   EXPECT_LE(covered, 588) << "coverage " << covered / 600.0;  // 98%
 }
 
-std::map<std::string, std::string> RunOf(const std::string& study, const std::string& participant, const Trial& t,
+// What `dyad study run` has the recorder write: `study` may name another study than `s`.
+std::map<std::string, std::string> RunOf(const Study& s, const std::string& study, const std::string& participant, const Trial& t,
                                          const std::string& rehearsal = "false") {
-  return {{"study", study}, {"participant", participant}, {"trial", std::to_string(t.number)}, {"rehearsal", rehearsal}};
+  const Condition& c = s.conditions[static_cast<size_t>(t.condition)];
+  return {{"study", study},
+          {"participant", participant},
+          {"condition", s.blind ? c.label : c.name},
+          {"trial", std::to_string(t.number)},
+          {"attempt", "1"},
+          {"rehearsal", rehearsal}};
 }
 
 // A recording of one trial as `dyad analyze` reads it: a synthetic human's event at steps 10..19
@@ -280,12 +287,12 @@ TEST_F(StudyFile, AnalyzeMakesOneTableAcrossEveryoneAndSaysWhatIsMissing) {
   for (const std::string p : {"P01", "P02"})
     for (const Trial& t : s.TrialsOf(p))
       trial_of[p + "/" + s.conditions[static_cast<size_t>(t.condition)].name + "/" + std::to_string(t.repetition)] = t;
-  WriteTrial(trial_of.at("P01/low/1").file, 0.2, 4, 4, RunOf("gain", "P01", trial_of.at("P01/low/1")));  // said 4, drew 2
-  WriteTrial(trial_of.at("P01/low/2").file, 0.4, 4, 2, RunOf("gain", "P01", trial_of.at("P01/low/2")));
-  WriteTrial(trial_of.at("P01/high/1").file, 0.6, 2, 2, RunOf("gain", "P01", trial_of.at("P01/high/1")));
-  WriteTrial(trial_of.at("P01/high/2").file, 0.6, 2, 2, RunOf("gain", "P01", trial_of.at("P01/high/2")));
-  WriteTrial(trial_of.at("P02/high/1").file, 0.8, 6, 2, RunOf("gain", "P02", trial_of.at("P02/high/1")));
-  WriteTrial(trial_of.at("P02/high/2").file, 1.0, 8, 2, RunOf("gain", "P02", trial_of.at("P02/high/2")));
+  WriteTrial(trial_of.at("P01/low/1").file, 0.2, 4, 4, RunOf(s, "gain", "P01", trial_of.at("P01/low/1")));  // said 4, drew 2
+  WriteTrial(trial_of.at("P01/low/2").file, 0.4, 4, 2, RunOf(s, "gain", "P01", trial_of.at("P01/low/2")));
+  WriteTrial(trial_of.at("P01/high/1").file, 0.6, 2, 2, RunOf(s, "gain", "P01", trial_of.at("P01/high/1")));
+  WriteTrial(trial_of.at("P01/high/2").file, 0.6, 2, 2, RunOf(s, "gain", "P01", trial_of.at("P01/high/2")));
+  WriteTrial(trial_of.at("P02/high/1").file, 0.8, 6, 2, RunOf(s, "gain", "P02", trial_of.at("P02/high/1")));
+  WriteTrial(trial_of.at("P02/high/2").file, 1.0, 8, 2, RunOf(s, "gain", "P02", trial_of.at("P02/high/2")));
   const Trial& broken = trial_of.at("P02/low/1");  // a file that is no recording: listed with the reason
   fs::create_directories(fs::path(broken.file).parent_path());
   std::ofstream(broken.file) << "not an MCAP file";
@@ -364,15 +371,17 @@ TEST_F(StudyFile, AnalyzeTakesTheLastCompleteAttemptAndRefusesOtherRecordings) {
   ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"start","trial":1,"attempt":2,"file":")" + second +
                                                R"(","reason":"fire alarm"})").ok());
   ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"end","trial":1,"attempt":2,"outcome":"complete","seconds":120})").ok());
-  WriteTrial(p1[0].file, 0.1, 2, 2, RunOf("gain", "P01", p1[0]));
-  WriteTrial(second, 0.5, 2, 2, RunOf("gain", "P01", p1[0]));
+  WriteTrial(p1[0].file, 0.1, 2, 2, RunOf(s, "gain", "P01", p1[0]));
+  auto second_run = RunOf(s, "gain", "P01", p1[0]);
+  second_run["attempt"] = "2";
+  WriteTrial(second, 0.5, 2, 2, second_run);
   // P01 trial 2: started, and the session ended during it (no end in the log).
   ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"start","trial":2,"attempt":1,"file":")" + p1[1].file + R"("})").ok());
-  WriteTrial(p1[1].file, 0.9, 2, 2, RunOf("gain", "P01", p1[1]));
+  WriteTrial(p1[1].file, 0.9, 2, 2, RunOf(s, "gain", "P01", p1[1]));
   // P02: a recording of another study, and one of the rehearsal, at its planned paths.
-  WriteTrial(p2[0].file, 0.9, 2, 2, RunOf("other", "P02", p2[0]));
-  WriteTrial(p2[1].file, 0.9, 2, 2, RunOf("gain", "P02", p2[1], "true"));
-  WriteTrial(fs::path(s.data) / "P02" / "copy.mcap", 0.9, 2, 2, RunOf("gain", "P02", p2[1]));
+  WriteTrial(p2[0].file, 0.9, 2, 2, RunOf(s, "other", "P02", p2[0]));
+  WriteTrial(p2[1].file, 0.9, 2, 2, RunOf(s, "gain", "P02", p2[1], "true"));
+  WriteTrial(fs::path(s.data) / "P02" / "copy.mcap", 0.9, 2, 2, RunOf(s, "gain", "P02", p2[1]));
   std::ofstream(fs::path(s.data) / "P01" / "session.log", std::ios::app) << "not json\n";
 
   std::ostringstream warnings;
@@ -386,7 +395,7 @@ TEST_F(StudyFile, AnalyzeTakesTheLastCompleteAttemptAndRefusesOtherRecordings) {
       EXPECT_NEAR(value, 0.5, 1e-9) << "not the analysed attempt's";
     }
   ASSERT_EQ(a.missing.size(), 3u);
-  EXPECT_EQ(a.missing[0], "P01 trial 2 (" + p1[1].file + "): incomplete (attempt 1 ended with the session)");
+  EXPECT_EQ(a.missing[0], "P01 trial 2 (" + p1[1].file + "): incomplete (attempt 1 interrupted (the session ended during it))");
   EXPECT_EQ(a.missing[1], "P02 trial 1 (" + p2[0].file + "): a recording of study other, not gain");
   EXPECT_EQ(a.missing[2], "P02 trial 2 (" + p2[1].file + "): a rehearsal's recording (synthetic participant)");
   EXPECT_EQ(a.unplanned, (std::vector<std::string>{(fs::path(s.data) / "P02" / "copy.mcap").string()}));
