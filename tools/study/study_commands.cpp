@@ -69,11 +69,6 @@ int Plan(const PlanOptions& o) {
   return kOk;
 }
 
-std::string ThisExecutable() {
-  std::error_code ec;
-  return std::filesystem::read_symlink("/proc/self/exe", ec).string();
-}
-
 std::string TrialLine(const study::Study& s, const study::Trial& t, size_t of) {
   return "trial " + std::to_string(t.number) + " of " + std::to_string(of) + ": " +
          s.Shown(s.conditions[static_cast<size_t>(t.condition)]);
@@ -122,7 +117,7 @@ bool RunOne(const study::Study& s, const RunOptions& o, const study::Trial& t, s
   const study::Session session = study::ReadSession(s, o.participant);
   const study::Attempt* last = session.Last(t.number);
   study::AttemptRequest r;
-  r.dyad = ThisExecutable();
+  r.dyad = tools::ThisExecutable();
   r.participant = o.participant;
   r.trial = t;
   r.attempt = last ? last->attempt + 1 : 1;
@@ -185,7 +180,7 @@ int RunSession(const RunOptions& o) {
       return 1;
     }
     study::PageOptions po = o.page_options;
-    po.dyad = ThisExecutable();
+    po.dyad = tools::ThisExecutable();
     return study::RunStudyPage(s, o.participant, po);
   }
   const std::optional<std::string> consent = ConsentGiven(s, o, before);
@@ -274,7 +269,7 @@ int Rehearse(const AnalyzeOptions& o) {
       if (session.Complete(t.number)) continue;
       const study::Attempt* last = session.Last(t.number);
       study::AttemptRequest req;
-      req.dyad = ThisExecutable();
+      req.dyad = tools::ThisExecutable();
       req.participant = p;
       req.trial = t;
       req.attempt = last ? last->attempt + 1 : 1;

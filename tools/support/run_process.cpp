@@ -70,10 +70,15 @@ int RunProcess(const std::vector<std::string>& args, const std::string& log) {
   return pid < 0 ? 127 : WaitProcess(pid);
 }
 
-std::string DyadScriptPath(const std::string& name) {
+std::string ThisExecutable() {
   std::error_code ec;
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (ec || exe.empty()) return "/nonexistent/share/dyad/" + name;  // never a script of the working folder
+  return ec ? std::string() : exe.string();
+}
+
+std::string DyadScriptPath(const std::string& name) {
+  const std::filesystem::path exe = ThisExecutable();
+  if (exe.empty()) return "/nonexistent/share/dyad/" + name;  // never a script of the working folder
   return (exe.parent_path().parent_path() / "share" / "dyad" / name).string();
 }
 

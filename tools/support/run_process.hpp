@@ -30,6 +30,7 @@ int RunProcess(const std::vector<std::string>& args, const std::string& log = ""
 int StartProcess(const std::vector<std::string>& args, const std::string& log, bool own_group);
 int WaitProcess(int pid);
 bool ProcessEnded(int pid, int* status);  // without waiting: true (and *status as above) once it has
+std::string ThisExecutable();  // /proc/self/exe: the running dyad (its runs and jobs run it again); "" if unknown
 std::string DyadScriptPath(const std::string& name);
 int RunDyadScript(const std::string& name, const std::vector<std::string>& args);
 std::string ShellQuoted(const std::vector<std::string>& args);

@@ -30,12 +30,6 @@ struct Options {
   sweep::SlurmOptions slurm_options;
 };
 
-// The dyad executable itself (the runs and Slurm's jobs run it).
-std::string Self() {
-  std::error_code ec;
-  return fs::read_symlink("/proc/self/exe", ec).string();
-}
-
 int Plot(const std::string& csv, const std::string& dir) { return tools::RunDyadScript("plot_sweep.py", {csv, dir}); }
 
 // Back to the folder it started in, whatever happens (the command may run inside a test binary).
@@ -62,7 +56,7 @@ int RunHere(const Options& o, const sweep::SweepPlan& plan, const fs::path& out,
     std::cerr << "dyad sweep: " << out.string() << ": " << ec.message() << "\n";
     return kFailure;
   }
-  const sweep::RunnerOptions runner{out.string(), workers, Self()};
+  const sweep::RunnerOptions runner{out.string(), workers, tools::ThisExecutable()};
   // A Slurm task of runs does not train: the training job before it did (or failed, said per run).
   if (o.task.empty() && !plan.trainings.empty()) {
     std::cout << "training " << plan.trainings.size() << " model" << (plan.trainings.size() == 1 ? "" : "s") << " into "
@@ -114,13 +108,13 @@ int TrainOnly(const Options& o, const sweep::SweepPlan& plan, const fs::path& ou
   const auto trainings = o.task.empty() ? plan.trainings : sweep::TaskChunk(plan.trainings, task);
   std::cout << "sweep " << plan.name << ": " << trainings.size() << " of " << plan.trainings.size() << " models into "
             << (out / "models").string() << "\n";
-  const sweep::RunnerResult r = sweep::TrainModels(plan, trainings, sweep::RunnerOptions{out.string(), workers, Self()}, std::cout);
+  const sweep::RunnerResult r = sweep::TrainModels(plan, trainings, sweep::RunnerOptions{out.string(), workers, tools::ThisExecutable()}, std::cout);
   std::cout << "sweep " << plan.name << ": " << r.ran << " trained, " << r.skipped << " there before, " << r.failed << " failed\n";
   return r.failed > 0 ? kFailure : kOk;
 }
 
 int Submit(const Options& o, const sweep::SweepPlan& plan, const fs::path& file, const fs::path& out) {
-  auto job = sweep::SubmitToSlurm(plan, file.string(), out.string(), Self(), o.plugins, o.plots, o.slurm_options);
+  auto job = sweep::SubmitToSlurm(plan, file.string(), out.string(), tools::ThisExecutable(), o.plugins, o.plots, o.slurm_options);
   if (!job.ok()) {
     std::cerr << "dyad sweep --slurm: " << job.status().message() << "\n";
     return kFailure;

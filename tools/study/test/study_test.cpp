@@ -130,6 +130,26 @@ TEST_F(StudyFile, EveryBadInputIsSaidAtItsLine) {
     EXPECT_NE(all.find(expected), std::string::npos) << "no '" << expected << "' in\n" << all;
 }
 
+// The keys dyad study run and rehearse read: a recorder the graph lacks, a rehearsal graph that
+// is not there or whose keys a condition does not find, after_trial (not built yet).
+TEST_F(StudyFile, BadRecorderRehearsalAndSelfReportsAreSaidAtTheirLine) {
+  std::ofstream(dir_ / "other.yaml") << "graph: other\nclock: stepped\ncomponents:\n"
+                                        "  src: {type: counter_source, rate_hz: 10, outputs: {out: c}}\n";
+  for (const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"recorder: rec\n", "s.yaml:6:11: recorder: the graph's recorder 'rec' cannot record a trial:"},
+           {"rehearsal: {graph: missing.yaml}\n", "s.yaml:6:20: rehearsal.graph: no such file: " + (dir_ / "missing.yaml").string()},
+           {"rehearsal: {graph: other.yaml}\n", "s.yaml:6:12: rehearsal: condition low does not validate on the rehearsal graph"},
+           {"rehearsal: {colour: blue}\n", "s.yaml:6:13: rehearsal.colour: unknown key"},
+           {"self_reports: after_trial\n", "s.yaml:6:15: self_reports: after_trial is not asked by the subject's page yet"}}) {
+    const std::string f = Write("study: gain\ngraph: g.yaml\nparticipants: [P01]\nconditions:\n  low: {sink.rate_hz: 5}\n" + text);
+    std::vector<Diagnostic> problems;
+    LoadStudy(f, {}, &problems);
+    std::string all;
+    for (const auto& p : problems) all += p.ToString() + "\n";
+    EXPECT_NE(all.find(expected), std::string::npos) << "no '" << expected << "' in\n" << all;
+  }
+}
+
 // `dyad study plan s.yaml` in the file's own folder: a bare file name has no parent folder (it
 // used to throw from std::filesystem::absolute("")).
 TEST_F(StudyFile, AFileNamedWithoutItsFolderIsReadInTheWorkingFolder) {
