@@ -13,17 +13,12 @@
 #include "study_session.hpp"
 #include "build_report.hpp"
 #include "text_output.hpp"
+#include "yaml_file.hpp"
 
 namespace dyad::study {
 namespace {
 
 // FNV-1a: a seed from names that is the same on every machine (std::hash is not).
-uint64_t SeedOf(const std::string& text) {
-  uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : text) h = (h ^ c) * 1099511628211ULL;
-  return h;
-}
-
 std::string Num(double v) {
   if (std::isnan(v)) return "";
   std::ostringstream s;
@@ -104,7 +99,7 @@ Summaries Summary(const Study& s, const StudyAnalysis& a) {
       }
       std::vector<double> means;
       for (const auto& [p, sum] : by_participant) means.push_back(sum.first / sum.second);
-      cm.interval = BootstrapMean(means, SeedOf(s.name + "/" + s.conditions[c].name + "/" + m));
+      cm.interval = BootstrapMean(means, tools::Fnv1a(s.name + "/" + s.conditions[c].name + "/" + m));
       measures.push_back(std::move(cm));
     }
     out.emplace_back(&s.conditions[c], std::move(measures));
