@@ -28,6 +28,9 @@ int StartProcess(const std::vector<std::string>& args, const std::string& log, b
   pthread_sigmask(SIG_BLOCK, &stop_signals, &old_mask);
   const pid_t pid = fork();
   if (pid != 0) {
+    // Also here: a kill(-pid) right after we return must find the group (the child may not
+    // have run its own setpgid yet).
+    if (pid > 0 && own_group) setpgid(pid, pid);
     pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
     return pid;  // -1: not started
   }
