@@ -7,20 +7,12 @@
 #include <vector>
 
 #include <dyad/msg/types.hpp>
-#include <fastdds/dds/topic/TopicDataType.hpp>
-#include <fastdds/rtps/common/SerializedPayload.h>
+#include <dyad/testing/cdr.hpp>
 
 namespace dyad {
 namespace {
 
-// The bytes a serialized subscription hands over: the type's own CDR, encapsulation included.
-template <class T>
-std::vector<uint8_t> Cdr(T& sample) {
-  std::unique_ptr<eprosima::fastdds::dds::TopicDataType> support(TypeInfoOf<T>().make_type_support());
-  eprosima::fastrtps::rtps::SerializedPayload_t payload(support->getSerializedSizeProvider(&sample)());
-  EXPECT_TRUE(support->serialize(&sample, &payload));
-  return std::vector<uint8_t>(payload.data, payload.data + payload.length);
-}
+using testing::Cdr;
 
 TEST(DecodeSample, GivesBackEveryFieldOfASerializedMessage) {
   msg::ComponentStats in;

@@ -86,6 +86,18 @@ std::set<std::pair<std::string, std::string>> GraphsComponents(const Context& ct
   return out;
 }
 
+// {"op":"learner", ...}: the learner's status for the experimenter's page (NaN: null).
+nlohmann::json LearnerJson(const msg::LearnerStatus& m) {
+  auto number = [](double v) -> nlohmann::json { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  nlohmann::json segments = nlohmann::json::array();
+  for (size_t i = 0; i < m.segment_start_s().size() && i < m.segment_duration_s().size() && i < m.segment_laps().size(); ++i)
+    segments.push_back({{"start_s", m.segment_start_s()[i]}, {"duration_s", m.segment_duration_s()[i]}, {"laps", m.segment_laps()[i]}});
+  return {{"op", "learner"}, {"component", m.component_name()}, {"state", m.state()}, {"run", m.run()}, {"segments", segments},
+          {"chosen", m.chosen()}, {"epoch", m.epoch()}, {"epochs", m.epochs()}, {"loss", number(m.loss())},
+          {"folder", m.folder()}, {"model", m.model()}, {"message", m.message()}, {"elapsed_s", number(m.elapsed_s())},
+          {"since_demonstration_s", number(m.since_demonstration_s())}};
+}
+
 }  // namespace
 
 // A sample of dyad/processes or dyad/health into the experimenter's list of run events (one not
@@ -139,6 +151,9 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Input<msg::CartesianState>("robot").Optional().Doc("robot state shown on the subject's page");
   spec.Input<msg::Intention>("intention").Optional().Doc("experimenter's page: the deliberator's N-ELBO");
   spec.Input<msg::IntentionLabel>("labels").Optional().Doc("experimenter's page: the observer's P(C_t) and labels");
+  spec.Input<msg::LearnerStatus>("learner").Optional().Doc(
+      "experimenter's page: a learner's status; the page then offers \"learn from this session\" (its demonstrations, "
+      "the training's loss, the swap)");
   spec.Output<msg::Annotation>("notes").Doc("experimenter's notes (record this topic to align them with the run)");
   spec.Output<msg::HumanInput>("pointer").Doc("the steering page's pointer, at the browser's event rate (to web_human)");
   spec.Output<msg::SelfReport>("self_report").Optional().Doc(
@@ -264,6 +279,7 @@ Status WebComponent::PublishSelfReport(int choice) {
 Status WebComponent::ConfigureExperimenter(Context& ctx) {
   intention_ = &ctx.input<msg::Intention>("intention");
   labels_ = &ctx.input<msg::IntentionLabel>("labels");
+  learner_ = &ctx.input<msg::LearnerStatus>("learner");
   notes_ = &ctx.output<msg::Annotation>("notes");
   // Requests are written as the page asks (a generic writer: the runtime's topic, not a port to bind).
   auto requests = ctx.AdvertiseSerialized("dyad/param_requests", TypeInfoOf<msg::ParamChange>());
@@ -386,6 +402,8 @@ Status WebComponent::Step(const StepInfo& info) {
     // Whether the participant's page is there and holding (the experimenter cannot see it).
     experimenter_->Broadcast(5, nlohmann::json{{"op", "subject"}, {"pages", subject_->pages()}, {"engaged", holding_.load()}}.dump());
   }
+  if (learner_->new_count() > 0)
+    experimenter_->Broadcast(6, LearnerJson(*learner_->latest()).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   bridge_->ReportDrops();
   return Status::OK();
 }

@@ -3,7 +3,8 @@
 ///     each release of a hold of at least `self_report_min_hold_s`, when `self_report` is bound,
 ///     it asks "What were you drawing?" and the answer leaves on `self_report` with the hold's
 ///     start and end on the runtime clock),
-///   - `/experimenter`: the experimenter's page,
+///   - `/experimenter`: the experimenter's page (with `learner` bound, also "learn from this
+///     session": the learner's demonstrations, a run's loss, the swap; docs/components.md#learner),
 ///   - `/`: an index page, and the Foxglove WebSocket bridge over the graph's topics for
 ///     Foxglove ("Foxglove WebSocket" connection to ws://ADDRESS:PORT).
 /// Pages are embedded in the plugin. The server binds 127.0.0.1 unless `address` says otherwise
@@ -68,6 +69,7 @@ class WebComponent final : public Component {
   Output<msg::HumanInput>* pointer_ = nullptr;    // owned by the runtime
   Input<msg::Intention>* intention_ = nullptr;    // owned by the runtime
   Input<msg::IntentionLabel>* labels_ = nullptr;  // owned by the runtime
+  Input<msg::LearnerStatus>* learner_ = nullptr;  // owned by the runtime
   Output<msg::Annotation>* notes_ = nullptr;      // owned by the runtime
   std::unique_ptr<ExperimenterChannel> experimenter_;
   std::shared_ptr<StatsTable> stats_;  // filled by the dyad/stats subscription

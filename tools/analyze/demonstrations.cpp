@@ -64,21 +64,30 @@ std::string SegmentList(const std::vector<Segment>& segments) {
 }  // namespace
 
 StatusOr<Demonstrations> DemonstrationsFromTable(const TopicTable& table, const DemonstrationOptions& o) {
-  if (o.steps < 2) return Status::InvalidArgument("--steps must be >= 2, got " + std::to_string(o.steps));
-  if (o.min_samples < 2) return Status::InvalidArgument("--min-samples must be >= 2, got " + std::to_string(o.min_samples));
   const int cx = table.Column("x"), cy = table.Column("y"), ce = table.Column("engaged"), ct = table.Column("header.stamp_ns");
   if (cx < 0 || cy < 0 || ce < 0)
     return Status::InvalidArgument("topic '" + o.topic + "' has no x, y and engaged fields (not HumanInput?)");
+  std::vector<HumanSample> samples;
+  samples.reserve(table.rows.size());
+  for (const auto& row : table.rows) {
+    HumanSample s;
+    if (!ParseBool(row[ce], &s.engaged) || !ParseNumber(row[cx], &s.x) || !ParseNumber(row[cy], &s.y))
+      return Status::DataLoss("topic '" + o.topic + "': a sample with unreadable x, y or engaged");
+    if (ct >= 0) ParseNumber(row[ct], &s.stamp_ns);
+    samples.push_back(s);
+  }
+  return DemonstrationsFromSamples(samples, o);
+}
+
+StatusOr<Demonstrations> DemonstrationsFromSamples(const std::vector<HumanSample>& samples, const DemonstrationOptions& o) {
+  if (o.steps < 2) return Status::InvalidArgument("--steps must be >= 2, got " + std::to_string(o.steps));
+  if (o.min_samples < 2) return Status::InvalidArgument("--min-samples must be >= 2, got " + std::to_string(o.min_samples));
   std::vector<std::vector<Sample>> runs(1);
   double first_t = NAN;
-  for (const auto& row : table.rows) {
-    bool engaged = false;
-    Sample s{0, 0, 0};
-    if (!ParseBool(row[ce], &engaged) || !ParseNumber(row[cx], &s.x) || !ParseNumber(row[cy], &s.y))
-      return Status::DataLoss("topic '" + o.topic + "': a sample with unreadable x, y or engaged");
-    if (ct >= 0) ParseNumber(row[ct], &s.t);
+  for (const HumanSample& h : samples) {
+    const Sample s{h.x, h.y, h.stamp_ns};
     if (std::isnan(first_t)) first_t = s.t;
-    if (engaged && std::isfinite(s.x) && std::isfinite(s.y)) runs.back().push_back(s);
+    if (h.engaged && std::isfinite(s.x) && std::isfinite(s.y)) runs.back().push_back(s);
     else if (!runs.back().empty()) runs.emplace_back();
   }
   Demonstrations out;
@@ -101,7 +110,7 @@ StatusOr<Demonstrations> DemonstrationsFromTable(const TopicTable& table, const 
   } else {
     for (int i : o.choose)
       if (i < 0 || i >= static_cast<int>(qualifying.size()))
-        return Status::InvalidArgument("--segments: no segment " + std::to_string(i) + "; the recording has " +
+        return Status::InvalidArgument(o.choose_name + ": no segment " + std::to_string(i) + "; " + o.source_name + " has " +
                                        std::to_string(qualifying.size()) + ": " + SegmentList(out.segments));
     out.chosen = o.choose;
   }
@@ -116,11 +125,11 @@ StatusOr<Demonstrations> DemonstrationsFromTable(const TopicTable& table, const 
     const std::string which = "primitive " + std::to_string(k) + " (segment " + std::to_string(out.chosen[k]) + ")";
     if (info.laps > 1)
       out.warnings.push_back(which + ": holds " + std::to_string(info.laps) + " laps of its shape, squeezed into one primitive of " +
-                             std::to_string(o.steps) + " steps (draw one lap per hold, or pick segments with --segments)");
+                             std::to_string(o.steps) + " steps (draw one lap per hold, or pick segments with " + o.choose_name + ")");
     if (info.sample_period_ms > 0 && std::abs(step_ms / info.sample_period_ms - 1) > 0.2)
       out.warnings.push_back(which + Format(": drawn in %.0f samples %.0f ms apart, resampled to steps %.0f ms apart", info.samples,
                                             info.sample_period_ms, step_ms) +
-                             ": the model learns it at another pace than it was drawn (--steps " + std::to_string(info.samples) +
+                             ": the model learns it at another pace than it was drawn (" + o.steps_name + " " + std::to_string(info.samples) +
                              " keeps it)");
   }
   out.dataset.sampling_period_ms = period_sum / out.dataset.size();

@@ -32,6 +32,8 @@ struct DemonstrationOptions {
   int steps = 72;           // T of every primitive (the study's 72)
   int min_samples = 10;     // shorter engaged segments are not demonstrations
   std::vector<int> choose;  // primitive k <- segment choose[k]; empty: every segment in order
+  // What messages call `choose`, `steps` and where the segments are (the learner's own words).
+  std::string choose_name = "--segments", steps_name = "--steps", source_name = "the recording";
 };
 
 struct Segment {
@@ -49,8 +51,18 @@ struct Demonstrations {
   int skipped = 0;  // engaged segments shorter than min_samples
 };
 
-// Fails InvalidArgument when `table` lacks x, y or engaged columns, when no segment qualifies,
-// or when `choose` names a segment that does not exist (the message lists the segments found).
+// One sample of the human topic.
+struct HumanSample {
+  double stamp_ns = 0;  // header.stamp_ns
+  double x = 0, y = 0;
+  bool engaged = false;
+};
+
+// Fails InvalidArgument when no segment qualifies, or when `choose` names a segment that does not
+// exist (the message lists the segments found). The learner component cuts a live session with it.
+StatusOr<Demonstrations> DemonstrationsFromSamples(const std::vector<HumanSample>& samples, const DemonstrationOptions& options);
+
+// The same from a recording's table; also fails when `table` lacks x, y or engaged columns.
 StatusOr<Demonstrations> DemonstrationsFromTable(const TopicTable& table, const DemonstrationOptions& options);
 
 }  // namespace dyad::analyze

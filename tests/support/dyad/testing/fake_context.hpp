@@ -6,6 +6,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -95,6 +96,36 @@ class FakeContext final : public Context {
   void RequestStop(std::string reason) override { stop_reason = std::move(reason); }
   bool stepped() const override { return stepped_clock; }
 
+  // Live parameters as the runtime applies them at a step boundary: the component's check, its
+  // prepare (here on the calling thread), the new value, then its commit. Returns the refusal.
+  void CheckLiveParam(const std::string& name, LiveParamCheck check) override { checks_[name] = std::move(check); }
+  void PrepareLiveParam(const std::string& name, LiveParamPrepare prepare, LiveParamCommit commit) override {
+    prepares_[name] = {std::move(prepare), std::move(commit)};
+  }
+  Status SetLive(const std::string& name, const ParamValue& value) {
+    if (auto c = checks_.find(name); c != checks_.end())
+      if (Status s = c->second(value); !s.ok()) return s;
+    auto p = prepares_.find(name);
+    if (p != prepares_.end())
+      if (Status s = p->second.first(value); !s.ok()) return s;
+    params_.Set(name, value);
+    if (p != prepares_.end()) p->second.second(value);
+    return Status::OK();
+  }
+  // Serialized subscriptions: kept per topic; Deliver() hands them a sample's CDR bytes.
+  Status SubscribeSerialized(const std::string& topic, SerializedCallback callback) override {
+    subscriptions_[topic].push_back(std::move(callback));
+    return Status::OK();
+  }
+  void Deliver(const std::string& topic, std::span<const uint8_t> cdr) {
+    SerializedSample sample;
+    sample.cdr = cdr;
+    sample.receive_ns = clock_.now;
+    for (auto& callback : subscriptions_[topic]) callback(sample);
+  }
+  void set_graph_yaml(std::string yaml) { graph_yaml_ = std::move(yaml); }
+  const std::string& graph_yaml() const override { return graph_yaml_; }
+
   std::string stop_reason;
   bool stepped_clock = false;
   FakeClock clock_;
@@ -113,6 +144,10 @@ class FakeContext final : public Context {
   std::map<std::string, std::unique_ptr<OutputBase>> outputs_;
   std::vector<std::unique_ptr<detail::WriterEndpoint>> writers_;
   std::vector<std::unique_ptr<detail::ReaderEndpoint>> readers_;
+  std::map<std::string, LiveParamCheck> checks_;
+  std::map<std::string, std::pair<LiveParamPrepare, LiveParamCommit>> prepares_;
+  std::string graph_yaml_;
+  std::map<std::string, std::vector<SerializedCallback>> subscriptions_;
 };
 
 }  // namespace dyad::testing
