@@ -148,7 +148,16 @@ void WebComponent::Describe(ComponentSpec& spec) {
       "subject's page: with `self_report` bound, ask \"What were you drawing?\" after each release (the data set's "
       "primitives as thumbnails, and \"something else\")");
   spec.Param("self_report_min_hold_s", 1.0).Min(0).Unit("s").Doc("subject's page: ask only after a hold at least this long");
+  spec.Param("task_target", int64_t{-1}).Range(-1, 1e6).Live().Doc(
+      "subject's page: the data set's primitive to draw, drawn boldly over the workspace (-1: none; needs params.dataset)");
+  spec.Param("task_message", "").Live().Doc("subject's page: a message above the workspace (empty: none)");
+  spec.Param("task_countdown_s", 0.0).Range(0, 3600).Unit("s").Live().Doc(
+      "subject's page: setting it starts a countdown of that many seconds, then \"go\" (the same value again restarts it)");
+  spec.Param("practice", false).Live().Doc("subject's page says \"practice\"; dyad analyze leaves the events meanwhile out (the `task` output recorded)");
   spec.Input<msg::CartesianState>("robot").Optional().Doc("robot state shown on the subject's page");
+  spec.Output<msg::SubjectTask>("task").Optional().Doc(
+      "what the subject's page shows besides the robot (target, message, countdown, practice): at the start and each change; "
+      "bind to subject/task, which dyad analyze reads");
   spec.Input<msg::Intention>("intention").Optional().Doc("experimenter's page: the deliberator's N-ELBO");
   spec.Input<msg::IntentionLabel>("labels").Optional().Doc("experimenter's page: the observer's P(C_t) and labels");
   spec.Input<msg::LearnerStatus>("learner").Optional().Doc(
@@ -175,6 +184,7 @@ Status WebComponent::Configure(Context& ctx) {
   port_file_ = p.String("port_file");
   if (Status s = ConfigureBridge(ctx, p); !s.ok()) return s;
   if (Status s = ConfigureSubject(ctx, p); !s.ok()) return s;
+  if (Status s = ConfigureTask(ctx, p); !s.ok()) return s;
   if (Status s = ConfigureExperimenter(ctx); !s.ok()) return s;
   ConfigurePages();
   return Status::OK();
@@ -228,9 +238,13 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
   so.ask = reports_->bound() && p.String("self_reports") == "after_event";
   so.ask_after_hold_s = p.Double("self_report_min_hold_s");
   min_hold_ns_ = static_cast<int64_t>(std::llround(so.ask_after_hold_s * 1e9));
-  if (so.watermark || so.ask) {
-    const std::string why = so.watermark ? "params.show_primitives" : "params.self_reports (the question's thumbnails)";
+  if (so.watermark || so.ask || p.Int("task_target") >= 0) {
+    const std::string why = so.watermark ? "params.show_primitives"
+                            : so.ask     ? "params.self_reports (the question's thumbnails)"
+                                         : "params.task_target";
     if (p.String("dataset").empty()) return Status::InvalidArgument(why + ": needs params.dataset (an NRL data set folder)");
+  }
+  if (!p.String("dataset").empty()) {  // a target may be shown later too
     auto data = pvrnn::LoadNrlDataset(p.String("dataset"));
     if (!data.ok()) return data.status().WithContext("params.dataset");
     for (const auto& seq : data->sequences) {
@@ -240,6 +254,7 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
       so.primitives.push_back(std::move(pts));
     }
   }
+  primitives_ = static_cast<int>(so.primitives.size());
   robot_ = &ctx.input<msg::CartesianState>("robot");
   pointer_ = &ctx.output<msg::HumanInput>("pointer");
   // Both sinks are serialised by SubjectChannel (component.hpp: one Output's Publish calls must
@@ -258,6 +273,53 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
       },
       [this](int choice) { return PublishSelfReport(choice); });
   return Status::OK();
+}
+
+// The experimenter's task for the person: live params, checked here, sent to the subject's pages
+// and published on `task` by Step().
+Status WebComponent::ConfigureTask(Context& ctx, const Params& p) {
+  task_out_ = &ctx.output<msg::SubjectTask>("task");
+  auto check_target = [this](int64_t target) -> Status {
+    if (target < 0) return Status::OK();
+    if (primitives_ == 0) return Status::InvalidArgument("no data set to show a target from (params.dataset)");
+    if (target >= primitives_)
+      return Status::InvalidArgument("the data set has " + std::to_string(primitives_) + " primitives (0.." + std::to_string(primitives_ - 1) +
+                                     "), got " + std::to_string(target));
+    return Status::OK();
+  };
+  if (Status s = check_target(p.Int("task_target")); !s.ok()) return Status::InvalidArgument("params.task_target: " + s.message());
+  ctx.CheckLiveParam("task_target", [check_target](const ParamValue& v) { return check_target(std::get<int64_t>(v)); });
+  ctx.PrepareLiveParam(
+      "task_countdown_s", [](const ParamValue&) { return Status::OK(); }, [this](const ParamValue&) { countdown_asked_ = true; });
+  countdown_asked_ = p.Double("task_countdown_s") > 0;
+  return Status::OK();
+}
+
+// At the first step and whenever the task changed: to the subject's pages and on `task`.
+Status WebComponent::StepTask() {
+  const Params& p = ctx_->params();
+  SubjectChannel::Task t = task_;
+  t.target = static_cast<int>(p.Int("task_target"));
+  t.message = p.String("task_message");
+  t.practice = p.Bool("practice");
+  const bool countdown = countdown_asked_;
+  if (countdown) {
+    t.countdown_s = p.Double("task_countdown_s");
+    t.countdown_start = std::chrono::steady_clock::now();
+    countdown_asked_ = false;
+  }
+  if (task_sent_ && !countdown && t.target == task_.target && t.message == task_.message && t.practice == task_.practice)
+    return Status::OK();
+  task_ = t;
+  task_sent_ = true;
+  subject_->SetTask(t);
+  if (!task_out_->bound()) return Status::OK();
+  msg::SubjectTask m;
+  m.target(t.target);
+  m.message(t.message);
+  m.countdown_s(countdown ? t.countdown_s : 0);
+  m.practice(t.practice);
+  return task_out_->Publish(m);
 }
 
 // The answer about the last hold, once (a second click, or an answer while holding again, is ignored).
@@ -375,6 +437,7 @@ Status WebComponent::Activate() {
 }
 
 Status WebComponent::Step(const StepInfo& info) {
+  if (Status s = StepTask(); !s.ok()) return s;
   if (robot_->new_count() > 0) {
     const msg::CartesianState* r = robot_->latest();
     subject_->BroadcastState(r->x(), r->y());
@@ -400,7 +463,13 @@ Status WebComponent::Step(const StepInfo& info) {
     if (std::string events = events_->Json(); !events.empty()) experimenter_->Broadcast(3, std::move(events));
     if (std::string answers = answers_->Json(); !answers.empty()) experimenter_->Broadcast(4, std::move(answers));
     // Whether the participant's page is there and holding (the experimenter cannot see it).
-    experimenter_->Broadcast(5, nlohmann::json{{"op", "subject"}, {"pages", subject_->pages()}, {"engaged", holding_.load()}}.dump());
+    experimenter_->Broadcast(5, nlohmann::json{{"op", "subject"},
+                                               {"pages", subject_->pages()},
+                                               {"engaged", holding_.load()},
+                                               {"component", ctx_->name()},
+                                               {"primitives", primitives_},
+                                               {"task", {{"target", task_.target}, {"message", task_.message}, {"practice", task_.practice}}}}
+                                    .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   }
   if (learner_->new_count() > 0)
     experimenter_->Broadcast(6, LearnerJson(*learner_->latest()).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));

@@ -1,5 +1,6 @@
 /// The `web` component: one embedded web server per process (civetweb) with
-///   - `/subject`: the subject's page (steer the robot with the mouse; see web_human.hpp; after
+///   - `/subject`: the subject's page (steer the robot with the mouse, the experimenter's task:
+///     a target primitive, a message, a countdown, "practice"; see web_human.hpp; after
 ///     each release of a hold of at least `self_report_min_hold_s`, when `self_report` is bound,
 ///     it asks "What were you drawing?" and the answer leaves on `self_report` with the hold's
 ///     start and end on the runtime clock),
@@ -55,6 +56,8 @@ class WebComponent final : public Component {
   void ConfigurePages();
   StatusOr<std::string> PublishParamRequest(const ParamRequest& request);  // ExperimenterChannel's param sink
   Status PublishSelfReport(int choice);                                    // SubjectChannel's report sink
+  Status ConfigureTask(Context& ctx, const Params& p);
+  Status StepTask();
   Context* ctx_ = nullptr;
   WebServer::Options options_;
   std::string port_file_;
@@ -84,6 +87,11 @@ class WebComponent final : public Component {
   std::unique_ptr<WebServer> server_;
   msg::HumanInput pointer_sample_;
   Output<msg::SelfReport>* reports_ = nullptr;  // owned by the runtime; may be unbound
+  Output<msg::SubjectTask>* task_out_ = nullptr;  // owned by the runtime; may be unbound
+  int primitives_ = 0;                            // of params.dataset (0: none)
+  SubjectChannel::Task task_;                     // as sent (Step's; the experimenter's page reads it there too)
+  bool task_sent_ = false;
+  bool countdown_asked_ = false;                  // set by task_countdown_s's commit (step thread)
   // The steering page's last hold (runtime clock), for its self-report; touched only by the
   // subject channel's sinks, which it serialises.
   std::atomic<bool> holding_{false};  // read by Step for the experimenter's page

@@ -24,7 +24,7 @@ StatusOr<Report> BuildReport(const std::string& recording, std::ostream& warning
       !folder.empty() && !report.plan.dataset.empty() && std::filesystem::path(report.plan.dataset).is_relative())
     report.plan.dataset = (std::filesystem::path(folder) / report.plan.dataset).lexically_normal().string();
   auto tables = ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels",
-                                     "dyad/clock_offsets", "dyad/params", "human/self_report"});
+                                     "dyad/clock_offsets", "dyad/params", "human/self_report", "subject/task"});
   if (!tables.ok()) return tables.status();
   auto corrections = ClockCorrections(*tables, report.plan);
   if (!corrections.ok()) return corrections.status().WithContext(recording);
@@ -40,6 +40,9 @@ StatusOr<Report> BuildReport(const std::string& recording, std::ostream& warning
   auto reports = SelfReports(*tables, report.plan, report.timeline);
   if (!reports.ok()) return reports.status().WithContext(recording);
   AttachSelfReports(*reports, &events);
+  auto practice = PracticeSpans(*tables, report.plan, report.timeline);
+  if (!practice.ok()) return practice.status().WithContext(recording);
+  report.practice_events = DropPracticeEvents(*practice, &events);
   report.events = SummariseEvents(report.timeline, events);
   report.confusion = HumanConfusion(report.timeline, events);
   report.reported_confusion = ReportedConfusion(report.timeline, events);

@@ -352,6 +352,39 @@ void AttachSelfReports(const std::vector<SelfReportEvent>& reports, std::vector<
   }
 }
 
+StatusOr<std::vector<PracticeSpan>> PracticeSpans(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
+                                                  const Timeline& timeline) {
+  std::vector<PracticeSpan> out;
+  auto it = tables.find("subject/task");
+  if (it == tables.end()) return out;
+  Cells cells("subject/task", it->second);
+  if (Status s = cells.Need({"header.source", "header.stamp_ns", "practice"}); !s.ok()) return s;
+  std::optional<int64_t> t0 = timeline.t0_ns;
+  bool open = false;
+  for (size_t r = 0; r < it->second.size(); ++r) {
+    auto stamp = ComponentStamp(cells, r, plan, timeline.clock_corrections_ns);
+    if (!stamp.ok()) return stamp.status();
+    bool practice = false;
+    if (!ParseBool(cells.Text(r, "practice"), &practice))
+      return Status::DataLoss("topic subject/task message " + std::to_string(r + 1),
+                              "field \"practice\" holds " + cells.Text(r, "practice") + ": not a bool");
+    if (!t0) t0 = static_cast<int64_t>(*stamp);
+    const int64_t step = StepOf(*stamp, *t0, plan.period_ns);
+    if (practice && !open) out.push_back({step, std::numeric_limits<int64_t>::max()}), open = true;
+    if (!practice && open) out.back().end_step = step, open = false;
+  }
+  return out;
+}
+
+int DropPracticeEvents(const std::vector<PracticeSpan>& spans, std::vector<PlannedEvent>* events) {
+  const auto in_practice = [&spans](const PlannedEvent& e) {
+    return std::any_of(spans.begin(), spans.end(), [&e](const PracticeSpan& s) { return e.start_step >= s.start_step && e.start_step < s.end_step; });
+  };
+  const size_t before = events->size();
+  events->erase(std::remove_if(events->begin(), events->end(), in_practice), events->end());
+  return static_cast<int>(before - events->size());
+}
+
 int MostLikelyClass(const std::vector<double>& p) {
   if (p.empty()) return -1;
   return static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin());

@@ -6,6 +6,8 @@
 //   robot/state      CartesianState  -> executed position
 //   observer/labels  IntentionLabel  -> class probabilities of human and robot, congruence P(C_t)
 //   dyad/params      ParamChange     -> live parameter changes applied during the run
+//   human/self_report SelfReport     -> what the person said they drew
+//   subject/task     SubjectTask     -> practice: events that start meanwhile are left out
 //
 // Samples are put on one step grid: step = round((stamp - t0) / period), t0 the first human
 // sample's stamp, period from the graph (the human source's rate_hz; 100 ms if unknown). A topic
@@ -128,6 +130,18 @@ StatusOr<std::vector<SelfReportEvent>> SelfReports(const std::map<std::string, T
 // overlaps none is left out, and an event keeps its first report). An event of unknown primitive
 // (a person's) takes a reported primitive as its primitive: what the observer is judged against.
 void AttachSelfReports(const std::vector<SelfReportEvent>& reports, std::vector<PlannedEvent>* events);
+
+// Steps [start_step, end_step) the subject's page said "practice" (subject/task, the web
+// component's `task` output: each sample holds from its stamp until the next; the last until the
+// end). Stamps placed as SelfReports places them. No subject/task: empty. Fails (DataLoss) on a
+// table without SubjectTask's fields.
+struct PracticeSpan {
+  int64_t start_step = 0, end_step = 0;
+};
+StatusOr<std::vector<PracticeSpan>> PracticeSpans(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
+                                                  const Timeline& timeline);
+// Leaves out the events that start inside a span; returns how many.
+int DropPracticeEvents(const std::vector<PracticeSpan>& spans, std::vector<PlannedEvent>* events);
 
 // Index of the largest probability (the first on ties); -1 for an empty vector (no label).
 int MostLikelyClass(const std::vector<double>& p);

@@ -198,6 +198,9 @@ std::string OrUnknown(const EventSummary& e, double v) { return e.event.primitiv
 
 void EventsSection(const Report& r, std::ostream& s) {
   s << "\n## Events\n\n";
+  if (r.practice_events > 0)
+    s << r.practice_events << " event(s) started while the subject's page said \"practice\" (subject/task) and are left out of "
+      << "everything below.\n\n";
   if (r.events.empty()) {
     s << "No interventions (the human never engaged).\n\n";
   } else {

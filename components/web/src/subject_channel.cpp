@@ -12,9 +12,32 @@ namespace dyad::web {
 namespace {
 using json = nlohmann::json;
 constexpr uint32_t kStateChannel = 1;
+constexpr uint32_t kTaskChannel = 2;
 }  // namespace
 
 void SubjectChannel::SetServer(WebServer* server) { server_.store(server); }
+
+std::string SubjectChannel::TaskJson() const {
+  double left = 0;
+  if (task_.countdown_s > 0)
+    left = std::max(0.0, task_.countdown_s - std::chrono::duration<double>(std::chrono::steady_clock::now() - task_.countdown_start).count());
+  return json{{"op", "task"}, {"target", task_.target}, {"message", task_.message}, {"countdown_s", left}, {"practice", task_.practice}}
+      .dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+void SubjectChannel::SetTask(const Task& task) {
+  std::vector<ClientId> pages;
+  std::string frame;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    task_ = task;
+    pages = pages_;
+    frame = TaskJson();
+  }
+  WebServer* server = server_.load();
+  if (server == nullptr) return;
+  for (ClientId c : pages) server->SendLatest(c, kTaskChannel, frame, /*binary=*/false);
+}
 
 size_t SubjectChannel::pages() const {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -52,8 +75,10 @@ void SubjectChannel::SendRole(ClientId client, bool steering) {
 void SubjectChannel::OnOpen(ClientId client, Role role) {
   bool steering = false;
   ClientId demoted = 0;
+  std::string task;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    task = TaskJson();
     pages_.push_back(client);
     roles_[client] = role;
     // The subject's page steers before the experimenter's: an experimenter who opened /subject
@@ -86,6 +111,7 @@ void SubjectChannel::OnOpen(ClientId client, Role role) {
                                 {"ask", options_.ask && static_cast<bool>(report_)},
                                 {"ask_after_hold_s", options_.ask_after_hold_s}}
                                .dump());
+  server->SendText(client, task);
 }
 
 Status SubjectChannel::OnText(ClientId client, std::string_view text) {

@@ -7,7 +7,9 @@
 /// drawing?" (k: a primitive's index, -1 "something else"; from the steering page only, a viewer's
 /// is refused). Server -> page: {"op":"hello",...} (role, steering, workspace, engage key,
 /// primitives, whether they are a watermark, whether and after how long a hold to ask),
-/// {"op":"role","steering":bool}, {"op":"state","x","y"} (newest
+/// {"op":"role","steering":bool}, {"op":"task","target":k,"message":"..","countdown_s":s,
+/// "practice":bool} (the experimenter's task: sent to every page at each change and to a page
+/// that opens, its countdown as what is left of it then), {"op":"state","x","y"} (newest
 /// only: a slow page never builds a backlog), {"op":"ack","t":ms} after each pointer sample was
 /// published (the page measures the round trip). A pointer sample may carry "wall" (the event's
 /// time, ms since the epoch): the channel then keeps the event-to-publication delay.
@@ -22,6 +24,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -53,6 +56,16 @@ class SubjectChannel final : public ClientHandler {
   void SetServer(WebServer* server);
   // Sends the robot's position to every page (newest only).
   void BroadcastState(double x, double y);
+  // The experimenter's task for the person (web component's task_* params, practice).
+  struct Task {
+    int target = -1;          // a primitive to draw; -1: none
+    std::string message;      // empty: none
+    double countdown_s = 0;   // a countdown of this length started at `countdown_start` (0: none)
+    std::chrono::steady_clock::time_point countdown_start{};
+    bool practice = false;
+  };
+  // Sends it to every page, and to every page that opens later.
+  void SetTask(const Task& task);
   size_t pages() const;
   // Where a pointer sample's time went, in ms, for each sample that carried the page's "wall"
   // stamp (meaningful when page and server share a clock; the first 100,000). The hops add up to
@@ -72,6 +85,7 @@ class SubjectChannel final : public ClientHandler {
 
  private:
   void SendRole(ClientId client, bool steering);
+  std::string TaskJson() const;  // with mutex_ held
   const Options options_;
   const PointerSink sink_;
   const ReportSink report_;
@@ -81,6 +95,7 @@ class SubjectChannel final : public ClientHandler {
   std::map<ClientId, Role> roles_;
   ClientId steering_ = 0;        // 0: none
   double last_x_ = 0, last_y_ = 0;
+  Task task_;
   PointerDelays delays_;
 };
 

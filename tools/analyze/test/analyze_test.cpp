@@ -72,9 +72,11 @@ std::vector<double> OneHot(int k, int n = 7) {
 // except at steps 12 and 13 (says 3); the robot's class is 1 until step 15, then 2 until 25,
 // then 1. Congruence = step / 100.
 // `reports`: self-reports {first step, release step, choice} written 2 steps after the release.
+// `practice`: {step, practice} samples of subject/task.
 std::string WriteExperiment(const std::string& path, bool with_observer = true,
                             const std::map<std::string, std::string>& graph = {{"yaml", kGraph}},
-                            const std::vector<std::array<int64_t, 3>>& reports = {}) {
+                            const std::vector<std::array<int64_t, 3>>& reports = {},
+                            const std::vector<std::pair<int64_t, bool>>& practice = {}) {
   auto writer = mcap::Writer::Open(path);
   EXPECT_TRUE(writer.ok());
   EXPECT_TRUE(writer->AddMetadata("dyad.graph", graph).ok());
@@ -84,7 +86,17 @@ std::string WriteExperiment(const std::string& path, bool with_observer = true,
   Channel<msg::IntentionLabel> labels(*writer, "observer/labels");
   std::optional<Channel<msg::SelfReport>> said;
   if (!reports.empty()) said.emplace(*writer, "human/self_report");
+  std::optional<Channel<msg::SubjectTask>> task;
+  if (!practice.empty()) task.emplace(*writer, "subject/task");
   for (int t = 0; t < 40; ++t) {
+    for (const auto& [step, on] : practice) {
+      if (step != t) continue;
+      msg::SubjectTask k;
+      k.header().source("web");
+      k.target(-1);
+      k.practice(on);
+      task->Write(k, t);
+    }
     for (const auto& [first, release, choice] : reports) {
       if (release + 2 != t) continue;
       msg::SelfReport r;
@@ -362,6 +374,27 @@ TEST(Analyze, SelfReportsJoinTheirEventsAndJudgeTheObserverInASecondMatrix) {
   EXPECT_EQ(events[2].substr(events[2].rfind(',') + 1), "4");
   const auto counts = Lines(dir + "/reported_confusion.csv");
   EXPECT_NE(std::find(counts.begin(), counts.end(), "4,5,4"), counts.end());
+}
+
+// Events that start while the subject's page says "practice" are left out, and the report says so.
+TEST(Analyze, EventsStartedInPracticeAreLeftOutAndSaidSo) {
+  const std::string path = WriteExperiment(TempPath("practice.mcap"), true, {{"yaml", kGraph}}, {}, {{0, true}, {25, false}});
+  std::ostringstream warnings;
+  auto r = BuildReport(path, warnings);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(r->practice_events, 1);
+  ASSERT_EQ(r->events.size(), 1u);
+  EXPECT_EQ(r->events[0].event.start_step, 30);
+  EXPECT_EQ(r->confusion[2][2], 0) << "the practice event's steps are not in the matrix";
+  EXPECT_NE(FormatMarkdown(*r).find("1 event(s) started while the subject's page said \"practice\""), std::string::npos);
+  // Practice from step 12 to the end (its last sample repeats it): the event from step 10 started
+  // before and is kept, the one from 30 is left out.
+  auto spans = WriteExperiment(TempPath("practice2.mcap"), true, {{"yaml", kGraph}}, {}, {{5, false}, {12, true}, {32, true}});
+  auto r2 = BuildReport(spans, warnings);
+  ASSERT_TRUE(r2.ok()) << r2.status().ToString();
+  EXPECT_EQ(r2->practice_events, 1);
+  ASSERT_EQ(r2->events.size(), 1u);
+  EXPECT_EQ(r2->events[0].event.start_step, 10);
 }
 
 // A self-report whose choice is neither a primitive nor -1 fails the analysis, naming the message.
