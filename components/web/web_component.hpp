@@ -57,7 +57,7 @@ class WebComponent final : public Component {
   StatusOr<std::string> PublishParamRequest(const ParamRequest& request);  // ExperimenterChannel's param sink
   Status PublishSelfReport(int choice);                                    // SubjectChannel's report sink
   Status ConfigureTask(Context& ctx, const Params& p);
-  Status StepTask();
+  void StepTask();
   Context* ctx_ = nullptr;
   WebServer::Options options_;
   std::string port_file_;
