@@ -6,6 +6,7 @@
 #include <thread>
 
 #include <dyad/msg/types.hpp>
+#include <dyad/msg/types_support.hpp>
 
 #include "dds/dds_participant.hpp"
 

@@ -11,6 +11,7 @@
 #include <fastdds/rtps/common/SerializedPayload.h>
 
 #include <dyad/message_traits.hpp>
+#include <dyad/msg/types_support.hpp>  // MessageTraits<T>::PubSubType, complete
 
 namespace dyad::web {
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "dyad/cdr_decoder.hpp"
+#include <dyad/msg/types_support.hpp>  // PubSubType of the message types it serializes
 
 #if DYAD_CDR_WITH_FASTCDR
 #include <fastdds/dds/topic/TopicDataType.hpp>

@@ -13,6 +13,11 @@
 // A message type T must have a member `dyad::msg::Header& header()` (every dyad IDL struct
 // starts with `Header header;`), which Output<T>::Publish stamps.
 //
+// The traits only declare MakeTypeSupport: its definition (DYAD_MESSAGE_TYPE_SUPPORT) needs
+// fastddsgen's PubSubTypes headers, and with them most of Fast DDS, so it lives in the generated
+// types_support.cpp of the messages' library, and the headers in types_support.hpp for code that
+// instantiates a PubSubType itself. A file that only uses messages does not parse Fast DDS.
+//
 // ROS 2 message types (idl/ros2/, docs/ros2.md) are the exception: named as ROS 2's middlewares
 // name them on the wire ("geometry_msgs::msg::dds_::TwistStamped_", also known by their ROS 2
 // name "geometry_msgs/msg/TwistStamped"), their DDS type name carries no hash (ROS 2 peers
@@ -60,9 +65,7 @@ const TypeInfo& TypeInfoOf() {
     i.ros2_name = MessageTraits<T>::kRos2Name;
     std::string dds_name = i.dds_name();
     i.make_type_support = [dds_name]() -> eprosima::fastdds::dds::TopicDataType* {
-      auto* t = new typename MessageTraits<T>::PubSubType();
-      t->setName(dds_name.c_str());
-      return t;
+      return MessageTraits<T>::MakeTypeSupport(dds_name.c_str());
     };
     return i;
   }();
@@ -81,6 +84,7 @@ const TypeInfo& TypeInfoOf() {
     static constexpr const char* kIdl = IDL;                     \
     static constexpr const char* kRos2Name = "";                 \
     static constexpr bool kDyadHeader = true;                    \
+    static ::eprosima::fastdds::dds::TopicDataType* MakeTypeSupport(const char* dds_name); \
   }
 
 // Declares MessageTraits for the ROS 2 type NS::NAME ("<pkg>::msg::dds_", "<Type>_"), known as
@@ -94,4 +98,14 @@ const TypeInfo& TypeInfoOf() {
     static constexpr const char* kIdl = IDL;                     \
     static constexpr const char* kRos2Name = ROS2_NAME;          \
     static constexpr bool kDyadHeader = false;                   \
+    static ::eprosima::fastdds::dds::TopicDataType* MakeTypeSupport(const char* dds_name); \
+  }
+
+// Defines MessageTraits<NS::NAME>::MakeTypeSupport (generated types_support.cpp, where NS::NAME's
+// PubSubTypes header is included): a new type support named `dds_name`, owned by the caller.
+#define DYAD_MESSAGE_TYPE_SUPPORT(NS, NAME)                                                              \
+  ::eprosima::fastdds::dds::TopicDataType* dyad::MessageTraits<NS::NAME>::MakeTypeSupport(const char* dds_name) { \
+    auto* t = new NS::NAME##PubSubType();                                                                \
+    t->setName(dds_name);                                                                                \
+    return t;                                                                                            \
   }

@@ -11,6 +11,7 @@
 #include <fastdds/rtps/common/SerializedPayload.h>
 
 #include <dyad/msg/types.hpp>
+#include <dyad/msg/types_support.hpp>
 
 #include "bag_commands.hpp"
 #include "dyad/testing/cli.hpp"

@@ -15,6 +15,8 @@
 #include <fastdds/rtps/common/SerializedPayload.h>
 
 #include <dyad/message_traits.hpp>
+#include <dyad/msg/ros2_types_support.hpp>  // MessageTraits<T>::PubSubType, complete
+#include <dyad/msg/types_support.hpp>
 
 #include "dyad/mcap/writer.hpp"
 
