@@ -16,6 +16,7 @@
 
 #include "dyad/pvrnn/dataset.hpp"
 #include "run_process.hpp"
+#include "yaml_file.hpp"
 
 namespace dyad::learner {
 namespace {
@@ -64,12 +65,6 @@ StatusOr<std::string> MakeRunFolder(const std::string& out, uint32_t run, bool s
     if (ec) return Status::Internal("params.out: cannot create " + folder + ": " + ec.message());
   }
   return Status::Internal("params.out: no free folder name beside " + base);
-}
-
-std::string DoubleQuoted(const std::string& text) {
-  YAML::Emitter e;
-  e << YAML::DoubleQuoted << text;
-  return e.c_str();
 }
 
 }  // namespace
@@ -249,10 +244,10 @@ void Learner::StartTrainer() {
   // reconstruction), so the page's loss curve moves.
   const std::vector<std::string> args = {
       trainer_, "train", train_config_,
-      "--set", "dataset=" + DoubleQuoted(run.folder + "/dataset"),
-      "--set", "output=" + DoubleQuoted(run.model),
-      "--set", "checkpoint=" + DoubleQuoted(run.model + ".ckpt"),
-      "--set", "log_csv=" + DoubleQuoted(run.model + ".csv"),
+      "--set", "dataset=" + tools::YamlQuoted(run.folder + "/dataset"),
+      "--set", "output=" + tools::YamlQuoted(run.model),
+      "--set", "checkpoint=" + tools::YamlQuoted(run.model + ".ckpt"),
+      "--set", "log_csv=" + tools::YamlQuoted(run.model + ".csv"),
       "--set", "epochs=" + std::to_string(epochs_),
       "--set", "threads=" + std::to_string(threads_),
       "--set", "log_every=" + std::to_string(std::clamp(epochs_ / 100, 1, 100))};
@@ -306,7 +301,7 @@ Status Learner::AskSwap(int64_t now_ns) {
   request.component_name(target_component_);
   request.param_name(target_param_);
   request.op("set");
-  request.value(DoubleQuoted(trained_model_));
+  request.value(tools::YamlQuoted(trained_model_));
   request.who("learner " + ctx_->name());
   // Unique per request (as dyad/param_requests wants): the run, this process and its clock.
   request.request_id(ctx_->name() + "/run" + std::to_string(run_) + "/" + std::to_string(::getpid()) + "/" +

@@ -41,14 +41,6 @@ std::string UtcNow() {
   return buf;
 }
 
-// 'text' as a YAML single-quoted scalar ('' is a quote inside it): a --set value that stays a
-// string whatever it holds (" #", ": ", a leading '[').
-std::string YamlQuoted(const std::string& text) {
-  std::string q = "'";
-  for (char ch : text) q += ch == '\'' ? std::string("''") : std::string(1, ch);
-  return q + "'";
-}
-
 // JSON text of `j`; text that is not UTF-8 (a reason typed in another encoding) is replaced, not thrown.
 std::string Dump(const Json& j) { return j.dump(-1, ' ', false, Json::error_handler_t::replace); }
 
@@ -70,7 +62,7 @@ std::vector<std::string> RunSets(const Study& s, const AttemptRequest& r) {
   if (r.rehearsal) return sets;
   sets.insert(sets.end(), s.page_sets.begin(), s.page_sets.end());
   for (const std::string& web : s.token_file_webs)
-    sets.push_back(web + ".token_file=" + YamlQuoted((fs::path(s.data) / r.participant / (web + "-tokens")).string()));
+    sets.push_back(web + ".token_file=" + tools::YamlQuoted((fs::path(s.data) / r.participant / (web + "-tokens")).string()));
   return sets;
 }
 
@@ -246,8 +238,8 @@ std::vector<std::string> AttemptCommand(const Study& s, const AttemptRequest& r)
       {"dyad_version", DYAD_VERSION},
       {"graph_hash", GraphHash(graph, ExperimentSets(s, r))}};
   std::string list;  // a YAML flow list of quoted scalars
-  for (const auto& [key, value] : metadata) list += (list.empty() ? "[" : ", ") + YamlQuoted(key + "=" + value);
-  args.insert(args.end(), {"--set", s.recorder + ".file=" + YamlQuoted(AttemptFile(r.trial, r.attempt)), "--set",
+  for (const auto& [key, value] : metadata) list += (list.empty() ? "[" : ", ") + tools::YamlQuoted(key + "=" + value);
+  args.insert(args.end(), {"--set", s.recorder + ".file=" + tools::YamlQuoted(AttemptFile(r.trial, r.attempt)), "--set",
                            s.recorder + ".metadata=" + list + "]"});
   return args;
 }

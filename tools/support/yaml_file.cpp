@@ -25,6 +25,12 @@ std::string SetText(const YAML::Node& node) {
   return e.c_str();
 }
 
+std::string YamlQuoted(const std::string& text) {
+  std::string q = "'";
+  for (char ch : text) q += ch == '\'' ? std::string("''") : std::string(1, ch);
+  return q + "'";
+}
+
 std::string PathBeside(const std::string& file, const std::string& path) {
   std::filesystem::path p(path);
   // absolute(file) first: a bare "s.yaml" has an empty parent, which absolute() refuses.
