@@ -411,6 +411,11 @@ bool WebServer::OriginAllowed(const std::string& origin) const {
 int WebServer::OnConnect(const mg_connection* conn, void* endpoint) {
   auto* self = static_cast<EndpointState*>(endpoint)->server;
   const mg_request_info* info = mg_get_request_info(conn);
+  // libcivetweb 1.15 keeps the subprotocol its worker's previous WebSocket accepted and answers a
+  // client that asked for none with it, which the client must refuse (civetweb#1091, fixed after
+  // 1.15 by clearing it per connection, as here: this runs before the handshake is sent).
+  if (mg_get_header(conn, "Sec-WebSocket-Protocol") == nullptr)
+    const_cast<mg_request_info*>(info)->acceptedWebSocketSubprotocol = nullptr;
   if (const char* origin = mg_get_header(conn, "Origin"); origin != nullptr && !self->OriginAllowed(origin)) return 1;
   const std::optional<Role> role = self->RoleOf(info->query_string);
   if (!role || !static_cast<EndpointState*>(endpoint)->roles.count(*role)) return 1;

@@ -172,6 +172,37 @@ TEST(WebServer, TokensMustBeGivenAndDistinct) {
   EXPECT_EQ(WebServer::Start(o).status().code(), Status::Code::kInvalidArgument);
 }
 
+// libcivetweb 1.15 keeps, in each worker's connection, the subprotocol the last WebSocket it
+// served accepted, and answers the next client with it even when that one asked for none
+// (civetweb#1091, fixed after 1.15). Node's ws and the browsers then refuse the connection: a page
+// opened after a Foxglove viewer could not connect. Every worker here serves a viewer first.
+TEST(WebServer, AClientThatAsksForNoSubprotocolIsAnsweredWithNone) {
+  RecordingHandler handler;
+  WebServer::Options o = TestOptions(&handler);
+  o.max_clients = 1;  // the fewest workers, so each serves both kinds
+  o.endpoints.push_back(WebServer::Endpoint{"/viewer", {"foxglove.websocket.v1"}, &handler, {Role::kExperimenter}});
+  auto server = WebServer::Start(o);
+  ASSERT_TRUE(server.ok()) << server.status().ToString();
+  const int port = (*server)->port();
+  std::string with_protocol = Upgrade("/viewer?token=" + kExperimenter);
+  with_protocol.insert(with_protocol.size() - 2, "Sec-WebSocket-Protocol: foxglove.websocket.v1\r\n");
+  int connections = 0;
+  for (int round = 0; round < 12; ++round) {
+    for (const bool asks : {true, false}) {
+      const int fd = Connect(port);
+      const std::string head = Exchange(fd, asks ? with_protocol : Upgrade("/ws?token=" + kExperimenter));
+      close(fd);
+      ASSERT_NE(head.find("101 Switching Protocols"), std::string::npos) << "round " << round << (asks ? ", the viewer: " : ", the page: ") << head;
+      EXPECT_EQ(head.find("Sec-WebSocket-Protocol"), asks ? head.find("Sec-WebSocket-Protocol: foxglove.websocket.v1")
+                                                          : std::string::npos)
+          << "round " << round << (asks ? ", the viewer" : ", the page") << ":\n" << head;
+      // The one client slot is free again once the server has seen the close.
+      ++connections;
+      ASSERT_TRUE(WaitFor([&] { return handler.closes == connections; }, std::chrono::seconds(5)));
+    }
+  }
+}
+
 // A client that stops reading: once a write has waited `write_timeout_ms`, the server ends the
 // connection (the handler hears OnClose) instead of keeping a sender-less client queuing.
 TEST(WebServer, AClientThatStopsReadingIsDisconnectedAfterTheWriteTimeout) {
