@@ -160,6 +160,8 @@ void WebComponent::Describe(ComponentSpec& spec) {
       "bind to subject/task, which dyad analyze reads");
   spec.Input<msg::Intention>("intention").Optional().Doc("experimenter's page: the deliberator's N-ELBO");
   spec.Input<msg::IntentionLabel>("labels").Optional().Doc("experimenter's page: the observer's P(C_t) and labels");
+  spec.Input<msg::RecordingStatus>("recording").Optional().Doc(
+      "experimenter's page: a recorder's status (its `status` output): the file, samples, size and elapsed time, or its failure");
   spec.Input<msg::LearnerStatus>("learner").Optional().Doc(
       "experimenter's page: a learner's status; the page then offers \"learn from this session\" (its demonstrations, "
       "the training's loss, the swap)");
@@ -253,6 +255,7 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
       for (Eigen::Index t = 0; t < seq.cols(); ++t) pts.push_back({seq(0, t), seq(1, t)});
       so.primitives.push_back(std::move(pts));
     }
+    so.names = primitive_names_ = data->names;
   }
   primitives_ = static_cast<int>(so.primitives.size());
   robot_ = &ctx.input<msg::CartesianState>("robot");
@@ -342,6 +345,7 @@ Status WebComponent::ConfigureExperimenter(Context& ctx) {
   intention_ = &ctx.input<msg::Intention>("intention");
   labels_ = &ctx.input<msg::IntentionLabel>("labels");
   learner_ = &ctx.input<msg::LearnerStatus>("learner");
+  recording_ = &ctx.input<msg::RecordingStatus>("recording");
   notes_ = &ctx.output<msg::Annotation>("notes");
   // Requests are written as the page asks (a generic writer: the runtime's topic, not a port to bind).
   auto requests = ctx.AdvertiseSerialized("dyad/param_requests", TypeInfoOf<msg::ParamChange>());
@@ -468,11 +472,19 @@ Status WebComponent::Step(const StepInfo& info) {
                                                {"engaged", holding_.load()},
                                                {"component", ctx_->name()},
                                                {"primitives", primitives_},
+                                               {"names", primitive_names_},
                                                {"task", {{"target", task_.target}, {"message", task_.message}, {"practice", task_.practice}}}}
                                     .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   }
   if (learner_->new_count() > 0)
     experimenter_->Broadcast(6, LearnerJson(*learner_->latest()).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  if (recording_->new_count() > 0) {
+    const msg::RecordingStatus& r = *recording_->latest();
+    experimenter_->Broadcast(7, nlohmann::json{{"op", "recording"}, {"component", r.component_name()}, {"file", r.file()},
+                                               {"samples", r.samples()}, {"bytes", r.bytes()}, {"elapsed_s", r.elapsed_s()},
+                                               {"error", r.error()}}
+                                    .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  }
   bridge_->ReportDrops();
   return Status::OK();
 }

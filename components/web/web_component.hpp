@@ -73,6 +73,7 @@ class WebComponent final : public Component {
   Input<msg::Intention>* intention_ = nullptr;    // owned by the runtime
   Input<msg::IntentionLabel>* labels_ = nullptr;  // owned by the runtime
   Input<msg::LearnerStatus>* learner_ = nullptr;  // owned by the runtime
+  Input<msg::RecordingStatus>* recording_ = nullptr;  // owned by the runtime
   Output<msg::Annotation>* notes_ = nullptr;      // owned by the runtime
   std::unique_ptr<ExperimenterChannel> experimenter_;
   std::shared_ptr<StatsTable> stats_;  // filled by the dyad/stats subscription
@@ -89,6 +90,7 @@ class WebComponent final : public Component {
   Output<msg::SelfReport>* reports_ = nullptr;  // owned by the runtime; may be unbound
   Output<msg::SubjectTask>* task_out_ = nullptr;  // owned by the runtime; may be unbound
   int primitives_ = 0;                            // of params.dataset (0: none)
+  std::vector<std::string> primitive_names_;     // of params.dataset (empty: it names none)
   SubjectChannel::Task task_;                     // as sent (Step's; the experimenter's page reads it there too)
   bool task_sent_ = false;
   bool countdown_asked_ = false;                  // set by task_countdown_s's commit (step thread)

@@ -87,4 +87,13 @@ StatusOr<int> OpenPrivateLog(const std::string& path, const PrivateFileOptions& 
   return fd;
 }
 
+Status SyncDirectory(const std::string& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return Errno(dir, "open the folder", errno);
+  const bool ok = ::fsync(fd) == 0;
+  const int err = errno;
+  ::close(fd);
+  return ok ? Status::OK() : Errno(dir, "fsync the folder", err);
+}
+
 }  // namespace dyad

@@ -84,6 +84,7 @@ int RunAnalyze(const Options& o) {
 
 struct FromRecordingOptions {
   std::string recording, out, preview;
+  std::vector<std::string> names;  // --names: one per primitive, in order (names.txt)
   analyze::DemonstrationOptions demo;
 };
 
@@ -141,6 +142,12 @@ int RunFromRecording(const FromRecordingOptions& o) {
     std::cerr << "dyad dataset from-recording: " << o.recording << ": " << demos.status().message() << "\n";
     return kBadInput;
   }
+  if (!o.names.empty() && static_cast<int>(o.names.size()) != demos->dataset.size()) {
+    std::cerr << "dyad dataset from-recording: --names gives " << o.names.size() << " names for " << demos->dataset.size()
+              << " primitive(s)\n";
+    return kBadInput;
+  }
+  demos->dataset.names = o.names;
   if (Status s = pvrnn::WriteNrlDataset(demos->dataset, o.out); !s.ok()) {
     std::cerr << "dyad dataset from-recording: " << s.message() << "\n";
     return kFailure;
@@ -168,6 +175,8 @@ void AddAnalyzeCommands(CLI::App& app, int& exit_code) {
     fr->add_option("--steps", o->demo.steps, "steps T of every primitive (default 72)");
     fr->add_option("--min-samples", o->demo.min_samples, "shorter engaged segments are skipped (default 10)");
     fr->add_option("--segments", o->demo.choose, "which segments become the primitives, in order, e.g. 2,0,1 (default: all)")
+        ->delimiter(',');
+    fr->add_option("--names", o->names, "the primitives' names, in order, e.g. circle,star (names.txt: pages and reports use them)")
         ->delimiter(',');
     fr->add_option("--preview", o->preview, "PNG file: the primitives drawn, each with its segment");
     fr->callback([o, &exit_code] { exit_code = RunFromRecording(*o); });

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "dyad/mcap/reader.hpp"
+#include "dyad/pvrnn/dataset.hpp"
 #include "experiment_analysis.hpp"
 #include "losses.hpp"
 #include "recording_tables.hpp"
@@ -23,8 +24,15 @@ StatusOr<Report> BuildReport(const std::string& recording, std::ostream& warning
   if (const std::string folder = GraphMetadata(*reader, "folder");
       !folder.empty() && !report.plan.dataset.empty() && std::filesystem::path(report.plan.dataset).is_relative())
     report.plan.dataset = (std::filesystem::path(folder) / report.plan.dataset).lexically_normal().string();
+  // The primitives' names, when the graph's data set is here and names them ("heart (5)").
+  if (std::error_code ec; !report.plan.dataset.empty() && std::filesystem::is_directory(report.plan.dataset, ec)) {
+    auto data = pvrnn::LoadNrlDataset(report.plan.dataset);
+    if (data.ok()) report.primitive_names = data->names;
+    else warnings << "dyad analyze: " << recording << ": the primitives' names not read: " << data.status().message() << "\n";
+  }
   auto tables = ReadTables(*reader, {"human/input", "robot/intention", "robot/state", "observer/labels",
-                                     "dyad/clock_offsets", "dyad/params", "human/self_report", "subject/task"});
+                                     "dyad/clock_offsets", "dyad/params", "human/self_report", "subject/task",
+                                     "experiment/notes"});
   if (!tables.ok()) return tables.status();
   auto corrections = ClockCorrections(*tables, report.plan);
   if (!corrections.ok()) return corrections.status().WithContext(recording);
@@ -34,6 +42,9 @@ StatusOr<Report> BuildReport(const std::string& recording, std::ostream& warning
   auto changes = AppliedParamChanges(*tables, report.plan, report.timeline);
   if (!changes.ok()) return changes.status().WithContext(recording);
   report.param_changes = std::move(*changes);
+  auto notes = ExperimenterNotes(*tables, report.plan, report.timeline);
+  if (!notes.ok()) return notes.status().WithContext(recording);
+  report.notes = std::move(*notes);
   if (auto losses = bag::FindLosses(*reader); losses.ok()) report.transport = bag::FormatLosses(*losses);
   else warnings << "dyad analyze: " << recording << ": losses not read: " << losses.status().message() << "\n";
   auto events = Events(report.timeline, report.plan);

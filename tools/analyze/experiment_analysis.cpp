@@ -376,6 +376,28 @@ StatusOr<std::vector<PracticeSpan>> PracticeSpans(const std::map<std::string, To
   return out;
 }
 
+StatusOr<std::vector<NoteEvent>> ExperimenterNotes(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
+                                                   const Timeline& timeline) {
+  std::vector<NoteEvent> out;
+  auto it = tables.find("experiment/notes");
+  if (it == tables.end()) return out;
+  Cells cells("experiment/notes", it->second);
+  if (Status s = cells.Need({"header.source", "header.stamp_ns", "author", "text"}); !s.ok()) return s;
+  std::optional<int64_t> t0 = timeline.t0_ns;
+  for (size_t r = 0; r < it->second.size(); ++r) {
+    auto stamp = ComponentStamp(cells, r, plan, timeline.clock_corrections_ns);
+    if (!stamp.ok()) return stamp.status();
+    if (!t0) t0 = static_cast<int64_t>(*stamp);
+    NoteEvent n;
+    n.step = StepOf(*stamp, *t0, plan.period_ns);
+    n.time_s = static_cast<double>(n.step) * static_cast<double>(plan.period_ns) * 1e-9;
+    n.author = cells.Text(r, "author");
+    n.text = cells.Text(r, "text");
+    out.push_back(std::move(n));
+  }
+  return out;
+}
+
 int DropPracticeEvents(const std::vector<PracticeSpan>& spans, std::vector<PlannedEvent>* events) {
   const auto in_practice = [&spans](const PlannedEvent& e) {
     return std::any_of(spans.begin(), spans.end(), [&e](const PracticeSpan& s) { return e.start_step >= s.start_step && e.start_step < s.end_step; });

@@ -107,6 +107,19 @@ struct ParamChangeEvent {
 StatusOr<std::vector<ParamChangeEvent>> AppliedParamChanges(const std::map<std::string, TopicTable>& tables,
                                                             const ExperimentPlan& plan, const Timeline& timeline);
 
+// A note the experimenter wrote during the run (idl/annotation.idl Annotation, topic
+// experiment/notes: the web component's `notes` output), placed on the step grid as
+// AppliedParamChanges places stamps (the writer's process is that of header.source's component).
+struct NoteEvent {
+  int64_t step = 0;
+  double time_s = 0;  // step * period, as timeline.csv's time_s
+  std::string author, text;
+};
+// No experiment/notes: empty. Fails (DataLoss) on a table without Annotation's fields or with a
+// stamp that is not a number.
+StatusOr<std::vector<NoteEvent>> ExperimenterNotes(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
+                                                   const Timeline& timeline);
+
 // Events of the plan, or engaged runs of the timeline when the plan has none. Planned events are
 // limited to the recorded steps: one starting after the last recorded step is left out (the run
 // ended before it), one running past it ends there.

@@ -4,7 +4,8 @@
 usage: plot_report.py REPORT_DIR [--dataset DATASET_DIR]
 
 Reads REPORT_DIR/timeline.csv and events.csv (written by `dyad analyze`), params.csv when the
-run had live parameter changes (drawn as dotted lines on the time axes) and, when given, the
+run had live parameter changes (dotted lines on the time axes), notes.csv when the experimenter
+wrote notes (dashed green lines with the note) and, when given, the
 data set's primitive_<id>_0.csv files (NRL layout) as a grey watermark. Writes
 workspace.png, nelbo.png and congruence.png into REPORT_DIR. Needs python3-matplotlib only.
 """
@@ -66,28 +67,42 @@ def column(rows, name):
     return [number(r[name]) for r in rows]
 
 
-def read_changes(report_dir):
-    """The live parameter changes of params.csv; none when the report has no such file."""
-    path = os.path.join(report_dir, "params.csv")
+def read_optional(report_dir, name):
+    """The rows of REPORT_DIR/name; none when the report has no such file."""
+    path = os.path.join(report_dir, name)
     return read_csv(path) if os.path.exists(path) else []
 
 
-def change_label(change, limit=40):
-    """The line's label, e.g. mixer.gain 0.9→0.2; a long value (a list) cut, a '$' kept out of mathtext."""
-    text = f"{change['component']}.{change['param']} {change['old_value']}\u2192{change['value']}"
+def short(text, limit=40):
+    """A line's label: a long text cut, a '$' kept out of mathtext."""
     if len(text) > limit:
         text = text[:limit - 1] + "\u2026"
     return text.replace("$", r"\$")
 
 
-def mark_changes(ax, changes):
-    """Each change as a dotted vertical line at its step, its label rotated along it near the top."""
-    for i, c in enumerate(changes):
-        t = number(c["time_s"])
-        ax.axvline(t, color="0.3", ls=":", lw=1.0, zorder=3, label="parameter change" if i == 0 else None)
+def read_marks(report_dir):
+    """What the time axes mark: the live parameter changes (params.csv), e.g. mixer.gain 0.9→0.2,
+    and the experimenter's notes (notes.csv), as (kind, time_s, label)."""
+    marks = [("parameter change", number(c["time_s"]), short(f"{c['component']}.{c['param']} {c['old_value']}\u2192{c['value']}"))
+             for c in read_optional(report_dir, "params.csv")]
+    marks += [("experimenter's note", number(n["time_s"]), short("note: " + n["text"]))
+              for n in read_optional(report_dir, "notes.csv")]
+    return marks
+
+
+MARK_STYLE = {"parameter change": dict(color="0.3", ls=":"), "experimenter's note": dict(color="tab:green", ls="--")}
+
+
+def mark_times(ax, marks):
+    """Each mark as a vertical line at its time, its label rotated along it near the top."""
+    seen = set()
+    for kind, t, label in marks:
+        style = MARK_STYLE[kind]
+        ax.axvline(t, lw=1.0, zorder=3, label=kind if kind not in seen else None, **style)
+        seen.add(kind)
         # x in data, y in axes fractions: the label stays near the top whatever the y scale.
-        ax.text(t, 0.97, change_label(c), transform=ax.get_xaxis_transform(), rotation=90, fontsize=6.5,
-                ha="right", va="top", color="0.25", zorder=4)
+        ax.text(t, 0.97, label, transform=ax.get_xaxis_transform(), rotation=90, fontsize=6.5,
+                ha="right", va="top", color=style["color"], zorder=4)
 
 
 def plot_workspace(rows, shapes, out):
@@ -120,14 +135,14 @@ def shade(ax, spans):
         ax.axvspan(a, b, color="tab:red", alpha=0.12, lw=0, label="human engaged" if i == 0 else None)
 
 
-def plot_nelbo(rows, changes, out):
+def plot_nelbo(rows, marks, out):
     t = column(rows, "time_s")
     fig, ax = plt.subplots(figsize=(10, 3.5))
     shade(ax, engaged_spans(rows))
     ax.plot(t, column(rows, "nelbo"), color="tab:purple", lw=0.8, label="N-ELBO")
     ax.plot(t, column(rows, "reconstruction"), color="tab:green", lw=0.6, alpha=0.7, label="reconstruction")
     ax.set_yscale("symlog", linthresh=1e-3)
-    mark_changes(ax, changes)
+    mark_times(ax, marks)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("free energy of the window")
     ax.set_title("Robot's N-ELBO after each step's error regression")
@@ -137,13 +152,13 @@ def plot_nelbo(rows, changes, out):
     plt.close(fig)
 
 
-def plot_congruence(rows, events, changes, out):
+def plot_congruence(rows, events, marks, out):
     t = column(rows, "time_s")
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(10, 6), gridspec_kw={"height_ratios": [2, 1]})
     shade(top, engaged_spans(rows))
     top.plot(t, column(rows, "congruence"), color="tab:orange", lw=0.9, label="P(C_t)")
     top.set_ylim(-0.02, 1.02)
-    mark_changes(top, changes)
+    mark_times(top, marks)
     top.set_xlabel("time (s)")
     top.set_ylabel("intention congruence")
     top.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize=8)
@@ -172,7 +187,7 @@ def main():
     try:
         rows = read_csv(os.path.join(args.report_dir, "timeline.csv"))
         events = read_csv(os.path.join(args.report_dir, "events.csv"))
-        changes = read_changes(args.report_dir)
+        marks = read_marks(args.report_dir)
     except (OSError, csv.Error, KeyError) as e:
         print(f"plot_report.py: {e}", file=sys.stderr)
         return 2
@@ -181,8 +196,8 @@ def main():
         return 2
     shapes = load_dataset(args.dataset) if args.dataset else []
     plot_workspace(rows, shapes, os.path.join(args.report_dir, "workspace.png"))
-    plot_nelbo(rows, changes, os.path.join(args.report_dir, "nelbo.png"))
-    plot_congruence(rows, events, changes, os.path.join(args.report_dir, "congruence.png"))
+    plot_nelbo(rows, marks, os.path.join(args.report_dir, "nelbo.png"))
+    plot_congruence(rows, events, marks, os.path.join(args.report_dir, "congruence.png"))
     return 0
 
 

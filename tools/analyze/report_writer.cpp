@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+#include <tuple>
 
 #include "text_output.hpp"
 
@@ -67,26 +68,33 @@ std::string ParamsCsv(const Report& r) {
   return s.str();
 }
 
-// Text for a Markdown table cell: a '|' would end the cell, a line break the row.
-std::string MdCell(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '|') out += "\\|";
-    else out += (c == '\n' || c == '\r') ? ' ' : c;
-  }
-  return out;
-}
-
 void ParamChangesSection(const Report& r, std::ostream& s) {
   if (r.param_changes.empty()) return;
   s << "\n## Live parameter changes\n\n";
   s << "| time | component.param | old -> new | who |\n|---|---|---|---|\n";
   for (const ParamChangeEvent& c : r.param_changes) {
-    s << "| " << Num(c.time_s, 3) << " s (step " << c.step << ") | " << MdCell(c.component + "." + c.param) << " | "
-      << MdCell(c.old_value) << " -> " << MdCell(c.value) << " | " << MdCell(c.who) << " |\n";
+    s << "| " << Num(c.time_s, 3) << " s (step " << c.step << ") | " << tools::MarkdownCell(c.component + "." + c.param) << " | "
+      << tools::MarkdownCell(c.old_value) << " -> " << tools::MarkdownCell(c.value) << " | " << tools::MarkdownCell(c.who) << " |\n";
   }
   s << "\nEach change was applied at the component's step boundary (between two of its steps, never mid-step): "
        "its steps from then on used the new value (params.csv).\n";
+}
+
+std::string NotesCsv(const Report& r) {
+  std::ostringstream s;
+  s << "step,time_s,author,text\n";
+  for (const NoteEvent& n : r.notes)
+    s << n.step << ',' << Num(n.time_s, 3) << ',' << tools::CsvCell(n.author) << ',' << tools::CsvCell(n.text) << '\n';
+  return s.str();
+}
+
+void NotesSection(const Report& r, std::ostream& s) {
+  if (r.notes.empty()) return;
+  s << "\n## The experimenter's notes\n\n| time | who | note |\n|---|---|---|\n";
+  for (const NoteEvent& n : r.notes)
+    s << "| " << Num(n.time_s, 3) << " s (step " << n.step << ") | " << tools::MarkdownCell(n.author) << " | "
+      << tools::MarkdownCell(n.text) << " |\n";
+  s << "\nThe plots mark each note at its time (notes.csv).\n";
 }
 
 double Percentile(std::vector<double> v, double q) {
@@ -184,12 +192,18 @@ void SummarySection(const Report& r, std::ostream& s) {
   if (!r.transport.empty()) s << "\n## Transport: what the recording lost, what the runtime healed\n\n```\n" << r.transport << "```\n";
 }
 
+// A primitive by its data set's name when it has one: "heart (5)", else "5".
+std::string Primitive(const Report& r, int k) {
+  return static_cast<size_t>(k) < r.primitive_names.size() ? r.primitive_names[static_cast<size_t>(k)] + " (" + std::to_string(k) + ")"
+                                                           : std::to_string(k);
+}
+
 // The event's primitive, and what the person said when it differs: "3", "3 (said 5)",
 // "3 (said: something else)"; "unknown" when neither the plan nor a self-report names it.
-std::string PrimitiveCell(const PlannedEvent& e) {
-  std::string cell = e.primitive < 0 ? std::string("unknown") : std::to_string(e.primitive);
+std::string PrimitiveCell(const Report& r, const PlannedEvent& e) {
+  std::string cell = e.primitive < 0 ? std::string("unknown") : Primitive(r, e.primitive);
   if (e.reported == -1) cell += " (said: something else)";
-  else if (e.reported >= 0 && e.reported != e.primitive) cell += " (said " + std::to_string(e.reported) + ")";
+  else if (e.reported >= 0 && e.reported != e.primitive) cell += " (said " + Primitive(r, e.reported) + ")";
   return cell;
 }
 
@@ -213,7 +227,7 @@ void EventsSection(const Report& r, std::ostream& s) {
         if (p.start_step == e.event.start_step && p.end_step > e.event.end_step)
           cut = " (cut off by the end of the recording; planned to " + std::to_string(p.end_step - 1) + ")";
       s << "| " << e.index << " | " << e.event.start_step << "-" << e.event.end_step - 1 << cut << " | "
-        << PrimitiveCell(e.event) << " | "
+        << tools::MarkdownCell(PrimitiveCell(r, e.event)) << " | "
         << Num(e.mean_congruence) << " | " << Num(e.final_congruence) << " | " << OrUnknown(e, e.human_accuracy) << " | "
         << OrUnknown(e, e.robot_follows) << " | "
         << (e.event.primitive < 0        ? std::string("unknown")
@@ -229,8 +243,9 @@ void EventsSection(const Report& r, std::ostream& s) {
   }
 }
 
-// A row-normalised confusion matrix as a markdown table (rows with no count left out).
-void ConfusionTable(const std::vector<std::vector<int64_t>>& m, std::ostream& s) {
+// A row-normalised confusion matrix as a markdown table (rows with no count left out), the rows
+// by name when the data set names its primitives.
+void ConfusionTable(const Report& r, const std::vector<std::vector<int64_t>>& m, std::ostream& s) {
   s << "|   |";
   for (size_t p = 0; p < m.size(); ++p) s << ' ' << p << " |";
   s << "\n|---|";
@@ -240,7 +255,7 @@ void ConfusionTable(const std::vector<std::vector<int64_t>>& m, std::ostream& s)
     int64_t total = 0;
     for (int64_t c : m[t]) total += c;
     if (total == 0) continue;
-    s << "| **" << t << "** |";
+    s << "| **" << tools::MarkdownCell(Primitive(r, static_cast<int>(t))) << "** |";
     for (int64_t c : m[t]) s << ' ' << Num(static_cast<double>(c) / static_cast<double>(total), 2) << " |";
     s << "\n";
   }
@@ -253,13 +268,13 @@ void ConfusionSection(const Report& r, std::ostream& s) {
   } else {
     s << "Rows: primitive the human traced; columns: the observer's most likely class; row-normalised "
          "(counts in confusion.csv).\n\n";
-    ConfusionTable(r.confusion, s);
+    ConfusionTable(r, r.confusion, s);
   }
   if (r.reported_confusion.empty()) return;
   s << "\n## Observer confusion against the self-reports\n\n"
        "Rows: the primitive the person said they drew when they released; columns: the observer's most likely "
        "class over that event's steps; row-normalised (counts in reported_confusion.csv).\n\n";
-  ConfusionTable(r.reported_confusion, s);
+  ConfusionTable(r, r.reported_confusion, s);
 }
 
 }  // namespace
@@ -298,6 +313,7 @@ std::string FormatMarkdown(const Report& r) {
   SummarySection(r, s);
   // Before the scores: a change of a parameter during the run may explain them.
   ParamChangesSection(r, s);
+  NotesSection(r, s);
   EventsSection(r, s);
   ConfusionSection(r, s);
   s << "\n## Plots\n\n![workspace](workspace.png)\n\n![N-ELBO](nelbo.png)\n\n![congruence](congruence.png)\n";
@@ -321,11 +337,17 @@ Status WriteReport(const Report& r, const std::string& dir) {
   } else {
     std::filesystem::remove(reported, ec);
   }
-  // The plots draw whatever params.csv the folder holds: one of an earlier report must go.
-  const std::string params = dir + "/params.csv";
-  if (!r.param_changes.empty()) return tools::WriteTextFile(params, ParamsCsv(r));
-  std::filesystem::remove(params, ec);
-  if (ec) return Status::IOError(params, "cannot remove the previous report's: " + ec.message());
+  // The plots draw whatever params.csv and notes.csv the folder holds: an earlier report's must go.
+  const std::tuple<std::string, bool, std::string> marked[] = {{dir + "/params.csv", !r.param_changes.empty(), ParamsCsv(r)},
+                                                               {dir + "/notes.csv", !r.notes.empty(), NotesCsv(r)}};
+  for (const auto& [path, present, text] : marked) {
+    if (present) {
+      if (Status s = tools::WriteTextFile(path, text); !s.ok()) return s;
+      continue;
+    }
+    std::filesystem::remove(path, ec);
+    if (ec) return Status::IOError(path, "cannot remove the previous report's: " + ec.message());
+  }
   return Status::OK();
 }
 

@@ -30,6 +30,8 @@ struct Report {
   std::vector<std::vector<int64_t>> confusion;
   std::vector<std::vector<int64_t>> reported_confusion;  // against the self-reports; empty: none
   std::vector<ParamChangeEvent> param_changes;  // applied during the run, in recording order
+  std::vector<NoteEvent> notes;  // the experimenter's, in recording order
+  std::vector<std::string> primitive_names;  // the plan's data set's (names.txt); empty: numbers only
   int practice_events = 0;  // events left out: they started while the subject's page said "practice"
   // What the recording lost in transport and what the runtime healed: `dyad bag info`'s losses:
   // and health: sections (tools/bag/losses.hpp); empty: not read.

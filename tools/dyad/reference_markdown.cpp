@@ -9,19 +9,10 @@
 #include <sstream>
 #include <vector>
 
+#include "text_output.hpp"
+
 namespace dyad::cli {
 namespace {
-
-// Text inside a table cell: a '|' would end the cell.
-std::string Cell(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '|') out += "\\|";
-    else if (c == '\n') out += ' ';
-    else out += c;
-  }
-  return out;
-}
 
 std::string Trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r");
@@ -112,9 +103,9 @@ std::string ComponentReferenceMarkdown(const std::string& name, const CatalogEnt
     out << "| port | message | |\n| --- | --- | --- |\n";
     for (const auto& p : spec.inputs())
       out << "| input `" << p.name << "`" << (p.optional ? " (optional)" : "") << " | " << p.type->short_name() << " | "
-          << Cell(p.doc) << " |\n";
+          << tools::MarkdownCell(p.doc) << " |\n";
     for (const auto& p : spec.outputs())
-      out << "| output `" << p.name << "` | " << p.type->short_name() << " | " << Cell(p.doc) << " |\n";
+      out << "| output `" << p.name << "` | " << p.type->short_name() << " | " << tools::MarkdownCell(p.doc) << " |\n";
     out << "\n";
   }
   if (!spec.params().empty()) {
@@ -133,13 +124,13 @@ std::string ComponentReferenceMarkdown(const std::string& name, const CatalogEnt
           type += '`';
         }
       }
-      out << "| `" << p.name << "` | " << Cell(type) << " | ";
+      out << "| `" << p.name << "` | " << tools::MarkdownCell(type) << " | ";
       // A kYaml default is YAML text already: shown as written, not as a quoted string.
       const auto* yaml = p.type == ParamType::kYaml && p.default_value ? std::get_if<std::string>(&*p.default_value) : nullptr;
-      if (yaml) out << '`' << Cell(*yaml) << '`';
-      else if (p.default_value) out << '`' << Cell(ToYamlText(*p.default_value)) << '`';
+      if (yaml) out << '`' << tools::MarkdownCell(*yaml) << '`';
+      else if (p.default_value) out << '`' << tools::MarkdownCell(ToYamlText(*p.default_value)) << '`';
       else out << "required";
-      out << " | " << Cell(p.doc) << " |\n";
+      out << " | " << tools::MarkdownCell(p.doc) << " |\n";
     }
   }
   out << "<!-- END dyad types --markdown " << name << " -->\n";
@@ -175,7 +166,7 @@ std::string MessageReferenceMarkdown(const Catalog& catalog) {
     }
     out << "| field | IDL type | |\n| --- | --- | --- |\n";
     for (const Member& m : s.members)
-      out << "| `" << Cell(m.name) << "` | `" << Cell(m.type) << "` | " << Cell(m.doc) << " |\n";
+      out << "| `" << tools::MarkdownCell(m.name) << "` | `" << tools::MarkdownCell(m.type) << "` | " << tools::MarkdownCell(m.doc) << " |\n";
   }
   return out.str();
 }

@@ -156,6 +156,16 @@ std::string ReportMd(const Study& s, const StudyAnalysis& a, const Summaries& su
     any_repeated = true;
     out << "- " << r.participant << " trial " << r.trial.number << ": " << r.repeated << "\n";
   }
+  if (!a.left_out.empty()) {
+    out << "\n## Participants left out\n\n";
+    for (const std::string& l : a.left_out) out << "- " << l << "\n";
+  }
+  if (!a.notes.empty()) {
+    out << "\n## The experimenter's notes\n\n| participant | time | during | note |\n|---|---|---|---|\n";
+    for (const auto& [p, n] : a.notes)
+      out << "| " << p << " | " << n.time << " | " << (n.trial > 0 ? "trial " + std::to_string(n.trial) : "between trials") << " | "
+          << tools::MarkdownCell(n.text) << " |\n";
+  }
   if (!a.unplanned.empty()) {
     out << "\n## Files not in the plan (not analysed)\n\n";
     for (const std::string& f : a.unplanned) out << "- " << f << "\n";
@@ -246,6 +256,16 @@ StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehe
   for (const std::string& p : study.participants) {
     const Session session = ReadSession(study, p);
     for (const std::string& problem : session.problems) warnings << "warning: " << problem << "\n";
+    if (session.withdrawn) {
+      a.left_out.push_back(p + ": withdrew consent" + (session.withdrawn_time.empty() ? "" : " on " + session.withdrawn_time) +
+                           (session.data_deleted ? "; their data was deleted" : "; their data is kept but not analysed"));
+      continue;
+    }
+    for (const Note& n : session.notes) a.notes.emplace_back(p, n);
+    if (session.excluded) {
+      a.left_out.push_back(p + ": excluded: " + session.exclusion_reason);
+      continue;
+    }
     std::set<std::string> planned;
     for (const Trial& t : study.TrialsOf(p)) {
       for (int k = 1; k <= 99; ++k) planned.insert(fs::path(AttemptFile(t, k)).filename().string());

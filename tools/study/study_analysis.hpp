@@ -11,6 +11,9 @@
 //     trial of this participant of this study (another study's file, a rehearsal's among the
 //     participants' or the reverse, or a file without that metadata).
 //   - Every other .mcap file in a participant's folder is listed as not part of the plan.
+//   - A participant who withdrew consent, or whom the researcher excluded, is left out whole
+//     (no trial, no missing trial) and listed with the reason. The experimenter's session notes
+//     go into the report, except a withdrawn participant's.
 //   - WriteStudyAnalysis writes into `dir` (created): trials.csv (one row per trial: participant,
 //     condition, label, trial, repetition, attempt, file, then RunMetrics' measures), events.csv (one row
 //     per event of every trial: participant, condition, trial, the event's steps, primitive,
@@ -34,6 +37,7 @@
 #include "dyad/status.hpp"
 #include "experiment_analysis.hpp"
 #include "study_file.hpp"
+#include "study_session.hpp"
 
 namespace dyad::study {
 
@@ -51,6 +55,8 @@ struct StudyAnalysis {
   std::vector<TrialResult> trials;  // in the plan's order
   std::vector<std::string> missing;  // "P02 trial 3 (FILE): not recorded" and the like
   std::vector<std::string> unplanned;  // .mcap files in a participant's folder that are no attempt of the plan
+  std::vector<std::string> left_out;   // "P03: withdrew consent on ...", "P04: excluded: REASON"
+  std::vector<std::pair<std::string, Note>> notes;  // (participant, note), in the plan's order of participants
   // The files name the conditions (the unblinded step); false: "condition A" only (a blind
   // study's rehearsal, seen by the experimenter before the study).
   bool unblinded = true;

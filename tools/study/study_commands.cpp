@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -102,7 +103,12 @@ struct RunOptions {
 // Consent before the first trial records: how it was given ("" when it is not needed or already
 // marked), or nothing when it was not (said). Asked before anything is written.
 std::optional<std::string> ConsentGiven(const study::Study& s, const RunOptions& o, const study::Session& before) {
-  if (!s.consent_required || before.consent) return std::string();
+  if (before.withdrawn && !o.consent) {  // a new consent after a withdrawal is never asked for at a prompt
+    std::cerr << "dyad study run: " << o.participant << " withdrew consent (" << before.log
+              << "): nothing is recorded for them. If they give consent again, --consent marks it\n";
+    return std::nullopt;
+  }
+  if ((!s.consent_required && !before.withdrawn) || before.consent) return std::string();
   if (o.consent) return std::string("--consent");
   if (!o.yes && Ask("Has " + o.participant + " given informed consent? Type yes to mark it: ").value_or("") == "yes")
     return std::string("marked at the prompt");
@@ -232,6 +238,84 @@ int RunSession(const RunOptions& o) {
   return kOk;
 }
 
+struct ParticipantOptions {
+  std::string file, participant, text, reason;
+  std::vector<std::string> plugins;
+  bool delete_data = false, yes = false, include = false;
+};
+
+// The study and the participant, or false after saying what is wrong.
+bool LoadParticipant(const ParticipantOptions& o, const char* command, study::Study* s) {
+  if (!Load(o.file, o.plugins, s)) return false;
+  if (s->TrialsOf(o.participant).empty()) {
+    std::cerr << command << ": --participant " << o.participant << " is not a participant of " << o.file << "\n";
+    return false;
+  }
+  return true;
+}
+
+// `dyad study note`: a line in the participant's session log (the study's report lists them).
+int Note(const ParticipantOptions& o) {
+  study::Study s;
+  if (!LoadParticipant(o, "dyad study note", &s)) return kBadInput;
+  if (Status st = study::AddNote(s, o.participant, o.text); !st.ok()) {
+    std::cerr << "dyad study note: " << st.ToString() << "\n";
+    return st.code() == Status::Code::kInvalidArgument ? kBadInput : 1;
+  }
+  std::cout << "noted in " << study::SessionLogPath(s, o.participant) << "\n";
+  return kOk;
+}
+
+// `dyad study exclude` / `include`: the researcher's decision about a participant, with its reason.
+int Exclude(const ParticipantOptions& o) {
+  const char* command = o.include ? "dyad study include" : "dyad study exclude";
+  study::Study s;
+  if (!LoadParticipant(o, command, &s)) return kBadInput;
+  if (Status st = study::ExcludeParticipant(s, o.participant, !o.include, o.reason); !st.ok()) {
+    std::cerr << command << ": " << st.ToString() << "\n";
+    return st.code() == Status::Code::kInvalidArgument ? kBadInput : 1;
+  }
+  std::cout << o.participant << (o.include ? " is analysed again" : " is left out of the analysis") << " (logged in "
+            << study::SessionLogPath(s, o.participant) << "; run dyad study analyze again)\n";
+  return kOk;
+}
+
+// `dyad study withdraw`: the participant withdraws consent; with --delete-data their files go.
+int Withdraw(const ParticipantOptions& o) {
+  study::Study s;
+  if (!LoadParticipant(o, "dyad study withdraw", &s)) return kBadInput;
+  auto lock = study::SessionLock::Acquire(s, o.participant);
+  if (!lock.ok()) {
+    std::cerr << "dyad study withdraw: " << lock.status().ToString() << ": stop the session first\n";
+    return kBadInput;
+  }
+  const std::string folder = (std::filesystem::path(s.data) / o.participant).string();
+  if (o.delete_data && !o.yes) {
+    const auto answer = Ask("This deletes every file in " + folder + " (recordings, logs, notes) for good. Type delete to go on: ");
+    if (answer.value_or("") != "delete") {
+      std::cerr << "dyad study withdraw: nothing was done\n";
+      return kBadInput;
+    }
+  }
+  auto deleted = study::WithdrawConsent(s, o.participant, o.delete_data, "dyad study withdraw");
+  if (!deleted.ok()) {
+    std::cerr << "dyad study withdraw: " << deleted.status().ToString() << "\n";
+    return 1;
+  }
+  std::cout << o.participant << " withdrew consent: nothing more is recorded for them, and the analysis leaves them out";
+  if (o.delete_data) std::cout << "; " << *deleted << " files deleted from " << folder;
+  std::cout << "\n";
+  // An analysis made before still holds their rows.
+  const std::string trials_csv = s.data + "/analysis/trials.csv";
+  std::ifstream in(trials_csv);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(o.participant + ",", 0) == 0) {
+      std::cout << "warning: " << trials_csv << " still has " << o.participant << "'s rows: run dyad study analyze again\n";
+      break;
+    }
+  return kOk;
+}
+
 struct AnalyzeOptions {
   std::string file, out;
   std::vector<std::string> plugins;
@@ -358,6 +442,35 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   run->add_option("--page-port-file", r->page_options.port_file, "Write the study page's port here")->needs(page);
   page->excludes("--yes")->excludes("--trial");
   run->callback([r, &exit_code] { exit_code = RunSession(*r); });
+  auto n = std::make_shared<ParticipantOptions>();
+  auto* note = study->add_subcommand("note", "Add a note to a participant's session log (the study's report lists the notes)");
+  note->add_option("study", n->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
+  note->add_option("--participant", n->participant, "The participant's ID")->required();
+  note->add_option("text", n->text, "The note")->required();
+  note->add_option("--plugins", n->plugins, "Extra plugin file or folder (repeatable)");
+  note->callback([n, &exit_code] { exit_code = Note(*n); });
+  for (const bool include : {false, true}) {
+    auto e = std::make_shared<ParticipantOptions>();
+    e->include = include;
+    auto* c = study->add_subcommand(include ? "include" : "exclude",
+                                    include ? "Analyse an excluded participant again (logged with the reason)"
+                                            : "Leave a participant out of the analysis, with the reason (logged; nothing is deleted)");
+    c->add_option("study", e->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
+    c->add_option("--participant", e->participant, "The participant's ID")->required();
+    c->add_option("--reason", e->reason, "Why (kept in the session log and the report)")->required();
+    c->add_option("--plugins", e->plugins, "Extra plugin file or folder (repeatable)");
+    c->callback([e, &exit_code] { exit_code = Exclude(*e); });
+  }
+  auto w = std::make_shared<ParticipantOptions>();
+  auto* withdraw = study->add_subcommand(
+      "withdraw", "A participant withdraws consent: nothing more records for them and the analysis leaves them out");
+  withdraw->add_option("study", w->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
+  withdraw->add_option("--participant", w->participant, "The participant's ID")->required();
+  withdraw->add_flag("--delete-data", w->delete_data,
+                     "Also delete every file of theirs (recordings, logs, notes); the session log keeps one line saying so");
+  withdraw->add_flag("--yes", w->yes, "With --delete-data: do not ask");
+  withdraw->add_option("--plugins", w->plugins, "Extra plugin file or folder (repeatable)");
+  withdraw->callback([w, &exit_code] { exit_code = Withdraw(*w); });
   auto h = std::make_shared<AnalyzeOptions>();
   auto* rehearse = study->add_subcommand(
       "rehearse", "Run the whole study stepped with synthetic participants (the rehearsal graph), then analyse it, into DATA/rehearsal");

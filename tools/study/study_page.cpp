@@ -65,6 +65,13 @@ class StudyChannel final : public web::ClientHandler {
     std::string refused;
     if (op == "consent") refused = Consent();
     else if (op == "stop") stop_.store(true);
+    else if (op == "note") {
+      if (!j.contains("text") || !j["text"].is_string()) return Status::InvalidArgument("note: needs a string \"text\"");
+      if (Status st = AddNote(study_, participant_, j["text"].get<std::string>()); !st.ok()) refused = st.ToString();
+    } else if (op == "withdraw") {
+      if (!j.contains("delete") || !j["delete"].is_boolean()) return Status::InvalidArgument("withdraw: needs a boolean \"delete\"");
+      refused = Withdraw(j["delete"].get<bool>());
+    }
     else if (op == "start") {
       if (!j.contains("trial") || !j["trial"].is_number_integer()) return Status::InvalidArgument("start: needs an integer \"trial\"");
       refused = Start(j["trial"].get<int>(), j.contains("reason") && j["reason"].is_string() ? j["reason"].get<std::string>() : "");
@@ -79,9 +86,22 @@ class StudyChannel final : public web::ClientHandler {
 
  private:
   std::string Consent() {
-    if (ReadSession(study_, participant_).consent) return "";
+    const Session session = ReadSession(study_, participant_);
+    if (session.consent) return "";
+    if (session.withdrawn)
+      return participant_ + " withdrew consent: a new consent is marked only with dyad study run --consent";
     if (Status s = MarkConsent(study_, participant_, "marked on the study page"); !s.ok()) return s.ToString();
     std::cout << "consent marked for " << participant_ << " (on the study page)" << std::endl;
+    return "";
+  }
+
+  // The runner holds the participant's lock; no trial may run while their files go.
+  std::string Withdraw(bool delete_data) {
+    if (running_.load()) return "trial " + std::to_string(current_trial_) + " is running: stop it first";
+    auto deleted = WithdrawConsent(study_, participant_, delete_data, "on the study page");
+    if (!deleted.ok()) return deleted.status().ToString();
+    std::cout << participant_ << " withdrew consent (on the study page)"
+              << (delete_data ? ": " + std::to_string(*deleted) + " files deleted" : std::string()) << std::endl;
     return "";
   }
 
@@ -90,6 +110,7 @@ class StudyChannel final : public web::ClientHandler {
     if (closing_.load()) return "the study page is closing";
     if (running_.load()) return "trial " + std::to_string(current_trial_) + " is running: stop it first";
     const Session session = ReadSession(study_, participant_);
+    if (session.withdrawn) return participant_ + " withdrew consent: nothing is recorded for them";
     if (study_.consent_required && !session.consent) return "consent is required and not marked: nothing was recorded";
     if (std::string why = WhyNotStart(session, trials_, k, reason); !why.empty()) return why;
     const Attempt* last = session.Last(k);
@@ -146,6 +167,8 @@ class StudyChannel final : public web::ClientHandler {
                         {"status", status},
                         {"attempts", attempts}});
     }
+    Json notes = Json::array();
+    for (const Note& n : session.notes) notes.push_back({{"time", n.time}, {"trial", n.trial}, {"text", n.text}});
     Json running = nullptr;
     if (running_.load())
       running = {{"trial", current_trial_.load()},
@@ -162,6 +185,8 @@ class StudyChannel final : public web::ClientHandler {
             {"blind", study_.blind},
             {"consent_required", study_.consent_required},
             {"consent", session.consent},
+            {"withdrawn", session.withdrawn},
+            {"notes", notes},
             {"duration_s", study_.duration_s},
             {"trials", trials},
             {"running", running},

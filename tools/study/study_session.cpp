@@ -132,7 +132,7 @@ Session ReadSession(const Study& s, const std::string& participant) {
   Session out;
   out.log = SessionLogPath(s, participant);
   std::ifstream in(out.log);
-  int line_number = 0;
+  int line_number = 0, running = 0;  // running: the trial started and not yet ended
   for (std::string line; std::getline(in, line);) {
     ++line_number;
     if (line.empty()) continue;
@@ -142,9 +142,20 @@ Session ReadSession(const Study& s, const std::string& participant) {
       const std::string event = j.at("event").get<std::string>();
       if (event == "consent") {
         out.consent = true;
+        out.withdrawn = out.data_deleted = false;
+      } else if (event == "withdrawn") {
+        out.consent = false;
+        out.withdrawn = true;
+        out.data_deleted = j.value("data", "kept") == "deleted";
+        out.withdrawn_time = j.value("time", "");
+      } else if (event == "excluded" || event == "included") {
+        out.excluded = event == "excluded";
+        out.exclusion_reason = j.at("reason").get<std::string>();
+      } else if (event == "note") {
+        out.notes.push_back(Note{j.value("time", ""), j.at("text").get<std::string>(), running});
       } else if (event == "start") {
         Attempt a;
-        a.trial = j.at("trial").get<int>();
+        a.trial = running = j.at("trial").get<int>();
         a.attempt = j.at("attempt").get<int>();
         a.file = j.at("file").get<std::string>();
         a.reason = j.value("reason", "");
@@ -162,7 +173,8 @@ Session ReadSession(const Study& s, const std::string& participant) {
         a->outcome = j.at("outcome").get<std::string>();
         a->seconds = j.value("seconds", 0.0);
         a->exit = j.value("exit", 0);
-      }  // other events (notes) are for people
+        if (running == trial) running = 0;
+      }  // other events are for people
     } catch (const std::exception& e) {
       out.problems.push_back(where + "not a session event: " + e.what());
     }
@@ -177,13 +189,64 @@ Status AppendSessionEvent(const Study& s, const std::string& participant, const 
   line.update(j);
   const std::string path = SessionLogPath(s, participant);
   if (Status st = CreatePrivateDirectories(fs::path(path).parent_path().string()); !st.ok()) return st;
+  std::error_code ec;
+  const bool is_new = !fs::exists(path, ec);
   auto fd = OpenPrivateLog(path);
   if (!fd.ok()) return fd.status();
   const std::string text = Dump(line) + "\n";
   const ssize_t n = ::write(*fd, text.data(), text.size());
+  const int sync_error = ::fdatasync(*fd) == 0 ? 0 : errno;
   ::close(*fd);
   if (n != static_cast<ssize_t>(text.size())) return Status::IOError(path, "cannot append to the session log");
-  return Status::OK();
+  if (sync_error != 0)
+    return Status::IOError(path, std::string("the session log could not be flushed to disk: ") + std::strerror(sync_error));
+  return is_new ? SyncDirectory(fs::path(path).parent_path().string()) : Status::OK();
+}
+
+Status AddNote(const Study& s, const std::string& participant, const std::string& text) {
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos) return Status::InvalidArgument("a note needs its text");
+  return AppendSessionEvent(s, participant, Dump(Json{{"event", "note"}, {"text", text}}));
+}
+
+Status ExcludeParticipant(const Study& s, const std::string& participant, bool excluded, const std::string& reason) {
+  if (reason.find_first_not_of(" \t\r\n") == std::string::npos)
+    return Status::InvalidArgument(std::string(excluded ? "excluding " : "including ") + participant + " needs the reason");
+  return AppendSessionEvent(s, participant, Dump(Json{{"event", excluded ? "excluded" : "included"}, {"reason", reason}}));
+}
+
+StatusOr<int> WithdrawConsent(const Study& s, const std::string& participant, bool delete_data, const std::string& how) {
+  const Json line = {{"event", "withdrawn"}, {"how", how}, {"data", delete_data ? "deleted" : "kept"}};
+  if (Status st = AppendSessionEvent(s, participant, Dump(line)); !st.ok()) return st;
+  if (!delete_data) return 0;
+  const fs::path dir = fs::path(s.data) / participant;
+  int deleted = 0;
+  std::error_code ec;
+  std::vector<fs::path> entries;
+  for (const auto& e : fs::directory_iterator(dir, ec)) entries.push_back(e.path());
+  if (ec) return Status::IOError(dir.string(), "cannot list the participant's folder: " + ec.message());
+  for (const fs::path& p : entries) {
+    const std::string name = p.filename().string();
+    if (name == "session.lock" || name == "session.log") continue;
+    const auto n = fs::remove_all(p, ec);
+    if (ec) return Status::IOError(p.string(), "cannot delete it: " + ec.message() + " (the withdrawal is logged; delete it by hand)");
+    deleted += static_cast<int>(n);
+  }
+  // The log last, replaced whole: written and flushed beside it, then renamed over it, so a
+  // power cut leaves the old log or the new one, never an empty one.
+  const Json only = {{"time", UtcNow()}, {"event", "withdrawn"}, {"how", how}, {"data", "deleted"}, {"files_deleted", deleted}};
+  const std::string log = SessionLogPath(s, participant), next = log + ".new";
+  fs::remove(next, ec);
+  auto fd = CreatePrivateFile(next, CreateMode::kNew);
+  if (!fd.ok()) return fd.status();
+  const std::string text = Dump(only) + "\n";
+  const bool written = ::write(*fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) && ::fdatasync(*fd) == 0;
+  const int write_error = written ? 0 : errno;
+  ::close(*fd);
+  if (!written) return Status::IOError(next, std::string("cannot write the new session log: ") + std::strerror(write_error));
+  if (::rename(next.c_str(), log.c_str()) != 0)
+    return Status::IOError(log, std::string("cannot replace the session log: ") + std::strerror(errno));
+  if (Status st = SyncDirectory(dir.string()); !st.ok()) return st;
+  return deleted;
 }
 
 Status MarkConsent(const Study& s, const std::string& participant, const std::string& how) {
@@ -247,6 +310,9 @@ std::vector<std::string> AttemptCommand(const Study& s, const AttemptRequest& r)
 StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   const std::string who = r.participant + " trial " + std::to_string(r.trial.number);
   const Session session = ReadSession(s, r.participant);
+  if (session.withdrawn)
+    return Status::FailedPrecondition(who + ": " + r.participant + " withdrew consent (" + session.log +
+                                      "): nothing is recorded for them unless a new consent is marked");
   if (!r.rehearsal && s.consent_required && !session.consent)
     return Status::FailedPrecondition(who + ": consent is required (consent_required in " + s.file +
                                       ") and not marked for " + r.participant + ": nothing was recorded");

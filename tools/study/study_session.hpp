@@ -6,6 +6,12 @@
 //   {"time":"2026-11-26T20:31:05Z","event":"consent","how":"..."}
 //   {"time":...,"event":"start","trial":3,"attempt":2,"file":"/abs/03-B.try2.mcap","reason":"..."}
 //   {"time":...,"event":"end","trial":3,"attempt":2,"outcome":"complete","seconds":120.0,"exit":0}
+//   {"time":...,"event":"note","text":"..."}                 the experimenter's (dyad study note, the page)
+//   {"time":...,"event":"withdrawn","how":"...","data":"kept"|"deleted"}   consent withdrawn
+//   {"time":...,"event":"excluded","reason":"..."} / {"time":...,"event":"included","reason":"..."}
+// Consent and withdrawal: the later line holds. Exclusion and inclusion: the later line holds.
+// Each line is on disk (fdatasync, and the folder's entry when the log is new) before the call
+// that wrote it returns: a trial never starts on a consent a power cut could lose.
 // outcome: complete | stopped (the experimenter ended a timed trial early) | failed (the graph
 // exited non-zero other than after a stop, was killed, or left a recording cut short or none).
 // A start without its end: the session itself ended mid-trial ("interrupted").
@@ -31,6 +37,15 @@
 //   - WhyNotStart: the plan's order, the same for every front end: a trial never run starts only
 //     when it is the first one not complete; one run before starts again only with a reason.
 //   - SessionLock: one runner per participant at a time (flock on DATA/P/session.lock).
+//   - Withdrawal: nothing records for a participant who withdrew consent (RunAttempt refuses, and
+//     so do both front ends) until a new consent is marked explicitly, and the analysis leaves
+//     them out. WithdrawConsent with delete_data removes every file of the participant's folder
+//     but the lock and then replaces the log with one line saying so (the one exception to "only
+//     appended": notes and reasons may name the person). The withdrawal is logged first, so a
+//     deletion cut short still leaves a participant nobody records or analyses.
+//   - Exclusion (ExcludeParticipant): the researcher's decision, with its reason; the analysis
+//     leaves the participant out and says why. Nothing is deleted.
+//   - AddNote: an experimenter's note; no lock (it may come from another terminal during a trial).
 #pragma once
 
 #include <atomic>
@@ -51,9 +66,19 @@ struct Attempt {
   bool interrupted = false;  // RunAttempt: SIGINT/SIGTERM reached the runner (a person wants it all to stop)
 };
 
+struct Note {
+  std::string time, text;
+  int trial = 0;  // the trial running when it was written (0: none)
+};
+
 struct Session {
   std::string log;  // its path
   bool consent = false;
+  bool withdrawn = false, data_deleted = false;  // consent withdrawn (later than any consent)
+  std::string withdrawn_time;
+  bool excluded = false;
+  std::string exclusion_reason;  // of the latest exclusion or inclusion
+  std::vector<Note> notes;
   std::vector<Attempt> attempts;  // in the order they started
   std::vector<std::string> problems;
 
@@ -69,6 +94,11 @@ Session ReadSession(const Study& s, const std::string& participant);
 // Appends one event (its "time" is added) to the participant's log.
 Status AppendSessionEvent(const Study& s, const std::string& participant, const std::string& json_object);
 Status MarkConsent(const Study& s, const std::string& participant, const std::string& how);
+Status AddNote(const Study& s, const std::string& participant, const std::string& text);
+// `excluded` false: the participant is analysed again. The reason is required.
+Status ExcludeParticipant(const Study& s, const std::string& participant, bool excluded, const std::string& reason);
+// The caller holds the participant's SessionLock (no trial runs). Returns the files deleted.
+StatusOr<int> WithdrawConsent(const Study& s, const std::string& participant, bool delete_data, const std::string& how);
 
 struct AttemptRequest {
   std::string dyad;         // the dyad executable

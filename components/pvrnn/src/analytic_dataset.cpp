@@ -67,6 +67,7 @@ Dataset MakeAnalyticDataset() {
     const double r = 30 * std::cos(3 * v);
     return Eigen::Vector2d(r * std::cos(v), r * std::sin(v));
   }));
+  d.names = {"circle", "square", "triangle", "figure eight", "star", "heart", "trefoil"};
   return d;
 }
 

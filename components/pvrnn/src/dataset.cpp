@@ -9,6 +9,35 @@
 namespace dyad::pvrnn {
 namespace fs = std::filesystem;
 
+namespace {
+
+// names.txt, when there is one (dataset.hpp: its rules).
+Status ReadNames(const std::string& dir, Dataset* data) {
+  const std::string file = (fs::path(dir) / "names.txt").string();
+  std::ifstream in(file);
+  if (!in) return fs::exists(file) ? Status::IOError(file + ": cannot open") : Status::OK();
+  std::vector<std::string> names;
+  std::string line;
+  for (int line_no = 1; std::getline(in, line); ++line_no) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::string where = file + ":" + std::to_string(line_no) + ": ";
+    if (line.empty() && in.peek() == EOF) break;  // a last line that only ends the file
+    if (line.empty() || line.size() > 40) return Status::DataLoss(where + "a name is 1 to 40 bytes, got " + std::to_string(line.size()));
+    for (unsigned char c : line)
+      if (c < 0x20 || c == 0x7f) return Status::DataLoss(where + "a name holds no control characters");
+    for (size_t k = 0; k < names.size(); ++k)
+      if (names[k] == line) return Status::DataLoss(where + "'" + line + "' names primitive " + std::to_string(k) + " already");
+    names.push_back(line);
+  }
+  if (names.size() != data->sequences.size())
+    return Status::DataLoss(file + ": " + std::to_string(names.size()) + " names, dataset.d says numberprims=" +
+                            std::to_string(data->sequences.size()));
+  data->names = std::move(names);
+  return Status::OK();
+}
+
+}  // namespace
+
 StatusOr<Dataset> LoadNrlDataset(const std::string& dir) {
   const std::string meta = (fs::path(dir) / "dataset.d").string();
   auto kv = ReadKeyValueFile(meta);
@@ -62,6 +91,7 @@ StatusOr<Dataset> LoadNrlDataset(const std::string& dir) {
                                std::to_string(data.sequences[0].rows()));
     data.sequences.push_back(std::move(seq));
   }
+  if (Status st = ReadNames(dir, &data); !st.ok()) return st;
   return data;
 }
 
@@ -87,6 +117,14 @@ Status WriteNrlDataset(const Dataset& data, const std::string& dir) {
     }
     if (!out) return Status::IOError(file + ": write failed");
   }
+  const std::string names = (fs::path(dir) / "names.txt").string();
+  if (data.names.empty()) {
+    fs::remove(names, ec);  // an earlier data set's names do not describe this one
+    return Status::OK();
+  }
+  std::ofstream out(names);
+  for (const std::string& n : data.names) out << n << "\n";
+  if (!out) return Status::IOError(names + ": write failed");
   return Status::OK();
 }
 

@@ -23,6 +23,7 @@ TEST(Dataset, ReadsTheMacawSet) {
 TEST(AnalyticDataset, SevenClosedPrimitivesInsideTheWorkspace) {
   const Dataset d = MakeAnalyticDataset();
   ASSERT_EQ(d.size(), 7);
+  EXPECT_EQ(d.names, (std::vector<std::string>{"circle", "square", "triangle", "figure eight", "star", "heart", "trefoil"}));
   for (const auto& s : d.sequences) {
     ASSERT_EQ(s.rows(), 2);
     ASSERT_EQ(s.cols(), 72);
@@ -53,6 +54,46 @@ TEST(Dataset, WrittenAnalyticSetReadsBackIdentically) {
   ASSERT_TRUE(back.ok()) << back.status().message();
   ASSERT_EQ(back->size(), 7);
   for (int p = 0; p < 7; ++p) EXPECT_EQ(back->sequences[p], d.sequences[p]);
+  EXPECT_EQ(back->names, d.names);
+  EXPECT_EQ(back->names.at(5), "heart");
+  // A set without names (NRL's, a person's demonstrations) reads back without, and writing it
+  // over a named one removes the old names.
+  Dataset unnamed = d;
+  unnamed.names.clear();
+  ASSERT_TRUE(WriteNrlDataset(unnamed, dir).ok());
+  EXPECT_FALSE(std::filesystem::exists(dir + "/names.txt"));
+  back = LoadNrlDataset(dir);
+  ASSERT_TRUE(back.ok()) << back.status().message();
+  EXPECT_TRUE(back->names.empty());
+  std::filesystem::remove_all(dir);
+}
+
+// names.txt: exactly one printable name of 1..40 bytes per primitive, none twice; else an error
+// naming the file and line. A CRLF file and a last empty line are fine.
+TEST(Dataset, BadNamesAreReportedAtTheirLine) {
+  const std::string dir = testing::TempPath("named_set");
+  std::filesystem::remove_all(dir);
+  ASSERT_TRUE(WriteNrlDataset(MakeAnalyticDataset(), dir).ok());
+  const std::string file = dir + "/names.txt";
+  const std::pair<std::string, std::string> cases[] = {
+      {"a\nb\n", file + ": 2 names, dataset.d says numberprims=7"},
+      {"a\nb\nc\nd\ne\nf\ng\nh\n", file + ": 8 names, dataset.d says numberprims=7"},
+      {"a\nb\nc\nb\ne\nf\ng\n", file + ":4: 'b' names primitive 1 already"},
+      {"a\n\nc\nd\ne\nf\ng\n", file + ":2: a name is 1 to 40 bytes, got 0"},
+      {"a\nb\nc\nd\ne\nf\n" + std::string(41, 'x') + "\n", file + ":7: a name is 1 to 40 bytes, got 41"},
+      {"a\nb\tc\nc\nd\ne\nf\ng\n", file + ":2: a name holds no control characters"},
+  };
+  for (const auto& [text, error] : cases) {
+    { std::ofstream(file, std::ios::binary) << text; }
+    auto d = LoadNrlDataset(dir);
+    ASSERT_FALSE(d.ok()) << text;
+    EXPECT_EQ(d.status().message(), error) << text;
+  }
+  { std::ofstream(file, std::ios::binary) << "left eye\r\nhead\r\nbeak\r\nneck\r\nright wing\r\nbelly\r\nleft wing\r\n"; }
+  auto d = LoadNrlDataset(dir);
+  ASSERT_TRUE(d.ok()) << d.status().message();
+  EXPECT_EQ(d->names.front(), "left eye");
+  EXPECT_EQ(d->names.back(), "left wing");
   std::filesystem::remove_all(dir);
 }
 

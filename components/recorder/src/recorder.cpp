@@ -4,6 +4,7 @@
 #include <ctime>
 #include <filesystem>
 
+#include <dyad/msg/types.hpp>
 #include <dyad/topic_select.hpp>
 #include <dyad/join_list.hpp>
 #include <dyad/private_file.hpp>
@@ -55,6 +56,9 @@ void Recorder::Describe(ComponentSpec& spec) {
   spec.Param("compression", "zstd").OneOf({"zstd", "none"}).Doc("chunk compression");
   spec.Param("compression_level", int64_t{1}).Range(1, 19).Doc("zstd level (1 fastest)");
   spec.Param("queue_mb", int64_t{64}).Range(1, 4096).Unit("MiB").Doc("hand-over queue bound; when full the publisher waits, nothing is dropped");
+  spec.Output<msg::RecordingStatus>("status").Optional().Doc(
+      "what it records: file, samples and bytes so far, elapsed time, a write failure (the experimenter's page shows it), "
+      "each step");
   spec.Param("flush_period_s", 1.0).Min(0).Unit("s").Doc("wall clock: close the current chunk at least this often (0: only when full)");
 }
 
@@ -98,6 +102,10 @@ Status Recorder::Configure(Context& ctx) {
   if (!chosen.ok()) return chosen.status();
   if (chosen->empty()) return Status::InvalidArgument("params.topics: the graph has no topic to record");
 
+  status_ = &ctx.output<msg::RecordingStatus>("status");
+  status_msg_.component_name(ctx.name());
+  status_msg_.file(std::filesystem::absolute(path_).lexically_normal().string());
+  first_step_ns_.reset();
   queue_ = std::make_unique<RecordQueue>(static_cast<size_t>(p.Int("queue_mb")) << 20);
   for (const auto& name : *chosen) {
     const TopicInfo* info = nullptr;
@@ -178,6 +186,7 @@ void Recorder::WriterLoop() {
       if (Status s = writer_->Flush(); !s.ok()) SetFailure(s);
       next_flush = Clock::now() + period;
     }
+    bytes_written_.store(writer_->bytes_written(), std::memory_order_relaxed);  // the writer is this thread's alone
   }
 }
 
@@ -192,8 +201,20 @@ Status Recorder::failure() const {
   return failure_;
 }
 
-Status Recorder::Step(const StepInfo&) {
-  if (failed_.load(std::memory_order_acquire)) return failure();
+Status Recorder::Step(const StepInfo& info) {
+  const bool failed = failed_.load(std::memory_order_acquire);
+  if (status_->bound()) {
+    if (!first_step_ns_) first_step_ns_ = info.now_ns;
+    uint64_t samples = 0;
+    for (const auto& c : channels_) samples += c->received.load(std::memory_order_relaxed);
+    status_msg_.samples(samples);
+    status_msg_.bytes(bytes_written_.load(std::memory_order_relaxed));
+    status_msg_.elapsed_s(static_cast<double>(info.now_ns - *first_step_ns_) * 1e-9);
+    status_msg_.error(failed ? failure().message() : std::string());
+    // Said before the failure ends the run: the page shows why.
+    if (Status s = status_->Publish(status_msg_); !s.ok() && !failed) return s;
+  }
+  if (failed) return failure();
   return Status::OK();
 }
 

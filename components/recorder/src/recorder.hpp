@@ -3,7 +3,7 @@
 /// @component recorder
 /// rate_hz: any (1 is plenty): each step only checks that the writer thread is healthy; samples
 ///          are taken as they are published, not per step.
-/// inputs, outputs: none (topics are subscribed generically, Context::SubscribeSerialized)
+/// inputs: none (topics are subscribed generically, Context::SubscribeSerialized)
 /// params:
 ///   file (string, "{graph}-{time}.mcap"): output path; {graph} = graph name, {time} = local
 ///        start time YYYYMMDD-HHMMSS. Missing parent folders are created.
@@ -19,6 +19,10 @@
 ///        waits (back-pressure), nothing is dropped.
 ///   flush_period_s (double, 1.0, >= 0): wall clock only: close the current chunk at least this
 ///        often, bounding what a crash loses in time; 0: only when a chunk is full.
+/// outputs:
+///   status (RecordingStatus, optional): each step, the file, the samples taken and bytes written
+///        so far, the seconds since its first step, and a write failure's message (published in
+///        the step that then fails the run).
 /// @endcomponent
 ///
 /// The file: one `omgidl` schema per message type (the IDL text, includes inlined, named by the
@@ -45,12 +49,14 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include <dyad/component.hpp>
 #include <dyad/mcap/writer.hpp>
+#include <dyad/msg/types.hpp>
 
 #include "record_queue.hpp"
 
@@ -90,6 +96,10 @@ class Recorder final : public Component {
   std::atomic<bool> failed_{false};
   mutable std::mutex failure_mutex_;
   Status failure_;
+  Output<msg::RecordingStatus>* status_ = nullptr;  // optional: unbound, nothing is published
+  msg::RecordingStatus status_msg_;
+  std::optional<int64_t> first_step_ns_;  // the run's clock at the first step: elapsed_s counts from it
+  std::atomic<uint64_t> bytes_written_{0};  // the writer thread's count, for the step thread
 };
 
 }  // namespace dyad::recorder

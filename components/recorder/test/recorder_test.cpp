@@ -6,6 +6,7 @@
 #include "dyad/testing/dds_domain.hpp"
 
 #include "dyad/testing/child_process.hpp"
+#include "dyad/testing/csv.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -296,6 +297,36 @@ TEST_F(RecorderTest, SteppedGraphRecordsEverySampleOfThreePublishersReadBackByMc
   EXPECT_EQ(CheckWithNode(file, r, false), "");
   EXPECT_EQ(CheckWithNode(file, r, true), "");
   EXPECT_EQ(DecodeWithFoxglove(file), "") << "every message decodes with its omgidl schema, header sequence = MCAP sequence";
+}
+
+// The status output, recorded with the rest and read back by `dyad bag export`: stepped, so each
+// status is exact: its step's time, and the samples taken before its step (a at 100 Hz: one per
+// 10 ms; the recorder's 10 Hz steps run after a's step of the same instant, in the graph's order).
+TEST_F(RecorderTest, TheStatusSaysTheFileTheSamplesAndTheTimeEachStep) {
+  std::string g = ThreePublishers("stepped", 100, 100, 50, "file: '" + (dir_ / "s.mcap").string() + "', topics: [ca, rec/status]");
+  g.replace(g.find("rate_hz: 1, params"), 18, "rate_hz: 10, outputs: {status: rec/status}, params");
+  g += "topics:\n  rec/status: {type: RecordingStatus}\n";
+  const fs::path graph = Write("g.yaml", g);
+  ASSERT_EQ(Run({"run", graph.string(), "--steps", "100", "--quiet"}), 0);
+  ASSERT_EQ(Run({"bag", "export", (dir_ / "s.mcap").string(), "--csv", (dir_ / "csv").string()}), 0);
+  const auto status = dyad::testing::ReadCsv(dir_ / "csv" / "rec_status.csv");
+  const auto ca = dyad::testing::ReadCsv(dir_ / "csv" / "ca.csv");
+  ASSERT_EQ(ca.size(), 100u);
+  ASSERT_EQ(status.size(), 10u);
+  uint64_t last_bytes = 0;
+  for (size_t k = 0; k < status.size(); ++k) {
+    const auto& r = status[k];
+    EXPECT_EQ(r.at("component_name"), "rec");
+    EXPECT_EQ(r.at("file"), (dir_ / "s.mcap").string());
+    EXPECT_EQ(r.at("error"), "");
+    EXPECT_DOUBLE_EQ(std::stod(r.at("elapsed_s")), 0.1 * static_cast<double>(k)) << k;
+    // ca's samples of steps 0..10k, and the status samples before this one.
+    EXPECT_EQ(std::stoull(r.at("samples")), 10 * k + 1 + k) << k;
+    const uint64_t bytes = std::stoull(r.at("bytes"));
+    EXPECT_GE(bytes, last_bytes) << k;
+    last_bytes = bytes;
+  }
+  EXPECT_LE(last_bytes, fs::file_size(dir_ / "s.mcap"));
 }
 
 TEST_F(RecorderTest, SteppedRecordingsOfTheSameGraphAreByteIdentical) {

@@ -107,6 +107,7 @@ void SubjectChannel::OnOpen(ClientId client, Role role) {
                                 {"engage_key", options_.engage_key},
                                 {"role", RoleName(role)},
                                 {"primitives", prims},
+                                {"names", options_.names},
                                 {"watermark", options_.watermark},
                                 {"ask", options_.ask && static_cast<bool>(report_)},
                                 {"ask_after_hold_s", options_.ask_after_hold_s}}

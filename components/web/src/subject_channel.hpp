@@ -41,6 +41,7 @@ class SubjectChannel final : public ClientHandler {
     std::string engage_key = "Space";  // KeyboardEvent.code; the mouse button always engages
     double half_width = 50;            // the workspace is [-half_width, half_width]^2
     std::vector<std::vector<std::array<double, 2>>> primitives;  // for the watermark and the question
+    std::vector<std::string> names;  // the data set's names of the primitives (empty: none)
     bool watermark = true;          // draw the primitives faintly behind the workspace
     bool ask = false;               // ask "What were you drawing?" after each release
     double ask_after_hold_s = 1.0;  // ... of a hold at least this long (a tap is no event)

@@ -48,6 +48,8 @@ rows = list(csv.DictReader(open(sys.argv[2])))
 def fail(why): sys.exit("FAIL: " + why)
 n = len(b["choices"])
 if b["choices"] != list(range(n - 1)) + [-1] or n != 8: fail("the question's choices: %s (want 7 primitives and -1)" % b["choices"])
+want = ["circle", "square", "triangle", "figure eight", "star", "heart", "trefoil", "something else (0)"]
+if b["captions"] != want: fail("the choices are captioned %s (want the data set's names: %s)" % (b["captions"], want))
 if len(rows) != 1: fail("%d self-reports recorded (want 1): %s" % (len(rows), rows))
 r = rows[0]
 if r["choice"] != "2": fail("choice %s, want 2" % r["choice"])

@@ -16,6 +16,8 @@
 //     create no folder: call this first for a path whose folder may be missing.
 //   - WritePrivateFile(path, text, mode): CreatePrivateFile, then all of `text` written and the
 //     file closed (small files: keys, tokens, documents).
+//   - SyncDirectory(dir): fsync of the folder itself, so a file created, renamed or removed in it
+//     stays so after a power cut (the file's own data needs its own fdatasync).
 // Every function returns a Status naming the path and the system's reason; the returned file
 // descriptor is O_CLOEXEC and owned by the caller. The umask still applies (it can only remove
 // permissions).
@@ -38,5 +40,6 @@ Status WritePrivateFile(const std::string& path, const std::string& text, Create
                         const PrivateFileOptions& options = {});
 StatusOr<int> OpenPrivateLog(const std::string& path, const PrivateFileOptions& options = {});
 Status CreatePrivateDirectories(const std::string& dir, const PrivateFileOptions& options = {});
+Status SyncDirectory(const std::string& dir);
 
 }  // namespace dyad

@@ -21,6 +21,7 @@
 #include "dyad/testing/mcap_channel.hpp"
 #include "dyad/mcap/writer.hpp"
 #include "demonstrations.hpp"
+#include "dyad/pvrnn/analytic_dataset.hpp"
 #include "dyad/pvrnn/dataset.hpp"
 #include "experiment_analysis.hpp"
 #include "recording_tables.hpp"
@@ -397,6 +398,33 @@ TEST(Analyze, EventsStartedInPracticeAreLeftOutAndSaidSo) {
   EXPECT_EQ(r2->events[0].event.start_step, 10);
 }
 
+// The graph's data set names its primitives (names.txt): the report calls them so, in the events
+// and in the confusion's rows; the numbers stay in the CSV files. A bad names.txt is a warning.
+TEST(Analyze, PrimitivesAreCalledByTheirDataSetsNames) {
+  const std::string data = TempPath("named_set");
+  ASSERT_TRUE(pvrnn::WriteNrlDataset(pvrnn::MakeAnalyticDataset(), data).ok());
+  std::string graph = kGraph;
+  graph.replace(graph.find("/nonexistent/dataset"), std::string("/nonexistent/dataset").size(), data);
+  const std::string path = WriteExperiment(TempPath("named.mcap"), true, {{"yaml", graph}}, {{30, 34, 4}});
+  std::ostringstream warnings;
+  auto r = BuildReport(path, warnings);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  EXPECT_EQ(warnings.str(), "");
+  const std::string md = FormatMarkdown(*r);
+  EXPECT_NE(md.find("| 0 | 10-19 | triangle (2) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 1 | 30-33 | heart (5) (said star (4)) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| **triangle (2)** |"), std::string::npos) << md;
+  const std::string dir = TempPath("report");
+  ASSERT_TRUE(WriteReport(*r, dir).ok());
+  EXPECT_EQ(Lines(dir + "/events.csv").at(1).rfind("0,10,20,2,", 0), 0u) << Lines(dir + "/events.csv").at(1);
+  { std::ofstream(data + "/names.txt") << "just one\n"; }
+  auto bad = BuildReport(path, warnings);
+  ASSERT_TRUE(bad.ok()) << bad.status().ToString();
+  EXPECT_NE(warnings.str().find("the primitives' names not read: " + data + "/names.txt: 1 names, dataset.d says numberprims=7"),
+            std::string::npos) << warnings.str();
+  EXPECT_NE(FormatMarkdown(*bad).find("| 0 | 10-19 | 2 |"), std::string::npos);
+}
+
 // A self-report whose choice is neither a primitive nor -1 fails the analysis, naming the message.
 TEST(Analyze, ASelfReportWithABadChoiceIsRefusedNamingTheMessage) {
   const std::string path = WriteExperiment(TempPath("bad_report.mcap"), true, {{"yaml", kGraph}}, {{10, 20, 2}, {30, 34, -5}});
@@ -522,13 +550,15 @@ TEST(AnalyzeCli, BadInputExitsTwoNamingTheFile) {
 
 // Live parameter changes: human/input at 10 Hz for 20 steps; on dyad/params, mixer.gain applied
 // 1.0 s after the first human sample (the mixer had made 9 steps: the answer's own step count is
-// not the timeline's step) and a refusal, which changed nothing.
+// not the timeline's step) and a refusal, which changed nothing. On experiment/notes, a note at
+// step 5 (web's clock 0.2 s ahead: another process).
 std::string WriteParamChanges(const std::string& path) {
   auto writer = mcap::Writer::Open(path);
   EXPECT_TRUE(writer.ok());
   EXPECT_TRUE(writer->AddMetadata("dyad.graph", {{"yaml", kGraph}}).ok());
   Channel<msg::HumanInput> human(*writer, "human/input");
   Channel<msg::ParamChange> params(*writer, "dyad/params");
+  Channel<msg::Annotation> notes(*writer, "experiment/notes");
   auto answer = [](const std::string& op, const std::string& value, uint64_t step) {
     msg::ParamChange a;
     a.header().source("dyad/main");
@@ -539,6 +569,13 @@ std::string WriteParamChanges(const std::string& path) {
   for (int t = 0; t < 20; ++t) {
     msg::HumanInput h; h.x(t); h.y(-t);
     human.Write(h, t);
+    if (t == 5) {
+      msg::Annotation n;
+      n.header().source("web");
+      n.author("experimenter");
+      n.text("coughed, then | \"laughed\"");
+      notes.Write(n, t);
+    }
     if (t == 10) {
       msg::ParamChange applied = answer("applied", "0.2", 9);
       applied.old_value("0.9"); applied.who("dyad param set (ana@lab-pc)");
@@ -584,6 +621,44 @@ TEST(AnalyzeParams, AnAppliedChangeIsPlacedOnTheTimelinesStepGrid) {
   EXPECT_EQ(md.find("| 7"), std::string::npos) << md;  // refused: not shown
 }
 
+// The experimenter's notes: on the step grid, in the report (escaped for its table), in notes.csv.
+TEST(AnalyzeNotes, TheExperimentersNotesAreOnTheTimelineInTheReportAndInTheirTable) {
+  std::ostringstream warnings;
+  auto r = BuildReport(WriteParamChanges(TempPath("p.mcap")), warnings);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->notes.size(), 1u);
+  EXPECT_EQ(r->notes[0].step, 5);
+  EXPECT_DOUBLE_EQ(r->notes[0].time_s, 0.5);
+  EXPECT_EQ(r->notes[0].author, "experimenter");
+  const std::string md = FormatMarkdown(*r);
+  const auto section = md.find("## The experimenter's notes\n\n| time | who | note |\n");
+  ASSERT_NE(section, std::string::npos) << md;
+  EXPECT_NE(md.find("| 0.500 s (step 5) | experimenter | coughed, then \\| \"laughed\" |\n", section), std::string::npos) << md;
+  const std::string dir = TempPath("report");
+  ASSERT_TRUE(WriteReport(*r, dir).ok());
+  EXPECT_EQ(Lines(dir + "/notes.csv"),
+            (std::vector<std::string>{"step,time_s,author,text", "5,0.500,experimenter,\"coughed, then | \"\"laughed\"\"\""}));
+  // Placed as any stamp of its writer's process: web's clock 200 ms ahead moves it 2 steps back.
+  auto reader = mcap::Reader::Open(r->recording);
+  ASSERT_TRUE(reader.ok());
+  auto tables = ReadTables(*reader, {});
+  ASSERT_TRUE(tables.ok());
+  ExperimentPlan plan = r->plan;
+  plan.process_of["web"] = "lab";
+  auto timeline = BuildTimeline(*tables, plan, {{"lab", 200'000'000}});
+  ASSERT_TRUE(timeline.ok()) << timeline.status().ToString();
+  auto notes = ExperimenterNotes(*tables, plan, *timeline);
+  ASSERT_TRUE(notes.ok()) << notes.status().ToString();
+  ASSERT_EQ(notes->size(), 1u);
+  EXPECT_EQ((*notes)[0].step, 3);
+  // No notes: no section, and an earlier report's notes.csv is gone (the plots would draw it).
+  Report without = *r;
+  without.notes.clear();
+  ASSERT_TRUE(WriteReport(without, dir).ok());
+  EXPECT_FALSE(std::filesystem::exists(dir + "/notes.csv"));
+  EXPECT_EQ(FormatMarkdown(without).find("experimenter's notes"), std::string::npos);
+}
+
 // The answer is stamped by its writer's process ("dyad/main"): when the timeline moves stamps of
 // that process onto the recorder's clock, the change moves with them.
 TEST(AnalyzeParams, AChangeGetsTheClockCorrectionOfItsWritersProcess) {
@@ -621,13 +696,15 @@ TEST(AnalyzeParams, WithoutChangesThereIsNoTableAndCellsAreQuoted) {
   EXPECT_TRUE(std::filesystem::exists(dir + "/report.md"));
 }
 
-// `dyad analyze` end to end with a change: params.csv is written and plot_report.py draws it.
+// `dyad analyze` end to end with a change and a note: params.csv and notes.csv are written and
+// plot_report.py draws them.
 TEST(AnalyzeCli, DrawsThePlotsWithParameterChanges) {
   const std::string rec = WriteParamChanges(TempPath("p.mcap"));
   const std::string out = TempPath("report");
   const std::string cmd = std::string(DYAD_BIN_DIR) + "/dyad analyze " + rec + " -o " + out + " > " + out + ".log 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << Head(out + ".log", 4000);
   EXPECT_EQ(Lines(out + "/params.csv").size(), 2u);
+  EXPECT_EQ(Lines(out + "/notes.csv").size(), 2u);
   for (const char* f : {"nelbo.png", "congruence.png"}) EXPECT_EQ(Head(out + "/" + f, 8), "\x89PNG\r\n\x1a\n") << f;
 }
 
@@ -764,17 +841,25 @@ TEST(Demonstrations, CliTakesSegmentsAndDrawsAPreview) {
   const std::string rec = WriteExperiment(TempPath("d.mcap"));
   const std::string out = TempPath("chosen"), png = TempPath("preview.png");
   auto r = dyad::testing::RunCommand(dyad::cli::AddAnalyzeCommands, {"dataset", "from-recording", rec, "--out", out, "--min-samples",
-                                                                     "4", "--segments", "1,0", "--preview", png});
+                                                                     "4", "--segments", "1,0", "--preview", png,
+                                                                     "--names", "zigzag,long stroke"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("   0  at     1.0 s    0.9 s    10 samples  1 lap -> primitive 1"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("   1  at     3.0 s    0.3 s     4 samples  1 lap -> primitive 0"), std::string::npos) << r.out;
   auto data = pvrnn::LoadNrlDataset(out);
   ASSERT_TRUE(data.ok());
   EXPECT_NEAR(data->sequences[0](0, 0), 30, 1e-6);  // segment 1 (steps 30-33) first
+  EXPECT_EQ(data->names, (std::vector<std::string>{"zigzag", "long stroke"}));
   std::ifstream f(png, std::ios::binary);
   char magic[4] = {};
   f.read(magic, 4);
   EXPECT_EQ(std::string(magic + 1, 3), "PNG") << "no preview at " << png << "\n" << r.err;
+  const std::string not_written = TempPath("wrong");
+  auto wrong = dyad::testing::RunCommand(dyad::cli::AddAnalyzeCommands, {"dataset", "from-recording", rec, "--out", not_written,
+                                                                         "--min-samples", "4", "--names", "only one"});
+  EXPECT_EQ(wrong.code, 2);
+  EXPECT_NE(wrong.err.find("--names gives 1 names for 2 primitive(s)"), std::string::npos) << wrong.err;
+  EXPECT_FALSE(std::filesystem::exists(not_written + "/dataset.d")) << "nothing is written";
 }
 
 }  // namespace

@@ -3,7 +3,8 @@
 //   node study_page.mjs STUDY_PAGE_URL SCREENSHOT_DIR
 // Marks consent (confirming the dialog), starts trial 1 and waits for it to complete, repeats it
 // with a reason, starts trial 2 and stops it early, sees that it must be repeated, repeats it with
-// a reason, and sees the session complete. Fails (exit 1) at the first step the page gets wrong.
+// a reason (adding a note while it runs), sees the session complete, then withdraws the
+// participant's consent keeping their data. Fails (exit 1) at the first step the page gets wrong.
 import { chromium } from "playwright-core";
 
 const [url, shotDir] = process.argv.slice(2);
@@ -14,7 +15,8 @@ const browser = await chromium.launch({
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 try {
   const page = await browser.newPage({ viewport: { width: 1100, height: 700 } });
-  page.on("dialog", (d) => d.accept());
+  const answers = [];  // what the next confirm() dialogs are answered (then: OK)
+  page.on("dialog", (d) => (answers.length === 0 || answers.shift() ? d.accept() : d.dismiss()));
   await page.goto(url);
   const text = (sel) => page.textContent(sel);
   const status = (k) => text(`tr[data-trial="${k}"] td:nth-child(4)`);
@@ -52,10 +54,21 @@ try {
   await page.fill("#reason", "stopped by mistake");
   await page.click('tr[data-trial="2"] button.repeat');
   await waitStatus(2, "running", 5000);
+  // A note while it runs: listed at once, with the trial it was written during.
+  await page.fill("#note", "the participant | laughed");
+  await page.click("#add-note");
+  await page.waitForFunction(() => document.getElementById("notes").textContent.includes("(trial 2): the participant | laughed"));
   await waitStatus(2, "complete");
   await page.waitForFunction(() => document.getElementById("elapsed").textContent === "session complete");
   await page.screenshot({ path: `${shotDir}/study_page_done.png` });
-  console.log("page: consent, trial 1 twice, trial 2 stopped and repeated, session complete (" + (await status(2)) + ")");
+  // The participant withdraws consent, and the data is kept (the second dialog answered Cancel).
+  answers.push(true, false);
+  await page.click("#withdraw");
+  await page.waitForFunction(() => document.getElementById("consent").textContent.startsWith("consent withdrawn"));
+  if (!(await page.isDisabled("#withdraw"))) throw new Error("withdraw is still offered after a withdrawal");
+  if (!(await page.isHidden("#mark-consent"))) throw new Error("the page offers to mark consent again after a withdrawal");
+  if (await page.isEnabled('tr[data-trial="1"] button.repeat')) throw new Error("a repetition is offered after a withdrawal");
+  console.log("page: consent, trial 1 twice, trial 2 stopped and repeated, a note, session complete (" + (await status(2)) + "), consent withdrawn");
 } finally {
   await browser.close();
 }

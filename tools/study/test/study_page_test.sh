@@ -49,7 +49,19 @@ ends = [(l["trial"], l["attempt"], l["outcome"]) for l in lines if l["event"] ==
 if ends != [(1, 1, "complete"), (1, 2, "complete"), (2, 1, "stopped"), (2, 2, "complete")]: fail("attempts %s" % ends)
 reasons = [(l["trial"], l.get("reason")) for l in lines if l["event"] == "start" and l["attempt"] == 2]
 if reasons != [(1, "the participant sneezed"), (2, "stopped by mistake")]: fail("reasons %s" % reasons)
+notes = [(l["text"], l["time"]) for l in lines if l["event"] == "note"]
+if [n[0] for n in notes] != ["the participant | laughed"]: fail("notes %s" % notes)
+if (lines[-1]["event"], lines[-1].get("how"), lines[-1].get("data")) != ("withdrawn", "on the study page", "kept"): fail("the last line is not the withdrawal")
 print("PASS: session log as the page drove it")
 PY
 n=$(ls page_test-data/P01/*.mcap | wc -l)
-[ "$n" = 4 ] || fail "$n recordings (want 4: two attempts of each trial): $(ls page_test-data/P01)"
+[ "$n" = 4 ] || fail "$n recordings (want 4: two attempts of each trial, kept after the withdrawal): $(ls page_test-data/P01)"
+# Withdrawn: the analysis leaves P01 out and says so; a new session records nothing.
+"$build/bin/dyad" study analyze s.yaml --no-plots > analyze.out 2>&1 || fail "analyze: $(cat analyze.out)"
+grep -q "^- P01: withdrew consent on .*; their data is kept but not analysed$" page_test-data/analysis/report.md ||
+  fail "the report does not say P01 withdrew: $(cat page_test-data/analysis/report.md)"
+grep -q "0 trials analysed, 0 missing" analyze.out || fail "analyze: $(cat analyze.out)"
+if "$build/bin/dyad" study run s.yaml --participant P01 --trial 1 --reason again > again.out 2>&1; then fail "a withdrawn participant's trial ran"; fi
+grep -q "P01 withdrew consent" again.out || fail "the refusal: $(cat again.out)"
+[ "$(ls page_test-data/P01/*.mcap | wc -l)" = 4 ] || fail "something recorded after the withdrawal"
+echo "PASS: withdrawn: left out of the analysis, and refused a trial"

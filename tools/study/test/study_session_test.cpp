@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -200,6 +202,98 @@ TEST_F(StudySession, AStoppedOrKilledTrialIsIncompleteAndItsRecordingStaysReadab
   ASSERT_FALSE(a.missing.empty());
   EXPECT_EQ(a.missing[0], "P01 trial 1 (" + trials[0].file +
                               "): incomplete (attempt 1 stopped; attempt 2 interrupted (the session ended during it), repeated because: stopped by mistake)");
+}
+
+
+// The experimenter's notes, a participant excluded (and included again) by the researcher, and
+// one who withdraws consent with their data deleted: all in the session log, the analysis leaves
+// them out saying why, and nothing records for a withdrawn participant without a new consent.
+TEST_F(StudySession, NotesExclusionsAndWithdrawalsAreLoggedAndTheAnalysisLeavesThemOut) {
+  const Study s = Make("stepped", 2);
+  const std::string study_file = (dir_ / "s.yaml").string();
+  auto study = [&](std::vector<std::string> args, const std::string& tag) {
+    args.insert(args.begin(), {DYAD_EXE, "study"});
+    args.insert(args.begin() + 3, study_file);
+    return std::make_unique<ChildProcess>(args, dir_, tag);
+  };
+  for (const std::string p : {"P01", "P02"}) {
+    ChildProcess run({DYAD_EXE, "study", "run", study_file, "--participant", p, "--consent", "--yes"}, dir_, "run" + p);
+    ASSERT_EQ(run.Wait(120), 0) << run.err();
+  }
+  auto note = study({"note", "--participant", "P01", "arrived late | tired"}, "note");
+  ASSERT_EQ(note->Wait(30), 0) << note->err();
+  auto empty_note = study({"note", "--participant", "P01", "  "}, "empty_note");
+  EXPECT_EQ(empty_note->Wait(30), 2);
+  EXPECT_NE(empty_note->err().find("a note needs its text"), std::string::npos) << empty_note->err();
+  auto stranger = study({"note", "--participant", "P09", "who?"}, "stranger");
+  EXPECT_EQ(stranger->Wait(30), 2);
+  EXPECT_NE(stranger->err().find("--participant P09 is not a participant of"), std::string::npos) << stranger->err();
+  EXPECT_FALSE(fs::exists(fs::path(s.data) / "P09"));
+  auto no_reason = study({"exclude", "--participant", "P02"}, "no_reason");
+  EXPECT_EQ(no_reason->Wait(30), 2) << "an exclusion needs its reason";
+  auto exclude = study({"exclude", "--participant", "P02", "--reason", "did not follow the instructions"}, "exclude");
+  ASSERT_EQ(exclude->Wait(30), 0) << exclude->err();
+
+  StudyAnalysis a = AnalyzeStudy(s, std::cerr);
+  EXPECT_EQ(a.trials.size(), 2u);
+  for (const TrialResult& t : a.trials) EXPECT_EQ(t.participant, "P01");
+  EXPECT_TRUE(a.missing.empty()) << a.missing.front();
+  ASSERT_EQ(a.left_out.size(), 1u);
+  EXPECT_EQ(a.left_out[0], "P02: excluded: did not follow the instructions");
+  ASSERT_EQ(a.notes.size(), 1u);
+  EXPECT_EQ(a.notes[0].first, "P01");
+  EXPECT_EQ(a.notes[0].second.text, "arrived late | tired");
+  EXPECT_EQ(a.notes[0].second.trial, 0) << "written between trials";
+  ASSERT_TRUE(WriteStudyAnalysis(s, a, (dir_ / "analysis").string()).ok());
+  const std::string report = dyad::testing::ReadFile(dir_ / "analysis" / "report.md");
+  EXPECT_NE(report.find("## Participants left out\n\n- P02: excluded: did not follow the instructions\n"), std::string::npos) << report;
+  EXPECT_NE(report.find(" | between trials | arrived late \\| tired |"), std::string::npos) << report;
+
+  auto include = study({"include", "--participant", "P02", "--reason", "the instructions were unclear"}, "include");
+  ASSERT_EQ(include->Wait(30), 0) << include->err();
+  EXPECT_EQ(AnalyzeStudy(s, std::cerr).trials.size(), 4u);
+
+  // A withdrawal waits for a running session; the end of input deletes nothing.
+  {
+    auto held = SessionLock::Acquire(s, "P02");
+    ASSERT_TRUE(held.ok());
+    auto busy = study({"withdraw", "--participant", "P02", "--delete-data", "--yes"}, "busy");
+    EXPECT_EQ(busy->Wait(30), 2);
+    EXPECT_NE(busy->err().find("stop the session first"), std::string::npos) << busy->err();
+  }
+  auto unconfirmed = study({"withdraw", "--participant", "P02", "--delete-data"}, "unconfirmed");
+  EXPECT_EQ(unconfirmed->Wait(30), 2);
+  EXPECT_EQ(LogLines(SessionLogPath(s, "P02")).back()["event"], "included") << "an unconfirmed withdrawal was logged";
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(s.data) / "P02"))
+    files += e.path().filename() != "session.log" && e.path().filename() != "session.lock";
+  ASSERT_GE(files, 2u) << "two recordings at least";
+  auto withdraw = study({"withdraw", "--participant", "P02", "--delete-data", "--yes"}, "withdraw");
+  ASSERT_EQ(withdraw->Wait(30), 0) << withdraw->err();
+  std::set<std::string> left;
+  for (const auto& e : fs::directory_iterator(fs::path(s.data) / "P02")) left.insert(e.path().filename().string());
+  EXPECT_EQ(left, (std::set<std::string>{"session.lock", "session.log"})) << "a file of a withdrawn participant was kept";
+  const auto log = LogLines(SessionLogPath(s, "P02"));
+  ASSERT_EQ(log.size(), 1u) << "the log, with its notes and reasons, is replaced by one line";
+  EXPECT_EQ(log[0]["event"], "withdrawn");
+  EXPECT_EQ(log[0]["data"], "deleted");
+  EXPECT_EQ(log[0]["files_deleted"], files);
+  EXPECT_EQ(fs::status(SessionLogPath(s, "P02")).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write);
+  a = AnalyzeStudy(s, std::cerr);
+  EXPECT_EQ(a.trials.size(), 2u);
+  ASSERT_EQ(a.left_out.size(), 1u);
+  EXPECT_EQ(a.left_out[0].rfind("P02: withdrew consent on 20", 0), 0u) << a.left_out[0];
+  EXPECT_NE(a.left_out[0].find("their data was deleted"), std::string::npos) << a.left_out[0];
+  EXPECT_TRUE(a.missing.empty()) << "a withdrawn participant's trials are not missing: " << a.missing.front();
+
+  // Nothing records for them, at a prompt or not, until a new consent is marked explicitly.
+  ChildProcess refused({DYAD_EXE, "study", "run", study_file, "--participant", "P02", "--yes"}, dir_, "refused");
+  EXPECT_EQ(refused.Wait(60), 2);
+  EXPECT_NE(refused.err().find("P02 withdrew consent"), std::string::npos) << refused.err();
+  EXPECT_EQ(LogLines(SessionLogPath(s, "P02")).size(), 1u);
+  ChildProcess again({DYAD_EXE, "study", "run", study_file, "--participant", "P02", "--consent", "--yes"}, dir_, "again");
+  ASSERT_EQ(again.Wait(120), 0) << again.err();
+  EXPECT_EQ(AnalyzeStudy(s, std::cerr).trials.size(), 4u) << "consent given again: recorded and analysed";
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // Live parameters from the experimenter's page in Debian's Chromium (headless, playwright-core;
 // no browser download), for experimenter_params_test.sh:
 //   node experimenter_params.mjs BASE_URL SCREENSHOT_DIR
+// 0. its header shows the recording: rec.mcap, its samples growing, its size and time;
 // 1. the experimenter's page sets mixer.gain to 0.25: its list shows "mixer.gain 0.9 → 0.25
 //    (experimenter page)";
 // 2. sets it to 7: the list shows the mixer's refusal ("must be <= 1, got 7");
@@ -42,6 +43,17 @@ try {
     await page.waitForFunction(() => document.getElementById("subject").textContent === "subject: no page", null, { timeout: 5000 });
   } catch {
     failures.push("the header's subject status: " + (await page.textContent("#subject")));
+  }
+  // The recording in the header: its file, samples (growing), size and time (the recorder's status).
+  const recording = /^recording rec\.mcap · ([\d,]+) samples · \d+\.\d MB · 0:\d\d$/;
+  try {
+    await page.waitForFunction((src) => new RegExp(src).test(document.getElementById("recording").textContent), recording.source, { timeout: 5000 });
+    const first = Number(recording.exec(await page.textContent("#recording"))[1].replace(/,/g, ""));
+    await page.waitForFunction(([src, n]) => Number(new RegExp(src).exec(document.getElementById("recording").textContent)?.[1].replace(/,/g, "")) > n,
+      [recording.source, first], { timeout: 5000 });
+    console.log("the header: " + (await page.textContent("#recording")));
+  } catch {
+    failures.push("the header's recording: " + (await page.textContent("#recording")));
   }
 
   await ask(page, "mixer.gain", "0.25");

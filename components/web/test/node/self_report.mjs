@@ -41,6 +41,7 @@ try {
   out.first = await hold(1500);
   await page.waitForFunction(() => document.getElementById("question").classList.contains("on"), null, { timeout: 3000 });
   out.choices = await page.evaluate(() => [...document.querySelectorAll("#choices button")].map((b) => Number(b.dataset.choice)));
+  out.captions = await page.evaluate(() => [...document.querySelectorAll("#choices button")].map((b) => b.querySelector(".name")?.textContent ?? b.textContent));
   await page.screenshot({ path: `${shotDir}/subject_question.png` });
   await page.keyboard.down("Space");
   await sleep(150);

@@ -28,6 +28,10 @@ try {
   const page = await context.newPage();
   await page.goto(base + "/experimenter?token=experimenter-token-0001");
   await page.waitForFunction(() => document.getElementById("ttarget").options.length === 8, null, { timeout: 10000 });
+  // The targets by the data set's names.
+  const labels = await page.evaluate(() => [...document.getElementById("ttarget").options].map((o) => o.textContent));
+  if (labels.join("|") !== "none|circle (0)|square (1)|triangle (2)|figure eight (3)|star (4)|heart (5)|trefoil (6)")
+    throw new Error("the target list: " + labels.join(", "));
   await page.selectOption("#ttarget", "3");
   await subject.waitForFunction(() => target === 3, null, { timeout: 5000 });
   await page.fill("#tmsg", "Draw the yellow shape");
