@@ -3,7 +3,7 @@
 #
 #   bash tools/demo.sh          the demo: a model dyad trains itself, nothing needed beside the clone
 #     1. the analytic 7-primitive data set  -> build/data/analytic         (dyad generate dataset)
-#     2. the robot's PV-RNN, study settings -> build/models/demo.dpvrnn    (dyad train, ~1-2 min)
+#     2. the robot's PV-RNN, study settings -> build/models/demo.dpvrnn    (dyad train, ~20 s on 2 cores)
 #     3. the intention observer             -> build/models/demo.dobs      (dyad train-observer)
 #   bash tools/demo.sh interactive   the same models; a person steers from the browser
 #     (configs/interactive.yaml, wall clock, until Ctrl-C; open the printed /subject address)
