@@ -120,7 +120,10 @@ class Executor::ContextImpl final : public Context, public detail::ContextExtens
   Logger& log() override { return logger_; }
   uint64_t seed() const override { return seed_; }
   int64_t period_ns() const override { return inst_->rc->period_ns; }
-  void RequestStop(std::string reason) override { ex_->RequestStop(inst_->name() + ": " + reason); }
+  void RequestStop(std::string reason) override {
+    logger_.Info("ends the run: " + reason);  // a run that ends by itself says why
+    ex_->RequestStop(inst_->name() + ": " + reason);
+  }
 
   const std::string& graph_name() const override { return ex_->graph_.name; }
   const std::string& graph_yaml() const override { return ex_->graph_yaml_; }
