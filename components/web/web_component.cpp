@@ -144,10 +144,18 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Param("half_width", 50.0).Min(1e-6).Doc("subject's page: the workspace drawn is [-half_width, half_width]^2 (the study's 50)");
   spec.Param("show_primitives", false).Doc("subject's page: draw the data set's primitives as a faint watermark");
   spec.Param("dataset", "").Path().Doc("subject's page: NRL data set folder of the primitives (the watermark, the question's thumbnails)");
-  spec.Param("self_reports", "after_event").OneOf({"after_event", "off"}).Doc(
-      "subject's page: with `self_report` bound, ask \"What were you drawing?\" after each release (the data set's "
-      "primitives as thumbnails, and \"something else\")");
-  spec.Param("self_report_min_hold_s", 1.0).Min(0).Unit("s").Doc("subject's page: ask only after a hold at least this long");
+  spec.Param("self_reports", "after_event").OneOf({"after_event", "after_trial", "off"}).Doc(
+      "subject's page: with `self_report` bound, ask \"What were you drawing?\" (the data set's primitives as thumbnails, "
+      "and \"something else\") after each release, or after the trial about each of its holds in turn (see `ask`)");
+  spec.Param("self_report_min_hold_s", 1.0).Min(0).Unit("s").Doc("subject's page: ask only about a hold at least this long");
+  spec.Param("ask", false).Live().Doc(
+      "after_trial: setting it true ends the trial: steering stops, the subject's page asks about each hold (its trace as the "
+      "picture), and once all are answered (or self_report_timeout_s passed) the run ends by itself");
+  spec.Param("ask_after_s", 0.0).Range(0, 1e7).Unit("s").Doc(
+      "after_trial: ask by itself this long after the run's start (`dyad study run` sets it to the trial's duration; 0: only "
+      "when `ask` is set)");
+  spec.Param("self_report_timeout_s", 120.0).Range(1, 86400).Unit("s").Doc(
+      "after_trial: the run ends this long after the questions began, answered or not");
   spec.Param("task_target", int64_t{-1}).Range(-1, 1e6).Live().Doc(
       "subject's page: the data set's primitive to draw, drawn boldly over the workspace (-1: none; needs params.dataset)");
   spec.Param("task_message", "").Live().Doc("subject's page: a message above the workspace (empty: none)");
@@ -238,11 +246,19 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
   reports_ = &ctx.output<msg::SelfReport>("self_report");
   so.watermark = p.Bool("show_primitives");
   so.ask = reports_->bound() && p.String("self_reports") == "after_event";
+  after_trial_ = reports_->bound() && p.String("self_reports") == "after_trial";
+  ask_after_ns_ = static_cast<int64_t>(std::llround(p.Double("ask_after_s") * 1e9));
+  question_timeout_ns_ = static_cast<int64_t>(std::llround(p.Double("self_report_timeout_s") * 1e9));
+  ctx.CheckLiveParam("ask", [this](const ParamValue& v) {
+    if (std::get<bool>(v) && !after_trial_)
+      return Status::FailedPrecondition("only a page with self_reports: after_trial and its self_report output bound asks after the trial");
+    return Status::OK();
+  });
   so.ask_after_hold_s = p.Double("self_report_min_hold_s");
   min_hold_ns_ = static_cast<int64_t>(std::llround(so.ask_after_hold_s * 1e9));
-  if (so.watermark || so.ask || p.Int("task_target") >= 0) {
-    const std::string why = so.watermark ? "params.show_primitives"
-                            : so.ask     ? "params.self_reports (the question's thumbnails)"
+  if (so.watermark || so.ask || after_trial_ || p.Int("task_target") >= 0) {
+    const std::string why = so.watermark              ? "params.show_primitives"
+                            : so.ask || after_trial_ ? "params.self_reports (the question's thumbnails)"
                                          : "params.task_target";
     if (p.String("dataset").empty()) return Status::InvalidArgument(why + ": needs params.dataset (an NRL data set folder)");
   }
@@ -268,13 +284,14 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
         const int64_t now = ctx_->clock().now_ns();
         if (engaged && !holding_) hold_start_ns_ = now;
         if (!engaged && holding_) hold_end_ns_ = now, answerable_ = true;
+        if (after_trial_) MarkHold(x, y, engaged && !holding_, !engaged && holding_, now);
         holding_ = engaged;
         pointer_sample_.x(x);
         pointer_sample_.y(y);
         pointer_sample_.engaged(engaged);
         if (Status s = pointer_->Publish(pointer_sample_); !s.ok()) ctx_->log().Warn("pointer: " + s.ToString());
       },
-      [this](int choice) { return PublishSelfReport(choice); });
+      [this](int choice, int segment) { return PublishSelfReport(choice, segment); });
   return Status::OK();
 }
 
@@ -325,19 +342,110 @@ void WebComponent::StepTask() {
   if (Status s = task_out_->Publish(m); !s.ok()) ctx_->log().Warn("task: not published: " + s.ToString());
 }
 
-// The answer about the last hold, once (a second click, or an answer while holding again, is ignored).
-Status WebComponent::PublishSelfReport(int choice) {
-  // The server's own checks, whatever a page sends: a finished hold, long enough to be asked about.
-  if (!answerable_ || holding_ || hold_end_ns_ - hold_start_ns_ < min_hold_ns_) return Status::OK();
-  answerable_ = false;
+// A pointer sample (after_trial): where it is (a trace without robot states), and whether a hold
+// starts or ends; the holds are kept for the questions after the trial. A hold shorter than
+// self_report_min_hold_s is no event and is forgotten.
+void WebComponent::MarkHold(double x, double y, bool starts, bool ends, int64_t now) {
+  std::lock_guard<std::mutex> lock(holds_mutex_);
+  last_pointer_ = {x, y};
+  if (asking_) return;  // the trial is over: nothing more to ask about
+  if (starts) {
+    holds_.push_back(Hold{now, 0, {}});
+    return;
+  }
+  if (!ends || holds_.empty() || holds_.back().end_ns != 0) return;
+  holds_.back().end_ns = now;
+  if (now - holds_.back().start_ns < min_hold_ns_) holds_.pop_back();
+}
+
+// The answer: after an event (segment -1), about the last hold, once (a second click, or an
+// answer while holding again, is ignored); after the trial, about hold `segment`.
+Status WebComponent::PublishSelfReport(int choice, int segment) {
   const int64_t now = ctx_->clock().now_ns();
   msg::SelfReport r;
   r.choice(choice);
-  r.response_s(static_cast<double>(now - hold_end_ns_) * 1e-9);
-  r.segment_start_ns(hold_start_ns_);
-  r.segment_end_ns(hold_end_ns_);
+  if (segment >= 0) {
+    std::lock_guard<std::mutex> lock(holds_mutex_);
+    if (!asking_ || segment >= static_cast<int>(asked_.size())) return Status::OK();
+    const Hold& h = asked_[static_cast<size_t>(segment)];
+    r.response_s(static_cast<double>(now - question_shown_ns_) * 1e-9);
+    r.segment_start_ns(h.start_ns);
+    r.segment_end_ns(h.end_ns);
+    question_shown_ns_ = now;  // the next question is shown now
+  } else {
+    // The server's own checks, whatever a page sends: a finished hold, long enough to be asked about.
+    if (!answerable_ || holding_ || hold_end_ns_ - hold_start_ns_ < min_hold_ns_) return Status::OK();
+    answerable_ = false;
+    r.response_s(static_cast<double>(now - hold_end_ns_) * 1e-9);
+    r.segment_start_ns(hold_start_ns_);
+    r.segment_end_ns(hold_end_ns_);
+  }
   if (Status s = reports_->Publish(r); !s.ok()) ctx_->log().Warn("self_report: the subject's answer was lost: " + s.ToString());
+  if (segment >= 0) ++answered_;
   return Status::OK();
+}
+
+namespace {
+// At most `n` points of `trace`, evenly taken, the last one kept (a page draws it in a thumbnail).
+SubjectChannel::Trace Thin(const SubjectChannel::Trace& trace, size_t n) {
+  if (trace.size() <= n) return trace;
+  SubjectChannel::Trace out;
+  for (size_t i = 0; i < n; ++i) out.push_back(trace[i * (trace.size() - 1) / (n - 1)]);
+  return out;
+}
+}  // namespace
+
+// Each step of self_reports: after_trial: the trace of the hold under way; then, once asked (the
+// `ask` param, or ask_after_s into the run), the questions; the run's end once they are answered
+// or timed out.
+void WebComponent::StepAfterTrial(int64_t now, bool robot_moved) {
+  if (first_step_ns_ < 0) first_step_ns_ = now;
+  if (!asking_) {
+    {
+      std::lock_guard<std::mutex> lock(holds_mutex_);
+      if (!holds_.empty() && holds_.back().end_ns == 0 && (robot_moved || holds_.back().trace.empty())) {
+        // What the subject saw drawn: the robot's path, else (no robot state) the pointer's.
+        const msg::CartesianState* r = robot_->latest();
+        holds_.back().trace.push_back(r != nullptr ? std::array<double, 2>{r->x(), r->y()} : last_pointer_);
+      }
+    }
+    const bool due = ctx_->params().Bool("ask") || (ask_after_ns_ > 0 && now - first_step_ns_ >= ask_after_ns_);
+    if (due) StartQuestions(now);
+    return;
+  }
+  if (stop_requested_) return;
+  const int of = static_cast<int>(asked_.size());
+  if (answered_ >= of || now - question_start_ns_ >= question_timeout_ns_) {
+    stop_requested_ = true;
+    const std::string what = std::to_string(answered_.load()) + " of " + std::to_string(of) + " holds answered";
+    if (answered_ < of) ctx_->log().Warn("self_report: the questions timed out (params.self_report_timeout_s): " + what);
+    ctx_->RequestStop("the trial is over and its questions ended (" + what + ")");
+  }
+}
+
+nlohmann::json WebComponent::QuestionsJson() {
+  if (!after_trial_) return nullptr;
+  std::lock_guard<std::mutex> lock(holds_mutex_);
+  return {{"asked", asking_}, {"answered", answered_.load()}, {"of", asking_ ? asked_.size() : holds_.size()}};
+}
+
+// Ends the steering; asks the subject's page about each hold of the trial (the one under way
+// ends now).
+void WebComponent::StartQuestions(int64_t now) {
+  std::vector<SubjectChannel::Trace> traces;
+  {
+    std::lock_guard<std::mutex> lock(holds_mutex_);
+    asking_ = true;
+    if (!holds_.empty() && holds_.back().end_ns == 0) {
+      holds_.back().end_ns = now;
+      if (now - holds_.back().start_ns < min_hold_ns_) holds_.pop_back();
+    }
+    asked_ = std::move(holds_);
+    for (const Hold& h : asked_) traces.push_back(Thin(h.trace, 300));
+    question_start_ns_ = question_shown_ns_ = now;
+  }
+  ctx_->log().Info("self_report: the trial is over; asking the subject about its " + std::to_string(traces.size()) + " holds");
+  subject_->AskAfterTrial(std::move(traces));
 }
 
 // The experimenter's page: series, notes, live parameters, stats, run events.
@@ -442,6 +550,7 @@ Status WebComponent::Activate() {
 
 Status WebComponent::Step(const StepInfo& info) {
   StepTask();
+  if (after_trial_) StepAfterTrial(ctx_->clock().now_ns(), robot_->new_count() > 0);
   if (robot_->new_count() > 0) {
     const msg::CartesianState* r = robot_->latest();
     subject_->BroadcastState(r->x(), r->y());
@@ -470,6 +579,8 @@ Status WebComponent::Step(const StepInfo& info) {
     experimenter_->Broadcast(5, nlohmann::json{{"op", "subject"},
                                                {"pages", subject_->pages()},
                                                {"engaged", holding_.load()},
+                                               {"after_trial", after_trial_},
+                                               {"questions", QuestionsJson()},
                                                {"component", ctx_->name()},
                                                {"primitives", primitives_},
                                                {"names", primitive_names_},

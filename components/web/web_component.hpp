@@ -3,7 +3,10 @@
 ///     a target primitive, a message, a countdown, "practice"; see web_human.hpp; after
 ///     each release of a hold of at least `self_report_min_hold_s`, when `self_report` is bound,
 ///     it asks "What were you drawing?" and the answer leaves on `self_report` with the hold's
-///     start and end on the runtime clock),
+///     start and end on the runtime clock; with self_reports: after_trial it asks nothing during
+///     the trial: when `ask` is set, or `ask_after_s` into the run, steering ends, the page asks
+///     about each hold in turn (its trace as the picture), and once all are answered or
+///     `self_report_timeout_s` passed the component ends the run with RequestStop),
 ///   - `/experimenter`: the experimenter's page (with `learner` bound, also "learn from this
 ///     session": the learner's demonstrations, a run's loss, the swap; docs/components.md#learner),
 ///   - `/`: an index page, and the Foxglove WebSocket bridge over the graph's topics for
@@ -24,8 +27,12 @@
 /// YAML like every other part.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <memory>
+#include <mutex>
+
+#include <nlohmann/json.hpp>
 
 #include <dyad/component.hpp>
 #include <dyad/msg/types.hpp>
@@ -55,7 +62,11 @@ class WebComponent final : public Component {
   Status ConfigureExperimenter(Context& ctx);
   void ConfigurePages();
   StatusOr<std::string> PublishParamRequest(const ParamRequest& request);  // ExperimenterChannel's param sink
-  Status PublishSelfReport(int choice);                                    // SubjectChannel's report sink
+  Status PublishSelfReport(int choice, int segment);                       // SubjectChannel's report sink
+  void MarkHold(double x, double y, bool starts, bool ends, int64_t now);  // after_trial: the holds asked about
+  void StepAfterTrial(int64_t now, bool robot_moved);
+  void StartQuestions(int64_t now);
+  nlohmann::json QuestionsJson();  // for the experimenter's page: null, or asked/answered/of
   Status ConfigureTask(Context& ctx, const Params& p);
   void StepTask();
   Context* ctx_ = nullptr;
@@ -99,6 +110,21 @@ class WebComponent final : public Component {
   std::atomic<bool> holding_{false};  // read by Step for the experimenter's page
   bool answerable_ = false;
   int64_t hold_start_ns_ = 0, hold_end_ns_ = 0, min_hold_ns_ = 0;
+  // self_reports: after_trial. The holds of the trial, kept by the pointer sink (ends) and Step
+  // (traces), until the questions start; then `asked_`, read by the report sink.
+  struct Hold {
+    int64_t start_ns = 0, end_ns = 0;  // end 0: under way
+    SubjectChannel::Trace trace;
+  };
+  bool after_trial_ = false;
+  int64_t ask_after_ns_ = 0, question_timeout_ns_ = 0, first_step_ns_ = -1;
+  std::mutex holds_mutex_;  // guards the members below
+  std::vector<Hold> holds_, asked_;
+  std::array<double, 2> last_pointer_{};  // the steering page's last position
+  bool asking_ = false;
+  int64_t question_start_ns_ = 0, question_shown_ns_ = 0;
+  std::atomic<int> answered_{0};
+  bool stop_requested_ = false;  // step thread only
 };
 
 }  // namespace dyad::web

@@ -13,6 +13,7 @@ namespace {
 using json = nlohmann::json;
 constexpr uint32_t kStateChannel = 1;
 constexpr uint32_t kTaskChannel = 2;
+constexpr uint32_t kQuestionChannel = 3;
 }  // namespace
 
 void SubjectChannel::SetServer(WebServer* server) { server_.store(server); }
@@ -25,18 +26,47 @@ std::string SubjectChannel::TaskJson() const {
       .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
-void SubjectChannel::SetTask(const Task& task) {
+void SubjectChannel::SendToAll(uint32_t channel, const std::string& frame) {
   std::vector<ClientId> pages;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pages = pages_;
+  }
+  if (WebServer* server = server_.load())
+    for (ClientId c : pages) server->SendLatest(c, channel, frame, /*binary=*/false);
+}
+
+void SubjectChannel::SetTask(const Task& task) {
   std::string frame;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     task_ = task;
-    pages = pages_;
     frame = TaskJson();
   }
-  WebServer* server = server_.load();
-  if (server == nullptr) return;
-  for (ClientId c : pages) server->SendLatest(c, kTaskChannel, frame, /*binary=*/false);
+  SendToAll(kTaskChannel, frame);
+}
+
+std::string SubjectChannel::QuestionJson() const {
+  const int of = static_cast<int>(questions_.size());
+  if (asked_ >= questions_.size()) return json{{"op", "question"}, {"segment", -1}, {"of", of}}.dump();
+  json trace = json::array();
+  for (const auto& xy : questions_[asked_]) trace.push_back({xy[0], xy[1]});
+  return json{{"op", "question"}, {"segment", static_cast<int>(asked_)}, {"of", of}, {"trace", trace}}
+      .dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+void SubjectChannel::AskAfterTrial(std::vector<Trace> traces) {
+  std::string frame;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (trial_over_) return;
+    trial_over_ = true;
+    if (steering_ != 0) sink_(last_x_, last_y_, false);  // a hold ends now
+    questions_ = std::move(traces);
+    asked_ = 0;
+    frame = QuestionJson();
+  }
+  SendToAll(kQuestionChannel, frame);
 }
 
 size_t SubjectChannel::pages() const {
@@ -75,10 +105,11 @@ void SubjectChannel::SendRole(ClientId client, bool steering) {
 void SubjectChannel::OnOpen(ClientId client, Role role) {
   bool steering = false;
   ClientId demoted = 0;
-  std::string task;
+  std::string task, question;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     task = TaskJson();
+    if (trial_over_) question = QuestionJson();
     pages_.push_back(client);
     roles_[client] = role;
     // The subject's page steers before the experimenter's: an experimenter who opened /subject
@@ -113,6 +144,7 @@ void SubjectChannel::OnOpen(ClientId client, Role role) {
                                 {"ask_after_hold_s", options_.ask_after_hold_s}}
                                .dump());
   server->SendText(client, task);
+  if (!question.empty()) server->SendLatest(client, kQuestionChannel, question, /*binary=*/false);
 }
 
 Status SubjectChannel::OnText(ClientId client, std::string_view text) {
@@ -136,7 +168,7 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
       if (client != steering_) return Status::OK();  // a watching page: ignored
       last_x_ = std::clamp(px, -h, h);
       last_y_ = std::clamp(py, -h, h);
-      sink_(last_x_, last_y_, engaged->get<bool>());
+      sink_(last_x_, last_y_, engaged->get<bool>() && !trial_over_);  // after the trial nobody steers
       if (auto wall = j.find("wall"); wall != j.end() && wall->is_number() && delays_.total.size() < 100000) {
         const double event_ms = wall->get<double>(), published_ms = WallNowMs();
         delays_.total.push_back(published_ms - event_ms);
@@ -172,10 +204,26 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
     if (choice == j.end() || !choice->is_number_integer() || choice->get<int64_t>() < -1 || choice->get<int64_t>() > last)
       return Status::InvalidArgument("self_report: needs an integer \"choice\" in -1.." + std::to_string(last) +
                                      " (a primitive, or -1: something else)");
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("self_report: a viewer's token may not answer");
-    if (client != steering_ || !report_ || !options_.ask) return Status::OK();  // nobody asked this page
-    return report_(static_cast<int>(choice->get<int64_t>()));
+    auto segment = j.find("segment");
+    if (segment != j.end() && (!segment->is_number_integer() || segment->get<int64_t>() < 0))
+      return Status::InvalidArgument("self_report: \"segment\" must be the index of the question answered (an integer >= 0)");
+    std::string next;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("self_report: a viewer's token may not answer");
+      if (client != steering_ || !report_) return Status::OK();  // nobody asked this page
+      if (!trial_over_) {
+        if (!options_.ask) return Status::OK();
+        return report_(static_cast<int>(choice->get<int64_t>()), -1);
+      }
+      // After the trial: only an answer to the question shown (a second click, or a stale page's, is ignored).
+      if (segment == j.end() || asked_ >= questions_.size() || segment->get<int64_t>() != static_cast<int64_t>(asked_)) return Status::OK();
+      if (Status s = report_(static_cast<int>(choice->get<int64_t>()), static_cast<int>(asked_)); !s.ok()) return s;
+      ++asked_;
+      next = QuestionJson();
+    }
+    SendToAll(kQuestionChannel, next);
+    return Status::OK();
   }
   return Status::InvalidArgument("unknown op");
 }

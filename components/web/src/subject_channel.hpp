@@ -5,14 +5,22 @@
 /// pointer or key event and every 50 ms while engaged (a keepalive); {"op":"steer"} to take the
 /// steering role; {"op":"self_report","choice":k} the subject's answer to "What were you
 /// drawing?" (k: a primitive's index, -1 "something else"; from the steering page only, a viewer's
-/// is refused). Server -> page: {"op":"hello",...} (role, steering, workspace, engage key,
+/// is refused), with "segment":i when it answers a question after the trial (below). Server -> page: {"op":"hello",...} (role, steering, workspace, engage key,
 /// primitives, whether they are a watermark, whether and after how long a hold to ask),
 /// {"op":"role","steering":bool}, {"op":"task","target":k,"message":"..","countdown_s":s,
 /// "practice":bool} (the experimenter's task: sent to every page at each change and to a page
 /// that opens, its countdown as what is left of it then), {"op":"state","x","y"} (newest
 /// only: a slow page never builds a backlog), {"op":"ack","t":ms} after each pointer sample was
-/// published (the page measures the round trip). A pointer sample may carry "wall" (the event's
-/// time, ms since the epoch): the channel then keeps the event-to-publication delay.
+/// published (the page measures the round trip), {"op":"question","segment":i,"of":n,"trace":
+/// [[x,y],...]} after the trial (segment -1: every question answered, "thank you"). A pointer
+/// sample may carry "wall" (the event's time, ms since the epoch): the channel then keeps the
+/// event-to-publication delay.
+///
+/// After the trial (self_reports: after_trial, AskAfterTrial): steering ends for good (the hold
+/// ends at once, every later pointer sample is published released) and the pages are asked about
+/// each of the trial's holds in turn, its trace as the picture; the steering page's answer to the
+/// question shown (an answer to another is stale and ignored) goes to the ReportSink with its
+/// index, then the next question is shown, to a page that opens later too.
 ///
 /// Several pages may watch; one steers: the first to connect with the subject's or the
 /// experimenter's token, until it leaves (the oldest such page left then steers, a subject's
@@ -49,8 +57,9 @@ class SubjectChannel final : public ClientHandler {
   // Publishes one pointer sample on the graph (called on civetweb threads, serialised here).
   using PointerSink = std::function<void(double x, double y, bool engaged)>;
 
-  // Publishes the steering page's answer (called like PointerSink); its Status goes back to the page.
-  using ReportSink = std::function<Status(int choice)>;
+  // Publishes the steering page's answer (called like PointerSink); its Status goes back to the
+  // page. segment: -1 after an event (after_event), else the index of the hold asked about.
+  using ReportSink = std::function<Status(int choice, int segment)>;
 
   SubjectChannel(Options options, PointerSink sink, ReportSink report = {})
       : options_(std::move(options)), sink_(std::move(sink)), report_(std::move(report)) {}
@@ -68,6 +77,10 @@ class SubjectChannel final : public ClientHandler {
   // Sends it to every page, and to every page that opens later.
   void SetTask(const Task& task);
   size_t pages() const;
+  // Ends the steering and asks about each trace in turn (see the file comment); none: thanks at
+  // once. Once per channel; a second call is ignored.
+  using Trace = std::vector<std::array<double, 2>>;
+  void AskAfterTrial(std::vector<Trace> traces);
   // Where a pointer sample's time went, in ms, for each sample that carried the page's "wall"
   // stamp (meaningful when page and server share a clock; the first 100,000). The hops add up to
   // the total; the hops are empty when no server delivered the samples.
@@ -86,7 +99,9 @@ class SubjectChannel final : public ClientHandler {
 
  private:
   void SendRole(ClientId client, bool steering);
-  std::string TaskJson() const;  // with mutex_ held
+  std::string TaskJson() const;      // with mutex_ held
+  std::string QuestionJson() const;  // with mutex_ held
+  void SendToAll(uint32_t channel, const std::string& frame);
   const Options options_;
   const PointerSink sink_;
   const ReportSink report_;
@@ -97,6 +112,9 @@ class SubjectChannel final : public ClientHandler {
   ClientId steering_ = 0;        // 0: none
   double last_x_ = 0, last_y_ = 0;
   Task task_;
+  bool trial_over_ = false;  // AskAfterTrial came: no more steering
+  std::vector<Trace> questions_;
+  size_t asked_ = 0;         // the question shown; questions_.size(): all answered
   PointerDelays delays_;
 };
 

@@ -15,7 +15,8 @@ struct Answers {
     SubjectChannel::Options o;
     o.primitives.assign(7, {{0.0, 0.0}, {1.0, 1.0}});
     o.ask = ask;
-    return SubjectChannel(o, [](double, double, bool) {}, [this](int c) {
+    return SubjectChannel(o, [](double, double, bool) {}, [this](int c, int segment) {
+      EXPECT_EQ(segment, -1) << "an answer after an event is about no question of the trial";
       choices.push_back(c);
       return Status::OK();
     });
@@ -56,6 +57,44 @@ TEST(SubjectChannel, AnAnswerNobodyAskedForIsIgnored) {
   ch.OnOpen(1, Role::kSubject);
   EXPECT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":2})").ok());
   EXPECT_TRUE(a.choices.empty());
+}
+
+// self_reports: after_trial. Once the trial is over nobody steers (the hold under way ends, a
+// later pointer sample is published released), and only the steering page's answer to the
+// question shown counts: one answer per hold, in turn.
+TEST(SubjectChannel, AfterTheTrialEachHoldIsAskedInTurnAndNobodySteers) {
+  std::vector<bool> engaged;
+  std::vector<std::pair<int, int>> answers;  // (choice, segment)
+  SubjectChannel::Options o;
+  o.primitives.assign(7, {{0.0, 0.0}, {1.0, 1.0}});
+  SubjectChannel ch(o, [&](double, double, bool e) { engaged.push_back(e); }, [&](int c, int segment) {
+    answers.push_back({c, segment});
+    return Status::OK();
+  });
+  ch.OnOpen(1, Role::kSubject);  // steers
+  ch.OnOpen(2, Role::kSubject);  // watches
+  ch.OnOpen(3, Role::kViewer);
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":1,"segment":0})").ok());
+  EXPECT_TRUE(answers.empty()) << "nothing is asked before the trial ends (and after_event is off)";
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"pointer","x":1,"y":2,"engaged":true})").ok());
+  ch.AskAfterTrial({{{0, 0}, {1, 1}}, {{2, 2}, {3, 3}}});
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"pointer","x":1,"y":2,"engaged":true})").ok());
+  EXPECT_EQ(engaged, (std::vector<bool>{true, false, false})) << "the hold ends when the trial does; no steering after it";
+  ch.AskAfterTrial({{{9, 9}}});  // a second call changes nothing
+  for (const char* ignored : {R"({"op":"self_report","choice":2})",               // no question named
+                              R"({"op":"self_report","choice":2,"segment":1})"})  // not the one shown
+    ASSERT_TRUE(ch.OnText(1, ignored).ok()) << ignored;
+  ASSERT_TRUE(ch.OnText(2, R"({"op":"self_report","choice":2,"segment":0})").ok()) << "a watching page is ignored";
+  EXPECT_EQ(ch.OnText(3, R"({"op":"self_report","choice":2,"segment":0})").code(), Status::Code::kFailedPrecondition);
+  for (const char* bad : {R"({"op":"self_report","choice":2,"segment":-1})", R"({"op":"self_report","choice":2,"segment":"0"})",
+                          R"({"op":"self_report","choice":2,"segment":0.5})"})
+    EXPECT_EQ(ch.OnText(1, bad).code(), Status::Code::kInvalidArgument) << bad;
+  EXPECT_TRUE(answers.empty());
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":3,"segment":0})").ok());
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":4,"segment":0})").ok());  // a second click: ignored
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":-1,"segment":1})").ok());
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":5,"segment":2})").ok());  // there is no third
+  EXPECT_EQ(answers, (std::vector<std::pair<int, int>>{{3, 0}, {-1, 1}}));
 }
 
 // The experimenter opens /subject before the participant: the participant's page, once it
