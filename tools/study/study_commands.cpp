@@ -138,8 +138,12 @@ bool RunOne(const study::Study& s, const RunOptions& o, const study::Trial& t, s
   }
   std::cout << TrialLine(s, t, of) << (r.attempt > 1 ? ", attempt " + std::to_string(r.attempt) : "") << " -> "
             << study::AttemptFile(t, r.attempt) << "\n"
-            << (s.duration_s > 0 ? "  running for " + std::to_string(static_cast<int>(s.duration_s)) + " s (Ctrl-C stops it early)"
-                                 : std::string("  running (Ctrl-C ends it)"))
+            << (s.self_reports == "after_trial"
+                    ? (s.duration_s > 0 ? "  running for " + std::to_string(static_cast<int>(s.duration_s)) + " s"
+                                        : std::string("  running until the experimenter's page ends it")) +
+                          ", then the subject is asked about each hold and the trial ends once they answer (Ctrl-C stops it)"
+                    : s.duration_s > 0 ? "  running for " + std::to_string(static_cast<int>(s.duration_s)) + " s (Ctrl-C stops it early)"
+                                       : std::string("  running (Ctrl-C ends it)"))
             << std::endl;
   auto a = study::RunAttempt(s, r);
   if (!a.ok()) {

@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dyad/graph.hpp"
+#include "dyad/join_list.hpp"
 #include "dyad/strict_yaml.hpp"
 #include "graph_check.hpp"
 #include "yaml_file.hpp"
@@ -44,10 +45,8 @@ void ReadScalars(StrictYaml& y, const YAML::Node& root, const std::string& path,
   y.Get(root, "blind", "blind", &s->blind, "true or false");
   y.Get(root, "consent_required", "consent_required", &s->consent_required, "true or false");
   if (y.Get(root, "self_reports", "self_reports", &s->self_reports, "a word") && s->self_reports != "after_event" &&
-      s->self_reports != "off")
-    y.Error(root["self_reports"], "self_reports",
-            s->self_reports == "after_trial" ? "after_trial is not asked by the subject's page yet: after_event or off"
-                                             : "must be after_event or off");
+      s->self_reports != "after_trial" && s->self_reports != "off")
+    y.Error(root["self_reports"], "self_reports", "must be after_event, after_trial or off");
 }
 
 void ReadParticipants(StrictYaml& y, const YAML::Node& root, Study* s) {
@@ -111,13 +110,28 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
   // Whether the subject's page asks: each `web` component of the graph is told.
   if (!s->graph.empty()) {
     std::vector<Diagnostic> ignored;  // the graph's own problems were said above
+    std::vector<std::string> webs, answering;  // the web components; those whose answers are recorded
     for (const ComponentConfig& c : LoadGraph(s->graph, {}, &ignored).components)
       if (c.type == "web") {
+        webs.push_back(c.name);
+        for (const PortBinding& out : c.outputs)
+          if (out.port == "self_report" && !out.topic.empty()) answering.push_back(c.name);
         s->page_sets.push_back(c.name + ".self_reports=" + s->self_reports);
+        // After the trial the page asks, then ends the run: at the trial's duration.
+        if (s->self_reports == "after_trial" && s->duration_s > 0)
+          s->page_sets.push_back(c.name + ".ask_after_s=" + tools::SetText(YAML::Node(s->duration_s)));
         // The same tokens for every trial of a participant (each participant their own), so the
         // pages reconnect to the next trial's graph.
         if (!c.params || !c.params["token_file"]) s->token_file_webs.push_back(c.name);
       }
+    // The one page that asks after the trial also ends it: two would end it at the first's end.
+    if (s->self_reports == "after_trial" && (webs.size() != 1 || answering.size() != 1))
+      y.Error(root["self_reports"], "self_reports",
+              "after_trial needs the graph's one `web` component (its subject's page asks, then ends the trial) with its "
+              "self_report output bound; " + s->graph + " has " +
+                  (webs.empty() ? std::string("none")
+                                : std::to_string(webs.size()) + " (" + JoinList(webs) + "), " +
+                                      std::to_string(answering.size()) + " binding self_report"));
   }
   s->rehearsal_graph = s->graph;
   const YAML::Node r = root["rehearsal"];

@@ -188,6 +188,7 @@ class StudyChannel final : public web::ClientHandler {
             {"withdrawn", session.withdrawn},
             {"notes", notes},
             {"duration_s", study_.duration_s},
+            {"after_trial", study_.self_reports == "after_trial"},
             {"trials", trials},
             {"running", running},
             {"done", done},

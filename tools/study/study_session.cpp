@@ -66,6 +66,8 @@ std::vector<std::string> RunSets(const Study& s, const AttemptRequest& r) {
   return sets;
 }
 
+bool AskedAfterTrial(const Study& s) { return s.self_reports == "after_trial"; }
+
 std::string GraphHash(const std::string& graph, const std::vector<std::string>& sets) {
   std::ifstream in(graph, std::ios::binary);
   std::ostringstream text;
@@ -288,7 +290,10 @@ std::vector<std::string> AttemptCommand(const Study& s, const AttemptRequest& r)
   const Condition& c = ConditionOf(s, r.trial);
   std::vector<std::string> args = {r.dyad, "run", graph};
   if (r.rehearsal) args.push_back("--quiet");
-  if (s.duration_s > 0) args.insert(args.end(), {"--duration", std::to_string(s.duration_s)});
+  // Asked after the trial, the subject's page ends the run once answered (its ask_after_s is the
+  // duration, see LoadStudy); a rehearsal's synthetic people answer after each event.
+  if (s.duration_s > 0 && (r.rehearsal || !AskedAfterTrial(s)))
+    args.insert(args.end(), {"--duration", std::to_string(s.duration_s)});
   if (r.rehearsal) args.insert(args.end(), {"--set", "clock=stepped"});
   for (const std::string& set : sets) args.insert(args.end(), {"--set", set});
   const std::vector<std::pair<std::string, std::string>> metadata = {
@@ -351,9 +356,11 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   // A trial without a duration ends when the experimenter stops it (the graph then exits 0, or
   // 130 for the signal); a timed one stopped early is incomplete. A recording cut short (a
   // crash, a second stop) is never complete.
+  // Stopped while the subject answered after a full trial: the trial was complete.
   const bool stopped = forwarded > 0;
   const bool ended_well = a.exit == 0 || (stopped && a.exit == 128 + SIGINT);
-  if (stopped && s.duration_s > 0) a.outcome = "stopped";
+  const bool asking = !r.rehearsal && AskedAfterTrial(s) && a.seconds >= s.duration_s;
+  if (stopped && s.duration_s > 0 && !asking) a.outcome = "stopped";
   else a.outcome = ended_well ? "complete" : "failed";
   if (a.outcome == "complete") {
     auto recording = mcap::Reader::Open(a.file);

@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -151,6 +152,67 @@ TEST_F(StudySession, ConsentComesFirstThenEveryTrialRecordsItsMetadataAndNothing
   for (const std::string& m : a.missing) EXPECT_EQ(m.find("P01"), std::string::npos) << m;
   // P02 never came: their trials are missing, and said so.
   EXPECT_EQ(a.missing.size(), 2u);
+}
+
+// self_reports: after_trial, with the real `dyad` and `web`: the trial's graph gets no
+// --duration; its subject's page is told to ask at the duration (ask_after_s), asks about the
+// holds (none here: nobody came) and ends the run itself, so the trial is complete and its
+// recording whole. A rehearsal's stepped run keeps --duration. A graph with two pages, or whose
+// page records no answers, is refused at the key.
+TEST_F(StudySession, AfterTheTrialTheSubjectsPageEndsTheRun) {
+  ChildProcess data({DYAD_EXE, "generate", "dataset", "--out", (dir_ / "data").string()}, dir_, "data");
+  ASSERT_EQ(data.Wait(60), 0) << data.err();
+  const std::string web = "  web: {type: web, rate_hz: 20, params: {port: 0, dataset: " + (dir_ / "data").string() +
+                          "}, outputs: {pointer: web/pointer, notes: experiment/notes, self_report: human/self_report}}\n";
+  auto write_graph = [&](const std::string& webs) {
+    std::ofstream(dir_ / "w.yaml") << "graph: w\nclock: wall\ndomain_id: " << 1 + getpid() % 200 << "\ncomponents:\n" << webs
+                                   << "  src: {type: counter_source, rate_hz: 20, outputs: {out: c}}\n"
+                                      "  sink: {type: counter_sink, rate_hz: 20, inputs: {in: c}}\n"
+                                      "  recorder: {type: recorder, rate_hz: 1}\n";
+  };
+  write_graph(web);
+  std::ofstream(dir_ / "s.yaml") << "study: gain\ngraph: w.yaml\nparticipants: [P01]\nconditions:\n  low: {src.start: 1}\n"
+                                    "duration: 2\nself_reports: after_trial\n";
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy((dir_ / "s.yaml").string(), {}, &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  AttemptRequest r;
+  r.dyad = DYAD_EXE;
+  r.participant = "P01";
+  r.trial = s.TrialsOf("P01")[0];
+  const std::vector<std::string> command = AttemptCommand(s, r);
+  EXPECT_EQ(std::count(command.begin(), command.end(), "--duration"), 0) << "the page ends the run";
+  EXPECT_EQ(std::count(command.begin(), command.end(), "web.self_reports=after_trial"), 1);
+  EXPECT_EQ(std::count(command.begin(), command.end(), "web.ask_after_s=2"), 1);
+  r.rehearsal = true;
+  const std::vector<std::string> rehearsal = AttemptCommand(s, r);
+  EXPECT_EQ(std::count(rehearsal.begin(), rehearsal.end(), "--duration"), 1) << "stepped, synthetic people: the duration ends it";
+
+  ChildProcess run(Command({"--consent", "--yes"}), dir_, "run");
+  ASSERT_EQ(run.Wait(120), 0) << run.out() << run.err();
+  EXPECT_NE(run.err().find("web: ends the run: the trial is over and its questions ended (0 of 0 holds answered)"), std::string::npos)
+      << run.err();
+  const auto log = LogLines(SessionLogPath(s, "P01"));
+  ASSERT_EQ(log.size(), 3u);
+  EXPECT_EQ(log[2]["outcome"], "complete");
+  EXPECT_EQ(log[2]["exit"], 0);
+  EXPECT_GE(log[2]["seconds"].get<double>(), 2.0);
+  auto recording = mcap::Reader::Open(r.trial.file);
+  ASSERT_TRUE(recording.ok()) << recording.status().message();
+  EXPECT_FALSE(recording->recovery().truncated);
+
+  for (const auto& [webs, has] : std::vector<std::pair<std::string, std::string>>{
+           {web + "  web2: {type: web, rate_hz: 10, params: {port: 0}, outputs: {pointer: p2, notes: n2}}\n",
+            "has 2 (web, web2), 1 binding self_report"},
+           {"  web: {type: web, rate_hz: 10, outputs: {pointer: p, notes: n}}\n", "has 1 (web), 0 binding self_report"}}) {
+    write_graph(webs);
+    problems.clear();
+    LoadStudy((dir_ / "s.yaml").string(), {}, &problems);
+    std::string all;
+    for (const auto& p : problems) all += p.ToString() + "\n";
+    EXPECT_NE(all.find("s.yaml:7:15: self_reports: after_trial needs the graph's one `web` component"), std::string::npos) << all;
+    EXPECT_NE(all.find(has), std::string::npos) << "no '" << has << "' in\n" << all;
+  }
 }
 
 // A timed trial stopped early (Ctrl-C) is incomplete; a session killed mid-trial stops its graph

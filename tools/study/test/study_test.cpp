@@ -125,13 +125,13 @@ TEST_F(StudyFile, EveryBadInputIsSaidAtItsLine) {
   for (const std::string expected :
        {"s.yaml:3:21: participants[1]: 'Jane Doe' is not a pseudonymous ID", "s.yaml:3:31: participants[2]: participant P01 is listed twice (first at line 3)",
         "s.yaml:5:19: conditions.low.src.nope: does not validate:", "s.yaml:6:9: conditions.high: overrides nothing",
-        "s.yaml:7:9: trials: must be in 1..99", "s.yaml:8:15: self_reports: must be after_event or off",
+        "s.yaml:7:9: trials: must be in 1..99", "s.yaml:8:15: self_reports: must be after_event, after_trial or off",
         "s.yaml:9:1: colour: unknown key"})
     EXPECT_NE(all.find(expected), std::string::npos) << "no '" << expected << "' in\n" << all;
 }
 
 // The keys dyad study run and rehearse read: a recorder the graph lacks, a rehearsal graph that
-// is not there or whose keys a condition does not find, after_trial (not built yet).
+// is not there or whose keys a condition does not find, after_trial without a page to ask.
 TEST_F(StudyFile, BadRecorderRehearsalAndSelfReportsAreSaidAtTheirLine) {
   std::ofstream(dir_ / "other.yaml") << "graph: other\nclock: stepped\ncomponents:\n"
                                         "  src: {type: counter_source, rate_hz: 10, outputs: {out: c}}\n";
@@ -140,7 +140,9 @@ TEST_F(StudyFile, BadRecorderRehearsalAndSelfReportsAreSaidAtTheirLine) {
            {"rehearsal: {graph: missing.yaml}\n", "s.yaml:6:20: rehearsal.graph: no such file: " + (dir_ / "missing.yaml").string()},
            {"rehearsal: {graph: other.yaml}\n", "s.yaml:6:12: rehearsal: condition low does not validate on the rehearsal graph"},
            {"rehearsal: {colour: blue}\n", "s.yaml:6:13: rehearsal.colour: unknown key"},
-           {"self_reports: after_trial\n", "s.yaml:6:15: self_reports: after_trial is not asked by the subject's page yet"}}) {
+           {"self_reports: after_trial\n", "s.yaml:6:15: self_reports: after_trial needs the graph's one `web` component (its "
+                                            "subject's page asks, then ends the trial) with its self_report output bound; " +
+                                                (dir_ / "g.yaml").string() + " has none"}}) {
     const std::string f = Write("study: gain\ngraph: g.yaml\nparticipants: [P01]\nconditions:\n  low: {sink.rate_hz: 5}\n" + text);
     std::vector<Diagnostic> problems;
     LoadStudy(f, {}, &problems);
