@@ -155,15 +155,22 @@ bool RunOne(const study::Study& s, const RunOptions& o, const study::Trial& t, s
   return true;
 }
 
+// The study and the participant, or false after saying what is wrong.
+bool LoadParticipant(const std::string& file, const std::vector<std::string>& plugins, const std::string& participant,
+                     const char* command, study::Study* s) {
+  if (!Load(file, plugins, s)) return false;
+  if (s->TrialsOf(participant).empty()) {
+    std::cerr << command << ": --participant " << participant << " is not a participant of " << s->file << "\n";
+    return false;
+  }
+  return true;
+}
+
 // `dyad study run`: the participant's trials in their order, from the first not yet complete.
 int RunSession(const RunOptions& o) {
   study::Study s;
-  if (!Load(o.file, o.plugins, &s)) return kBadInput;
+  if (!LoadParticipant(o.file, o.plugins, o.participant, "dyad study run", &s)) return kBadInput;
   const std::vector<study::Trial> trials = s.TrialsOf(o.participant);
-  if (trials.empty()) {
-    std::cerr << "dyad study run: --participant " << o.participant << " is not a participant of " << s.file << "\n";
-    return kBadInput;
-  }
   if (o.trial > static_cast<int>(trials.size())) {
     std::cerr << "dyad study run: --trial " << o.trial << ": " << o.participant << " has " << trials.size() << " trials\n";
     return kBadInput;
@@ -248,20 +255,11 @@ struct ParticipantOptions {
   bool delete_data = false, yes = false, include = false;
 };
 
-// The study and the participant, or false after saying what is wrong.
-bool LoadParticipant(const ParticipantOptions& o, const char* command, study::Study* s) {
-  if (!Load(o.file, o.plugins, s)) return false;
-  if (s->TrialsOf(o.participant).empty()) {
-    std::cerr << command << ": --participant " << o.participant << " is not a participant of " << o.file << "\n";
-    return false;
-  }
-  return true;
-}
 
 // `dyad study note`: a line in the participant's session log (the study's report lists them).
 int Note(const ParticipantOptions& o) {
   study::Study s;
-  if (!LoadParticipant(o, "dyad study note", &s)) return kBadInput;
+  if (!LoadParticipant(o.file, o.plugins, o.participant, "dyad study note", &s)) return kBadInput;
   if (Status st = study::AddNote(s, o.participant, o.text); !st.ok()) {
     std::cerr << "dyad study note: " << st.ToString() << "\n";
     return st.code() == Status::Code::kInvalidArgument ? kBadInput : 1;
@@ -274,7 +272,7 @@ int Note(const ParticipantOptions& o) {
 int Exclude(const ParticipantOptions& o) {
   const char* command = o.include ? "dyad study include" : "dyad study exclude";
   study::Study s;
-  if (!LoadParticipant(o, command, &s)) return kBadInput;
+  if (!LoadParticipant(o.file, o.plugins, o.participant, command, &s)) return kBadInput;
   if (Status st = study::ExcludeParticipant(s, o.participant, !o.include, o.reason); !st.ok()) {
     std::cerr << command << ": " << st.ToString() << "\n";
     return st.code() == Status::Code::kInvalidArgument ? kBadInput : 1;
@@ -287,7 +285,7 @@ int Exclude(const ParticipantOptions& o) {
 // `dyad study withdraw`: the participant withdraws consent; with --delete-data their files go.
 int Withdraw(const ParticipantOptions& o) {
   study::Study s;
-  if (!LoadParticipant(o, "dyad study withdraw", &s)) return kBadInput;
+  if (!LoadParticipant(o.file, o.plugins, o.participant, "dyad study withdraw", &s)) return kBadInput;
   auto lock = study::SessionLock::Acquire(s, o.participant);
   if (!lock.ok()) {
     std::cerr << "dyad study withdraw: " << lock.status().ToString() << ": stop the session first\n";

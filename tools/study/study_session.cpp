@@ -202,7 +202,11 @@ Status AppendSessionEvent(const Study& s, const std::string& participant, const 
   if (n != static_cast<ssize_t>(text.size())) return Status::IOError(path, "cannot append to the session log");
   if (sync_error != 0)
     return Status::IOError(path, std::string("the session log could not be flushed to disk: ") + std::strerror(sync_error));
-  return is_new ? SyncDirectory(fs::path(path).parent_path().string()) : Status::OK();
+  if (!is_new) return Status::OK();
+  // A new log: its entry in the participant's folder, and that folder's in the data folder (it
+  // may be new too).
+  if (Status st = SyncDirectory(fs::path(path).parent_path().string()); !st.ok()) return st;
+  return SyncDirectory(fs::path(path).parent_path().parent_path().string());
 }
 
 Status AddNote(const Study& s, const std::string& participant, const std::string& text) {
