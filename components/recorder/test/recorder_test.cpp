@@ -329,6 +329,30 @@ TEST_F(RecorderTest, TheStatusSaysTheFileTheSamplesAndTheTimeEachStep) {
   EXPECT_LE(last_bytes, fs::file_size(dir_ / "s.mcap"));
 }
 
+// A write that fails (here the file size limit: EFBIG, SIGXFSZ ignored) is said on `status`
+// before the failure ends the run, so a page showing the status says why the recording stopped;
+// a second recorder, whose small file stays under the limit, keeps what was said.
+TEST_F(RecorderTest, AFailedWriteIsSaidOnTheStatusBeforeTheRunEnds) {
+  std::string g = ThreePublishers("wall", 2000, 5, 5, "file: '" + (dir_ / "big.mcap").string() + "', topics: [ca], chunk_size: 4096");
+  g.replace(g.find("recorder, rate_hz: 1, params"), 28, "recorder, rate_hz: 20, outputs: {status: rec/status}, params");
+  g += "  watch: {type: recorder, rate_hz: 20, params: {file: '" + (dir_ / "status.mcap").string() + "', topics: [rec/status]}}\n";
+  g += "topics:\n  rec/status: {type: RecordingStatus, reliability: reliable, depth: 100}\n";
+  const fs::path graph = Write("g.yaml", g);
+  // 256 KiB: ca's 2000 samples a second pass it in about a second; status.mcap stays far below.
+  Child c({"/bin/sh", "-c", "trap '' XFSZ; ulimit -f 256; exec \"$0\" run \"$1\" --duration 30", DYAD_EXE, graph.string()}, dir_, "limited");
+  const int code = c.Wait(60);
+  ASSERT_NE(code, -1) << "the run did not end at the failure";
+  EXPECT_NE(code, 0) << c.err();
+  EXPECT_NE(c.err().find("params.file = '" + (dir_ / "big.mcap").string() + "'"), std::string::npos) << c.err();
+  ASSERT_EQ(Run({"bag", "export", (dir_ / "status.mcap").string(), "--csv", (dir_ / "csv").string()}), 0);
+  const auto status = dyad::testing::ReadCsv(dir_ / "csv" / "rec_status.csv");
+  ASSERT_GE(status.size(), 2u);
+  EXPECT_EQ(status.front().at("error"), "") << "the recording was fine at first";
+  const std::string said = status.back().at("error");
+  EXPECT_NE(said.find("params.file = '" + (dir_ / "big.mcap").string() + "'"), std::string::npos) << said;
+  EXPECT_NE(c.err().find(said), std::string::npos) << "the status says what the run's failure says: " << said << "\n" << c.err();
+}
+
 TEST_F(RecorderTest, SteppedRecordingsOfTheSameGraphAreByteIdentical) {
   const fs::path graph = Write("g.yaml", ThreePublishers("stepped", 100, 100, 50, "file: " + (dir_ / "out.mcap").string() +
                                                                                       ", topics: ['c.'], chunk_size: 2048"));
