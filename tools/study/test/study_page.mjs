@@ -4,7 +4,8 @@
 // Marks consent (confirming the dialog), starts trial 1 and waits for it to complete, repeats it
 // with a reason, starts trial 2 and stops it early, sees that it must be repeated, repeats it with
 // a reason (adding a note while it runs), sees the session complete, then withdraws the
-// participant's consent keeping their data. Fails (exit 1) at the first step the page gets wrong.
+// participant's consent keeping their data. Before all that, malformed operations from a
+// hand-made client are refused with their reasons. Fails (exit 1) at the first step the page gets wrong.
 import { chromium } from "playwright-core";
 
 const [url, shotDir] = process.argv.slice(2);
@@ -24,6 +25,29 @@ try {
   const waitStatus = (k, s, ms = 20000) =>
     page.waitForFunction(([k, s]) => document.querySelector(`tr[data-trial="${k}"] td:nth-child(4)`)?.textContent === s, [k, s], { timeout: ms });
   await page.waitForSelector('tr[data-trial="1"]');
+  // Malformed operations (a hand-made client, not the page) are refused: the socket that sent
+  // them is closed with the reason, and nothing is written (the shell script reads the session
+  // log: the page's note is its only note, the withdrawal its last line, consent its first).
+  const bad = [
+    ['{"op":"note"}', 'note: needs a string "text"'], ['{"op":"note","text":5}', 'note: needs a string "text"'],
+    ['{"op":"withdraw"}', 'withdraw: needs a boolean "delete"'], ['{"op":"withdraw","delete":"yes"}', 'withdraw: needs a boolean "delete"'],
+    ['{"op":"start","trial":"1"}', 'start: needs an integer "trial"'], ['{"op":"fly"}', "unknown op 'fly'"],
+    ["[1]", 'not a JSON object with an "op"'],
+  ];
+  const closed = await page.evaluate(async (frames) => {
+    const one = (frame) => new Promise((resolve) => {
+      const s = new WebSocket(location.origin.replace(/^http/, "ws") + "/study/ws" + location.search);
+      s.onopen = () => s.send(frame);
+      s.onclose = (ev) => resolve([ev.code, ev.reason]);
+    });
+    const out = [];
+    for (const frame of frames) out.push(await one(frame));
+    return out;
+  }, bad.map(([frame]) => frame));
+  bad.forEach(([frame, reason], i) => {
+    if (closed[i][0] !== 1008 || closed[i][1] !== reason)
+      throw new Error(frame + " was answered " + JSON.stringify(closed[i]) + " (want 1008, " + reason + ")");
+  });
   if ((await text("#consent")) !== "consent required, not given") throw new Error("consent shown as: " + (await text("#consent")));
   if (!(await page.isDisabled("#start"))) throw new Error("Start is enabled before consent");
   await page.click("#mark-consent");
