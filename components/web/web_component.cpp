@@ -151,7 +151,7 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Param("ask", false).Live().Doc(
       "after_trial: setting it true ends the trial: steering stops, the subject's page asks about each hold (its trace as the "
       "picture), and once all are answered (or self_report_timeout_s passed) the run ends by itself");
-  spec.Param("ask_after_s", 0.0).Range(0, 1e7).Unit("s").Doc(
+  spec.Param("ask_after_s", 0.0).Min(0).Unit("s").Doc(
       "after_trial: ask by itself this long after the run's start (`dyad study run` sets it to the trial's duration; 0: only "
       "when `ask` is set)");
   spec.Param("self_report_timeout_s", 120.0).Range(1, 86400).Unit("s").Doc(
@@ -176,7 +176,8 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Output<msg::Annotation>("notes").Doc("experimenter's notes (record this topic to align them with the run)");
   spec.Output<msg::HumanInput>("pointer").Doc("the steering page's pointer, at the browser's event rate (to web_human)");
   spec.Output<msg::SelfReport>("self_report").Optional().Doc(
-      "the subject's answers: choice, response time from the release, the hold's start and end (runtime clock)");
+      "the subject's answers: choice, response time (from the release; after the trial from its question), the hold's start "
+      "and end (runtime clock)");
 }
 
 Status WebComponent::Configure(Context& ctx) {
@@ -247,6 +248,9 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
   so.watermark = p.Bool("show_primitives");
   so.ask = reports_->bound() && p.String("self_reports") == "after_event";
   after_trial_ = reports_->bound() && p.String("self_reports") == "after_trial";
+  if (!reports_->bound() && p.String("self_reports") == "after_trial")
+    ctx.log().Warn("params.self_reports: after_trial, but the self_report output is not bound: the page asks nothing and "
+                   "does not end the run");
   ask_after_ns_ = static_cast<int64_t>(std::llround(p.Double("ask_after_s") * 1e9));
   question_timeout_ns_ = static_cast<int64_t>(std::llround(p.Double("self_report_timeout_s") * 1e9));
   ctx.CheckLiveParam("ask", [this](const ParamValue& v) {
@@ -380,8 +384,12 @@ Status WebComponent::PublishSelfReport(int choice, int segment) {
     r.segment_start_ns(hold_start_ns_);
     r.segment_end_ns(hold_end_ns_);
   }
-  if (Status s = reports_->Publish(r); !s.ok()) ctx_->log().Warn("self_report: the subject's answer was lost: " + s.ToString());
-  if (segment >= 0) ++answered_;
+  Status published = reports_->Publish(r);
+  if (!published.ok()) ctx_->log().Warn("self_report: the subject's answer was lost: " + published.ToString());
+  if (segment >= 0) {
+    if (!published.ok()) ++lost_;
+    ++answered_;  // the page goes on to the next question either way
+  }
   return Status::OK();
 }
 
@@ -403,10 +411,12 @@ void WebComponent::StepAfterTrial(int64_t now, bool robot_moved) {
   if (!asking_) {
     {
       std::lock_guard<std::mutex> lock(holds_mutex_);
-      if (!holds_.empty() && holds_.back().end_ns == 0 && (robot_moved || holds_.back().trace.empty())) {
+      if (!holds_.empty() && holds_.back().end_ns == 0) {
         // What the subject saw drawn: the robot's path, else (no robot state) the pointer's.
+        SubjectChannel::Trace& trace = holds_.back().trace;
         const msg::CartesianState* r = robot_->latest();
-        holds_.back().trace.push_back(r != nullptr ? std::array<double, 2>{r->x(), r->y()} : last_pointer_);
+        const std::array<double, 2> at = r != nullptr ? std::array<double, 2>{r->x(), r->y()} : last_pointer_;
+        if (trace.empty() || (r != nullptr ? robot_moved : at != trace.back())) trace.push_back(at);
       }
     }
     const bool due = ctx_->params().Bool("ask") || (ask_after_ns_ > 0 && now - first_step_ns_ >= ask_after_ns_);
@@ -415,9 +425,13 @@ void WebComponent::StepAfterTrial(int64_t now, bool robot_moved) {
   }
   if (stop_requested_) return;
   const int of = static_cast<int>(asked_.size());
-  if (answered_ >= of || now - question_start_ns_ >= question_timeout_ns_) {
+  const bool timed_out = now - question_start_ns_ >= question_timeout_ns_;
+  if (answered_ >= of && all_answered_ns_ < 0) all_answered_ns_ = now;
+  // Half a second after the last answer: the page's "thank you" leaves before the server goes.
+  if (timed_out || (all_answered_ns_ >= 0 && now - all_answered_ns_ >= 500'000'000)) {
     stop_requested_ = true;
-    const std::string what = std::to_string(answered_.load()) + " of " + std::to_string(of) + " holds answered";
+    std::string what = std::to_string(answered_.load()) + " of " + std::to_string(of) + " holds answered";
+    if (lost_ > 0) what += ", " + std::to_string(lost_.load()) + " of the answers lost (see above)";
     if (answered_ < of) ctx_->log().Warn("self_report: the questions timed out (params.self_report_timeout_s): " + what);
     ctx_->RequestStop("the trial is over and its questions ended (" + what + ")");
   }
@@ -426,12 +440,16 @@ void WebComponent::StepAfterTrial(int64_t now, bool robot_moved) {
 nlohmann::json WebComponent::QuestionsJson() {
   if (!after_trial_) return nullptr;
   std::lock_guard<std::mutex> lock(holds_mutex_);
-  return {{"asked", asking_}, {"answered", answered_.load()}, {"of", asking_ ? asked_.size() : holds_.size()}};
+  // Before the questions: the holds ended so far (one under way, or too short, is not one yet).
+  const auto ended = std::count_if(holds_.begin(), holds_.end(), [](const Hold& h) { return h.end_ns != 0; });
+  return {{"asked", asking_}, {"answered", answered_.load()}, {"of", asking_ ? static_cast<int64_t>(asked_.size()) : ended}};
 }
 
-// Ends the steering; asks the subject's page about each hold of the trial (the one under way
-// ends now).
+// Ends the steering, then asks the subject's page about each hold of the trial. The steering
+// ends first: the hold under way ends with the release the channel publishes (MarkHold, at its
+// time), and no hold starts after it.
 void WebComponent::StartQuestions(int64_t now) {
+  subject_->EndSteering();
   std::vector<SubjectChannel::Trace> traces;
   {
     std::lock_guard<std::mutex> lock(holds_mutex_);

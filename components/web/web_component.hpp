@@ -123,8 +123,9 @@ class WebComponent final : public Component {
   std::array<double, 2> last_pointer_{};  // the steering page's last position
   bool asking_ = false;
   int64_t question_start_ns_ = 0, question_shown_ns_ = 0;
-  std::atomic<int> answered_{0};
-  bool stop_requested_ = false;  // step thread only
+  std::atomic<int> answered_{0}, lost_{0};  // questions answered; of those, answers not published
+  int64_t all_answered_ns_ = -1;  // step thread only
+  bool stop_requested_ = false;   // step thread only
 };
 
 }  // namespace dyad::web

@@ -121,8 +121,8 @@ class Executor::ContextImpl final : public Context, public detail::ContextExtens
   uint64_t seed() const override { return seed_; }
   int64_t period_ns() const override { return inst_->rc->period_ns; }
   void RequestStop(std::string reason) override {
-    logger_.Info("ends the run: " + reason);  // a run that ends by itself says why
-    ex_->RequestStop(inst_->name() + ": " + reason);
+    // A run that ends by itself says why, once (the first reason is the one that holds).
+    if (ex_->RequestStop(inst_->name() + ": " + reason)) logger_.Info("ends the run: " + reason);
   }
 
   const std::string& graph_name() const override { return ex_->graph_.name; }
@@ -248,13 +248,16 @@ Executor::~Executor() {
   transport_.reset();
 }
 
-void Executor::RequestStop(const std::string& reason) {
+bool Executor::RequestStop(const std::string& reason) {
+  bool first = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (stop_reason_.empty()) stop_reason_ = reason;
+    first = stop_reason_.empty();
+    if (first) stop_reason_ = reason;
     stop_.store(true, std::memory_order_release);
   }
   cv_.notify_all();
+  return first;
 }
 
 void Executor::Fail(const Status& status) {

@@ -86,7 +86,8 @@ class Executor {
   // Runs to the end. Returns OK, or the first failure.
   Status Run();
   // Thread-safe, async-signal-unsafe: call from a normal thread (the signal thread does).
-  void RequestStop(const std::string& reason);
+  // Returns true for the first request (its reason is the run's).
+  bool RequestStop(const std::string& reason);
 
   struct Row {
     std::string component;

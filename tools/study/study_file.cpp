@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <map>
 #include <regex>
+#include <set>
 
 #include <yaml-cpp/yaml.h>
 
@@ -111,7 +112,10 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
   if (!s->graph.empty()) {
     std::vector<Diagnostic> ignored;  // the graph's own problems were said above
     std::vector<std::string> webs, answering;  // the web components; those whose answers are recorded
-    for (const ComponentConfig& c : LoadGraph(s->graph, {}, &ignored).components)
+    std::set<std::string> processes;
+    const Graph graph = LoadGraph(s->graph, {}, &ignored);
+    for (const ComponentConfig& c : graph.components) {
+      processes.insert(graph.ProcessOf(c));
       if (c.type == "web") {
         webs.push_back(c.name);
         for (const PortBinding& out : c.outputs)
@@ -124,6 +128,7 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
         // pages reconnect to the next trial's graph.
         if (!c.params || !c.params["token_file"]) s->token_file_webs.push_back(c.name);
       }
+    }
     // The one page that asks after the trial also ends it: two would end it at the first's end.
     if (s->self_reports == "after_trial" && (webs.size() != 1 || answering.size() != 1))
       y.Error(root["self_reports"], "self_reports",
@@ -132,6 +137,11 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
                   (webs.empty() ? std::string("none")
                                 : std::to_string(webs.size()) + " (" + JoinList(webs) + "), " +
                                       std::to_string(answering.size()) + " binding self_report"));
+    // A component's end of the run ends its own process only: the others would run on.
+    else if (s->self_reports == "after_trial" && processes.size() > 1)
+      y.Error(root["self_reports"], "self_reports",
+              "after_trial needs the graph in one process (the page ends the run of its own process only); " + s->graph +
+                  " has " + std::to_string(processes.size()) + " (" + JoinList(processes) + ")");
   }
   s->rehearsal_graph = s->graph;
   const YAML::Node r = root["rehearsal"];

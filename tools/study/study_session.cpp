@@ -341,6 +341,7 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
 
   const auto t0 = std::chrono::steady_clock::now();
   int forwarded = 0;  // SIGINTs sent to the graph
+  double first_stop_s = 0;  // when the first was sent, from the graph's start
   {
     StopSignals signals;
     const int pid = tools::StartProcess(AttemptCommand(s, r), r.run_log, true);
@@ -352,6 +353,7 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
       const int signals_now = g_stop_signals.load();
       const int wanted = std::min(2, signals_now + (r.stop && r.stop->load() ? 1 : 0));
       a.interrupted = a.interrupted || signals_now > 0;
+      if (forwarded == 0 && wanted > 0) first_stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       for (; forwarded < wanted; ++forwarded) ::kill(pid, SIGINT);
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
@@ -360,10 +362,11 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   // A trial without a duration ends when the experimenter stops it (the graph then exits 0, or
   // 130 for the signal); a timed one stopped early is incomplete. A recording cut short (a
   // crash, a second stop) is never complete.
-  // Stopped while the subject answered after a full trial: the trial was complete.
+  // Stopped while the subject answered, after a full trial: the trial was complete. (The graph's
+  // start-up, a second or two, counts in first_stop_s: a stop that much before the end counts too.)
   const bool stopped = forwarded > 0;
   const bool ended_well = a.exit == 0 || (stopped && a.exit == 128 + SIGINT);
-  const bool asking = !r.rehearsal && AskedAfterTrial(s) && a.seconds >= s.duration_s;
+  const bool asking = !r.rehearsal && AskedAfterTrial(s) && first_stop_s >= s.duration_s;
   if (stopped && s.duration_s > 0 && !asking) a.outcome = "stopped";
   else a.outcome = ended_well ? "complete" : "failed";
   if (a.outcome == "complete") {

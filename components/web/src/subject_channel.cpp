@@ -55,13 +55,23 @@ std::string SubjectChannel::QuestionJson() const {
       .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
+void SubjectChannel::EndSteering() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (trial_over_) return;
+  trial_over_ = true;
+  if (steering_ != 0) sink_(last_x_, last_y_, false);  // a hold ends now
+}
+
 void SubjectChannel::AskAfterTrial(std::vector<Trace> traces) {
   std::string frame;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (trial_over_) return;
-    trial_over_ = true;
-    if (steering_ != 0) sink_(last_x_, last_y_, false);  // a hold ends now
+    if (asking_) return;
+    if (!trial_over_) {
+      trial_over_ = true;
+      if (steering_ != 0) sink_(last_x_, last_y_, false);
+    }
+    asking_ = true;
     questions_ = std::move(traces);
     asked_ = 0;
     frame = QuestionJson();
@@ -105,11 +115,10 @@ void SubjectChannel::SendRole(ClientId client, bool steering) {
 void SubjectChannel::OnOpen(ClientId client, Role role) {
   bool steering = false;
   ClientId demoted = 0;
-  std::string task, question;
+  std::string task;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     task = TaskJson();
-    if (trial_over_) question = QuestionJson();
     pages_.push_back(client);
     roles_[client] = role;
     // The subject's page steers before the experimenter's: an experimenter who opened /subject
@@ -144,6 +153,13 @@ void SubjectChannel::OnOpen(ClientId client, Role role) {
                                 {"ask_after_hold_s", options_.ask_after_hold_s}}
                                .dump());
   server->SendText(client, task);
+  // The question shown, read after the hello is queued: the hello resets a page, so a question
+  // sent to this page before it (by AskAfterTrial meanwhile) is sent again after it.
+  std::string question;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (asking_) question = QuestionJson();
+  }
   if (!question.empty()) server->SendLatest(client, kQuestionChannel, question, /*binary=*/false);
 }
 
@@ -208,6 +224,7 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
     if (segment != j.end() && (!segment->is_number_integer() || segment->get<int64_t>() < 0))
       return Status::InvalidArgument("self_report: \"segment\" must be the index of the question answered (an integer >= 0)");
     std::string next;
+    bool stale = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("self_report: a viewer's token may not answer");
@@ -216,13 +233,22 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
         if (!options_.ask) return Status::OK();
         return report_(static_cast<int>(choice->get<int64_t>()), -1);
       }
-      // After the trial: only an answer to the question shown (a second click, or a stale page's, is ignored).
-      if (segment == j.end() || asked_ >= questions_.size() || segment->get<int64_t>() != static_cast<int64_t>(asked_)) return Status::OK();
-      if (Status s = report_(static_cast<int>(choice->get<int64_t>()), static_cast<int>(asked_)); !s.ok()) return s;
-      ++asked_;
+      // After the trial: only an answer to the question shown counts. Another (a second click, a
+      // stale page's) is ignored, and that page is shown the question again (it hid its own).
+      if (!asking_) return Status::OK();
+      if (segment == j.end() || asked_ >= questions_.size() || segment->get<int64_t>() != static_cast<int64_t>(asked_)) {
+        stale = true;
+      } else {
+        if (Status s = report_(static_cast<int>(choice->get<int64_t>()), static_cast<int>(asked_)); !s.ok()) return s;
+        ++asked_;
+      }
       next = QuestionJson();
     }
-    SendToAll(kQuestionChannel, next);
+    if (stale) {
+      if (WebServer* server = server_.load()) server->SendLatest(client, kQuestionChannel, next, /*binary=*/false);
+    } else {
+      SendToAll(kQuestionChannel, next);
+    }
     return Status::OK();
   }
   return Status::InvalidArgument("unknown op");

@@ -19,8 +19,9 @@
 /// After the trial (self_reports: after_trial, AskAfterTrial): steering ends for good (the hold
 /// ends at once, every later pointer sample is published released) and the pages are asked about
 /// each of the trial's holds in turn, its trace as the picture; the steering page's answer to the
-/// question shown (an answer to another is stale and ignored) goes to the ReportSink with its
-/// index, then the next question is shown, to a page that opens later too.
+/// question shown goes to the ReportSink with its index, then the next question is shown, to a
+/// page that opens later too. An answer to another question (stale) is ignored and that page is
+/// shown the current one again.
 ///
 /// Several pages may watch; one steers: the first to connect with the subject's or the
 /// experimenter's token, until it leaves (the oldest such page left then steers, a subject's
@@ -77,9 +78,11 @@ class SubjectChannel final : public ClientHandler {
   // Sends it to every page, and to every page that opens later.
   void SetTask(const Task& task);
   size_t pages() const;
-  // Ends the steering and asks about each trace in turn (see the file comment); none: thanks at
-  // once. Once per channel; a second call is ignored.
+  // After the trial (see the file comment). EndSteering: no page steers any more (a hold under
+  // way ends now, through the PointerSink). AskAfterTrial: ends the steering if not yet, then
+  // asks about each trace in turn (none: thanks at once). Each acts once per channel.
   using Trace = std::vector<std::array<double, 2>>;
+  void EndSteering();
   void AskAfterTrial(std::vector<Trace> traces);
   // Where a pointer sample's time went, in ms, for each sample that carried the page's "wall"
   // stamp (meaningful when page and server share a clock; the first 100,000). The hops add up to
@@ -112,7 +115,8 @@ class SubjectChannel final : public ClientHandler {
   ClientId steering_ = 0;        // 0: none
   double last_x_ = 0, last_y_ = 0;
   Task task_;
-  bool trial_over_ = false;  // AskAfterTrial came: no more steering
+  bool trial_over_ = false;  // EndSteering came: no more steering
+  bool asking_ = false;      // AskAfterTrial came: questions_ are asked
   std::vector<Trace> questions_;
   size_t asked_ = 0;         // the question shown; questions_.size(): all answered
   PointerDelays delays_;

@@ -77,9 +77,13 @@ TEST(SubjectChannel, AfterTheTrialEachHoldIsAskedInTurnAndNobodySteers) {
   ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":1,"segment":0})").ok());
   EXPECT_TRUE(answers.empty()) << "nothing is asked before the trial ends (and after_event is off)";
   ASSERT_TRUE(ch.OnText(1, R"({"op":"pointer","x":1,"y":2,"engaged":true})").ok());
-  ch.AskAfterTrial({{{0, 0}, {1, 1}}, {{2, 2}, {3, 3}}});
+  ch.EndSteering();
   ASSERT_TRUE(ch.OnText(1, R"({"op":"pointer","x":1,"y":2,"engaged":true})").ok());
   EXPECT_EQ(engaged, (std::vector<bool>{true, false, false})) << "the hold ends when the trial does; no steering after it";
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":1,"segment":0})").ok());
+  EXPECT_TRUE(answers.empty()) << "steering ended, nothing asked yet";
+  ch.AskAfterTrial({{{0, 0}, {1, 1}}, {{2, 2}, {3, 3}}});
+  EXPECT_EQ(engaged.size(), 3u) << "the steering had ended already: no second release";
   ch.AskAfterTrial({{{9, 9}}});  // a second call changes nothing
   for (const char* ignored : {R"({"op":"self_report","choice":2})",               // no question named
                               R"({"op":"self_report","choice":2,"segment":1})"})  // not the one shown

@@ -4,9 +4,11 @@
 //   node after_trial.mjs BASE_URL OUT.json SCREENSHOT_DIR timed|button
 // timed (the graph has ask_after_s): the subject taps (300 ms: no event), holds 1.5 s, holds
 //   1.2 s, then waits. When the trial ends the page asks "What were you drawing here? (1 of 2)"
-//   with the first hold's trace; Space then steers nothing; the subject clicks the third
-//   thumbnail (choice 2); 700 ms into the second question presses 0 ("something else"); the page
-//   then thanks them and the graph ends by itself.
+//   with the first hold's trace; Space then steers nothing, nor does an engaged pointer sample
+//   sent on the page's own socket (the server refuses to steer); a second subject's page opened
+//   now is shown "The subject is answering (1 of 2)" without the choices; the subject clicks the
+//   third thumbnail (choice 2); 700 ms into the second question presses 0 ("something else"); the
+//   page then thanks them and the graph ends by itself.
 // button: one hold of 1.5 s, then the experimenter's page's "end the trial and ask the subject";
 //   the subject's page asks "1 of 1" and nobody answers (the graph's timeout ends it).
 // OUT.json: the holds' and answers' wall-clock times and what the pages showed.
@@ -69,6 +71,15 @@ try {
     await sleep(300);
     out.engaged_text = await page.evaluate(() => document.getElementById("engaged").textContent);
     await page.keyboard.up("Space");
+    await page.evaluate(() => ws.send(JSON.stringify({ op: "pointer", x: 10, y: 10, engaged: true })));  // the server's check
+    const watcher = await context.newPage();
+    await watcher.goto(base + "/subject?token=subject-token-000001");
+    await watcher.waitForFunction(() => document.getElementById("question").classList.contains("on"), null, { timeout: 10000 });
+    out.watcher = await watcher.evaluate(() => ({
+      title: document.getElementById("question-title").textContent,
+      choices_shown: getComputedStyle(document.getElementById("choices")).display !== "none",
+      trace_shown: getComputedStyle(document.getElementById("trace")).display !== "none" }));
+    await watcher.close();
     if (!(await asking())) fail("holding after the trial dismissed the question");
     await page.click('#choices button[data-choice="2"]');
     out.answers = [Date.now()];
