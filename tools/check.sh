@@ -3,7 +3,7 @@
 #
 #   bash tools/check.sh sanitize   asan without the `e2e` label, then tsan (below); CI runs this.
 #                                  e2e (the demos, the watcher stress, the pages in Chromium, the ROS 2 driver against
-#                                  its fake arm) are whole-program timings
+#                                  its fake arm, the out-of-tree plugin's build) are whole-program timings
 #                                  the Release suite runs; under ASan they cost CI ~4 minutes and
 #                                  cover code the unit tests already run under ASan. Left out too:
 #                                  the observer's two training-quality tests (accuracy after 100
