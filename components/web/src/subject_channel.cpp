@@ -57,6 +57,10 @@ std::string SubjectChannel::QuestionJson() const {
 
 void SubjectChannel::EndSteering() {
   std::lock_guard<std::mutex> lock(mutex_);
+  EndSteeringLocked();
+}
+
+void SubjectChannel::EndSteeringLocked() {
   if (trial_over_) return;
   trial_over_ = true;
   if (steering_ != 0) sink_(last_x_, last_y_, false);  // a hold ends now
@@ -67,10 +71,7 @@ void SubjectChannel::AskAfterTrial(std::vector<Trace> traces) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (asking_) return;
-    if (!trial_over_) {
-      trial_over_ = true;
-      if (steering_ != 0) sink_(last_x_, last_y_, false);
-    }
+    EndSteeringLocked();
     asking_ = true;
     questions_ = std::move(traces);
     asked_ = 0;

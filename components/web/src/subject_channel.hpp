@@ -104,6 +104,7 @@ class SubjectChannel final : public ClientHandler {
   void SendRole(ClientId client, bool steering);
   std::string TaskJson() const;      // with mutex_ held
   std::string QuestionJson() const;  // with mutex_ held
+  void EndSteeringLocked();          // with mutex_ held
   void SendToAll(uint32_t channel, const std::string& frame);
   const Options options_;
   const PointerSink sink_;

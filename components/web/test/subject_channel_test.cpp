@@ -101,6 +101,27 @@ TEST(SubjectChannel, AfterTheTrialEachHoldIsAskedInTurnAndNobodySteers) {
   EXPECT_EQ(answers, (std::vector<std::pair<int, int>>{{3, 0}, {-1, 1}}));
 }
 
+// AskAfterTrial alone ends the steering too (the hold under way ends once), and with no holds
+// to ask about an answer finds no question.
+TEST(SubjectChannel, AskingAfterTheTrialEndsTheSteeringByItself) {
+  std::vector<bool> engaged;
+  int answers = 0;
+  SubjectChannel::Options o;
+  o.primitives.assign(7, {{0.0, 0.0}, {1.0, 1.0}});
+  SubjectChannel ch(o, [&](double, double, bool e) { engaged.push_back(e); }, [&](int, int) {
+    ++answers;
+    return Status::OK();
+  });
+  ch.OnOpen(1, Role::kSubject);
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"pointer","x":1,"y":2,"engaged":true})").ok());
+  ch.AskAfterTrial({});
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"pointer","x":1,"y":2,"engaged":true})").ok());
+  ch.EndSteering();  // already ended: no second release
+  EXPECT_EQ(engaged, (std::vector<bool>{true, false, false}));
+  ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":1,"segment":0})").ok());
+  EXPECT_EQ(answers, 0);
+}
+
 // The experimenter opens /subject before the participant: the participant's page, once it
 // comes, steers; the experimenter's stops (its hold ends: one disengaged sample), and steers again
 // only when the participant's page leaves.
