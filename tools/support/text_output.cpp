@@ -1,5 +1,7 @@
 #include "text_output.hpp"
 
+#include <charconv>
+#include <cmath>
 #include <fstream>
 
 namespace dyad::tools {
@@ -18,6 +20,13 @@ std::string MarkdownCell(const std::string& text) {
     else out += (c == '\n' || c == '\r') ? ' ' : c;
   }
   return out;
+}
+
+std::string CsvNumber(double v) {
+  if (std::isnan(v)) return "";
+  char text[32];  // the longest shortest double, "-2.2250738585072014e-308", is 24 characters
+  const auto r = std::to_chars(text, text + sizeof text, v);
+  return std::string(text, r.ptr);
 }
 
 Status WriteTextFile(const std::string& path, const std::string& text) {
