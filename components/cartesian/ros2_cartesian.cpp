@@ -1,6 +1,7 @@
 #include "ros2_cartesian.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 namespace dyad::cartesian {
 
@@ -9,6 +10,12 @@ using geometry_msgs::msg::dds_::PoseStamped_;
 using geometry_msgs::msg::dds_::TwistStamped_;
 
 int64_t SecondsToNs(double s) { return static_cast<int64_t>(std::llround(s * 1e9)); }
+
+std::string Seconds(int64_t ns) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g s", ns * 1e-9);
+  return text;
+}
 
 StatusOr<Vec3> Vec3Param(const Params& p, const std::string& key, const std::string& prefix) {
   const auto& l = p.DoubleList(key);
@@ -47,7 +54,15 @@ void Ros2Cartesian::Describe(ComponentSpec& spec) {
   spec.Param("max_acceleration", 2.0).Min(1e-9).Unit("m/s^2").Doc("acceleration limit (norm)");
   spec.Param("watchdog_s", 0.5).Min(1e-6).Unit("s").Doc("no command this long: zero twist / setpoint held");
   spec.Param("pose_timeout_s", 0.5).Min(1e-6).Unit("s").Doc(
-      "no arm pose this long: stopped = true, zero twist / setpoint held, until poses return");
+      "no arm pose this long: stopped = true, zero twist / the measured pose re-sent, until poses return; none "
+      "this long after activation: an error (logged, stopped states published)");
+  spec.Param("require_arm", false).Doc(
+      "true: no pose within pose_timeout_s of activation fails the run (false: an error on the log and the state)");
+  spec.Param("pose_frame", "").Doc(
+      "header.frame_id of the arm's poses; empty: frame_id. Poses in any other frame are refused (counted, logged once)");
+  spec.Param("pose_transform", std::vector<double>{}).Doc(
+      "[x, y, z, qx, qy, qz, qw]: pose_frame's fixed pose in frame_id (p = t + R(q) p_pose_frame); required when "
+      "pose_frame is not frame_id (dyad reads no TF)");
   spec.Input<msg::CartesianCommand>("command").Doc("target position, workspace units");
   spec.Input<PoseStamped_>("arm_pose").Doc("the arm's measured pose (a ROS 2 topic)");
   spec.Output<msg::CartesianState>("state").Doc(
@@ -78,6 +93,8 @@ Status Ros2Cartesian::Configure(Context& ctx) {
   motion_.emplace(p.Double("max_velocity"), p.Double("max_acceleration"));
   twist_mode_ = p.String("mode") == "twist";
   frame_id_ = p.String("frame_id");
+  if (Status s = ConfigurePoseFrame(p, prefix); !s.ok()) return s;
+  require_arm_ = p.Bool("require_arm");
   watchdog_ns_ = SecondsToNs(p.Double("watchdog_s"));
   pose_timeout_ns_ = SecondsToNs(p.Double("pose_timeout_s"));
   command_ = &ctx.input<msg::CartesianCommand>("command");
@@ -88,9 +105,54 @@ Status Ros2Cartesian::Configure(Context& ctx) {
   return Status::OK();
 }
 
+Status Ros2Cartesian::ConfigurePoseFrame(const Params& p, const std::string& prefix) {
+  pose_frame_ = p.String("pose_frame").empty() ? frame_id_ : p.String("pose_frame");
+  const auto& t = p.DoubleList("pose_transform");
+  if (pose_frame_ == frame_id_) {
+    if (!t.empty())
+      return Status::InvalidArgument(prefix + "pose_transform: only for poses in another frame: set " + prefix +
+                                     "pose_frame to the frame they come in (it is frame_id, '" + frame_id_ + "')");
+    return Status::OK();
+  }
+  if (t.empty())
+    return Status::InvalidArgument(prefix + "pose_frame: poses in '" + pose_frame_ + "' need " + prefix +
+                                   "pose_transform ([x, y, z, qx, qy, qz, qw]: '" + pose_frame_ + "' in '" + frame_id_ +
+                                   "', e.g. from `ros2 run tf2_ros tf2_echo " + frame_id_ + " " + pose_frame_ +
+                                   "`); dyad reads no TF");
+  const double n = std::sqrt(t.size() == 7 ? t[3] * t[3] + t[4] * t[4] + t[5] * t[5] + t[6] * t[6] : 0.0);
+  if (t.size() != 7 || !std::isfinite(t[0] + t[1] + t[2] + n) || std::abs(n - 1) > 1e-6)
+    return Status::InvalidArgument(prefix + "pose_transform: must be [x, y, z, qx, qy, qz, qw], finite, a unit quaternion");
+  pose_transform_ = PoseTransform{{t[0], t[1], t[2]}, {t[3], t[4], t[5], t[6]}};
+  return Status::OK();
+}
+
+Vec3 Ros2Cartesian::PoseTransform::Apply(const Vec3& p) const {
+  // v' = v + 2w (u x v) + 2 u x (u x v), u the quaternion's vector part.
+  const Vec3 u{q[0], q[1], q[2]};
+  auto cross = [](const Vec3& a, const Vec3& b) {
+    return Vec3{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  };
+  const Vec3 uv = cross(u, p);
+  return t + p + (2 * q[3]) * uv + 2.0 * cross(u, uv);
+}
+
+Status Ros2Cartesian::Activate() {
+  activated_ns_ = ctx_->clock().now_ns();
+  return Status::OK();
+}
+
 void Ros2Cartesian::TakePoses(int64_t now_ns) {
   for (size_t i = arm_pose_->received().size() - arm_pose_->new_count(); i < arm_pose_->received().size(); ++i) {
-    const Vec3 p = PositionOf(arm_pose_->received()[i]);
+    const PoseStamped_& m = arm_pose_->received()[i];
+    if (m.header().frame_id() != pose_frame_) {
+      ++wrong_frame_poses_;
+      WarnOnce(&wrong_frame_logged_, [&] {
+        return "the arm reported a pose in frame '" + m.header().frame_id() + "', not '" + pose_frame_ +
+               "': refused (poses must come in frame_id; another frame: set pose_frame and pose_transform)";
+      });
+      continue;
+    }
+    const Vec3 p = pose_transform_ ? pose_transform_->Apply(PositionOf(m)) : PositionOf(m);
     if (!Finite(p)) {
       ++nonfinite_poses_;
       WarnOnce(&nonfinite_pose_logged_,
@@ -106,7 +168,6 @@ void Ros2Cartesian::TakePoses(int64_t now_ns) {
     }
     pose_ = p;
     last_pose_ns_ = now_ns;
-    if (!setpoint_) setpoint_ = plane_->Clamp(p, nullptr);  // pose mode starts where the arm is: no jump
   }
 }
 
@@ -119,8 +180,9 @@ void Ros2Cartesian::TakeCommand(int64_t now_ns) {
              [] { return std::string("a command with NaN or infinite coordinates: rejected, the goal is kept"); });
     return;
   }
-  last_command_ns_ = now_ns;  // a hold feeds the watchdog and keeps the goal
-  if (c.hold() && goal_) return;
+  last_command_ns_ = now_ns;  // a hold feeds the watchdog
+  holding_ = c.hold();
+  if (holding_) return;       // "stay where you are": its position is never a goal
   bool clamped = false;
   goal_ = plane_->Clamp(plane_->ToRobot(c.x(), c.y()), &clamped);
   if (clamped) {
@@ -136,28 +198,72 @@ Status Ros2Cartesian::Step(const StepInfo& info) {
   const int64_t now = info.now_ns;
   const double dt = last_step_ns_ < 0 ? 0 : (now - last_step_ns_) * 1e-9;
   last_step_ns_ = now;
+  if (activated_ns_ < 0) activated_ns_ = now;  // Activate() not called (unit tests)
   TakePoses(now);
   TakeCommand(now);
   const bool stale_pose = last_pose_ns_ < 0 || now - last_pose_ns_ > pose_timeout_ns_;
   const bool stale_command = last_command_ns_ < 0 || now - last_command_ns_ > watchdog_ns_;
-  if (stale_pose && last_pose_ns_ >= 0)
-    WarnOnce(&stale_logged_, [] { return std::string("no pose from the arm for pose_timeout_s: stopped"); });
-  if (!stale_pose) stale_logged_ = false;
+  if (Status s = WatchArm(now, stale_pose); !s.ok()) return s;
   if (stale_command && last_command_ns_ >= 0)
     WarnOnce(&watchdog_logged_, [] { return std::string("no command for watchdog_s: holding"); });
   if (!stale_command) watchdog_logged_ = false;
-  const bool move = !stale_pose && !stale_command && goal_.has_value();
-  Status s;
-  if (twist_mode_) {
-    if (!move) motion_->Reset();  // Servo stops on a zero twist
-    s = SendTwist(move ? motion_->Toward(*pose_, *goal_, dt) : Vec3{0, 0, 0}, now);
-  } else if (setpoint_) {
-    if (move) setpoint_ = plane_->Clamp(*setpoint_ + dt * motion_->Toward(*setpoint_, *goal_, dt), nullptr);
-    else motion_->Reset();
-    s = SendPose(*setpoint_, now);
+  const bool move = !stale_pose && !stale_command && !holding_ && goal_.has_value();
+  if (Status s = move ? Move(dt, now) : StayPut(now); !s.ok()) return s;
+  moving_ = move;
+  if (pose_) return PublishState(now, stale_pose || stale_command);
+  return no_pose_logged_ ? PublishState(now, true) : Status::OK();
+}
+
+Status Ros2Cartesian::WatchArm(int64_t now_ns, bool stale_pose) {
+  if (last_pose_ns_ < 0) {
+    if (now_ns - activated_ns_ <= pose_timeout_ns_ || no_pose_logged_) return Status::OK();
+    no_pose_logged_ = true;
+    if (require_arm_) return Status::FailedPrecondition(NoPoseMessage() + " (require_arm)");
+    ctx_->log().Error(NoPoseMessage() + ": stopped until one arrives (logged once)");
+    return Status::OK();
   }
-  if (!s.ok()) return s;
-  return pose_ ? PublishState(now, stale_pose || stale_command) : Status::OK();
+  if (stale_pose && outage_start_ns_ < 0) {
+    outage_start_ns_ = last_pose_ns_;
+    ++outages_;
+    WarnOnce(&stale_logged_, [] { return std::string("no pose from the arm for pose_timeout_s: stopped"); });
+  } else if (!stale_pose && outage_start_ns_ >= 0) {
+    outage_ns_ += now_ns - outage_start_ns_;
+    outage_start_ns_ = -1;
+    stale_logged_ = false;
+    ctx_->log().Info("poses from the arm again: moving");
+  }
+  return Status::OK();
+}
+
+std::string Ros2Cartesian::NoPoseMessage() const {
+  return "no pose from the arm on '" + arm_pose_->topic() + "' within pose_timeout_s (" + Seconds(pose_timeout_ns_) +
+         ") of activation" + WhyNoPose();
+}
+
+std::string Ros2Cartesian::WhyNoPose() const {
+  std::string m;
+  if (wrong_frame_poses_ > 0)
+    m += "; " + std::to_string(wrong_frame_poses_) + " poses refused: not in frame '" + pose_frame_ + "'";
+  else if (nonfinite_poses_ > 0)
+    m += "; " + std::to_string(nonfinite_poses_) + " poses refused: NaN or infinite";
+  else
+    m += " (check the arm's pose topic name, domain_id, QoS and network)";
+  return m;
+}
+
+Status Ros2Cartesian::Move(double dt, int64_t now_ns) {
+  if (twist_mode_) return SendTwist(motion_->Toward(*pose_, *goal_, dt), now_ns);
+  if (!moving_ || !setpoint_) setpoint_ = plane_->Clamp(*pose_, nullptr);  // starts where the arm is: no jump
+  setpoint_ = plane_->Clamp(*setpoint_ + dt * motion_->Toward(*setpoint_, *goal_, dt), nullptr);
+  return SendPose(*setpoint_, now_ns);
+}
+
+Status Ros2Cartesian::StayPut(int64_t now_ns) {
+  motion_->Reset();  // Servo stops on a zero twist; the next motion starts at rest
+  if (twist_mode_) return SendTwist(Vec3{0, 0, 0}, now_ns);
+  if (!pose_) return Status::OK();  // nothing to stay at yet: nothing is sent
+  setpoint_ = plane_->Clamp(*pose_, nullptr);
+  return SendPose(*setpoint_, now_ns);
 }
 
 Status Ros2Cartesian::SendTwist(const Vec3& v, int64_t now_ns) {
@@ -183,7 +289,7 @@ Status Ros2Cartesian::SendPose(const Vec3& p, int64_t now_ns) {
 }
 
 Status Ros2Cartesian::PublishState(int64_t now_ns, bool stopped) {
-  const ArmPlane::Workspace ws = plane_->ToWorkspace(*pose_);
+  const ArmPlane::Workspace ws = pose_ ? plane_->ToWorkspace(*pose_) : ArmPlane::Workspace{};  // no pose: 0, stopped
   if (last_pose_ns_ == now_ns && last_ws_ && now_ns > last_ws_ns_) {
     const double span = (now_ns - last_ws_ns_) * 1e-9;
     vx_ = (ws.x - last_ws_->x) / span;
@@ -204,11 +310,22 @@ Status Ros2Cartesian::PublishState(int64_t now_ns, bool stopped) {
 }
 
 Status Ros2Cartesian::Deactivate() {
-  if (nonfinite_commands_ + nonfinite_poses_ + clamped_ + outside_poses_ > 0)
+  const Status last = last_step_ns_ >= 0 ? StayPut(ctx_->clock().now_ns()) : Status::OK();
+  if (last_pose_ns_ < 0 && last_step_ns_ >= 0) {
+    ctx_->log().Error("no pose from the arm on '" + arm_pose_->topic() + "' in the whole run: the arm was never driven" +
+                      WhyNoPose());
+  } else if (outages_ > 0) {
+    const int64_t total = outage_ns_ + (outage_start_ns_ >= 0 ? ctx_->clock().now_ns() - outage_start_ns_ : 0);
+    ctx_->log().Warn("the arm's poses stopped " + std::to_string(outages_) + " time(s), " + Seconds(total) +
+                     " in all: stopped meanwhile");
+  }
+  if (nonfinite_commands_ + nonfinite_poses_ + clamped_ + outside_poses_ + wrong_frame_poses_ > 0)
     ctx_->log().Info("rejected " + std::to_string(nonfinite_commands_) + " non-finite commands and " +
                      std::to_string(nonfinite_poses_) + " non-finite poses; clamped " + std::to_string(clamped_) +
-                     " targets into the box; the arm reported " + std::to_string(outside_poses_) + " poses outside it");
-  return Status::OK();
+                     " targets into the box; the arm reported " + std::to_string(outside_poses_) +
+                     " poses outside it; refused " + std::to_string(wrong_frame_poses_) + " poses not in frame '" +
+                     pose_frame_ + "'");
+  return last.ok() ? Status::OK() : last.WithContext("the last zero twist / pose");
 }
 
 }  // namespace dyad::cartesian

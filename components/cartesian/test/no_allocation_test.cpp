@@ -321,7 +321,8 @@ TEST(NoAllocation, Ros2CartesianStepAllocatesNothingWhileItsWarningsLast) {
                    {"y_axis", std::vector<double>{0, 0, 1}}, {"scale", 0.002},
                    {"box_min", std::vector<double>{0.2, -0.3, 0.1}}, {"box_max", std::vector<double>{0.6, 0.3, 0.5}},
                    {"orientation", std::vector<double>{0, 0, 0, 1}}, {"max_velocity", 0.25},
-                   {"max_acceleration", 2.0}, {"watchdog_s", 0.5}, {"pose_timeout_s", 0.5}});
+                   {"max_acceleration", 2.0}, {"watchdog_s", 0.5}, {"pose_timeout_s", 0.5},
+                   {"require_arm", false}, {"pose_frame", std::string()}, {"pose_transform", std::vector<double>{}}});
   Ros2Cartesian driver;
   ASSERT_TRUE(driver.Configure(ctx).ok());
   ASSERT_TRUE(driver.Activate().ok());
