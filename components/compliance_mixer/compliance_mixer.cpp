@@ -2,10 +2,43 @@
 
 #include <cinttypes>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
+#include <vector>
+
+#include <fastdds/rtps/common/SerializedPayload.h>
+
+#include <dyad/msg/types_support.hpp>  // MessageTraits<T>::PubSubType, complete
 
 namespace dyad::mixer {
+
+namespace {
+// A message as CDR with its encapsulation header (SerializedWriter::Write); empty if it cannot be.
+// Builds the type support each call: for an event now and then, not a hot loop.
+template <class T>
+std::vector<uint8_t> Encode(const T& sample) {
+  typename MessageTraits<T>::PubSubType support;
+  void* data = const_cast<T*>(&sample);  // Fast DDS 2's serialize takes void*; it only reads
+  try {
+    eprosima::fastrtps::rtps::SerializedPayload_t payload(support.getSerializedSizeProvider(data)());
+    if (!support.serialize(data, &payload)) return {};
+    return std::vector<uint8_t>(payload.data, payload.data + payload.length);
+  } catch (...) {  // fastcdr throws when the buffer is short: cannot happen with the size asked for
+    return {};
+  }
+}
+std::string Fixed(double v, const char* format = "%.1f") {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+std::string Point(Vec2 p) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "(%g, %g)", p.x, p.y);
+  return buf;
+}
+}  // namespace
 
 void ComplianceMixer::Describe(ComponentSpec& spec) {
   spec.Summary("Blends human and robot positions into the driver's command (g*human + (1-g)*robot while engaged), "
@@ -25,14 +58,20 @@ void ComplianceMixer::Describe(ComponentSpec& spec) {
   spec.Param("stale_timeout_s", 0.5).Min(1e-6).Unit("s").Doc(
       "an input without a sample for longer is stale (runtime clock): hold the last command; one whose "
       "writers are gone (DDS liveliness, across processes) is stale at once");
+  spec.Param("state_period_s", 0.1).Min(1e-6).Unit("s").Doc(
+      "the period of the driver's state (input state): no state for 5 periods (runtime clock) and the arm is lost, "
+      "as when the driver reports stopped: the mixer holds at its last command until the arm is back");
   spec.Param("z", 0.0).Unit("workspace units").Doc("z of every command (planar robot)");
   spec.Input<msg::HumanInput>("human").Doc("the human's hand position and engaged flag");
   spec.Input<msg::Intention>("robot").Doc("the robot's intended position");
   spec.Input<msg::CartesianState>("state").Optional().Doc(
-      "measured position: required by mode pi; bound, the first command waits for it (until then: hold "
-      "commands, the driver stays where it is) and moves at most max_step from it; unbound, the first "
-      "command is not limited");
-  spec.Output<msg::CartesianCommand>("command").Doc("target position for the driver; hold while inputs are stale");
+      "measured position: required by mode pi; bound, the mixer moves only while the arm is known (its state fresh, "
+      "not stopped): before its first state, and while it is lost, hold commands (the driver stays where it is); the "
+      "first motion, and the first after an outage, moves at most max_step from it; unbound, the first command is "
+      "not limited");
+  spec.Output<msg::CartesianCommand>("command").Doc(
+      "target position for the driver; hold = stay where you are (inputs stale, arm lost or not known yet), at the "
+      "last motion command, never the target");
 }
 
 Status ComplianceMixer::Configure(Context& ctx) {
@@ -47,6 +86,7 @@ Status ComplianceMixer::Configure(Context& ctx) {
   o.ki = p.Double("ki");
   o.integral_limit = p.Double("integral_limit");
   o.stale_timeout_ns = static_cast<int64_t>(std::llround(p.Double("stale_timeout_s") * 1e9));
+  o.state_timeout_ns = static_cast<int64_t>(std::llround(kStatePeriodsBeforeLost * p.Double("state_period_s") * 1e9));
   if (Status s = o.Validate(); !s.ok()) return Status::InvalidArgument("components." + ctx.name() + ".params." + s.message());
   z_ = p.Double("z");
   human_ = &ctx.input<msg::HumanInput>("human");
@@ -60,7 +100,47 @@ Status ComplianceMixer::Configure(Context& ctx) {
     ctx.log().Warn("input 'state' is not bound: the first command cannot start from where the arm is, and is not "
                    "limited (bind it to the driver's state topic)");
   core_.emplace(o);
+  if (state_->bound()) {  // the arm's outages go to the runtime's health topic too, when there is one
+    auto w = ctx.AdvertiseSerialized("dyad/health", TypeInfoOf<msg::HealthEvent>());
+    health_ = w.ok() ? *w : nullptr;
+    if (!w.ok() && w.status().code() != Status::Code::kUnimplemented)  // unimplemented: a context without DDS
+      ctx.log().Warn("dyad/health: " + w.status().ToString() + ": the arm's outages are only logged");
+  }
   return Status::OK();
+}
+
+// An outage's edge on dyad/health (docs/components.md, compliance_mixer): action "arm lost" or
+// "arm back", the state's topic, starved_s its length so far, renewals the outage's number.
+void ComplianceMixer::ReportOutage(const char* action, int64_t lost_ns, int64_t now_ns) {
+  if (health_ == nullptr) return;
+  health_event_.header().source(ctx_->name());
+  health_event_.header().sequence_number(health_event_.header().sequence_number() + 1);
+  health_event_.header().stamp_ns(now_ns);
+  health_event_.graph_name(ctx_->graph_name());
+  health_event_.process_name("component '" + ctx_->name() + "'");
+  health_event_.topic(state_->topic());
+  health_event_.endpoint("reader");
+  health_event_.action(action);
+  health_event_.starved_s(lost_ns * 1e-9);
+  health_event_.renewals(static_cast<uint32_t>(core_->arm_outages().count));
+  const std::vector<uint8_t> cdr = Encode(health_event_);
+  if (cdr.empty() || !health_->Write(cdr, now_ns).ok()) ctx_->log().Warn(std::string("dyad/health: '") + action + "' not published");
+}
+
+// The arm's outages, said once each way (an outage is an event of the run, not a stale input).
+void ComplianceMixer::LogArm(const MixerCore::Result& r, int64_t now_ns) {
+  if (r.outage_started) {
+    const std::string why = r.stopped ? "its driver reports stopped"
+                                      : "no state on '" + state_->topic() + "' for more than " +
+                                            std::to_string(core_->options().state_timeout_ns / 1'000'000) + " ms";
+    ctx_->log().Warn("arm lost (" + why + "): holding at the last command " + Point(r.position) +
+                     " until it is back");
+    ReportOutage("arm lost", 0, now_ns);
+  } else if (r.outage_ended_ns >= 0) {
+    ctx_->log().Info("arm back after " + Fixed(r.outage_ended_ns * 1e-9) +
+                     " s: moving again from its measured position, at most max_step per step");
+    ReportOutage("arm back", r.outage_ended_ns, now_ns);
+  }
 }
 
 Status ComplianceMixer::Step(const StepInfo& info) {
@@ -75,7 +155,10 @@ Status ComplianceMixer::Step(const StepInfo& info) {
     in.human = {{h->x(), h->y()}, received_at(human_)};
     in.engaged = h->engaged();
   }
-  if (const msg::CartesianState* s = state_->latest()) in.state = {{s->x(), s->y()}, received_at(state_)};
+  if (const msg::CartesianState* s = state_->latest()) {
+    in.state = {{s->x(), s->y()}, received_at(state_)};
+    in.stopped = s->stopped();
+  }
 
   const Params& p = ctx_->params();  // live: a change takes effect at this step
   core_->SetGainAndMaxStep(p.Double("gain"), p.Double("max_step"));
@@ -89,21 +172,30 @@ Status ComplianceMixer::Step(const StepInfo& info) {
                                                                  : static_cast<const InputBase*>(state_);
   const bool never_received = r.hold && !r.non_finite && input->last_receive_ns() < 0;
   const bool starting = never_received && info.now_ns - first_step_ns_ <= timeout;
-  if (r.hold && !holding_ && !starting) {
+  LogArm(r, info.now_ns);
+  if (r.arm_lost && r.stale == MixerCore::Stale::kState) {
+    // said by LogArm
+  } else if (r.hold && !holding_ && !starting) {
     holding_ = true;
+    const bool state = r.stale == MixerCore::Stale::kState;
     const std::string ms = std::to_string(timeout / 1'000'000);
+    const std::string stale_ms = std::to_string((state ? core_->options().state_timeout_ns : timeout) / 1'000'000);
     const std::string why = r.non_finite               ? "' not finite (NaN or infinite position)"
                             : never_received         ? "' has sent nothing in the " + ms + " ms since start"
+                            : state && in.stopped    ? "' says stopped (its driver cannot move the arm)"
                             : input->writers_gone() ? "': its writer is gone (DDS liveliness)"
-                                                     : "' stale (no sample for more than " + ms + " ms)";
+                                                     : "' stale (no sample for more than " + stale_ms + " ms)";
     ctx_->log().Warn(std::string("input '") + ToString(r.stale) + why + ": " +
-                     (r.has_command ? "holding the last command" : "no command yet"));
+                     (r.waiting_for_state ? "holding until the arm reports where it is"
+                      : r.has_command     ? "holding the last command"
+                                          : "no command yet"));
   } else if (!r.hold && holding_) {
     holding_ = false;
     ctx_->log().Info("inputs fresh again: mixing resumed");
   }
   if (!r.has_command) return Status::OK();
   held_ += r.hold;
+  waiting_held_ += r.waiting_for_state;
   saturated_ += r.saturated;
   ++published_;
   out_.x(r.position.x);
@@ -114,8 +206,21 @@ Status ComplianceMixer::Step(const StepInfo& info) {
 }
 
 Status ComplianceMixer::Deactivate() {
-  ctx_->log().Info(std::to_string(published_) + " commands published, " + std::to_string(held_) + " held, " +
-                   std::to_string(saturated_) + " saturated");
+  std::string summary = std::to_string(published_) + " commands published, " + std::to_string(held_) + " held, " +
+                        std::to_string(saturated_) + " saturated";
+  if (state_->bound()) {
+    const MixerCore::Outages& o = core_->arm_outages();
+    summary += "; arm lost " + std::to_string(o.count) + (o.count == 1 ? " time, " : " times, ") +
+               Fixed(o.lost_ns * 1e-9) + " s" + (o.ongoing ? " (still lost at the end)" : "") + "; " +
+               std::to_string(o.holds) + " holds sent while lost; " + std::to_string(waiting_held_) +
+               " holds sent waiting for the arm's first state";
+  }
+  if (state_->bound() && published_ > 0 && waiting_held_ == published_) {
+    ctx_->log().Warn(summary + ": the arm never reported where it is (no fresh state on '" + state_->topic() +
+                     "' that is not stopped), so nothing moved");
+  } else {
+    ctx_->log().Info(summary);
+  }
   return Status::OK();
 }
 

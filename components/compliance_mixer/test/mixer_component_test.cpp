@@ -18,6 +18,7 @@ struct Mixer {
   testing::CapturingWriter<msg::CartesianCommand>& out = ctx.Capture<msg::CartesianCommand>("command");
   ComplianceMixer mixer;
   uint64_t index = 0;
+  msg::CartesianState arm;  // the state the driver reports at each step
 
   Mixer() { EXPECT_TRUE(mixer.Configure(ctx).ok()); }
   // One step at t = index * 100 ms; `robot`/`human` say whether a sample arrives before it.
@@ -25,7 +26,7 @@ struct Mixer {
     ctx.clock_.now = static_cast<int64_t>(index) * kStep;
     if (robot_sample) robot.queue.push_back(msg::Intention());
     if (human_sample) human.queue.push_back(msg::HumanInput());
-    state.queue.push_back(msg::CartesianState());
+    state.queue.push_back(arm);
     ctx.PollInputs();
     ASSERT_TRUE(mixer.Step(StepInfo{ctx.clock_.now, index++, kStep}).ok());
   }
@@ -82,6 +83,59 @@ TEST(MixerComponent, AFloodedTriggerMovesTheCommandsNoFasterThanMaxSpeed) {
   ASSERT_EQ(m.out.samples.size(), 101u);
   EXPECT_NEAR(m.out.samples.back().x(), 5.0, 1e-9);
   for (const auto& c : m.out.samples) EXPECT_LE(c.x(), 5.0 + 1e-9);
+}
+
+// A lost arm is said: once when it goes (why), once when it is back (after how long), and in the
+// end-of-run summary with the holds sent meanwhile. Before, a driver reporting stopped changed
+// nothing: the commands moved on, and the summary did not mention it.
+TEST(MixerComponent, TheArmsOutageIsSaidAndSummarised) {
+  Mixer m;
+  msg::Intention far;
+  far.x(1000);
+  auto step = [&] {
+    m.robot.queue.push_back(far);
+    m.Step(false, true);
+  };
+  step();  // the first command: 5 from the arm at 0
+  step();
+  ASSERT_EQ(m.out.samples.size(), 2u);
+  EXPECT_DOUBLE_EQ(m.out.samples[1].x(), 10);
+  m.arm.stopped(true);
+  for (int i = 0; i < 3; ++i) step();
+  m.arm.stopped(false);
+  m.arm.x(12);
+  step();
+  ASSERT_EQ(m.out.samples.size(), 6u);
+  for (size_t k = 2; k < 5; ++k) {
+    EXPECT_TRUE(m.out.samples[k].hold()) << k;
+    EXPECT_DOUBLE_EQ(m.out.samples[k].x(), 10) << k;  // the last motion command, not the intention
+  }
+  EXPECT_FALSE(m.out.samples[5].hold());
+  EXPECT_DOUBLE_EQ(m.out.samples[5].x(), 17);  // from the measured 12, max_step 5
+  ASSERT_EQ(m.Warnings().size(), 2u);
+  EXPECT_NE(m.Warnings()[0].find("arm lost (its driver reports stopped): holding at the last command (10, 0)"),
+            std::string::npos)
+      << m.Warnings()[0];
+  EXPECT_NE(m.Warnings()[1].find("arm back after 0.3 s"), std::string::npos) << m.Warnings()[1];
+  ASSERT_TRUE(m.mixer.Deactivate().ok());
+  EXPECT_NE(m.Warnings().back().find("6 commands published, 3 held, 3 saturated; arm lost 1 time, 0.3 s; 3 holds "
+                                     "sent while lost; 0 holds sent waiting for the arm's first state"),
+            std::string::npos)
+      << m.Warnings().back();
+}
+
+// An arm that never reports where it is: every command is a hold, and the summary says so.
+TEST(MixerComponent, AnArmThatNeverReportsIsNotSilent) {
+  Mixer m;
+  m.arm.stopped(true);
+  for (int i = 0; i < 3; ++i) m.Step(true, true);
+  ASSERT_EQ(m.out.samples.size(), 3u);
+  for (const auto& c : m.out.samples) EXPECT_TRUE(c.hold());
+  ASSERT_TRUE(m.mixer.Deactivate().ok());
+  EXPECT_NE(m.Warnings().back().find("3 holds sent waiting for the arm's first state: the arm never reported where "
+                                     "it is"),
+            std::string::npos)
+      << m.Warnings().back();
 }
 
 // Unbound, the state cannot limit the first command: Configure says so, once.

@@ -150,8 +150,8 @@ TEST(MixerCore, FirstCommandIsSaturatedAgainstTheMeasuredState) {
   EXPECT_DOUBLE_EQ(r.position.x, 5);
 }
 
-// wait_for_state: no motion before the arm's position is known. Holds at the target (the
-// driver stays where it is and reports), then the first command moves max_step from the state.
+// wait_for_state: no motion before the arm's position is known. Holds (the driver stays where it
+// is and reports), then the first command moves max_step from the state.
 TEST(MixerCore, WaitsForTheArmsStateBeforeItsFirstCommand) {
   for (const Mode mode : {Mode::kBlend, Mode::kPi}) {
     SCOPED_TRACE(mode == Mode::kPi ? "pi" : "blend");
@@ -174,7 +174,7 @@ TEST(MixerCore, WaitsForTheArmsStateBeforeItsFirstCommand) {
     EXPECT_FALSE(r.waiting_for_state);
     EXPECT_TRUE(r.saturated);
     EXPECT_DOUBLE_EQ(r.position.x, 3);  // -2 + max_step
-    // From now on the previous command is the reference: a state gone stale does not matter in blend.
+    // From now on the previous command is the reference (the state, 100 ms old, is fresh).
     in = Fresh({1000, 0}, {0, 0}, false, 4 * kStep);
     in.state = {{-2, 0}, mode == Mode::kPi ? 4 * kStep : 3 * kStep};
     r = m.Update(in, 4 * kStep);
@@ -237,6 +237,151 @@ TEST(MixerCore, NonFiniteInputHoldsTheLastCommandAndDoesNotPoisonLaterOnes) {
   EXPECT_FALSE(r.non_finite);
   EXPECT_DOUBLE_EQ(r.position.x, 3);
   EXPECT_DOUBLE_EQ(r.position.y, 2);
+}
+
+// The command contract: a hold carries the position to hold, never the intention. Before the
+// arm's first state the holds carried the target (x = 1000 with the arm at 0: a driver that took
+// it as a goal drove off). Now: the placeholder (0, 0) before anything is known, the arm's
+// measured position once it was known, the last motion command after one.
+TEST(MixerCore, NoHoldCarriesTheIntention) {
+  MixerOptions o;
+  o.wait_for_state = true;
+  MixerCore m(o);
+  int64_t t = 0;
+  for (; t < 3 * kStep; t += kStep) {
+    const auto r = m.Update(Fresh({1000, 0}, {0, 0}, false, t), t);
+    ASSERT_TRUE(r.has_command);
+    ASSERT_TRUE(r.hold);
+    EXPECT_EQ(r.position.x, 0) << "a hold before the arm's first state carried the intention";
+    EXPECT_EQ(r.position.y, 0);
+  }
+  // A state that says stopped is not a position to start from: still holding, not at its x.
+  auto in = Fresh({1000, 0}, {0, 0}, false, t);
+  in.state = {{-7, 3}, t};
+  in.stopped = true;
+  auto r = m.Update(in, t);
+  EXPECT_TRUE(r.waiting_for_state);
+  EXPECT_EQ(r.position.x, 0);
+  // Known once, then stale: the hold carries where the arm was measured.
+  t += kStep;
+  in = Fresh({1000, 0}, {0, 0}, false, t);
+  in.state = {{-7, 3}, t};
+  in.robot.receive_ns = -1;  // no intention: no motion, and no command before the first one
+  r = m.Update(in, t);
+  EXPECT_FALSE(r.has_command);
+  t += 10 * kStep;
+  in = Fresh({1000, 0}, {0, 0}, false, t);
+  in.state = {{-7, 3}, t - 10 * kStep};  // 1 s old
+  r = m.Update(in, t);
+  ASSERT_TRUE(r.hold);
+  EXPECT_EQ(r.position.x, -7);
+  EXPECT_EQ(r.position.y, 3);
+  // After motion: every hold (stale human, lost arm) is the last motion command.
+  t += kStep;
+  in = Fresh({1000, 0}, {0, 0}, false, t);
+  in.state = {{-7, 3}, t};
+  r = m.Update(in, t);
+  ASSERT_FALSE(r.hold);
+  Vec2 last = r.position;
+  EXPECT_LE(std::hypot(last.x + 7, last.y - 3), 5 + 1e-9);
+  for (int k = 1; k <= 3; ++k) {
+    in = Fresh({1000, 0}, {0, 0}, false, t + k * kStep);
+    in.human.receive_ns = k == 1 ? t + k * kStep : -1;  // the human never again
+    in.state = {last, t + k * kStep};
+    in.stopped = k == 3;
+    r = m.Update(in, t + k * kStep);
+    if (k == 1) {  // one more motion command
+      ASSERT_FALSE(r.hold);
+      last = r.position;
+      continue;
+    }
+    ASSERT_TRUE(r.hold) << k;
+    EXPECT_EQ(r.position.x, last.x) << k;
+    EXPECT_EQ(r.position.y, last.y) << k;
+  }
+}
+
+// A lost arm holds the experiment. Before, the mixer went on moving the command while the driver
+// said stopped (84 commands, 159 units in one run), and the arm came back to a goal far away.
+// Now: holds at the last command while stopped or stale, counted; the first motion after starts
+// from where the arm is measured and moves at most max_step.
+TEST(MixerCore, ALostArmHoldsAndTheFirstMotionAfterStartsFromItsMeasuredPosition) {
+  for (const bool stale : {false, true}) {
+    SCOPED_TRACE(stale ? "state stale" : "driver reports stopped");
+    MixerOptions o;
+    o.wait_for_state = true;
+    o.state_timeout_ns = 300'000'000;
+    MixerCore m(o);
+    auto step = [&](int k, Vec2 arm, bool stopped, int64_t state_ns) {
+      auto in = Fresh({1000.0 * (1 + k), 0}, {0, 0}, false, k * kStep);  // the intention runs on
+      in.state = {arm, state_ns};
+      in.stopped = stopped;
+      return m.Update(in, k * kStep);
+    };
+    auto r = step(0, {0, 0}, false, 0);
+    EXPECT_DOUBLE_EQ(r.position.x, 5);
+    r = step(1, {5, 0}, false, kStep);
+    EXPECT_DOUBLE_EQ(r.position.x, 10);
+    // Lost from step 2: stopped states, or the last state (at step 1) older than 300 ms from step 5.
+    const int first_lost = stale ? 5 : 2;
+    for (int k = 2; k <= 8; ++k) {
+      r = step(k, {10, 0}, !stale, stale ? kStep : k * kStep);
+      ASSERT_TRUE(r.has_command) << k;
+      if (k < first_lost) {  // stale but not yet 300 ms: moving on
+        EXPECT_FALSE(r.hold) << k;
+        continue;
+      }
+      EXPECT_TRUE(r.hold) << k;
+      EXPECT_TRUE(r.arm_lost) << k;
+      EXPECT_EQ(r.stopped, !stale) << k;
+      EXPECT_EQ(r.stale, MixerCore::Stale::kState) << k;
+      EXPECT_EQ(r.outage_started, k == first_lost) << k;
+      EXPECT_DOUBLE_EQ(r.position.x, stale ? 25 : 10) << k;  // the last motion command
+    }
+    EXPECT_TRUE(m.arm_outages().ongoing);
+    EXPECT_EQ(m.arm_outages().count, 1u);
+    // Back at step 9, measured at 40 (pushed while it was away): 40 + max_step, not last + 5.
+    r = step(9, {40, 0}, false, 9 * kStep);
+    EXPECT_FALSE(r.hold);
+    EXPECT_FALSE(r.arm_lost);
+    EXPECT_TRUE(r.saturated);
+    EXPECT_DOUBLE_EQ(r.position.x, 45);
+    EXPECT_EQ(r.outage_ended_ns, (9 - first_lost) * kStep);
+    r = step(10, {45, 0}, false, 10 * kStep);
+    EXPECT_DOUBLE_EQ(r.position.x, 50);  // then from the last command, as usual
+    const MixerCore::Outages& out = m.arm_outages();
+    EXPECT_FALSE(out.ongoing);
+    EXPECT_EQ(out.count, 1u);
+    EXPECT_EQ(out.lost_ns, (9 - first_lost) * kStep);
+    EXPECT_EQ(out.holds, static_cast<uint64_t>(9 - first_lost));
+  }
+}
+
+// Back from an outage, the PI loop starts afresh: what it summed before is not about where the arm is.
+TEST(MixerCore, PiIntegralIsResetWhenTheArmComesBack) {
+  MixerOptions o;
+  o.wait_for_state = true;
+  o.mode = Mode::kPi;
+  o.ki = 1;
+  o.max_step = 0;
+  o.max_speed = 0;
+  MixerCore m(o);
+  for (int k = 0; k < 5; ++k) {
+    auto in = Fresh({10, 0}, {0, 0}, false, k * kStep);
+    in.state = {{0, 0}, k * kStep};  // the arm does not follow: the integral grows
+    m.Update(in, k * kStep);
+  }
+  ASSERT_GT(m.integral().x, 0);
+  auto in = Fresh({10, 0}, {0, 0}, false, 5 * kStep);
+  in.state = {{0, 0}, 5 * kStep};
+  in.stopped = true;
+  EXPECT_TRUE(m.Update(in, 5 * kStep).arm_lost);
+  in = Fresh({10, 0}, {0, 0}, false, 6 * kStep);
+  in.state = {{0, 0}, 6 * kStep};
+  const auto r = m.Update(in, 6 * kStep);
+  EXPECT_FALSE(r.hold);
+  EXPECT_NEAR(m.integral().x, 10 * 0.1, 1e-9);  // one step's e*dt, from zero
+  EXPECT_NEAR(r.position.x, 0 + 10 + 1.0, 1e-9);
 }
 
 TEST(MixerCore, NoCommandBeforeAnyInputArrived) {
