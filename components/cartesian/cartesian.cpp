@@ -34,7 +34,7 @@ void VirtualCartesian::Describe(ComponentSpec& spec) {
   spec.Param("watchdog_s", 0.5).Min(1e-6).Unit("s").Doc(
       "no command for longer (runtime clock): brake to rest and report stopped (acts when stepped periodically)");
   spec.Param("initial_position", std::vector<double>{}).Unit("workspace units").Doc(
-      "[x, y] start position; []: start at rest at the first command");
+      "[x, y] start position; []: start at rest at the first motion command (a hold first: the box's centre)");
   spec.Input<msg::CartesianCommand>("command").Doc("target position");
   spec.Output<msg::CartesianState>("state").Doc("simulated position and velocity; stopped = watchdog stop");
 }
@@ -70,7 +70,9 @@ Status VirtualCartesian::Step(const StepInfo& info) {
         nonfinite_logged_ = true;
         ctx_->log().Warn(NonFiniteMessage(c));
       }
-    } else if (c.hold() ? robot_->Hold({c.x(), c.y()}, info.now_ns) : robot_->SetTarget({c.x(), c.y()}, info.now_ns)) {
+    } else if (c.hold()) {  // stay where you are: the hold's x, y are never a goal
+      robot_->Hold(info.now_ns);
+    } else if (robot_->SetTarget({c.x(), c.y()}, info.now_ns)) {
       z_ = c.z();
     }
     if (robot_->state().clamped && !clamp_logged_) {
@@ -296,7 +298,7 @@ Status UdpCartesian::SendCommand(const msg::CartesianCommand& c, int64_t now_ns)
   packet.y = std::clamp(c.y(), y_limits_[0], y_limits_[1]);
   packet.z = c.z();
   packet.hold = c.hold();
-  if (packet.x != c.x() || packet.y != c.y()) {
+  if (!c.hold() && (packet.x != c.x() || packet.y != c.y())) {  // a hold is no target
     ++clamped_;
     if (!clamp_logged_) {
       clamp_logged_ = true;

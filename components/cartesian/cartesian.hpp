@@ -6,8 +6,10 @@
 /// inputs:  command (CartesianCommand): target position
 /// outputs: state (CartesianState): simulated position and velocity, stopped = watchdog stop
 /// A command with a NaN or infinite coordinate is rejected (logged once): the robot keeps its
-/// last target, and the watchdog is not fed. A command with hold = true keeps the robot's target
-/// (feeding the watchdog); a robot with no position yet starts at rest at the hold's x, y.
+/// last target, and the watchdog is not fed. A command with hold = true means "stay where you
+/// are" (the command contract, docs/components.md): the robot keeps its target (feeding the
+/// watchdog) and never moves towards the hold's x, y; a robot with no position yet starts at rest
+/// at the centre of its workspace box.
 /// params:
 ///   max_velocity (double, 100, > 0, units/s): speed limit, vector norm
 ///   max_acceleration (double, 2000, > 0, units/s^2): acceleration limit, vector norm
@@ -37,7 +39,9 @@
 ///   key_file (string, "", path): a pre-shared key (>= 32 bytes, mode 600) for protocol v2:
 ///     every packet authenticated (HMAC-SHA256), the session set by a handshake, replays and
 ///     packets of other sessions rejected and counted; empty: protocol v1, unauthenticated
-/// A command with hold = true goes out with the hold flag: the controller keeps its target.
+/// A command with hold = true goes out with the hold flag: the controller stays where it is (the
+/// command contract; the fake controller never moves towards a hold's x, y, which are sent
+/// clamped to the workspace box like any position, but not counted as clamped targets).
 /// Every accepted state is published once, in order (a late one in the next step, before the
 /// reply to that step's command); out-of-order, duplicate and malformed packets are dropped.
 /// @endcomponent

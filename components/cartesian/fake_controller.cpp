@@ -217,7 +217,8 @@ int main(int argc, char** argv) {
     }
     has_applied = true;
     applied = c.sequence;
-    if (c.hold) robot->Hold({c.x, c.y}, c.stamp_ns);  // stay (a robot not placed yet starts there)
+    // A hold: stay where you are, never a goal (a robot not placed yet starts at the box's centre).
+    if (c.hold) robot->Hold(c.stamp_ns);
     else robot->SetTarget({c.x, c.y}, c.stamp_ns);
     const auto& s = robot->Advance(c.stamp_ns);
     udp::StatePacket st;

@@ -60,13 +60,15 @@ bool VirtualRobot::SetTarget(Vec2 target, int64_t now_ns) {
   return true;
 }
 
-bool VirtualRobot::Hold(Vec2 start, int64_t now_ns) {
-  if (!started_) return SetTarget(start, now_ns);
+void VirtualRobot::Hold(int64_t now_ns) {
+  if (!started_) {  // no position yet: at rest at the centre of the box, not where the hold says
+    state_.position = {(o_.x_min + o_.x_max) / 2, (o_.y_min + o_.y_max) / 2};
+    started_ = true;
+  }
   if (!has_target_) target_ = state_.position;
   has_target_ = true;
   target_ns_ = now_ns;
   state_.clamped = false;
-  return true;
 }
 
 const VirtualRobot::State& VirtualRobot::Advance(int64_t now_ns) {

@@ -14,7 +14,9 @@
 /// one and the path keeps its direction. `v` is the mean velocity over the step.
 /// Watchdog: when no command arrived for longer than `watchdog_ns` (or none ever), the robot
 /// brakes at max_acceleration to rest and reports stopped = true; a fresh command clears it.
-/// Without an initial position, the robot starts (at rest) at its first target.
+/// Without an initial position, the robot starts (at rest) at its first target, or, if a hold
+/// comes first, at the centre of its workspace box: a hold never places or moves it anywhere
+/// (the command contract, docs/components.md), whatever position the hold carries.
 ///
 ///   VirtualRobot robot(options);               // options.Validate() must be OK
 ///   robot.SetTarget({10, 0}, now);
@@ -61,10 +63,10 @@ class VirtualRobot {
   // infinite coordinate is rejected (returns false, changes nothing, does not feed the
   // watchdog): clamping cannot make it safe, and one would poison the position for good.
   bool SetTarget(Vec2 target, int64_t now_ns);
-  // Stay: keep the current target (with none yet, the current position) and feed the watchdog.
-  // A robot without a position yet appears at rest at `start` (where the experiment begins);
-  // then, as SetTarget, a NaN or infinite `start` is rejected (returns false, changes nothing).
-  bool Hold(Vec2 start, int64_t now_ns);
+  // A hold: stay where you are. Keeps the current target (with none yet, the current position)
+  // and feeds the watchdog. A robot without a position yet starts at rest at the centre of its
+  // workspace box. The hold's own position is not an argument: a hold is never a goal.
+  void Hold(int64_t now_ns);
   // Moves the robot to time `now_ns` (never decreasing) and returns its state.
   const State& Advance(int64_t now_ns);
 

@@ -5,7 +5,8 @@
 //                    steps, silent from step `silent_from` (-1: never)
 //   test_intention   Intention moving along x by `speed` units per step from `start`
 //   test_command     CartesianCommand moving along x by `speed` units per step, silent from
-//                    step `silent_from` (-1: never)
+//                    step `silent_from` (-1: never); the steps before `hold_until` send holds
+//                    at `hold_at` instead (a far position: a driver must not go there)
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>
@@ -151,11 +152,17 @@ class Command final : public Component {
     spec.Summary("test: a command moving along x, then silence");
     spec.Param("speed", 1.0).Doc("units per step along x");
     spec.Param("silent_from", int64_t{-1});
+    spec.Param("hold_until", int64_t{0});
+    spec.Param("hold_at", std::vector<double>{0, 0});
     spec.Output<msg::CartesianCommand>("out");
   }
   Status Configure(Context& ctx) override {
     speed_ = ctx.params().Double("speed");
     silent_ = ctx.params().Int("silent_from");
+    hold_until_ = ctx.params().Int("hold_until");
+    const auto& at = ctx.params().DoubleList("hold_at");
+    if (at.size() != 2) return Status::InvalidArgument("hold_at: [x, y]");
+    hold_x_ = at[0], hold_y_ = at[1];
     out_ = &ctx.output<msg::CartesianCommand>("out");
     return Status::OK();
   }
@@ -163,13 +170,16 @@ class Command final : public Component {
     const auto k = static_cast<int64_t>(info.index);
     if (silent_ >= 0 && k >= silent_) return Status::OK();
     msg::CartesianCommand c;
-    c.x(speed_ * static_cast<double>(k));
+    const bool hold = k < hold_until_;
+    c.x(hold ? hold_x_ : speed_ * static_cast<double>(k));
+    c.y(hold ? hold_y_ : 0);
+    c.hold(hold);
     return out_->Publish(c);
   }
 
  private:
-  double speed_ = 1;
-  int64_t silent_ = -1;
+  double speed_ = 1, hold_x_ = 0, hold_y_ = 0;
+  int64_t silent_ = -1, hold_until_ = 0;
   Output<msg::CartesianCommand>* out_ = nullptr;
 };
 

@@ -191,32 +191,47 @@ TEST(VirtualRobot, NonFiniteTargetsAreRejectedAndDoNotFeedTheWatchdog) {
   }
 }
 
-// The mixer's hold: the robot stays (on its target, or where it is) and the watchdog is fed; a
-// robot with no position yet starts at rest where the hold says the experiment begins.
+
+// A hold: the robot stays (on its target, or where it is) and the watchdog is fed. A robot with
+// no position yet starts at rest at the centre of its box: a hold is never a goal (the command
+// contract). Before, it started at the hold's x, y, so a hold far away placed the arm there.
 TEST(VirtualRobot, HoldKeepsTheRobotWhereItIsAndFeedsTheWatchdog) {
   VirtualRobotOptions o;
   o.initial = Vec2{0, 0};
   VirtualRobot r(o);
   r.Advance(0);
   for (int64_t k = 1; k <= 10; ++k) {
-    ASSERT_TRUE(r.Hold({50, 0}, k * kStep));  // the start it names is ignored: the robot has a position
+    r.Hold(k * kStep);
     const auto& s = r.Advance(k * kStep);
     EXPECT_EQ(s.position.x, 0) << k;
     EXPECT_FALSE(s.stopped) << k;
   }
   ASSERT_TRUE(r.SetTarget({3, 0}, 11 * kStep));
   r.Advance(12 * kStep);
-  ASSERT_TRUE(r.Hold({50, 0}, 13 * kStep));  // keeps the target it had
+  r.Hold(13 * kStep);  // keeps the target it had
   EXPECT_NEAR(r.Advance(20 * kStep).position.x, 3, 1e-9);
+}
 
-  VirtualRobot fresh{VirtualRobotOptions()};
-  EXPECT_FALSE(fresh.Hold({std::nan(""), 0}, 0));
-  EXPECT_FALSE(fresh.started());
-  ASSERT_TRUE(fresh.Hold({7, -2}, 0));
-  const auto& s = fresh.Advance(kStep);
-  EXPECT_EQ(s.position.x, 7);
-  EXPECT_EQ(s.position.y, -2);
-  EXPECT_EQ(Norm(s.velocity), 0);
+// The driver test of the command contract on the model both drivers run: holds while the goal is
+// far away (the mixer's intention), then the first motion command max_step (5) away.
+TEST(VirtualRobot, WithoutAPositionAHoldStartsItAtTheBoxCentreAndTheFirstMotionMovesAtMostMaxStep) {
+  VirtualRobotOptions o;
+  o.x_min = -20, o.x_max = 60;  // centre (20, 10)
+  o.y_min = -10, o.y_max = 30;
+  VirtualRobot r(o);
+  for (int64_t k = 0; k < 5; ++k) {
+    r.Hold(k * kStep);
+    const auto& s = r.Advance(k * kStep);
+    EXPECT_TRUE(r.started());
+    EXPECT_EQ(s.position.x, 20) << k;
+    EXPECT_EQ(s.position.y, 10) << k;
+    EXPECT_EQ(Norm(s.velocity), 0) << k;
+    EXPECT_FALSE(s.stopped) << k;
+  }
+  ASSERT_TRUE(r.SetTarget({25, 10}, 5 * kStep));
+  const auto& s = r.Advance(5 * kStep);
+  EXPECT_LE(std::hypot(s.position.x - 20, s.position.y - 10), 5 + 1e-9);
+  EXPECT_NEAR(s.position.x, 25, 1e-9);
 }
 
 }  // namespace
