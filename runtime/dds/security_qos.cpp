@@ -1,5 +1,7 @@
 #include "dds/security_qos.hpp"
 
+#include "dds/dds_participant.hpp"
+
 #include <string>
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
@@ -20,6 +22,14 @@ void ApplySecurity(const IdentityFiles& identity, eprosima::fastdds::dds::Domain
   set("dds.sec.access.builtin.Access-Permissions.governance", uri + identity.governance);
   set("dds.sec.access.builtin.Access-Permissions.permissions", uri + identity.permissions);
   set("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+}
+
+// The security room of DdsParticipant (dds_internal.hpp): what an endpoint refused on a secured
+// participant adds to its error.
+std::string DdsParticipant::SecurityHint(const std::string& verb) const {
+  if (!secured_) return "";
+  return " (DDS Security: the permissions of participant '" + name_ + "' do not let it " + verb +
+         " this topic; after changing the graph, rerun `dyad security init`)";
 }
 
 }  // namespace dyad

@@ -5,6 +5,8 @@
 // builtin.Access-Permissions enforces the signed governance (no unauthenticated participant,
 // discovery, liveliness and data encrypted) and the identity's signed permissions;
 // builtin.AES-GCM-GMAC encrypts. Nothing is set for IdentityFiles without a certificate.
+// security_qos.cpp also holds DdsParticipant::SecurityHint: what the error of an endpoint refused
+// on a secured participant adds (the permissions, and how to renew them).
 #pragma once
 
 #include <dyad/security.hpp>

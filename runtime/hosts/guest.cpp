@@ -40,7 +40,7 @@ class GuestSession final : public ProcessSession {
     // Then 50 ms for the rest of that burst (another reader, say). A guest that writes waits
     // 0.5 s: its writer matched the graph's readers, but they match it only when its announcement
     // reaches their process (discovery is not symmetric; no Fast DDS call tells a writer).
-    // Samples written before come late, by repair (dds_participant.cpp, KeepForLateMatches): a
+    // Samples written before come late, by repair (dds_endpoints.cpp, KeepForLateMatches): a
     // bag played into a loaded graph had its first samples up to 100 ms late.
     if (!missing.empty())
       std::fprintf(stderr, "warning: %s: not discovered within %g s: %s; going on\n", o_.label.c_str(), o_.watch.wait_s,
