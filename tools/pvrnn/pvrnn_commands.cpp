@@ -93,6 +93,9 @@ int RunTraining(const TrainConfig& c, const std::string& config_path, const Data
   std::printf("training %s (%d sequences x %d steps) from epoch %lld to %lld, %s, seed %llu\n", c.dataset.c_str(),
               data.size(), data.steps(), static_cast<long long>(start_epoch), static_cast<long long>(c.epochs),
               c.scalar.c_str(), static_cast<unsigned long long>(c.seed));
+  std::string per_primitive;
+  for (int n : data.SequencesPerPrimitive()) per_primitive += (per_primitive.empty() ? "" : ", ") + std::to_string(n);
+  std::printf("sequences per primitive (samples of primitives 0..%d): %s\n", data.primitives() - 1, per_primitive.c_str());
   auto snapshot = [&](bool with_state, const LossTerms& l) {
     Model m = trainer.Snapshot(with_state);
     m.provenance.epochs = trainer.epoch();
@@ -150,6 +153,7 @@ int Train(const std::string& config_path, bool resume, const std::vector<std::st
   if (!c.ok()) return Fail(kBadInput, c.status().message());
   auto data = LoadNrlDataset(c->dataset);
   if (!data.ok()) return Fail(kBadInput, data.status().message());
+  for (const std::string& w : data->warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   if (c->loops > 1) data = RepeatSequences(*data, static_cast<int>(c->loops));
   if (data->dofs() != c->spec.num_dofs())
     return Fail(kBadInput, config_path + ": encoding.dofs lists " + std::to_string(c->spec.num_dofs()) +

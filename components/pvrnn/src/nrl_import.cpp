@@ -121,7 +121,7 @@ StatusOr<Model> ImportNrlModel(const NrlImportOptions& options) {
   if (data->dofs() != spec.num_dofs())
     return Status::InvalidArgument(options.dataset_dir + ": " + std::to_string(data->dofs()) + " DOFs, properties activate " +
                                    std::to_string(spec.num_dofs()));
-  const int prims = data->size(), steps = data->steps();
+  const int prims = data->primitives(), steps = data->steps();  // NRL: one A per primitive, whatever its samples
 
   NetworkLayout layout(spec);
   Model m;

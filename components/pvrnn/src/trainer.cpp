@@ -40,7 +40,9 @@ StatusOr<std::unique_ptr<Trainer<Scalar>>> Trainer<Scalar>::Create(const Model& 
         const double v = data.sequences[p](i, t), margin = 0.5 * (r.max - r.min);
         if (!(v >= r.min - margin && v <= r.max + margin)) {
           std::ostringstream m;
-          m << "dataset " << data.name << ": primitive " << p << ", step " << t << " (row " << t + 1 << "), DOF " << i
+          m << "dataset " << data.name << ": primitive " << data.PrimitiveOf(p);
+          if (data.SequencesPerPrimitive()[data.PrimitiveOf(p)] > 1) m << ", sample " << data.SampleOf(p);
+          m << ", step " << t << " (row " << t + 1 << "), DOF " << i
             << " = " << v << ": outside the encoding range [" << r.min << ", " << r.max
             << "] by more than half its width";
           return Status::InvalidArgument(m.str());
