@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <pwd.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,8 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <string>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -232,14 +235,26 @@ int Param(GuestState& st, bool set) {
   r.param = name.substr(dot + 1);
   r.set = set;
   if (set) r.value = text.substr(eq + 1);
-  const char* user = std::getenv("USER");
-  char host[256] = {0};
-  gethostname(host, sizeof(host) - 1);
-  r.who = std::string("dyad param (") + (user ? user : "?") + "@" + host + ")";
+  r.who = ParamRequester();
   return RequestParam(r, catalog, std::cout, std::cerr);
 }
 
 }  // namespace
+
+std::string ParamRequester() {
+  std::string user;
+  if (const char* env = std::getenv("USER"); env != nullptr) user = env;
+  if (user.empty()) {
+    std::vector<char> buf(16384);
+    passwd pw{};
+    passwd* found = nullptr;
+    if (getpwuid_r(getuid(), &pw, buf.data(), buf.size(), &found) == 0 && found != nullptr && found->pw_name != nullptr)
+      user = found->pw_name;
+  }
+  char host[256] = {0};
+  gethostname(host, sizeof(host) - 1);
+  return "dyad param (" + (user.empty() ? std::string("?") : user) + "@" + host + ")";
+}
 
 void AddGuestCommands(CLI::App& app, int& exit_code) {
   auto st = std::make_shared<GuestState>();
