@@ -1,5 +1,7 @@
 #include "graph_dot.hpp"
 
+#include <dyad/topic_readers.hpp>
+
 #include <map>
 #include <set>
 #include <sstream>
@@ -72,6 +74,8 @@ std::string GraphDot(const Graph& graph, const ResolvedGraph& resolved) {
     }
     if (!host.empty()) out << "  }\n";
   }
+  // Every topic a port binds or `topics:` declares (bound to no port or not), and what recorders
+  // record (the runtime's own topics too: drawn dashed).
   std::set<std::string> topics;
   for (const auto& c : graph.components) {
     for (const auto& b : c.outputs)
@@ -79,16 +83,31 @@ std::string GraphDot(const Graph& graph, const ResolvedGraph& resolved) {
     for (const auto& b : c.inputs)
       if (!b.topic.empty()) topics.insert(b.topic);
   }
+  for (const auto& t : graph.topics) topics.insert(t.name);
+  for (const auto& [name, t] : resolved.topics) topics.insert(name);
+  std::map<std::string, std::vector<std::string>> recorded;  // recorder -> its topics
+  for (const auto& c : graph.components)
+    if (c.type == "recorder") recorded[c.name] = RecordedTopics(graph, resolved, c);
+  std::set<std::string> runtime_only;
+  for (const auto& [recorder, names] : recorded)
+    for (const auto& t : names)
+      if (!topics.count(t)) runtime_only.insert(t);
   for (const auto& t : topics) {
     auto r = resolved.topics.find(t);
     const std::string type = r != resolved.topics.end() && r->second.type != nullptr ? r->second.type->short_name() : "?";
     out << "  " << TopicId(t) << " [shape=ellipse, label=" << Quoted(t + "\n" + type) << "];\n";
   }
+  for (const auto& t : runtime_only)
+    out << "  " << TopicId(t) << " [shape=ellipse, style=dashed, label=" << Quoted(t + "\n(runtime)") << "];\n";
   for (const auto& c : graph.components) {
     for (const auto& b : c.outputs)
       if (!b.topic.empty()) out << "  " << ComponentId(c.name) << " -> " << TopicId(b.topic) << " [label=" << Quoted(b.port) << "];\n";
     for (const auto& b : c.inputs)
       if (!b.topic.empty()) out << "  " << TopicId(b.topic) << " -> " << ComponentId(c.name) << " [label=" << Quoted(b.port) << "];\n";
+    auto rec = recorded.find(c.name);
+    if (rec == recorded.end()) continue;
+    for (const auto& t : rec->second)
+      out << "  " << TopicId(t) << " -> " << ComponentId(c.name) << " [label=\"records\", style=dashed];\n";
   }
   out << "}\n";
   return out.str();

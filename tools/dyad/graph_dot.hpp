@@ -3,8 +3,11 @@
 //
 // Contract of GraphDot(graph, resolved):
 //   - One box per component: its name, type, and rate ("10 Hz") or trigger ("on state"); one
-//     ellipse per topic a port binds: its name and message type. Edges run writer -> topic ->
-//     reader, each labelled with its port.
+//     ellipse per topic a port binds or `topics:` declares (bound to no port too): its name and
+//     message type. Edges run writer -> topic -> reader, each labelled with its port.
+//   - A recorder has a dashed edge "records" from every topic it records (dyad/topic_readers.hpp:
+//     its params.topics; none: all); the runtime's own topics it records (dyad/stats, ...) are
+//     dashed ellipses labelled "(runtime)".
 //   - Processes are clusters ("process mind"); when the graph places processes on hosts, each
 //     host is a cluster around its processes, labelled with its address from network.hosts.
 //   - Every name is quoted and escaped: any component or topic name gives valid DOT, and the

@@ -76,5 +76,26 @@ TEST(GraphDotErrors, ABadGraphIsRefusedAndNothingIsDrawn) {
   fs::remove(g);
 }
 
+// A topic declared under `topics:` and bound to no port is drawn, and a recorder has an edge from
+// each topic it records (its params.topics), the unbound one too.
+TEST(GraphDotRecorder, DrawsUnboundTopicsAndWhatTheRecorderRecords) {
+  const fs::path g = fs::temp_directory_path() / ("dyad_graph_rec_" + std::to_string(getpid()) + ".yaml");
+  const fs::path mcap = fs::temp_directory_path() / ("dyad_graph_rec_" + std::to_string(getpid()) + ".mcap");
+  std::ofstream(g) << "graph: drawn\n"
+                      "components:\n"
+                      "  src: {type: counter_source, rate_hz: 10, outputs: {out: count}}\n"
+                      "  rec: {type: recorder, rate_hz: 1, params: {file: \"" << mcap.string() << "\", topics: [count, spare]}}\n"
+                      "topics:\n"
+                      "  spare: {type: Counter}\n";
+  auto r = dyad::testing::RunCommand(AddRuntimeCommands, {"graph", g.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"t:spare\" [shape=ellipse, label=\"spare\\nCounter\"]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"t:count\" -> \"c:rec\" [label=\"records\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"t:spare\" -> \"c:rec\" [label=\"records\""), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("\"c:rec\" ->"), std::string::npos) << "a recorder writes no topic of the graph\n" << r.out;
+  fs::remove(g);
+  fs::remove(mcap);
+}
+
 }  // namespace
 }  // namespace dyad::cli
