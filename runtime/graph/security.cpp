@@ -9,6 +9,8 @@
 #include <set>
 #include <tuple>
 
+#include <openssl/err.h>
+#include <openssl/evp.h>
 #include <openssl/pem.h>
 #include <openssl/x509.h>
 
@@ -45,6 +47,24 @@ std::string CheckCertificateDates(const std::string& path, int64_t now_s) {
   if (X509_cmp_time(X509_get0_notAfter(cert.get()), &now) < 0)
     return path + ": certificate expired (renew it: dyad security init --renew)";
   return "";
+}
+
+// "" when the private key at `key_path` is the key of the certificate at `cert_path`; else what
+// is wrong. A renewal cut short between its two writes (by an older dyad, or by hand) leaves a
+// pair whose files each pass every check and whose handshake fails: say so here instead.
+std::string CheckKeyMatchesCertificate(const std::string& cert_path, const std::string& key_path) {
+  std::unique_ptr<FILE, int (*)(FILE*)> cf(std::fopen(cert_path.c_str(), "r"), &std::fclose);
+  std::unique_ptr<FILE, int (*)(FILE*)> kf(std::fopen(key_path.c_str(), "r"), &std::fclose);
+  if (!cf || !kf) return "";  // CheckFile said it
+  std::unique_ptr<X509, void (*)(X509*)> cert(PEM_read_X509(cf.get(), nullptr, nullptr, nullptr), &X509_free);
+  std::unique_ptr<EVP_PKEY, void (*)(EVP_PKEY*)> key(PEM_read_PrivateKey(kf.get(), nullptr, nullptr, nullptr), &EVP_PKEY_free);
+  ERR_clear_error();
+  if (!cert) return "";  // CheckCertificateDates said it
+  if (!key) return key_path + ": not a PEM private key";
+  const bool match = X509_check_private_key(cert.get(), key.get()) == 1;
+  ERR_clear_error();
+  if (match) return "";
+  return key_path + ": not the key of " + cert_path + " (renew the pair: dyad security init --renew)";
 }
 
 }  // namespace
@@ -118,6 +138,9 @@ std::vector<std::string> CheckKeystore(const Graph& graph, int64_t now_s) {
       if (problem.empty() && certificate) problem = CheckCertificateDates(path, now_s);
       if (!problem.empty()) problems.push_back("identity '" + identity + "': " + problem);
     }
+    if (CheckFile(f.certificate, false).empty() && CheckFile(f.private_key, true).empty())
+      if (std::string problem = CheckKeyMatchesCertificate(f.certificate, f.private_key); !problem.empty())
+        problems.push_back("identity '" + identity + "': " + problem);
   }
   return problems;
 }

@@ -1,6 +1,7 @@
 #include "keystore.hpp"
 
-
+#include <cerrno>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,9 @@
 #include <sstream>
 
 #include <arpa/inet.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <unistd.h>
 
 #include <openssl/bio.h>
 #include <openssl/err.h>
@@ -189,6 +193,9 @@ class Authority {
     if (!k.ok()) return k.status();
     auto c = Issue(k.value().get(), subject, nullptr, k.value().get(), days, Use::kCa);
     if (!c.ok()) return c.status();
+    // The CA folder is made only here, for a new CA: an empty one would be where a restored
+    // offline folder is then moved into (`mv OFFLINE keys/ca` nesting it as keys/ca/OFFLINE).
+    if (Status s = CreatePrivateDirectories(fs::path(key_path_).parent_path().string()); !s.ok()) return s;
     if (Status s = WritePrivateFile(key_path_, KeyPem(k.value().get()), CreateMode::kNew); !s.ok()) return s;
     if (Status s = WritePrivateFile(cert_path_, CertPem(c.value().get()), CreateMode::kNew); !s.ok()) return s;
     key_ = std::move(k.value());
@@ -200,9 +207,7 @@ class Authority {
   // The key, read when first needed: a CA kept offline is only needed to issue or sign.
   StatusOr<EVP_PKEY*> key(const std::string& why) {
     if (key_) return key_.get();
-    if (!fs::exists(fs::symlink_status(key_path_)))
-      return Status::FailedPrecondition(key_path_ + ": the " + name_ + "'s key is not here, and it is needed to " + why +
-                                        " (bring the ca/ folder back for this step)");
+    if (!fs::exists(fs::symlink_status(key_path_))) return MissingKey(why);
     auto k = ReadKey(key_path_);
     if (!k.ok()) return k.status();
     key_ = std::move(k.value());
@@ -211,6 +216,21 @@ class Authority {
   X509* cert() const { return cert_.get(); }
 
  private:
+  // The key is needed and not at key_path_: say where it was looked for, how to point elsewhere,
+  // and where it is when an offline folder was moved into an existing CA folder.
+  Status MissingKey(const std::string& why) const {
+    const fs::path ca_dir = fs::path(key_path_).parent_path(), file = fs::path(key_path_).filename();
+    std::string message = key_path_ + ": the " + name_ + "'s key is not here, and it is needed to " + why +
+                          ". Bring the CA folder back for this step (mv /path/to/offline/ca " + ca_dir.string() +
+                          ") or name it with --ca DIR";
+    std::error_code ec;
+    for (fs::directory_iterator it(ca_dir, ec), end; !ec && it != end; it.increment(ec))
+      if (it->is_directory(ec) && fs::exists(fs::symlink_status(it->path() / file, ec)))
+        message += "; it is at " + (it->path() / file).string() + ": the folder was moved inside " + ca_dir.string() +
+                   " (move its files up, or use --ca " + it->path().string() + ")";
+    return Status::FailedPrecondition(message);
+  }
+
   std::string name_, cert_path_, key_path_;
   Cert cert_;
   Key key_;
@@ -228,8 +248,10 @@ Status SignDocument(const std::string& xml_path, const std::string& signed_path,
   if (!key.ok()) return key.status();
   auto signed_text = SmimeSigned(text, ca.cert(), key.value());
   if (!signed_text.ok()) return signed_text.status().WithContext(signed_path);
-  if (Status s = WritePrivateFile(xml_path, text, CreateMode::kReplace); !s.ok()) return s;
+  // The signed document first: the XML is what a rerun compares, so a crash between the two
+  // writes leaves an XML that differs and the next init signs again (never a stale .p7s kept).
   if (Status s = WritePrivateFile(signed_path, signed_text.value(), CreateMode::kReplace); !s.ok()) return s;
+  if (Status s = WritePrivateFile(xml_path, text, CreateMode::kReplace); !s.ok()) return s;
   out << "signed   " << signed_path << "\n";
   return Status::OK();
 }
@@ -248,10 +270,10 @@ std::string AltNames(const std::vector<std::string>& hosts) {
 
 // The web CA and web/tls.pem (see the header); the hosts a certificate was issued for are kept
 // in web/hosts, so a rerun with other hosts reissues it.
-Status InitWebCertificate(const Graph& graph, const KeystoreOptions& options, std::ostream& out) {
+Status InitWebCertificate(const Graph& graph, const KeystoreOptions& options, const fs::path& ca_dir, std::ostream& out) {
   const fs::path dir = fs::path(options.dir), web = dir / "web";
   if (Status s = CreatePrivateDirectories(web.string()); !s.ok()) return s;
-  Authority web_ca("web CA", (dir / "web_ca.cert.pem").string(), (dir / "ca" / "web_ca.key.pem").string());
+  Authority web_ca("web CA", (dir / "web_ca.cert.pem").string(), (ca_dir / "web_ca.key.pem").string());
   if (Status s = web_ca.Open("CN=dyad web CA " + graph.name, options.ca_days, out); !s.ok()) return s;
   const std::string alt = AltNames(options.web_hosts), tls_path = (web / "tls.pem").string(),
                     hosts_path = (web / "hosts").string();
@@ -276,16 +298,77 @@ Status InitWebCertificate(const Graph& graph, const KeystoreOptions& options, st
   return Status::OK();
 }
 
+// The validity of `cert` as the permissions grant's dates.
+std::pair<std::string, std::string> Validity(X509* cert) {
+  std::tm tm{};
+  ASN1_TIME_to_tm(X509_get0_notBefore(cert), &tm);
+  const time_t not_before = timegm(&tm);
+  ASN1_TIME_to_tm(X509_get0_notAfter(cert), &tm);
+  return {Utc(not_before), Utc(timegm(&tm))};
+}
+
+// Removes what a crashed init left of `identity`'s staging folders (".<identity>.new-*").
+void RemoveStaleStaging(const fs::path& identities, const std::string& identity) {
+  std::error_code ec;
+  const std::string prefix = "." + identity + ".new-";
+  for (fs::directory_iterator it(identities, ec), end; !ec && it != end; it.increment(ec))
+    if (it->path().filename().string().rfind(prefix, 0) == 0) fs::remove_all(it->path(), ec);
+}
+
+// A new key, certificate and signed permissions for `identity`, made whole in a staging folder
+// and then put in place in one step: renamed when the identity is new, exchanged with the old
+// folder (renameat2 RENAME_EXCHANGE) on renewal. A failure or a crash at any point leaves the
+// identity as it was (nothing, or the old pair): never a key without its certificate, never a
+// renewed key beside the old certificate.
+Status IssueIdentity(const Graph& graph, const std::map<std::string, TopicAccess>& access, const KeystoreOptions& options,
+                     const std::string& identity, Authority& identity_ca, Authority& permissions_ca, std::ostream& out) {
+  const fs::path identities = fs::path(options.dir) / "identities", own = identities / identity;
+  auto ca_key = identity_ca.key("issue identity " + identity);
+  if (!ca_key.ok()) return ca_key.status();
+  auto k = NewKey();
+  if (!k.ok()) return k.status();
+  auto c = Issue(k.value().get(), IdentitySubject(graph, identity), identity_ca.cert(), ca_key.value(), options.identity_days,
+                 Use::kIdentity);
+  if (!c.ok()) return c.status();
+  RemoveStaleStaging(identities, identity);
+  const fs::path staging = identities / ("." + identity + ".new-" + std::to_string(getpid()));
+  auto made = [&]() -> Status {
+    if (Status s = CreatePrivateDirectories(staging.string()); !s.ok()) return s;
+    if (Status s = WritePrivateFile((staging / "key.pem").string(), KeyPem(k.value().get()), CreateMode::kNew); !s.ok()) return s;
+    if (Status s = WritePrivateFile((staging / "cert.pem").string(), CertPem(c.value().get()), CreateMode::kNew); !s.ok()) return s;
+    const auto [from, to] = Validity(c.value().get());
+    std::ostringstream quiet;  // the staging folder's name is not what the user should read
+    return SignDocument((staging / "permissions.xml").string(), (staging / "permissions.p7s").string(),
+                        PermissionsXml(graph, identity, access, from, to), permissions_ca, quiet);
+  }();
+  std::error_code ec;
+  if (!made.ok()) {
+    fs::remove_all(staging, ec);
+    return made;
+  }
+  const bool existed = fs::exists(fs::symlink_status(own, ec));
+  if (::renameat2(AT_FDCWD, staging.c_str(), AT_FDCWD, own.c_str(), existed ? RENAME_EXCHANGE : RENAME_NOREPLACE) != 0) {
+    const int err = errno;
+    fs::remove_all(staging, ec);
+    return Status::IOError(own.string() + ": cannot put the new identity in place: " + std::strerror(err));
+  }
+  if (existed) fs::remove_all(staging, ec);  // now the old identity
+  if (Status s = SyncDirectory(identities.string()); !s.ok()) return s;
+  out << (existed ? "renewed  " : "issued   ") << identity << ": " << (own / "cert.pem").string() << "\n";
+  return Status::OK();
+}
+
 }  // namespace
 
 Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>& access, const KeystoreOptions& options,
                     std::ostream& out) {
-  const fs::path dir(options.dir);
-  for (const fs::path& d : {dir, dir / "ca", dir / "identities"})
+  const fs::path dir(options.dir), identities = dir / "identities";
+  const fs::path ca_dir = options.ca_dir.empty() ? dir / "ca" : fs::path(options.ca_dir);
+  for (const fs::path& d : {dir, identities})
     if (Status s = CreatePrivateDirectories(d.string()); !s.ok()) return s;
-  Authority identity_ca("identity CA", (dir / "identity_ca.cert.pem").string(), (dir / "ca" / "identity_ca.key.pem").string());
+  Authority identity_ca("identity CA", (dir / "identity_ca.cert.pem").string(), (ca_dir / "identity_ca.key.pem").string());
   Authority permissions_ca("permissions CA", (dir / "permissions_ca.cert.pem").string(),
-                           (dir / "ca" / "permissions_ca.key.pem").string());
+                           (ca_dir / "permissions_ca.key.pem").string());
   if (Status s = identity_ca.Open("CN=dyad identity CA " + graph.name, options.ca_days, out); !s.ok()) return s;
   if (Status s = permissions_ca.Open("CN=dyad permissions CA " + graph.name, options.ca_days, out); !s.ok()) return s;
   if (Status s = SignDocument((dir / "governance.xml").string(), (dir / "governance.p7s").string(), GovernanceXml(),
@@ -294,46 +377,25 @@ Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>
     return s;
 
   for (const std::string& identity : GraphIdentities(graph)) {
-    const fs::path own = dir / "identities" / identity;
-    if (Status s = CreatePrivateDirectories(own.string()); !s.ok()) return s;
+    const fs::path own = identities / identity;
     const std::string cert_path = (own / "cert.pem").string(), key_path = (own / "key.pem").string();
     const bool renew = options.renew.count("all") > 0 || options.renew.count(identity) > 0;
     const bool have = fs::exists(fs::symlink_status(cert_path)) && fs::exists(fs::symlink_status(key_path));
-    Cert cert;
-    if (have && !renew) {
-      auto c = ReadCert(cert_path);
-      if (!c.ok()) return c.status();
-      cert = std::move(c.value());
-      out << "kept     " << identity << ": " << cert_path << "\n";
-    } else {
-      auto ca_key = identity_ca.key("issue identity " + identity);
-      if (!ca_key.ok()) return ca_key.status();
-      auto k = NewKey();
-      if (!k.ok()) return k.status();
-      auto c = Issue(k.value().get(), IdentitySubject(graph, identity), identity_ca.cert(), ca_key.value(),
-                     options.identity_days, Use::kIdentity);
-      if (!c.ok()) return c.status();
-      const CreateMode mode = renew ? CreateMode::kReplace : CreateMode::kNew;
-      if (Status s = WritePrivateFile(key_path, KeyPem(k.value().get()), mode); !s.ok()) return s;
-      if (Status s = WritePrivateFile(cert_path, CertPem(c.value().get()), mode); !s.ok()) return s;
-      cert = std::move(c.value());
-      out << (renew && have ? "renewed  " : "issued   ") << identity << ": " << cert_path << "\n";
+    if (!have || renew) {
+      if (Status s = IssueIdentity(graph, access, options, identity, identity_ca, permissions_ca, out); !s.ok()) return s;
+      continue;
     }
+    auto cert = ReadCert(cert_path);
+    if (!cert.ok()) return cert.status();
+    out << "kept     " << identity << ": " << cert_path << "\n";
     // The grant is valid as long as the certificate.
-    time_t not_before = 0, not_after = 0;
-    {
-      std::tm tm{};
-      ASN1_TIME_to_tm(X509_get0_notBefore(cert.get()), &tm);
-      not_before = timegm(&tm);
-      ASN1_TIME_to_tm(X509_get0_notAfter(cert.get()), &tm);
-      not_after = timegm(&tm);
-    }
-    const std::string xml = PermissionsXml(graph, identity, access, Utc(not_before), Utc(not_after));
+    const auto [from, to] = Validity(cert.value().get());
+    const std::string xml = PermissionsXml(graph, identity, access, from, to);
     if (Status s = SignDocument((own / "permissions.xml").string(), (own / "permissions.p7s").string(), xml, permissions_ca, out);
         !s.ok())
       return s;
   }
-  if (!options.web_hosts.empty()) return InitWebCertificate(graph, options, out);
+  if (!options.web_hosts.empty()) return InitWebCertificate(graph, options, ca_dir, out);
   return Status::OK();
 }
 

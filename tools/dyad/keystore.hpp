@@ -3,10 +3,16 @@
 //
 // Contract:
 //   - Two CAs (identity, permissions): self-signed ECDSA P-256, valid `ca_days`. Made once; their
-//     keys stay in DIR/ca/ (move that folder off the experiment machines after issuing: a run
-//     needs only the certificates; `init` needs the keys again only to issue or sign something).
+//     keys stay in the CA folder, `ca_dir` (default DIR/ca/; move it off the experiment machines
+//     after issuing: a run needs only the certificates; `init` needs the keys again only to issue
+//     or sign something, and then names the key file it looked for). The CA folder is created
+//     only when a CA is made: an init that has nothing to issue never makes an empty one.
 //   - One identity per process and per host (GraphIdentities): an ECDSA P-256 key and a
-//     certificate issued by the identity CA for `identity_days`, subject IdentitySubject.
+//     certificate issued by the identity CA for `identity_days`, subject IdentitySubject. An
+//     identity is issued or renewed as one step: key, certificate and permissions are made in a
+//     staging folder that then replaces DIR/identities/<identity> atomically, so a failure or
+//     crash leaves the identity as it was (never an empty folder, never a key beside another
+//     key's certificate).
 //   - governance.p7s and every permissions.p7s: the XML of access_documents.hpp, S/MIME-signed
 //     by the permissions CA (openssl smime -sign -text, as Fast DDS verifies it).
 //   - A rerun is safe: existing keys and certificates are kept (an identity the graph gained is
@@ -36,6 +42,7 @@ namespace dyad::cli {
 
 struct KeystoreOptions {
   std::string dir;
+  std::string ca_dir;  // the CA keys' folder; empty: DIR/ca
   int ca_days = 3650;
   int identity_days = 365;
   std::set<std::string> renew;  // identities to reissue; {"all"}: every one

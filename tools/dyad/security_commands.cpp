@@ -59,6 +59,8 @@ void AddSecurityCommands(CLI::App& app, int& exit_code) {
               "permissions from what each process reads and writes; existing keys are kept");
   init->add_option("dir", st->keystore.dir, "The keystore folder (the graph's security.keystore)")->required();
   init->add_option("--graph", st->graph, "The graph")->required();
+  init->add_option("--ca", st->keystore.ca_dir,
+                   "The folder of the CA keys (default DIR/ca): where an offline CA is brought back from, e.g. a USB key");
   init->add_option("--plugins", st->plugins, "Extra plugin file or folder (repeatable)");
   init->add_option("--set", st->sets, "Change a key of the graph, as `dyad run --set` does (the runs must use the same sets)");
   init->add_option("--renew", st->renew, "Replace the key and certificate of this identity (process.NAME, host.NAME, web, or all; repeatable)");

@@ -222,6 +222,51 @@ TEST_F(KeystoreTest, CaKeysKeptOfflineAreNeededOnlyToIssue) {
   EXPECT_NE(issued.out.find("issued   process.extra"), std::string::npos) << issued.out;
 }
 
+TEST_F(KeystoreTest, AFailedIssueOrRenewalLeavesEachIdentityAsItWas) {
+  ASSERT_EQ(Init().code, 0);
+  const std::string key = ReadFile(Identity("process.pub", "key.pem")), cert = ReadFile(Identity("process.pub", "cert.pem"));
+  // The identity CA's key is here, the permissions CA's is not: a renewal can make the new pair
+  // but cannot sign its permissions, so it fails, and the old pair must still be the pair.
+  fs::rename(keys_ / "ca" / "permissions_ca.key.pem", dir_ / "permissions_ca.key.pem");
+  auto renew = Init({"--renew", "process.pub"});
+  EXPECT_EQ(renew.code, 1);
+  EXPECT_NE(renew.err.find("permissions_ca.key.pem: the permissions CA's key is not here"), std::string::npos) << renew.err;
+  EXPECT_EQ(ReadFile(Identity("process.pub", "key.pem")), key);
+  EXPECT_EQ(ReadFile(Identity("process.pub", "cert.pem")), cert);
+  // A new process fails the same way: no folder of it is left, empty or half made.
+  const fs::path bigger = WriteGraph("", "g2.yaml");
+  std::string text = ReadFile(bigger);
+  text.replace(text.find("rec: {}"), 7, "rec: {}\n  extra: {}");
+  text += "  x: {type: counter_source, rate_hz: 10, process: extra, outputs: {out: cc}}\n";
+  std::ofstream(bigger) << text;
+  EXPECT_EQ(Init({}, bigger).code, 1);
+  EXPECT_FALSE(fs::exists(fs::symlink_status(Identity("process.extra", ""))));
+  for (const auto& e : fs::directory_iterator(keys_ / "identities"))
+    EXPECT_EQ(e.path().filename().string().find(".new-"), std::string::npos) << e.path();
+  fs::rename(dir_ / "permissions_ca.key.pem", keys_ / "ca" / "permissions_ca.key.pem");
+  auto issued = Init({"--renew", "process.pub"}, bigger);
+  ASSERT_EQ(issued.code, 0) << issued.err;
+  EXPECT_NE(issued.out.find("renewed  process.pub"), std::string::npos) << issued.out;
+  EXPECT_NE(issued.out.find("issued   process.extra"), std::string::npos) << issued.out;
+  EXPECT_NE(ReadFile(Identity("process.pub", "key.pem")), key);
+  EXPECT_EQ(Mode(keys_ / "identities" / "process.extra"), 0700u);
+  EXPECT_EQ(Mode(Identity("process.extra", "key.pem")), 0600u);
+}
+
+TEST_F(KeystoreTest, ValidateRefusesAKeyThatIsNotTheKeyOfItsCertificate) {
+  const fs::path secured = WriteGraph("security: {keystore: keys}\n", "secured.yaml");
+  ASSERT_EQ(Init().code, 0);
+  // What a renewal cut between its two writes left: another key beside the certificate. Each
+  // file passes the file checks (present, regular, 0600, a valid certificate).
+  fs::copy_file(Identity("process.rec", "key.pem"), Identity("process.pub", "key.pem"), fs::copy_options::overwrite_existing);
+  auto v = dyad::testing::RunCommand(AddRuntimeCommands, {"validate", secured.string()});
+  EXPECT_EQ(v.code, 2);
+  EXPECT_NE(v.err.find("identity 'process.pub': " + Identity("process.pub", "key.pem").string() + ": not the key of " +
+                       Identity("process.pub", "cert.pem").string()),
+            std::string::npos)
+      << v.err;
+}
+
 TEST_F(KeystoreTest, ValidateRefusesAKeystoreThatIsIncompleteLeakyOrExpired) {
   const fs::path secured = WriteGraph("security: {keystore: keys}\n", "secured.yaml");
   auto validate = [&] { return dyad::testing::RunCommand(AddRuntimeCommands, {"validate", secured.string()}); };
