@@ -96,7 +96,8 @@ TEST_F(OutputRelayTest, ALogPathThatIsASymlinkIsRefused) {
   }
   EXPECT_EQ(Read(target), "precious\n");
   EXPECT_EQ(out_.str(), "[mind] hello\n");
-  EXPECT_NE(err_.str().find("[mind] warning: cannot write its log: " + log.string() + ": is a symbolic link: refused"),
+  EXPECT_NE(err_.str().find("[mind] warning: cannot write its log: " + log.string() + ": is a symbolic link to '" +
+                            target.string() + "': refused"),
             std::string::npos)
       << err_.str();
 }

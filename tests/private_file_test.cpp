@@ -70,7 +70,8 @@ TEST_F(PrivateFileTest, AnExistingFileIsAnErrorAndKeepsItsContent) {
   std::ofstream(f) << "earlier recording";
   auto fd = CreatePrivateFile(f.string(), CreateMode::kNew);
   ASSERT_FALSE(fd.ok());
-  EXPECT_EQ(fd.status().message(), f.string() + ": exists (a private file is never opened through an existing entry)");
+  EXPECT_EQ(fd.status().message(),
+            f.string() + ": exists: a file of 17 bytes (a private file is never opened through an existing entry)");
   EXPECT_EQ(Read(f), "earlier recording");
 }
 
@@ -80,10 +81,17 @@ TEST_F(PrivateFileTest, APlantedSymlinkIsRefusedAndItsTargetUntouched) {
   fs::create_symlink(target, link);
   auto fd = CreatePrivateFile(link.string(), CreateMode::kNew);
   ASSERT_FALSE(fd.ok());
-  EXPECT_NE(fd.status().message().find("exists"), std::string::npos) << fd.status().message();
+  // The refusal says what is there: the link and where it points.
+  EXPECT_EQ(fd.status().message(), link.string() + ": exists: a symbolic link to '" + target.string() +
+                                       "' (a private file is never opened through an existing entry)");
   auto log = OpenPrivateLog(link.string());
   ASSERT_FALSE(log.ok());
-  EXPECT_EQ(log.status().message(), link.string() + ": is a symbolic link: refused (it could point anywhere)");
+  EXPECT_EQ(log.status().message(), link.string() + ": is a symbolic link to '" + target.string() +
+                                        "': refused (it could point anywhere)");
+  fs::create_directory(dir_ / "a_folder");
+  auto folder = CreatePrivateFile((dir_ / "a_folder").string(), CreateMode::kNew);
+  ASSERT_FALSE(folder.ok());
+  EXPECT_NE(folder.status().message().find("a_folder: exists: a folder"), std::string::npos) << folder.status().message();
   // A dangling link too (O_CREAT would have created its target).
   const fs::path dangling = dir_ / "dangling";
   fs::create_symlink(dir_ / "would_be_created", dangling);

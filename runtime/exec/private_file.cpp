@@ -16,8 +16,10 @@ mode_t FileMode(const PrivateFileOptions& o) { return o.group_readable ? 0640 : 
 mode_t DirMode(const PrivateFileOptions& o) { return o.group_readable ? 0750 : 0700; }
 
 Status Errno(const std::string& path, const char* what, int err) {
-  if (err == EEXIST) return Status::FailedPrecondition(path, "exists (a private file is never opened through an existing entry)");
-  if (err == ELOOP) return Status::FailedPrecondition(path, "is a symbolic link: refused (it could point anywhere)");
+  if (err == EEXIST)
+    return Status::FailedPrecondition(path, "exists: " + WhatIsAt(path) +
+                                                " (a private file is never opened through an existing entry)");
+  if (err == ELOOP) return Status::FailedPrecondition(path, "is " + WhatIsAt(path) + ": refused (it could point anywhere)");
   return Status::IOError(path, std::string(what) + ": " + std::strerror(err));
 }
 
@@ -28,6 +30,19 @@ StatusOr<int> CreateExclusive(const std::string& path, const PrivateFileOptions&
 }
 
 }  // namespace
+
+std::string WhatIsAt(const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0) return "nothing";
+  if (S_ISLNK(st.st_mode)) {
+    std::error_code ec;
+    const std::filesystem::path target = std::filesystem::read_symlink(path, ec);
+    return ec ? "a symbolic link" : "a symbolic link to '" + target.string() + "'";
+  }
+  if (S_ISDIR(st.st_mode)) return "a folder";
+  if (S_ISREG(st.st_mode)) return "a file of " + std::to_string(st.st_size) + " bytes";
+  return "a special file (not a regular file)";
+}
 
 Status CreatePrivateDirectories(const std::string& dir, const PrivateFileOptions& options) {
   if (dir.empty()) return Status::OK();

@@ -78,8 +78,11 @@ Status Recorder::Configure(Context& ctx) {
   // early; Activate's exclusive creation is what guarantees it.)
   options_.replace_existing = p.Bool("overwrite");
   if (!p.Bool("overwrite") && std::filesystem::exists(std::filesystem::symlink_status(path_)))
-    return Status::InvalidArgument("params.file = '" + path_ +
-                                   "': exists; set params.overwrite: true to replace it, or put {time} in the name");
+    return Status::InvalidArgument("params.file = '" + path_ + "': exists; set params.overwrite: true to replace it, or put " +
+                                   "{time} in the name (there now: " + WhatIsAt(path_) +
+                                   "; a link is replaced as an entry, its target never written)");
+  if (std::filesystem::is_directory(std::filesystem::symlink_status(path_)))
+    return Status::InvalidArgument("params.file = '" + path_ + "': is a folder; name a file in it");
   options_.chunk_size = static_cast<uint64_t>(p.Int("chunk_size"));
   options_.compression = p.String("compression") == "none" ? mcap::Compression::kNone : mcap::Compression::kZstd;
   options_.zstd_level = static_cast<int>(p.Int("compression_level"));

@@ -387,6 +387,8 @@ TEST_F(RecorderTest, RecordingsArePrivateAndAPlantedSymlinkIsRefused) {
   std::string err;
   EXPECT_NE(Run({"run", graph.string(), "--steps", "20", "--quiet"}, nullptr, &err), 0);
   EXPECT_NE(err.find("P01.mcap': exists; set params.overwrite: true"), std::string::npos) << err;
+  EXPECT_NE(err.find("(there now: a symbolic link to '" + victim.string() + "'"), std::string::npos)
+      << "the refusal says it is a link and where it points: " << err;
   EXPECT_EQ(ReadFile(victim), "precious");
   // overwrite replaces the link itself, never writes through it.
   ASSERT_EQ(Run({"run", graph.string(), "--steps", "20", "--quiet", "--set", "rec.overwrite=true"}), 0);

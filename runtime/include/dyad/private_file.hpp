@@ -18,6 +18,9 @@
 //     file closed (small files: keys, tokens, documents).
 //   - SyncDirectory(dir): fsync of the folder itself, so a file created, renamed or removed in it
 //     stays so after a power cut (the file's own data needs its own fdatasync).
+//   - WhatIsAt(path): what a refusal should name: "nothing", "a symbolic link to '<target>'", "a
+//     folder", "a file of N bytes", or "a special file (not a regular file)". The refusals above
+//     say it ("exists: a symbolic link to '/etc/passwd' (...)").
 // Every function returns a Status naming the path and the system's reason; the returned file
 // descriptor is O_CLOEXEC and owned by the caller. The umask still applies (it can only remove
 // permissions).
@@ -41,5 +44,6 @@ Status WritePrivateFile(const std::string& path, const std::string& text, Create
 StatusOr<int> OpenPrivateLog(const std::string& path, const PrivateFileOptions& options = {});
 Status CreatePrivateDirectories(const std::string& dir, const PrivateFileOptions& options = {});
 Status SyncDirectory(const std::string& dir);
+std::string WhatIsAt(const std::string& path);
 
 }  // namespace dyad
