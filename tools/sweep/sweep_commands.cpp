@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -18,7 +19,7 @@ namespace dyad::cli {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr int kOk = 0, kFailure = 1, kBadInput = 2;
+constexpr int kOk = 0, kFailure = 1, kBadInput = 2, kStopped = 130;
 
 struct Options {
   std::string file, out;
@@ -49,8 +50,19 @@ void Plots(const Options& o, const fs::path& out) {
     std::cout << "plots: " << (out / "plots").string() << "/\n";
 }
 
+// A stop signal ended the jobs: what is missing, and how to finish them. `what(i)` names job i.
+template <typename What>
+int Stopped(const std::string& name, const sweep::RunnerResult& r, const std::string& jobs, What what) {
+  std::cout << "sweep " << name << ": stopped by " << (r.signal == SIGINT ? "SIGINT" : "SIGTERM") << ": " << r.ran << " ran, "
+            << r.skipped << " done before, " << r.failed << " failed, " << r.not_done.size() << " " << jobs << " missing:\n";
+  for (size_t i : r.not_done) std::cout << "  " << what(i) << "\n";
+  std::cout << "the finished ones are kept: the same command again runs the missing ones\n" << std::flush;
+  return kStopped;
+}
+
 // The runs of `plan` here, `workers` at once; with `table`, then sweep.csv and the plots.
 int RunHere(const Options& o, const sweep::SweepPlan& plan, const fs::path& out, int workers, bool table) {
+  sweep::StopOnSignals stop_on_signals;
   std::error_code ec;
   if (fs::create_directories(out / "runs", ec); ec) {
     std::cerr << "dyad sweep: " << out.string() << ": " << ec.message() << "\n";
@@ -61,9 +73,19 @@ int RunHere(const Options& o, const sweep::SweepPlan& plan, const fs::path& out,
   if (o.task.empty() && !plan.trainings.empty()) {
     std::cout << "training " << plan.trainings.size() << " model" << (plan.trainings.size() == 1 ? "" : "s") << " into "
               << (out / "models").string() << "\n";
-    sweep::TrainModels(plan, plan.trainings, runner, std::cout);
+    const sweep::RunnerResult t = sweep::TrainModels(plan, plan.trainings, runner, std::cout);
+    if (t.signal != 0) return Stopped(plan.name, t, "models (and every run)", [&](size_t i) { return "model " + plan.trainings[i].id; });
   }
   const sweep::RunnerResult r = sweep::RunSweep(plan, runner, std::cout);
+  if (r.signal != 0) {
+    if (Status s = table ? sweep::WriteSweepCsv(plan, out.string()) : Status::OK(); !s.ok())  // the others: missing
+      std::cerr << "dyad sweep: " << s.message() << "\n";
+    return Stopped(plan.name, r, "runs", [&](size_t i) {
+      std::string what = plan.runs[i].id;
+      for (const auto& [key, value] : plan.runs[i].params) what += " " + key + "=" + value;
+      return what + " seed=" + std::to_string(plan.runs[i].seed);
+    });
+  }
   std::cout << "sweep " << plan.name << (o.task.empty() ? "" : " task " + o.task) << ": " << r.ran << " ran, " << r.skipped
             << " done before, " << r.failed << " failed";
   if (!table) {
@@ -105,10 +127,12 @@ int Collect(const Options& o, const sweep::SweepPlan& plan, const fs::path& out)
 
 // --train-only: the models (this task's chunk of them), no runs: a Slurm training task.
 int TrainOnly(const Options& o, const sweep::SweepPlan& plan, const fs::path& out, int workers, sweep::TaskSlice task) {
+  sweep::StopOnSignals stop_on_signals;
   const auto trainings = o.task.empty() ? plan.trainings : sweep::TaskChunk(plan.trainings, task);
   std::cout << "sweep " << plan.name << ": " << trainings.size() << " of " << plan.trainings.size() << " models into "
             << (out / "models").string() << "\n";
   const sweep::RunnerResult r = sweep::TrainModels(plan, trainings, sweep::RunnerOptions{out.string(), workers, tools::ThisExecutable()}, std::cout);
+  if (r.signal != 0) return Stopped(plan.name, r, "models", [&](size_t i) { return "model " + trainings[i].id; });
   std::cout << "sweep " << plan.name << ": " << r.ran << " trained, " << r.skipped << " there before, " << r.failed << " failed\n";
   return r.failed > 0 ? kFailure : kOk;
 }

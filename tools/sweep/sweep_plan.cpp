@@ -10,9 +10,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "dyad/catalog.hpp"
 #include "dyad/graph.hpp"
+#include "dyad/params.hpp"
 #include "dyad/pvrnn/train_config.hpp"
 #include "dyad/strict_yaml.hpp"
+#include "dyad/validate.hpp"
 #include "graph_check.hpp"
 #include "study_file.hpp"
 #include "yaml_file.hpp"
@@ -41,7 +44,13 @@ void ReadGrid(StrictYaml& y, const YAML::Node& g, const std::string& at, const s
     }
     columns->push_back(column_prefix + key);
     grid->emplace_back();
-    for (const auto& v : kv.second) grid->back().push_back({key, tools::SetText(v), v, where});
+    std::set<std::string> seen;
+    for (const auto& v : kv.second) {
+      const std::string text = tools::SetText(v);
+      // One id run twice at once into one folder, and counted twice in the plots' means.
+      if (!seen.insert(text).second) y.Error(v, where, "the value " + text + " is repeated (each combination runs once per seed)");
+      grid->back().push_back({key, text, v, where});
+    }
   }
 }
 
@@ -97,6 +106,22 @@ void ReadBase(StrictYaml& y, const YAML::Node& root, const std::string& path, co
   y.Error(condition_node, "condition", "the study " + st.name + " has no condition '" + condition + "' (it has: " + known + ")");
 }
 
+// `seed` in the grid: the seeds (a column of their own in the table, and the last --set of each
+// run, so a grid value would be overridden by the default seed), taken out of the grid.
+void TakeGridSeeds(StrictYaml& y, const YAML::Node& root, SweepPlan* plan, std::vector<std::vector<SweptValue>>* grid,
+                   std::vector<int64_t>* seeds) {
+  for (size_t i = 0; i < grid->size(); ++i) {
+    if ((*grid)[i].empty() || (*grid)[i][0].key != "seed") continue;
+    const YAML::Node node = root["grid"]["seed"];
+    if (root["seeds"]) y.Error(node, "grid.seed", "give the seeds once: in grid or as seeds:, not both");
+    std::vector<int64_t> given;
+    if (y.Get(node, "grid.seed", &given, "a list of integers")) *seeds = given;  // (a repeated one: refused as any grid value)
+    grid->erase(grid->begin() + static_cast<std::ptrdiff_t>(i));
+    plan->parameters.erase(std::find(plan->parameters.begin(), plan->parameters.end(), "seed"));
+    return;
+  }
+}
+
 // Reads the parts of the file; the overrides it names go to *swept (grid) or *listed (runs).
 void ReadFile(StrictYaml& y, const YAML::Node& root, SweepPlan* plan,
               std::vector<std::string>* base_sets, std::vector<std::vector<SweptValue>>* grid,
@@ -124,6 +149,10 @@ void ReadFile(StrictYaml& y, const YAML::Node& root, SweepPlan* plan,
         listed->emplace_back();
         for (const auto& kv : r[i]) {
           const std::string key = kv.first.Scalar();
+          if (key == "seed") {
+            y.Error(kv.second, where + ".seed", "the seeds are the sweep's: give seeds: [...] (each run once per seed)");
+            continue;
+          }
           if (std::find(plan->parameters.begin(), plan->parameters.end(), key) == plan->parameters.end())
             plan->parameters.push_back(key);
           listed->back().push_back({key, tools::SetText(kv.second), kv.second, where + "." + key});
@@ -142,6 +171,7 @@ void ReadFile(StrictYaml& y, const YAML::Node& root, SweepPlan* plan,
   } else {
     seeds->push_back(1);
   }
+  if (g) TakeGridSeeds(y, root, plan, grid, seeds);
 }
 
 std::string ReadText(const std::string& path) {
@@ -155,6 +185,7 @@ std::string ReadText(const std::string& path) {
 std::vector<std::vector<const SweptValue*>> Combinations(const std::vector<std::vector<SweptValue>>& grid,
                                                       const std::vector<std::vector<SweptValue>>& listed) {
   std::vector<std::vector<const SweptValue*>> combos;
+  if (grid.empty() && listed.empty()) return {{}};  // a grid of seeds only
   if (grid.empty()) {
     for (const auto& run : listed) {
       combos.emplace_back();
@@ -261,6 +292,78 @@ void CheckModelKey(StrictYaml& y, const YAML::Node& t, const std::string& graph_
   y.Error(at, "train.model", "the graph has no component " + component);
 }
 
+// Path parameters that name what a run writes, not what it reads: their content is no input.
+bool WrittenByTheRun(const std::string& type, const std::string& param) {
+  static const std::set<std::pair<std::string, std::string>> written = {
+      {"recorder", "file"}, {"counter_sink", "file"}, {"learner", "out"}, {"web", "port_file"}, {"web", "token_file"}};
+  return written.count({type, param}) > 0;
+}
+
+// What `path` names, as hex: a file's bytes, a folder's files (names and bytes), or its absence.
+// Cached: a sweep's runs share their files.
+const std::string& ContentHash(const std::string& path, std::map<std::string, std::string>* cache) {
+  auto [it, added] = cache->emplace(path, "");
+  if (!added) return it->second;
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (fs::is_regular_file(st)) it->second = Hex(tools::Fnv1a(ReadText(path), tools::Fnv1a("file\n")));
+  else if (fs::is_directory(st)) it->second = Hex(HashFolder(path, tools::Fnv1a("folder\n")));
+  else it->second = "absent";
+  return it->second;
+}
+
+// A run's cache key (see the header): the graph as run, the duration, and every file it reads.
+class RunKey {
+ public:
+  RunKey(const SweepPlan& plan, const std::vector<std::string>& base, const std::vector<std::string>& plugins) : plan_(plan) {
+    std::vector<Diagnostic> ignored;  // the graph validated with these before
+    const Graph g = LoadGraph(plan.graph, Overrides(base), &ignored);
+    // Their problems were the validation's (a plugin that does not load fails it).
+    for (const auto& p : g.plugins) (void)catalog_.Load(p);
+    for (const auto& p : plugins) (void)catalog_.Load(p);
+    (void)catalog_.LoadDefault({});
+    replaced_.insert(plan.recorder + ".file");  // each run's own recording
+    if (!plan.trainings.empty()) {              // each run's trained model (its id counts instead)
+      const std::string key = plan.model_key, param = key.substr(key.find('.') + 1);
+      replaced_.insert(key.substr(0, key.find('.')) + "." + (param.rfind("params.", 0) == 0 ? param.substr(7) : param));
+    }
+  }
+
+  uint64_t Hash(const std::vector<std::string>& sets) {
+    std::vector<Diagnostic> ignored;
+    const Graph g = LoadGraph(plan_.graph, Overrides(sets), &ignored);
+    uint64_t h = tools::Fnv1a(g.yaml_text);  // every file it extends, merged, and the sets
+    char duration[40];
+    std::snprintf(duration, sizeof duration, "duration %.17g\n", plan_.duration_s);
+    h = tools::Fnv1a(duration, h);
+    const ResolvedGraph resolved = ValidateGraph(g, catalog_, &ignored);
+    for (const ResolvedComponent& rc : resolved.components) {
+      if (rc.config == nullptr || rc.entry == nullptr) continue;
+      for (const ParamSpec& ps : rc.entry->spec.params()) {
+        const std::string key = rc.config->name + "." + ps.name;
+        if (!ps.path || WrittenByTheRun(rc.config->type, ps.name) || replaced_.count(key) || !rc.params.Has(ps.name)) continue;
+        std::vector<std::string> paths;
+        if (ps.type == ParamType::kStringList) paths = rc.params.StringList(ps.name);
+        else paths.push_back(rc.params.String(ps.name));
+        for (const std::string& p : paths)
+          if (!p.empty()) h = tools::Fnv1a(key + " " + p + " " + ContentHash(p, &contents_) + "\n", h);
+      }
+    }
+    return h;
+  }
+
+ private:
+  static std::vector<Override> Overrides(const std::vector<std::string>& sets) {
+    std::vector<Override> overrides;
+    for (const auto& s : sets) overrides.push_back({s});
+    return overrides;
+  }
+  const SweepPlan& plan_;
+  Catalog catalog_;
+  std::set<std::string> replaced_;  // COMPONENT.PARAM the sweep gives each run
+  std::map<std::string, std::string> contents_;
+};
+
 }  // namespace
 
 std::string ModelPath(const std::string& out, const SweepTraining& training) {
@@ -313,7 +416,7 @@ SweepPlan LoadSweep(const std::string& path, const std::vector<std::string>& plu
   if (!problems->empty()) return plan;
 
   const std::vector<std::vector<const SweptValue*>> combos = Combinations(grid, listed);
-  const std::string graph_text = ReadText(plan.graph);
+  RunKey key(plan, base, plugins);
   const int trainings = static_cast<int>(plan.trainings.size());
   for (int t = trainings > 0 ? 0 : -1; t < trainings; ++t)
     for (const auto& combo : combos)
@@ -328,7 +431,7 @@ SweepPlan LoadSweep(const std::string& path, const std::vector<std::string>& plu
           run.sets.push_back(o->key + "=" + o->value);
         }
         run.sets.push_back("seed=" + std::to_string(seed));
-        uint64_t h = tools::Fnv1a(graph_text);
+        uint64_t h = key.Hash(run.sets);
         for (const auto& s : run.sets) h = tools::Fnv1a(s + "\n", h);
         if (t >= 0) h = tools::Fnv1a("model " + plan.trainings[static_cast<size_t>(t)].id + "\n", h);
         run.id = Hex(tools::Fnv1a(DYAD_VERSION, h));

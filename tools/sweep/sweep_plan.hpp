@@ -13,6 +13,7 @@
 //   runs:                            # ...or explicit override sets (one of grid and runs)
 //     - {mixer.gain: 0.3, mind.optimizer: ceres}
 //   seeds: [1, 2, 3]                 # each combination once per seed (graph key `seed`); default [1]
+//                                    # (or `seed: [1, 2, 3]` in grid:, the same; not both)
 //   train:                           # optional: the runs use models the sweep trains
 //     config: ../train/demo.yaml     # `dyad train`'s config, relative to this file
 //     model: mind.model              # the graph's key each trained model goes to (default mind.model)
@@ -22,7 +23,8 @@
 // Contract of LoadSweep:
 //   - Every problem of the file at once, each "file:line:col: key: message" (strict YAML: unknown
 //     keys, wrong types, an empty grid or list, both grid and runs, both graph and study, a
-//     condition the study lacks; a study file's own problems at its lines).
+//     condition the study lacks, a value repeated in a grid key's list or in seeds, seeds given
+//     in grid: and seeds: both, `seed` in a runs: entry; a study file's own problems at its lines).
 //   - Every override (each value of each key) is checked against the graph, as `dyad validate
 //     --set` would: a key the graph lacks, a value its component refuses. Its problems are
 //     reported at the sweep file's line of that value.
@@ -33,8 +35,15 @@
 //     data set, its overrides and the dyad version: its model is OUT/models/<id>.dpvrnn, trained
 //     once and reused by any sweep into that folder until one of those changes.
 //   - Runs come in a fixed order: trainings, then grid (or list) order, then seeds. Each run's
-//     id is a hash of the graph file's text, its overrides, its training's id and the dyad
-//     version: the same run in any sweep, and in a resumed one, has the same id.
+//     id is a hash of the run fully resolved: the graph as run (every file of its extends:
+//     chain merged, with all its overrides, the seed among them: Graph::yaml_text), the
+//     duration, the content of every file or folder a path parameter (ParamSpec::path) of its
+//     components names (a folder: each file's name and bytes; a path to nothing counts as
+//     absent), its training's id and the dyad version. Not inputs, so not hashed: the
+//     recorder's file and the trained model's key (the sweep sets them per run), and the paths
+//     a run writes (recorder.file, counter_sink.file, learner.out, web.port_file,
+//     web.token_file). The same run in any sweep, and in a resumed one, has the same id;
+//     changing any input gives new ids to exactly the runs that read it.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,7 @@
 #include "sweep_runner.hpp"
 
+#include <signal.h>
+
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -9,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <system_error>
 #include <sstream>
 #include <thread>
 
@@ -36,7 +39,42 @@ std::string Tail(const std::string& path, size_t lines) {
   return out;
 }
 
-enum class Outcome { kOk, kSkipped, kFailed };
+enum class Outcome { kOk, kSkipped, kFailed, kStopped };
+
+// How a job ended; `why`: a failure's reason when it could not be written to its file.
+struct JobEnd {
+  Outcome outcome;
+  std::string why;
+};
+
+std::atomic<int> g_stop_signal{0};  // lock-free: set in a handler, read by the workers
+static_assert(std::atomic<int>::is_always_lock_free);
+extern "C" void OnSweepStopSignal(int signal) { g_stop_signal.store(signal); }
+
+// `args` with its output in `log`, in a process group of its own (SIGINT when we die); a stop
+// signal sends its group SIGINT, then SIGKILL after kStopGraceS. False when a stop came before
+// it ended (*rc is then how it ended, for nobody).
+bool RunChild(const std::vector<std::string>& args, const std::string& log, int* rc) {
+  *rc = 127;
+  if (g_stop_signal.load() != 0) return false;
+  const int pid = tools::StartProcess(args, log, true);
+  if (pid < 0) return true;
+  bool stopped = false, killed = false;
+  Clock::time_point stop_sent;
+  while (!tools::ProcessEnded(pid, rc)) {
+    if (!stopped && g_stop_signal.load() != 0) {
+      ::kill(-pid, SIGINT);
+      stopped = true;
+      stop_sent = Clock::now();
+    }
+    if (stopped && !killed && Clock::now() - stop_sent > std::chrono::duration<double>(kStopGraceS)) {
+      ::kill(-pid, SIGKILL);
+      killed = true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return !stopped;
+}
 
 // `dyad analyze --no-plots`, in this process (a second process per run cost a fifth of a short
 // run); its warnings go to analyze.log beside the report.
@@ -48,37 +86,53 @@ Status Analyze(const std::string& recording, const std::string& report_dir) {
   return analyze::WriteReport(*report, report_dir);
 }
 
+// A failure: `text` into `file`; when that cannot be written, its first line is the reason.
+JobEnd Failed(const fs::path& file, const std::string& text) {
+  std::ofstream out(file);
+  out << text;
+  out.close();
+  if (out) return {Outcome::kFailed, ""};
+  return {Outcome::kFailed, text.substr(0, text.find('\n')) + " (and " + file.string() + " cannot be written)"};
+}
+
+// `dir` made (or there) and `stale` gone; else why not.
+std::string PrepareFolder(const fs::path& dir, const fs::path& stale) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!ec && !fs::is_directory(dir, ec)) ec = std::make_error_code(std::errc::not_a_directory);
+  if (ec) return "cannot make its folder " + dir.string() + ": " + ec.message();
+  if (fs::remove(stale, ec); ec) return "cannot remove " + stale.string() + ": " + ec.message();
+  return "";
+}
+
 // One run, start to end (see the header).
-Outcome DoRun(const SweepPlan& plan, const SweepRun& run, const RunnerOptions& o) {
+JobEnd DoRun(const SweepPlan& plan, const SweepRun& run, const RunnerOptions& o) {
   const fs::path dir = fs::path(o.out) / "runs" / run.id;
-  if (fs::exists(dir / "metrics.json")) return Outcome::kSkipped;
-  fs::create_directories(dir);
-  fs::remove(dir / "failed.txt");
+  std::error_code ec;
+  if (fs::exists(dir / "metrics.json", ec)) return {Outcome::kSkipped, ""};
+  if (std::string why = PrepareFolder(dir, dir / "failed.txt"); !why.empty()) return {Outcome::kFailed, why};
   std::vector<std::string> run_args = {o.dyad, "run", plan.graph, "--quiet", "--duration", std::to_string(plan.duration_s)};
   for (const auto& s : run.sets) run_args.insert(run_args.end(), {"--set", s});
   run_args.insert(run_args.end(), {"--set", plan.recorder + ".file=" + (dir / "rec.mcap").string()});
-  std::string failed;
   if (run.training >= 0) {
     const SweepTraining& training = plan.trainings[static_cast<size_t>(run.training)];
     const std::string model = ModelPath(o.out, training);
     run_args.insert(run_args.end(), {"--set", plan.model_key + "=" + model});
-    if (!fs::exists(model))
-      failed = "its model " + model + " was not trained (see " + (fs::path(o.out) / "models" / (training.id + ".log")).string() + ")\n";
+    if (!fs::exists(model, ec))
+      return Failed(dir / "failed.txt", "its model " + model + " was not trained (see " +
+                                            (fs::path(o.out) / "models" / (training.id + ".log")).string() + ")\n");
   }
-  if (!failed.empty()) {
-  } else if (int rc = tools::RunProcess(run_args, (dir / "run.log").string()); rc != 0) {
-    failed = tools::ShellQuoted(run_args) + "\nexited " + std::to_string(rc) + "; the end of run.log:\n" + Tail((dir / "run.log").string(), 20);
-  } else if (Status s = Analyze((dir / "rec.mcap").string(), (dir / "report").string()); !s.ok()) {
-    failed = "dyad analyze " + (dir / "rec.mcap").string() + ": " + s.message() + "\n";
-  } else {
-    std::error_code ec;
-    fs::copy_file(dir / "report" / "metrics.json", dir / "metrics.json.new", fs::copy_options::overwrite_existing, ec);
-    if (!ec) fs::rename(dir / "metrics.json.new", dir / "metrics.json", ec);
-    if (ec) failed = "cannot keep the metrics: " + ec.message() + "\n";
-  }
-  if (failed.empty()) return Outcome::kOk;
-  std::ofstream(dir / "failed.txt") << failed;
-  return Outcome::kFailed;
+  int rc = 0;
+  if (!RunChild(run_args, (dir / "run.log").string(), &rc)) return {Outcome::kStopped, ""};
+  if (rc != 0)
+    return Failed(dir / "failed.txt", tools::ShellQuoted(run_args) + "\nexited " + std::to_string(rc) + "; the end of run.log:\n" +
+                                          Tail((dir / "run.log").string(), 20));
+  if (Status s = Analyze((dir / "rec.mcap").string(), (dir / "report").string()); !s.ok())
+    return Failed(dir / "failed.txt", "dyad analyze " + (dir / "rec.mcap").string() + ": " + s.message() + "\n");
+  fs::copy_file(dir / "report" / "metrics.json", dir / "metrics.json.new", fs::copy_options::overwrite_existing, ec);
+  if (!ec) fs::rename(dir / "metrics.json.new", dir / "metrics.json", ec);
+  if (ec) return Failed(dir / "failed.txt", "cannot keep the metrics: " + ec.message() + "\n");
+  return {Outcome::kOk, ""};
 }
 
 std::string Duration(double s) {
@@ -90,64 +144,85 @@ std::string Duration(double s) {
 
 // What Pool runs: job i, what it is (for the log), and the file that says why it failed.
 struct PoolJobs {
-  std::function<Outcome(size_t)> run;
+  std::function<JobEnd(size_t)> run;
   std::function<std::string(size_t)> what, why_file;
 };
 
+// The log line of a job that ended, under Pool's lock.
+struct PoolProgress {
+  size_t count = 0, finished = 0, executed = 0;
+  Clock::time_point t0 = Clock::now();
+
+  void Line(std::ostream& log, const std::string& what, const JobEnd& end, const std::string& why_file, double secs) {
+    const Outcome outcome = end.outcome;
+    ++finished;
+    if (outcome != Outcome::kSkipped) ++executed;
+    std::string how = outcome == Outcome::kOk ? "ok" : outcome == Outcome::kSkipped ? "done before" : "stopped";
+    if (outcome == Outcome::kFailed) how = "FAILED (" + (end.why.empty() ? why_file : end.why) + ")";
+    const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
+    const size_t left = count - finished;
+    log << "[" << finished << "/" << count << "] " << what << ": " << how;
+    if (outcome != Outcome::kSkipped) {
+      char s[32];
+      std::snprintf(s, sizeof s, " in %.1f s", secs);
+      log << s;
+    }
+    if (left > 0 && executed > 0 && outcome != Outcome::kStopped)
+      log << ", about " << Duration(elapsed / static_cast<double>(executed) * static_cast<double>(left)) << " left";
+    log << "\n" << std::flush;
+  }
+};
+
 // Runs jobs 0..count-1, `workers` at once; after each, a line to `log`: its count, what it was,
-// how it ended, and the estimated time left.
+// how it ended, and the estimated time left. A stop signal ends the loop: the jobs not done are
+// listed in the result.
 RunnerResult Pool(size_t count, int workers, std::ostream& log, const PoolJobs& jobs) {
   RunnerResult result;
   std::atomic<size_t> next{0};
-  std::mutex mutex;  // guards result, log, the counts below
-  size_t finished = 0, executed = 0;
-  const auto t0 = Clock::now();
+  std::mutex mutex;  // guards result, log, progress, done
+  PoolProgress progress;
+  progress.count = count;
+  std::vector<bool> done(count, false);
   auto worker = [&] {
-    for (size_t i; (i = next.fetch_add(1)) < count;) {
+    for (size_t i; g_stop_signal.load() == 0 && (i = next.fetch_add(1)) < count;) {
       const auto start = Clock::now();
-      const Outcome outcome = jobs.run(i);
+      const JobEnd end = jobs.run(i);
       const double secs = std::chrono::duration<double>(Clock::now() - start).count();
       std::lock_guard<std::mutex> lock(mutex);
-      ++finished;
-      std::string how = "ok";
-      if (outcome == Outcome::kSkipped) ++result.skipped, how = "done before";
-      else ++executed, ++(outcome == Outcome::kOk ? result.ran : result.failed);
-      if (outcome == Outcome::kFailed) how = "FAILED (" + jobs.why_file(i) + ")";
-      const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
-      const size_t left = count - finished;
-      log << "[" << finished << "/" << count << "] " << jobs.what(i) << ": " << how;
-      if (outcome != Outcome::kSkipped) {
-        char s[32];
-        std::snprintf(s, sizeof s, " in %.1f s", secs);
-        log << s;
-      }
-      if (left > 0 && executed > 0) log << ", about " << Duration(elapsed / static_cast<double>(executed) * static_cast<double>(left)) << " left";
-      log << "\n" << std::flush;
+      if (end.outcome == Outcome::kSkipped) ++result.skipped;
+      else if (end.outcome == Outcome::kOk) ++result.ran;
+      else if (end.outcome == Outcome::kFailed) ++result.failed;
+      done[i] = end.outcome != Outcome::kStopped;
+      progress.Line(log, jobs.what(i), end, jobs.why_file(i), secs);
     }
   };
   std::vector<std::thread> threads;
   for (int w = 0; w < std::max(1, workers); ++w) threads.emplace_back(worker);
   for (auto& t : threads) t.join();
+  result.signal = g_stop_signal.load();
+  if (result.signal != 0)
+    for (size_t i = 0; i < count; ++i)
+      if (!done[i]) result.not_done.push_back(i);
   return result;
 }
 
-Outcome Train(const SweepPlan& plan, const SweepTraining& training, const RunnerOptions& o) {
+JobEnd Train(const SweepPlan& plan, const SweepTraining& training, const RunnerOptions& o) {
   const std::string model = ModelPath(o.out, training);
   const fs::path dir = fs::path(model).parent_path();
-  if (fs::exists(model)) return Outcome::kSkipped;
-  fs::create_directories(dir);
-  fs::remove(dir / (training.id + ".failed.txt"));
+  std::error_code ec;
+  if (fs::exists(model, ec)) return {Outcome::kSkipped, ""};
+  if (std::string why = PrepareFolder(dir, dir / (training.id + ".failed.txt")); !why.empty()) return {Outcome::kFailed, why};
   std::vector<std::string> args = {o.dyad, "train", plan.train_config};
   for (const auto& s : training.sets) args.insert(args.end(), {"--set", s});
   args.insert(args.end(), {"--set", "output=" + model});
   // Workers already fill the cores: one thread per training (same bits whatever the count).
   if (o.workers > 1) args.insert(args.end(), {"--set", "threads=1"});
   const std::string log = (dir / (training.id + ".log")).string();
-  const int rc = tools::RunProcess(args, log);
-  if (rc == 0 && fs::exists(model)) return Outcome::kOk;
-  std::ofstream(dir / (training.id + ".failed.txt"))
-      << tools::ShellQuoted(args) << "\nexited " << rc << "; the end of its log:\n" << Tail(log, 20);
-  return Outcome::kFailed;
+  int rc = 0;
+  if (!RunChild(args, log, &rc)) return {Outcome::kStopped, ""};
+  if (rc == 0 && fs::exists(model, ec)) return {Outcome::kOk, ""};
+  return Failed(dir / (training.id + ".failed.txt"),
+                tools::ShellQuoted(args) + "\nexited " + std::to_string(rc) + "; the end of its log:\n" + Tail(log, 20));
 }
 
 std::string Params(const std::vector<std::pair<std::string, std::string>>& params) {
@@ -157,6 +232,23 @@ std::string Params(const std::vector<std::pair<std::string, std::string>>& param
 }
 
 }  // namespace
+
+StopOnSignals::StopOnSignals() {
+  g_stop_signal.store(0);
+  struct sigaction sa {};
+  sa.sa_handler = OnSweepStopSignal;
+  sa.sa_flags = SA_RESTART;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &old_int_);  // over SIG_IGN too: a script's background sweep stops on Ctrl-C's SIGINT
+  sigaction(SIGTERM, &sa, &old_term_);
+}
+
+StopOnSignals::~StopOnSignals() {
+  sigaction(SIGINT, &old_int_, nullptr);
+  sigaction(SIGTERM, &old_term_, nullptr);
+}
+
+int StopOnSignals::Received() { return g_stop_signal.load(); }
 
 RunnerResult RunSweep(const SweepPlan& plan, const RunnerOptions& options, std::ostream& log) {
   PoolJobs jobs;
@@ -188,7 +280,7 @@ Status WriteSweepCsv(const SweepPlan& plan, const std::string& out) {
       status[i] = "ok";
       if (metric_names.empty())
         for (const auto& [name, value] : metrics[i].items()) metric_names.push_back(name);
-    } else if (fs::exists(dir / "failed.txt")) {
+    } else if (std::error_code ec; fs::exists(dir / "failed.txt", ec)) {
       status[i] = "failed";
     }
   }

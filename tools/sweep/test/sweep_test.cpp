@@ -2,11 +2,15 @@
 // their table do not depend on the number of workers, a failing run is recorded and the sweep
 // goes on, a rerun resumes (finished runs skipped, failed ones tried again).
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <thread>
 
 #include "dyad/testing/child_process.hpp"
 #include "dyad/testing/cli.hpp"
@@ -49,9 +53,33 @@ class SweepTest : public ::testing::Test {
     if (out) *out = p.out() + p.err();
     return code;
   }
+  // The run ids of a sweep, in its order (from --dry-run).
+  std::vector<std::string> Ids(const fs::path& file) {
+    std::string out;
+    EXPECT_EQ(Sweep({file.string(), "--dry-run"}, &out), 0) << out;
+    std::vector<std::string> ids;
+    std::istringstream lines(out);
+    for (std::string line; std::getline(lines, line);)
+      if (line.size() > 17 && line[16] == ' ' && line.find_first_not_of("0123456789abcdef") == 16) ids.push_back(line.substr(0, 16));
+    return ids;
+  }
   fs::path dir_;
   int runs_ = 0;
 };
+
+// The processes whose command line names `text` (the test's folder: its sweeps and their runs).
+std::vector<int> ProcessesNaming(const std::string& text) {
+  std::vector<int> pids;
+  std::error_code ec;
+  for (fs::directory_iterator it("/proc", ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::string cmdline = ReadFile(it->path() / "cmdline");
+    std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+    if (cmdline.find(text) != std::string::npos) pids.push_back(std::stoi(name));
+  }
+  return pids;
+}
 
 TEST_F(SweepTest, BadSweepFilesAreRefusedAtTheirLineAndNothingRuns) {
   const std::string head = "sweep: s\ngraph: g.yaml\nduration: 1\n";
@@ -63,6 +91,9 @@ TEST_F(SweepTest, BadSweepFilesAreRefusedAtTheirLineAndNothingRuns) {
       {head + "grid:\n  src.nope: [1, 2]\n", "s.yaml:5:14: grid.src.nope: does not validate"},
       {head + "grid:\n  src.start: [1, -5, x]\n", "s.yaml:5:22: grid.src.start: does not validate"},
       {head + "grid: {src.start: [1]}\nseeds: [1, 1]\n", "s.yaml:5:8: seeds: a seed is repeated"},
+      {head + "grid:\n  src.start: [0.5, 0.5, 0.9]\n", "s.yaml:5:20: grid.src.start: the value 0.5 is repeated"},
+      {head + "grid: {src.start: [1], seed: [1, 2]}\nseeds: [3]\n", "s.yaml:4:30: grid.seed: give the seeds once"},
+      {head + "runs: [{src.start: 1, seed: 2}]\n", "s.yaml:4:29: runs[0].seed: the seeds are the sweep's: give seeds:"},
       {"sweep: s\ngraph: nowhere.yaml\nduration: 0\ngrid: {a: [1]}\n", "s.yaml:2:8: graph: no such file"},
   };
   for (const auto& [text, expected] : cases) {
@@ -110,6 +141,134 @@ TEST_F(SweepTest, AFailingRunIsRecordedTheRestRunAndARerunResumes) {
   EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "-j", "2", "--no-plots"}, &out), 0) << out;
   EXPECT_NE(out.find("1 ran, 2 done before, 0 failed"), std::string::npos) << out;
   EXPECT_EQ(ReadFile(dir_ / "o" / "sweep.csv").find("failed"), std::string::npos);
+}
+
+// The cache key is the run as it runs: a rerun after a duration change runs every run again.
+TEST_F(SweepTest, ARerunWithAnotherDurationRunsEveryRunAgain) {
+  const std::string grid = "grid: {src.start: [0, 100]}\n";
+  std::string out;
+  ASSERT_EQ(Sweep({Write("sweep: s\ngraph: g.yaml\nduration: 1\n" + grid).string(), "-o", (dir_ / "o").string(), "--no-plots"}, &out), 0)
+      << out;
+  EXPECT_NE(out.find("2 ran, 0 done before, 0 failed"), std::string::npos) << out;
+  const std::string short_csv = ReadFile(dir_ / "o" / "sweep.csv");
+  ASSERT_EQ(Sweep({Write("sweep: s\ngraph: g.yaml\nduration: 3\n" + grid).string(), "-o", (dir_ / "o").string(), "--no-plots"}, &out), 0)
+      << out;
+  EXPECT_NE(out.find("2 ran, 0 done before, 0 failed"), std::string::npos) << out;
+  EXPECT_NE(ReadFile(dir_ / "o" / "sweep.csv"), short_csv) << "the table kept the shorter runs' metrics";
+  ASSERT_EQ(Sweep({(dir_ / "s.yaml").string(), "-o", (dir_ / "o").string(), "--no-plots"}, &out), 0) << out;
+  EXPECT_NE(out.find("0 ran, 2 done before, 0 failed"), std::string::npos) << out;
+}
+
+// A file a run reads (a path parameter's) changed: the runs that read it run again, the others
+// not; a change in a graph the run's graph extends reruns them all.
+TEST_F(SweepTest, AChangedInputFileRerunsExactlyTheRunsThatReadIt) {
+  std::string track = "x,y,engaged\n";
+  for (int i = 0; i < 100; ++i) track += "0.1,0.2,1\n";
+  Write(track, "a.csv");
+  Write(track, "b.csv");
+  Write("extends: g.yaml\ncomponents:\n  player: {type: human_replay, rate_hz: 10, params: {file: a.csv}, outputs: {out: h}}\n",
+        "over.yaml");
+  const fs::path file = Write("sweep: s\ngraph: over.yaml\nduration: 1\ngrid: {player.file: [a.csv, b.csv]}\nseeds: [1, 2]\n");
+  const fs::path o = dir_ / "o";
+  std::string out;
+  ASSERT_EQ(Sweep({file.string(), "-o", o.string(), "--no-plots"}, &out), 0) << out;
+  EXPECT_NE(out.find("4 ran, 0 done before, 0 failed"), std::string::npos) << out;
+  const std::vector<std::string> before = Ids(file);
+  Write("x,y,engaged\n" + track.substr(12, 10 * 50), "a.csv");  // the same length of header, other rows
+  ASSERT_EQ(Sweep({file.string(), "-o", o.string(), "--no-plots"}, &out), 0) << out;
+  EXPECT_NE(out.find("2 ran, 2 done before, 0 failed"), std::string::npos) << out;
+  const std::vector<std::string> after = Ids(file);
+  ASSERT_EQ(after.size(), 4u);
+  EXPECT_NE(after[0], before[0]);  // a.csv, seeds 1 and 2
+  EXPECT_NE(after[1], before[1]);
+  EXPECT_EQ(after[2], before[2]);  // b.csv
+  EXPECT_EQ(after[3], before[3]);
+  // The graph it extends: every run.
+  Write(ReadFile(dir_ / "g.yaml") + "  other: {type: counter_sink, rate_hz: 10, inputs: {in: c}}\n", "g.yaml");
+  ASSERT_EQ(Sweep({file.string(), "-o", o.string(), "--no-plots"}, &out), 0) << out;
+  EXPECT_NE(out.find("4 ran, 0 done before, 0 failed"), std::string::npos) << out;
+}
+
+// `seed` in the grid is the seeds (not overridden by the default seeds: [1]), one column.
+TEST_F(SweepTest, SeedInTheGridIsTheSeeds) {
+  const fs::path file = Write("sweep: s\ngraph: g.yaml\nduration: 1\ngrid: {src.start: [0], seed: [3, 4]}\n");
+  std::string out;
+  ASSERT_EQ(Sweep({file.string(), "--dry-run"}, &out), 0) << out;
+  EXPECT_NE(out.find("--set src.start=0 --set seed=3\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("--set src.start=0 --set seed=4\n"), std::string::npos) << out;
+  EXPECT_EQ(out.find("seed=1"), std::string::npos) << out;
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--no-plots"}, &out), 0) << out;
+  const std::string csv = ReadFile(dir_ / "o" / "sweep.csv");
+  EXPECT_EQ(csv.rfind("run,status,src.start,seed,steps,", 0), 0u) << csv;
+  EXPECT_NE(csv.find(",ok,0,3,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",ok,0,4,"), std::string::npos) << csv;
+}
+
+// A run whose folder cannot be made (a file where it should be; the tests run as root, so
+// permissions cannot do it) fails with the reason; the other runs go on.
+TEST_F(SweepTest, ARunWhoseFolderCannotBeMadeFailsAndTheSweepGoesOn) {
+  const fs::path file = Write("sweep: s\ngraph: g.yaml\nduration: 1\ngrid: {src.start: [0, 100, 7]}\n");
+  const std::vector<std::string> ids = Ids(file);
+  ASSERT_EQ(ids.size(), 3u);
+  fs::create_directories(dir_ / "o" / "runs");
+  std::ofstream(dir_ / "o" / "runs" / ids[1]) << "not a folder\n";
+  std::string out;
+  EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "-j", "2", "--no-plots"}, &out), 1) << out;
+  EXPECT_NE(out.find("2 ran, 0 done before, 1 failed"), std::string::npos) << out;
+  EXPECT_NE(out.find(ids[1] + " src.start=100 seed=1: FAILED (cannot make its folder " + (dir_ / "o" / "runs" / ids[1]).string() + ": "),
+            std::string::npos)
+      << out;
+}
+
+// SIGTERM: no run starts, the one under way stops (its whole process group), the finished one
+// is kept, what is missing is said, exit 130, no process of the sweep is left. A rerun skips the
+// finished run; SIGINT stops it the same way, even when the sweep was started with SIGINT
+// ignored (a script's background job).
+TEST_F(SweepTest, AStopSignalEndsEveryRunKeepsTheFinishedAndSaysWhatIsMissing) {
+  // The sink ends a run after `expect` samples; expect 0: the run lasts its (long) duration.
+  const fs::path file = Write("sweep: s\ngraph: g.yaml\nduration: 1000000\ngrid: {sink.expect: [5, 0, 6]}\n");
+  const std::vector<std::string> ids = Ids(file);
+  ASSERT_EQ(ids.size(), 3u);
+  const fs::path runs = dir_ / "o" / "runs";
+  auto stop_when_second_runs = [&](int signal, const std::string& tag, std::string* out) {
+    std::vector<std::string> argv = {std::string(DYAD_BIN_DIR) + "/dyad", "sweep", file.string(), "-o", (dir_ / "o").string(), "-j", "1",
+                                     "--no-plots"};
+    dyad::testing::ChildProcess p(argv, dir_, tag);
+    for (int i = 0; i < 600 && !(fs::exists(runs / ids[0] / "metrics.json") && fs::exists(runs / ids[1] / "run.log")); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    EXPECT_GE(ProcessesNaming(runs.string()).size(), 1u) << "the second run is not running";
+    p.Signal(signal);
+    const int code = p.Wait(60);
+    *out = p.out() + p.err();
+    return code;
+  };
+  std::string out;
+  EXPECT_EQ(stop_when_second_runs(SIGTERM, "term", &out), 130) << out;
+  EXPECT_NE(out.find("stopped by SIGTERM: 1 ran, 0 done before, 0 failed, 2 runs missing:\n  " + ids[1] + " sink.expect=0 seed=1\n  " +
+                     ids[2] + " sink.expect=6 seed=1\n"),
+            std::string::npos)
+      << out;
+  std::vector<int> left = ProcessesNaming(dir_.string());
+  EXPECT_TRUE(left.empty()) << left.size() << " processes of the sweep left";
+  for (int pid : left) kill(pid, SIGKILL);
+  EXPECT_TRUE(fs::exists(runs / ids[0] / "metrics.json"));
+  EXPECT_FALSE(fs::exists(runs / ids[1] / "metrics.json"));
+  EXPECT_FALSE(fs::exists(runs / ids[1] / "failed.txt")) << "a stopped run is missing, not failed";
+  EXPECT_FALSE(fs::exists(runs / ids[2])) << "a run started after the stop";
+  EXPECT_NE(ReadFile(dir_ / "o" / "sweep.csv").find(ids[1] + ",missing,"), std::string::npos);
+
+  fs::remove(runs / ids[1] / "run.log");
+  struct sigaction ignore {}, old {};
+  ignore.sa_handler = SIG_IGN;
+  sigaction(SIGINT, &ignore, &old);  // inherited by the sweep, as a script's background job
+  const int code = stop_when_second_runs(SIGINT, "int", &out);
+  sigaction(SIGINT, &old, nullptr);
+  EXPECT_EQ(code, 130) << out;
+  EXPECT_NE(out.find("stopped by SIGINT: 0 ran, 1 done before, 0 failed, 2 runs missing:"), std::string::npos) << out;
+  left = ProcessesNaming(dir_.string());
+  EXPECT_TRUE(left.empty()) << left.size() << " processes of the sweep left";
+  for (int pid : left) kill(pid, SIGKILL);
 }
 
 // A study's condition as the base: the study's graph with the condition's overrides first (the
