@@ -149,8 +149,8 @@ void WebComponent::Describe(ComponentSpec& spec) {
       "and \"something else\") after each release, or after the trial about each of its holds in turn (see `ask`)");
   spec.Param("self_report_min_hold_s", 1.0).Min(0).Unit("s").Doc("subject's page: ask only about a hold at least this long");
   spec.Param("ask", false).Live().Doc(
-      "after_trial: setting it true ends the trial: steering stops, the subject's page asks about each hold (its trace as the "
-      "picture), and once all are answered (or self_report_timeout_s passed) the run ends by itself");
+      "after_trial: setting it true ends the trial: steering stops, the subject's page asks about each hold (its stroke, the "
+      "pointer's path while held, as the picture), and once all are answered (or self_report_timeout_s passed) the run ends by itself");
   spec.Param("ask_after_s", 0.0).Min(0).Unit("s").Doc(
       "after_trial: ask by itself this long after the run's start (`dyad study run` sets it to the trial's duration; 0: only "
       "when `ask` is set)");
@@ -346,18 +346,34 @@ void WebComponent::StepTask() {
   if (Status s = task_out_->Publish(m); !s.ok()) ctx_->log().Warn("task: not published: " + s.ToString());
 }
 
-// A pointer sample (after_trial): where it is (a trace without robot states), and whether a hold
-// starts or ends; the holds are kept for the questions after the trial. A hold shorter than
+namespace {
+// Appends `at` to a hold's path unless it is where the path already is (a keepalive, a robot at
+// rest). A long hold's path is halved (every other point) when it reaches kMaxPathPoints: its
+// memory stays bounded, its shape kept.
+constexpr size_t kMaxPathPoints = 8192;
+void Extend(SubjectChannel::Trace& path, const std::array<double, 2>& at) {
+  if (!path.empty() && path.back() == at) return;
+  if (path.size() >= kMaxPathPoints) {
+    for (size_t i = 0; 2 * i < path.size(); ++i) path[i] = path[2 * i];
+    path.resize((path.size() + 1) / 2);
+  }
+  path.push_back(at);
+}
+}  // namespace
+
+// A pointer sample (after_trial): whether a hold starts or ends, and where the pointer is (the
+// hold's stroke: the person's own drawing, asked about after the trial). A hold shorter than
 // self_report_min_hold_s is no event and is forgotten.
 void WebComponent::MarkHold(double x, double y, bool starts, bool ends, int64_t now) {
   std::lock_guard<std::mutex> lock(holds_mutex_);
-  last_pointer_ = {x, y};
   if (asking_) return;  // the trial is over: nothing more to ask about
   if (starts) {
-    holds_.push_back(Hold{now, 0, {}});
+    holds_.push_back(Hold{now, 0, {{x, y}}, {}});
     return;
   }
-  if (!ends || holds_.empty() || holds_.back().end_ns != 0) return;
+  if (holds_.empty() || holds_.back().end_ns != 0) return;  // no hold under way
+  Extend(holds_.back().stroke, {x, y});
+  if (!ends) return;
   holds_.back().end_ns = now;
   if (now - holds_.back().start_ns < min_hold_ns_) holds_.pop_back();
 }
@@ -411,13 +427,10 @@ void WebComponent::StepAfterTrial(int64_t now, bool robot_moved) {
   if (!asking_) {
     {
       std::lock_guard<std::mutex> lock(holds_mutex_);
-      if (!holds_.empty() && holds_.back().end_ns == 0) {
-        // What the subject saw drawn: the robot's path, else (no robot state) the pointer's.
-        SubjectChannel::Trace& trace = holds_.back().trace;
-        const msg::CartesianState* r = robot_->latest();
-        const std::array<double, 2> at = r != nullptr ? std::array<double, 2>{r->x(), r->y()} : last_pointer_;
-        if (trace.empty() || (r != nullptr ? robot_moved : at != trace.back())) trace.push_back(at);
-      }
+      // The robot's path during the hold under way, drawn faintly beside the person's stroke.
+      const msg::CartesianState* r = robot_->latest();
+      if (r != nullptr && !holds_.empty() && holds_.back().end_ns == 0 && (robot_moved || holds_.back().robot.empty()))
+        Extend(holds_.back().robot, {r->x(), r->y()});
     }
     const bool due = ctx_->params().Bool("ask") || (ask_after_ns_ > 0 && now - first_step_ns_ >= ask_after_ns_);
     if (due) StartQuestions(now);
@@ -450,7 +463,7 @@ nlohmann::json WebComponent::QuestionsJson() {
 // time), and no hold starts after it.
 void WebComponent::StartQuestions(int64_t now) {
   subject_->EndSteering();
-  std::vector<SubjectChannel::Trace> traces;
+  std::vector<SubjectChannel::Question> questions;
   {
     std::lock_guard<std::mutex> lock(holds_mutex_);
     asking_ = true;
@@ -459,11 +472,11 @@ void WebComponent::StartQuestions(int64_t now) {
       if (now - holds_.back().start_ns < min_hold_ns_) holds_.pop_back();
     }
     asked_ = std::move(holds_);
-    for (const Hold& h : asked_) traces.push_back(Thin(h.trace, 300));
+    for (const Hold& h : asked_) questions.push_back({Thin(h.stroke, 300), Thin(h.robot, 300)});
     question_start_ns_ = question_shown_ns_ = now;
   }
-  ctx_->log().Info("self_report: the trial is over; asking the subject about its " + std::to_string(traces.size()) + " holds");
-  subject_->AskAfterTrial(std::move(traces));
+  ctx_->log().Info("self_report: the trial is over; asking the subject about its " + std::to_string(questions.size()) + " holds");
+  subject_->AskAfterTrial(std::move(questions));
 }
 
 // The experimenter's page: series, notes, live parameters, stats, run events.

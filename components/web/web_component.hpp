@@ -5,8 +5,9 @@
 ///     it asks "What were you drawing?" and the answer leaves on `self_report` with the hold's
 ///     start and end on the runtime clock; with self_reports: after_trial it asks nothing during
 ///     the trial: when `ask` is set, or `ask_after_s` into the run, steering ends, the page asks
-///     about each hold in turn (its trace as the picture), and once all are answered or
-///     `self_report_timeout_s` passed the component ends the run with RequestStop),
+///     about each hold in turn (its stroke, the pointer's path while held, as the picture), and
+///     once all are answered or `self_report_timeout_s` passed the component ends the run with
+///     RequestStop),
 ///   - `/experimenter`: the experimenter's page (with `learner` bound, also "learn from this
 ///     session": the learner's demonstrations, a run's loss, the swap; docs/components.md#learner),
 ///   - `/`: an index page, and the Foxglove WebSocket bridge over the graph's topics for
@@ -110,17 +111,17 @@ class WebComponent final : public Component {
   std::atomic<bool> holding_{false};  // read by Step for the experimenter's page
   bool answerable_ = false;
   int64_t hold_start_ns_ = 0, hold_end_ns_ = 0, min_hold_ns_ = 0;
-  // self_reports: after_trial. The holds of the trial, kept by the pointer sink (ends) and Step
-  // (traces), until the questions start; then `asked_`, read by the report sink.
+  // self_reports: after_trial. The holds of the trial, kept by the pointer sink (ends, strokes)
+  // and Step (the robot's paths), until the questions start; then `asked_`, read by the report sink.
   struct Hold {
     int64_t start_ns = 0, end_ns = 0;  // end 0: under way
-    SubjectChannel::Trace trace;
+    SubjectChannel::Trace stroke;      // the steering page's pointer while held: what the person drew
+    SubjectChannel::Trace robot;       // the robot's path meanwhile (empty without robot state)
   };
   bool after_trial_ = false;
   int64_t ask_after_ns_ = 0, question_timeout_ns_ = 0, first_step_ns_ = -1;
   std::mutex holds_mutex_;  // guards the members below
   std::vector<Hold> holds_, asked_;
-  std::array<double, 2> last_pointer_{};  // the steering page's last position
   bool asking_ = false;
   int64_t question_start_ns_ = 0, question_shown_ns_ = 0;
   std::atomic<int> answered_{0}, lost_{0};  // questions answered; of those, answers not published

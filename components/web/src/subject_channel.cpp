@@ -49,9 +49,13 @@ void SubjectChannel::SetTask(const Task& task) {
 std::string SubjectChannel::QuestionJson() const {
   const int of = static_cast<int>(questions_.size());
   if (asked_ >= questions_.size()) return json{{"op", "question"}, {"segment", -1}, {"of", of}}.dump();
-  json trace = json::array();
-  for (const auto& xy : questions_[asked_]) trace.push_back({xy[0], xy[1]});
-  return json{{"op", "question"}, {"segment", static_cast<int>(asked_)}, {"of", of}, {"trace", trace}}
+  auto points = [](const Trace& path) {
+    json out = json::array();
+    for (const auto& xy : path) out.push_back({xy[0], xy[1]});
+    return out;
+  };
+  const Question& q = questions_[asked_];
+  return json{{"op", "question"}, {"segment", static_cast<int>(asked_)}, {"of", of}, {"stroke", points(q.stroke)}, {"robot", points(q.robot)}}
       .dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
@@ -66,14 +70,14 @@ void SubjectChannel::EndSteeringLocked() {
   if (steering_ != 0) sink_(last_x_, last_y_, false);  // a hold ends now
 }
 
-void SubjectChannel::AskAfterTrial(std::vector<Trace> traces) {
+void SubjectChannel::AskAfterTrial(std::vector<Question> questions) {
   std::string frame;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (asking_) return;
     EndSteeringLocked();
     asking_ = true;
-    questions_ = std::move(traces);
+    questions_ = std::move(questions);
     asked_ = 0;
     frame = QuestionJson();
   }

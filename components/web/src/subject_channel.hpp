@@ -11,14 +11,16 @@
 /// "practice":bool} (the experimenter's task: sent to every page at each change and to a page
 /// that opens, its countdown as what is left of it then), {"op":"state","x","y"} (newest
 /// only: a slow page never builds a backlog), {"op":"ack","t":ms} after each pointer sample was
-/// published (the page measures the round trip), {"op":"question","segment":i,"of":n,"trace":
-/// [[x,y],...]} after the trial (segment -1: every question answered, "thank you"). A pointer
+/// published (the page measures the round trip), {"op":"question","segment":i,"of":n,"stroke":
+/// [[x,y],...],"robot":[[x,y],...]} after the trial (the hold's stroke: the pointer's path while
+/// held, what the person drew; the robot's path meanwhile, maybe empty; segment -1: every
+/// question answered, "thank you"). A pointer
 /// sample may carry "wall" (the event's time, ms since the epoch): the channel then keeps the
 /// event-to-publication delay.
 ///
 /// After the trial (self_reports: after_trial, AskAfterTrial): steering ends for good (the hold
 /// ends at once, every later pointer sample is published released) and the pages are asked about
-/// each of the trial's holds in turn, its trace as the picture; the steering page's answer to the
+/// each of the trial's holds in turn, its stroke as the picture; the steering page's answer to the
 /// question shown goes to the ReportSink with its index, then the next question is shown, to a
 /// page that opens later too. An answer to another question (stale) is ignored and that page is
 /// shown the current one again.
@@ -80,10 +82,14 @@ class SubjectChannel final : public ClientHandler {
   size_t pages() const;
   // After the trial (see the file comment). EndSteering: no page steers any more (a hold under
   // way ends now, through the PointerSink). AskAfterTrial: ends the steering if not yet, then
-  // asks about each trace in turn (none: thanks at once). Each acts once per channel.
+  // asks about each hold in turn (none: thanks at once). Each acts once per channel.
   using Trace = std::vector<std::array<double, 2>>;
+  struct Question {
+    Trace stroke;  // the pointer's path while held: what the person drew (the picture)
+    Trace robot;   // the robot's path meanwhile, drawn faintly beside it (may be empty)
+  };
   void EndSteering();
-  void AskAfterTrial(std::vector<Trace> traces);
+  void AskAfterTrial(std::vector<Question> questions);
   // Where a pointer sample's time went, in ms, for each sample that carried the page's "wall"
   // stamp (meaningful when page and server share a clock; the first 100,000). The hops add up to
   // the total; the hops are empty when no server delivered the samples.
@@ -118,7 +124,7 @@ class SubjectChannel final : public ClientHandler {
   Task task_;
   bool trial_over_ = false;  // EndSteering came: no more steering
   bool asking_ = false;      // AskAfterTrial came: questions_ are asked
-  std::vector<Trace> questions_;
+  std::vector<Question> questions_;
   size_t asked_ = 0;         // the question shown; questions_.size(): all answered
   PointerDelays delays_;
 };

@@ -2,7 +2,8 @@
 # Asking after the trial (self_reports: after_trial) in Debian's Chromium, two runs of one graph
 # (node/after_trial.mjs says what the browser does):
 #   timed:  ask_after_s 12 and no --duration: at 12 s steering ends, the page asks about each of
-#           the two holds (not the tap) in turn, the answers land in the recording with each
+#           the two holds (not the tap) in turn, each pictured by the person's own stroke (the
+#           pointer's path while held) with the robot's path beside it, the answers land in the recording with each
 #           hold's start and end, and the graph then ends by itself, exit 0, with its recording
 #           whole; nothing the subject does after the trial is engaged on human/input.
 #   button: the experimenter's page's "end the trial and ask the subject"; nobody answers; the
@@ -73,6 +74,13 @@ if b["titles"] != ["What were you drawing here? (1 of 2)", "What were you drawin
     fail("the page's questions: %s" % b["titles"])
 if b["thanks_after_end"] != "Thank you. This trial is over.": fail("after the graph ended the page says %r" % b["thanks_after_end"])
 if b["trace_pixels"] < 200: fail("the question's picture has %d pixels drawn: no trace" % b["trace_pixels"])
+# The picture is the person's stroke: the pointer's path while held, every position the browser
+# moved to and no other (the robot's path, which lags and is pulled by the intention, is not it).
+p = b["paths"]
+if p["stroke_points"] < 10 or p["stroke_off"] > 0.3 or p["stroke_missed"] > 0:
+    fail("the question's stroke is not the pointer's path while held: %s (want >= 10 points, each within 0.3 of where the browser's "
+         "pointer was, none of its %d positions missed)" % (p, len(b["holds"][0]["points"])))
+if p["robot_points"] < 2: fail("the question shows no robot path beside the stroke: %s" % p)
 if b["choices"] != list(range(7)) + [-1]: fail("the choices: %s" % b["choices"])
 if b["engaged_text"] != "released": fail("the engage key after the trial shows %r" % b["engaged_text"])
 # Asked at ask_after_s on the run's clock: 12 s after the graph's first step, which follows the

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The subject's question in Debian's Chromium: after a release the page asks "What were you
 # drawing?"; the answer lands in the recording (human/self_report) with the hold's start and end
-# on the run's clock, once (node/self_report.mjs says what the browser does).
+# on the run's clock, once; the question never covers the workspace: a press on it right after a
+# release steers at once (node/self_report.mjs says what the browser does).
 #   self_report_test.sh BUILD_DIR WORK_DIR TEST_PLUGIN
 set -euo pipefail
 build=$1
@@ -62,5 +63,14 @@ if not 0.5 <= resp <= 2.0: fail("response %.3f s, the subject answered %.3f s af
 engaged = [int(x["header.stamp_ns"]) / 1e6 for x in csv.DictReader(open(sys.argv[3])) if x["engaged"] in ("1", "true")]
 inside = [t for t in engaged if start - 150 <= t <= end + 150]
 if len(inside) < 8: fail("human/input has %d engaged steps in the reported segment" % len(inside))
-print("PASS: one self-report, choice 2, segment %.2f s, response %.2f s" % ((end - start) / 1e3, resp))
+# The press on the workspace right after the third hold's release (where the question used to
+# be) steered: human/input engaged at the pressed point while it was held.
+p = b["press"]
+at_press = [x for x in csv.DictReader(open(sys.argv[3])) if p["start"] - 50 <= int(x["header.stamp_ns"]) / 1e6 <= p["end"] + 50
+            and x["engaged"] in ("1", "true")]
+near = [x for x in at_press if abs(float(x["x"]) - p["x"]) < 1.5 and abs(float(x["y"]) - p["y"]) < 1.5]
+if len(near) < 3: fail("the press at (%.1f, %.1f) right after a release: %d engaged human/input steps there (want >= 3 in its 0.6 s): %s"
+                       % (p["x"], p["y"], len(near), [(x["x"], x["y"]) for x in at_press][:5]))
+print("PASS: one self-report, choice 2, segment %.2f s, response %.2f s; a press on the workspace after a release steered (%d steps)"
+      % ((end - start) / 1e3, resp, len(near)))
 PY

@@ -82,9 +82,10 @@ TEST(SubjectChannel, AfterTheTrialEachHoldIsAskedInTurnAndNobodySteers) {
   EXPECT_EQ(engaged, (std::vector<bool>{true, false, false})) << "the hold ends when the trial does; no steering after it";
   ASSERT_TRUE(ch.OnText(1, R"({"op":"self_report","choice":1,"segment":0})").ok());
   EXPECT_TRUE(answers.empty()) << "steering ended, nothing asked yet";
-  ch.AskAfterTrial({{{0, 0}, {1, 1}}, {{2, 2}, {3, 3}}});
+  using Q = SubjectChannel::Question;
+  ch.AskAfterTrial({Q{{{0, 0}, {1, 1}}, {}}, Q{{{2, 2}, {3, 3}}, {{2, 3}}}});
   EXPECT_EQ(engaged.size(), 3u) << "the steering had ended already: no second release";
-  ch.AskAfterTrial({{{9, 9}}});  // a second call changes nothing
+  ch.AskAfterTrial({Q{{{9, 9}}, {}}});  // a second call changes nothing
   for (const char* ignored : {R"({"op":"self_report","choice":2})",               // no question named
                               R"({"op":"self_report","choice":2,"segment":1})"})  // not the one shown
     ASSERT_TRUE(ch.OnText(1, ignored).ok()) << ignored;

@@ -4,7 +4,8 @@
 //   node after_trial.mjs BASE_URL OUT.json SCREENSHOT_DIR timed|button
 // timed (the graph has ask_after_s): the subject taps (300 ms: no event), holds 1.5 s, holds
 //   1.2 s, then waits. When the trial ends the page asks "What were you drawing here? (1 of 2)"
-//   with the first hold's trace; Space then steers nothing, nor does an engaged pointer sample
+//   with the first hold's stroke (the pointer's path while held: every point the browser moved
+//   to, nothing else) and the robot's path beside it; Space then steers nothing, nor does an engaged pointer sample
 //   sent on the page's own socket (the server refuses to steer); a second subject's page opened
 //   now is shown "The subject is answering (1 of 2)" without the choices; the subject clicks the
 //   third thumbnail (choice 2); 700 ms into the second question presses 0 ("something else"); the
@@ -30,17 +31,34 @@ try {
   await page.waitForFunction(() => document.getElementById("role").textContent === "you steer", null, { timeout: 10000 });
   const asking = () => page.evaluate(() => document.getElementById("question").classList.contains("on"));
   const title = () => page.evaluate(() => document.getElementById("question-title").textContent);
-  await page.mouse.move(500, 400);
+  let at = [500, 400];  // where the browser's pointer is (page px)
+  await page.mouse.move(...at);
   async function hold(ms) {
+    const points = [at];  // where the pointer was while held
     await page.keyboard.down("Space");
     const start = Date.now();
     for (let t = 0; t < ms; t += 100) {
-      await page.mouse.move(500 + 120 * Math.cos(t / 250), 400 + 120 * Math.sin(t / 250));
+      at = [500 + 120 * Math.cos(t / 250), 400 + 120 * Math.sin(t / 250)];
+      await page.mouse.move(...at);
+      points.push(at);
       await sleep(100);
     }
     await page.keyboard.up("Space");
-    return { start, end: Date.now() };
+    return { start, end: Date.now(), points };
   }
+  // The question's paths against the browser's pointer while held (workspace units, the page's
+  // mapping: the square centred in the canvas, side min(width, height) - 48 px): how far a
+  // path's farthest point is from every pointer position, and how many pointer positions the
+  // stroke misses (none within 0.3).
+  const comparePaths = (points) => page.evaluate((pts) => {
+    const r = canvas.getBoundingClientRect(), scale = (Math.min(r.width, r.height) - 48) / (2 * H);
+    const held = pts.map(([px, py]) => [(px - r.left - r.width / 2) / scale, -(py - r.top - r.height / 2) / scale]);
+    const dist = (p, path) => Math.min(...path.map(([x, y]) => Math.hypot(p[0] - x, p[1] - y)));
+    const stroke = lastQuestion.stroke ?? [], robot = lastQuestion.robot ?? [];
+    return { stroke_points: stroke.length, stroke_off: Math.max(0, ...stroke.map((p) => dist(p, held))),
+             stroke_missed: held.filter((p) => !stroke.length || dist(p, stroke) > 0.3).length,
+             robot_points: robot.length, robot_off: Math.max(0, ...robot.map((p) => dist(p, held))) };
+  }, points);
   // The question's picture: how many of the trace canvas's pixels are drawn.
   const tracePixels = () => page.evaluate(() => {
     const c = document.getElementById("trace"), d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
@@ -62,6 +80,7 @@ try {
     out.asked_at = Date.now();
     out.titles.push(await title());
     out.trace_pixels = await tracePixels();
+    out.paths = await comparePaths(out.holds[0].points);
     out.choices = await page.evaluate(() => [...document.querySelectorAll("#choices button")].map((b) => Number(b.dataset.choice)));
     await page.screenshot({ path: `${shotDir}/after_trial_question.png` });
     // Nobody steers after the trial: the engage key does nothing, and the question stays.

@@ -6,7 +6,12 @@
 //    per primitive and "something else";
 // 3. holding again dismisses the question unanswered; the release of that 1.2 s hold asks again;
 // 4. 700 ms later the subject clicks the third thumbnail (choice 2); the question goes away and
-//    a digit key then answers nothing.
+//    a digit key then answers nothing;
+// 5. the question never covers the workspace: while it is shown, every point of a 21 x 21 grid
+//    over the workspace square (its edges included) is the canvas, and right after the release of
+//    a third hold (1.2 s) a mouse press at the square's bottom centre, (0, -0.9 H), where the
+//    question used to be, steers at once (the page shows ENGAGED, the question goes) and is held
+//    600 ms; the shell test finds it engaged on human/input at that point.
 // OUT.json gets the wall-clock times of the holds and the answer, for the shell test's checks.
 import { writeFile } from "node:fs/promises";
 import { chromium } from "playwright-core";
@@ -55,6 +60,41 @@ try {
   if (await asking()) fail("the question stayed after the answer");
   await page.keyboard.press("Digit4");  // nothing is asked: no second answer
   await sleep(500);
+  // 5. The workspace square as the page draws it (page px), and what lies on it.
+  out.third = await hold(1200);
+  await page.waitForFunction(() => document.getElementById("question").classList.contains("on"), null, { timeout: 3000 });
+  const square = await page.evaluate(() => {
+    const r = canvas.getBoundingClientRect(), tl = toCanvas(-H, H), br = toCanvas(H, -H);
+    return { left: r.left + tl.px, top: r.top + tl.py, right: r.left + br.px, bottom: r.top + br.py, H };
+  });
+  out.square = square;
+  out.question_box = await page.evaluate(() => {
+    const r = document.getElementById("question").getBoundingClientRect();
+    return { left: r.left, top: r.top, right: r.right, bottom: r.bottom };
+  });
+  const covered = await page.evaluate((sq) => {
+    const out = [];
+    for (let i = 0; i <= 20; i++)
+      for (let j = 0; j <= 20; j++) {
+        const x = sq.left + 1 + (sq.right - sq.left - 2) * i / 20, y = sq.top + 1 + (sq.bottom - sq.top - 2) * j / 20;
+        const e = document.elementFromPoint(x, y);
+        if (e !== canvas) out.push([Math.round(x), Math.round(y), e ? (e.id || e.tagName) : "nothing"]);
+      }
+    return out;
+  }, square);
+  if (covered.length) fail(`the question covers the workspace at ${covered.length} of 441 points, e.g. ${JSON.stringify(covered.slice(0, 3))}`);
+  const press = { x: (square.left + square.right) / 2, y: square.bottom - 0.05 * (square.bottom - square.top) };  // (0, -0.9 H)
+  await page.mouse.move(press.x, press.y);
+  await page.mouse.down();
+  out.press = { start: Date.now(), x: 0, y: -0.9 * square.H };
+  out.press_page = await page.evaluate(() => ({ engaged: document.getElementById("engaged").textContent,
+                                               asking: document.getElementById("question").classList.contains("on") }));
+  await sleep(600);
+  out.press.end = Date.now();
+  await page.mouse.up();
+  if (out.press_page.engaged !== "ENGAGED") fail(`a press on the workspace right after a release did not steer (the page shows ${out.press_page.engaged})`);
+  if (out.press_page.asking) fail("a press on the workspace right after a release left the question shown");
+  await sleep(300);
 } finally {
   await browser.close();
 }
