@@ -360,6 +360,8 @@ TEST_F(DriverProcessTest, TheFirstCommandStartsWhereTheArmIs) {
     while (in >> r[0] >> r[1] >> r[2] >> r[3]) cmds.push_back(r);
     ASSERT_EQ(cmds.size(), 10u);
     EXPECT_EQ(cmds[0][3], 1) << "the first command must hold: the arm's position is not known yet";
+    EXPECT_EQ(cmds[0][1], 0) << "a hold carries the position to hold (none known yet: the origin), never the "
+                                "intention (1000)";
     const auto states = ReadStates(slog);
     ASSERT_EQ(states.size(), 10u);
     EXPECT_EQ(states[0].x, 0);  // the hold did not move the arm
@@ -369,6 +371,104 @@ TEST_F(DriverProcessTest, TheFirstCommandStartsWhereTheArmIs) {
       EXPECT_LE(states[k].x, 5.0 * k + 1e-9) << k;
     }
   }
+}
+
+// The command contract, driver by driver: a hold is "stay where you are", never a goal. Five
+// holds at (50, 40), far from the arm, then motion commands from x = 5 (max_step from the arm).
+// Neither driver has a start position (the fake controller runs without --initial): before, each
+// put its robot at the first hold's x, y, so the arm "was" at (50, 40) before any motion command;
+// now it stays at the centre of its box until the first motion command, which moves it 5 units.
+TEST_F(DriverProcessTest, NoDriverMovesOnAHold) {
+  for (const std::string driver : {"virtual_cartesian", "udp_cartesian"}) {
+    SCOPED_TRACE(driver);
+    const fs::path slog = dir_ / (driver + "_states.txt");
+    const fs::path g = dir_ / (driver + "_holds.yaml");
+    std::ofstream(g) << "graph: holds\nclock: stepped\ndomain_id: " << domain_ << "\ncomponents:\n"
+                     << "  script: {type: test_command, rate_hz: 10, params: {speed: 1, hold_until: 5, hold_at: [50, 40]}, "
+                        "outputs: {out: robot/command}}\n"
+                     << "  driver: {type: " << driver << ", trigger: command, params: "
+                     << (driver == "virtual_cartesian" ? "{}"
+                                                       : "{controller_port: " + std::to_string(port_) + ", reply_wait_ms: 1000}")
+                     << ", inputs: {command: robot/command}, outputs: {state: robot/state}}\n"
+                     << "  slog: {type: test_state_log, trigger: state, params: {file: " << slog.string()
+                     << "}, inputs: {state: robot/state}}\n";
+    std::optional<Child> fake;
+    if (driver == "udp_cartesian") {
+      fake.emplace(std::vector<std::string>{DYAD_FAKE_CONTROLLER, "--port", std::to_string(port_), "--idle-exit", "60"},
+                   dir_, "fake");
+      ASSERT_TRUE(fake->WaitForOutput("listening", 10)) << fake->err();
+    }
+    Child c(Dyad({"run", g.string(), "--steps", "8", "--quiet"}), dir_, driver);
+    ASSERT_EQ(c.Wait(60), 0) << c.err();
+    if (fake) {
+      fake->Signal(SIGTERM);
+      EXPECT_EQ(fake->Wait(10), 0);
+    }
+    const auto states = ReadStates(slog);
+    ASSERT_EQ(states.size(), 8u);
+    for (size_t k = 0; k < 5; ++k) {  // the holds: at rest where it is, not at (50, 40)
+      EXPECT_EQ(states[k].x, 0) << k;
+      EXPECT_EQ(states[k].y, 0) << k;
+      EXPECT_EQ(states[k].vx, 0) << k;
+      EXPECT_EQ(states[k].stopped, 0) << k;  // a hold feeds the watchdog
+    }
+    // The first motion command (x = 5): the arm moves at most max_step (5) from where it was.
+    EXPECT_LE(std::hypot(states[5].x, states[5].y), 5 + 1e-9);
+    EXPECT_NEAR(states[5].x, 5, 1e-9);
+  }
+}
+
+// A lost arm holds the experiment, end to end: the arm reports stopped for its steps 10..19 (1 s)
+// while the intention stays far away. Before, the mixer went on: 10 more motion commands of 5,
+// and the arm came back to a goal 50 units on, without a word in the summary. Now: holds at the
+// last motion command while it is lost, the first motion after it 5 from where the arm is, the
+// outage in the log, the summary and `dyad bag info`.
+TEST_F(DriverProcessTest, ALostArmHoldsTheMixerAndIsSaid) {
+  const fs::path clog = dir_ / "commands.txt", bag = dir_ / "run.mcap";
+  const fs::path g = dir_ / "lost.yaml";
+  std::ofstream(g) << "graph: lost\nclock: stepped\ndomain_id: " << domain_ << "\ncomponents:\n"
+                   << "  human: {type: test_human, rate_hz: 10, outputs: {out: human/input}}\n"
+                   << "  robot: {type: test_intention, rate_hz: 10, params: {start: [1000, 0], speed: 0}, outputs: {out: robot/intention}}\n"
+                   << "  mixer: {type: compliance_mixer, trigger: robot, inputs: {human: human/input, robot: robot/intention, "
+                      "state: robot/state}, outputs: {command: robot/command}}\n"
+                   << "  arm: {type: test_arm, trigger: command, params: {stopped_from: 10, stopped_to: 20}, "
+                      "inputs: {command: robot/command}, outputs: {state: robot/state}}\n"
+                   << "  clog: {type: test_command_log, trigger: command, params: {file: " << clog.string()
+                   << "}, inputs: {command: robot/command}}\n"
+                   << "  rec: {type: recorder, rate_hz: 1, params: {file: " << bag.string() << "}}\n";
+  Child c(Dyad({"run", g.string(), "--steps", "30"}), dir_, "lost");
+  ASSERT_EQ(c.Wait(60), 0) << c.err();
+  std::istringstream in(Read(clog));
+  std::vector<std::array<double, 4>> cmds;  // stamp x y hold
+  std::array<double, 4> r{};
+  while (in >> r[0] >> r[1] >> r[2] >> r[3]) cmds.push_back(r);
+  ASSERT_EQ(cmds.size(), 30u);
+  EXPECT_EQ(cmds[0][3], 1);  // waiting for the arm's first state
+  for (size_t k = 1; k <= 10; ++k) EXPECT_DOUBLE_EQ(cmds[k][1], 5.0 * static_cast<double>(k)) << k;
+  // The arm's answer to command 10 says stopped (it stayed at 45): commands 11..20 hold at 50.
+  for (size_t k = 11; k <= 20; ++k) {
+    EXPECT_EQ(cmds[k][3], 1) << k;
+    EXPECT_DOUBLE_EQ(cmds[k][1], 50) << k;
+  }
+  EXPECT_EQ(cmds[21][3], 0);
+  EXPECT_DOUBLE_EQ(cmds[21][1], 50);  // back at 45: 45 + max_step
+  EXPECT_DOUBLE_EQ(cmds[22][1], 55);
+  EXPECT_NE(c.err().find("arm lost (its driver reports stopped): holding at the last command (50, 0) until it is back"),
+            std::string::npos)
+      << c.err();
+  EXPECT_NE(c.err().find("arm back after 1.0 s"), std::string::npos) << c.err();
+  EXPECT_NE(c.err().find("30 commands published, 11 held, 19 saturated; arm lost 1 time, 1.0 s; 10 holds sent while "
+                         "lost; 1 holds sent waiting for the arm's first state"),
+            std::string::npos)
+      << c.err();
+  Child info({DYAD_EXE, "bag", "info", bag.string()}, dir_, "info");
+  ASSERT_EQ(info.Wait(30), 0) << info.err();
+  // From the recorded robot state (dyad/health is a graph topic, and so recorded, only in graphs of
+  // several wall-clock processes; dyad analyze prints the same section in its report).
+  EXPECT_NE(info.out().find("arm:         robot/state: stopped 1 time, 1.0 s (the driver could not move the arm; "
+                            "the mixer holds meanwhile)\n  +1.0 s  for 1.0 s\n"),
+            std::string::npos)
+      << info.out();
 }
 
 // Without the state, the mixer cannot know where the arm is: it says so.

@@ -7,6 +7,9 @@
 //   test_command     CartesianCommand moving along x by `speed` units per step, silent from
 //                    step `silent_from` (-1: never); the steps before `hold_until` send holds
 //                    at `hold_at` instead (a far position: a driver must not go there)
+//   test_arm         a driver (trigger: command): at each motion command its position becomes
+//                    the command's x, y; holds change nothing; during its steps
+//                    [stopped_from, stopped_to) it reports stopped and does not move (a lost arm)
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>
@@ -183,6 +186,40 @@ class Command final : public Component {
   Output<msg::CartesianCommand>* out_ = nullptr;
 };
 
+class Arm final : public Component {
+ public:
+  static void Describe(ComponentSpec& spec) {
+    spec.Summary("test: an arm that goes where motion commands say, and is lost for a while");
+    spec.Param("stopped_from", int64_t{-1});
+    spec.Param("stopped_to", int64_t{-1});
+    spec.Input<msg::CartesianCommand>("command");
+    spec.Output<msg::CartesianState>("state");
+  }
+  Status Configure(Context& ctx) override {
+    from_ = ctx.params().Int("stopped_from");
+    to_ = ctx.params().Int("stopped_to");
+    command_ = &ctx.input<msg::CartesianCommand>("command");
+    state_ = &ctx.output<msg::CartesianState>("state");
+    return Status::OK();
+  }
+  Status Step(const StepInfo& info) override {
+    const auto k = static_cast<int64_t>(info.index);
+    const bool stopped = k >= from_ && k < to_;
+    if (const msg::CartesianCommand* c = command_->latest(); c != nullptr && !c->hold() && !stopped) {
+      out_.x(c->x());
+      out_.y(c->y());
+    }
+    out_.stopped(stopped);
+    return state_->Publish(out_);
+  }
+
+ private:
+  int64_t from_ = -1, to_ = -1;
+  Input<msg::CartesianCommand>* command_ = nullptr;
+  Output<msg::CartesianState>* state_ = nullptr;
+  msg::CartesianState out_;
+};
+
 }  // namespace
 
 DYAD_PLUGIN(registry) {
@@ -191,4 +228,5 @@ DYAD_PLUGIN(registry) {
   registry.Add<Human>("test_human");
   registry.Add<Intention>("test_intention");
   registry.Add<Command>("test_command");
+  registry.Add<Arm>("test_arm");
 }
