@@ -36,6 +36,26 @@ std::string Seconds(double s) {
   return text;
 }
 
+// One state sample of a driver: a stop begins at the first stopped sample and ends at the first
+// one that is not.
+void NoteArm(const std::string& topic, const std::string* stopped, std::int64_t t, std::vector<ArmStops>* arms) {
+  if (stopped == nullptr) return;
+  auto it = std::find_if(arms->begin(), arms->end(), [&](const ArmStops& a) { return a.topic == topic; });
+  const bool now = *stopped == "true";
+  if (it == arms->end()) {
+    if (!now) return;
+    arms->push_back({topic, {}, false});
+    it = arms->end() - 1;
+  }
+  if (now && !it->stopped_now) it->stops.push_back({t, t, true});
+  if (now) it->stops.back().to_ns = t;
+  if (!now && it->stopped_now) {
+    it->stops.back().to_ns = t;
+    it->stops.back().until_end = false;
+  }
+  it->stopped_now = now;
+}
+
 }  // namespace
 
 StatusOr<Losses> FindLosses(const mcap::Reader& reader) {
@@ -65,6 +85,7 @@ StatusOr<Losses> FindLosses(const mcap::Reader& reader) {
     const std::int64_t t = std::stoll(*stamp);
     end_ns = std::max(end_ns, t);
     start_ns = std::min(start_ns, t);
+    if (type == "dyad::msg::CartesianState") NoteArm(m.channel->topic, FieldValue(fields, "stopped"), t, &out.arms);
     if (m.channel->topic == "dyad/health") {
       const auto get = [&](const char* p) { const std::string* v = FieldValue(fields, p); return v ? *v : std::string(); };
       std::string line = get("process_name") + " " + get("endpoint");
@@ -125,6 +146,16 @@ std::string FormatLosses(const Losses& losses) {
       out += "    silent for the last " + Seconds(w.silent_at_end_s) + " of the recording\n";
   }
   if (!any) out += "  none: every writer's samples are contiguous to the end\n";
+  for (const auto& a : losses.arms) {
+    double total = 0;
+    for (const auto& st : a.stops) total += (st.to_ns - st.from_ns) * 1e-9;
+    out += "arm:         " + a.topic + ": stopped " + std::to_string(a.stops.size()) +
+           (a.stops.size() == 1 ? " time, " : " times, ") + Seconds(total) +
+           " (the driver could not move the arm; the mixer holds meanwhile)\n";
+    for (const auto& st : a.stops)
+      out += "  +" + Seconds((st.from_ns - losses.start_ns) * 1e-9) + "  for " + Seconds((st.to_ns - st.from_ns) * 1e-9) +
+             (st.until_end ? ", still stopped at the end" : "") + "\n";
+  }
   if (!losses.health.empty()) {
     out += "health:      " + std::to_string(losses.health.size()) + " event(s) on dyad/health\n";
     for (const auto& [t, what] : losses.health) out += "  +" + Seconds((t - losses.start_ns) * 1e-9) + "  " + what + "\n";

@@ -26,7 +26,20 @@ struct WriterLosses {
   double silent_at_end_s = 0;  // > 0: its last sample is this long before the recording's end
 };
 
+// A driver's outages, from its recorded CartesianState: runs of samples with stopped = true (the
+// arm could not be moved: the mixer held, docs/components.md "The command contract").
+struct ArmStops {
+  std::string topic;
+  struct Stop {
+    std::int64_t from_ns = 0, to_ns = 0;  // first stopped sample; first sample after (or the last stopped)
+    bool until_end = false;               // still stopped at the recording's last sample
+  };
+  std::vector<Stop> stops;
+  bool stopped_now = false;  // while reading
+};
+
 struct Losses {
+  std::vector<ArmStops> arms;  // every CartesianState channel that reported stopped at some time
   std::vector<WriterLosses> writers;  // every writer of every channel with a dyad header
   std::vector<std::pair<std::int64_t, std::string>> health;  // dyad/health events: stamp, what
   std::int64_t start_ns = 0;  // the earliest stamp (times are printed from it)
@@ -37,7 +50,8 @@ struct Losses {
 // intervals before the last stamp of the recording.
 StatusOr<Losses> FindLosses(const mcap::Reader& reader);
 
-// The `losses:` and `health:` sections of `dyad bag info` (end with a newline).
+// The `losses:`, `arm:` (only when a driver reported stopped) and `health:` sections of
+// `dyad bag info` (end with a newline).
 std::string FormatLosses(const Losses& losses);
 
 }  // namespace dyad::bag

@@ -330,6 +330,45 @@ TEST(BagLosses, SaysPerWriterWhatWasLostAndWhen) {
   EXPECT_EQ(text.find("  c  b "), std::string::npos) << "a complete writer is not listed\n" << text;
 }
 
+// A driver's stopped states (#40: a lost arm must not be silent): each run of stopped samples with
+// its start and length, and one still under way at the end. Before, bag info said nothing of them.
+TEST(BagLosses, SaysWhenAndHowLongTheArmWasStopped) {
+  const std::string path = TempPath("arm.mcap");
+  {
+    auto writer = mcap::Writer::Open(path);
+    ASSERT_TRUE(writer.ok());
+    auto schema = writer->AddSchema(MessageTraits<msg::CartesianState>::kName, "omgidl",
+                                    MessageTraits<msg::CartesianState>::kIdl);
+    auto channel = writer->AddChannel("robot/state", "cdr", *schema);
+    MessageTraits<msg::CartesianState>::PubSubType type;
+    for (std::uint32_t i = 0; i < 40; ++i) {  // 10 Hz from 0 s; stopped at 1.0..1.9 s and from 3.5 s
+      msg::CartesianState m;
+      m.header().source("arm");
+      m.header().sequence_number(i + 1);
+      m.header().stamp_ns(static_cast<std::int64_t>(i) * 100'000'000);
+      m.stopped((i >= 10 && i < 20) || i >= 35);
+      eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(&m)());
+      ASSERT_TRUE(type.serialize(&m, &payload));
+      ASSERT_TRUE(writer->Write(*channel, i, i * 100'000'000ull, i * 100'000'000ull, {payload.data, payload.length}).ok());
+    }
+    ASSERT_TRUE(writer->Close().ok());
+  }
+  auto reader = mcap::Reader::Open(path);
+  ASSERT_TRUE(reader.ok());
+  auto losses = FindLosses(*reader);
+  ASSERT_TRUE(losses.ok()) << losses.status().message();
+  ASSERT_EQ(losses->arms.size(), 1u);
+  ASSERT_EQ(losses->arms[0].stops.size(), 2u);
+  EXPECT_EQ(losses->arms[0].stops[0].from_ns, 1'000'000'000);
+  EXPECT_EQ(losses->arms[0].stops[0].to_ns, 2'000'000'000);
+  EXPECT_TRUE(losses->arms[0].stops[1].until_end);
+  const std::string text = FormatLosses(*losses);
+  EXPECT_NE(text.find("arm:         robot/state: stopped 2 times, 1.4 s (the driver could not move the arm; the mixer "
+                      "holds meanwhile)\n  +1.0 s  for 1.0 s\n  +3.5 s  for 0.4 s, still stopped at the end\n"),
+            std::string::npos)
+      << text;
+}
+
 // `dyad bag filter`: read back by the reader (an independent path from the writer's buffers):
 // the chosen topic and window, every field of each message kept, the graph's metadata and a note.
 TEST(BagFilter, KeepsTheChosenTopicsAndWindowExactly) {
