@@ -27,6 +27,7 @@ constexpr int kOk = 0, kFailure = 1, kBadInput = 2;
 
 struct Options {
   std::string recording, out, dataset;
+  double duration_s = 0;  // the run's planned length: a shorter recording is incomplete
   bool plots = true;
 };
 
@@ -43,6 +44,9 @@ int RunAnalyze(const Options& o) {
     return kBadInput;
   }
   analyze::Report& report = *built;
+  report.planned_s = o.duration_s;
+  const std::string incomplete = analyze::IncompleteReason(report);
+  if (!incomplete.empty()) std::cerr << "dyad analyze: " << o.recording << ": incomplete recording: " << incomplete << "\n";
 
   std::string out = o.out;
   if (out.empty()) {
@@ -54,7 +58,7 @@ int RunAnalyze(const Options& o) {
     return kFailure;
   }
   std::cout << "report: " << out << "/report.md (" << report.timeline.steps.size() << " steps, "
-            << report.events.size() << " events)\n";
+            << report.events.size() << " events" << (incomplete.empty() ? "" : "; incomplete, its first lines say why") << ")\n";
   if (!o.plots) return kOk;
   const std::string script = tools::DyadScriptPath("plot_report.py");
   if (!std::filesystem::exists(script)) {
@@ -186,6 +190,9 @@ void AddAnalyzeCommands(CLI::App& app, int& exit_code) {
   cmd->add_option("recording", options->recording, "MCAP file written by the recorder")->required();
   cmd->add_option("-o,--out", options->out, "report folder (default: RECORDING without .mcap + _report)");
   cmd->add_option("--dataset", options->dataset, "data set folder drawn as watermark (default: the graph's human dataset)");
+  cmd->add_option("--duration", options->duration_s,
+                  "the run's planned seconds: a recording under 95% of them is reported incomplete (as a cut-short file is)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("!--no-plots", options->plots, "write tables only");
   cmd->callback([options, &exit_code] { exit_code = RunAnalyze(*options); });
 }

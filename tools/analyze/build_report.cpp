@@ -13,9 +13,12 @@ namespace dyad::analyze {
 StatusOr<Report> BuildReport(const std::string& recording, std::ostream& warnings) {
   auto reader = mcap::Reader::Open(recording);
   if (!reader.ok()) return reader.status();
-  if (reader->recovery().truncated) warnings << "dyad analyze: " << recording << ": " << reader->recovery().Describe() << "\n";
+  const mcap::Recovery& recovery = reader->recovery();
+  if (recovery.truncated) warnings << "dyad analyze: " << recording << ": " << recovery.Describe() << "\n";
   Report report;
   report.recording = recording;
+  // Without its footer the file is not what the recorder closed, even when no message was lost.
+  if (recovery.truncated || !recovery.damaged_chunks.empty()) report.incomplete = recovery.Describe();
   report.graph_yaml = GraphMetadata(*reader, "yaml");
   auto plan = PlanFromGraphYaml(report.graph_yaml);
   if (!plan.ok()) return plan.status().WithContext(recording);

@@ -1,7 +1,8 @@
 // tools/analyze/build_report.hpp: a recording read into the report `dyad analyze` writes.
 //
 // Contract of BuildReport(recording, warnings):
-//   - Reads the MCAP file (a cut-short one too: what it recovers is said on `warnings`), the
+//   - Reads the MCAP file (a cut-short one too: what it recovers is said on `warnings`, and in
+//     Report::incomplete, which IncompleteReason and the report's first lines say), the
 //     graph recorded with it, the experiment's topics, the clock offsets between processes, the
 //     live parameter changes applied (dyad/params; none recorded: an empty list, no warning) and
 //     the transport's losses (a loss table that cannot be read is a warning, not a failure).

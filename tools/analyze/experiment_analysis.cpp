@@ -284,7 +284,6 @@ StatusOr<std::vector<ParamChangeEvent>> AppliedParamChanges(const std::map<std::
       !s.ok())
     return s;
   std::optional<int64_t> t0 = timeline.t0_ns;
-  const double period_s = static_cast<double>(plan.period_ns) * 1e-9;
   for (size_t r = 0; r < it->second.size(); ++r) {
     if (cells.Text(r, "op") != "applied") continue;  // refusals changed nothing; "value" answers a get
     const std::string& graph = cells.Text(r, "graph_name");
@@ -295,7 +294,7 @@ StatusOr<std::vector<ParamChangeEvent>> AppliedParamChanges(const std::map<std::
     if (!t0) t0 = static_cast<int64_t>(on_recorder);
     ParamChangeEvent e;
     e.step = StepOf(on_recorder, *t0, plan.period_ns);
-    e.time_s = static_cast<double>(e.step) * period_s;
+    e.time_s = static_cast<double>(e.step * plan.period_ns) / 1e9;  // 1.2, not 12 * 0.1 = 1.2000000000000002 (CSV prints it exactly)
     e.component = cells.Text(r, "component_name");
     e.param = cells.Text(r, "param_name");
     e.old_value = cells.Text(r, "old_value");
@@ -390,7 +389,7 @@ StatusOr<std::vector<NoteEvent>> ExperimenterNotes(const std::map<std::string, T
     if (!t0) t0 = static_cast<int64_t>(*stamp);
     NoteEvent n;
     n.step = StepOf(*stamp, *t0, plan.period_ns);
-    n.time_s = static_cast<double>(n.step) * static_cast<double>(plan.period_ns) * 1e-9;
+    n.time_s = static_cast<double>(n.step * plan.period_ns) / 1e9;
     n.author = cells.Text(r, "author");
     n.text = cells.Text(r, "text");
     out.push_back(std::move(n));

@@ -20,14 +20,17 @@ std::string Num(double v, int precision = 3) {
   return s.str();
 }
 
+// A number in a CSV file: exact (tools::CsvNumber).
+std::string X(double v) { return tools::CsvNumber(v); }
+
 std::string EventsCsv(const Report& r) {
   std::ostringstream s;
   s << "event,start_step,end_step,primitive,mean_congruence,final_congruence,human_accuracy,robot_follows,"
        "robot_switch_after,self_report\n";
   for (const EventSummary& e : r.events) {
     s << e.index << ',' << e.event.start_step << ',' << e.event.end_step << ',' << e.event.primitive << ','
-      << Num(e.mean_congruence, 6) << ',' << Num(e.final_congruence, 6) << ',' << Num(e.human_accuracy, 6) << ','
-      << Num(e.robot_follows, 6) << ',' << e.robot_switch_after << ','
+      << X(e.mean_congruence) << ',' << X(e.final_congruence) << ',' << X(e.human_accuracy) << ','
+      << X(e.robot_follows) << ',' << e.robot_switch_after << ','
       << (e.event.reported == kNotReported ? std::string() : std::to_string(e.event.reported)) << '\n';
   }
   return s.str();
@@ -47,13 +50,13 @@ std::string TimelineCsv(const Report& r) {
   std::ostringstream s;
   s << "step,time_s,human_x,human_y,engaged,robot_x,robot_y,executed_x,executed_y,nelbo,reconstruction,"
        "regulation,optimisation_s,congruence,human_class,robot_class\n";
-  const double period_s = static_cast<double>(r.plan.period_ns) * 1e-9;
   for (const StepSample& x : r.timeline.steps) {
-    s << x.step << ',' << Num(static_cast<double>(x.step) * period_s, 3) << ',' << Num(x.human_x, 4) << ','
-      << Num(x.human_y, 4) << ',' << (x.engaged ? 1 : 0) << ',' << Num(x.robot_x, 4) << ',' << Num(x.robot_y, 4)
-      << ',' << Num(x.executed_x, 4) << ',' << Num(x.executed_y, 4) << ',' << Num(x.nelbo, 6) << ','
-      << Num(x.reconstruction, 6) << ',' << Num(x.regulation, 6) << ',' << Num(x.optimisation_s, 7) << ','
-      << Num(x.congruence, 6) << ',' << MostLikelyClass(x.p_human) << ',' << MostLikelyClass(x.p_robot) << '\n';
+    // step * period in ns, divided once: 0.3, not 3 * 0.1 = 0.30000000000000004.
+    s << x.step << ',' << X(static_cast<double>(x.step * r.plan.period_ns) / 1e9) << ',' << X(x.human_x) << ','
+      << X(x.human_y) << ',' << (x.engaged ? 1 : 0) << ',' << X(x.robot_x) << ',' << X(x.robot_y)
+      << ',' << X(x.executed_x) << ',' << X(x.executed_y) << ',' << X(x.nelbo) << ','
+      << X(x.reconstruction) << ',' << X(x.regulation) << ',' << X(x.optimisation_s) << ','
+      << X(x.congruence) << ',' << MostLikelyClass(x.p_human) << ',' << MostLikelyClass(x.p_robot) << '\n';
   }
   return s.str();
 }
@@ -62,7 +65,7 @@ std::string ParamsCsv(const Report& r) {
   std::ostringstream s;
   s << "step,time_s,component,param,old_value,value,who\n";
   for (const ParamChangeEvent& c : r.param_changes) {
-    s << c.step << ',' << Num(c.time_s, 3) << ',' << tools::CsvCell(c.component) << ',' << tools::CsvCell(c.param) << ','
+    s << c.step << ',' << X(c.time_s) << ',' << tools::CsvCell(c.component) << ',' << tools::CsvCell(c.param) << ','
       << tools::CsvCell(c.old_value) << ',' << tools::CsvCell(c.value) << ',' << tools::CsvCell(c.who) << '\n';
   }
   return s.str();
@@ -84,7 +87,7 @@ std::string NotesCsv(const Report& r) {
   std::ostringstream s;
   s << "step,time_s,author,text\n";
   for (const NoteEvent& n : r.notes)
-    s << n.step << ',' << Num(n.time_s, 3) << ',' << tools::CsvCell(n.author) << ',' << tools::CsvCell(n.text) << '\n';
+    s << n.step << ',' << X(n.time_s) << ',' << tools::CsvCell(n.author) << ',' << tools::CsvCell(n.text) << '\n';
   return s.str();
 }
 
@@ -120,8 +123,7 @@ std::string MetricsJson(const Report& r) {
   for (const auto& [name, value] : RunMetrics(r)) {
     s << (first ? "\n  " : ",\n  ") << '"' << name << "\": ";
     if (std::isfinite(value)) {
-      s.precision(9);
-      s << value;
+      s << X(value);  // exact: sweep.csv copies it
     } else {
       s << "null";
     }
@@ -134,6 +136,10 @@ std::string MetricsJson(const Report& r) {
 // The run's header and the bullets that summarise it.
 void SummarySection(const Report& r, std::ostream& s) {
   s << "# Experiment report\n\n";
+  // First, before any number: a cut-short or short recording is not the run it claims to be.
+  if (const std::string why = IncompleteReason(r); !why.empty())
+    s << "**Incomplete recording: " << tools::MarkdownCell(why) << ".** Every number below is of what it holds; "
+      << "`dyad study analyze` and `dyad sweep` leave such a run out of their summaries.\n\n";
   s << "- recording: `" << r.recording << "`\n";
   if (!r.plan.graph_name.empty()) s << "- graph: `" << r.plan.graph_name << "`\n";
   s << "- steps: " << r.timeline.steps.size() << " of " << Num(static_cast<double>(r.plan.period_ns) * 1e-6, 1)
@@ -279,6 +285,16 @@ void ConfusionSection(const Report& r, std::ostream& s) {
 
 }  // namespace
 
+std::string IncompleteReason(const Report& r) {
+  if (!r.incomplete.empty()) return r.incomplete;
+  if (!(r.planned_s > 0)) return "";
+  const double recorded_s = static_cast<double>(static_cast<int64_t>(r.timeline.steps.size()) * r.plan.period_ns) / 1e9;
+  if (recorded_s >= 0.95 * r.planned_s) return "";
+  return "shorter than planned: " + std::to_string(r.timeline.steps.size()) + " steps of " +
+         tools::CsvNumber(static_cast<double>(r.plan.period_ns) / 1e6) + " ms (" + tools::CsvNumber(recorded_s) + " s) of the " +
+         tools::CsvNumber(r.planned_s) + " s planned";
+}
+
 std::vector<std::pair<std::string, double>> RunMetrics(const Report& r) {
   std::vector<double> congruence, final_congruence, accuracy, follows, switch_s, switched, nelbo;
   const double period_s = static_cast<double>(r.plan.period_ns) * 1e-9;
@@ -337,9 +353,12 @@ Status WriteReport(const Report& r, const std::string& dir) {
   } else {
     std::filesystem::remove(reported, ec);
   }
-  // The plots draw whatever params.csv and notes.csv the folder holds: an earlier report's must go.
+  // The plots draw whatever params.csv and notes.csv the folder holds, and a sweep's table reads
+  // incomplete.txt: an earlier report's must go.
+  const std::string incomplete = IncompleteReason(r);
   const std::tuple<std::string, bool, std::string> marked[] = {{dir + "/params.csv", !r.param_changes.empty(), ParamsCsv(r)},
-                                                               {dir + "/notes.csv", !r.notes.empty(), NotesCsv(r)}};
+                                                               {dir + "/notes.csv", !r.notes.empty(), NotesCsv(r)},
+                                                               {dir + "/incomplete.txt", !incomplete.empty(), incomplete + "\n"}};
   for (const auto& [path, present, text] : marked) {
     if (present) {
       if (Status s = tools::WriteTextFile(path, text); !s.ok()) return s;

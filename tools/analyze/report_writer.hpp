@@ -8,6 +8,11 @@
 //                  step,time_s,component,param,old_value,value,who (cells quoted as RFC 4180 says)
 //   graph.yaml     the recorded graph (when the recording has it)
 //   metrics.json   the run in numbers (RunMetrics): what `dyad sweep` tabulates
+//   incomplete.txt why the recording is incomplete (IncompleteReason), one line; only when it is
+//                  (an old one goes): what a table of many runs (`dyad sweep`) reads from the folder
+// Numbers in the CSV files and metrics.json are the shortest text that reads back to the same
+// double (tools::CsvNumber); report.md rounds them for people. An incomplete recording
+// (IncompleteReason) is said in report.md's first lines, before any number.
 // The PNG plots are drawn from timeline.csv, events.csv and params.csv by
 // tools/analyze/plot_report.py.
 #pragma once
@@ -36,7 +41,18 @@ struct Report {
   // What the recording lost in transport and what the runtime healed: `dyad bag info`'s losses:
   // and health: sections (tools/bag/losses.hpp); empty: not read.
   std::string transport;
+  // Why the recording is not the whole run, "" when it is: the file is cut short (no footer: a
+  // crash, a full disk, a cut copy; what the reader recovered) or has damaged chunks. BuildReport.
+  std::string incomplete;
+  // The run's planned length in seconds (0: unknown): a recording shorter than it is incomplete.
+  double planned_s = 0;
 };
+
+// Why `report`'s recording is incomplete, "" when it is whole: Report::incomplete, else, when
+// planned_s > 0, its steps span less than 95% of it ("903 steps of 100 ms (90.3 s) of the 170 s
+// planned"; the slack is a wall-clock run's start-up). `dyad analyze`, `dyad study analyze` and
+// `dyad sweep` leave such a run out of their summaries by this rule.
+std::string IncompleteReason(const Report& report);
 
 // Creates `dir` if needed. Fails with IOError naming the file that cannot be written.
 Status WriteReport(const Report& report, const std::string& dir);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -535,6 +536,56 @@ TEST(AnalyzeCli, WritesTablesAndPngPlots) {
   EXPECT_EQ(lines, 41);
 }
 
+// A recording cut short (a crash, a full disk) is said in the report's first lines, before any
+// number; so is one shorter than the run's planned duration (--duration). Numbers in the tables
+// read back to the doubles the analysis computed.
+TEST(AnalyzeCli, AnIncompleteRecordingIsSaidInTheReportsFirstLines) {
+  const std::string whole = WriteExperiment(TempPath("whole.mcap"));
+  std::ostringstream warnings;
+  auto full = BuildReport(whole, warnings);
+  ASSERT_TRUE(full.ok()) << full.status().ToString();
+  EXPECT_EQ(IncompleteReason(*full), "");
+  EXPECT_EQ(FormatMarkdown(*full).find("**Incomplete recording"), std::string::npos);
+  full->planned_s = 4.2;  // 40 steps of 100 ms: 4 s, 95% of 4.2 s is 3.99 s
+  EXPECT_EQ(IncompleteReason(*full), "");
+  full->planned_s = 5;
+  EXPECT_EQ(IncompleteReason(*full), "shorter than planned: 40 steps of 100 ms (4 s) of the 5 s planned");
+  EXPECT_EQ(FormatMarkdown(*full).rfind("# Experiment report\n\n**Incomplete recording: shorter than planned", 0), 0u)
+      << FormatMarkdown(*full);
+  // The last bytes gone: the reader recovers what it can, the report says so first.
+  const std::string cut = TempPath("cut.mcap");
+  std::filesystem::copy_file(whole, cut);
+  std::filesystem::resize_file(cut, std::filesystem::file_size(whole) - 10);
+  auto part = BuildReport(cut, warnings);
+  ASSERT_TRUE(part.ok()) << part.status().ToString();
+  EXPECT_EQ(IncompleteReason(*part).rfind("cut short", 0), 0u) << IncompleteReason(*part);
+  std::string err;
+  const std::string out = TempPath("cut_report");
+  EXPECT_EQ(RunCli({"analyze", cut, "-o", out, "--no-plots"}, &err), 0) << err;
+  EXPECT_NE(err.find("incomplete recording: cut short"), std::string::npos) << err;
+  const auto md = Lines(out + "/report.md");
+  ASSERT_GE(md.size(), 3u);
+  EXPECT_EQ(md[2].rfind("**Incomplete recording: cut short", 0), 0u) << md[2];
+  ASSERT_EQ(Lines(out + "/incomplete.txt").size(), 1u);  // what a sweep's table reads
+  EXPECT_EQ(Lines(out + "/incomplete.txt")[0], IncompleteReason(*part));
+  ASSERT_TRUE(WriteReport(*full, out).ok());  // planned 5 s: incomplete too
+  full->planned_s = 0;
+  ASSERT_TRUE(WriteReport(*full, out).ok());
+  EXPECT_FALSE(std::filesystem::exists(out + "/incomplete.txt")) << "a whole run's report keeps an earlier one's";
+  EXPECT_EQ(RunCli({"analyze", whole, "-o", TempPath("short_report"), "--no-plots", "--duration", "60"}, &err), 0) << err;
+  EXPECT_NE(err.find("incomplete recording: shorter than planned: 40 steps of 100 ms (4 s) of the 60 s planned"), std::string::npos)
+      << err;
+  // Exact numbers: every event's mean congruence reads back to the double computed.
+  const auto events = Lines(out + "/events.csv");
+  ASSERT_EQ(events.size(), part->events.size() + 1);
+  for (size_t i = 0; i < part->events.size(); ++i) {
+    std::stringstream row(events[i + 1]);
+    std::string cell;
+    for (int k = 0; k < 5; ++k) std::getline(row, cell, ',');
+    EXPECT_EQ(std::strtod(cell.c_str(), nullptr), part->events[i].mean_congruence) << events[i + 1];
+  }
+}
+
 TEST(AnalyzeCli, BadInputExitsTwoNamingTheFile) {
   std::string err;
   EXPECT_EQ(RunCli({"analyze", TempPath("missing.mcap")}, &err), 2);
@@ -611,7 +662,7 @@ TEST(AnalyzeParams, AnAppliedChangeIsPlacedOnTheTimelinesStepGrid) {
   const std::string dir = TempPath("report");
   ASSERT_TRUE(WriteReport(*r, dir).ok());
   EXPECT_EQ(Lines(dir + "/params.csv"), (std::vector<std::string>{"step,time_s,component,param,old_value,value,who",
-                                                                    "10,1.000,mixer,gain,0.9,0.2,dyad param set (ana@lab-pc)"}));
+                                                                    "10,1,mixer,gain,0.9,0.2,dyad param set (ana@lab-pc)"}));
   const std::string md = FormatMarkdown(*r);
   const auto section = md.find("## Live parameter changes\n\n| time | component.param | old -> new | who |\n");
   ASSERT_NE(section, std::string::npos) << md;
@@ -637,7 +688,7 @@ TEST(AnalyzeNotes, TheExperimentersNotesAreOnTheTimelineInTheReportAndInTheirTab
   const std::string dir = TempPath("report");
   ASSERT_TRUE(WriteReport(*r, dir).ok());
   EXPECT_EQ(Lines(dir + "/notes.csv"),
-            (std::vector<std::string>{"step,time_s,author,text", "5,0.500,experimenter,\"coughed, then | \"\"laughed\"\"\""}));
+            (std::vector<std::string>{"step,time_s,author,text", "5,0.5,experimenter,\"coughed, then | \"\"laughed\"\"\""}));
   // Placed as any stamp of its writer's process: web's clock 200 ms ahead moves it 2 steps back.
   auto reader = mcap::Reader::Open(r->recording);
   ASSERT_TRUE(reader.ok());
@@ -690,7 +741,7 @@ TEST(AnalyzeParams, WithoutChangesThereIsNoTableAndCellsAreQuoted) {
   Report with = *r;
   with.param_changes.push_back({12, 1.2, "mind", "meta_prior", "[1, 1]", "[0.5, 2]", "page \"lab\""});
   ASSERT_TRUE(WriteReport(with, dir).ok());
-  EXPECT_EQ(Lines(dir + "/params.csv").at(1), "12,1.200,mind,meta_prior,\"[1, 1]\",\"[0.5, 2]\",\"page \"\"lab\"\"\"");
+  EXPECT_EQ(Lines(dir + "/params.csv").at(1), "12,1.2,mind,meta_prior,\"[1, 1]\",\"[0.5, 2]\",\"page \"\"lab\"\"\"");
   ASSERT_TRUE(WriteReport(*r, dir).ok());
   EXPECT_FALSE(std::filesystem::exists(dir + "/params.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir + "/report.md"));
