@@ -1,14 +1,17 @@
 #!/usr/bin/env python3
 """Plots of a study's analysis: each measure per condition.
 
-    plot_study.py ANALYSIS_DIR
+    plot_study.py ANALYSIS_DIR [--include-incomplete]
 
 From ANALYSIS_DIR/trials.csv and summary.csv (dyad study analyze), ANALYSIS_DIR/plots/<measure>.png
-shows, for each condition (in the study file's order, named with its blind label), every
+shows, for each condition (in summary.csv's order: by label when blind, else the study file's;
+named with its blind label), every
 participant's mean over their trials of it as a dot, a participant's conditions joined by a faint
 line (the design is within participants: what matters is how each person changes), and the
 condition's mean over participants with its 95% bootstrap interval from summary.csv (the same
 numbers as the report). Trials that lack the measure are left out; a measure nobody has is not drawn.
+Incomplete trials (trials.csv's `complete` false: cut short, or shorter than planned) are left
+out, as summary.csv leaves them out, unless --include-incomplete (given when the analysis counted them).
 """
 import csv
 import math
@@ -30,13 +33,16 @@ def number(text):
 
 
 def main():
-    if len(sys.argv) != 2:
+    args = sys.argv[1:]
+    include_incomplete = "--include-incomplete" in args
+    args = [a for a in args if a != "--include-incomplete"]
+    if len(args) != 1:
         sys.exit(__doc__)
-    folder = sys.argv[1]
+    folder = args[0]
     with open(os.path.join(folder, "summary.csv"), newline="") as f:
         summary = list(csv.DictReader(f))
     with open(os.path.join(folder, "trials.csv"), newline="") as f:
-        trials = list(csv.DictReader(f))
+        trials = [t for t in csv.DictReader(f) if include_incomplete or t.get("complete") != "false"]
     conditions, labels = [], {}
     for row in summary:
         if row["condition"] not in labels:

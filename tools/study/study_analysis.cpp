@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 #include <tuple>
 #include <filesystem>
@@ -18,13 +19,24 @@
 namespace dyad::study {
 namespace {
 
-// FNV-1a: a seed from names that is the same on every machine (std::hash is not).
+// A number for people (report.md): six significant digits.
 std::string Num(double v) {
   if (std::isnan(v)) return "";
   std::ostringstream s;
   s.precision(6);
   s << v;
   return s.str();
+}
+
+// A number in a CSV file: exact (a summary recomputed from the rows is the same double).
+std::string X(double v) { return tools::CsvNumber(v); }
+
+// The share of a confusion's counts on its diagonal; NaN when it has none.
+double Accuracy(const std::vector<std::vector<int64_t>>& m) {
+  int64_t all = 0, right = 0;
+  for (size_t t = 0; t < m.size(); ++t)
+    for (size_t p = 0; p < m[t].size(); ++p) all += m[t][p], right += t == p ? m[t][p] : 0;
+  return all > 0 ? static_cast<double>(right) / static_cast<double>(all) : std::nan("");
 }
 
 void AddConfusion(const std::vector<std::vector<int64_t>>& m, std::vector<std::vector<int64_t>>* sum) {
@@ -40,14 +52,15 @@ std::string NameOf(const StudyAnalysis& a, const Condition& c) { return a.unblin
 
 std::string TrialsCsv(const Study& s, const StudyAnalysis& a) {
   std::ostringstream out;
-  out << "participant,condition,label,trial,repetition,attempt,file";
-  for (const auto& [name, value] : analyze::RunMetrics(analyze::Report{})) out << ',' << name;  // the same names for every trial
+  out << "participant,condition,label,trial,repetition,attempt,file,complete,reason";
+  for (const std::string& name : TrialMeasures()) out << ',' << name;  // the same names for every trial
   out << '\n';
   for (const TrialResult& r : a.trials) {
     const Condition& c = s.conditions[static_cast<size_t>(r.trial.condition)];
     out << r.participant << ',' << NameOf(a, c) << ',' << c.label << ',' << r.trial.number << ',' << r.trial.repetition << ','
-        << r.attempt << ',' << tools::CsvCell(r.trial.file);
-    for (const auto& [name, value] : r.metrics) out << ',' << Num(value);
+        << r.attempt << ',' << tools::CsvCell(r.trial.file) << ',' << (r.incomplete.empty() ? "true" : "false") << ','
+        << tools::CsvCell(r.incomplete);
+    for (const auto& [name, value] : r.metrics) out << ',' << X(value);
     out << '\n';
   }
   return out.str();
@@ -56,16 +69,16 @@ std::string TrialsCsv(const Study& s, const StudyAnalysis& a) {
 std::string EventsCsv(const Study& s, const StudyAnalysis& a) {
   std::ostringstream out;
   out << "participant,condition,trial,event,start_step,end_step,primitive,self_report,mean_congruence,final_congruence,"
-         "human_accuracy,robot_follows,robot_switch_after\n";
+         "human_accuracy,robot_follows,robot_switch_after,complete\n";
   for (const TrialResult& r : a.trials)
     for (const analyze::EventSummary& e : r.events) {
       out << r.participant << ',' << NameOf(a, s.conditions[static_cast<size_t>(r.trial.condition)]) << ',' << r.trial.number << ','
           << e.index << ',' << e.event.start_step << ',' << e.event.end_step << ','
           << (e.event.primitive < 0 ? std::string() : std::to_string(e.event.primitive)) << ','
           << (e.event.reported == analyze::kNotReported ? std::string() : std::to_string(e.event.reported)) << ','
-          << Num(e.mean_congruence) << ',' << Num(e.final_congruence) << ',' << Num(e.human_accuracy) << ','
-          << Num(e.robot_follows) << ',' << (e.robot_switch_after < 0 ? std::string() : std::to_string(e.robot_switch_after))
-          << '\n';
+          << X(e.mean_congruence) << ',' << X(e.final_congruence) << ',' << X(e.human_accuracy) << ','
+          << X(e.robot_follows) << ',' << (e.robot_switch_after < 0 ? std::string() : std::to_string(e.robot_switch_after))
+          << ',' << (r.incomplete.empty() ? "true" : "false") << '\n';
     }
   return out.str();
 }
@@ -76,20 +89,20 @@ struct ConditionMeasure {
   MeanInterval interval;  // over participants: n counts those with the measure
 };
 
-// Per condition and measure: each participant's mean over their trials of it (trials of one
-// person are not independent), then the mean over participants and its bootstrap interval,
-// resampling participants.
+// Per condition (in the listing order) and measure: each participant's mean over their counted
+// trials of it (trials of one person are not independent), then the mean over participants and
+// its bootstrap interval, resampling participants.
 using Summaries = std::vector<std::pair<const Condition*, std::vector<ConditionMeasure>>>;
 Summaries Summary(const Study& s, const StudyAnalysis& a) {
   Summaries out;
-  for (size_t c = 0; c < s.conditions.size(); ++c) {
+  for (const size_t c : s.ListingOrder()) {
     std::vector<ConditionMeasure> measures;
     for (const std::string& m : SummaryMeasures()) {
       ConditionMeasure cm;
       cm.measure = m;
       std::map<std::string, std::pair<double, int>> by_participant;  // sum, count
       for (const TrialResult& r : a.trials) {
-        if (static_cast<size_t>(r.trial.condition) != c) continue;
+        if (static_cast<size_t>(r.trial.condition) != c || !a.Counted(r)) continue;
         for (const auto& [name, value] : r.metrics)
           if (name == m && !std::isnan(value)) {
             by_participant[r.participant].first += value;
@@ -112,14 +125,88 @@ std::string SummaryCsv(const StudyAnalysis& a, const Summaries& summary) {
   out << "condition,label,measure,participants,trials,mean,ci_low,ci_high\n";
   for (const auto& [c, measures] : summary)
     for (const ConditionMeasure& m : measures)
-      out << NameOf(a, *c) << ',' << c->label << ',' << m.measure << ',' << m.interval.n << ',' << m.trials << ',' << Num(m.interval.mean)
-          << ',' << Num(m.interval.low) << ',' << Num(m.interval.high) << '\n';
+      out << NameOf(a, *c) << ',' << c->label << ',' << m.measure << ',' << m.interval.n << ',' << m.trials << ',' << X(m.interval.mean)
+          << ',' << X(m.interval.low) << ',' << X(m.interval.high) << '\n';
   return out.str();
+}
+
+// A condition as a heading or cell of report.md: "assist (A)" once unblinded, else "condition A".
+std::string Heading(const StudyAnalysis& a, const Condition& c) { return a.unblinded ? c.name + " (" + c.label + ")" : NameOf(a, c); }
+
+void IncompleteSection(const StudyAnalysis& a, std::ostream& out) {
+  bool any = false;
+  for (const TrialResult& r : a.trials) {
+    if (r.incomplete.empty()) continue;
+    if (!any)
+      out << "\n## Incomplete trials\n\n"
+          << (a.include_incomplete ? "Counted in the summary (--include-incomplete)."
+                                   : "Left out of the summary, summary.csv, the confusion and the plots (--include-incomplete "
+                                     "counts them); trials.csv has their rows, `complete` false.")
+          << "\n\n";
+    any = true;
+    out << "- " << r.participant << " trial " << r.trial.number << " (" << r.trial.file << "): " << r.incomplete << "\n";
+  }
+}
+
+// A confusion as a markdown table: each row's shares (its counts in brackets); empty rows left out.
+void ConfusionTable(const std::vector<std::vector<int64_t>>& m, std::ostream& out) {
+  size_t classes = m.size();
+  for (const auto& row : m) classes = std::max(classes, row.size());
+  out << "| said / observer |";
+  for (size_t p = 0; p < classes; ++p) out << ' ' << p << " |";
+  out << "\n|---|";
+  for (size_t p = 0; p < classes; ++p) out << "---|";
+  out << "\n";
+  for (size_t t = 0; t < m.size(); ++t) {
+    int64_t total = 0;
+    for (int64_t n : m[t]) total += n;
+    if (total == 0) continue;
+    out << "| **" << t << "** |";
+    for (size_t p = 0; p < classes; ++p) {
+      const int64_t n = p < m[t].size() ? m[t][p] : 0;
+      char share[32];
+      std::snprintf(share, sizeof share, "%.2f", static_cast<double>(n) / static_cast<double>(total));
+      out << ' ' << share << " (" << n << ") |";
+    }
+    out << "\n";
+  }
+}
+
+// Per condition: the observer against what the participants said they drew, summed over the
+// condition's counted trials, and its accuracy over participants with the interval.
+void ReportedConfusionSection(const Study& s, const StudyAnalysis& a, const Summaries& summary, std::ostream& out) {
+  if (a.reported_confusion.empty()) return;
+  out << "\n## The observer against the self-reports, per condition\n\n"
+         "Rows: the primitive the participant said they drew; columns: the observer's most likely class of their motion "
+         "over the event's labelled steps; each row's shares, its step counts in brackets, over the condition's trials. "
+         "Accuracy: the share on the diagonal per trial (reported_accuracy), each participant's mean over their trials, "
+         "then the mean over participants with its 95% bootstrap interval.\n";
+  for (const auto& [c, measures] : summary) {
+    const size_t index = static_cast<size_t>(c - s.conditions.data());
+    std::vector<std::vector<int64_t>> m;
+    for (const TrialResult& r : a.trials)
+      if (static_cast<size_t>(r.trial.condition) == index && a.Counted(r)) AddConfusion(r.reported_confusion, &m);
+    out << "\n### " << Heading(a, *c) << "\n\n";
+    const auto acc =
+        std::find_if(measures.begin(), measures.end(), [](const ConditionMeasure& x) { return x.measure == "reported_accuracy"; });
+    if (m.empty() || acc == measures.end() || acc->interval.n == 0) {
+      out << "No self-report with observer labels.\n";
+      continue;
+    }
+    const MeanInterval& ci = acc->interval;
+    out << "Accuracy " << Num(ci.mean) << " (95% interval " << Num(ci.low) << " to " << Num(ci.high) << "; " << ci.n << " participant"
+        << (ci.n == 1 ? "" : "s") << ", " << acc->trials << " trial" << (acc->trials == 1 ? "" : "s") << ").\n\n";
+    ConfusionTable(m, out);
+  }
 }
 
 std::string ReportMd(const Study& s, const StudyAnalysis& a, const Summaries& summary) {
   std::ostringstream out;
   out << "# Study " << s.name << "\n\n" << a.trials.size() << " trial" << (a.trials.size() == 1 ? "" : "s") << " analysed";
+  const auto incomplete = std::count_if(a.trials.begin(), a.trials.end(), [](const TrialResult& r) { return !r.incomplete.empty(); });
+  if (incomplete > 0)
+    out << " (" << incomplete << " incomplete, " << (a.include_incomplete ? "counted: --include-incomplete" : "left out of the summary")
+        << "; below)";
   if (!a.missing.empty()) out << ", " << a.missing.size() << " missing (below)";
   out << ". Per condition: each participant's mean over their trials, then the mean over participants and a 95% "
          "bootstrap interval (percentile, resampling participants); \"participants\" and \"trials\" count those that "
@@ -127,7 +214,7 @@ std::string ReportMd(const Study& s, const StudyAnalysis& a, const Summaries& su
   for (const auto& [c, measures] : summary)
     for (const ConditionMeasure& m : measures) {
       const MeanInterval& ci = m.interval;
-      out << "| " << (a.unblinded ? c->name + " (" + c->label + ")" : NameOf(a, *c)) << " | " << m.measure << " | " << ci.n << " | " << m.trials << " | "
+      out << "| " << Heading(a, *c) << " | " << m.measure << " | " << ci.n << " | " << m.trials << " | "
           << (ci.n > 0 ? Num(ci.mean) : "unknown") << " | " << (ci.n > 0 ? Num(ci.low) + " to " + Num(ci.high) : "unknown") << " |\n";
     }
   out << "\nmean_congruence: P(C_t), the observer's belief that human and robot intend the same primitive, averaged over "
@@ -135,7 +222,9 @@ std::string ReportMd(const Study& s, const StudyAnalysis& a, const Summaries& su
          "names the human's primitive, averaged over events; robot_follows: the same for the robot's intention; "
          "switch_latency_s: from an event's start to the robot's first step on the human's primitive (events where it "
          "switched); nelbo_mean: the deliberator's free energy (negative ELBO) of its window, lower when its model "
-         "explains what it perceived.\n";
+         "explains what it perceived; reported_accuracy: the observer against the participant's self-reports (below).\n";
+  ReportedConfusionSection(s, a, summary, out);
+  IncompleteSection(a, out);
   if (!a.missing.empty()) {
     out << "\n## Missing trials\n\n";
     for (const std::string& m : a.missing) out << "- " << m << "\n";
@@ -175,9 +264,16 @@ std::string ReportMd(const Study& s, const StudyAnalysis& a, const Summaries& su
 
 }  // namespace
 
+std::vector<std::string> TrialMeasures() {
+  std::vector<std::string> names;
+  for (const auto& [name, value] : analyze::RunMetrics(analyze::Report{})) names.push_back(name);
+  names.push_back("reported_accuracy");
+  return names;
+}
+
 const std::vector<std::string>& SummaryMeasures() {
-  static const std::vector<std::string> m = {"mean_congruence", "observer_accuracy", "robot_follows", "switch_latency_s",
-                                             "nelbo_mean"};
+  static const std::vector<std::string> m = {"mean_congruence", "observer_accuracy", "reported_accuracy", "robot_follows",
+                                             "switch_latency_s", "nelbo_mean"};
   return m;
 }
 
@@ -250,8 +346,9 @@ Chosen ChooseAttempt(const Session& session, const Trial& t) {
 
 }  // namespace
 
-StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehearsal) {
+StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehearsal, bool include_incomplete) {
   StudyAnalysis a;
+  a.include_incomplete = include_incomplete;
   namespace fs = std::filesystem;
   for (const std::string& p : study.participants) {
     const Session session = ReadSession(study, p);
@@ -290,13 +387,20 @@ StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehe
         a.missing.push_back(name + ": " + report.status().message());
         continue;
       }
+      report->planned_s = study.duration_s;  // a trial's recording shorter than planned is incomplete
       TrialResult r{p, t, c.attempt, !report->plan.events.empty(), c.repeated, analyze::RunMetrics(*report), report->events};
       r.trial.file = c.file;
-      if (r.planned)
-        for (const analyze::EventSummary& e : r.events)
-          if (e.event.primitive >= 0 && e.event.reported != analyze::kNotReported) ++a.reports_vs_plan[{e.event.primitive, e.event.reported}];
+      r.incomplete = analyze::IncompleteReason(*report);
+      r.reported_confusion = report->reported_confusion;
+      r.metrics.emplace_back("reported_accuracy", Accuracy(r.reported_confusion));
+      if (a.Counted(r)) {
+        if (r.planned)
+          for (const analyze::EventSummary& e : r.events)
+            if (e.event.primitive >= 0 && e.event.reported != analyze::kNotReported)
+              ++a.reports_vs_plan[{e.event.primitive, e.event.reported}];
+        AddConfusion(r.reported_confusion, &a.reported_confusion);
+      }
       a.trials.push_back(std::move(r));
-      AddConfusion(report->reported_confusion, &a.reported_confusion);
     }
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(fs::path(study.data) / p, ec))

@@ -10,21 +10,31 @@
 //     file that cannot be analysed; a recording whose "dyad.run" metadata does not say it is this
 //     trial of this participant of this study (another study's file, a rehearsal's among the
 //     participants' or the reverse, or a file without that metadata).
+//   - A trial whose recording is analysed but incomplete (analyze::IncompleteReason: the file is
+//     cut short or damaged, or spans less than 95% of the study's `duration`) is kept in
+//     trials.csv and events.csv, marked (complete false, its reason), and left out of everything
+//     summed over trials (summary.csv, the confusion, reports_vs_plan.csv, the plots) unless
+//     include_incomplete; report.md lists it with its reason.
 //   - Every other .mcap file in a participant's folder is listed as not part of the plan.
 //   - A participant who withdrew consent, or whom the researcher excluded, is left out whole
 //     (no trial, no missing trial) and listed with the reason. The experimenter's session notes
 //     go into the report, except a withdrawn participant's.
 //   - WriteStudyAnalysis writes into `dir` (created): trials.csv (one row per trial: participant,
-//     condition, label, trial, repetition, attempt, file, then RunMetrics' measures), events.csv (one row
-//     per event of every trial: participant, condition, trial, the event's steps, primitive,
-//     self-report, congruence, the observer's accuracy on the human, whether the robot follows,
-//     its switch latency), summary.csv (per condition and measure: each participant's mean over
-//     their trials, then the mean over participants with a 95% percentile-bootstrap interval that
-//     resamples participants, seeded from the study, condition and measure names),
+//     condition, label, trial, repetition, attempt, file, complete, reason, then TrialMeasures()),
+//     events.csv (one row per event of every trial: participant, condition, trial, the event's
+//     steps, primitive, self-report, congruence, the observer's accuracy on the human, whether
+//     the robot follows, its switch latency, whether its trial is complete), summary.csv (per
+//     condition and measure: each participant's mean over their trials (summed in the plan's
+//     order), then the mean over participants (summed in ID order) with a 95% percentile-bootstrap
+//     interval that resamples participants, seeded from the study, condition and measure names),
 //     reported_confusion.csv (the observer against the self-reports, summed over trials; only
 //     when there are some), reports_vs_plan.csv (synthetic participants: the primitive each traced
-//     against the one it reported, per event; only when there are some) and report.md (the summary, the missing trials). Conditions are named
-//     (the analysis is the unblinded step) with their labels beside them.
+//     against the one it reported, per event; only when there are some) and report.md (the
+//     summary; per condition the observer's confusion against the self-reports and its accuracy
+//     with its interval; the incomplete and the missing trials). Conditions are named (the
+//     analysis is the unblinded step) with their labels beside them, listed in
+//     Study::ListingOrder (by label when blind). Numbers in the CSV files are exact
+//     (tools::CsvNumber): a summary recomputed from trials.csv as above is the same double.
 #pragma once
 
 #include <cstdint>
@@ -49,6 +59,9 @@ struct TrialResult {
   std::string repeated;  // the earlier attempts' fate and reasons, for the report
   std::vector<std::pair<std::string, double>> metrics;  // analyze::RunMetrics
   std::vector<analyze::EventSummary> events;
+  // Why its recording is incomplete (analyze::IncompleteReason against the study's duration); "": whole.
+  std::string incomplete;
+  std::vector<std::vector<int64_t>> reported_confusion;  // its own: [reported][the observer's class]
 };
 
 struct StudyAnalysis {
@@ -60,13 +73,17 @@ struct StudyAnalysis {
   // The files name the conditions (the unblinded step); false: "condition A" only (a blind
   // study's rehearsal, seen by the experimenter before the study).
   bool unblinded = true;
-  std::vector<std::vector<int64_t>> reported_confusion;  // empty: no self-report with labels
-  // Planned trials only: (traced primitive, reported choice) -> events; how wrong the reports are.
+  bool include_incomplete = false;  // --include-incomplete: incomplete trials are summed too
+  // Whether a trial counts in what is summed over trials.
+  bool Counted(const TrialResult& r) const { return r.incomplete.empty() || include_incomplete; }
+  std::vector<std::vector<int64_t>> reported_confusion;  // of the counted trials; empty: no self-report with labels
+  // Planned and counted trials only: (traced primitive, reported choice) -> events; how wrong the reports are.
   std::map<std::pair<int, int>, int64_t> reports_vs_plan;
 };
 
 // `rehearsal`: the recordings `dyad study rehearse` made (their metadata says so), in study.data.
-StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehearsal = false);
+// `include_incomplete`: incomplete trials count in the sums (StudyAnalysis::Counted).
+StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehearsal = false, bool include_incomplete = false);
 
 // Empty when `file`'s "dyad.run" metadata names this study, participant, trial, condition (its
 // label when blind) and rehearsal flag; else why not.
@@ -74,7 +91,11 @@ std::string NotThisTrial(const std::string& file, const Study& study, const std:
                          bool rehearsal);
 Status WriteStudyAnalysis(const Study& study, const StudyAnalysis& analysis, const std::string& dir);
 
-// The measures summarised per condition (names of RunMetrics).
+// A trial's measures, trials.csv's columns: RunMetrics', then reported_accuracy (the share of
+// the labelled steps of events with a self-report where the observer's most likely class is the
+// reported primitive; NaN: none).
+std::vector<std::string> TrialMeasures();
+// The measures summarised per condition (of TrialMeasures).
 const std::vector<std::string>& SummaryMeasures();
 
 }  // namespace dyad::study

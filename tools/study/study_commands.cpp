@@ -47,7 +47,8 @@ int Plan(const PlanOptions& o) {
   if (n % static_cast<size_t>(s.square_rows) != 0)
     std::cout << " (" << n << " participants are not a multiple of " << s.square_rows << ": the orders are not balanced)";
   std::cout << "\nconditions" << (s.blind && !o.unblind ? " (blind: --unblind shows what they are)" : "") << ":\n";
-  for (const auto& c : s.conditions) {
+  for (const size_t i : s.ListingOrder()) {  // by label when blind
+    const study::Condition& c = s.conditions[i];
     if (s.blind && !o.unblind) {
       std::cout << "  " << s.Shown(c) << "\n";
       continue;
@@ -321,7 +322,7 @@ int Withdraw(const ParticipantOptions& o) {
 struct AnalyzeOptions {
   std::string file, out;
   std::vector<std::string> plugins;
-  bool rehearsal = false, plots = true, unblind = false;
+  bool rehearsal = false, plots = true, unblind = false, include_incomplete = false;
 };
 
 // The analysis of `s` into `dir`, with its plots; false (said) when it could not be written.
@@ -331,8 +332,10 @@ bool WriteAnalysis(const study::Study& s, const study::StudyAnalysis& a, const s
     std::cerr << command << ": " << st.ToString() << "\n";
     return false;
   }
+  std::vector<std::string> args = {dir};
+  if (a.include_incomplete) args.push_back("--include-incomplete");
   if (plots && !a.trials.empty())
-    if (int rc = tools::RunDyadScript("plot_study.py", {dir}); rc != 0)
+    if (int rc = tools::RunDyadScript("plot_study.py", args); rc != 0)
       std::cerr << command << ": warning: the plots were not drawn (python3 with matplotlib; exit " << rc << ")\n";
   return true;
 }
@@ -384,7 +387,7 @@ int Rehearse(const AnalyzeOptions& o) {
       std::cout << p << " " << TrialLine(r, t, r.TrialsOf(p).size()) << ": " << Ended(*a) << std::endl;
     }
   std::cout << "rehearsal of " << s.name << ": " << ran << " trial" << (ran == 1 ? "" : "s") << " run, " << failed << " failed\n";
-  study::StudyAnalysis a = study::AnalyzeStudy(r, std::cerr, true);
+  study::StudyAnalysis a = study::AnalyzeStudy(r, std::cerr, true, o.include_incomplete);
   // Rehearsed before anyone comes, seen by the experimenter: a blind study's stays blind.
   a.unblinded = !s.blind || o.unblind;
   const std::string dir = o.out.empty() ? r.data + "/analysis" : o.out;
@@ -398,13 +401,22 @@ int Analyze(const AnalyzeOptions& o) {
   study::Study s;
   if (!Load(o.file, o.plugins, &s)) return kBadInput;
   if (o.rehearsal) s = AsRehearsal(s);
-  study::StudyAnalysis a = study::AnalyzeStudy(s, std::cerr, o.rehearsal);
+  study::StudyAnalysis a = study::AnalyzeStudy(s, std::cerr, o.rehearsal, o.include_incomplete);
   a.unblinded = !s.blind || !o.rehearsal || o.unblind;
   const std::string dir = o.out.empty() ? s.data + "/analysis" : o.out;
   if (!WriteAnalysis(s, a, dir, o.plots, "dyad study analyze")) return 1;
   std::cout << "study " << s.name << ": " << a.trials.size() << " trial" << (a.trials.size() == 1 ? "" : "s") << " analysed, "
-            << a.missing.size() << " missing\n";
+            << a.missing.size() << " missing";
+  int incomplete = 0;
+  for (const auto& t : a.trials) incomplete += t.incomplete.empty() ? 0 : 1;
+  if (incomplete > 0)
+    std::cout << "; " << incomplete << " incomplete, "
+              << (a.include_incomplete ? "counted (--include-incomplete)" : "left out of the summary (--include-incomplete counts them)");
+  std::cout << "\n";
   for (const auto& m : a.missing) std::cout << "  missing: " << m << "\n";
+  for (const auto& t : a.trials)
+    if (!t.incomplete.empty())
+      std::cout << "  incomplete: " << t.participant << " trial " << t.trial.number << " (" << t.trial.file << "): " << t.incomplete << "\n";
   std::cout << "analysis: " << dir << "/report.md (trials.csv, events.csv, summary.csv, plots/)\n";
   return kOk;
 }
@@ -428,6 +440,8 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   analyze->add_option("--plugins", a->plugins, "Extra plugin file or folder (repeatable)");
   analyze->add_flag("!--no-plots", a->plots, "Tables and report only");
   analyze->add_flag("--unblind", a->unblind, "With --rehearsal: name a blind study's conditions (the participants' analysis always does)");
+  analyze->add_flag("--include-incomplete", a->include_incomplete,
+                    "Count trials whose recording is cut short or shorter than planned in the summary and plots (they are left out)");
   analyze->add_flag("--rehearsal", a->rehearsal, "Analyse the rehearsal's recordings (DATA/rehearsal) instead of the participants'");
   analyze->callback([a, &exit_code] { exit_code = Analyze(*a); });
   auto r = std::make_shared<RunOptions>();
@@ -480,6 +494,8 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   rehearse->add_option("-o,--out", h->out, "Analysis folder (default: DATA/rehearsal/analysis)");
   rehearse->add_option("--plugins", h->plugins, "Extra plugin file or folder (repeatable)");
   rehearse->add_flag("!--no-plots", h->plots, "Tables and report only");
+  rehearse->add_flag("--include-incomplete", h->include_incomplete,
+                     "Count trials whose recording is cut short or shorter than planned in the summary and plots");
   rehearse->add_flag("--unblind", h->unblind, "Name a blind study's conditions in the rehearsal's analysis (not for the experimenter's eyes)");
   rehearse->callback([h, &exit_code] { exit_code = Rehearse(*h); });
 }

@@ -1,6 +1,7 @@
 #include "study_file.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <map>
 #include <regex>
@@ -55,24 +56,33 @@ void ReadParticipants(StrictYaml& y, const YAML::Node& root, Study* s) {
   if (!list) return y.Error(root, "participants", "required key missing");
   if (!list.IsSequence() || list.size() == 0) return y.Error(list, "participants", "must be a non-empty list of IDs");
   static const std::regex pseudonym("[A-Za-z]{1,4}[0-9]{1,4}");
-  std::map<std::string, YAML::Node> seen;
+  // By the ID in lower case: AB12 and ab12 would share a folder on a case-insensitive file system.
+  std::map<std::string, std::pair<std::string, YAML::Node>> seen;
   for (size_t i = 0; i < list.size(); ++i) {
     const std::string key = "participants[" + std::to_string(i) + "]";
     std::string id;
     if (!y.Get(list[i], key, &id, "an ID")) continue;
+    std::string folded = id;
+    std::transform(folded.begin(), folded.end(), folded.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     if (!std::regex_match(id, pseudonym)) {
       y.Error(list[i], key, "'" + id + "' is not a pseudonymous ID: 1-4 letters then 1-4 digits, such as P01 (never a name)");
-    } else if (auto it = seen.find(id); it != seen.end()) {
-      y.Error(list[i], key, "participant " + id + " is listed twice (first at line " + std::to_string(it->second.Mark().line + 1) + ")");
+    } else if (auto it = seen.find(folded); it != seen.end()) {
+      const std::string line = std::to_string(it->second.second.Mark().line + 1);
+      y.Error(list[i], key, it->second.first == id ? "participant " + id + " is listed twice (first at line " + line + ")"
+                                                   : "participant " + id + " is " + it->second.first + " (line " + line +
+                                                         ") in another case: IDs must differ in more than case (their folders "
+                                                         "would be one on a case-insensitive file system)");
     } else {
-      seen.emplace(id, list[i]);
+      seen.emplace(folded, std::make_pair(id, list[i]));
       s->participants.push_back(id);
     }
   }
 }
 
-// The conditions; each override is checked against the graph at its line, then each condition whole.
-void ReadConditions(StrictYaml& y, const YAML::Node& root, const std::vector<std::string>& plugins, Study* s) {
+// The conditions; each override is checked against the graph at its line, then each condition
+// whole. Adds to `bad_conditions` those a problem was said of (the rehearsal's check skips them).
+void ReadConditions(StrictYaml& y, const YAML::Node& root, const std::vector<std::string>& plugins, Study* s,
+                    std::set<std::string>* bad_conditions) {
   const YAML::Node conditions = root["conditions"];
   if (!conditions) return y.Error(root, "conditions", "required key missing");
   if (!y.Map(conditions, "conditions", {})) return;
@@ -94,15 +104,18 @@ void ReadConditions(StrictYaml& y, const YAML::Node& root, const std::vector<std
       c.sets.push_back(set);
     }
     if (!bad && !s->graph.empty() && c.sets.size() > 1)
-      if (std::string why = tools::GraphProblems(s->graph, c.sets, plugins); !why.empty())
+      if (std::string why = tools::GraphProblems(s->graph, c.sets, plugins); !why.empty()) {
         y.Error(kv.second, where, "its overrides together do not validate:\n" + why);
+        bad = true;
+      }
+    if (bad) bad_conditions->insert(name);
     s->conditions.push_back(std::move(c));
   }
 }
 
 // `recorder` and `rehearsal`, after the conditions: the rehearsal graph is checked against each.
 void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& path, const std::vector<std::string>& plugins,
-                   Study* s) {
+                   const std::set<std::string>& bad_conditions, Study* s) {
   y.Get(root, "recorder", "recorder", &s->recorder, "a component name");
   if (!s->graph.empty())
     if (std::string why = tools::GraphProblems(s->graph, {"clock=stepped", s->recorder + ".metadata=[study=" + s->name + "]"}, plugins);
@@ -158,6 +171,8 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
     for (const auto& kv : set) s->rehearsal_sets.push_back(kv.first.Scalar() + "=" + tools::SetText(kv.second));
   if (s->rehearsal_graph.empty()) return;
   for (const Condition& c : s->conditions) {
+    // Its problem was said at its line: said again here it would be said twice (the study's own graph).
+    if (bad_conditions.count(c.name)) continue;
     std::vector<std::string> sets = {"clock=stepped"};
     sets.insert(sets.end(), c.sets.begin(), c.sets.end());
     sets.insert(sets.end(), s->rehearsal_sets.begin(), s->rehearsal_sets.end());
@@ -179,6 +194,14 @@ void GiveLabels(Study* s) {
 }
 
 }  // namespace
+
+std::vector<size_t> Study::ListingOrder() const {
+  std::vector<size_t> order(conditions.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  if (blind)
+    std::stable_sort(order.begin(), order.end(), [this](size_t a, size_t b) { return conditions[a].label < conditions[b].label; });
+  return order;
+}
 
 std::vector<Trial> Study::TrialsOf(const std::string& participant) const {
   const auto it = std::find(participants.begin(), participants.end(), participant);
@@ -212,8 +235,9 @@ Study LoadStudy(const std::string& path, const std::vector<std::string>& plugins
     return s;
   ReadScalars(y, root, path, &s);
   ReadParticipants(y, root, &s);
-  ReadConditions(y, root, plugins, &s);  // checked against the graph when it was found
-  ReadRehearsal(y, root, path, plugins, &s);
+  std::set<std::string> bad_conditions;
+  ReadConditions(y, root, plugins, &s, &bad_conditions);  // checked against the graph when it was found
+  ReadRehearsal(y, root, path, plugins, bad_conditions, &s);
   GiveLabels(&s);
   s.square_rows = static_cast<int>(BalancedLatinSquare(std::max(1, static_cast<int>(s.conditions.size()))).size());
   return s;

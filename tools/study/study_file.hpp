@@ -20,11 +20,13 @@
 //
 // Contract of LoadStudy:
 //   - Every problem of the file at once, each "file:line:col: key: message": unknown keys, wrong
-//     types, a participant ID that is not pseudonymous or is used twice (naming the first), no
+//     types, a participant ID that is not pseudonymous or is used twice, also in another case
+//     (AB12, ab12: one folder on a case-insensitive file system; naming the first), no
 //     conditions, a condition that overrides nothing, an override the graph refuses (checked as
 //     `dyad validate --set` would, at the line of that value, and each condition as a whole).
 //   - The rehearsal graph, with its overrides, is checked against every condition like the
-//     study's graph (a condition must mean the same keys in both).
+//     study's graph (a condition must mean the same keys in both); a condition already refused
+//     above is not checked again (each problem is said once).
 //   - The plan is a function of the file alone, fixed before the first participant comes:
 //     participant i (file order) does the conditions in row i of a balanced Latin square
 //     (latin_square.hpp), each as `trials` consecutive trials; blind labels A, B, ... are given
@@ -68,6 +70,10 @@ struct Study {
 
   // The trials of `participant` (one of `participants`) in their order.
   std::vector<Trial> TrialsOf(const std::string& participant) const;
+  // The conditions' indices in the order every listing shows them (plan, report, summary.csv,
+  // plots): by label when blind (the file's order would tell which label is which condition to
+  // whoever knows the file), else the file's order.
+  std::vector<size_t> ListingOrder() const;
   // What the experimenter is shown of a condition: its label when blind, else its name.
   std::string Shown(const Condition& c) const { return blind ? "condition " + c.label : c.name; }
 };

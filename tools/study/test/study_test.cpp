@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -19,6 +21,7 @@
 #include "bootstrap.hpp"
 #include "dyad/testing/cli.hpp"
 #include "dyad/testing/csv.hpp"
+#include "dyad/mcap/reader.hpp"
 #include "dyad/testing/mcap_channel.hpp"
 #include "latin_square.hpp"
 #include "study_commands.hpp"
@@ -258,10 +261,14 @@ std::map<std::string, std::string> RunOf(const Study& s, const std::string& stud
 // A recording of one trial as `dyad analyze` reads it: a synthetic human's event at steps 10..19
 // (primitive 2), 30 steps; the observer names the human's primitive throughout, the robot's from
 // step 10 + `switch_after`; congruence `c` at every step; the human's self-report `said`.
-// `run`: its "dyad.run" metadata, as `dyad study run` has the recorder write it.
-void WriteTrial(const fs::path& file, double c, int switch_after, int said, const std::map<std::string, std::string>& run) {
+// `run`: its "dyad.run" metadata, as `dyad study run` has the recorder write it. `steps`: how
+// long it is; `chunk`: the writer's chunk size (small: a cut loses only the last chunks).
+void WriteTrial(const fs::path& file, double c, int switch_after, int said, const std::map<std::string, std::string>& run,
+                int steps = 30, uint64_t chunk = 256 * 1024) {
   fs::create_directories(file.parent_path());
-  auto w = mcap::Writer::Open(file.string());
+  mcap::WriterOptions options;
+  options.chunk_size = chunk;
+  auto w = mcap::Writer::Open(file.string(), options);
   ASSERT_TRUE(w.ok());
   if (!run.empty()) {
     ASSERT_TRUE(w->AddMetadata("dyad.run", run).ok());
@@ -272,7 +279,7 @@ void WriteTrial(const fs::path& file, double c, int switch_after, int said, cons
   testing::McapChannel<msg::HumanInput> human(*w, "human/input");
   testing::McapChannel<msg::IntentionLabel> labels(*w, "observer/labels");
   testing::McapChannel<msg::SelfReport> reports(*w, "human/self_report");
-  for (int t = 0; t < 30; ++t) {
+  for (int t = 0; t < steps; ++t) {
     msg::HumanInput h;
     h.engaged(t >= 10 && t < 20);
     human.Write(h, t);
@@ -330,7 +337,7 @@ TEST_F(StudyFile, AnalyzeMakesOneTableAcrossEveryoneAndSaysWhatIsMissing) {
   const fs::path out = fs::path(s.data) / "analysis";
   std::map<std::string, std::map<std::string, std::string>> summary;  // "low/measure" -> row
   for (const auto& row : dyad::testing::ReadCsv(out / "summary.csv")) summary[row.at("condition") + "/" + row.at("measure")] = row;
-  ASSERT_EQ(summary.size(), 10u);
+  ASSERT_EQ(summary.size(), 12u);
   auto num = [&](const std::string& key, const std::string& col) { return std::stod(summary.at(key).at(col)); };
   EXPECT_EQ(summary.at("low/mean_congruence").at("participants"), "1");
   EXPECT_EQ(summary.at("low/mean_congruence").at("trials"), "2");
@@ -372,6 +379,18 @@ TEST_F(StudyFile, AnalyzeMakesOneTableAcrossEveryoneAndSaysWhatIsMissing) {
   EXPECT_NE(report.find("| high (" + s.conditions[1].label + ") | mean_congruence | 2 | 4 | 0.75 | 0.6 to 0.9 |"), std::string::npos) << report;
   EXPECT_NE(report.find("## Missing trials"), std::string::npos) << report;
   EXPECT_NE(report.find("1 of 6 self-reports name another primitive than the one traced (16.6667%"), std::string::npos) << report;
+  // Per condition, the observer against the self-reports: in low P01 said 4 once (the observer:
+  // 2 throughout), so their trials' accuracies are 0 and 1; in high everyone said 2.
+  const auto per_condition = report.find("## The observer against the self-reports, per condition");
+  ASSERT_NE(per_condition, std::string::npos) << report;
+  const auto low = report.find("### low (" + s.conditions[0].label + ")\n\nAccuracy 0.5 (95% interval 0.5 to 0.5; 1 participant, 2 trials).",
+                               per_condition);
+  EXPECT_NE(low, std::string::npos) << report;
+  EXPECT_NE(report.find("| **4** | 0.00 (0) | 0.00 (0) | 1.00 (10) | 0.00 (0) |", low), std::string::npos) << report;
+  EXPECT_NE(report.find("### high (" + s.conditions[1].label + ")\n\nAccuracy 1 (95% interval 1 to 1; 2 participants, 4 trials).",
+                        per_condition),
+            std::string::npos) << report;
+  EXPECT_EQ(summary.at("low/reported_accuracy").at("mean"), "0.5");
 }
 
 // What the analysis takes from a folder: the last complete attempt of a trial (the session log
@@ -433,6 +452,170 @@ TEST_F(StudyFile, AnalyzeTakesTheLastCompleteAttemptAndRefusesOtherRecordings) {
             std::string::npos) << report;
   EXPECT_NE(report.find("## Files not in the plan (not analysed)"), std::string::npos) << report;
   EXPECT_EQ(dyad::testing::ReadCsv(dir_ / "out" / "trials.csv").at(0).at("attempt"), "2");
+}
+
+// Each summary.csv row recomputed from trials.csv as the contract says (per participant the mean
+// of their counted trials in the file's order, then the mean of those in ID order): the same
+// double, bit for bit (the numbers are printed exactly).
+void ExpectSummaryRecomputedExactly(const fs::path& dir, bool include_incomplete) {
+  const auto trials = dyad::testing::ReadCsv(dir / "trials.csv");
+  const auto summary = dyad::testing::ReadCsv(dir / "summary.csv");
+  ASSERT_FALSE(summary.empty());
+  for (const auto& row : summary) {
+    std::map<std::string, std::pair<double, int>> by;  // participant -> sum, count
+    int n = 0;
+    for (const auto& t : trials) {
+      if (t.at("condition") != row.at("condition") || (t.at("complete") != "true" && !include_incomplete)) continue;
+      const std::string& cell = t.at(row.at("measure"));
+      if (cell.empty()) continue;
+      by[t.at("participant")].first += std::strtod(cell.c_str(), nullptr);
+      ++by[t.at("participant")].second;
+      ++n;
+    }
+    const std::string what = row.at("condition") + " " + row.at("measure");
+    EXPECT_EQ(row.at("participants"), std::to_string(by.size())) << what;
+    EXPECT_EQ(row.at("trials"), std::to_string(n)) << what;
+    if (by.empty()) {
+      EXPECT_EQ(row.at("mean"), "") << what;
+      continue;
+    }
+    double sum = 0;
+    for (const auto& [p, s] : by) sum += s.first / s.second;
+    const double mean = sum / static_cast<double>(by.size());
+    const double said = std::strtod(row.at("mean").c_str(), nullptr);
+    EXPECT_EQ(std::memcmp(&mean, &said, sizeof mean), 0) << what << ": recomputed " << mean << ", summary.csv " << row.at("mean");
+  }
+}
+
+// Three participants; P01's trial of low cut in its middle (a crash, a full disk), P03's
+// shorter than the study's duration. Both are marked in trials.csv, left out of the summary and
+// the confusion, and listed in the report with their reasons; --include-incomplete counts them.
+// Every summary is the exact mean of trials.csv's rows.
+TEST_F(StudyFile, AnIncompleteTrialIsMarkedLeftOutOfTheSummaryAndReported) {
+  const std::string f = Write("study: gain\ngraph: g.yaml\nparticipants: [P01, P02, P03]\n"
+                              "conditions:\n  low: {src.start: 1}\n  high: {src.start: 3}\nduration: 3\n");
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy(f, {}, &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  const std::map<std::string, double> congruence = {{"P01/low", 0.1234567891}, {"P02/low", 0.7654321987}, {"P03/low", 1.0 / 3},
+                                                    {"P01/high", 0.55555555555}, {"P02/high", 0.61803398875}, {"P03/high", 0.2718281828}};
+  std::map<std::string, Trial> low;
+  for (const std::string p : {"P01", "P02", "P03"})
+    for (const Trial& t : s.TrialsOf(p)) {
+      const std::string c = s.conditions[static_cast<size_t>(t.condition)].name;
+      if (c == "low") low[p] = t;
+      WriteTrial(t.file, congruence.at(p + "/" + c), 3, 2, RunOf(s, "gain", p, t), p == "P03" && c == "low" ? 20 : 30, 1024);
+    }
+  {  // cut inside its middle chunk, as a crash or a full disk leaves a file
+    auto whole = mcap::Reader::Open(low.at("P01").file);
+    ASSERT_TRUE(whole.ok()) << whole.status().ToString();
+    ASSERT_GE(whole->chunks().size(), 4u);
+    const mcap::ChunkInfo& middle = whole->chunks()[whole->chunks().size() / 2];
+    fs::resize_file(low.at("P01").file, middle.offset + middle.length / 2);
+  }
+
+  auto r = dyad::testing::RunCommand(dyad::cli::AddStudyCommands, {"study", "analyze", f, "--no-plots"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("6 trials analysed, 0 missing; 2 incomplete, left out of the summary"), std::string::npos) << r.out;
+  const std::string cut =
+      "P01 trial " + std::to_string(low.at("P01").number) + " (" + low.at("P01").file + "): cut short: file ends at byte";
+  const std::string short_one = "P03 trial " + std::to_string(low.at("P03").number) + " (" + low.at("P03").file +
+                                "): shorter than planned: 20 steps of 100 ms (2 s) of the 3 s planned";
+  EXPECT_NE(r.out.find("  incomplete: " + cut), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  incomplete: " + short_one), std::string::npos) << r.out;
+  const fs::path out = fs::path(s.data) / "analysis";
+  std::map<std::string, std::map<std::string, std::string>> trials;  // "P01/low" -> row
+  for (const auto& row : dyad::testing::ReadCsv(out / "trials.csv")) trials[row.at("participant") + "/" + row.at("condition")] = row;
+  EXPECT_EQ(trials.at("P01/low").at("complete"), "false");
+  EXPECT_EQ(trials.at("P01/low").at("reason").rfind("cut short: file ends at byte", 0), 0u) << trials.at("P01/low").at("reason");
+  EXPECT_EQ(trials.at("P03/low").at("complete"), "false");
+  EXPECT_EQ(trials.at("P02/low").at("complete"), "true");
+  EXPECT_EQ(trials.at("P02/low").at("reason"), "");
+  std::map<std::string, std::map<std::string, std::string>> summary;
+  for (const auto& row : dyad::testing::ReadCsv(out / "summary.csv")) summary[row.at("condition") + "/" + row.at("measure")] = row;
+  EXPECT_EQ(summary.at("low/mean_congruence").at("participants"), "1");
+  EXPECT_EQ(summary.at("high/mean_congruence").at("participants"), "3");
+  ExpectSummaryRecomputedExactly(out, false);
+  // The confusion against the self-reports: four whole trials of 10 labelled steps said 2.
+  std::map<std::string, std::string> confusion;
+  for (const auto& row : dyad::testing::ReadCsv(out / "reported_confusion.csv"))
+    confusion[row.at("reported") + "," + row.at("predicted")] = row.at("count");
+  EXPECT_EQ(confusion.at("2,2"), "40");
+  std::ifstream md(out / "report.md");
+  const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("6 trials analysed (2 incomplete, left out of the summary; below)"), std::string::npos) << report;
+  const auto section = report.find("## Incomplete trials\n\nLeft out of the summary");
+  ASSERT_NE(section, std::string::npos) << report;
+  EXPECT_NE(report.find("- " + cut, section), std::string::npos) << report;
+  EXPECT_NE(report.find("- " + short_one, section), std::string::npos) << report;
+
+  const std::string all = (dir_ / "all").string();
+  r = dyad::testing::RunCommand(dyad::cli::AddStudyCommands, {"study", "analyze", f, "--no-plots", "--include-incomplete", "-o", all});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("2 incomplete, counted (--include-incomplete)"), std::string::npos) << r.out;
+  for (const auto& row : dyad::testing::ReadCsv(fs::path(all) / "summary.csv")) {
+    if (row.at("measure") == "mean_congruence") {
+      EXPECT_EQ(row.at("participants"), "3") << row.at("condition");
+    }
+  }
+  ExpectSummaryRecomputedExactly(all, true);
+}
+
+// AB12 and ab12 would share a folder on a case-insensitive file system: refused at the line. A
+// bad override is said once, not again by the rehearsal's check (its own overrides on the study's
+// graph).
+TEST_F(StudyFile, IdsDifferingOnlyInCaseAreRefusedAndABadOverrideIsSaidOnce) {
+  const std::string f = Write("study: gain\ngraph: g.yaml\nparticipants: [AB12, ab12]\nconditions:\n  low: {src.nope: 1}\n"
+                              "rehearsal: {set: {sink.rate_hz: 5}}\n");  // on the study's own graph
+  std::vector<Diagnostic> problems;
+  LoadStudy(f, {}, &problems);
+  std::string all;
+  int nope = 0;
+  for (const auto& p : problems) {
+    all += p.ToString() + "\n";
+    nope += p.ToString().find("src.nope") != std::string::npos;
+  }
+  EXPECT_NE(all.find("s.yaml:3:22: participants[1]: participant ab12 is AB12 (line 3) in another case"), std::string::npos) << all;
+  EXPECT_EQ(nope, 1) << all;
+}
+
+// Labels are drawn from the study's name; a blind listing in the file's order would tell whoever
+// knows the file which label is which condition. Plan, summary and report list them by label.
+TEST_F(StudyFile, BlindListingsAreSortedByLabelNotInTheFilesOrder) {
+  std::string f;
+  Study s;
+  for (int k = 0; k < 50; ++k) {  // a name whose labels are not in the file's order
+    f = Write("study: s" + std::to_string(k) + "\ngraph: g.yaml\nparticipants: [P01]\nconditions:\n  low: {src.start: 1}\n"
+              "  mid: {src.start: 2}\n  high: {src.start: 3}\nblind: true\n");
+    std::vector<Diagnostic> problems;
+    s = LoadStudy(f, {}, &problems);
+    ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+    if (s.conditions[0].label != "A" || s.conditions[1].label != "B") break;
+  }
+  ASSERT_FALSE(s.conditions[0].label == "A" && s.conditions[1].label == "B");
+  auto in_order = [](const std::string& text, const std::vector<std::string>& parts) {
+    size_t at = 0;
+    for (const std::string& p : parts) {
+      at = text.find(p, at);
+      if (at == std::string::npos) return false;
+    }
+    return true;
+  };
+  auto plan = dyad::testing::RunCommand(dyad::cli::AddStudyCommands, {"study", "plan", f});
+  ASSERT_EQ(plan.code, 0) << plan.err;
+  EXPECT_TRUE(in_order(plan.out, {"  condition A\n", "  condition B\n", "  condition C\n"})) << plan.out;
+  auto unblind = dyad::testing::RunCommand(dyad::cli::AddStudyCommands, {"study", "plan", f, "--unblind"});
+  EXPECT_TRUE(in_order(unblind.out, {"(condition A):", "(condition B):", "(condition C):"})) << unblind.out;
+  StudyAnalysis nothing;
+  nothing.unblinded = false;  // a blind rehearsal's
+  ASSERT_TRUE(WriteStudyAnalysis(s, nothing, (dir_ / "out").string()).ok());
+  std::vector<std::string> labels;
+  for (const auto& row : dyad::testing::ReadCsv(dir_ / "out" / "summary.csv"))
+    if (labels.empty() || labels.back() != row.at("label")) labels.push_back(row.at("label"));
+  EXPECT_EQ(labels, (std::vector<std::string>{"A", "B", "C"}));
+  std::ifstream md(dir_ / "out" / "report.md");
+  const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_TRUE(in_order(report, {"| condition A |", "| condition B |", "| condition C |"})) << report;
 }
 
 }  // namespace
