@@ -14,8 +14,10 @@
 /// Command (kind 1), after the header:
 ///  16  i64 stamp_ns driver's runtime clock when the command was sent
 ///  24  f64 x, 32 f64 y, 40 f64 z   target position, workspace units
-///  48  u32 flags    bit 0: hold: keep the current target, do not move to x, y, z (the
-///                   mixer holds, or waits for the arm's first state before its first command)
+///  48  u32 flags    bit 0: hold: stay, keep the current target, never move to x, y, z (the
+///                   mixer holds: stale inputs, a lost arm, or waiting for the arm's first
+///                   state; x, y, z are the position held, docs/components.md "The command
+///                   contract")
 ///  52  u32 reserved 0
 /// State (kind 2), after the header:
 ///  16  u32 ack      sequence of the newest command the controller has applied (0: none yet)
