@@ -11,7 +11,9 @@
 //    over the workspace square (its edges included) is the canvas, and right after the release of
 //    a third hold (1.2 s) a mouse press at the square's bottom centre, (0, -0.9 H), where the
 //    question used to be, steers at once (the page shows ENGAGED, the question goes) and is held
-//    600 ms; the shell test finds it engaged on human/input at that point.
+//    600 ms; the shell test finds it engaged on human/input at that point; in a tall window (a
+//    viewer's page, 600 x 900, the question shown) the band is below the square, no grid point
+//    covered either.
 // OUT.json gets the wall-clock times of the holds and the answer, for the shell test's checks.
 import { writeFile } from "node:fs/promises";
 import { chromium } from "playwright-core";
@@ -72,7 +74,7 @@ try {
     const r = document.getElementById("question").getBoundingClientRect();
     return { left: r.left, top: r.top, right: r.right, bottom: r.bottom };
   });
-  const covered = await page.evaluate((sq) => {
+  const coveredPoints = (p, sq) => p.evaluate((sq) => {
     const out = [];
     for (let i = 0; i <= 20; i++)
       for (let j = 0; j <= 20; j++) {
@@ -81,7 +83,8 @@ try {
         if (e !== canvas) out.push([Math.round(x), Math.round(y), e ? (e.id || e.tagName) : "nothing"]);
       }
     return out;
-  }, square);
+  }, sq);
+  const covered = await coveredPoints(page, square);
   if (covered.length) fail(`the question covers the workspace at ${covered.length} of 441 points, e.g. ${JSON.stringify(covered.slice(0, 3))}`);
   const press = { x: (square.left + square.right) / 2, y: square.bottom - 0.05 * (square.bottom - square.top) };  // (0, -0.9 H)
   await page.mouse.move(press.x, press.y);
@@ -95,6 +98,21 @@ try {
   if (out.press_page.engaged !== "ENGAGED") fail(`a press on the workspace right after a release did not steer (the page shows ${out.press_page.engaged})`);
   if (out.press_page.asking) fail("a press on the workspace right after a release left the question shown");
   await sleep(300);
+  const tall = await (await browser.newContext({ viewport: { width: 600, height: 900 } })).newPage();
+  await tall.goto(base + "/subject?token=viewer-token-0000001");
+  await tall.waitForFunction(() => document.getElementById("role").textContent === "watching (viewer)", null, { timeout: 10000 });
+  await tall.evaluate(() => showQuestion(true));  // a viewer is never asked: shown here for its place only
+  const tallSquare = await tall.evaluate(() => {
+    const r = canvas.getBoundingClientRect(), tl = toCanvas(-H, H), br = toCanvas(H, -H);
+    return { left: r.left + tl.px, top: r.top + tl.py, right: r.left + br.px, bottom: r.top + br.py, H };
+  });
+  out.tall = { square: tallSquare, question_box: await tall.evaluate(() => {
+    const r = document.getElementById("question").getBoundingClientRect();
+    return { left: r.left, top: r.top, right: r.right, bottom: r.bottom };
+  }) };
+  const tallCovered = await coveredPoints(tall, tallSquare);
+  if (tallCovered.length) fail(`in a 600 x 900 window the question covers the workspace at ${tallCovered.length} of 441 points`);
+  if (out.tall.question_box.top < tallSquare.bottom) fail(`in a 600 x 900 window the question is not below the square: ${JSON.stringify(out.tall)}`);
 } finally {
   await browser.close();
 }
