@@ -302,12 +302,9 @@ Status WriteSweepCsv(const SweepPlan& plan, const std::string& out) {
     csv << ',' << run.seed;
     for (const auto& m : metric_names) {
       csv << ',';
-      if (metrics[i].is_object() && metrics[i].contains(m) && metrics[i][m].is_number()) {
-        std::ostringstream v;
-        v.precision(9);
-        v << metrics[i][m].get<double>();
-        csv << v.str();
-      }
+      // Exact, as metrics.json has it: the plots' means are of the runs' doubles.
+      if (metrics[i].is_object() && metrics[i].contains(m) && metrics[i][m].is_number())
+        csv << tools::CsvNumber(metrics[i][m].get<double>());
     }
     csv << '\n';
   }
