@@ -20,7 +20,10 @@
  * the timeout) or t_s,cmd_x,cmd_y,cmd_z,x,y,z (pose; the target), t_s since start, x,y,z as
  * published. Exit 0 on SIGINT/SIGTERM (participant deleted), 2 on bad arguments, 1 on DDS errors.
  * Faults for the driver's tests: --nan-after-s S publishes NaN positions from S s on;
- * --offset-after-s S,DX adds DX metres to the reported x from S s on. */
+ * --offset-after-s S,DX adds DX metres to the reported x from S s on; --no-pose never publishes
+ * its pose (an arm that never answers: its writer exists, nothing is written; it still moves as
+ * commanded and --verbose/--log still record it); --frame ID sends poses in another frame.
+ * What it received: --verbose (every command, in order: the last line is the last command). */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <signal.h>
@@ -49,6 +52,7 @@ typedef struct {
   double nan_after_s;    /* < 0: never */
   double offset_after_s; /* < 0: never */
   double offset_dx;
+  bool no_pose;
   bool verbose;
 } arm_options;
 
@@ -81,7 +85,7 @@ static void usage(void) {
       "usage: dyad_ros2_fake_arm --mode twist|pose [--command-topic NAME] [--pose-topic NAME]\n"
       "  [--rate HZ] [--lag-s S] [--initial X,Y,Z] [--frame ID] [--command-qos default|sensor_data]\n"
       "  [--pose-qos default|sensor_data] [--command-timeout-s S] [--domain N] [--log FILE]\n"
-      "  [--nan-after-s S] [--offset-after-s S,DX] [--verbose]\n");
+      "  [--nan-after-s S] [--offset-after-s S,DX] [--no-pose] [--verbose]\n");
 }
 
 static void parse_offset(const char *option, const char *value, arm_options *o) {
@@ -113,6 +117,7 @@ static void set_defaults(arm_options *o) {
 static bool parse_option(int argc, char **argv, int *i, arm_options *o) {
   const char *opt = argv[*i];
   if (strcmp(opt, "--verbose") == 0) { o->verbose = true; return true; }
+  if (strcmp(opt, "--no-pose") == 0) { o->no_pose = true; return true; }
   if (strncmp(opt, "--", 2) != 0) return false;
   const char *known[] = {"--mode", "--command-topic", "--pose-topic", "--rate", "--lag-s",
                          "--initial", "--frame", "--command-qos", "--pose-qos",
@@ -247,7 +252,7 @@ static void publish(const arm_options *o, const arm_dds *d, const arm_state *s, 
   m.pose.orientation.y = s->orientation[1];
   m.pose.orientation.z = s->orientation[2];
   m.pose.orientation.w = s->orientation[3];
-  ros2_check(dds_write(d->writer, &m), "writing the pose");
+  if (!o->no_pose) ros2_check(dds_write(d->writer, &m), "writing the pose");
   if (d->log != NULL)
     fprintf(d->log, "%.6f,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", t_s, s->command[0], s->command[1],
             s->command[2], p[0], p[1], p[2]);

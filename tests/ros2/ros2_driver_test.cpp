@@ -2,7 +2,8 @@
 // vendor exactly as rmw_cyclonedds_cpp would be): configs/drivers/ros2_servo.yaml and
 // ros2_pose.yaml run in real `dyad run` processes with a recorder; the recording, read back with
 // dyad's IDL-driven decoder, shows the arm following the commands, stopping when the arm dies and
-// resuming when it returns; bad arms and bad wiring are reported by name.
+// resuming when it returns; bad arms and bad wiring are reported by name; holds far away do not
+// move the arm, a run ends on a zero twist, a silent arm and poses in another frame are named.
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <thread>
 #include <nlohmann/json.hpp>
 
@@ -64,9 +66,143 @@ class Ros2DriverTest : public ::testing::Test {
       out.push_back({m.t_ns, std::move(m.value)});
     return out;
   }
+  // The arm's commands as it printed them (--verbose), one "twist ..." or "pose ..." line each.
+  static std::vector<std::string> Received(const std::string& out, const std::string& kind) {
+    std::vector<std::string> lines;
+    std::istringstream in(out);
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind(kind + " ", 0) == 0) lines.push_back(line);
+    return lines;
+  }
+  // The recorder of the previous run wrote run.mcap: a fresh one for the next.
+  void ForgetRecording() { fs::remove(dir_ / "run.mcap"); }
   fs::path dir_;
   int domain_ = 0;
 };
+
+// The intention far away (x = 1000: beyond the box's wall) in hold commands for 2 s, then
+// motion commands at x = -20 (0.04 m along +y): the arm, as its own pose stream shows, does not
+// move before the first motion command, and follows that one. The driver used to take the first
+// hold as its goal and drive towards the wall.
+void ExpectNoMotionBeforeTheFirstMotionCommand(const std::vector<Sample>& commands, const std::vector<Sample>& poses) {
+  size_t first_motion = 0;
+  while (first_motion < commands.size() && commands[first_motion].value["hold"].get<bool>()) ++first_motion;
+  ASSERT_GE(first_motion, 15u) << "holds before the first motion command";
+  ASSERT_LT(first_motion, commands.size()) << "no motion command";
+  const int64_t moved_at = commands[first_motion].t_ns;
+  ASSERT_GT(poses.size(), 200u);
+  const json start = poses.front().value["pose"]["position"];
+  size_t before = 0;
+  for (const Sample& p : poses) {
+    if (p.t_ns >= moved_at) break;
+    ++before;
+    for (const char* axis : {"x", "y", "z"})
+      ASSERT_NEAR(p.value["pose"]["position"][axis].get<double>(), start[axis].get<double>(), 1e-9)
+          << axis << " of the arm's pose " << before << ", before the first motion command";
+  }
+  EXPECT_GT(before, 100u);
+  EXPECT_NEAR(poses.back().value["pose"]["position"]["y"].get<double>(), 0.04, 0.005) << "followed x = -20";
+}
+
+std::string HoldThenMove() {
+  return "  pattern: !reset\n"
+         "  holder:\n    type: test_hold_then_move\n    rate_hz: 10\n"
+         "    params: {hold_at: [1000, 0], hold_steps: 20, move_to: [-20, 0]}\n"
+         "    outputs: {command: robot/command}\n";
+}
+
+TEST_F(Ros2DriverTest, TwistModeHoldsFarAwayDoNotMoveTheArm) {
+  ChildProcess arm(Arm("twist"), dir_, "arm");
+  ASSERT_TRUE(arm.WaitForOutput("ready", 10)) << arm.err();
+  ChildProcess run({DYAD_EXE, "run", Graph("ros2_servo.yaml", HoldThenMove()), "--duration", "4", "--plugins",
+                    DYAD_ROS2_TEST_PLUGIN},
+                   dir_, "run");
+  ASSERT_EQ(run.Wait(30), 0) << run.err();
+  ExpectNoMotionBeforeTheFirstMotionCommand(Read("robot/command"), Read("arm/pose"));
+}
+
+TEST_F(Ros2DriverTest, PoseModeHoldsFarAwayDoNotMoveTheArm) {
+  ChildProcess arm(Arm("pose", {"--command-topic", "/target_pose"}), dir_, "arm");
+  ASSERT_TRUE(arm.WaitForOutput("ready", 10)) << arm.err();
+  ChildProcess run({DYAD_EXE, "run", Graph("ros2_pose.yaml", HoldThenMove()), "--duration", "4", "--plugins",
+                    DYAD_ROS2_TEST_PLUGIN},
+                   dir_, "run");
+  ASSERT_EQ(run.Wait(30), 0) << run.err();
+  ExpectNoMotionBeforeTheFirstMotionCommand(Read("robot/command"), Read("arm/pose"));
+}
+
+// The test pattern is still moving when the run ends: the last twist the arm receives is zero
+// (Deactivate), so Servo does not keep going until its own timeout.
+TEST_F(Ros2DriverTest, TwistModeEndsOnAZeroTwist) {
+  ChildProcess arm(Arm("twist", {"--verbose"}), dir_, "arm");
+  ASSERT_TRUE(arm.WaitForOutput("ready", 10)) << arm.err();
+  ChildProcess run({DYAD_EXE, "run", Graph("ros2_servo.yaml"), "--duration", "3"}, dir_, "run");
+  ASSERT_EQ(run.Wait(30), 0) << run.err();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  arm.Signal(SIGINT);
+  ASSERT_EQ(arm.Wait(10), 0) << arm.err();
+  const std::vector<std::string> twists = Received(arm.out(), "twist");
+  ASSERT_GT(twists.size(), 100u);
+  EXPECT_NE(twists[twists.size() - 2], "twist 0 0 0") << "the pattern was still moving";
+  EXPECT_EQ(twists.back(), "twist 0 0 0");
+}
+
+// An arm whose pose topic never delivers: an error naming the topic, stopped states, nothing
+// but zero twists; with require_arm the run fails. It used to run silently and exit 0.
+TEST_F(Ros2DriverTest, AnArmThatNeverAnswersIsAnErrorAndWithRequireArmFailsTheRun) {
+  ChildProcess arm(Arm("twist", {"--no-pose", "--verbose"}), dir_, "arm");
+  ASSERT_TRUE(arm.WaitForOutput("ready", 10)) << arm.err();
+  ChildProcess run({DYAD_EXE, "run", Graph("ros2_servo.yaml"), "--duration", "2"}, dir_, "run");
+  ASSERT_EQ(run.Wait(30), 0) << run.err();
+  EXPECT_NE(run.err().find("no pose from the arm on 'arm/pose' within pose_timeout_s (0.5 s) of activation"),
+            std::string::npos)
+      << run.err();
+  EXPECT_NE(run.err().find("the arm was never driven"), std::string::npos) << run.err();
+  const std::vector<Sample> states = Read("robot/state");
+  ASSERT_GT(states.size(), 5u) << run.err();
+  for (const Sample& s : states) EXPECT_TRUE(s.value["stopped"].get<bool>());
+  const std::vector<std::string> twists = Received(arm.out(), "twist");
+  ASSERT_GT(twists.size(), 50u);
+  for (const std::string& t : twists) ASSERT_EQ(t, "twist 0 0 0");
+
+  ForgetRecording();
+  ChildProcess strict({DYAD_EXE, "run", Graph("ros2_servo.yaml"), "--duration", "2", "--set",
+                       "driver.params.require_arm=true"},
+                      dir_, "strict");
+  EXPECT_EQ(strict.Wait(30), 1) << strict.err();
+  EXPECT_NE(strict.err().find("failed: no pose from the arm on 'arm/pose' within pose_timeout_s (0.5 s) of activation"),
+            std::string::npos)
+      << strict.err();
+  EXPECT_NE(strict.err().find("(require_arm)"), std::string::npos) << strict.err();
+}
+
+// Poses in 'world' while the driver works in base_link: refused, said once, stopped; with
+// pose_frame and pose_transform saying how, taken (here the identity: the arm follows).
+TEST_F(Ros2DriverTest, PosesInAnotherFrameAreRefusedUnlessPoseFrameSaysHow) {
+  ChildProcess arm(Arm("twist", {"--frame", "world"}), dir_, "arm");
+  ASSERT_TRUE(arm.WaitForOutput("ready", 10)) << arm.err();
+  ChildProcess run({DYAD_EXE, "run", Graph("ros2_servo.yaml"), "--duration", "2"}, dir_, "run");
+  ASSERT_EQ(run.Wait(30), 0) << run.err();
+  EXPECT_NE(run.err().find("the arm reported a pose in frame 'world', not 'base_link': refused"), std::string::npos)
+      << run.err();
+  std::vector<Sample> states = Read("robot/state");
+  ASSERT_GT(states.size(), 5u) << run.err();
+  for (const Sample& s : states) EXPECT_TRUE(s.value["stopped"].get<bool>());
+
+  ForgetRecording();
+  ChildProcess taken({DYAD_EXE, "run",
+                      Graph("ros2_servo.yaml",
+                            "  driver:\n    params: {pose_frame: world, pose_transform: [0, 0, 0, 0, 0, 0, 1]}\n"),
+                      "--duration", "2"},
+                     dir_, "taken");
+  ASSERT_EQ(taken.Wait(30), 0) << taken.err();
+  EXPECT_EQ(taken.err().find("': refused"), std::string::npos) << taken.err();
+  states = Read("robot/state");
+  ASSERT_GT(states.size(), 5u) << taken.err();
+  int following = 0;
+  for (const Sample& s : states) following += !s.value["stopped"].get<bool>();
+  EXPECT_GT(following, 10);
+}
 
 // The arm follows the test pattern through Servo-style twists; killed, the driver reports stopped
 // within its pose timeout (0.5 s); restarted, it follows again.
