@@ -185,6 +185,48 @@ TEST(GraphValidation, OverrideSetsParamAndIsValidated) {
   EXPECT_EQ(Check(kValid, {"garbage"}).size(), 1u);
 }
 
+// Issue #40: where yaml-cpp threw out of the loader (`dyad validate` died with "terminate called
+// after throwing an instance of 'YAML::InvalidNode'", exit 134): a malformed file given with a
+// --set, a node of another kind where a mapping belongs, a --set into a section the file does not
+// have. Each is a diagnostic at the file (or the --set) now; a --set is not checked against a
+// file that could not be read (its syntax error is the one problem).
+TEST(GraphValidation, MalformedInputIsADiagnosticAtItsFileNeverAnException) {
+  const std::string v = kValid;
+  struct Case {
+    const char* name;
+    std::string yaml;
+    std::vector<std::string> sets;
+    std::string where;  // the start of the diagnostic's text
+    std::string message_part;
+  };
+  const Case cases[] = {
+      {"syntax error with a set", "components: {a: [1, 2}\n", {"src.noise=2"}, "g.yaml:1:", "YAML syntax error"},
+      {"tab indentation with a set", Replace(v, "  sink:\n    type", "  sink:\n\ttype"), {"src.noise=2"}, "g.yaml:", "YAML syntax error"},
+      {"cut short in a flow mapping with a set", v.substr(0, v.find("{noise: 1}") + 9), {"src.noise=2"}, "g.yaml:", "YAML syntax error"},
+      {"empty file with a set", "", {"src.noise=2"}, "g.yaml:1:1", "must be a YAML mapping"},
+      {"network a scalar", v + "network: 5\n", {}, "g.yaml:13:10: network: must be a mapping", ""},
+      {"cut short in a block with a set", v.substr(0, v.find("rate_hz") + 3), {"src.noise=2"}, "g.yaml:6:5: components.src.rat",
+       "unknown key"},  // (a plain "rat" at the end is a key without a value to YAML)
+      {"a set into absent processes", v, {"processes.robot.host=lab"}, "--set processes.robot.host=lab: processes.robot",
+       "no such process"},
+      {"a set into absent components", "graph: x\n", {"src.noise=2"}, "--set src.noise=2: components.src", "no such component"},
+  };
+  for (const Case& c : cases) {
+    std::vector<Diagnostic> diags;
+    EXPECT_NO_THROW(diags = Check(c.yaml, c.sets)) << c.name;
+    std::string all;
+    bool found = false;
+    for (const auto& d : diags) {
+      all += d.ToString() + "\n";
+      found |= d.ToString().rfind(c.where, 0) == 0 && d.message.find(c.message_part) != std::string::npos;
+    }
+    EXPECT_TRUE(found) << c.name << ": expected " << c.where << "..." << c.message_part << "\ngot:\n" << all;
+    if (c.message_part == "YAML syntax error") {
+      EXPECT_EQ(diags.size(), 1u) << c.name << ":\n" << all;
+    }
+  }
+}
+
 TEST(GraphValidation, OverrideSetsTheGraphsOwnScalars) {
   std::vector<Diagnostic> diags;
   Graph g = ParseGraph(kValid, "g.yaml", {{"clock=wall"}, {"seed=7"}, {"domain_id=12"}, {"graph=renamed"}}, &diags);

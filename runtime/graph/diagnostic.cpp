@@ -4,6 +4,7 @@
 namespace dyad {
 
 SourceMark SourceMark::Of(const std::string& file, const YAML::Node& node) {
+  if (!node.IsDefined()) return SourceMark{file, 0, 0};  // an absent key: Mark() would throw InvalidNode
   const YAML::Mark m = node.Mark();
   if (m.is_null()) return SourceMark{file, 0, 0};
   return SourceMark{file, m.line + 1, m.column + 1};

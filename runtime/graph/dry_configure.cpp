@@ -222,6 +222,16 @@ bool PlaceMessage(const Graph& graph, const ComponentConfig& c, const ComponentS
   return true;
 }
 
+// A plugin's Configure that throws (a file it reads with yaml-cpp, a bad conversion) is a problem
+// of its component, said at its line, not an abort of `dyad validate`.
+Status ConfigureCatching(Component& component, DryContext& ctx) {
+  try {
+    return component.Configure(ctx);
+  } catch (const std::exception& e) {
+    return Status::InvalidArgument(std::string("configuring it threw: ") + e.what());
+  }
+}
+
 void Configure(const Graph& graph, const ResolvedGraph& resolved, const Catalog& catalog,
                std::vector<Diagnostic>* diagnostics, const std::set<std::string>& only_processes,
                std::map<std::string, TopicAccess>* access) {
@@ -237,7 +247,7 @@ void Configure(const Graph& graph, const ResolvedGraph& resolved, const Catalog&
     const auto topics = GraphTopics(graph, resolved, process);
     DryContext ctx(graph, rc, catalog, topics, access ? &(*access)[process] : nullptr);
     std::unique_ptr<Component> component = rc.entry->type.create();
-    const Status s = component->Configure(ctx);
+    const Status s = ConfigureCatching(*component, ctx);
     if (s.ok()) {
       component->Shutdown();
       continue;

@@ -16,6 +16,7 @@
 #include "graph/graph_document.hpp"
 #include "graph/graph_keys.hpp"
 #include "graph/host_port.hpp"
+#include "graph/network_scope.hpp"
 #include "graph/run_partition.hpp"
 
 namespace dyad {
@@ -133,7 +134,8 @@ void ResolveScope(StrictYaml& r, const YAML::Node& network, Graph* g) {
   else if (n.transport == NetTransport::kTcp) why_lan = "network.transport tcp";
   else if (n.discovery != Discovery::kMulticast) why_lan = "network.discovery";
   std::string s;
-  if (!network || !network["scope"] || !r.String(network["scope"], "network.scope", &s)) {
+  // (`network: 5` or `network: [a]`, reported with the section: no scope to read in it.)
+  if (!network || !network.IsMap() || !network["scope"] || !r.String(network["scope"], "network.scope", &s)) {
     n.scope = why_lan.empty() ? NetScope::kLocal : NetScope::kLan;
   } else if (s == "lan") {
     n.scope = NetScope::kLan;
@@ -361,6 +363,27 @@ void ReadGraphScalars(StrictYaml& r, const YAML::Node& root, Graph* g) {
   }
 }
 
+// `security.guests: {publish: [...], subscribe: [...]}`: topic names or patterns.
+void ReadSecurityGuests(StrictYaml& r, const YAML::Node& node, Graph* g) {
+  // Where a refusal sends the user: the publish list when there is one (the usual change).
+  g->security.guests_mark = node["publish"] ? r.Mark(node["publish"], "security.guests.publish") : r.Mark(node, "security.guests");
+  if (!r.Map(node, "security.guests", graph_keys::kSecurityGuests)) return;
+  g->security.guests = true;
+  for (const auto& [name, out] : {std::pair{"publish", &g->security.guest_publish}, {"subscribe", &g->security.guest_subscribe}}) {
+    const std::string key = std::string("security.guests.") + name;
+    const YAML::Node list = node[name];
+    if (!list) continue;
+    if (!list.IsSequence()) {
+      r.Error(list, key, "must be a list of topics (names or patterns such as robot/*)");
+      continue;
+    }
+    for (const auto& t : list) {
+      std::string topic;
+      if (r.String(t, key, &topic)) out->push_back(topic);
+    }
+  }
+}
+
 void ReadSecurity(StrictYaml& r, const YAML::Node& node, Graph* g) {
   if (!r.Map(node, "security", graph_keys::kSecurity)) return;
   if (!node["keystore"]) {
@@ -376,6 +399,7 @@ void ReadSecurity(StrictYaml& r, const YAML::Node& node, Graph* g) {
   }
   const std::filesystem::path base = g->FolderOf("security.keystore");
   g->security.keystore = std::filesystem::path(keystore).is_absolute() ? keystore : (base / keystore).lexically_normal().string();
+  if (const YAML::Node guests = node["guests"]) ReadSecurityGuests(r, guests, g);
 }
 
 // transport: tcp: each process listens on its tcp_port at its host's address; with processes on
@@ -498,6 +522,30 @@ void NoteOverrides(Graph* g) {
   }
 }
 
+// The document (the file, its `extends:` chain, the --sets), read into *g.
+void ReadGraph(const std::string& yaml_text, const std::string& path, const std::vector<Override>& overrides, Graph* g,
+               std::vector<Diagnostic>* diagnostics) {
+  GraphDocument doc = ReadGraphDocument(yaml_text, path, diagnostics);
+  if (!doc.root.IsMap()) return;  // unreadable: said why; a --set has nothing to be checked against
+  ApplySets(overrides, &doc, diagnostics);
+  g->origins = doc.origins;
+  const YAML::Node root = doc.root;
+  // Each problem at the file (or --set) that wrote its key.
+  StrictYaml r([g](const std::string& key, const YAML::Node& node) { return g->MarkOf(key, node); }, diagnostics);
+  r.Map(root, "", graph_keys::kTopLevel);
+  ReadGraphScalars(r, root, g);
+  if (const YAML::Node network = root["network"]) ReadNetwork(r, network, &g->network);
+  if (const YAML::Node procs = root["processes"]) ReadProcesses(r, procs, g);
+  if (const YAML::Node security = root["security"]) ReadSecurity(r, security, g);
+  ResolveScope(r, root["network"], g);
+  if (const YAML::Node topics = root["topics"]) ReadTopics(r, topics, g);
+  if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, g);
+  else r.Error(SourceMark{path, 1, 1}, "components", "missing: a graph needs at least one component");
+  CheckPlacement(r, *g);
+  NoteOverrides(g);
+  if (!doc.bases.empty() || !doc.sets.empty()) g->yaml_text = GraphAsRun(doc, path);
+}
+
 }  // namespace
 
 Graph ParseGraph(const std::string& yaml_text, const std::string& path, const std::vector<Override>& overrides,
@@ -510,26 +558,28 @@ Graph ParseGraph(const std::string& yaml_text, const std::string& path, const st
     g.folder = (path.empty() ? cwd : std::filesystem::absolute(path, ec).parent_path()).lexically_normal().string();
   }
   g.yaml_text = yaml_text;
-  GraphDocument doc = ReadGraphDocument(yaml_text, path, diagnostics);
-  if (!doc.root) return g;
-  ApplySets(overrides, &doc, diagnostics);
-  g.origins = doc.origins;
-  const YAML::Node root = doc.root;
-  // Each problem at the file (or --set) that wrote its key.
-  StrictYaml r([&g](const std::string& key, const YAML::Node& node) { return g.MarkOf(key, node); }, diagnostics);
-  r.Map(root, "", graph_keys::kTopLevel);
-  ReadGraphScalars(r, root, &g);
-  if (const YAML::Node network = root["network"]) ReadNetwork(r, network, &g.network);
-  if (const YAML::Node procs = root["processes"]) ReadProcesses(r, procs, &g);
-  if (const YAML::Node security = root["security"]) ReadSecurity(r, security, &g);
-  ResolveScope(r, root["network"], &g);
-  if (const YAML::Node topics = root["topics"]) ReadTopics(r, topics, &g);
-  if (const YAML::Node comps = root["components"]) ReadComponents(r, comps, &g);
-  else r.Error(SourceMark{path, 1, 1}, "components", "missing: a graph needs at least one component");
-  CheckPlacement(r, g);
-  NoteOverrides(&g);
-  if (!doc.bases.empty() || !doc.sets.empty()) g.yaml_text = GraphAsRun(doc, path);
+  // Every reader above turns what it finds into diagnostics; yaml-cpp throws where a node is used
+  // as what it is not (a key of a scalar, the type of an absent key). Should a path still do so,
+  // that is a diagnostic at the graph file too, never an exception out of the loader (the CLI
+  // would die with std::terminate, exit 134).
+  try {
+    ReadGraph(yaml_text, path, overrides, &g, diagnostics);
+  } catch (const YAML::Exception& e) {
+    diagnostics->push_back({SourceMark{path, e.mark.is_null() ? 0 : e.mark.line + 1, e.mark.is_null() ? 0 : e.mark.column + 1},
+                            "", "cannot read the graph: " + e.msg});
+  }
   return g;
+}
+
+std::string LocalScopeNote(const NetworkConfig& network, bool watcher) {
+  if (network.scope != NetScope::kLocal) return "";
+  if (watcher)
+    return "this watcher is local (network.scope: local, as a graph that names no other machine is, and a watcher "
+           "without --graph): it reaches this machine only and sees no graph of scope lan; to watch one, give its "
+           "--graph (a graph on another machine needs `network.scope: lan` or its hosts named)";
+  return "the graph is local (network.scope: local, the default of a graph that names no other machine): it reaches "
+         "this machine only, so a process on another machine is never seen; to run it on several machines, set "
+         "`network.scope: lan` (or --set network.scope=lan) or name the hosts (network.hosts, and each process's host:)";
 }
 
 Graph LoadGraph(const std::string& path, const std::vector<Override>& overrides, std::vector<Diagnostic>* diagnostics) {

@@ -173,13 +173,13 @@ std::vector<std::string> SetPath(const std::string& text, const YAML::Node& root
   if (head == "topics") return parts.size() == 3 ? parts : fail("topics", "expected topics.TOPIC.KEY=VALUE");
   if (head == "processes") {
     if (parts.size() != 3) return fail("processes", "expected processes.NAME.KEY=VALUE");
-    const YAML::Node procs = root["processes"];
-    if (!procs.IsMap() || !procs[parts[1]])
+    const YAML::Node procs = root["processes"];  // (a key that is absent: a node that throws on IsMap)
+    if (!procs || !procs.IsMap() || !procs[parts[1]])
       return fail("processes." + parts[1], "no such process in the graph's `processes:`");
     return parts;
   }
   const YAML::Node comps = root["components"];
-  if (!comps.IsMap() || !comps[head]) return fail("components." + head, "no such component in the graph");
+  if (!comps || !comps.IsMap() || !comps[head]) return fail("components." + head, "no such component in the graph");
   std::vector<std::string> path = {"components", head};
   if (parts.size() == 2 && (graph_keys::kComponentScalars.count(parts[1]) || parts[1] == "params")) {
     path.push_back(parts[1]);
@@ -215,7 +215,7 @@ GraphDocument ReadGraphDocument(const std::string& yaml_text, const std::string&
                                 std::vector<Diagnostic>* diagnostics) {
   GraphDocument doc;
   const YAML::Node root = LoadDocument(yaml_text, path, diagnostics);
-  if (!root) return doc;
+  if (!root.IsMap()) return doc;  // (a null node is "defined" to yaml-cpp: `!root` would not stop here)
   const auto chain = ReadChain(path, root, diagnostics);
   doc.root = chain.back().second;
   if (chain.size() > 1) doc.origins[""] = chain.back().first;  // what no overlay changes

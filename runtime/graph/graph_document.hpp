@@ -29,7 +29,7 @@
 namespace dyad {
 
 struct GraphDocument {
-  YAML::Node root;  // a mapping; null when the file could not be read (diagnostics say why)
+  YAML::Node root;  // a mapping; not one (test IsMap()) when the file could not be read (diagnostics say why)
   std::map<std::string, std::string> origins;  // see Graph::origins
   std::vector<std::string> bases;              // the files extended, nearest first
   std::vector<std::string> sets;               // the --set texts written in

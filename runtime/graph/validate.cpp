@@ -401,7 +401,12 @@ std::string RedactedGraphYaml(const Graph& graph, const ResolvedGraph& resolved)
 }
 
 ResolvedGraph ValidateGraph(const Graph& graph, const Catalog& catalog, std::vector<Diagnostic>* diags) {
-  return Validation(graph, catalog, diags).Run();
+  try {
+    return Validation(graph, catalog, diags).Run();
+  } catch (const YAML::Exception& e) {  // a node used as what it is not: a problem of the graph, not an abort
+    diags->push_back({SourceMark{graph.file, 0, 0}, "", "cannot validate the graph: " + e.msg});
+    return ResolvedGraph();
+  }
 }
 
 }  // namespace dyad

@@ -100,6 +100,7 @@ Status ApplyOverride(YAML::Node root, const std::string& spec) {
       size_t idx = 0;
       if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos)
         return Status::InvalidArgument("--set " + key + ": '" + part + "' is not a list index");
+      if (part.size() > 9) return Status::InvalidArgument("--set " + key + ": index " + part + " out of range");  // (stoul throws past 2^64)
       idx = std::stoul(part);
       if (idx >= node.size()) return Status::InvalidArgument("--set " + key + ": index " + part + " out of range");
       out->reset(node[idx]);
@@ -240,7 +241,7 @@ StatusOr<TrainConfig> LoadTrainConfig(const std::string& path, const std::vector
   }
   std::map<std::string, std::string> sets;  // key as messages spell it -> the --set text
   for (const auto& o : overrides) {
-    if (Status s = ApplyOverride(root, o); !s.ok()) return s;
+    if (Status s = ApplyOverride(root, o); !s.ok()) return Status::InvalidArgument(s.message() + " (in " + path + ")");
     sets[MessageKey(o.substr(0, o.find('=')))] = o;
   }
   std::vector<Diagnostic> problems;
