@@ -26,6 +26,7 @@
 #include "dyad/pvrnn/prior_generator.hpp"
 #include "dyad/pvrnn/train_config.hpp"
 #include "dyad/pvrnn/trainer.hpp"
+#include "text_output.hpp"
 
 namespace dyad::cli {
 namespace {
@@ -124,9 +125,11 @@ int RunTraining(const TrainConfig& c, const std::string& config_path, const Data
                   re_p, l.regulation, l.loss, 1e3 * elapsed / static_cast<double>(e - start_epoch),
                   Duration(eta).c_str(), tty ? "" : "\n");
       std::fflush(stdout);
-      csv << e << ',' << l.reconstruction << ',' << re_p << ',' << l.regulation << ',' << l.loss;
-      for (double kl : l.kl_per_layer) csv << ',' << kl;
-      csv << ',' << elapsed << '\n';
+      using tools::CsvNumber;  // exact: the log's numbers read back to the doubles computed
+      csv << e << ',' << CsvNumber(l.reconstruction) << ',' << CsvNumber(re_p) << ',' << CsvNumber(l.regulation) << ','
+          << CsvNumber(l.loss);
+      for (double kl : l.kl_per_layer) csv << ',' << CsvNumber(kl);
+      csv << ',' << CsvNumber(elapsed) << '\n';
       csv.flush();
     }
     const bool checkpoint_due = c.checkpoint_every > 0 && e % c.checkpoint_every == 0;
