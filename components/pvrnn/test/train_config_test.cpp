@@ -121,7 +121,8 @@ TEST(TrainConfig, OverrideBreakingASpecRuleIsNamed) {
 
 // --set through a scalar or past a list's end is an error, never an exception.
 TEST(TrainConfig, MalformedOverridePathsAreErrors) {
-  for (const char* o : {"epochs.x=3", "layers.9.d=1", "layers.x.d=1", "=1", "epochs", "adam=[1"}) {
+  // (A 23-digit index: std::stoul threw std::out_of_range, out of the loader: dyad train aborted.)
+  for (const char* o : {"epochs.x=3", "layers.9.d=1", "layers.x.d=1", "=1", "epochs", "adam=[1", "layers.99999999999999999999999.d=1"}) {
     auto c = LoadTrainConfig(kDir + "/valid_train.yaml", {o});
     ASSERT_FALSE(c.ok()) << o;
     EXPECT_EQ(c.status().message().rfind("--set ", 0), 0u) << o << ": " << c.status().message();
