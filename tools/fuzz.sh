@@ -44,7 +44,7 @@ run() {  # run TARGET SECONDS
   local args=(-max_total_time="$seconds" -rss_limit_mb=2048 -malloc_limit_mb=256 -timeout=10
     -print_final_stats=1 -artifact_prefix="$dir/fuzz/artifacts/$t/")
   case $t in
-    graph) args+=(-dict="$here/tests/fuzz/dict/graph.dict") ;;
+    graph | graph_chain) args+=(-dict="$here/tests/fuzz/dict/graph.dict") ;;
     cdr_schema) args+=(-dict="$here/tests/fuzz/dict/idl.dict") ;;
     model_file | observer_file) args+=(-dict="$here/tests/fuzz/dict/checked_file.dict") ;;
   esac

@@ -31,6 +31,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (const dyad::Diagnostic& d : diagnostics) {
     const std::string line = d.ToString();
     dyad::fuzz::Require(line.rfind("fuzz.yaml", 0) == 0 && !d.message.empty(), "diagnostic without its file: " + line);
+    dyad::fuzz::Require(!dyad::fuzz::IsLoaderFallback(d.message), "a yaml-cpp exception reached the loader's catch: " + line);
   }
   return 0;
 }

@@ -45,7 +45,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<dyad::Diagnostic> diagnostics;
   dyad::Graph graph = dyad::ParseGraph(BaseGraph(), "demo.yaml", overrides, &diagnostics);
   if (diagnostics.empty()) dyad::ValidateGraph(graph, BuiltinCatalog(), &diagnostics);
-  for (const dyad::Diagnostic& d : diagnostics)
+  for (const dyad::Diagnostic& d : diagnostics) {
     dyad::fuzz::Require(!d.message.empty() && !d.ToString().empty(), "empty diagnostic");
+    dyad::fuzz::Require(!dyad::fuzz::IsLoaderFallback(d.message), "a yaml-cpp exception reached the loader's catch: " + d.ToString());
+  }
   return 0;
 }
