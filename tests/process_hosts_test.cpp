@@ -30,7 +30,23 @@ TEST_F(ProcessTest, LauncherStartsOnlyThisHostsProcessesAndNamesTheOnesItWaitedF
                          "processes not ready: 'robot' (not seen); here: the writer of 'count' matched 0 of 1 readers"),
             std::string::npos)
       << c.err();
+  EXPECT_EQ(c.err().find("the graph is local"), std::string::npos) << c.err();  // it names hosts: scope lan
   EXPECT_FALSE(fs::exists(out));  // the robot's process was not started here
+}
+
+// Issue #40: a graph that names no host is local (loopback only: the safe default, kept). Started
+// with --process on several machines, each process waits for the others in vain: its message says
+// the graph is local and how to open it, not only "'mind' (not seen)".
+TEST_F(ProcessTest, AProcessOfALocalGraphThatWaitsInVainSaysTheGraphIsLocalAndHowToOpenIt) {
+  const fs::path g = Write("g.yaml", "graph: alone\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+                                         "\nnetwork: {start_timeout_s: 1}\nprocesses: {here: {}, mind: {}}\ncomponents:\n"
+                                         "  src: {type: counter_source, rate_hz: 50, process: here, outputs: {out: count}}\n"
+                                         "  sink: {type: counter_sink, trigger: in, process: mind, inputs: {in: count}}\n");
+  Child c(Dyad({"run", g.string(), "--process", "here"}), dir_, "alone");
+  ASSERT_EQ(c.Wait(30), 1) << c.err();
+  EXPECT_NE(c.err().find("processes not ready: 'mind' (not seen)"), std::string::npos) << c.err();
+  EXPECT_NE(c.err().find("the graph is local (network.scope: local"), std::string::npos) << c.err();
+  EXPECT_NE(c.err().find("set `network.scope: lan` (or --set network.scope=lan) or name the hosts"), std::string::npos) << c.err();
 }
 
 // Two launchers started 3 s apart, as on two machines, in each discovery mode (on loopback):

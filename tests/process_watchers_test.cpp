@@ -78,6 +78,8 @@ TEST_F(ProcessTest, IntrospectionSeesARunningGraph) {
   Child none(Dyad({"echo", "no/such/topic", "--domain", domain, "--wait", "1"}), dir_, "none");
   EXPECT_EQ(none.Wait(30), 1);
   EXPECT_NE(none.err().find("no writer of topic 'no/such/topic'"), std::string::npos) << none.err();
+  // Without --graph a watcher is local (this machine only): it says so, and how to watch a graph of scope lan.
+  EXPECT_NE(none.err().find("; this watcher is local (network.scope: local"), std::string::npos) << none.err();
 
   run.Signal(SIGINT);
   EXPECT_EQ(run.Wait(15), 130) << run.err();

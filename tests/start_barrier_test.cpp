@@ -1,7 +1,8 @@
 // StartBarrier (hosts/start_barrier.hpp) over the in-memory transport: the processes of a graph
 // start together at an instant each computes alike, a required process never heard ends the
 // wait naming it, another graph's announcements are not counted, a running graph is joined at
-// once, and Hear() reports who runs and how long the others have been silent.
+// once, and Hear() reports who runs and how long the others have been silent. A local graph's
+// timeout says the graph is local and how to open it (graph/network_scope.hpp).
 //
 // The in-memory transport reports no endpoint matches, so every process is "ready" as soon as it
 // waits: what is tested here is the exchange of announcements on dyad/processes.
@@ -14,6 +15,7 @@
 #include <dyad/msg/types.hpp>
 
 #include "exec/wall_clock.hpp"
+#include "graph/network_scope.hpp"
 #include "hosts/start_barrier.hpp"
 #include "memory_transport.hpp"
 
@@ -23,10 +25,11 @@ namespace {
 using SteadyClock = std::chrono::steady_clock;
 
 // lab: h writes human/input; mind: m reads it. `mind_spec`: mind's process entry.
-Graph TwoProcesses(const std::string& mind_spec = "{}", const std::string& name = "duo") {
+Graph TwoProcesses(const std::string& mind_spec = "{}", const std::string& name = "duo",
+                   const std::string& network = "{start_timeout_s: 1.5}") {
   std::vector<Diagnostic> diags;
   Graph g = ParseGraph("graph: " + name +
-                           "\nclock: wall\nnetwork: {start_timeout_s: 1.5}\n"
+                           "\nclock: wall\nnetwork: " + network + "\n"
                            "processes: {lab: {}, mind: " +
                            mind_spec +
                            "}\ncomponents:\n"
@@ -98,6 +101,42 @@ TEST(StartBarrier, ARequiredProcessNeverHeardEndsTheWaitNamingIt) {
   EXPECT_NE(m.find("waited 1.5 s (network.start_timeout_s)"), std::string::npos) << m;
   EXPECT_EQ(m.find("'lab' ("), std::string::npos) << "only mind is missing: " << m;
   EXPECT_GE(SteadyClock::now() - begun, std::chrono::milliseconds(1400));  // it did wait (1.5 s)
+  // The graph names no host: it is local (loopback only), and a process on another machine is
+  // never seen. The message says so and how to open it (issue #40).
+  EXPECT_NE(m.find("; " + LocalScopeNote(g.network)), std::string::npos) << m;
+  EXPECT_NE(m.find("the graph is local"), std::string::npos) << m;
+  EXPECT_NE(m.find("`network.scope: lan`"), std::string::npos) << m;
+}
+
+TEST(StartBarrier, AGraphOfScopeLanThatTimesOutSaysNothingOfTheScope) {
+  const Graph g = TwoProcesses("{}", "duo", "{scope: lan, start_timeout_s: 0.3}");
+  ASSERT_EQ(g.network.scope, NetScope::kLan);
+  testing::MemoryTransport bus;
+  StartBarrier lab(g, "lab", "h1", 0);
+  ASSERT_TRUE(lab.Open(&bus).ok());
+  const StatusOr<int64_t> start = lab.Wait(Never);
+  ASSERT_FALSE(start.ok());
+  EXPECT_NE(start.status().message().find("'mind' (not seen)"), std::string::npos) << start.status().message();
+  EXPECT_EQ(start.status().message().find("local"), std::string::npos) << start.status().message();
+}
+
+// graph/network_scope.hpp: said only for a local scope; for a process, the fix of the graph; for
+// a watcher, that it reaches this machine only and how to watch a graph of scope lan.
+TEST(LocalScopeNote, NamesTheFixForALocalScopeAndNothingForLan) {
+  NetworkConfig local;
+  ASSERT_EQ(local.scope, NetScope::kLocal);  // the default: a graph that names no other machine
+  const std::string process = LocalScopeNote(local);
+  EXPECT_NE(process.find("the graph is local (network.scope: local"), std::string::npos) << process;
+  EXPECT_NE(process.find("a process on another machine is never seen"), std::string::npos) << process;
+  EXPECT_NE(process.find("set `network.scope: lan`"), std::string::npos) << process;
+  EXPECT_NE(process.find("name the hosts (network.hosts"), std::string::npos) << process;
+  const std::string watcher = LocalScopeNote(local, /*watcher=*/true);
+  EXPECT_NE(watcher.find("this watcher is local"), std::string::npos) << watcher;
+  EXPECT_NE(watcher.find("--graph"), std::string::npos) << watcher;
+  NetworkConfig lan;
+  lan.scope = NetScope::kLan;
+  EXPECT_EQ(LocalScopeNote(lan), "");
+  EXPECT_EQ(LocalScopeNote(lan, /*watcher=*/true), "");
 }
 
 TEST(StartBarrier, StoppingEndsTheWaitWithoutAStart) {

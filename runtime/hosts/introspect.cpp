@@ -24,6 +24,7 @@
 #include "hosts/clock_sync.hpp"
 #include "dds/dds_participant.hpp"
 #include "graph/graph_topics.hpp"
+#include "graph/network_scope.hpp"
 #include "hosts/start_barrier.hpp"
 #include "hosts/watcher_join.hpp"
 #include "dyad/interrupt.hpp"
@@ -35,6 +36,13 @@ using Steady = std::chrono::steady_clock;
 
 std::unique_ptr<DdsParticipant> Join(const IntrospectOptions& o, std::ostream& err) {
   return JoinAsWatcher(o, "dyad/introspect", err);
+}
+
+// Appended where a watcher found nothing: a local watcher (no --graph, or a local graph's) reaches
+// this machine only (graph/network_scope.hpp).
+std::string ScopeNote(const IntrospectOptions& o) {
+  const std::string local = LocalScopeNote(o.network, /*watcher=*/true);
+  return local.empty() ? "" : "; " + local;
 }
 
 // A watcher's reader: the participant's serialized subscription (BEST_EFFORT: it matches every
@@ -104,7 +112,8 @@ std::optional<TopicTap> Tap(const IntrospectOptions& o, const Catalog& catalog, 
   const std::string dds_type = DiscoverType(*tap.participant, topic, o.wait_s, interrupt);
   if (interrupt.interrupted()) return std::nullopt;
   if (dds_type.empty()) {
-    err << "no writer of topic '" << topic << "' found on domain " << o.domain_id << " within " << o.wait_s << " s\n";
+    err << "no writer of topic '" << topic << "' found on domain " << o.domain_id << " within " << o.wait_s << " s"
+        << ScopeNote(o) << "\n";
     return std::nullopt;
   }
   tap.type = ResolveType(catalog, dds_type, topic, err);
@@ -202,7 +211,8 @@ int ListTopics(const IntrospectOptions& o, std::ostream& out, const Graph* graph
   if (rows.empty()) {
     std::cerr << "dyad topics: no endpoint discovered on domain " << o.domain_id << " within " << o.wait_s
               << " s (a longer --wait helps on a loaded machine or network; a stepped run, clock: stepped, is"
-                 " private to its process and never seen here)\n";
+                 " private to its process and never seen here)"
+              << ScopeNote(o) << "\n";
     return 1;
   }
   return 0;
@@ -228,7 +238,7 @@ int DiscoverLiveGraph(const IntrospectOptions& o, const Catalog& catalog, const 
   }
   if (live->endpoints.empty()) {
     err << "dyad graph --live: no endpoint discovered on domain " << o.domain_id << " within " << o.wait_s
-        << " s (a stepped run is private to its process and never seen here)\n";
+        << " s (a stepped run is private to its process and never seen here)" << ScopeNote(o) << "\n";
     return 1;
   }
   // Rates: one reader per written topic of a known type, counting for listen_s.
@@ -346,7 +356,7 @@ int ShowStatus(const IntrospectOptions& o, const Graph* graph, std::ostream& out
   }
   if (procs.empty()) {
     err << "dyad status: no process" << (graph_name.empty() ? "" : " of graph '" + graph_name + "'") << " heard on domain "
-        << o.domain_id << " within " << o.wait_s << " s\n";
+        << o.domain_id << " within " << o.wait_s << " s" << ScopeNote(o) << "\n";
     return 1;
   }
   std::set<std::string> process_names;

@@ -12,6 +12,8 @@
 
 #include <dyad/message_traits.hpp>
 
+#include "graph/network_scope.hpp"
+
 namespace dyad {
 
 bool StartBarrier::Required(const std::string& process) const {
@@ -128,6 +130,9 @@ StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
       std::string what;
       if (!not_heard.empty()) what = "processes not ready: " + not_heard;
       if (!missing_endpoints.empty()) what += std::string(what.empty() ? "" : "; ") + "here: " + missing_endpoints;
+      // A process never heard from, in a graph that reaches this machine only: say so, and how to open it.
+      if (const std::string local = LocalScopeNote(graph_.network); !local.empty() && not_heard.find("(not seen)") != std::string::npos)
+        what += "; " + local;
       char waited[32];
       std::snprintf(waited, sizeof waited, "%g", graph_.network.start_timeout_s);  // 0.5 s, not "0 s"
       return Status::FailedPrecondition("process '" + process_ + "' waited " + waited +
