@@ -75,6 +75,46 @@ TEST_F(SecurityTest, ASecuredGraphDeliversToItsOwnAndNothingToIntruders) {
   open_run.Wait(60);
 }
 
+// `security.guests`: dyad pub publishes into a secured graph as the guest identity init issues,
+// exactly what the graph grants; a topic outside the grant, or a graph that grants nothing, is
+// refused before any participant is made, naming the key to change.
+TEST_F(SecurityTest, AGuestPublishesWhatTheGraphGrantsItAndNothingElse) {
+  auto graph = [&](const std::string& guests) {
+    return "graph: secure\ndomain_id: " + std::to_string(domain_) + "\nsecurity:\n  keystore: keys\n" + guests +
+           "topics:\n  ext: {type: Counter}\n  other: {type: Counter}\nprocesses:\n  sub: {}\ncomponents:\n"
+           "  sink: {type: counter_sink, trigger: in, process: sub, params: {file: " + (dir_ / "sink.txt").string() +
+           "}, inputs: {in: ext}}\n"
+           "  sink2: {type: counter_sink, trigger: in, process: sub, params: {file: " + (dir_ / "sink2.txt").string() +
+           "}, inputs: {in: other}}\n";
+  };
+  const fs::path g = Write("g.yaml", graph("  guests:\n    publish: [ext]\n"));
+  ASSERT_EQ(Init(dir_ / "keys", g), 0);
+  EXPECT_NE(ReadFile(dir_ / "keys" / "identities" / "guest" / "permissions.xml").find("<topic>ext</topic>"), std::string::npos);
+  Child run(Dyad({"run", g.string(), "--duration", "60", "--quiet"}), dir_, "run");
+  Child pub(Dyad({"pub", "ext", "{value: 7}", "--graph", g.string(), "--wait", "30"}), dir_, "pub");
+  EXPECT_EQ(pub.Wait(60), 0) << pub.err();
+  Child refused(Dyad({"pub", "other", "{value: 8}", "--graph", g.string(), "--wait", "5"}), dir_, "refused");
+  EXPECT_EQ(refused.Wait(60), 2);
+  EXPECT_NE(refused.err().find("dyad pub: topic 'other': the graph's guests may not publish it: add it to "
+                               "security.guests.publish (" + g.string() + ":6:14), then rerun `dyad security init"),
+            std::string::npos)
+      << refused.err();
+  // Without the section, the guest has no identity: the message says which key to add.
+  const fs::path closed = Write("closed.yaml", graph(""));
+  Child none(Dyad({"pub", "ext", "{value: 9}", "--graph", closed.string(), "--wait", "5"}), dir_, "none");
+  EXPECT_EQ(none.Wait(60), 2);
+  EXPECT_NE(none.err().find("is secured and lets no guest publish: add `guests: {publish: [ext]}` under security:"),
+            std::string::npos)
+      << none.err();
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  run.Signal(SIGINT);
+  EXPECT_EQ(run.Wait(60), 130) << run.err();
+  const auto got = ReadSink(dir_ / "sink.txt");
+  ASSERT_EQ(got.size(), 1u) << ReadFile(dir_ / "sink.txt");
+  EXPECT_EQ(got[0].value, 7);
+  EXPECT_TRUE(ReadSink(dir_ / "sink2.txt").empty());
+}
+
 TEST_F(SecurityTest, AProcessCannotPublishWhatItsPermissionsDoNotGrant) {
   const fs::path graph = Write("g.yaml", Graph("keys"));
   ASSERT_EQ(Init(dir_ / "keys", graph), 0);

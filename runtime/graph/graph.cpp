@@ -382,6 +382,8 @@ void ReadSecurityGuests(StrictYaml& r, const YAML::Node& node, Graph* g) {
       if (r.String(t, key, &topic)) out->push_back(topic);
     }
   }
+  if (g->security.guest_publish.empty() && g->security.guest_subscribe.empty())
+    r.Error(node, "security.guests", "grants nothing: list the topics under publish: or subscribe: (or leave the section out)");
 }
 
 void ReadSecurity(StrictYaml& r, const YAML::Node& node, Graph* g) {

@@ -12,7 +12,8 @@ namespace dyad::graph_keys {
 inline const std::set<std::string> kScalars = {"graph", "domain_id", "clock", "seed", "plugins", "logs"};
 inline const std::set<std::string> kTopLevel = {"graph",   "domain_id", "clock",     "seed",   "plugins",
                                                 "logs",    "network",   "security",  "processes", "topics", "components"};
-inline const std::set<std::string> kSecurity = {"keystore"};
+inline const std::set<std::string> kSecurity = {"keystore", "guests"};
+inline const std::set<std::string> kSecurityGuests = {"publish", "subscribe"};
 inline const std::set<std::string> kNetwork = {"scope", "discovery", "hosts",   "peers",           "server",
                                                "transport", "interfaces", "lease_s",       "start_timeout_s",
                                                "max_clock_offset_ms", "launcher_tcp_port"};

@@ -1,5 +1,6 @@
 #include <dyad/security.hpp>
 
+#include <fnmatch.h>
 #include <sys/stat.h>
 
 #include <cstdio>
@@ -85,10 +86,18 @@ std::vector<std::string> GraphIdentities(const Graph& graph) {
   std::vector<std::string> out;
   for (const std::string& p : graph.ProcessNames()) out.push_back(ProcessIdentity(p));
   for (const std::string& h : IdentityHosts(graph)) out.push_back(HostIdentity(h));
+  if (graph.security.guests) out.push_back(kGuestIdentity);
   return out;
 }
 
+bool TopicGranted(const std::vector<std::string>& grants, const std::string& topic) {
+  for (const std::string& g : grants)
+    if (fnmatch(g.c_str(), topic.c_str(), 0) == 0) return true;
+  return false;
+}
+
 std::string IdentitySubject(const Graph& graph, const std::string& identity) {
+  if (identity == kGuestIdentity) return "CN=dyad/" + graph.name + "/guest/tools";
   const std::string host = "host.", process = "process.";
   if (identity.rfind(host, 0) == 0) return "CN=dyad/" + graph.name + "/host/" + identity.substr(host.size());
   return "CN=dyad/" + graph.name + "/" + identity.substr(identity.rfind(process, 0) == 0 ? process.size() : 0);

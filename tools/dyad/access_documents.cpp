@@ -80,6 +80,10 @@ std::string PermissionsXml(const Graph& graph, const std::string& identity,
       publish.insert(it->second.writes.begin(), it->second.writes.end());
       subscribe.insert(it->second.reads.begin(), it->second.reads.end());
     }
+  } else if (identity == kGuestIdentity) {
+    // Exactly the graph's grant: a guest announces nothing on the runtime's topics (dyad/guest.hpp).
+    publish = {graph.security.guest_publish.begin(), graph.security.guest_publish.end()};
+    subscribe = {graph.security.guest_subscribe.begin(), graph.security.guest_subscribe.end()};
   } else {
     publish = kLauncherWrites;
     subscribe = {"*"};

@@ -22,6 +22,7 @@
 #include <dyad/cdr_encoder.hpp>
 #include <dyad/guest.hpp>
 #include <dyad/mcap/reader.hpp>
+#include <dyad/security.hpp>
 #include <dyad/topic_select.hpp>
 
 #include "watcher_catalog.hpp"
@@ -64,6 +65,32 @@ std::vector<std::string> Intersect(const std::vector<std::string>& a, const std:
   for (const auto& x : a)
     if (std::find(b.begin(), b.end(), x) != b.end()) both.push_back(x);
   return both;
+}
+
+// In a secured graph, `dyad pub` and `dyad bag play` publish as the graph's guest identity
+// (dyad/security.hpp) and only what `security.guests.publish` grants: a topic outside the grant
+// is refused here, before any participant is made, naming the key to change. Returns false
+// having said why; true with st->opts.security set to the guest's files (or for an open graph).
+bool PublishAsGuest(const std::optional<Graph>& graph, const std::vector<std::string>& topics, const std::string& tool,
+                    GuestState* st) {
+  if (!graph || !graph->security.enabled()) return true;
+  const SecurityConfig& sec = graph->security;
+  const std::string init = "rerun `dyad security init " + sec.keystore + " --graph " + st->graph + "`";
+  if (!sec.guests) {
+    std::cerr << tool << ": graph '" << graph->name << "' is secured and lets no guest publish: add `guests: {publish: ["
+              << (topics.empty() ? "TOPIC" : topics.front()) << "]}` under security: (" << sec.mark.ToString() << "), then "
+              << init << "\n";
+    return false;
+  }
+  bool ok = true;
+  for (const std::string& t : topics)
+    if (!TopicGranted(sec.guest_publish, t)) {
+      std::cerr << tool << ": topic '" << t << "': the graph's guests may not publish it: add it to security.guests.publish ("
+                << sec.guests_mark.ToString() << "), then " << init << "\n";
+      ok = false;
+    }
+  if (ok) st->opts.security = IdentityOf(*graph, kGuestIdentity);
+  return ok;
 }
 
 // A guest of one component `name` of `type`, stepping at `rate_hz`, with `params`.
@@ -142,6 +169,7 @@ int Play(GuestState& st) {
   params["loop"] = st.loop;
   params["start_s"] = st.start;
   // 1000 Hz: each sample within a millisecond of its recorded spacing.
+  if (!PublishAsGuest(graph, *chosen, "dyad bag play", &st)) return 2;
   GuestOptions go = OneComponentGuest(st, "dyad bag play", "play", "replay", 1000, params);
   go.watched = graph ? &*graph : nullptr;
   // A reader of each played topic: a component's input, a recorder's subscription, a watcher's.
@@ -199,6 +227,7 @@ int Pub(GuestState& st) {
   Catalog catalog;
   std::optional<Graph> graph;
   if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph)) return 2;
+  if (!PublishAsGuest(graph, {st.topic}, "dyad pub", &st)) return 2;
   PublishOptions po;
   po.watch = st.opts;
   po.watched = graph ? &*graph : nullptr;

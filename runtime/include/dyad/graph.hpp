@@ -23,6 +23,9 @@
 //     max_clock_offset_ms: 5    # warn when another process's clock is further off than this
 //   security:                   # optional: DDS Security for every participant (dyad/security.hpp)
 //     keystore: keys/demo       # made by `dyad security init keys/demo --graph THIS_FILE`
+//     guests:                   # optional: what the lab's tools may do in the secured graph, with
+//       publish: [human/input]  #   the identity `guest` init issues (dyad pub, dyad bag play);
+//       subscribe: []           #   topic names or patterns (fnmatch, as DDS Security matches them)
 //   processes:                  # optional; default: one process "main"
 //     main: {}
 //     robot: {host: robot-pc}   # host: where `dyad run` without --process starts it (default: here;
@@ -117,6 +120,10 @@ struct NetworkConfig {
 struct SecurityConfig {
   std::string keystore;  // resolved against the file's folder; empty: no security
   SourceMark mark;       // of `security.keystore`
+  // `security.guests`: the grant of the identity `guest` (dyad/security.hpp: kGuestIdentity).
+  bool guests = false;   // the section is there (then init issues the guest identity)
+  std::vector<std::string> guest_publish, guest_subscribe;  // topic names or fnmatch patterns
+  SourceMark guests_mark;  // of `security.guests.publish` (else of `security.guests`)
   bool enabled() const { return !keystore.empty(); }
 };
 

@@ -20,7 +20,10 @@
 //   identities/<identity>/cert.pem, key.pem, permissions.xml, permissions.p7s
 // Identities: "process.<p>" for each process of the graph (its participant is dyad/<graph>/<p>,
 // subject CN=dyad/<graph>/<p>) and "host.<h>" for each host's launcher and watchers (subject
-// CN=dyad/<graph>/host/<h>; "host.local" when the graph places nothing on hosts).
+// CN=dyad/<graph>/host/<h>; "host.local" when the graph places nothing on hosts), and "guest"
+// when the graph has `security.guests` (subject CN=dyad/<graph>/guest/tools: no process or host
+// subject has that shape): the identity of `dyad pub` and `dyad bag play` in a secured graph,
+// allowed to publish `guests.publish` and read `guests.subscribe`, nothing else of the graph's.
 //
 // Loading a graph checks the keystore (CheckKeystore): every identity the graph needs is there,
 // no private key is readable by others or a symbolic link, every certificate is valid now. Fast
@@ -48,13 +51,17 @@ struct IdentityFiles {
 };
 
 inline constexpr const char* kLocalHost = "local";
+inline constexpr const char* kGuestIdentity = "guest";
+
+// True when `topic` is one of `grants` (names, or fnmatch patterns as DDS Security matches them).
+bool TopicGranted(const std::vector<std::string>& grants, const std::string& topic);
 
 std::string ProcessIdentity(const std::string& process);  // "process.<p>"
 std::string HostIdentity(const std::string& host);        // "host.<h>"
 // The hosts whose launchers and watchers get an identity: every host a process is placed on,
 // and those of network.hosts; {kLocalHost} for a graph on one machine.
 std::vector<std::string> IdentityHosts(const Graph& graph);
-// Every identity the graph needs: its processes', then its hosts'.
+// Every identity the graph needs: its processes', then its hosts', then the guest's (if any).
 std::vector<std::string> GraphIdentities(const Graph& graph);
 // The subject name of an identity's certificate and of its permissions grant.
 std::string IdentitySubject(const Graph& graph, const std::string& identity);

@@ -172,6 +172,44 @@ TEST_F(KeystoreTest, PermissionsGrantWhatEachProcessWritesAndReads) {
   EXPECT_NE(Section(host, "subscribe").find("<topic>*</topic>"), std::string::npos) << host;
 }
 
+TEST_F(KeystoreTest, TheGuestIdentityIsGrantedExactlyTheGraphsGuestsSection) {
+  const fs::path g = WriteGraph("security:\n  keystore: keys\n  guests: {publish: [cb, 'robot/*'], subscribe: [ca]}\n", "guests.yaml");
+  auto init = Init({}, g);
+  ASSERT_EQ(init.code, 0) << init.err;
+  EXPECT_NE(init.out.find("issued   guest"), std::string::npos) << init.out;
+  const std::string guest = ReadFile(Identity("guest", "permissions.xml"));
+  EXPECT_NE(guest.find("<subject_name>CN=dyad/sec/guest/tools</subject_name>"), std::string::npos) << guest;
+  const std::string publish = Section(guest, "publish"), subscribe = Section(guest, "subscribe");
+  EXPECT_NE(publish.find("<topic>cb</topic>"), std::string::npos) << guest;
+  EXPECT_NE(publish.find("<topic>robot/*</topic>"), std::string::npos) << guest;
+  EXPECT_EQ(publish.find("<topic>ca</topic>"), std::string::npos) << guest;
+  EXPECT_EQ(publish.find("dyad/launchers"), std::string::npos) << "a guest is no launcher:\n" << guest;
+  EXPECT_EQ(publish.find("dyad/param_requests"), std::string::npos) << guest;
+  EXPECT_NE(subscribe.find("<topic>ca</topic>"), std::string::npos) << guest;
+  EXPECT_EQ(subscribe.find("<topic>*</topic>"), std::string::npos) << "a guest does not read everything:\n" << guest;
+  int code = -1;
+  const std::string subject =
+      OpenSsl({"x509", "-noout", "-subject", "-in", Identity("guest", "cert.pem").string()}, &code);
+  EXPECT_EQ(code, 0);
+  EXPECT_NE(subject.find("dyad/sec/guest/tools"), std::string::npos) << subject;
+  // No section, no guest identity.
+  ASSERT_EQ(Init().code, 0);
+  EXPECT_TRUE(fs::exists(Identity("guest", "cert.pem")));  // kept from before, unused by this graph
+  EXPECT_TRUE(TopicGranted({"cb", "robot/*"}, "robot/command"));
+  EXPECT_FALSE(TopicGranted({"cb", "robot/*"}, "ca"));
+  // A section that is not a list is refused at its line.
+  const fs::path bad = WriteGraph("security:\n  keystore: keys\n  guests: {publish: cb, read: [ca]}\n", "bad.yaml");
+  auto refused = Init({}, bad);
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_NE(refused.err.find("bad.yaml:7:21: security.guests.publish: must be a list of topics"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("security.guests"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("read"), std::string::npos) << "the unknown key is named:\n" << refused.err;
+  const fs::path empty = WriteGraph("security:\n  keystore: keys\n  guests: {}\n", "empty.yaml");
+  auto nothing = Init({}, empty);
+  EXPECT_EQ(nothing.code, 2);
+  EXPECT_NE(nothing.err.find("empty.yaml:7:11: security.guests: grants nothing"), std::string::npos) << nothing.err;
+}
+
 TEST_F(KeystoreTest, ARerunKeepsKeysAndRenewReplacesOnlyTheNamedIdentity) {
   ASSERT_EQ(Init().code, 0);
   const std::string pub_key = ReadFile(Identity("process.pub", "key.pem"));
