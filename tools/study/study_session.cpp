@@ -79,6 +79,8 @@ std::string GraphHash(const std::string& graph, const std::vector<std::string>& 
   return hex;
 }
 
+constexpr std::chrono::seconds kStopGrace{10};  // a graph's time to end after the second stop
+
 std::atomic<int> g_stop_signals{0};  // lock-free: safe in a handler and read by another thread
 static_assert(std::atomic<int>::is_always_lock_free);
 extern "C" void OnStopSignal(int) { g_stop_signals.fetch_add(1); }
@@ -228,7 +230,8 @@ StatusOr<int> WithdrawConsent(const Study& s, const std::string& participant, bo
   int deleted = 0;
   std::error_code ec;
   std::vector<fs::path> entries;
-  for (const auto& e : fs::directory_iterator(dir, ec)) entries.push_back(e.path());
+  // The error_code increment: the range-for's would throw (the next entry unreadable, the folder gone).
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) entries.push_back(it->path());
   if (ec) return Status::IOError(dir.string(), "cannot list the participant's folder: " + ec.message());
   for (const fs::path& p : entries) {
     const std::string name = p.filename().string();
@@ -349,12 +352,20 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
     // One stop is forwarded as one SIGINT: the graph finishes its recording. A second stop (a
     // graph that hangs while ending) is forwarded too: dyad then exits at once, losing at most
     // its last chunk.
+    // A graph still there kStopGrace after the second stop is killed, with its process group.
+    std::chrono::steady_clock::time_point second_stop;
+    bool killed = false;
     while (pid >= 0 && !tools::ProcessEnded(pid, &a.exit)) {
       const int signals_now = g_stop_signals.load();
       const int wanted = std::min(2, signals_now + (r.stop && r.stop->load() ? 1 : 0));
       a.interrupted = a.interrupted || signals_now > 0;
       if (forwarded == 0 && wanted > 0) first_stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       for (; forwarded < wanted; ++forwarded) ::kill(pid, SIGINT);
+      if (forwarded == 2 && second_stop == std::chrono::steady_clock::time_point{}) second_stop = std::chrono::steady_clock::now();
+      if (forwarded == 2 && !killed && std::chrono::steady_clock::now() - second_stop > kStopGrace) {
+        ::kill(-pid, SIGKILL);
+        killed = true;
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }

@@ -24,9 +24,11 @@
 //   - RunAttempt refuses (nothing started, nothing logged) a trial when consent is required and
 //     not marked, or when the attempt's file exists. Otherwise it logs the start, runs
 //     `dyad run` on the graph with the condition's overrides, the recorder's file and the
-//     metadata below, and logs the end. While it runs, SIGINT (Ctrl-C) stops the trial: the
-//     graph gets one SIGINT (it is in a process group of its own) and finishes its recording; a
-//     second one is forwarded too (dyad then exits at once). Attempt::interrupted says a signal
+//     metadata below, and logs the end. While it runs, SIGINT (Ctrl-C) or SIGTERM stops the
+//     trial: the graph gets one SIGINT (it is in a process group of its own, with SIGINT as its
+//     parent-death signal: a runner that dies, even by SIGKILL, stops it too) and finishes its
+//     recording; a second one is forwarded too (dyad then exits at once), and a graph still
+//     there 10 s after it is killed with its process group. Attempt::interrupted says a signal
 //     came, so a caller running several trials stops there.
 //   - Recording metadata ("dyad.run" in the MCAP file): study, participant, condition (its label
 //     when the study is blind), trial, attempt, rehearsal (true|false), dyad_version (the
