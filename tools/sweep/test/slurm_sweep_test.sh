@@ -48,8 +48,11 @@ cmp local/sweep.csv cluster/sweep.csv || fail "Slurm's table differs from the lo
 awk -F, 'NR > 1 && ($2 != "ok" || $8 == "") { bad = 1 } END { exit bad }' cluster/sweep.csv ||
   fail "a run without a congruence: $(cat cluster/sweep.csv)"
 
-# The controller down: sbatch's own words, exit 1, nothing claimed.
+# The controller down: sbatch's own words, exit 1, nothing claimed. Stopped, nothing of this
+# Slurm is left (no daemon, no job step's slurmstepd, no job's process).
 bash "$here/single_node_slurm.sh" stop "$work/slurm"
+left=$(bash "$here/single_node_slurm.sh" leftovers "$work/slurm")
+[ -z "$left" ] || fail "still running after the single-node Slurm stopped: $(ps -o pid,args -p "$(echo $left | tr ' ' ,)")"
 if "$dyad" sweep s.yaml -o down --slurm > down.log 2>&1; then fail "submitted to a stopped Slurm: $(cat down.log)"; fi
 grep -q "Unable to contact slurm controller" down.log || { cat down.log; fail "the stopped controller was not said"; }
 echo "PASS: 2 models trained by a Slurm array, 12 runs in 5 array tasks after it, collected = the local sweep.csv; a stopped controller is said"
