@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """No input aborts dyad (issue #40): a corpus of malformed graph files, each run through the real
 `dyad validate` and `dyad run`, with and without a `--set`, and through the study, sweep and
-training file loaders (`dyad study plan`, `dyad sweep --dry-run`, `dyad train`). Every command
+training file loaders (`dyad study plan`, `dyad sweep --dry-run`, `dyad train`), with study and
+sweep files of the wrong shapes too. Every command
 must refuse the input with an exit code in 1..127 (never a signal: 134 is std::terminate's abort
 after an uncaught exception, 139 a crash), and its error output must name the file (or, for a
 bad --set on a good file, the --set and the file). Prints every failure and exits 1; exits 0 when
@@ -89,6 +90,24 @@ BAD_SETS = [
 ]
 
 
+# Study and sweep files of the right YAML but the wrong shapes, beside good.yaml (VALID) and
+# train.yaml (VALID too: not a training config): (command, file name, text). A study condition or a
+# sweep --set into a section the graph lacks, and a training --set with a list index past 2^64,
+# aborted before (YAML::InvalidNode, std::out_of_range).
+STUDY = "study: s\ngraph: good.yaml\nparticipants: [P01]\n"
+SHAPED = [
+    ("study plan", "shapes_study.yaml", "study: s\ngraph: good.yaml\nparticipants: 5\nconditions: 3\n"),
+    ("study plan", "kinds_study.yaml", "study: [s]\ngraph: {a: 1}\nparticipants: [[a]]\nconditions: {[a]: {src.noise: 2}}\n"),
+    ("study plan", "set_study.yaml", STUDY + "conditions: {A: {processes.x.host: lab, '': 2, '=': 3}}\nrehearsal: [a]\n"),
+    ("sweep", "shapes_sweep.yaml", "sweep: w\ngraph: good.yaml\nduration: 1\nruns: [5, [1], {a: 1}]\nseeds: {a: 1}\ntrain: 5\n"),
+    ("sweep", "set_sweep.yaml", "sweep: w\ngraph: good.yaml\nduration: 1\ngrid: {src.noise: [[1], {a: 1}]}\n"
+                                "set: {processes.a.host: lab}\n"),
+    ("sweep", "study_sweep.yaml", "sweep: w\nstudy: set_study.yaml\ncondition: A\nduration: 1\ngrid: {src.noise: [1]}\n"),
+    ("sweep", "train_sweep.yaml", "sweep: w\ngraph: good.yaml\nduration: 1\ngrid: {src.noise: [1]}\n"
+                                  "train: {config: train.yaml, model: src.noise, set: {layers.99999999999999999999.d: 1}}\n"),
+]
+
+
 def run(cmd, cwd):
     try:
         p = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=60)
@@ -141,6 +160,13 @@ def main():
         for cmd in (["validate", str(good)], ["run", str(good), "--duration", "1", "--quiet"]):
             check(failures, f"--set {s}: {cmd[0]}", [dyad] + cmd + ["--set", s], work, [str(good), "--set "])
             commands += 1
+    (work / "train.yaml").write_text(VALID)
+    for command, name, text in SHAPED:
+        (work / name).write_text(text)
+    for command, name, _ in SHAPED:
+        extra = ["--dry-run", "-o", str(work / "sweep-out")] if command == "sweep" else []
+        check(failures, f"{name}: {command}", [dyad] + command.split() + [str(work / name)] + extra, work, [name])
+        commands += 1
     # A file that is not there, and a folder where a file is expected.
     for f in (str(work / "missing.yaml"), str(work)):
         for cmd in (["validate", f], ["validate", f, "--set", GOOD_SET], ["run", f, "--set", GOOD_SET]):
@@ -148,7 +174,7 @@ def main():
             commands += 1
     for failure in failures:
         print("FAIL " + failure + "\n")
-    print(f"{commands} commands on {len(files)} malformed files and {len(BAD_SETS)} bad --sets: "
+    print(f"{commands} commands on {len(files)} malformed files, {len(BAD_SETS)} bad --sets and {len(SHAPED)} study and sweep files: "
           f"{len(failures)} failure{'s' if len(failures) != 1 else ''}")
     return 1 if failures else 0
 
