@@ -147,6 +147,31 @@ TEST_F(Ros2DriverTest, TwistModeEndsOnAZeroTwist) {
   EXPECT_EQ(twists.back(), "twist 0 0 0");
 }
 
+// Pose mode, the same: the last target the arm receives is a position it published itself (the
+// driver re-sends the measured pose), not the setpoint that ran ahead of it.
+TEST_F(Ros2DriverTest, PoseModeEndsOnTheMeasuredPose) {
+  const std::string log = (dir_ / "arm.csv").string();
+  ChildProcess arm(Arm("pose", {"--command-topic", "/target_pose", "--verbose", "--log", log}), dir_, "arm");
+  ASSERT_TRUE(arm.WaitForOutput("ready", 10)) << arm.err();
+  ChildProcess run({DYAD_EXE, "run", Graph("ros2_pose.yaml"), "--duration", "3"}, dir_, "run");
+  ASSERT_EQ(run.Wait(30), 0) << run.err();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  arm.Signal(SIGINT);
+  ASSERT_EQ(arm.Wait(10), 0) << arm.err();
+  const std::vector<std::string> targets = Received(arm.out(), "pose");
+  ASSERT_GT(targets.size(), 100u);
+  std::istringstream last(targets.back());
+  std::string kind, x, y, z;
+  last >> kind >> x >> y >> z;
+  // arm.csv: t_s,cmd_x,cmd_y,cmd_z,x,y,z, every position as published (%.17g, as --verbose prints).
+  std::ifstream csv(log);
+  const std::string position = "," + x + "," + y + "," + z;
+  bool published = false;
+  for (std::string row; std::getline(csv, row);)
+    published |= row.size() > position.size() && row.compare(row.size() - position.size(), position.size(), position) == 0;
+  EXPECT_TRUE(published) << "the last target " << targets.back() << " is not a pose the arm reported";
+}
+
 // An arm whose pose topic never delivers: an error naming the topic, stopped states, nothing
 // but zero twists; with require_arm the run fails. It used to run silently and exit 0.
 TEST_F(Ros2DriverTest, AnArmThatNeverAnswersIsAnErrorAndWithRequireArmFailsTheRun) {
