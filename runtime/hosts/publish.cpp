@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <map>
 #include <ostream>
 #include <set>
 #include <thread>
@@ -9,6 +10,7 @@
 #include "dyad/guest.hpp"
 #include "dyad/interrupt.hpp"
 #include "dyad/join_list.hpp"
+#include "dyad/topic_readers.hpp"
 #include "dyad/validate.hpp"
 #include "exec/wall_clock.hpp"
 #include "graph/graph_topics.hpp"
@@ -25,10 +27,10 @@ class WallClock final : public Clock {
 // The topic's type (and QoS) from the graph, the name given or its discovered endpoints; null
 // after saying why.
 const TypeInfo* TopicType(const PublishOptions& o, const Catalog& catalog, DdsParticipant& participant, TopicQos* qos,
-                          const InterruptWatcher& interrupt, std::ostream& err) {
+                          ResolvedGraph* resolved_out, const InterruptWatcher& interrupt, std::ostream& err) {
   if (o.watched != nullptr) {
     std::vector<Diagnostic> diags;
-    const ResolvedGraph resolved = ValidateGraph(*o.watched, catalog, &diags);
+    const ResolvedGraph& resolved = *resolved_out = ValidateGraph(*o.watched, catalog, &diags);
     for (const auto& d : diags) err << d.ToString() << "\n";
     if (!diags.empty()) return nullptr;
     auto it = resolved.topics.find(o.topic);
@@ -58,31 +60,49 @@ const TypeInfo* TopicType(const PublishOptions& o, const Catalog& catalog, DdsPa
   return nullptr;
 }
 
-// The participants whose readers the first sample waits for: with the graph, its processes that
-// read the topic (named ".../<graph>/<process>"); without, anyone's ("": any reader).
-std::set<std::string> ExpectedReaders(const PublishOptions& o) {
-  if (o.watched == nullptr) return {""};
-  std::set<std::string> names;
-  for (const auto& c : o.watched->components)
-    for (const auto& port : c.inputs)
-      if (port.topic == o.topic) names.insert("/" + o.watched->name + "/" + o.watched->ProcessOf(c));
-  return names.empty() ? std::set<std::string>{""} : names;
+// The readers the first sample waits for: with the graph, every reader it declares for the topic
+// (dyad/topic_readers.hpp: input ports and recorders), as {".../<graph>/<process>": how many in
+// that process}; without, anyone's ({"": 1}: any reader). `settle`: more readers may come than
+// the graph can say (none declared: a ROS 2 topic the robot's side reads; a web page that
+// subscribes through the web component's bridge).
+struct ExpectedReaders {
+  std::map<std::string, int> per_process;
+  bool settle = true;
+};
+
+ExpectedReaders ReadersToAwait(const PublishOptions& o, const ResolvedGraph& resolved) {
+  ExpectedReaders x;
+  if (o.watched != nullptr) {
+    x.settle = false;
+    for (const DeclaredReader& r : DeclaredReaders(*o.watched, resolved, o.topic)) {
+      if (r.kind == DeclaredReader::kWeb) x.settle = true;
+      else ++x.per_process["/" + o.watched->name + "/" + o.watched->ProcessOf(*r.component)];
+    }
+  }
+  if (x.per_process.empty()) x = {{{"", 1}}, true};
+  return x;
 }
 
 // Waits up to wait_s for those readers of the topic, then until this participant's writer has
 // matched every reader of the topic discovered in its partitions (discovered is not enough: a
 // sample written before the match is lost to a volatile reader).
-void AwaitReaders(const PublishOptions& o, DdsParticipant& participant, const InterruptWatcher& interrupt, std::ostream& err) {
-  std::set<std::string> missing = ExpectedReaders(o);
-  const bool any_reader = missing.count("") > 0;
+void AwaitReaders(const PublishOptions& o, const ResolvedGraph& resolved, DdsParticipant& participant,
+                  const InterruptWatcher& interrupt, std::ostream& err) {
+  const ExpectedReaders expected = ReadersToAwait(o, resolved);
+  std::set<std::string> missing;
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.watch.wait_s);
   auto readers = [&] {
     int n = 0;
+    std::map<std::string, int> found;
     for (const auto& e : participant.Discovered())
       if (!e.writer && e.topic == o.topic && e.same_partition && e.participant != participant.name()) {
         ++n;
-        std::erase_if(missing, [&](const std::string& suffix) { return e.participant.ends_with(suffix); });
+        for (const auto& [suffix, count] : expected.per_process)
+          if (e.participant.ends_with(suffix)) ++found[suffix];
       }
+    missing.clear();
+    for (const auto& [suffix, count] : expected.per_process)
+      if (found[suffix] < count) missing.insert(suffix);
     return n;
   };
   int discovered = readers();
@@ -91,13 +111,12 @@ void AwaitReaders(const PublishOptions& o, DdsParticipant& participant, const In
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
     discovered = readers();
   }
-  // When the graph does not say who reads the topic (none given, or none of its components: a
-  // ROS 2 topic the robot's side reads), nothing says how many readers there are: the rest of the
-  // discovery burst that brought the first (0.5 s), and they are matched too. The wait also lets
-  // a reader of another vendor match this writer from its side (seen with Cyclone DDS: a volatile
-  // reader ignores samples of a writer it has not matched yet, and a reliable writer's match says
-  // nothing about the reader's).
-  if (any_reader && missing.empty()) {
+  // When the graph cannot say every reader (see ExpectedReaders), nothing says how many there
+  // are: the rest of the discovery burst that brought the first (0.5 s), and they are matched
+  // too. The wait also lets a reader of another vendor match this writer from its side (seen
+  // with Cyclone DDS: a volatile reader ignores samples of a writer it has not matched yet, and a
+  // reliable writer's match says nothing about the reader's).
+  if (expected.settle && missing.empty()) {
     const auto settle = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
     while (std::chrono::steady_clock::now() < settle && std::chrono::steady_clock::now() < end && !interrupt.interrupted())
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -122,7 +141,8 @@ int PublishTopic(const PublishOptions& o, const Catalog& catalog, const SampleMa
   std::unique_ptr<DdsParticipant> participant = JoinAsWatcher(o.watch, "dyad/guest/pub/" + std::to_string(getpid()), err);
   if (!participant) return 1;
   TopicQos qos;
-  const TypeInfo* type = TopicType(o, catalog, *participant, &qos, interrupt, err);
+  ResolvedGraph resolved;
+  const TypeInfo* type = TopicType(o, catalog, *participant, &qos, &resolved, interrupt, err);
   if (interrupt.interrupted()) return ExitCodeForSignal(interrupt.signal());
   if (type == nullptr) return 2;
   StatusOr<std::vector<uint8_t>> sample = make_sample(*type, 0);
@@ -136,7 +156,7 @@ int PublishTopic(const PublishOptions& o, const Catalog& catalog, const SampleMa
     err << "dyad pub: " << writer.status().message() << "\n";
     return 1;
   }
-  AwaitReaders(o, *participant, interrupt, err);
+  AwaitReaders(o, resolved, *participant, interrupt, err);
   const auto period = std::chrono::duration<double>(o.rate_hz > 0 ? 1.0 / o.rate_hz : 0.0);
   const auto start = std::chrono::steady_clock::now();
   uint64_t written = 0;
