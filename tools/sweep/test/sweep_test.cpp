@@ -223,7 +223,8 @@ TEST_F(SweepTest, ARunWhoseFolderCannotBeMadeFailsAndTheSweepGoesOn) {
 // SIGTERM: no run starts, the one under way stops (its whole process group), the finished one
 // is kept, what is missing is said, exit 130, no process of the sweep is left. A rerun skips the
 // finished run; SIGINT stops it the same way, even when the sweep was started with SIGINT
-// ignored (a script's background job).
+// ignored (a script's background job). A sweep killed outright (SIGKILL) leaves no run behind
+// either (each has SIGINT as its parent-death signal).
 TEST_F(SweepTest, AStopSignalEndsEveryRunKeepsTheFinishedAndSaysWhatIsMissing) {
   // The sink ends a run after `expect` samples; expect 0: the run lasts its (long) duration.
   const fs::path file = Write("sweep: s\ngraph: g.yaml\nduration: 1000000\ngrid: {sink.expect: [5, 0, 6]}\n");
@@ -268,6 +269,14 @@ TEST_F(SweepTest, AStopSignalEndsEveryRunKeepsTheFinishedAndSaysWhatIsMissing) {
   EXPECT_NE(out.find("stopped by SIGINT: 0 ran, 1 done before, 0 failed, 2 runs missing:"), std::string::npos) << out;
   left = ProcessesNaming(dir_.string());
   EXPECT_TRUE(left.empty()) << left.size() << " processes of the sweep left";
+  for (int pid : left) kill(pid, SIGKILL);
+
+  // The sweep killed outright: its run gets its parent-death signal and ends too.
+  fs::remove(runs / ids[1] / "run.log");
+  EXPECT_EQ(stop_when_second_runs(SIGKILL, "kill", &out), 128 + SIGKILL) << out;
+  for (int i = 0; i < 300 && !ProcessesNaming(dir_.string()).empty(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  left = ProcessesNaming(dir_.string());
+  EXPECT_TRUE(left.empty()) << left.size() << " processes of the sweep outlived it";
   for (int pid : left) kill(pid, SIGKILL);
 }
 
