@@ -10,6 +10,7 @@
 // no exception, no abort.
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -34,12 +35,23 @@ const dyad::Catalog& BuiltinCatalog() {
   return *catalog;
 }
 
-// This process's folder of chain files (one per process: fuzzing jobs run side by side).
+std::string FolderName() {
+  const char* tmp = std::getenv("TMPDIR");
+  return std::string(tmp && *tmp ? tmp : "/tmp") + "/dyad_fuzz_chain_" + std::to_string(getpid());
+}
+
+void RemoveFolder() {
+  std::error_code ec;
+  std::filesystem::remove_all(FolderName(), ec);
+}
+
+// This process's folder of chain files (one per process: fuzzing jobs run side by side), removed
+// at exit.
 const std::string& Folder() {
   static const std::string dir = [] {
-    const char* tmp = std::getenv("TMPDIR");
-    const std::string d = std::string(tmp && *tmp ? tmp : "/tmp") + "/dyad_fuzz_chain_" + std::to_string(getpid());
+    const std::string d = FolderName();
     std::filesystem::create_directories(d);
+    std::atexit(RemoveFolder);
     return d;
   }();
   return dir;
