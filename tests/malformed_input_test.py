@@ -69,6 +69,7 @@ def corpus():
         ("extends_malformed_base", "extends: base_cut.yaml\ncomponents: {src: {params: {noise: 2}}}\n"),
         ("extends_itself", "extends: extends_itself.yaml\n"),
         ("extends_a_list", "extends: [a.yaml]\n" + v),
+        ("extends_a_folder", "extends: .\n" + v),
     ]
     extra = {"base_cut.yaml": v[: v.index("{noise: 1}") + 5]}
     return [(n, t.encode() if isinstance(t, str) else t) for n, t in files], extra

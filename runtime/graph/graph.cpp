@@ -586,8 +586,9 @@ std::string LocalScopeNote(const NetworkConfig& network, bool watcher) {
 
 Graph LoadGraph(const std::string& path, const std::vector<Override>& overrides, std::vector<Diagnostic>* diagnostics) {
   std::ifstream in(path);
-  if (!in) {
-    diagnostics->push_back({SourceMark{path, 0, 0}, "", "cannot open graph file"});
+  std::error_code ec;
+  if (!in || std::filesystem::is_directory(path, ec)) {
+    diagnostics->push_back({SourceMark{path, 0, 0}, "", in ? "is a folder, not a graph file" : "cannot open graph file"});
     Graph g;
     g.file = path;
     return g;

@@ -132,9 +132,14 @@ std::vector<std::pair<std::string, YAML::Node>> ReadChain(const std::string& pat
                       "a chain longer than " + std::to_string(kMaxChain) + " files: " + names + base});
       break;
     }
+    std::error_code ec;
     std::ifstream in(base);
     if (!in) {
       out->push_back({SourceMark::Of(file, ext), "extends", "cannot open '" + base + "'"});
+      break;
+    }
+    if (!std::filesystem::is_regular_file(base, ec)) {  // a folder; /dev/zero would be read until memory runs out
+      out->push_back({SourceMark::Of(file, ext), "extends", "'" + base + "' is not a file"});
       break;
     }
     std::stringstream text;
