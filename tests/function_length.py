@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """No function a reader has to scroll: every C++ function under a folder is at most LIMIT lines
-long (the runtime's house rule, docs/runtime.md). Functions are found by universal-ctags (their
-start and end lines); lambdas count as part of the function that holds them. Prints each longer
-one as file:line: name: N lines and exits 1; exits 0 when there is none.
+long (the house rule, docs/runtime.md; runs on runtime/, components/ and tools/). Functions are found
+by universal-ctags (their start and end lines); lambdas count as part of the function that holds them.
+Tests and generated code are aside: a file under a folder named test, tests or generated is not
+checked (a TEST body is a scenario read top to bottom). Prints each longer one as
+file:line: name: N lines and exits 1; exits 0 when there is none.
 
     function_length.py [--limit N] DIR
     function_length.py --self-test   the checker finds what it must in a made-up file
@@ -14,6 +16,7 @@ import sys
 import tempfile
 
 DEFAULT_LIMIT = 80
+ASIDE = {"test", "tests", "generated"}  # folders whose files are not checked
 
 
 def functions(root):
@@ -26,9 +29,14 @@ def functions(root):
         sys.exit("function_length: universal-ctags is not installed (bash tools/setup.sh installs it)")
     for line in out.splitlines():
         tag = json.loads(line)
-        if tag.get("_type") == "tag" and "end" in tag:
+        if tag.get("_type") == "tag" and "end" in tag and not aside(root, tag["path"]):
             scope = [s for s in tag.get("scope", "").split("::") if s and not s.startswith("__anon")]
             yield tag["path"], tag["line"], "::".join(scope + [tag["name"]]), tag["end"] - tag["line"] + 1
+
+
+def aside(root, path):
+    """True for a file under a test or generated folder (below root: root itself may be one)."""
+    return bool(ASIDE & set(pathlib.Path(path).relative_to(root).parts[:-1]))
 
 
 def check(root, limit):
@@ -43,11 +51,15 @@ def self_test():
             "int Short() {\n  return 1;\n}\n\n"
             f"int Long(int x) {{\n{body}\n  return x;\n}}\n\n"
             f"struct S {{\n  void Method() {{\n{body}\n  }}\n}};\n")
+        for folder in ("test", "generated"):
+            pathlib.Path(d, "x", folder).mkdir(parents=True)
+            pathlib.Path(d, "x", folder, "b.cpp").write_text(f"int Long(int x) {{\n{body}\n  return x;\n}}\n")
         problems = check(d, 8)
         assert len(problems) == 2, problems
         assert problems[0].endswith("a.cpp:5: Long: 13 lines (at most 8)"), problems
         assert "S::Method: 12 lines" in problems[1], problems
         assert check(d, 13) == [], check(d, 13)
+        assert len(check(pathlib.Path(d, "x", "test"), 8)) == 1  # the root itself may be named test
     print("function_length self-test: ok")
     return 0
 
