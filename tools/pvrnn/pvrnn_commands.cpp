@@ -49,22 +49,48 @@ std::string Duration(double s) {
   return buf;
 }
 
-template <typename Scalar>
-int RunTraining(const TrainConfig& c, const std::string& config_path, const Dataset& data, bool resume) {
-  Model init;
+// The model training starts from: the checkpoint (--resume), else a new one of the config's
+// shape; with its provenance. kOk, or the exit code having said why.
+int StartingModel(const TrainConfig& c, const std::string& config_path, const Dataset& data, bool resume, Model* init) {
   if (resume) {
     auto ck = LoadModel(c.checkpoint);
     if (!ck.ok()) return Fail(kBadInput, "--resume: " + ck.status().message());
     if (!ck->training) return Fail(kBadInput, c.checkpoint + ": has no training state (not a checkpoint)");
     if (!(ck->spec == c.spec)) return Fail(kBadInput, c.checkpoint + ": model shape differs from " + config_path);
-    init = std::move(ck.value());
+    *init = std::move(ck.value());
   } else {
-    init = Model::Initialize(c.spec, data.steps(), data.size(), c.seed);
+    *init = Model::Initialize(c.spec, data.steps(), data.size(), c.seed);
   }
-  init.provenance.source = "dyad train " + config_path;
-  init.provenance.dataset = c.dataset;
-  init.provenance.seed = c.seed;
-  init.provenance.scalar = c.scalar;
+  init->provenance.source = "dyad train " + config_path;
+  init->provenance.dataset = c.dataset;
+  init->provenance.seed = c.seed;
+  init->provenance.scalar = c.scalar;
+  return kOk;
+}
+
+// The folders of the outputs made, and the log CSV opened (appended to on --resume) with its
+// header when new. kOk, or the exit code having said why.
+int OpenTrainingLog(const TrainConfig& c, bool resume, std::ofstream* csv) {
+  for (const std::string& f : {c.output, c.checkpoint, c.log_csv}) {
+    const auto dir = std::filesystem::path(f).parent_path();
+    std::error_code ec;
+    if (!dir.empty()) std::filesystem::create_directories(dir, ec);
+    if (ec) return Fail(kFailure, dir.string() + ": cannot create folder: " + ec.message());
+  }
+  csv->open(c.log_csv, resume && std::filesystem::exists(c.log_csv) ? std::ios::app : std::ios::trunc);
+  if (!*csv) return Fail(kFailure, c.log_csv + ": cannot open for writing");
+  if (!resume || csv->tellp() == 0) {
+    *csv << "epoch,reconstruction_q,reconstruction_p,regulation,loss";
+    for (int k = 0; k < c.spec.num_layers(); ++k) *csv << ",kl_layer" << k;
+    *csv << ",elapsed_s\n";
+  }
+  return kOk;
+}
+
+template <typename Scalar>
+int RunTraining(const TrainConfig& c, const std::string& config_path, const Dataset& data, bool resume) {
+  Model init;
+  if (int code = StartingModel(c, config_path, data, resume, &init); code != kOk) return code;
   TrainerOptions opts;
   opts.adam = c.adam;
   opts.seed = c.seed;
@@ -77,19 +103,8 @@ int RunTraining(const TrainConfig& c, const std::string& config_path, const Data
   if (start_epoch >= c.epochs)
     return Fail(kBadInput, c.checkpoint + ": already at epoch " + std::to_string(start_epoch) + " of " + std::to_string(c.epochs));
 
-  for (const std::string& f : {c.output, c.checkpoint, c.log_csv}) {
-    const auto dir = std::filesystem::path(f).parent_path();
-    std::error_code ec;
-    if (!dir.empty()) std::filesystem::create_directories(dir, ec);
-    if (ec) return Fail(kFailure, dir.string() + ": cannot create folder: " + ec.message());
-  }
-  std::ofstream csv(c.log_csv, resume && std::filesystem::exists(c.log_csv) ? std::ios::app : std::ios::trunc);
-  if (!csv) return Fail(kFailure, c.log_csv + ": cannot open for writing");
-  if (!resume || csv.tellp() == 0) {
-    csv << "epoch,reconstruction_q,reconstruction_p,regulation,loss";
-    for (int k = 0; k < c.spec.num_layers(); ++k) csv << ",kl_layer" << k;
-    csv << ",elapsed_s\n";
-  }
+  std::ofstream csv;
+  if (int code = OpenTrainingLog(c, resume, &csv); code != kOk) return code;
   const bool tty = isatty(fileno(stdout));
   std::printf("training %s (%d sequences x %d steps) from epoch %lld to %lld, %s, seed %llu\n", c.dataset.c_str(),
               data.size(), data.steps(), static_cast<long long>(start_epoch), static_cast<long long>(c.epochs),
