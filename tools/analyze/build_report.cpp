@@ -19,6 +19,8 @@ StatusOr<Report> BuildReport(const std::string& recording, std::ostream& warning
   report.recording = recording;
   // Without its footer the file is not what the recorder closed, even when no message was lost.
   if (recovery.truncated || !recovery.damaged_chunks.empty()) report.incomplete = recovery.Describe();
+  if (const mcap::Statistics& stats = reader->statistics(); stats.message_count > 0)
+    report.message_span_s = static_cast<double>(stats.message_end_time - stats.message_start_time) / 1e9;
   report.graph_yaml = GraphMetadata(*reader, "yaml");
   auto plan = PlanFromGraphYaml(report.graph_yaml);
   if (!plan.ok()) return plan.status().WithContext(recording);

@@ -288,6 +288,14 @@ void ConfusionSection(const Report& r, std::ostream& s) {
 std::string IncompleteReason(const Report& r) {
   if (!r.incomplete.empty()) return r.incomplete;
   if (!(r.planned_s > 0)) return "";
+  const double period_s = static_cast<double>(r.plan.period_ns) / 1e9;
+  if (r.timeline.steps.empty()) {  // no experiment steps: the messages' span measures the run
+    const double recorded_s = r.message_span_s >= 0 ? r.message_span_s + period_s : 0;
+    if (recorded_s >= 0.95 * r.planned_s) return "";
+    if (r.message_span_s < 0) return "shorter than planned: no message recorded of the " + tools::CsvNumber(r.planned_s) + " s planned";
+    return "shorter than planned: messages over " + tools::CsvNumber(r.message_span_s) + " s (no experiment steps) of the " +
+           tools::CsvNumber(r.planned_s) + " s planned";
+  }
   const double recorded_s = static_cast<double>(static_cast<int64_t>(r.timeline.steps.size()) * r.plan.period_ns) / 1e9;
   if (recorded_s >= 0.95 * r.planned_s) return "";
   return "shorter than planned: " + std::to_string(r.timeline.steps.size()) + " steps of " +

@@ -46,11 +46,15 @@ struct Report {
   std::string incomplete;
   // The run's planned length in seconds (0: unknown): a recording shorter than it is incomplete.
   double planned_s = 0;
+  // From the first to the last message of any topic (log times), seconds; -1: no message. What
+  // the length rule measures when the recording has no experiment steps (a graph of other topics).
+  double message_span_s = -1;
 };
 
 // Why `report`'s recording is incomplete, "" when it is whole: Report::incomplete, else, when
 // planned_s > 0, its steps span less than 95% of it ("903 steps of 100 ms (90.3 s) of the 170 s
-// planned"; the slack is a wall-clock run's start-up). `dyad analyze`, `dyad study analyze` and
+// planned"; the slack is a wall-clock run's start-up); without experiment steps, its messages'
+// span plus one period does (the same measure: n steps span n - 1 periods). `dyad analyze`, `dyad study analyze` and
 // `dyad sweep` leave such a run out of their summaries by this rule.
 std::string IncompleteReason(const Report& report);
 

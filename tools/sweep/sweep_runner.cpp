@@ -76,13 +76,16 @@ bool RunChild(const std::vector<std::string>& args, const std::string& log, int*
   return !stopped;
 }
 
-// `dyad analyze --no-plots`, in this process (a second process per run cost a fifth of a short
-// run); its warnings go to analyze.log beside the report.
-Status Analyze(const std::string& recording, const std::string& report_dir) {
+// `dyad analyze --no-plots --duration planned_s`, in this process (a second process per run cost
+// a fifth of a short run); its warnings go to analyze.log beside the report. A recording cut
+// short or shorter than planned gets report/incomplete.txt (analyze::IncompleteReason), which
+// marks the run `incomplete` in sweep.csv.
+Status Analyze(const std::string& recording, const std::string& report_dir, double planned_s) {
   std::ostringstream warnings;
   auto report = analyze::BuildReport(recording, warnings);
   std::ofstream(fs::path(report_dir).parent_path() / "analyze.log") << warnings.str();
   if (!report.ok()) return report.status();
+  report->planned_s = planned_s;
   return analyze::WriteReport(*report, report_dir);
 }
 
@@ -127,7 +130,7 @@ JobEnd DoRun(const SweepPlan& plan, const SweepRun& run, const RunnerOptions& o)
   if (rc != 0)
     return Failed(dir / "failed.txt", tools::ShellQuoted(run_args) + "\nexited " + std::to_string(rc) + "; the end of run.log:\n" +
                                           Tail((dir / "run.log").string(), 20));
-  if (Status s = Analyze((dir / "rec.mcap").string(), (dir / "report").string()); !s.ok())
+  if (Status s = Analyze((dir / "rec.mcap").string(), (dir / "report").string(), plan.duration_s); !s.ok())
     return Failed(dir / "failed.txt", "dyad analyze " + (dir / "rec.mcap").string() + ": " + s.message() + "\n");
   fs::copy_file(dir / "report" / "metrics.json", dir / "metrics.json.new", fs::copy_options::overwrite_existing, ec);
   if (!ec) fs::rename(dir / "metrics.json.new", dir / "metrics.json", ec);
@@ -277,7 +280,10 @@ Status WriteSweepCsv(const SweepPlan& plan, const std::string& out) {
     if (in) {
       metrics[i] = nlohmann::ordered_json::parse(in, nullptr, false);
       if (!metrics[i].is_object()) return Status::DataLoss((dir / "metrics.json").string(), "not a JSON object");
-      status[i] = "ok";
+      // A recording cut short or shorter than planned: its numbers are in the table, marked, and
+      // out of the plots (which take the `ok` rows).
+      std::error_code ec;
+      status[i] = fs::exists(dir / "report" / "incomplete.txt", ec) ? "incomplete" : "ok";
       if (metric_names.empty())
         for (const auto& [name, value] : metrics[i].items()) metric_names.push_back(name);
     } else if (std::error_code ec; fs::exists(dir / "failed.txt", ec)) {

@@ -143,6 +143,25 @@ TEST_F(SweepTest, AFailingRunIsRecordedTheRestRunAndARerunResumes) {
   EXPECT_EQ(ReadFile(dir_ / "o" / "sweep.csv").find("failed"), std::string::npos);
 }
 
+// A run that ended itself before its duration (the source stops the run after 3 samples) is
+// marked incomplete in the table, with its reason in its report, and left out of the plots.
+TEST_F(SweepTest, ARunShorterThanItsDurationIsMarkedIncomplete) {
+  const fs::path file = Write("sweep: s\ngraph: g.yaml\nduration: 3\ngrid:\n  src.limit: [0, 3]\n");
+  std::string out;
+  EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--no-plots"}, &out), 0) << out;
+  const std::string csv = ReadFile(dir_ / "o" / "sweep.csv");
+  EXPECT_NE(csv.find(",ok,0,1,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",incomplete,3,1,"), std::string::npos) << csv;
+  size_t incomplete = 0;
+  for (const auto& run : fs::directory_iterator(dir_ / "o" / "runs"))
+    if (fs::exists(run.path() / "report" / "incomplete.txt")) {
+      ++incomplete;
+      EXPECT_NE(ReadFile(run.path() / "report" / "incomplete.txt").find("(no experiment steps) of the 3 s planned"), std::string::npos)
+          << ReadFile(run.path() / "report" / "incomplete.txt");
+    }
+  EXPECT_EQ(incomplete, 1u);
+}
+
 // The cache key is the run as it runs: a rerun after a duration change runs every run again.
 TEST_F(SweepTest, ARerunWithAnotherDurationRunsEveryRunAgain) {
   const std::string grid = "grid: {src.start: [0, 100]}\n";
