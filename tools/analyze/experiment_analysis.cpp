@@ -156,6 +156,23 @@ Status FillLabels(const Cells& c, size_t r, StepSample& s) {
 
 }  // namespace
 
+namespace {
+// A person's shortest event: with a web_human, the web component's self_report_min_hold_s (its
+// default 1 s when unset), what the subject's page asks about; else 0 (every engaged run counts).
+int64_t MinEventNs(const YAML::Node& components) {
+  bool web_human = false;
+  double min_hold_s = 1.0;
+  for (const auto& entry : components) {
+    const YAML::Node c = entry.second;
+    const std::string type = c["type"] ? c["type"].as<std::string>() : "";
+    if (type == "web_human") web_human = true;
+    if (type == "web" && c["params"] && c["params"]["self_report_min_hold_s"])
+      min_hold_s = c["params"]["self_report_min_hold_s"].as<double>();
+  }
+  return web_human ? std::llround(min_hold_s * 1e9) : 0;
+}
+}  // namespace
+
 StatusOr<ExperimentPlan> PlanFromGraphYaml(const std::string& yaml) {
   ExperimentPlan plan;
   if (yaml.empty()) return plan;
@@ -175,6 +192,7 @@ StatusOr<ExperimentPlan> PlanFromGraphYaml(const std::string& yaml) {
       plan.process_of[entry.first.as<std::string>()] = process;
       if (c["type"] && c["type"].as<std::string>() == "recorder") plan.recorder_process = process;
     }
+    plan.min_event_ns = MinEventNs(components);
     for (const auto& entry : components) {
       const YAML::Node c = entry.second;
       const std::string type = c["type"] ? c["type"].as<std::string>() : "";
@@ -430,6 +448,8 @@ std::vector<PlannedEvent> Events(const Timeline& timeline, const ExperimentPlan&
     }
     events.back().end_step = static_cast<int64_t>(i) + 1;
   }
+  // Taps: the page asked nothing about them (a hold shorter than its self_report_min_hold_s).
+  std::erase_if(events, [&](const PlannedEvent& e) { return (e.end_step - e.start_step) * plan.period_ns < plan.min_event_ns; });
   return events;
 }
 

@@ -20,7 +20,9 @@
 //
 // Events are the human's interventions: taken from the graph's human_synthetic `events` (with the
 // primitive the human traced, so confusion and "robot follows" can be scored), else from runs of
-// engaged steps (primitive unknown: -1).
+// engaged steps (primitive unknown: -1). A person's run shorter than the subject's page's
+// `self_report_min_hold_s` (a graph with a `web_human`: the `web` component's, 1 s when unset) is
+// a tap, not an event: the page never asks about it, and the analysis does not count it.
 #pragma once
 
 #include <cstdint>
@@ -52,6 +54,9 @@ struct ExperimentPlan {
   std::string dataset;               // the human's dataset param, "" if none
   std::map<std::string, std::string> process_of;  // component -> its process ("" when one process)
   std::string recorder_process;                   // the process of the recorder, "" if none
+  // An engaged run shorter than this is no event (a tap); 0: every run is one. A graph with a
+  // web_human: its web component's self_report_min_hold_s (1 s when unset).
+  int64_t min_event_ns = 0;
 };
 
 // Per process, what to subtract from its stamps to put them on the recorder's process's clock
@@ -120,7 +125,8 @@ struct NoteEvent {
 StatusOr<std::vector<NoteEvent>> ExperimenterNotes(const std::map<std::string, TopicTable>& tables, const ExperimentPlan& plan,
                                                    const Timeline& timeline);
 
-// Events of the plan, or engaged runs of the timeline when the plan has none. Planned events are
+// Events of the plan, or engaged runs of the timeline when the plan has none (those shorter than
+// plan.min_event_ns left out: taps). Planned events are
 // limited to the recorded steps: one starting after the last recorded step is left out (the run
 // ended before it), one running past it ends there.
 std::vector<PlannedEvent> Events(const Timeline& timeline, const ExperimentPlan& plan);

@@ -50,6 +50,21 @@ void AddConfusion(const std::vector<std::vector<int64_t>>& m, std::vector<std::v
 // A condition as the analysis's files name it: by name once unblinded, else by its label only.
 std::string NameOf(const StudyAnalysis& a, const Condition& c) { return a.unblinded ? c.name : "condition " + c.label; }
 
+// A primitive as people read it: its name (names.txt), else "primitive K"; -1 is `none`.
+std::string PrimitiveName(const StudyAnalysis& a, int k, const char* none) {
+  if (k < 0) return none;
+  return static_cast<size_t>(k) < a.primitive_names.size() ? a.primitive_names[static_cast<size_t>(k)] : "primitive " + std::to_string(k);
+}
+std::string Said(const StudyAnalysis& a, int k) { return PrimitiveName(a, k, "something else"); }
+std::string Observed(const StudyAnalysis& a, int k) { return PrimitiveName(a, k, "no label"); }
+
+void AddSaid(const SaidVsObserver& m, SaidVsObserver* sum) {
+  for (const auto& [key, cell] : m) {
+    (*sum)[key].events += cell.events;
+    (*sum)[key].steps += cell.steps;
+  }
+}
+
 std::string TrialsCsv(const Study& s, const StudyAnalysis& a) {
   std::ostringstream out;
   out << "participant,condition,label,trial,repetition,attempt,file,complete,reason";
@@ -148,25 +163,26 @@ void IncompleteSection(const StudyAnalysis& a, std::ostream& out) {
   }
 }
 
-// A confusion as a markdown table: each row's shares (its counts in brackets); empty rows left out.
-void ConfusionTable(const std::vector<std::vector<int64_t>>& m, std::ostream& out) {
-  size_t classes = m.size();
-  for (const auto& row : m) classes = std::max(classes, row.size());
+// The self-reports against the observer as a markdown table: a row per answer given (a primitive
+// by name, or "something else"), a column per class the observer named; each cell its events,
+// their labelled steps in brackets.
+void SaidTable(const StudyAnalysis& a, const SaidVsObserver& m, std::ostream& out) {
+  std::set<int> said, observed;
+  for (const auto& [key, cell] : m) said.insert(key.first), observed.insert(key.second);
   out << "| said / observer |";
-  for (size_t p = 0; p < classes; ++p) out << ' ' << p << " |";
+  for (const int o : observed) out << ' ' << tools::MarkdownCell(Observed(a, o)) << " |";
   out << "\n|---|";
-  for (size_t p = 0; p < classes; ++p) out << "---|";
+  for (size_t i = 0; i < observed.size(); ++i) out << "---|";
   out << "\n";
-  for (size_t t = 0; t < m.size(); ++t) {
-    int64_t total = 0;
-    for (int64_t n : m[t]) total += n;
-    if (total == 0) continue;
-    out << "| **" << t << "** |";
-    for (size_t p = 0; p < classes; ++p) {
-      const int64_t n = p < m[t].size() ? m[t][p] : 0;
-      char share[32];
-      std::snprintf(share, sizeof share, "%.2f", static_cast<double>(n) / static_cast<double>(total));
-      out << ' ' << share << " (" << n << ") |";
+  // "something else" (-1) last: its own row, after the primitives.
+  std::vector<int> rows(said.upper_bound(-1), said.end());
+  if (said.count(-1)) rows.push_back(-1);
+  for (const int r : rows) {
+    out << "| **" << tools::MarkdownCell(Said(a, r)) << "** |";
+    for (const int o : observed) {
+      const auto it = m.find({r, o});
+      const SaidCell c = it == m.end() ? SaidCell{} : it->second;
+      out << ' ' << c.events << " (" << c.steps << ") |";
     }
     out << "\n";
   }
@@ -175,28 +191,34 @@ void ConfusionTable(const std::vector<std::vector<int64_t>>& m, std::ostream& ou
 // Per condition: the observer against what the participants said they drew, summed over the
 // condition's counted trials, and its accuracy over participants with the interval.
 void ReportedConfusionSection(const Study& s, const StudyAnalysis& a, const Summaries& summary, std::ostream& out) {
-  if (a.reported_confusion.empty()) return;
+  if (a.said_vs_observer.empty()) return;
   out << "\n## The observer against the self-reports, per condition\n\n"
-         "Rows: the primitive the participant said they drew; columns: the observer's most likely class of their motion "
-         "over the event's labelled steps; each row's shares, its step counts in brackets, over the condition's trials. "
-         "Accuracy: the share on the diagonal per trial (reported_accuracy), each participant's mean over their trials, "
-         "then the mean over participants with its 95% bootstrap interval.\n";
+         "Rows: what the participant said they drew (\"something else\" its own row); columns: the class the observer "
+         "named most over the event's labelled steps; each cell counts events, with the labelled steps of those answers "
+         "on which the observer named that class in brackets, over the condition's trials (reported_confusion.csv). "
+         "Accuracy: per trial, the share of the labelled steps of events said to be a primitive on which the observer "
+         "named it (reported_accuracy), each participant's mean over their trials, then the mean over participants with "
+         "its 95% bootstrap interval.\n";
   for (const auto& [c, measures] : summary) {
     const size_t index = static_cast<size_t>(c - s.conditions.data());
-    std::vector<std::vector<int64_t>> m;
+    SaidVsObserver m;
     for (const TrialResult& r : a.trials)
-      if (static_cast<size_t>(r.trial.condition) == index && a.Counted(r)) AddConfusion(r.reported_confusion, &m);
+      if (static_cast<size_t>(r.trial.condition) == index && a.Counted(r)) AddSaid(r.said_vs_observer, &m);
     out << "\n### " << Heading(a, *c) << "\n\n";
-    const auto acc =
-        std::find_if(measures.begin(), measures.end(), [](const ConditionMeasure& x) { return x.measure == "reported_accuracy"; });
-    if (m.empty() || acc == measures.end() || acc->interval.n == 0) {
-      out << "No self-report with observer labels.\n";
+    if (m.empty()) {
+      out << "No self-report.\n";
       continue;
     }
-    const MeanInterval& ci = acc->interval;
-    out << "Accuracy " << Num(ci.mean) << " (95% interval " << Num(ci.low) << " to " << Num(ci.high) << "; " << ci.n << " participant"
-        << (ci.n == 1 ? "" : "s") << ", " << acc->trials << " trial" << (acc->trials == 1 ? "" : "s") << ").\n\n";
-    ConfusionTable(m, out);
+    const auto acc =
+        std::find_if(measures.begin(), measures.end(), [](const ConditionMeasure& x) { return x.measure == "reported_accuracy"; });
+    if (acc == measures.end() || acc->interval.n == 0) {
+      out << "Accuracy unknown (no self-report of a primitive with observer labels).\n\n";
+    } else {
+      const MeanInterval& ci = acc->interval;
+      out << "Accuracy " << Num(ci.mean) << " (95% interval " << Num(ci.low) << " to " << Num(ci.high) << "; " << ci.n << " participant"
+          << (ci.n == 1 ? "" : "s") << ", " << acc->trials << " trial" << (acc->trials == 1 ? "" : "s") << ").\n\n";
+    }
+    SaidTable(a, m, out);
   }
 }
 
@@ -275,6 +297,32 @@ const std::vector<std::string>& SummaryMeasures() {
   static const std::vector<std::string> m = {"mean_congruence", "observer_accuracy", "reported_accuracy", "robot_follows",
                                              "switch_latency_s", "nelbo_mean"};
   return m;
+}
+
+std::string EmptyTrialReason(const analyze::Report& r) {
+  const auto& missing = r.timeline.missing_topics;
+  if (std::find(missing.begin(), missing.end(), "human/input") != missing.end())
+    return "no participant: no human input recorded (human/input)";
+  if (std::none_of(r.timeline.steps.begin(), r.timeline.steps.end(), [](const analyze::StepSample& x) { return x.engaged; }))
+    return "no participant: not one engaged step (no subject's page connected, or nobody held)";
+  return "";
+}
+
+SaidVsObserver SaidAgainstObserver(const analyze::Report& r) {
+  SaidVsObserver out;
+  for (const analyze::EventSummary& e : r.events) {
+    if (e.event.reported == analyze::kNotReported) continue;
+    std::map<int, int64_t> named;  // the observer's class -> labelled steps
+    const auto end = std::min<int64_t>(e.event.end_step, static_cast<int64_t>(r.timeline.steps.size()));
+    for (int64_t t = std::max<int64_t>(e.event.start_step, 0); t < end; ++t)
+      if (const int k = analyze::MostLikelyClass(r.timeline.steps[static_cast<size_t>(t)].p_human); k >= 0) ++named[k];
+    int most = -1;  // the class most steps name, the first on ties; -1: no label
+    for (const auto& [k, n] : named)
+      if (most < 0 || n > named[most]) most = k;
+    ++out[{e.event.reported, most}].events;
+    for (const auto& [k, n] : named) out[{e.event.reported, k}].steps += n;
+  }
+  return out;
 }
 
 std::string NotThisTrial(const std::string& file, const Study& study, const std::string& participant, const Trial& trial,
@@ -391,7 +439,10 @@ StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehe
       TrialResult r{p, t, c.attempt, !report->plan.events.empty(), c.repeated, analyze::RunMetrics(*report), report->events};
       r.trial.file = c.file;
       r.incomplete = analyze::IncompleteReason(*report);
+      if (r.incomplete.empty()) r.incomplete = EmptyTrialReason(*report);
       r.reported_confusion = report->reported_confusion;
+      r.said_vs_observer = SaidAgainstObserver(*report);
+      if (a.primitive_names.empty()) a.primitive_names = report->primitive_names;
       r.metrics.emplace_back("reported_accuracy", Accuracy(r.reported_confusion));
       if (a.Counted(r)) {
         if (r.planned)
@@ -399,6 +450,7 @@ StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehe
             if (e.event.primitive >= 0 && e.event.reported != analyze::kNotReported)
               ++a.reports_vs_plan[{e.event.primitive, e.event.reported}];
         AddConfusion(r.reported_confusion, &a.reported_confusion);
+        AddSaid(r.said_vs_observer, &a.said_vs_observer);
       }
       a.trials.push_back(std::move(r));
     }
@@ -425,13 +477,14 @@ Status WriteStudyAnalysis(const Study& study, const StudyAnalysis& a, const std:
     if (Status s = tools::WriteTextFile((d / name).string(), text); !s.ok()) return s;
   // The two matrices exist only when there is something in them (an old file goes).
   std::ostringstream confusion, vs_plan;
-  confusion << "reported,predicted,count\n";
-  for (size_t t = 0; t < a.reported_confusion.size(); ++t)
-    for (size_t p = 0; p < a.reported_confusion[t].size(); ++p) confusion << t << ',' << p << ',' << a.reported_confusion[t][p] << '\n';
+  confusion << "reported,observer,events,steps\n";
+  for (const auto& [key, cell] : a.said_vs_observer)
+    confusion << tools::CsvCell(Said(a, key.first)) << ',' << tools::CsvCell(Observed(a, key.second)) << ',' << cell.events << ','
+              << cell.steps << '\n';
   vs_plan << "planned,reported,events\n";
   for (const auto& [pair, n] : a.reports_vs_plan) vs_plan << pair.first << ',' << pair.second << ',' << n << '\n';
   const std::tuple<const char*, bool, std::string> optional[] = {
-      {"reported_confusion.csv", !a.reported_confusion.empty(), confusion.str()},
+      {"reported_confusion.csv", !a.said_vs_observer.empty(), confusion.str()},
       {"reports_vs_plan.csv", !a.reports_vs_plan.empty(), vs_plan.str()}};
   for (const auto& [name, present, text] : optional) {
     if (!present) std::filesystem::remove(d / name, ec);

@@ -11,7 +11,8 @@
 //     trial of this participant of this study (another study's file, a rehearsal's among the
 //     participants' or the reverse, or a file without that metadata).
 //   - A trial whose recording is analysed but incomplete (analyze::IncompleteReason: the file is
-//     cut short or damaged, or spans less than 95% of the study's `duration`) is kept in
+//     cut short or damaged, or spans less than 95% of the study's `duration`; or EmptyTrialReason:
+//     nobody took part, no human input or not one engaged step) is kept in
 //     trials.csv and events.csv, marked (complete false, its reason), and left out of everything
 //     summed over trials (summary.csv, the confusion, reports_vs_plan.csv, the plots) unless
 //     include_incomplete; report.md lists it with its reason.
@@ -27,8 +28,12 @@
 //     condition and measure: each participant's mean over their trials (summed in the plan's
 //     order), then the mean over participants (summed in ID order) with a 95% percentile-bootstrap
 //     interval that resamples participants, seeded from the study, condition and measure names),
-//     reported_confusion.csv (the observer against the self-reports, summed over trials; only
-//     when there are some), reports_vs_plan.csv (synthetic participants: the primitive each traced
+//     reported_confusion.csv (reported,observer,events,steps: the primitive the participant said
+//     they drew, by its name (names.txt of the graph's data set; "primitive K" without one) or
+//     "something else", against the observer's most likely class over the event's labelled steps
+//     (the class most of them name; "no label": none), counted in events, with the labelled steps
+//     of those reports on which the observer named that class beside; summed over the counted
+//     trials; only when there are self-reports), reports_vs_plan.csv (synthetic participants: the primitive each traced
 //     against the one it reported, per event; only when there are some) and report.md (the
 //     summary; per condition the observer's confusion against the self-reports and its accuracy
 //     with its interval; the incomplete and the missing trials). Conditions are named (the
@@ -46,10 +51,18 @@
 
 #include "dyad/status.hpp"
 #include "experiment_analysis.hpp"
+#include "report_writer.hpp"
 #include "study_file.hpp"
 #include "study_session.hpp"
 
 namespace dyad::study {
+
+// A cell of the self-reports against the observer: events, and labelled steps.
+struct SaidCell {
+  int64_t events = 0, steps = 0;
+};
+// (what was said: a primitive, -1 "something else"; the observer's class, -1 "no label") -> cell.
+using SaidVsObserver = std::map<std::pair<int, int>, SaidCell>;
 
 struct TrialResult {
   std::string participant;
@@ -61,7 +74,8 @@ struct TrialResult {
   std::vector<analyze::EventSummary> events;
   // Why its recording is incomplete (analyze::IncompleteReason against the study's duration); "": whole.
   std::string incomplete;
-  std::vector<std::vector<int64_t>> reported_confusion;  // its own: [reported][the observer's class]
+  std::vector<std::vector<int64_t>> reported_confusion;  // its own, in steps: [reported][the observer's class]
+  SaidVsObserver said_vs_observer;  // its own, in events (reported_confusion.csv)
 };
 
 struct StudyAnalysis {
@@ -77,6 +91,8 @@ struct StudyAnalysis {
   // Whether a trial counts in what is summed over trials.
   bool Counted(const TrialResult& r) const { return r.incomplete.empty() || include_incomplete; }
   std::vector<std::vector<int64_t>> reported_confusion;  // of the counted trials; empty: no self-report with labels
+  SaidVsObserver said_vs_observer;                       // of the counted trials; empty: no self-report
+  std::vector<std::string> primitive_names;              // the graph's data set's (names.txt); empty: unknown
   // Planned and counted trials only: (traced primitive, reported choice) -> events; how wrong the reports are.
   std::map<std::pair<int, int>, int64_t> reports_vs_plan;
 };
@@ -84,6 +100,14 @@ struct StudyAnalysis {
 // `rehearsal`: the recordings `dyad study rehearse` made (their metadata says so), in study.data.
 // `include_incomplete`: incomplete trials count in the sums (StudyAnalysis::Counted).
 StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehearsal = false, bool include_incomplete = false);
+
+// Why a trial's recording holds no participation, "" when someone took part: no human input
+// recorded (human/input), or not one engaged step (no subject's page connected, or nobody held).
+// Such a trial is incomplete: empty trials are not data.
+std::string EmptyTrialReason(const analyze::Report& report);
+
+// The self-reports of `report`'s events against the observer (SaidVsObserver).
+SaidVsObserver SaidAgainstObserver(const analyze::Report& report);
 
 // Empty when `file`'s "dyad.run" metadata names this study, participant, trial, condition (its
 // label when blind) and rehearsal flag; else why not.

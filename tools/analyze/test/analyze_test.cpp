@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -451,6 +452,31 @@ TEST(Analyze, APersonsSelfReportsNameTheirEngagedRuns) {
   EXPECT_EQ(r->events[1].event.reported, -1);
   const std::string md = FormatMarkdown(*r);
   EXPECT_NE(md.find("| 1 | 30-33 | unknown (said: something else) |"), std::string::npos) << md;
+}
+
+// A person steering from the subject's page (web_human): a hold shorter than the page's
+// self_report_min_hold_s is a tap the page never asked about, and no event of the analysis (the
+// 0.4 s run at steps 30..33 under the default 1 s); the 1 s run at 10..19 is one. With the
+// minimum at 0.3 s both are events.
+TEST(Analyze, ATapShorterThanThePagesMinimumHoldIsNoEvent) {
+  const std::string person = "graph: unit\nclock: stepped\ncomponents:\n  web: {type: web}\n"
+                             "  human: {type: web_human, inputs: {pointer: web/pointer}, outputs: {input: human/input}}\n";
+  auto r = BuildReport(WriteExperiment(TempPath("tap.mcap"), true, {{"yaml", person}}), std::cerr);
+  ASSERT_TRUE(r.ok()) << r.status().ToString();
+  ASSERT_EQ(r->events.size(), 1u);
+  EXPECT_EQ(r->events[0].event.start_step, 10);
+  EXPECT_EQ(r->events[0].event.end_step, 20);
+  const auto metrics = RunMetrics(*r);
+  EXPECT_EQ(std::find_if(metrics.begin(), metrics.end(), [](const auto& m) { return m.first == "events"; })->second, 1.0);
+  std::string shorter = person;
+  shorter.replace(shorter.find("{type: web}"), 11, "{type: web, params: {self_report_min_hold_s: 0.3}}");
+  auto both = BuildReport(WriteExperiment(TempPath("tap03.mcap"), true, {{"yaml", shorter}}), std::cerr);
+  ASSERT_TRUE(both.ok()) << both.status().ToString();
+  EXPECT_EQ(both->events.size(), 2u);
+  // Without a subject's page (no web_human) every engaged run is an event, as before.
+  auto plain = BuildReport(WriteExperiment(TempPath("tap_plain.mcap"), true, {{"yaml", "graph: unit\nclock: stepped\n"}}), std::cerr);
+  ASSERT_TRUE(plain.ok()) << plain.status().ToString();
+  EXPECT_EQ(plain->events.size(), 2u);
 }
 
 TEST(Analyze, WithoutObserverTheReportSaysWhatIsMissing) {

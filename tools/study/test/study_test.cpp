@@ -22,6 +22,8 @@
 #include "dyad/testing/cli.hpp"
 #include "dyad/testing/csv.hpp"
 #include "dyad/mcap/reader.hpp"
+#include "dyad/pvrnn/analytic_dataset.hpp"
+#include "dyad/pvrnn/dataset.hpp"
 #include "dyad/testing/mcap_channel.hpp"
 #include "latin_square.hpp"
 #include "study_commands.hpp"
@@ -263,8 +265,10 @@ std::map<std::string, std::string> RunOf(const Study& s, const std::string& stud
 // step 10 + `switch_after`; congruence `c` at every step; the human's self-report `said`.
 // `run`: its "dyad.run" metadata, as `dyad study run` has the recorder write it. `steps`: how
 // long it is; `chunk`: the writer's chunk size (small: a cut loses only the last chunks).
+// `dataset`: the graph's data set (its names.txt names the primitives); `engaged` false: nobody
+// held (no subject's page connected), human/input disengaged throughout.
 void WriteTrial(const fs::path& file, double c, int switch_after, int said, const std::map<std::string, std::string>& run,
-                int steps = 30, uint64_t chunk = 256 * 1024) {
+                int steps = 30, uint64_t chunk = 256 * 1024, const std::string& dataset = "", bool engaged = true) {
   fs::create_directories(file.parent_path());
   mcap::WriterOptions options;
   options.chunk_size = chunk;
@@ -274,14 +278,15 @@ void WriteTrial(const fs::path& file, double c, int switch_after, int said, cons
     ASSERT_TRUE(w->AddMetadata("dyad.run", run).ok());
   }
   ASSERT_TRUE(w->AddMetadata("dyad.graph", {{"yaml", "graph: t\nclock: stepped\ncomponents:\n  human:\n    type: human_synthetic\n"
-                                                     "    rate_hz: 10\n    params:\n      events: [{start: 10, end: 20, primitive: 2}]\n"}})
+                                                     "    rate_hz: 10\n    params:\n      events: [{start: 10, end: 20, primitive: 2}]\n" +
+                                                         (dataset.empty() ? std::string() : "      dataset: " + dataset + "\n")}})
                   .ok());
   testing::McapChannel<msg::HumanInput> human(*w, "human/input");
   testing::McapChannel<msg::IntentionLabel> labels(*w, "observer/labels");
   testing::McapChannel<msg::SelfReport> reports(*w, "human/self_report");
   for (int t = 0; t < steps; ++t) {
     msg::HumanInput h;
-    h.engaged(t >= 10 && t < 20);
+    h.engaged(engaged && t >= 10 && t < 20);
     human.Write(h, t);
     msg::IntentionLabel l;
     std::vector<double> p(7, 0.01), q(7, 0.01);
@@ -364,12 +369,12 @@ TEST_F(StudyFile, AnalyzeMakesOneTableAcrossEveryoneAndSaysWhatIsMissing) {
   int said_four = 0;
   for (const auto& e : events) said_four += e.at("self_report") == "4" && e.at("participant") == "P01" && e.at("condition") == "low";
   EXPECT_EQ(said_four, 1);
-  // Against the self-reports: 10 steps of the event said to be 4 (the observer: 2), 50 said 2.
+  // Against the self-reports, in events (steps beside): one event said to be 4 (the observer: 2
+  // on its 10 steps), five said 2. No names.txt: "primitive K".
   std::map<std::string, std::string> confusion;
   for (const auto& row : dyad::testing::ReadCsv(out / "reported_confusion.csv"))
-    confusion[row.at("reported") + "," + row.at("predicted")] = row.at("count");
-  EXPECT_EQ(confusion.at("4,2"), "10");
-  EXPECT_EQ(confusion.at("2,2"), "50");
+    confusion[row.at("reported") + "," + row.at("observer")] = row.at("events") + "/" + row.at("steps");
+  EXPECT_EQ(confusion, (std::map<std::string, std::string>{{"primitive 4,primitive 2", "1/10"}, {"primitive 2,primitive 2", "5/50"}}));
   // The synthetic humans traced 2 every time; one of the six said 4.
   std::map<std::string, std::string> vs_plan;
   for (const auto& row : dyad::testing::ReadCsv(out / "reports_vs_plan.csv")) vs_plan[row.at("planned") + "," + row.at("reported")] = row.at("events");
@@ -386,7 +391,8 @@ TEST_F(StudyFile, AnalyzeMakesOneTableAcrossEveryoneAndSaysWhatIsMissing) {
   const auto low = report.find("### low (" + s.conditions[0].label + ")\n\nAccuracy 0.5 (95% interval 0.5 to 0.5; 1 participant, 2 trials).",
                                per_condition);
   EXPECT_NE(low, std::string::npos) << report;
-  EXPECT_NE(report.find("| **4** | 0.00 (0) | 0.00 (0) | 1.00 (10) | 0.00 (0) |", low), std::string::npos) << report;
+  EXPECT_NE(report.find("| said / observer | primitive 2 |\n|---|---|\n| **primitive 2** | 1 (10) |\n| **primitive 4** | 1 (10) |", low),
+            std::string::npos) << report;
   EXPECT_NE(report.find("### high (" + s.conditions[1].label + ")\n\nAccuracy 1 (95% interval 1 to 1; 2 participants, 4 trials).",
                         per_condition),
             std::string::npos) << report;
@@ -536,11 +542,12 @@ TEST_F(StudyFile, AnIncompleteTrialIsMarkedLeftOutOfTheSummaryAndReported) {
   EXPECT_EQ(summary.at("low/mean_congruence").at("participants"), "1");
   EXPECT_EQ(summary.at("high/mean_congruence").at("participants"), "3");
   ExpectSummaryRecomputedExactly(out, false);
-  // The confusion against the self-reports: four whole trials of 10 labelled steps said 2.
-  std::map<std::string, std::string> confusion;
-  for (const auto& row : dyad::testing::ReadCsv(out / "reported_confusion.csv"))
-    confusion[row.at("reported") + "," + row.at("predicted")] = row.at("count");
-  EXPECT_EQ(confusion.at("2,2"), "40");
+  // The confusion against the self-reports: four whole trials, an event of 10 labelled steps each, said 2.
+  const auto confusion = dyad::testing::ReadCsv(out / "reported_confusion.csv");
+  ASSERT_EQ(confusion.size(), 1u);
+  EXPECT_EQ(confusion[0].at("reported") + "," + confusion[0].at("observer"), "primitive 2,primitive 2");
+  EXPECT_EQ(confusion[0].at("events"), "4");
+  EXPECT_EQ(confusion[0].at("steps"), "40");
   std::ifstream md(out / "report.md");
   const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_NE(report.find("6 trials analysed (2 incomplete, left out of the summary; below)"), std::string::npos) << report;
@@ -559,6 +566,67 @@ TEST_F(StudyFile, AnIncompleteTrialIsMarkedLeftOutOfTheSummaryAndReported) {
     }
   }
   ExpectSummaryRecomputedExactly(all, true);
+}
+
+// Empty trials are not data: P02 never took part (no subject's page: human/input disengaged
+// throughout, though the recordings are whole and long enough). Both their trials are incomplete
+// with the reason, and the summary is P01's alone.
+TEST_F(StudyFile, TrialsWithNobodyEngagedAreIncompleteAndLeftOutOfTheSummary) {
+  const std::string f = Write("study: gain\ngraph: g.yaml\nparticipants: [P01, P02]\n"
+                              "conditions:\n  low: {src.start: 1}\n  high: {src.start: 3}\nduration: 3\n");
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy(f, {}, &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  for (const std::string p : {"P01", "P02"})
+    for (const Trial& t : s.TrialsOf(p)) WriteTrial(t.file, p == "P01" ? 0.25 : 0.75, 3, 2, RunOf(s, "gain", p, t), 30, 1024, "", p == "P01");
+
+  auto r = dyad::testing::RunCommand(dyad::cli::AddStudyCommands, {"study", "analyze", f, "--no-plots"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("4 trials analysed, 0 missing; 2 incomplete, left out of the summary"), std::string::npos) << r.out;
+  const fs::path out = fs::path(s.data) / "analysis";
+  int empty = 0;
+  for (const auto& row : dyad::testing::ReadCsv(out / "trials.csv")) {
+    const bool nobody = row.at("participant") == "P02";
+    EXPECT_EQ(row.at("complete"), nobody ? "false" : "true") << row.at("participant");
+    if (nobody) {
+      EXPECT_EQ(row.at("reason"), "no participant: not one engaged step (no subject's page connected, or nobody held)");
+      ++empty;
+    }
+  }
+  EXPECT_EQ(empty, 2);
+  for (const auto& row : dyad::testing::ReadCsv(out / "summary.csv"))
+    if (row.at("measure") == "mean_congruence") {
+      EXPECT_EQ(row.at("participants"), "1") << row.at("condition");
+      EXPECT_EQ(row.at("mean"), "0.25") << row.at("condition");
+    }
+  ExpectSummaryRecomputedExactly(out, false);
+}
+
+// Readable answers: reported_confusion.csv and report.md name the primitives (the graph's data
+// set's names.txt), "something else" is an answer of its own, and the counts are events with
+// their labelled steps beside.
+TEST_F(StudyFile, TheSelfReportsAreCountedInEventsByNameWithSomethingElseOfItsOwn) {
+  const std::string f = Write("study: gain\ngraph: g.yaml\nparticipants: [P01]\n"
+                              "conditions:\n  low: {src.start: 1}\n  high: {src.start: 3}\ntrials: 2\n");
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy(f, {}, &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  const std::string data = (dir_ / "named_set").string();
+  ASSERT_TRUE(pvrnn::WriteNrlDataset(pvrnn::MakeAnalyticDataset(), data).ok());
+  int k = 0;  // said: triangle (2), star (4), "something else" (-1), triangle
+  for (const Trial& t : s.TrialsOf("P01")) WriteTrial(t.file, 0.5, 3, std::vector<int>{2, 4, -1, 2}[static_cast<size_t>(k++)], RunOf(s, "gain", "P01", t), 30, 256 * 1024, data);
+  auto r = dyad::testing::RunCommand(dyad::cli::AddStudyCommands, {"study", "analyze", f, "--no-plots"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const fs::path out = fs::path(s.data) / "analysis";
+  std::map<std::string, std::string> confusion;
+  for (const auto& row : dyad::testing::ReadCsv(out / "reported_confusion.csv"))
+    confusion[row.at("reported") + "," + row.at("observer")] = row.at("events") + "/" + row.at("steps");
+  EXPECT_EQ(confusion, (std::map<std::string, std::string>{
+                           {"triangle,triangle", "2/20"}, {"star,triangle", "1/10"}, {"something else,triangle", "1/10"}}));
+  std::ifstream md(out / "report.md");
+  const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(report.find("| said / observer | triangle |\n|---|---|\n"), std::string::npos) << report;
+  EXPECT_NE(report.find("| **something else** | 1 (10) |"), std::string::npos) << report;
 }
 
 // AB12 and ab12 would share a folder on a case-insensitive file system: refused at the line. A
