@@ -75,6 +75,45 @@ StatusOr<pvrnn::Model> LoadTwoDofModel(const std::string& path) {
   return model;
 }
 
+// The error regression's options: the preset's, overridden by the params (window, iterations,
+// optimizer, adam, ceres, meta_prior, a_init, noise, a_steps) and checked for a model of
+// `layers` layers. Errors name "params.<param>".
+StatusOr<ErrorRegressionOptions> RegressionOptions(const Params& p, int layers) {
+  ErrorRegressionOptions o = ErrorRegressionOptions::Preset(p.String("preset")).value();
+  if (p.Int("window") > 0) o.window = static_cast<int>(p.Int("window"));
+  if (p.Int("iterations") > 0) o.iterations = static_cast<int>(p.Int("iterations"));
+  o.optimizer = pvrnn::ParseOptimizerKind(p.String("optimizer")).value();
+  if (Status s = ApplyMap<double>("adam", p.String("adam"),
+                                  {{"lr", &o.adam.lr}, {"beta1", &o.adam.beta1}, {"beta2", &o.adam.beta2},
+                                   {"epsilon", &o.adam.epsilon}});
+      !s.ok())
+    return s;
+  double rank = o.ceres.lbfgs_rank, ls = o.ceres.max_line_search_iterations;
+  if (Status s = ApplyMap<double>("ceres", p.String("ceres"),
+                                  {{"lbfgs_rank", &rank},
+                                   {"function_tolerance", &o.ceres.function_tolerance},
+                                   {"gradient_tolerance", &o.ceres.gradient_tolerance},
+                                   {"parameter_tolerance", &o.ceres.parameter_tolerance},
+                                   {"max_line_search_iterations", &ls}});
+      !s.ok())
+    return s;
+  // Integer options: a fraction or a value beyond int is an error, not a silent truncation.
+  for (const auto& [key, value] : {std::pair<const char*, double>{"lbfgs_rank", rank}, {"max_line_search_iterations", ls}}) {
+    if (value != std::floor(value) || std::abs(value) > 1e9)  // ranges: ErrorRegressionOptions::Problems
+      return Status::InvalidArgument(std::string("params.ceres.") + key + ": must be a whole number, got " +
+                                     std::to_string(value));
+  }
+  o.ceres.lbfgs_rank = static_cast<int>(rank);
+  o.ceres.max_line_search_iterations = static_cast<int>(ls);
+  if (!p.DoubleList("meta_prior").empty()) o.meta_prior = p.DoubleList("meta_prior");
+  o.a_init = pvrnn::ParseAInit(p.String("a_init")).value();
+  o.noise = pvrnn::ParseNoiseMode(p.String("noise")).value();
+  o.a_steps = static_cast<int>(p.Int("a_steps"));
+  if (auto problems = o.Problems(layers); !problems.empty())
+    return Status::InvalidArgument("params." + problems.front().ToString());
+  return o;
+}
+
 }  // namespace
 
 void Deliberator::Describe(ComponentSpec& spec) {
@@ -110,9 +149,9 @@ Status Deliberator::Configure(Context& ctx) {
   model_path_ = p.String("model");
   auto model = LoadTwoDofModel(model_path_);
   if (!model.ok()) return Status::InvalidArgument("params.model: " + model.status().message());
-  ErrorRegressionOptions o = ErrorRegressionOptions::Preset(p.String("preset")).value();
-  preset_iterations_ = o.iterations;
-  preset_meta_prior_ = o.meta_prior;
+  const ErrorRegressionOptions preset = ErrorRegressionOptions::Preset(p.String("preset")).value();
+  preset_iterations_ = preset.iterations;
+  preset_meta_prior_ = preset.meta_prior;
   live_iterations_ = p.Int("iterations");
   live_meta_prior_ = p.DoubleList("meta_prior");
   layers_ = model->spec.num_layers();
@@ -128,37 +167,9 @@ Status Deliberator::Configure(Context& ctx) {
       [this](const ParamValue&) {
         if (Status s = SwapModel(); !s.ok()) ctx_->log().Error("model swap: " + s.message());
       });
-  if (p.Int("window") > 0) o.window = static_cast<int>(p.Int("window"));
-  if (p.Int("iterations") > 0) o.iterations = static_cast<int>(p.Int("iterations"));
-  o.optimizer = pvrnn::ParseOptimizerKind(p.String("optimizer")).value();
-  if (Status s = ApplyMap<double>("adam", p.String("adam"),
-                                  {{"lr", &o.adam.lr}, {"beta1", &o.adam.beta1}, {"beta2", &o.adam.beta2},
-                                   {"epsilon", &o.adam.epsilon}});
-      !s.ok())
-    return s;
-  double rank = o.ceres.lbfgs_rank, ls = o.ceres.max_line_search_iterations;
-  if (Status s = ApplyMap<double>("ceres", p.String("ceres"),
-                                  {{"lbfgs_rank", &rank},
-                                   {"function_tolerance", &o.ceres.function_tolerance},
-                                   {"gradient_tolerance", &o.ceres.gradient_tolerance},
-                                   {"parameter_tolerance", &o.ceres.parameter_tolerance},
-                                   {"max_line_search_iterations", &ls}});
-      !s.ok())
-    return s;
-  // Integer options: a fraction or a value beyond int is an error, not a silent truncation.
-  for (const auto& [key, value] : {std::pair<const char*, double>{"lbfgs_rank", rank}, {"max_line_search_iterations", ls}}) {
-    if (value != std::floor(value) || std::abs(value) > 1e9)  // ranges: ErrorRegressionOptions::Problems
-      return Status::InvalidArgument(std::string("params.ceres.") + key + ": must be a whole number, got " +
-                                     std::to_string(value));
-  }
-  o.ceres.lbfgs_rank = static_cast<int>(rank);
-  o.ceres.max_line_search_iterations = static_cast<int>(ls);
-  if (!p.DoubleList("meta_prior").empty()) o.meta_prior = p.DoubleList("meta_prior");
-  o.a_init = pvrnn::ParseAInit(p.String("a_init")).value();
-  o.noise = pvrnn::ParseNoiseMode(p.String("noise")).value();
-  o.a_steps = static_cast<int>(p.Int("a_steps"));
-  if (auto problems = o.Problems(model->spec.num_layers()); !problems.empty())
-    return Status::InvalidArgument("params." + problems.front().ToString());
+  auto options = RegressionOptions(p, layers_);
+  if (!options.ok()) return options.status();
+  const ErrorRegressionOptions& o = *options;
   options_ = o;
   start_primitive_ = static_cast<int>(p.Int("start_primitive"));
   seed_ = p.Int("seed") >= 0 ? static_cast<uint64_t>(p.Int("seed")) : ctx.seed();
