@@ -41,6 +41,45 @@ struct Tensor {
   const double* data;
 };
 
+// The number of values the header's tensors span, each tensor's extent checked against the
+// payload (and the checksum, once the extents fit); DataLoss naming the path otherwise. Throws
+// on a malformed header (the caller catches).
+StatusOr<uint64_t> TensorExtent(const json& header, const std::string& path, const CheckedFileView& view) {
+  // Each tensor's extent is checked against the payload before anything is summed or
+  // multiplied: huge offsets or shapes must not wrap around into something that fits.
+  const size_t payload_bytes = view.payload_bytes;
+  const uint64_t payload_values = payload_bytes / 8;
+  uint64_t needed = 0;
+  for (const auto& t : header.at("tensors")) {
+    const uint64_t offset = JsonInt<uint64_t>(t, "offset"), rows = JsonInt<uint64_t>(t, "rows"),
+                   cols = JsonInt<uint64_t>(t, "cols");
+    if ((cols != 0 && rows > payload_values / cols) || offset > payload_values - rows * cols)
+      return Status::DataLoss(path + ": truncated: tensor " + t.at("name").get<std::string>() + " (offset " +
+                              std::to_string(offset) + ", " + std::to_string(rows) + " x " + std::to_string(cols) +
+                              ") does not fit in the payload of " + std::to_string(payload_bytes) + " bytes");
+    needed = std::max<uint64_t>(needed, offset + rows * cols);
+  }
+  if (needed * 8 > payload_bytes)
+    return Status::DataLoss(path + ": truncated: tensors need " + std::to_string(needed * 8) + " bytes, file has " +
+                             std::to_string(payload_bytes));
+  if (!view.crc_ok) return Status::DataLoss(path + ": corrupted (checksum mismatch)");
+  if (needed * 8 != payload_bytes)
+    return Status::DataLoss(path + ": " + std::to_string(payload_bytes - needed * 8) + " unexpected bytes after the tensors");
+  return needed;
+}
+
+// The model's provenance from the header's "provenance" object. Throws on a malformed one.
+void ReadProvenance(const json& p, Model* m) {
+  m->provenance.source = p.at("source").get<std::string>();
+  m->provenance.dataset = p.at("dataset").get<std::string>();
+  m->provenance.epochs = JsonInt<int64_t>(p, "epochs");
+  m->provenance.seed = JsonInt<uint64_t>(p, "seed");
+  m->provenance.scalar = p.at("scalar").get<std::string>();
+  m->provenance.final_loss = NumFrom(p.at("final_loss"));
+  m->provenance.final_reconstruction = NumFrom(p.at("final_reconstruction"));
+  m->provenance.final_regulation = NumFrom(p.at("final_regulation"));
+}
+
 }  // namespace
 
 Status SaveModel(const Model& model, const std::string& path) {
@@ -104,28 +143,11 @@ StatusOr<Model> LoadModel(const std::string& path) {
     return Status::DataLoss(path + ": unreadable header: " + e.what());
   }
   const size_t payload_at = view->payload_at;
-  const size_t payload_bytes = view->payload_bytes;
   Model m;
   try {
-    // Each tensor's extent is checked against the payload before anything is summed or
-    // multiplied: huge offsets or shapes must not wrap around into something that fits.
-    const uint64_t payload_values = payload_bytes / 8;
-    uint64_t needed = 0;
-    for (const auto& t : header.at("tensors")) {
-      const uint64_t offset = JsonInt<uint64_t>(t, "offset"), rows = JsonInt<uint64_t>(t, "rows"),
-                     cols = JsonInt<uint64_t>(t, "cols");
-      if ((cols != 0 && rows > payload_values / cols) || offset > payload_values - rows * cols)
-        return Status::DataLoss(path + ": truncated: tensor " + t.at("name").get<std::string>() + " (offset " +
-                                std::to_string(offset) + ", " + std::to_string(rows) + " x " + std::to_string(cols) +
-                                ") does not fit in the payload of " + std::to_string(payload_bytes) + " bytes");
-      needed = std::max<uint64_t>(needed, offset + rows * cols);
-    }
-    if (needed * 8 > payload_bytes)
-      return Status::DataLoss(path + ": truncated: tensors need " + std::to_string(needed * 8) + " bytes, file has " +
-                               std::to_string(payload_bytes));
-    if (!view->crc_ok) return Status::DataLoss(path + ": corrupted (checksum mismatch)");
-    if (needed * 8 != payload_bytes)
-      return Status::DataLoss(path + ": " + std::to_string(payload_bytes - needed * 8) + " unexpected bytes after the tensors");
+    auto extent = TensorExtent(header, path, *view);
+    if (!extent.ok()) return extent.status();
+    const uint64_t needed = *extent;
     m.spec = SpecFromJson(header.at("spec"));
     if (Status s = m.spec.Validate(); !s.ok()) return Status::DataLoss(path + ": spec: " + s.message());
     const int steps = JsonInt<int>(header, "steps"), sequences = JsonInt<int>(header, "sequences");
@@ -162,15 +184,7 @@ StatusOr<Model> LoadModel(const std::string& path) {
     auto ls = m.adaptive.log_sigma();
     if (Status s = read("A.mu", layout.total_z(), m.adaptive.cols(), [&](int r, int c, double v) { mu(r, c) = v; }); !s.ok()) return s;
     if (Status s = read("A.log_sigma", layout.total_z(), m.adaptive.cols(), [&](int r, int c, double v) { ls(r, c) = v; }); !s.ok()) return s;
-    const json& p = header.at("provenance");
-    m.provenance.source = p.at("source").get<std::string>();
-    m.provenance.dataset = p.at("dataset").get<std::string>();
-    m.provenance.epochs = JsonInt<int64_t>(p, "epochs");
-    m.provenance.seed = JsonInt<uint64_t>(p, "seed");
-    m.provenance.scalar = p.at("scalar").get<std::string>();
-    m.provenance.final_loss = NumFrom(p.at("final_loss"));
-    m.provenance.final_reconstruction = NumFrom(p.at("final_reconstruction"));
-    m.provenance.final_regulation = NumFrom(p.at("final_regulation"));
+    ReadProvenance(header.at("provenance"), &m);
     if (!header.at("training").is_null()) {
       TrainingState t;
       t.adam_step = JsonInt<int64_t>(header.at("training"), "adam_step");

@@ -58,29 +58,15 @@ StatusOr<std::vector<double>> Numbers(const std::string& file, const std::string
   return out;
 }
 
-}  // namespace
+// What the properties file says: the network's shape, and the epochs trained (0 if not said).
+struct NrlProperties {
+  ModelSpec spec;
+  int64_t epochs = 0;
+};
 
-StatusOr<std::vector<std::pair<std::string, std::string>>> ReadKeyValueFile(const std::string& path) {
-  std::error_code ec;
-  if (fs::is_directory(path, ec)) return Status::InvalidArgument(path + ": is a folder, not a file");
-  std::ifstream in(path);
-  if (!in) return Status::NotFound(path + ": cannot open");
-  std::vector<std::pair<std::string, std::string>> out;
-  std::string line;
-  int n = 0;
-  while (std::getline(in, line)) {
-    ++n;
-    const std::string_view t = Trim(std::string_view(line).substr(0, line.find('#')));
-    if (t.empty()) continue;
-    const size_t eq = t.find('=');
-    if (eq == std::string_view::npos) return Status::DataLoss(path + ":" + std::to_string(n) + ": expected key=value");
-    out.emplace_back(Trim(t.substr(0, eq)), Trim(t.substr(eq + 1)));
-  }
-  return out;
-}
-
-StatusOr<Model> ImportNrlModel(const NrlImportOptions& options) {
-  const std::string& pf = options.properties_file;
+// Reads NRL's properties file `pf` (d, z, t, w per layer, activejoints, dsoft, sigma, epochs);
+// errors name the file and the property.
+StatusOr<NrlProperties> ReadProperties(const std::string& pf) {
   auto kv = ReadKeyValueFile(pf);
   if (!kv.ok()) return kv.status();
   std::map<std::string, std::vector<double>> num;
@@ -115,22 +101,17 @@ StatusOr<Model> ImportNrlModel(const NrlImportOptions& options) {
   spec.output.dsoft = num.count("dsoft") ? num["dsoft"][0] : 10;
   spec.output.sigma = num.count("sigma") ? num["sigma"][0] : 0.2;
   if (Status s = spec.Validate(); !s.ok()) return Status::DataLoss(pf + ": " + s.message());
+  return NrlProperties{spec, num.count("epochs") ? static_cast<int64_t>(num["epochs"][0]) : 0};
+}
 
-  auto data = LoadNrlDataset(options.dataset_dir);
-  if (!data.ok()) return data.status();
-  if (data->dofs() != spec.num_dofs())
-    return Status::InvalidArgument(options.dataset_dir + ": " + std::to_string(data->dofs()) + " DOFs, properties activate " +
-                                   std::to_string(spec.num_dofs()));
-  const int prims = data->primitives(), steps = data->steps();  // NRL: one A per primitive, whatever its samples
-
-  NetworkLayout layout(spec);
-  Model m;
-  m.spec = spec;
-  m.weights = Weights<double>(layout);
-  m.adaptive = AdaptiveVariables<double>(layout.total_z(), steps, prims);
-  const fs::path dir(options.model_dir);
+// Reads the weights, biases and adaptive variables (A) of every layer and output of `dir` into
+// *m, whose weights and A are already shaped by `layout`; errors name the file and the matrix.
+Status ReadWeights(const fs::path& dir, const NetworkLayout& layout, Model* m) {
+  const ModelSpec& spec = m->spec;
+  const size_t K = spec.layers.size();
+  const int prims = m->adaptive.sequences(), steps = m->adaptive.steps();
   Eigen::MatrixXd buf;
-  auto group = [&](int k, const char* name) { return m.weights.Group(*layout.FindGroup("L" + std::to_string(k) + "." + name)); };
+  auto group = [&](int k, const char* name) { return m->weights.Group(*layout.FindGroup("L" + std::to_string(k) + "." + name)); };
   for (size_t k = 0; k < K; ++k) {
     const std::string L = "L" + std::to_string(k);
     auto wf = NrlMatrixFile::Open((dir / (L + "_w_p.d")).string());
@@ -150,13 +131,13 @@ StatusOr<Model> ImportNrlModel(const NrlImportOptions& options) {
       if (Status s = bf->Next(it.rows, it.cols, it.name, &buf); !s.ok()) return s;
       group(static_cast<int>(k), it.name) = buf;
     }
-    for (auto [suffix, view] : {std::pair{"_au_p.d", m.adaptive.mu()}, std::pair{"_al_p.d", m.adaptive.log_sigma()}}) {
+    for (auto [suffix, view] : {std::pair{"_au_p.d", m->adaptive.mu()}, std::pair{"_al_p.d", m->adaptive.log_sigma()}}) {
       auto af = NrlMatrixFile::Open((dir / (L + suffix)).string());
       if (!af.ok()) return af.status();
       for (int p = 0; p < prims; ++p)
         for (int t = 0; t < steps; ++t) {
           if (Status s = af->Next(z, 1, "A of primitive " + std::to_string(p) + " step " + std::to_string(t), &buf); !s.ok()) return s;
-          view.col(m.adaptive.Column(t, p)).segment(layout.z_offset(static_cast<int>(k)), z) = buf.col(0);
+          view.col(m->adaptive.Column(t, p)).segment(layout.z_offset(static_cast<int>(k)), z) = buf.col(0);
         }
     }
   }
@@ -166,16 +147,60 @@ StatusOr<Model> ImportNrlModel(const NrlImportOptions& options) {
     if (!wf.ok()) return wf.status();
     const int n = layout.output_units(o);
     if (Status s = wf->Next(n, spec.layers[0].d, "W_x", &buf); !s.ok()) return s;
-    m.weights.Group(*layout.FindGroup("out.W_x" + std::to_string(o))) = buf;
+    m->weights.Group(*layout.FindGroup("out.W_x" + std::to_string(o))) = buf;
     auto bf = NrlMatrixFile::Open((dir / (O + "_b_p.d")).string());
     if (!bf.ok()) return bf.status();
     if (Status s = bf->Next(n, 1, "b_x", &buf); !s.ok()) return s;
-    m.weights.Group(*layout.FindGroup("out.b_x" + std::to_string(o))) = buf;
+    m->weights.Group(*layout.FindGroup("out.b_x" + std::to_string(o))) = buf;
   }
+  return Status::OK();
+}
+
+}  // namespace
+
+StatusOr<std::vector<std::pair<std::string, std::string>>> ReadKeyValueFile(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return Status::InvalidArgument(path + ": is a folder, not a file");
+  std::ifstream in(path);
+  if (!in) return Status::NotFound(path + ": cannot open");
+  std::vector<std::pair<std::string, std::string>> out;
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    const std::string_view t = Trim(std::string_view(line).substr(0, line.find('#')));
+    if (t.empty()) continue;
+    const size_t eq = t.find('=');
+    if (eq == std::string_view::npos) return Status::DataLoss(path + ":" + std::to_string(n) + ": expected key=value");
+    out.emplace_back(Trim(t.substr(0, eq)), Trim(t.substr(eq + 1)));
+  }
+  return out;
+}
+
+StatusOr<Model> ImportNrlModel(const NrlImportOptions& options) {
+  const std::string& pf = options.properties_file;
+  auto properties = ReadProperties(pf);
+  if (!properties.ok()) return properties.status();
+  const ModelSpec& spec = properties->spec;
+
+  auto data = LoadNrlDataset(options.dataset_dir);
+  if (!data.ok()) return data.status();
+  if (data->dofs() != spec.num_dofs())
+    return Status::InvalidArgument(options.dataset_dir + ": " + std::to_string(data->dofs()) + " DOFs, properties activate " +
+                                   std::to_string(spec.num_dofs()));
+  const int prims = data->primitives(), steps = data->steps();  // NRL: one A per primitive, whatever its samples
+
+  NetworkLayout layout(spec);
+  Model m;
+  m.spec = spec;
+  m.weights = Weights<double>(layout);
+  m.adaptive = AdaptiveVariables<double>(layout.total_z(), steps, prims);
+  const fs::path dir(options.model_dir);
+  if (Status st = ReadWeights(dir, layout, &m); !st.ok()) return st;
   m.provenance.source = "import-nrl " + options.model_dir;
   m.provenance.dataset = options.dataset_dir;
   m.provenance.scalar = "float";
-  m.provenance.epochs = num.count("epochs") ? static_cast<int64_t>(num["epochs"][0]) : 0;
+  m.provenance.epochs = properties->epochs;
   // epoch.d: "<last saved epoch>,<loss>" (NRL saves greedily: the best loss seen).
   if (std::ifstream ef(dir / "epoch.d"); ef) {
     std::string line;
