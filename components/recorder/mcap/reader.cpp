@@ -65,6 +65,96 @@ struct ZstdDCtxDeleter {
   void operator()(ZSTD_DCtx* ctx) const { ZSTD_freeDCtx(ctx); }
 };
 
+// The records of a summary section: what ReadSummary keeps once all of it proved sound.
+struct SummaryRecords {
+  std::map<SchemaId, Schema> schemas;
+  std::map<ChannelId, Channel> channels;
+  std::vector<ChunkInfo> chunks;
+  std::vector<codec::MetadataIndexRecord> metadata_indexes;
+  std::optional<Statistics> statistics;
+};
+
+// Decodes the summary section's records (starting at file offset summary_start) into *out; a
+// chunk or metadata index must point inside the data section (header_end..data_end). "" or
+// what is wrong with the summary.
+std::string ParseSummary(Bytes summary, std::uint64_t header_end, std::uint64_t data_end, std::uint64_t summary_start,
+                         SummaryRecords* out) {
+  std::string problem;
+  bool framed = ForEachRecord(summary, [&](std::uint8_t op, Bytes content, std::uint64_t at) {
+    bool ok = true;
+    switch (op) {
+      case format::kSchema: {
+        Schema s;
+        ok = codec::DecodeSchema(content, &s);
+        if (ok && s.id != 0) out->schemas.try_emplace(s.id, std::move(s));
+        break;
+      }
+      case format::kChannel: {
+        Channel c;
+        ok = codec::DecodeChannel(content, &c);
+        if (ok) out->channels.try_emplace(c.id, std::move(c));
+        break;
+      }
+      case format::kChunkIndex: {
+        ChunkInfo c;
+        ok = codec::DecodeChunkIndex(content, &c) && c.offset >= header_end && c.length <= data_end &&
+             c.offset <= data_end - c.length;
+        if (ok) out->chunks.push_back(std::move(c));
+        break;
+      }
+      case format::kMetadataIndex: {
+        codec::MetadataIndexRecord m;
+        ok = codec::DecodeMetadataIndex(content, &m) && m.length <= data_end && m.offset <= data_end - m.length;
+        if (ok) out->metadata_indexes.push_back(std::move(m));
+        break;
+      }
+      case format::kStatistics: {
+        Statistics s;
+        ok = codec::DecodeStatistics(content, &s);
+        if (ok) out->statistics = std::move(s);
+        break;
+      }
+      default:
+        break;  // SummaryOffset, AttachmentIndex, newer records: not needed here.
+    }
+    if (!ok) problem = "bad " + std::string(format::OpcodeName(op)) + " record in the summary" +
+                       " (offset " + std::to_string(summary_start + at) + ")";
+    return ok;
+  });
+  if (!framed) return "summary records are cut or misframed";
+  if (!problem.empty()) return problem;
+  if (!out->statistics) return "the summary has no Statistics record";
+  return "";
+}
+
+// The chunks that may hold messages of options' time range, in groups to decode together: one
+// chunk in file order; in log-time order, chunks whose time ranges overlap (our writer's chunks
+// do not, so groups are single chunks in practice).
+std::vector<std::vector<const ChunkInfo*>> ChunkGroups(const std::vector<ChunkInfo>& chunks, const ReadOptions& options) {
+  std::vector<const ChunkInfo*> selected;
+  for (const ChunkInfo& c : chunks) {
+    if (c.message_end_time >= options.start_time && c.message_start_time <= options.end_time) selected.push_back(&c);
+  }
+  std::vector<std::vector<const ChunkInfo*>> groups;
+  if (options.order == ReadOptions::Order::kFile) {
+    for (const ChunkInfo* c : selected) groups.push_back({c});
+  } else {
+    std::stable_sort(selected.begin(), selected.end(), [](const ChunkInfo* a, const ChunkInfo* b) {
+      return a->message_start_time < b->message_start_time;
+    });
+    std::uint64_t group_end = 0;
+    for (const ChunkInfo* c : selected) {
+      if (groups.empty() || c->message_start_time > group_end) {
+        groups.push_back({});
+        group_end = 0;
+      }
+      groups.back().push_back(c);
+      group_end = std::max(group_end, c->message_end_time);
+    }
+  }
+  return groups;
+}
+
 }  // namespace
 
 std::string Recovery::Describe() const {
@@ -104,7 +194,17 @@ class Reader::Impl {
  private:
   // "" on success, else why the summary cannot be used (nothing is kept then).
   std::string ReadSummary(std::uint64_t header_end);
+  // Reads the Metadata records the summary's indexes point at into *out; "" or what is wrong.
+  std::string ReadIndexedMetadata(const std::vector<codec::MetadataIndexRecord>& indexes, std::vector<Metadata>* out);
+  // Reads the data section from `pos` record by record (no summary, or a file cut short):
+  // what it holds up to the first damage, which recovery_ describes.
   void Scan(std::uint64_t pos);
+  // Scan's reading of the record at `pos`: its opcode and content length, and its content into
+  // record_ when the scan needs it. False, with recovery_.stop_reason, when the file cannot give it.
+  bool ReadScannedRecord(std::uint64_t pos, std::uint8_t* op, std::uint64_t* len);
+  // Scan's Chunk record at `pos` (content in record_): its schemas, channels and message counts
+  // once it proves sound, else recovery_.damaged_chunks says why. `records`: scratch.
+  void ScanChunk(std::uint64_t pos, std::uint64_t len, std::vector<std::uint8_t>* records);
   bool EndsWithFooter();
   // Decompresses a chunk's records into *out and checks its CRC; "" or what is wrong.
   std::string DecodeChunkRecords(const codec::ChunkRecord& chunk, std::vector<std::uint8_t>* out);
@@ -232,59 +332,31 @@ std::string Reader::Impl::ReadSummary(std::uint64_t header_end) {
     if (crc != footer.summary_crc) return "summary CRC mismatch";
   }
 
-  std::map<SchemaId, Schema> schemas;
-  std::map<ChannelId, Channel> channels;
-  std::vector<ChunkInfo> chunks;
-  std::vector<codec::MetadataIndexRecord> metadata_indexes;
-  std::optional<Statistics> statistics;
-  std::string problem;
-  bool framed = ForEachRecord(summary, [&](std::uint8_t op, Bytes content, std::uint64_t at) {
-    bool ok = true;
-    switch (op) {
-      case format::kSchema: {
-        Schema s;
-        ok = codec::DecodeSchema(content, &s);
-        if (ok && s.id != 0) schemas.try_emplace(s.id, std::move(s));
-        break;
-      }
-      case format::kChannel: {
-        Channel c;
-        ok = codec::DecodeChannel(content, &c);
-        if (ok) channels.try_emplace(c.id, std::move(c));
-        break;
-      }
-      case format::kChunkIndex: {
-        ChunkInfo c;
-        ok = codec::DecodeChunkIndex(content, &c) && c.offset >= header_end && c.length <= data_end &&
-             c.offset <= data_end - c.length;
-        if (ok) chunks.push_back(std::move(c));
-        break;
-      }
-      case format::kMetadataIndex: {
-        codec::MetadataIndexRecord m;
-        ok = codec::DecodeMetadataIndex(content, &m) && m.length <= data_end && m.offset <= data_end - m.length;
-        if (ok) metadata_indexes.push_back(std::move(m));
-        break;
-      }
-      case format::kStatistics: {
-        Statistics s;
-        ok = codec::DecodeStatistics(content, &s);
-        if (ok) statistics = std::move(s);
-        break;
-      }
-      default:
-        break;  // SummaryOffset, AttachmentIndex, newer records: not needed here.
-    }
-    if (!ok) problem = "bad " + std::string(format::OpcodeName(op)) + " record in the summary" +
-                       " (offset " + std::to_string(footer.summary_start + at) + ")";
-    return ok;
-  });
-  if (!framed) return "summary records are cut or misframed";
-  if (!problem.empty()) return problem;
-  if (!statistics) return "the summary has no Statistics record";
-
+  SummaryRecords r;
+  if (std::string problem = ParseSummary(summary, header_end, data_end, footer.summary_start, &r); !problem.empty()) {
+    return problem;
+  }
   std::vector<Metadata> metadata;
-  for (const auto& index : metadata_indexes) {
+  if (std::string problem = ReadIndexedMetadata(r.metadata_indexes, &metadata); !problem.empty()) return problem;
+
+  std::sort(r.chunks.begin(), r.chunks.end(), [](const ChunkInfo& a, const ChunkInfo& b) { return a.offset < b.offset; });
+  schemas_ = std::move(r.schemas);
+  channels_ = std::move(r.channels);
+  chunks_ = std::move(r.chunks);
+  metadata_ = std::move(metadata);
+  statistics_ = std::move(*r.statistics);
+  data_end_offset_ = data_end;
+  data_crc_ = data_crc;
+  recovery_.used_summary = true;
+  recovery_.truncated = false;
+  recovery_.data_complete = true;
+  recovery_.valid_up_to = size;
+  return "";
+}
+
+std::string Reader::Impl::ReadIndexedMetadata(const std::vector<codec::MetadataIndexRecord>& indexes,
+                                              std::vector<Metadata>* out) {
+  for (const auto& index : indexes) {
     if (index.length < format::kRecordPrefix ||
         !ReadRecordContent(index.offset, index.length, &record_).ok() || record_[0] != format::kMetadata) {
       return "MetadataIndex for \"" + index.name + "\" does not point at a Metadata record";
@@ -293,21 +365,8 @@ std::string Reader::Impl::ReadSummary(std::uint64_t header_end) {
     if (!codec::DecodeMetadata(Bytes(record_).subspan(format::kRecordPrefix), &m)) {
       return "undecodable Metadata record at offset " + std::to_string(index.offset);
     }
-    metadata.push_back(std::move(m));
+    out->push_back(std::move(m));
   }
-
-  std::sort(chunks.begin(), chunks.end(), [](const ChunkInfo& a, const ChunkInfo& b) { return a.offset < b.offset; });
-  schemas_ = std::move(schemas);
-  channels_ = std::move(channels);
-  chunks_ = std::move(chunks);
-  metadata_ = std::move(metadata);
-  statistics_ = std::move(*statistics);
-  data_end_offset_ = data_end;
-  data_crc_ = data_crc;
-  recovery_.used_summary = true;
-  recovery_.truncated = false;
-  recovery_.data_complete = true;
-  recovery_.valid_up_to = size;
   return "";
 }
 
@@ -352,6 +411,80 @@ std::string Reader::Impl::DecodeChunkRecords(const codec::ChunkRecord& chunk, st
   return "";
 }
 
+bool Reader::Impl::ReadScannedRecord(std::uint64_t pos, std::uint8_t* op_out, std::uint64_t* len_out) {
+  const std::uint64_t size = file_.size();
+  if (size - pos < format::kRecordPrefix) {
+    recovery_.stop_reason = "file ends inside a record prefix at offset " + std::to_string(pos);
+    return false;
+  }
+  std::uint8_t prefix[9];
+  if (!file_.ReadAt(pos, prefix).ok()) {
+    recovery_.stop_reason = At("read error", pos);
+    return false;
+  }
+  const std::uint8_t op = *op_out = prefix[0];
+  std::uint64_t& len = *len_out;
+  std::memcpy(&len, prefix + 1, 8);
+  if (len > size - pos - format::kRecordPrefix) {
+    recovery_.stop_reason = std::string(format::OpcodeName(op)) + " record at offset " + std::to_string(pos) +
+                            " needs " + std::to_string(format::kRecordPrefix + len) +
+                            " bytes, file ends at " + std::to_string(size);
+    return false;
+  }
+  // Index records are not needed for a scan: skip their bytes without reading them.
+  const bool wanted = op == format::kSchema || op == format::kChannel || op == format::kChunk ||
+                      op == format::kMetadata || op == format::kDataEnd;
+  if (wanted && !ReadRecordContent(pos + format::kRecordPrefix, len, &record_).ok()) {
+    recovery_.stop_reason = At("read error", pos);
+    return false;
+  }
+  return true;
+}
+
+void Reader::Impl::ScanChunk(std::uint64_t pos, std::uint64_t len, std::vector<std::uint8_t>* records_buffer) {
+  std::vector<std::uint8_t>& records = *records_buffer;
+  codec::ChunkRecord chunk;
+  std::string damage = codec::DecodeChunk(record_, &chunk) ? DecodeChunkRecords(chunk, &records)
+                                                             : "undecodable Chunk record";
+  if (damage.empty()) {
+    // Schemas and channels may live inside chunks (other writers put them there). The
+    // messages count only once the whole chunk has proved well framed.
+    Statistics in_chunk;
+    bool framed = ForEachRecord(records, [&](std::uint8_t inner, Bytes content, std::uint64_t) {
+      if (inner == format::kSchema) {
+        Schema s;
+        if (codec::DecodeSchema(content, &s)) AddSchema(std::move(s));
+      } else if (inner == format::kChannel) {
+        Channel c;
+        if (codec::DecodeChannel(content, &c)) AddChannel(std::move(c));
+      } else if (inner == format::kMessage) {
+        codec::MessageRecord m;
+        if (!codec::DecodeMessage(content, &m)) return false;
+        CountMessage(m.channel_id, m.log_time, &in_chunk);
+      }
+      return true;
+    });
+    if (framed) {
+      AddMessageCounts(in_chunk, &statistics_);
+    } else {
+      damage = "records inside the chunk are misframed";
+    }
+  }
+  if (damage.empty()) {
+    ChunkInfo info;
+    info.offset = pos;
+    info.length = format::kRecordPrefix + len;
+    info.message_start_time = chunk.message_start_time;
+    info.message_end_time = chunk.message_end_time;
+    info.compression = chunk.compression;
+    info.compressed_size = chunk.records.size();
+    info.uncompressed_size = chunk.uncompressed_size;
+    chunks_.push_back(std::move(info));
+  } else {
+    recovery_.damaged_chunks[pos] = damage;
+  }
+}
+
 void Reader::Impl::Scan(std::uint64_t pos) {
   const std::uint64_t size = file_.size();
   Statistics& stats = statistics_;
@@ -362,31 +495,9 @@ void Reader::Impl::Scan(std::uint64_t pos) {
   bool done = false;
   while (!done) {
     if (pos == size) break;
-    if (size - pos < format::kRecordPrefix) {
-      recovery_.stop_reason = "file ends inside a record prefix at offset " + std::to_string(pos);
-      break;
-    }
-    std::uint8_t prefix[9];
-    if (!file_.ReadAt(pos, prefix).ok()) {
-      recovery_.stop_reason = At("read error", pos);
-      break;
-    }
-    const std::uint8_t op = prefix[0];
+    std::uint8_t op = 0;
     std::uint64_t len = 0;
-    std::memcpy(&len, prefix + 1, 8);
-    if (len > size - pos - format::kRecordPrefix) {
-      recovery_.stop_reason = std::string(format::OpcodeName(op)) + " record at offset " + std::to_string(pos) +
-                              " needs " + std::to_string(format::kRecordPrefix + len) +
-                              " bytes, file ends at " + std::to_string(size);
-      break;
-    }
-    // Index records are not needed for a scan: skip their bytes without reading them.
-    const bool wanted = op == format::kSchema || op == format::kChannel || op == format::kChunk ||
-                        op == format::kMetadata || op == format::kDataEnd;
-    if (wanted && !ReadRecordContent(pos + format::kRecordPrefix, len, &record_).ok()) {
-      recovery_.stop_reason = At("read error", pos);
-      break;
-    }
+    if (!ReadScannedRecord(pos, &op, &len)) break;
     bool ok = true;
     switch (op) {
       case format::kSchema: {
@@ -413,49 +524,9 @@ void Reader::Impl::Scan(std::uint64_t pos) {
       case format::kAttachment:
         ++stats.attachment_count;
         break;
-      case format::kChunk: {
-        codec::ChunkRecord chunk;
-        std::string damage = codec::DecodeChunk(record_, &chunk) ? DecodeChunkRecords(chunk, &records)
-                                                                   : "undecodable Chunk record";
-        if (damage.empty()) {
-          // Schemas and channels may live inside chunks (other writers put them there). The
-          // messages count only once the whole chunk has proved well framed.
-          Statistics in_chunk;
-          bool framed = ForEachRecord(records, [&](std::uint8_t inner, Bytes content, std::uint64_t) {
-            if (inner == format::kSchema) {
-              Schema s;
-              if (codec::DecodeSchema(content, &s)) AddSchema(std::move(s));
-            } else if (inner == format::kChannel) {
-              Channel c;
-              if (codec::DecodeChannel(content, &c)) AddChannel(std::move(c));
-            } else if (inner == format::kMessage) {
-              codec::MessageRecord m;
-              if (!codec::DecodeMessage(content, &m)) return false;
-              CountMessage(m.channel_id, m.log_time, &in_chunk);
-            }
-            return true;
-          });
-          if (framed) {
-            AddMessageCounts(in_chunk, &stats);
-          } else {
-            damage = "records inside the chunk are misframed";
-          }
-        }
-        if (damage.empty()) {
-          ChunkInfo info;
-          info.offset = pos;
-          info.length = format::kRecordPrefix + len;
-          info.message_start_time = chunk.message_start_time;
-          info.message_end_time = chunk.message_end_time;
-          info.compression = chunk.compression;
-          info.compressed_size = chunk.records.size();
-          info.uncompressed_size = chunk.uncompressed_size;
-          chunks_.push_back(std::move(info));
-        } else {
-          recovery_.damaged_chunks[pos] = damage;
-        }
+      case format::kChunk:
+        ScanChunk(pos, len, &records);
         break;
-      }
       case format::kDataEnd:
         recovery_.data_complete = true;
         if (codec::DecodeDataEnd(record_, &data_crc_)) data_end_offset_ = pos;
@@ -509,11 +580,6 @@ Status Reader::Impl::ReadMessages(const ReadOptions& options,
     if (options.skipped_chunks) *options.skipped_chunks += recovery_.damaged_chunks.size();
   }
 
-  // Chunks that may hold chosen messages.
-  std::vector<const ChunkInfo*> selected;
-  for (const ChunkInfo& c : chunks_) {
-    if (c.message_end_time >= options.start_time && c.message_start_time <= options.end_time) selected.push_back(&c);
-  }
   std::vector<bool> channel_chosen(65536, options.topics.empty());
   for (const auto& [id, channel] : channels_) {
     if (options.topics.count(channel.topic)) channel_chosen[id] = true;
@@ -556,26 +622,7 @@ Status Reader::Impl::ReadMessages(const ReadOptions& options,
     return true;
   };
 
-  // Groups of chunks to decode together: one chunk in file order; in log-time order, chunks whose
-  // time ranges overlap (our writer's chunks do not, so groups are single chunks in practice).
-  std::vector<std::vector<const ChunkInfo*>> groups;
-  if (options.order == ReadOptions::Order::kFile) {
-    for (const ChunkInfo* c : selected) groups.push_back({c});
-  } else {
-    std::stable_sort(selected.begin(), selected.end(), [](const ChunkInfo* a, const ChunkInfo* b) {
-      return a->message_start_time < b->message_start_time;
-    });
-    std::uint64_t group_end = 0;
-    for (const ChunkInfo* c : selected) {
-      if (groups.empty() || c->message_start_time > group_end) {
-        groups.push_back({});
-        group_end = 0;
-      }
-      groups.back().push_back(c);
-      group_end = std::max(group_end, c->message_end_time);
-    }
-  }
-
+  std::vector<std::vector<const ChunkInfo*>> groups = ChunkGroups(chunks_, options);
   for (auto& group : groups) {
     // File order within a group so that equal log times keep their writing order.
     std::sort(group.begin(), group.end(), [](const ChunkInfo* a, const ChunkInfo* b) { return a->offset < b->offset; });
