@@ -175,88 +175,100 @@ Status SubjectChannel::OnText(ClientId client, std::string_view text) {
   if (j.is_discarded() || !j.is_object()) return Status::InvalidArgument("not a JSON object");
   auto op = j.find("op");
   if (op == j.end() || !op->is_string()) return Status::InvalidArgument("no \"op\" string");
-  if (*op == "pointer") {
-    auto x = j.find("x"), y = j.find("y"), engaged = j.find("engaged");
-    if (x == j.end() || y == j.end() || engaged == j.end() || !x->is_number() || !y->is_number() || !engaged->is_boolean())
-      return Status::InvalidArgument("pointer: needs numbers \"x\", \"y\" and a boolean \"engaged\"");
-    const double px = x->get<double>(), py = y->get<double>();
-    if (!std::isfinite(px) || !std::isfinite(py)) return Status::InvalidArgument("pointer: x and y must be finite");
-    // The page clamps to the workspace; a position outside it is clamped here too.
-    const double h = options_.half_width;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("pointer: a viewer's token may not steer");
-      if (client != steering_) return Status::OK();  // a watching page: ignored
-      last_x_ = std::clamp(px, -h, h);
-      last_y_ = std::clamp(py, -h, h);
-      sink_(last_x_, last_y_, engaged->get<bool>() && !trial_over_);  // after the trial nobody steers
-      if (auto wall = j.find("wall"); wall != j.end() && wall->is_number() && delays_.total.size() < 100000) {
-        const double event_ms = wall->get<double>(), published_ms = WallNowMs();
-        delays_.total.push_back(published_ms - event_ms);
-        if (WebServer* server = server_.load(); server != nullptr && server->message_received_ns() > 0) {
-          const double received_ms = static_cast<double>(server->message_received_ns()) / 1e6;
-          delays_.page_to_socket.push_back(received_ms - event_ms);
-          delays_.socket_to_handler.push_back(handler_ms - received_ms);
-          delays_.handler_to_published.push_back(published_ms - handler_ms);
-        }
-      }
-    }
-    if (auto t = j.find("t"); t != j.end() && t->is_number())
-      if (WebServer* server = server_.load()) server->SendText(client, json{{"op", "ack"}, {"t", t->get<double>()}}.dump());
-    return Status::OK();
-  }
-  if (*op == "steer") {
-    ClientId previous;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("steer: a viewer's token may not steer");
-      previous = steering_;
-      if (previous == client) return Status::OK();
-      steering_ = client;
-      sink_(last_x_, last_y_, false);  // the previous steerer's hold ends now
-    }
-    if (previous != 0) SendRole(previous, false);
-    SendRole(client, true);
-    return Status::OK();
-  }
-  if (*op == "self_report") {
-    auto choice = j.find("choice");
-    const int last = static_cast<int>(options_.primitives.size()) - 1;
-    if (choice == j.end() || !choice->is_number_integer() || choice->get<int64_t>() < -1 || choice->get<int64_t>() > last)
-      return Status::InvalidArgument("self_report: needs an integer \"choice\" in -1.." + std::to_string(last) +
-                                     " (a primitive, or -1: something else)");
-    auto segment = j.find("segment");
-    if (segment != j.end() && (!segment->is_number_integer() || segment->get<int64_t>() < 0))
-      return Status::InvalidArgument("self_report: \"segment\" must be the index of the question answered (an integer >= 0)");
-    std::string next;
-    bool stale = false;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("self_report: a viewer's token may not answer");
-      if (client != steering_ || !report_) return Status::OK();  // nobody asked this page
-      if (!trial_over_) {
-        if (!options_.ask) return Status::OK();
-        return report_(static_cast<int>(choice->get<int64_t>()), -1);
-      }
-      // After the trial: only an answer to the question shown counts. Another (a second click, a
-      // stale page's) is ignored, and that page is shown the question again (it hid its own).
-      if (!asking_) return Status::OK();
-      if (segment == j.end() || asked_ >= questions_.size() || segment->get<int64_t>() != static_cast<int64_t>(asked_)) {
-        stale = true;
-      } else {
-        if (Status s = report_(static_cast<int>(choice->get<int64_t>()), static_cast<int>(asked_)); !s.ok()) return s;
-        ++asked_;
-      }
-      next = QuestionJson();
-    }
-    if (stale) {
-      if (WebServer* server = server_.load()) server->SendLatest(client, kQuestionChannel, next, /*binary=*/false);
-    } else {
-      SendToAll(kQuestionChannel, next);
-    }
-    return Status::OK();
-  }
+  if (*op == "pointer") return OnPointer(client, j, handler_ms);
+  if (*op == "steer") return OnSteer(client);
+  if (*op == "self_report") return OnSelfReport(client, j);
   return Status::InvalidArgument("unknown op");
+}
+
+// {"op": "pointer", "x", "y", "engaged"[, "wall", "t"]}: the steering page's pointer, published
+// (clamped to the workspace); a watching page's is ignored. "wall" adds to the pointer delays,
+// "t" is acknowledged.
+Status SubjectChannel::OnPointer(ClientId client, const json& j, double handler_ms) {
+  auto x = j.find("x"), y = j.find("y"), engaged = j.find("engaged");
+  if (x == j.end() || y == j.end() || engaged == j.end() || !x->is_number() || !y->is_number() || !engaged->is_boolean())
+    return Status::InvalidArgument("pointer: needs numbers \"x\", \"y\" and a boolean \"engaged\"");
+  const double px = x->get<double>(), py = y->get<double>();
+  if (!std::isfinite(px) || !std::isfinite(py)) return Status::InvalidArgument("pointer: x and y must be finite");
+  // The page clamps to the workspace; a position outside it is clamped here too.
+  const double h = options_.half_width;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("pointer: a viewer's token may not steer");
+    if (client != steering_) return Status::OK();  // a watching page: ignored
+    last_x_ = std::clamp(px, -h, h);
+    last_y_ = std::clamp(py, -h, h);
+    sink_(last_x_, last_y_, engaged->get<bool>() && !trial_over_);  // after the trial nobody steers
+    if (auto wall = j.find("wall"); wall != j.end() && wall->is_number() && delays_.total.size() < 100000) {
+      const double event_ms = wall->get<double>(), published_ms = WallNowMs();
+      delays_.total.push_back(published_ms - event_ms);
+      if (WebServer* server = server_.load(); server != nullptr && server->message_received_ns() > 0) {
+        const double received_ms = static_cast<double>(server->message_received_ns()) / 1e6;
+        delays_.page_to_socket.push_back(received_ms - event_ms);
+        delays_.socket_to_handler.push_back(handler_ms - received_ms);
+        delays_.handler_to_published.push_back(published_ms - handler_ms);
+      }
+    }
+  }
+  if (auto t = j.find("t"); t != j.end() && t->is_number())
+    if (WebServer* server = server_.load()) server->SendText(client, json{{"op", "ack"}, {"t", t->get<double>()}}.dump());
+  return Status::OK();
+}
+
+// {"op": "steer"}: this page takes the steering over; the previous steerer's hold ends.
+Status SubjectChannel::OnSteer(ClientId client) {
+  ClientId previous;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("steer: a viewer's token may not steer");
+    previous = steering_;
+    if (previous == client) return Status::OK();
+    steering_ = client;
+    sink_(last_x_, last_y_, false);  // the previous steerer's hold ends now
+  }
+  if (previous != 0) SendRole(previous, false);
+  SendRole(client, true);
+  return Status::OK();
+}
+
+// {"op": "self_report", "choice"[, "segment"]}: the subject's answer, during the trial or (to
+// the question shown, by its segment) after it.
+Status SubjectChannel::OnSelfReport(ClientId client, const json& j) {
+  auto choice = j.find("choice");
+  const int last = static_cast<int>(options_.primitives.size()) - 1;
+  if (choice == j.end() || !choice->is_number_integer() || choice->get<int64_t>() < -1 || choice->get<int64_t>() > last)
+    return Status::InvalidArgument("self_report: needs an integer \"choice\" in -1.." + std::to_string(last) +
+                                   " (a primitive, or -1: something else)");
+  auto segment = j.find("segment");
+  if (segment != j.end() && (!segment->is_number_integer() || segment->get<int64_t>() < 0))
+    return Status::InvalidArgument("self_report: \"segment\" must be the index of the question answered (an integer >= 0)");
+  std::string next;
+  bool stale = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("self_report: a viewer's token may not answer");
+    if (client != steering_ || !report_) return Status::OK();  // nobody asked this page
+    if (!trial_over_) {
+      if (!options_.ask) return Status::OK();
+      return report_(static_cast<int>(choice->get<int64_t>()), -1);
+    }
+    // After the trial: only an answer to the question shown counts. Another (a second click, a
+    // stale page's) is ignored, and that page is shown the question again (it hid its own).
+    if (!asking_) return Status::OK();
+    if (segment == j.end() || asked_ >= questions_.size() || segment->get<int64_t>() != static_cast<int64_t>(asked_)) {
+      stale = true;
+    } else {
+      if (Status s = report_(static_cast<int>(choice->get<int64_t>()), static_cast<int>(asked_)); !s.ok()) return s;
+      ++asked_;
+    }
+    next = QuestionJson();
+  }
+  if (stale) {
+    if (WebServer* server = server_.load()) server->SendLatest(client, kQuestionChannel, next, /*binary=*/false);
+  } else {
+    SendToAll(kQuestionChannel, next);
+  }
+  return Status::OK();
 }
 
 Status SubjectChannel::OnBinary(ClientId, std::span<const uint8_t>) {

@@ -42,6 +42,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "web_server.hpp"
 
 namespace dyad::web {
@@ -107,6 +109,10 @@ class SubjectChannel final : public ClientHandler {
   void OnClose(ClientId client) override;
 
  private:
+  // OnText's ops, the JSON object checked to be one with an "op" string.
+  Status OnPointer(ClientId client, const nlohmann::json& j, double handler_ms);
+  Status OnSteer(ClientId client);
+  Status OnSelfReport(ClientId client, const nlohmann::json& j);
   void SendRole(ClientId client, bool steering);
   std::string TaskJson() const;      // with mutex_ held
   std::string QuestionJson() const;  // with mutex_ held
