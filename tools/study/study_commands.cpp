@@ -81,6 +81,7 @@ std::string Ended(const study::Attempt& a) {
   std::snprintf(secs, sizeof secs, "%.1f s", a.seconds);
   if (a.outcome == "complete") return std::string("complete (") + secs + ")";
   if (a.outcome == "stopped") return std::string("stopped after ") + secs + ": incomplete";
+  if (a.outcome == "incomplete") return std::string("incomplete after ") + secs + ": " + a.incomplete;
   if (a.outcome.empty()) return "interrupted: the session ended during it";
   return "failed: the graph exited " + std::to_string(a.exit) + " after " + secs + (a.exit == 0 ? " and left no whole recording" : "");
 }
@@ -167,61 +168,33 @@ bool LoadParticipant(const std::string& file, const std::vector<std::string>& pl
   return true;
 }
 
-// `dyad study run`: the participant's trials in their order, from the first not yet complete.
-int RunSession(const RunOptions& o) {
-  study::Study s;
-  if (!LoadParticipant(o.file, o.plugins, o.participant, "dyad study run", &s)) return kBadInput;
-  const std::vector<study::Trial> trials = s.TrialsOf(o.participant);
-  if (o.trial > static_cast<int>(trials.size())) {
-    std::cerr << "dyad study run: --trial " << o.trial << ": " << o.participant << " has " << trials.size() << " trials\n";
-    return kBadInput;
-  }
-  if (!o.reason.empty() && o.trial == 0) {
-    std::cerr << "dyad study run: --reason is the reason of a --trial repetition; give --trial N too\n";
-    return kBadInput;
-  }
-  // One runner per participant, from the first thing that writes (consent, the page) on; a
-  // session refused for want of consent leaves nothing behind.
-  auto lock = [&]() -> StatusOr<study::SessionLock> {
-    auto l = study::SessionLock::Acquire(s, o.participant);
-    if (!l.ok()) std::cerr << "dyad study run: " << l.status().ToString() << "\n";
-    return l;
-  };
-  const study::Session before = study::ReadSession(s, o.participant);
-  for (const auto& p : before.problems) std::cerr << "warning: " << p << "\n";
-  std::cout << "study " << s.name << ", participant " << o.participant << ": " << trials.size() << " trials\n";
-  if (o.page) {  // the experimenter's study page instead of the terminal
-    auto held = lock();
-    if (!held.ok()) return kBadInput;
-    if (Status st = o.consent && !before.consent ? study::MarkConsent(s, o.participant, "--consent") : Status::OK(); !st.ok()) {
-      std::cerr << "dyad study run: " << st.ToString() << "\n";
-      return 1;
-    }
-    study::PageOptions po = o.page_options;
-    po.dyad = tools::ThisExecutable();
-    return study::RunStudyPage(s, o.participant, po);
-  }
-  const std::optional<std::string> consent = ConsentGiven(s, o, before);
-  if (!consent) return kBadInput;
-  auto held = lock();
+// The participant's session lock, or its reason on stderr. One runner per participant, from the
+// first thing that writes (consent, the page) on; a session refused for want of consent leaves
+// nothing behind.
+StatusOr<study::SessionLock> LockSession(const study::Study& s, const std::string& participant) {
+  auto l = study::SessionLock::Acquire(s, participant);
+  if (!l.ok()) std::cerr << "dyad study run: " << l.status().ToString() << "\n";
+  return l;
+}
+
+// `dyad study run --page`: the experimenter's study page instead of the terminal.
+int RunOnPage(const study::Study& s, const RunOptions& o, const study::Session& before) {
+  auto held = LockSession(s, o.participant);
   if (!held.ok()) return kBadInput;
-  if (!consent->empty()) {
-    if (Status st = study::MarkConsent(s, o.participant, *consent); !st.ok()) {
-      std::cerr << "dyad study run: " << st.ToString() << "\n";
-      return 1;
-    }
-    std::cout << "consent marked for " << o.participant << " (" << *consent << ")\n";
+  if (Status st = o.consent && !before.consent ? study::MarkConsent(s, o.participant, "--consent") : Status::OK(); !st.ok()) {
+    std::cerr << "dyad study run: " << st.ToString() << "\n";
+    return 1;
   }
+  study::PageOptions po = o.page_options;
+  po.dyad = tools::ThisExecutable();
+  return study::RunStudyPage(s, o.participant, po);
+}
+
+// The participant's trials in their order, each not yet complete run; a trial that did not
+// complete is run again, with the experimenter's reason, before the next. kOk when every trial is
+// complete (said on stdout) or the experimenter stopped at a prompt (q, end of input).
+int RunInOrder(const study::Study& s, const RunOptions& o, const std::vector<study::Trial>& trials) {
   study::Attempt a;
-  if (o.trial > 0) {  // a repetition, asked for on the command line
-    if (o.reason.empty()) {
-      std::cerr << "dyad study run: --trial " << o.trial << " needs --reason (why the trial is repeated)\n";
-      return kBadInput;
-    }
-    if (!RunOne(s, o, trials[static_cast<size_t>(o.trial - 1)], trials.size(), o.reason, &a)) return kBadInput;
-    return a.outcome == "complete" ? kOk : 1;
-  }
-  // A trial that did not complete is run again, with the experimenter's reason, before the next.
   auto why_again = [&](const study::Attempt& last) {
     if (o.yes) {
       std::cerr << "dyad study run: trial " << last.trial << " is incomplete (" << Ended(last) << "); repeat it with --trial "
@@ -248,6 +221,46 @@ int RunSession(const RunOptions& o) {
   }
   std::cout << o.participant << ": every trial complete (session log " << study::SessionLogPath(s, o.participant) << ")\n";
   return kOk;
+}
+
+// `dyad study run`: the participant's trials in their order, from the first not yet complete.
+int RunSession(const RunOptions& o) {
+  study::Study s;
+  if (!LoadParticipant(o.file, o.plugins, o.participant, "dyad study run", &s)) return kBadInput;
+  const std::vector<study::Trial> trials = s.TrialsOf(o.participant);
+  if (o.trial > static_cast<int>(trials.size())) {
+    std::cerr << "dyad study run: --trial " << o.trial << ": " << o.participant << " has " << trials.size() << " trials\n";
+    return kBadInput;
+  }
+  if (!o.reason.empty() && o.trial == 0) {
+    std::cerr << "dyad study run: --reason is the reason of a --trial repetition; give --trial N too\n";
+    return kBadInput;
+  }
+  const study::Session before = study::ReadSession(s, o.participant);
+  for (const auto& p : before.problems) std::cerr << "warning: " << p << "\n";
+  std::cout << "study " << s.name << ", participant " << o.participant << ": " << trials.size() << " trials\n";
+  if (o.page) return RunOnPage(s, o, before);
+  const std::optional<std::string> consent = ConsentGiven(s, o, before);
+  if (!consent) return kBadInput;
+  auto held = LockSession(s, o.participant);
+  if (!held.ok()) return kBadInput;
+  if (!consent->empty()) {
+    if (Status st = study::MarkConsent(s, o.participant, *consent); !st.ok()) {
+      std::cerr << "dyad study run: " << st.ToString() << "\n";
+      return 1;
+    }
+    std::cout << "consent marked for " << o.participant << " (" << *consent << ")\n";
+  }
+  if (o.trial > 0) {  // a repetition, asked for on the command line
+    if (o.reason.empty()) {
+      std::cerr << "dyad study run: --trial " << o.trial << " needs --reason (why the trial is repeated)\n";
+      return kBadInput;
+    }
+    study::Attempt a;
+    if (!RunOne(s, o, trials[static_cast<size_t>(o.trial - 1)], trials.size(), o.reason, &a)) return kBadInput;
+    return a.outcome == "complete" ? kOk : 1;
+  }
+  return RunInOrder(s, o, trials);
 }
 
 struct ParticipantOptions {
