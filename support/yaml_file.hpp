@@ -1,4 +1,6 @@
-// tools/support/yaml_file.hpp: what the tools' own YAML files (a sweep, a study) share.
+// support/yaml_file.hpp: what the tools' own YAML files (a sweep, a study) share, and the quoting
+// of a --set value (the learner component's too). Below the components (support/CMakeLists.txt);
+// the namespace is dyad::tools, its first users'.
 //
 // LoadYamlFile(path, what, &root, problems): the parsed file, or false with one problem: "cannot
 // read the WHAT file" (at the path), or the parser's message at its line and column.

@@ -1,5 +1,6 @@
-// tools/support/run_process.hpp: run a program and wait for it (the CLI's helpers: the plot
-// scripts, a sweep's runs).
+// support/run_process.hpp: run a program and wait for it (the CLI's helpers: the plot scripts, a
+// sweep's runs; the learner component's trainer). Below the components (support/CMakeLists.txt);
+// the namespace is dyad::tools, its first users'.
 //
 // Contract of RunProcess(args, log):
 //   - args[0] is a path, or a name looked up in PATH; the child inherits the environment.
