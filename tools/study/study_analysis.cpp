@@ -302,9 +302,9 @@ const std::vector<std::string>& SummaryMeasures() {
 std::string EmptyTrialReason(const analyze::Report& r) {
   const auto& missing = r.timeline.missing_topics;
   if (std::find(missing.begin(), missing.end(), "human/input") != missing.end())
-    return "no participant: no human input recorded (human/input)";
+    return "no subject: no human input recorded (human/input)";
   if (std::none_of(r.timeline.steps.begin(), r.timeline.steps.end(), [](const analyze::StepSample& x) { return x.engaged; }))
-    return "no participant: not one engaged step (no subject's page connected, or nobody held)";
+    return kNoEngagedStep;
   return "";
 }
 
@@ -366,25 +366,30 @@ std::string AttemptMismatch(const std::string& file, int attempt) {
 // The attempt of `t` to analyse, or the reason there is none (session: the participant's log).
 struct Chosen {
   std::string file, why_not, repeated;
+  std::string incomplete;  // the session log's reason the attempt was no data (outcome incomplete)
   int attempt = 1;
 };
 Chosen ChooseAttempt(const Session& session, const Trial& t) {
   Chosen c;
   c.file = t.file;
   const Attempt* done = session.Complete(t.number);
+  // None complete, the last whole but nobody took part (outcome incomplete): analysed, and marked.
+  if (const Attempt* last = session.Last(t.number); !done && last && last->outcome == "incomplete") done = last;
   auto add = [&c](const Attempt& a, const std::string& fate) {
     c.repeated += (c.repeated.empty() ? "" : "; ") + ("attempt " + std::to_string(a.attempt) + " " + fate) +
                   (a.reason.empty() ? "" : ", repeated because: " + a.reason);
   };
   for (const Attempt& a : session.attempts) {
     if (a.trial != t.number) continue;
-    if (&a == done) add(a, "analysed");
-    else add(a, a.outcome.empty() ? "interrupted (the session ended during it)" : a.outcome);
+    if (&a == done) add(a, a.outcome == "incomplete" ? "analysed, incomplete: " + a.incomplete : "analysed");
+    else add(a, a.outcome.empty() ? "interrupted (the session ended during it)"
+                                  : a.outcome + (a.incomplete.empty() ? "" : ": " + a.incomplete));
   }
   if (done) {
     // The plan names the file (the log's path is what it was then: the folder may have moved).
     c.file = AttemptFile(t, done->attempt);
     c.attempt = done->attempt;
+    c.incomplete = done->incomplete;
     if (done->attempt == 1 && c.repeated == "attempt 1 analysed") c.repeated.clear();
   } else if (session.Last(t.number)) {
     c.why_not = "incomplete (" + c.repeated + ")";
@@ -436,10 +441,18 @@ StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehe
         continue;
       }
       report->planned_s = study.duration_s;  // a trial's recording shorter than planned is incomplete
-      TrialResult r{p, t, c.attempt, !report->plan.events.empty(), c.repeated, analyze::RunMetrics(*report), report->events};
+      TrialResult r;
+      r.participant = p;
+      r.trial = t;
+      r.attempt = c.attempt;
+      r.planned = !report->plan.events.empty();
+      r.repeated = c.repeated;
+      r.metrics = analyze::RunMetrics(*report);
+      r.events = report->events;
       r.trial.file = c.file;
       r.incomplete = analyze::IncompleteReason(*report);
       if (r.incomplete.empty()) r.incomplete = EmptyTrialReason(*report);
+      if (r.incomplete.empty()) r.incomplete = c.incomplete;  // what the runner saw, when the analysis does not
       r.reported_confusion = report->reported_confusion;
       r.said_vs_observer = SaidAgainstObserver(*report);
       if (a.primitive_names.empty()) a.primitive_names = report->primitive_names;

@@ -10,6 +10,8 @@
 //     file that cannot be analysed; a recording whose "dyad.run" metadata does not say it is this
 //     trial of this participant of this study (another study's file, a rehearsal's among the
 //     participants' or the reverse, or a file without that metadata).
+//   - An attempt the session log says ended "incomplete" (nobody took part: NoSubject) is
+//     analysed when the trial has no complete attempt, and marked incomplete as below.
 //   - A trial whose recording is analysed but incomplete (analyze::IncompleteReason: the file is
 //     cut short or damaged, or spans less than 95% of the study's `duration`; or EmptyTrialReason:
 //     nobody took part, no human input or not one engaged step) is kept in
@@ -102,7 +104,8 @@ struct StudyAnalysis {
 StudyAnalysis AnalyzeStudy(const Study& study, std::ostream& warnings, bool rehearsal = false, bool include_incomplete = false);
 
 // Why a trial's recording holds no participation, "" when someone took part: no human input
-// recorded (human/input), or not one engaged step (no subject's page connected, or nobody held).
+// recorded (human/input), or not one engaged step (kNoEngagedStep: no subject's page connected,
+// or nobody held).
 // Such a trial is incomplete: empty trials are not data.
 std::string EmptyTrialReason(const analyze::Report& report);
 

@@ -159,6 +159,7 @@ class StudyChannel final : public web::ClientHandler {
       const bool now_running = running_.load() && current_trial_.load() == t.number;
       if (session.Complete(t.number)) status = "complete";
       else if (now_running) status = "running";
+      else if (last && last->outcome == "incomplete" && last->incomplete.rfind("no subject", 0) == 0) status = "no subject: repeat?";
       else if (last) status = last->outcome.empty() ? "interrupted" : last->outcome;
       done = done && session.Complete(t.number);
       trials.push_back({{"number", t.number},

@@ -12,7 +12,9 @@
 //   page -> server: {"op":"consent"}, {"op":"start","trial":k,"reason":"..."} (reason: for a
 //     trial with an earlier attempt), {"op":"stop"}
 //   server -> page: {"op":"state", "study", "participant", "blind", "consent_required",
-//     "consent", "duration_s", "trials":[{"number","shown","file","status","attempts"}],
+//     "consent", "duration_s", "trials":[{"number","shown","file","status","attempts"}] (status:
+//     to do, running, complete, stopped, failed, interrupted, incomplete, or "no subject: repeat?"
+//     as soon as a trial ends whole with nobody taking part: study_session.hpp's NoSubject),
 //     "running":{"trial","attempt","elapsed_s"}|null, "done":bool}, after each change and once a
 //     second while a trial runs; {"op":"error","message"} for a refused request (the page stays).
 // A trial starts only in the plan's order (the next one not complete), or again with a reason.

@@ -16,9 +16,11 @@
 #include <sstream>
 
 #include <nlohmann/json.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "dyad/mcap/reader.hpp"
 #include "dyad/private_file.hpp"
+#include "recording_tables.hpp"
 #include "run_process.hpp"
 #include "yaml_file.hpp"
 
@@ -156,7 +158,7 @@ Session ReadSession(const Study& s, const std::string& participant) {
         out.excluded = event == "excluded";
         out.exclusion_reason = j.at("reason").get<std::string>();
       } else if (event == "note") {
-        out.notes.push_back(Note{j.value("time", ""), j.at("text").get<std::string>(), running});
+        out.notes.push_back(Note{j.value("time", ""), j.at("text").get<std::string>(), j.value("trial", running)});
       } else if (event == "start") {
         Attempt a;
         a.trial = running = j.at("trial").get<int>();
@@ -175,6 +177,7 @@ Session ReadSession(const Study& s, const std::string& participant) {
           continue;
         }
         a->outcome = j.at("outcome").get<std::string>();
+        a->incomplete = j.value("incomplete", "");
         a->seconds = j.value("seconds", 0.0);
         a->exit = j.value("exit", 0);
         if (running == trial) running = 0;
@@ -211,9 +214,37 @@ Status AppendSessionEvent(const Study& s, const std::string& participant, const 
   return SyncDirectory(fs::path(path).parent_path().parent_path().string());
 }
 
+std::string NoSubject(const std::string& recording) {
+  auto reader = mcap::Reader::Open(recording);
+  if (!reader.ok()) return "";  // not this rule's to judge: RunAttempt's own checks say failed
+  bool subject_page = false;
+  try {
+    const YAML::Node components = YAML::Load(analyze::GraphMetadata(*reader, "yaml"))["components"];
+    if (components && components.IsMap())
+      for (const auto& c : components) subject_page = subject_page || (c.second["type"] && c.second["type"].as<std::string>() == "web_human");
+  } catch (const YAML::Exception&) {
+    return "";
+  }
+  if (!subject_page) return "";  // no person steers this graph (a test's, a rehearsal's)
+  auto tables = analyze::ReadTables(*reader, {"human/input"});
+  if (!tables.ok()) return "";
+  const auto it = tables->find("human/input");
+  if (it == tables->end() || it->second.size() == 0) return "no subject: no human input recorded (human/input)";
+  const int engaged = it->second.Column("engaged");
+  for (const auto& row : it->second.rows) {
+    bool on = false;
+    if (engaged >= 0 && analyze::ParseBool(row[static_cast<size_t>(engaged)], &on) && on) return "";
+  }
+  return kNoEngagedStep;
+}
+
 Status AddNote(const Study& s, const std::string& participant, const std::string& text) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) return Status::InvalidArgument("a note needs its text");
-  return AppendSessionEvent(s, participant, Dump(Json{{"event", "note"}, {"text", text}}));
+  // The trial under way, as ReadSession places notes: the last attempt started and not ended.
+  const Session now = ReadSession(s, participant);
+  Json note = {{"event", "note"}, {"text", text}};
+  if (!now.attempts.empty() && now.attempts.back().outcome.empty()) note["trial"] = now.attempts.back().trial;
+  return AppendSessionEvent(s, participant, Dump(note));
 }
 
 Status ExcludeParticipant(const Study& s, const std::string& participant, bool excluded, const std::string& reason) {
@@ -384,8 +415,10 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
     auto recording = mcap::Reader::Open(a.file);
     if (!recording.ok() || recording->recovery().truncated) a.outcome = "failed";
   }
+  if (a.outcome == "complete" && !(a.incomplete = NoSubject(a.file)).empty()) a.outcome = "incomplete";
   Json end = {{"event", "end"}, {"trial", a.trial}, {"attempt", a.attempt}, {"outcome", a.outcome},
               {"seconds", std::round(a.seconds * 10) / 10}, {"exit", a.exit}};
+  if (!a.incomplete.empty()) end["incomplete"] = a.incomplete;
   if (Status st = AppendSessionEvent(s, r.participant, Dump(end)); !st.ok()) return st;
   return a;
 }

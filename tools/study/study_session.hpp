@@ -6,14 +6,17 @@
 //   {"time":"2026-11-26T20:31:05Z","event":"consent","how":"..."}
 //   {"time":...,"event":"start","trial":3,"attempt":2,"file":"/abs/03-B.try2.mcap","reason":"..."}
 //   {"time":...,"event":"end","trial":3,"attempt":2,"outcome":"complete","seconds":120.0,"exit":0}
-//   {"time":...,"event":"note","text":"..."}                 the experimenter's (dyad study note, the page)
+//   {"time":...,"event":"end",...,"outcome":"incomplete","incomplete":"no subject: ..."}  nobody took part
+//   {"time":...,"event":"note","text":"...","trial":3}       the experimenter's (dyad study note, the page);
+//                                                             trial: the one under way (none between trials)
 //   {"time":...,"event":"withdrawn","how":"...","data":"kept"|"deleted"}   consent withdrawn
 //   {"time":...,"event":"excluded","reason":"..."} / {"time":...,"event":"included","reason":"..."}
 // Consent and withdrawal: the later line holds. Exclusion and inclusion: the later line holds.
 // Each line is on disk (fdatasync, and the folder's entry when the log is new) before the call
 // that wrote it returns: a trial never starts on a consent a power cut could lose.
 // outcome: complete | stopped (the experimenter ended a timed trial early) | failed (the graph
-// exited non-zero other than after a stop, was killed, or left a recording cut short or none).
+// exited non-zero other than after a stop, was killed, or left a recording cut short or none) |
+// incomplete (the run ended well, but nobody took part: NoSubject; "incomplete" says why).
 // A start without its end: the session itself ended mid-trial ("interrupted").
 //
 // Contract:
@@ -62,7 +65,8 @@ namespace dyad::study {
 struct Attempt {
   int trial = 0, attempt = 0;
   std::string file, reason;  // reason: why this attempt repeats the trial (empty for the first)
-  std::string outcome;       // complete | stopped | failed | "" (started, never ended)
+  std::string outcome;       // complete | stopped | failed | incomplete | "" (started, never ended)
+  std::string incomplete;    // outcome incomplete: why (NoSubject)
   double seconds = 0;
   int exit = 0;
   bool interrupted = false;  // RunAttempt: SIGINT/SIGTERM reached the runner (a person wants it all to stop)
@@ -113,6 +117,13 @@ struct AttemptRequest {
   std::string run_log;      // the graph's output; empty: the terminal
   const std::atomic<bool>* stop = nullptr;  // set: stop the trial as SIGINT does (the study page's Stop)
 };
+
+// Why a trial's whole recording is no data ("" when someone took part): its graph has a subject's
+// page (a `web_human` component) and its human/input holds not one engaged sample
+// (kNoEngagedStep), or none at all. Empty trials are not data: the attempt's outcome is then
+// incomplete, and `dyad study analyze` says the same of the recording (study_analysis.hpp).
+constexpr const char* kNoEngagedStep = "no subject: not one engaged step (no subject's page connected, or nobody held)";
+std::string NoSubject(const std::string& recording);
 
 // Runs one attempt (see the contract); the returned attempt says how it ended.
 StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r);

@@ -216,6 +216,47 @@ TEST_F(StudySession, AfterTheTrialTheSubjectsPageEndsTheRun) {
   }
 }
 
+// Empty trials are not data: a study graph with a subject's page (web + web_human) whose page
+// nobody opens. Each trial's run ends well and its recording is whole, but the session log says
+// "incomplete" with the reason, and the analysis keeps both trials marked, out of the summary.
+TEST_F(StudySession, TrialsWithoutASubjectsPageAreIncompleteInTheLogAndTheAnalysis) {
+  std::ofstream(dir_ / "w.yaml") << "graph: w\nclock: wall\ndomain_id: " << 1 + getpid() % 200 << "\ncomponents:\n"
+                                    "  web: {type: web, rate_hz: 20, params: {port: 0}, outputs: {pointer: web/pointer, notes: experiment/notes}}\n"
+                                    "  human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}\n"
+                                    "  recorder: {type: recorder, rate_hz: 1}\n";
+  std::ofstream(dir_ / "s.yaml") << "study: gain\ngraph: w.yaml\nparticipants: [P01]\n"
+                                    "conditions:\n  low: {human.engage_timeout_s: 0.3}\n  high: {human.engage_timeout_s: 0.4}\nduration: 2\n";
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy((dir_ / "s.yaml").string(), {}, &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  ASSERT_TRUE(MarkConsent(s, "P01", "test").ok());
+  for (const Trial& t : s.TrialsOf("P01")) {
+    AttemptRequest r;
+    r.dyad = DYAD_EXE;
+    r.participant = "P01";
+    r.trial = t;
+    r.run_log = (dir_ / ("run" + std::to_string(t.number) + ".log")).string();
+    auto a = RunAttempt(s, r);
+    ASSERT_TRUE(a.ok()) << a.status().ToString();
+    EXPECT_EQ(a->exit, 0) << r.run_log;
+    EXPECT_EQ(a->outcome, "incomplete") << r.run_log;
+    EXPECT_EQ(a->incomplete, kNoEngagedStep);
+  }
+  const auto log = LogLines(SessionLogPath(s, "P01"));
+  ASSERT_EQ(log.size(), 5u);
+  for (const size_t end : {2u, 4u}) {
+    EXPECT_EQ(log[end]["outcome"], "incomplete") << log[end].dump();
+    EXPECT_EQ(log[end]["incomplete"], kNoEngagedStep) << log[end].dump();
+  }
+  const StudyAnalysis a = AnalyzeStudy(s, std::cerr);
+  EXPECT_TRUE(a.missing.empty()) << a.missing.front();
+  ASSERT_EQ(a.trials.size(), 2u);
+  for (const TrialResult& t : a.trials) {
+    EXPECT_EQ(t.incomplete, kNoEngagedStep);
+    EXPECT_FALSE(a.Counted(t));
+  }
+}
+
 // A timed trial stopped early (Ctrl-C) is incomplete; a session killed mid-trial stops its graph
 // (which finishes its recording) and leaves the trial incomplete; the analysis goes on.
 TEST_F(StudySession, AStoppedOrKilledTrialIsIncompleteAndItsRecordingStaysReadable) {

@@ -589,7 +589,7 @@ TEST_F(StudyFile, TrialsWithNobodyEngagedAreIncompleteAndLeftOutOfTheSummary) {
     const bool nobody = row.at("participant") == "P02";
     EXPECT_EQ(row.at("complete"), nobody ? "false" : "true") << row.at("participant");
     if (nobody) {
-      EXPECT_EQ(row.at("reason"), "no participant: not one engaged step (no subject's page connected, or nobody held)");
+      EXPECT_EQ(row.at("reason"), "no subject: not one engaged step (no subject's page connected, or nobody held)");
       ++empty;
     }
   }
@@ -627,6 +627,32 @@ TEST_F(StudyFile, TheSelfReportsAreCountedInEventsByNameWithSomethingElseOfItsOw
   const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_NE(report.find("| said / observer | triangle |\n|---|---|\n"), std::string::npos) << report;
   EXPECT_NE(report.find("| **something else** | 1 (10) |"), std::string::npos) << report;
+}
+
+// The session log's note line names the trial under way (none between trials), and the log
+// reads it back so.
+TEST_F(StudyFile, ANoteLineNamesTheTrialUnderWay) {
+  const std::string f = Write("study: gain\ngraph: g.yaml\nparticipants: [P01]\nconditions:\n  low: {src.start: 1}\n");
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy(f, {}, &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  ASSERT_TRUE(AddNote(s, "P01", "before").ok());
+  ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"start","trial":1,"attempt":1,"file":"x.mcap"})").ok());
+  ASSERT_TRUE(AddNote(s, "P01", "during").ok());
+  ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"end","trial":1,"attempt":1,"outcome":"complete","seconds":1,"exit":0})").ok());
+  ASSERT_TRUE(AddNote(s, "P01", "after").ok());
+  std::ifstream in(SessionLogPath(s, "P01"));
+  std::vector<std::string> notes;
+  for (std::string line; std::getline(in, line);)
+    if (line.find("\"note\"") != std::string::npos) notes.push_back(line);
+  ASSERT_EQ(notes.size(), 3u);
+  EXPECT_EQ(notes[0].find("\"trial\""), std::string::npos) << notes[0];
+  EXPECT_NE(notes[1].find("\"trial\":1"), std::string::npos) << notes[1];
+  EXPECT_EQ(notes[2].find("\"trial\""), std::string::npos) << notes[2];
+  const Session read = ReadSession(s, "P01");
+  ASSERT_EQ(read.notes.size(), 3u);
+  EXPECT_EQ(read.notes[1].trial, 1);
+  EXPECT_EQ(read.notes[2].trial, 0);
 }
 
 // AB12 and ab12 would share a folder on a case-insensitive file system: refused at the line. A
