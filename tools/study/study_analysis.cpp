@@ -256,9 +256,10 @@ std::string ReportMd(const Study& s, const StudyAnalysis& a, const Summaries& su
     for (const auto& [pair, n] : a.reports_vs_plan) all += n, wrong += pair.first != pair.second ? n : 0;
     out << "\n## Self-reports against the plan (synthetic participants)\n\n" << wrong << " of " << all
         << " self-reports name another primitive than the one traced (" << Num(100.0 * static_cast<double>(wrong) / static_cast<double>(all))
-        << "%; -1: \"something else\"); reports_vs_plan.csv has every pair.\n\n| traced | reported | events |\n|---|---|---|\n";
+        << "%); reports_vs_plan.csv has every pair.\n\n| traced | reported | events |\n|---|---|---|\n";
     for (const auto& [pair, n] : a.reports_vs_plan)
-      if (pair.first != pair.second) out << "| " << pair.first << " | " << pair.second << " | " << n << " |\n";
+      if (pair.first != pair.second)
+        out << "| " << tools::MarkdownCell(Said(a, pair.first)) << " | " << tools::MarkdownCell(Said(a, pair.second)) << " | " << n << " |\n";
   }
   bool any_repeated = false;
   for (const TrialResult& r : a.trials) {
@@ -495,7 +496,8 @@ Status WriteStudyAnalysis(const Study& study, const StudyAnalysis& a, const std:
     confusion << tools::CsvCell(Said(a, key.first)) << ',' << tools::CsvCell(Observed(a, key.second)) << ',' << cell.events << ','
               << cell.steps << '\n';
   vs_plan << "planned,reported,events\n";
-  for (const auto& [pair, n] : a.reports_vs_plan) vs_plan << pair.first << ',' << pair.second << ',' << n << '\n';
+  for (const auto& [pair, n] : a.reports_vs_plan)
+    vs_plan << tools::CsvCell(Said(a, pair.first)) << ',' << tools::CsvCell(Said(a, pair.second)) << ',' << n << '\n';
   const std::tuple<const char*, bool, std::string> optional[] = {
       {"reported_confusion.csv", !a.said_vs_observer.empty(), confusion.str()},
       {"reports_vs_plan.csv", !a.reports_vs_plan.empty(), vs_plan.str()}};

@@ -36,7 +36,7 @@
 //     (the class most of them name; "no label": none), counted in events, with the labelled steps
 //     of those reports on which the observer named that class beside; summed over the counted
 //     trials; only when there are self-reports), reports_vs_plan.csv (synthetic participants: the primitive each traced
-//     against the one it reported, per event; only when there are some) and report.md (the
+//     against the one it reported, by name as above, in events; only when there are some) and report.md (the
 //     summary; per condition the observer's confusion against the self-reports and its accuracy
 //     with its interval; the incomplete and the missing trials). Conditions are named (the
 //     analysis is the unblinded step) with their labels beside them, listed in

@@ -378,7 +378,7 @@ TEST_F(StudyFile, AnalyzeMakesOneTableAcrossEveryoneAndSaysWhatIsMissing) {
   // The synthetic humans traced 2 every time; one of the six said 4.
   std::map<std::string, std::string> vs_plan;
   for (const auto& row : dyad::testing::ReadCsv(out / "reports_vs_plan.csv")) vs_plan[row.at("planned") + "," + row.at("reported")] = row.at("events");
-  EXPECT_EQ(vs_plan, (std::map<std::string, std::string>{{"2,2", "5"}, {"2,4", "1"}}));
+  EXPECT_EQ(vs_plan, (std::map<std::string, std::string>{{"primitive 2,primitive 2", "5"}, {"primitive 2,primitive 4", "1"}}));
   std::ifstream md(out / "report.md");
   const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_NE(report.find("| high (" + s.conditions[1].label + ") | mean_congruence | 2 | 4 | 0.75 | 0.6 to 0.9 |"), std::string::npos) << report;
@@ -627,6 +627,11 @@ TEST_F(StudyFile, TheSelfReportsAreCountedInEventsByNameWithSomethingElseOfItsOw
   const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_NE(report.find("| said / observer | triangle |\n|---|---|\n"), std::string::npos) << report;
   EXPECT_NE(report.find("| **something else** | 1 (10) |"), std::string::npos) << report;
+  // The rehearsal's table of reports against the plan names them too.
+  std::map<std::string, std::string> vs_plan;
+  for (const auto& row : dyad::testing::ReadCsv(out / "reports_vs_plan.csv")) vs_plan[row.at("planned") + "," + row.at("reported")] = row.at("events");
+  EXPECT_EQ(vs_plan, (std::map<std::string, std::string>{{"triangle,triangle", "2"}, {"triangle,star", "1"}, {"triangle,something else", "1"}}));
+  EXPECT_NE(report.find("| triangle | something else | 1 |"), std::string::npos) << report;
 }
 
 // The session log's note line names the trial under way (none between trials), and the log
