@@ -22,6 +22,9 @@
 #   NRL_REPRO  1: also measure NRL's reproducibility: build it with its CMake defaults (no flags)
 #              and with -O3 -march=native, run the fixed trajectory with both, print the first
 #              step where the intentions differ by more than 5e-5 (and at 1e-3, 1e-1)
+#   NRL_ENSEMBLE  N > 0: also run the closed loop N times with 1e-5 jitter on the executed
+#              positions (seeds 1..N, reference build) and print switching figures per run
+#              (bench/pvrnn/nrl_switch_figures.py; needs python3)
 #   NRL_WORK   a folder to build in and keep (default: a temporary one, removed); a build whose
 #              library exists there is reused
 # Needs cmake, a C++ compiler and Eigen (/usr/include/eigen3 or EIGEN3_INCLUDE_DIR).
@@ -39,6 +42,8 @@ noise="${NRL_NOISE:-0}"
 [[ -f "$nrl_src/src/lib/LibNRL.h" ]] || { echo "error: $nrl_src: not an NRL checkout (no src/lib/LibNRL.h)" >&2; exit 2; }
 [[ -d "$data/model/MacawBot" ]] || { echo "error: $data/model/MacawBot: the study's trained model is missing" >&2; exit 2; }
 [[ "$noise" == 0 || "$noise" == 1 ]] || { echo "error: NRL_NOISE must be 0 or 1, got '$noise'" >&2; exit 2; }
+ensemble="${NRL_ENSEMBLE:-0}"
+[[ "$ensemble" =~ ^[0-9]+$ ]] || { echo "error: NRL_ENSEMBLE must be a count, got '$ensemble'" >&2; exit 2; }
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 
@@ -101,7 +106,12 @@ if [[ "${NRL_REPRO:-0}" == 1 ]]; then
       if (d > max) max = d
     }
     END {
-      for (k = 1; k <= 3; k++) printf "NRL default vs -O3 -march=native: intentions first differ by > %s at step %s\n", tols[k], (k in first ? first[k] : "never")
+      for (k = 1; k <= 3; k++) printf "NRL default vs -O3 -march=native: intentions first differ by > %s at step %s (lead-in steps negative)\n", tols[k], (k in first ? first[k] : "never")
       printf "largest difference over the run: %g\n", max
     }'
 fi
+
+for ((s = 1; s <= ensemble; s++)); do
+  run ref "$work/ens-$s.csv" --closed-loop --jitter 1e-5 --seed "$s"
+  echo "seed $s: $(python3 "$here/nrl_switch_figures.py" "$work/ens-$s.csv" "$data/dataset/Macaw")"
+done
