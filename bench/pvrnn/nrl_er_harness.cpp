@@ -108,8 +108,14 @@ Options Parse(int argc, char** argv) {
   std::vector<std::string> positional;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a.rfind("--", 0) != 0) { positional.push_back(a); continue; }
-    if (a == "--closed-loop") { o.closed_loop = true; continue; }
+    if (a.rfind("--", 0) != 0) {
+      positional.push_back(a);
+      continue;
+    }
+    if (a == "--closed-loop") {
+      o.closed_loop = true;
+      continue;
+    }
     if (i + 1 >= argc) Fail(a + ": needs a value");
     const char* v = argv[++i];
     if (a == "--data") o.data = v;
