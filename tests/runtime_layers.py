@@ -16,6 +16,7 @@ LAYERS = ["graph", "dds", "exec", "hosts"]
 # API every layer may use.
 PUBLIC = {
     "component.hpp": None, "join_list.hpp": None, "message_traits.hpp": None, "status.hpp": None, "params.hpp": None,
+    "thread_annotations.hpp": None,
     "graph.hpp": "graph", "validate.hpp": "graph", "catalog.hpp": "graph", "topic_select.hpp": "graph", "topic_readers.hpp": "graph",
     "diagnostic.hpp": "graph", "strict_yaml.hpp": "graph", "security.hpp": "graph", "ros2_names.hpp": "graph",
     "on_demand_subscription.hpp": "graph",

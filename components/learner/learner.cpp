@@ -147,7 +147,7 @@ Status Learner::Configure(Context& ctx) {
   ctx.SubscribeSerialized("dyad/params", [this](const SerializedSample& sample) {
     msg::ParamChange answer;
     if (!DecodeSample(sample.cdr, &answer).ok() || answer.op() != "refused") return;
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     if (!swap_request_id_.empty() && answer.request_id() == swap_request_id_) refusal_ = answer.reason();
   }).IgnoreError();
   ctx.PrepareLiveParam(
@@ -186,7 +186,7 @@ Status Learner::PrepareRun(const std::string& which) {
   PreparedRun run;
   std::vector<analyze::HumanSample> samples;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     samples = samples_;
     run.last_demonstration = last_demonstration_;
   }
@@ -206,7 +206,7 @@ Status Learner::PrepareRun(const std::string& which) {
   for (const auto& w : demos->warnings) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
   run.model = run.folder + "/model.dpvrnn";
   run.asked = std::chrono::steady_clock::now();
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   prepared_ = std::move(run);
   have_prepared_ = true;
   return Status::OK();
@@ -215,7 +215,7 @@ Status Learner::PrepareRun(const std::string& which) {
 void Learner::StartTrainer() {
   PreparedRun run;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     if (!have_prepared_) return;
     run = std::move(prepared_);
     have_prepared_ = false;
@@ -307,7 +307,7 @@ Status Learner::AskSwap(int64_t now_ns) {
   request.request_id(ctx_->name() + "/run" + std::to_string(run_) + "/" + std::to_string(::getpid()) + "/" +
                      std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     swap_request_id_ = request.request_id();
     refusal_.clear();
   }
@@ -334,7 +334,7 @@ void Learner::WatchSwap(int64_t now_ns) {
   }
   std::string refusal;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     refusal = refusal_;
   }
   if (!refusal.empty()) return Fail(target_component_ + "." + target_param_ + " refused the model: " + refusal);
@@ -345,7 +345,7 @@ void Learner::WatchSwap(int64_t now_ns) {
 // The human's samples: a demonstration is complete at the first sample after it (its release).
 void Learner::TakeSamples() {
   bool released = false;
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   for (const msg::HumanInput& h : human_->received()) {
     const analyze::HumanSample s{static_cast<double>(h.header().stamp_ns()), h.x(), h.y(), h.engaged()};
     if (s.engaged) {

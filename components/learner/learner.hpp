@@ -49,6 +49,7 @@
 
 #include <dyad/component.hpp>
 #include <dyad/msg/types.hpp>
+#include <dyad/thread_annotations.hpp>
 
 #include "demonstrations.hpp"
 #include "training_log.hpp"
@@ -94,15 +95,16 @@ class Learner final : public Component {
   int epochs_ = 0, threads_ = 1;
   analyze::DemonstrationOptions cut_;
 
-  // Guards samples_, last_demonstration_, prepared_ and refusal_ (PrepareRun runs off the step
+  // Guards the members marked GUARDED_BY below (PrepareRun runs off the step
   // thread, dyad/params answers arrive on a delivering thread).
-  std::mutex mutex_;
-  std::vector<analyze::HumanSample> samples_;  // the session up to the end of its last demonstration
-  WallTime last_demonstration_{};              // when the newest demonstration was completed
-  PreparedRun prepared_;
-  bool have_prepared_ = false;
-  std::string swap_request_id_;  // of the swap asked; its refusal on dyad/params ends it
-  std::string refusal_;
+  Mutex mutex_;
+  // the session up to the end of its last demonstration
+  std::vector<analyze::HumanSample> samples_ GUARDED_BY(mutex_);
+  WallTime last_demonstration_ GUARDED_BY(mutex_){};  // when the newest demonstration was completed
+  PreparedRun prepared_ GUARDED_BY(mutex_);
+  bool have_prepared_ GUARDED_BY(mutex_) = false;
+  std::string swap_request_id_ GUARDED_BY(mutex_);  // of the swap asked; its refusal on dyad/params ends it
+  std::string refusal_ GUARDED_BY(mutex_);
 
   std::atomic<Phase> phase_{Phase::kIdle};
   std::atomic<uint32_t> run_{0};  // runs started

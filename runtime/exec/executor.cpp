@@ -251,7 +251,7 @@ Executor::~Executor() {
 bool Executor::RequestStop(const std::string& reason) {
   bool first = false;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     first = stop_reason_.empty();
     if (first) stop_reason_ = reason;
     stop_.store(true, std::memory_order_release);
@@ -262,7 +262,7 @@ bool Executor::RequestStop(const std::string& reason) {
 
 void Executor::Fail(const Status& status) {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     if (failure_.ok()) failure_ = status;
   }
   RequestStop("failure: " + status.message());
@@ -432,7 +432,7 @@ void Executor::TriggerStep(Instance& inst) {
 void Executor::PeriodicLoop(Instance& inst) {
   const int64_t period = inst.rc->period_ns;
   int64_t next = start_steady_ns_;
-  std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
+  std::unique_lock<std::mutex> lock(mutex_.native(), std::defer_lock);  // stop_ only: nothing guarded
   while (!stopping()) {
     lock.lock();
     cv_.wait_until(lock, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(next)), [&] { return stopping(); });
@@ -539,7 +539,7 @@ Status Executor::RunWall() {
       duration_ns = duration_ns > 0 ? std::min(duration_ns, by_steps) : by_steps;
     }
   }
-  std::unique_lock<std::mutex> lock(mutex_);
+  std::unique_lock<std::mutex> lock(mutex_.native());  // stop_ only: nothing guarded
   while (!stopping()) {
     auto wake = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<int64_t>(options_.stats_period_s * 1000));
     if (duration_ns > 0) {
@@ -608,7 +608,7 @@ Status Executor::Run() {
   }
   for (auto it = instances_.rbegin(); it != instances_.rend(); ++it)
     if ((*it)->configured) (*it)->component->Shutdown();
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(mutex_);
   if (!s.ok()) return s;
   return failure_;
 }

@@ -52,6 +52,7 @@
 
 #include <dyad/catalog.hpp>
 #include <dyad/graph.hpp>
+#include <dyad/thread_annotations.hpp>
 #include <dyad/validate.hpp>
 
 #include "dds/transport.hpp"
@@ -139,10 +140,10 @@ class Executor {
   std::atomic<bool> stop_{false};
   std::atomic<int> problems_{0};
   std::atomic<int> foreign_writers_{0};
-  mutable std::mutex mutex_;  // guards stop_reason_, failure_; with cv_ wakes sleepers on stop
+  mutable Mutex mutex_;  // guards stop_reason_, failure_; with cv_ wakes sleepers on stop
   std::condition_variable cv_;
-  std::string stop_reason_;
-  Status failure_;
+  std::string stop_reason_ GUARDED_BY(mutex_);
+  Status failure_ GUARDED_BY(mutex_);
   // Declared last, destroyed first (see Ownership above): owns every endpoint.
   std::unique_ptr<Transport> transport_;
 };

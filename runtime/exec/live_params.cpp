@@ -16,14 +16,18 @@ Status LiveParams::Open(Transport* transport, const std::string& graph_name, con
   graph_folder_ = graph_folder;
   stepped_ = stepped;
   targets_ = std::move(targets);
-  queues_.resize(targets_.size());
-  preparations_.resize(targets_.size());
+  {
+    MutexLock lock(mutex_);  // no other thread yet: for the analysis
+    queues_.resize(targets_.size());
+    preparations_.resize(targets_.size());
+  }
   auto r = CreateRuntimeReader(transport, runtime_topics::kParamRequests,
                                [this] { arrived_.store(true, std::memory_order_release); });
   if (!r.ok()) return r.status();
   reader_ = r.value();
   auto w = CreateRuntimeWriter(transport, runtime_topics::kParams);
   if (!w.ok()) return w.status();
+  MutexLock lock(publish_mutex_);
   answers_ = std::make_unique<Output<msg::ParamChange>>();
   answers_->Bind("params", runtime_topics::kParams.name, "dyad/" + process, w.value(), clock);
   return Status::OK();
@@ -61,7 +65,7 @@ void LiveParams::Apply(size_t index) {
   std::optional<Preparation> done;
   std::deque<msg::ParamChange> mine;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     Take();
     Preparation& preparation = preparations_[index];
     if (preparation.state == Preparation::State::kRunning) return;  // the requests after it wait
@@ -87,7 +91,7 @@ void LiveParams::Apply(size_t index) {
       Publish(ApplyOrRefuse(target, p));
       continue;
     }
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     queued_.fetch_add(static_cast<int>(mine.size()), std::memory_order_release);
     queues_[index].insert(queues_[index].begin(), std::make_move_iterator(mine.begin()), std::make_move_iterator(mine.end()));
     p.state = Preparation::State::kRunning;
@@ -100,17 +104,20 @@ void LiveParams::Apply(size_t index) {
 }
 
 void LiveParams::RunPreparations() {
-  std::unique_lock<std::mutex> lock(mutex_);
+  UniqueLock lock(mutex_);
   for (;;) {
-    prepare_cv_.wait(lock, [this] { return stopping_ || !to_prepare_.empty(); });
+    prepare_cv_.wait(lock.native(), [this] {
+      mutex_.AssertHeld();  // the wait calls its predicate with the lock held
+      return stopping_ || !to_prepare_.empty();
+    });
     if (stopping_) return;  // Stop() refuses what was not prepared
     const size_t index = to_prepare_.front();
     to_prepare_.pop_front();
     Preparation& p = preparations_[index];  // kRunning: this thread's until marked done
     const Context::LiveParamPrepare& prepare = targets_[index]->prepares.at(p.request.param_name()).prepare;
-    lock.unlock();
+    lock.Unlock();
     Status result = RunPrepare(prepare, p.value);
-    lock.lock();
+    lock.Lock();
     p.result = std::move(result);
     p.state = Preparation::State::kDone;
     prepared_.fetch_add(1, std::memory_order_release);
@@ -119,7 +126,7 @@ void LiveParams::RunPreparations() {
 
 void LiveParams::Stop() {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     if (stopped_) return;
     stopped_ = stopping_ = true;
   }
@@ -129,7 +136,7 @@ void LiveParams::Stop() {
   std::vector<msg::ParamChange> answers;
   const std::string why = "the run stopped before the change took effect";
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     Take();
     for (size_t i = 0; i < targets_.size(); ++i) {
       if (preparations_[i].state != Preparation::State::kNone) answers.push_back(Refused(*targets_[i], preparations_[i].request, why));
@@ -215,7 +222,7 @@ msg::ParamChange LiveParams::ApplyOrRefuse(Target& target, const Preparation& p)
 }
 
 void LiveParams::Publish(msg::ParamChange answer) {
-  std::lock_guard<std::mutex> lock(publish_mutex_);
+  MutexLock lock(publish_mutex_);
   answers_->Publish(answer).IgnoreError();  // the log has said it too
 }
 

@@ -21,6 +21,8 @@
 // Threads: BeforeStep(i) runs on target i's step thread (several targets, several threads);
 // the request reader's callback only raises a flag. Cost when nothing is asked: three atomic
 // loads. While a request waits behind a preparation, every target's boundary takes the mutex.
+// Lock discipline: what mutex_ and publish_mutex_ guard is declared with GUARDED_BY (clang checks
+// it, dyad/thread_annotations.hpp).
 #pragma once
 
 #include <atomic>
@@ -37,6 +39,7 @@
 
 #include <dyad/component.hpp>
 #include <dyad/msg/types.hpp>
+#include <dyad/thread_annotations.hpp>
 
 #include "dds/transport.hpp"
 
@@ -67,7 +70,7 @@ class LiveParams {
   // `clock` and sourced "dyad/<process>". Relative live paths resolve against `graph_folder`.
   // `stepped`: preparations run at the step boundary (above).
   Status Open(Transport* transport, const std::string& graph_name, const std::string& process, const Clock* clock,
-              const std::string& graph_folder, bool stepped, std::vector<Target*> targets);
+              const std::string& graph_folder, bool stepped, std::vector<Target*> targets) EXCLUDES(mutex_, publish_mutex_);
   // At a step boundary of targets[index], on its step thread.
   void BeforeStep(size_t index) {
     if (!arrived_.load(std::memory_order_acquire) && queued_.load(std::memory_order_acquire) == 0 &&
@@ -79,7 +82,7 @@ class LiveParams {
   // way (one at most is started), refuses the sets not applied ("the run stopped ...") and
   // answers the gets still waiting, so no request goes unanswered. Idempotent; REQUIRES the
   // transport alive the first time.
-  void Stop();
+  void Stop() EXCLUDES(mutex_, publish_mutex_);
 
  private:
   // A set being prepared for one target: it passed the quick checks; `result` once done. While
@@ -91,34 +94,36 @@ class LiveParams {
     Status result;
   };
 
-  void Apply(size_t index);
-  void Take();  // REQUIRES: mutex_ held
+  void Apply(size_t index) EXCLUDES(mutex_);
+  void Take() REQUIRES(mutex_);
   // The answer to `request`, or nullopt when it passed the quick checks of a prepared param:
   // then `*prepare` holds it, to be prepared and then Finish()ed.
   std::optional<msg::ParamChange> Answer(Target& target, const msg::ParamChange& request, Preparation* prepare);
   msg::ParamChange ApplyOrRefuse(Target& target, const Preparation& p);
   msg::ParamChange Refused(Target& target, msg::ParamChange answer, const std::string& why);
-  void RunPreparations();  // the preparer thread
-  void Publish(msg::ParamChange answer);
+  void RunPreparations() EXCLUDES(mutex_);  // the preparer thread
+  void Publish(msg::ParamChange answer) EXCLUDES(publish_mutex_);
 
   std::string graph_name_;
   std::vector<Target*> targets_;
-  TypedReader* reader_ = nullptr;  // owned by the transport
-  std::unique_ptr<Output<msg::ParamChange>> answers_;
+  // Both set by Open; the reader is owned by the transport.
+  TypedReader* reader_ PT_GUARDED_BY(mutex_) = nullptr;
+  std::unique_ptr<Output<msg::ParamChange>> answers_ PT_GUARDED_BY(publish_mutex_);
   std::atomic<bool> arrived_{false};
   std::atomic<int> queued_{0};
-  std::mutex mutex_;  // the reader, the queues, the preparations and the preparer's state
-  std::vector<std::deque<msg::ParamChange>> queues_;
+  Mutex mutex_;  // the reader, the queues, the preparations and the preparer's state
+  std::vector<std::deque<msg::ParamChange>> queues_ GUARDED_BY(mutex_);
   std::string graph_folder_;
   bool stepped_ = false;
-  // Preparations (prepared_: how many are done and not yet applied), guarded by mutex_.
-  std::vector<Preparation> preparations_;
+  // Preparations (prepared_: how many are done and not yet applied).
+  std::vector<Preparation> preparations_ GUARDED_BY(mutex_);
   std::atomic<int> prepared_{0};
-  std::deque<size_t> to_prepare_;  // target indices
-  bool stopping_ = false, stopped_ = false;
+  std::deque<size_t> to_prepare_ GUARDED_BY(mutex_);  // target indices
+  bool stopping_ GUARDED_BY(mutex_) = false;
+  bool stopped_ GUARDED_BY(mutex_) = false;
   std::condition_variable prepare_cv_;
   std::thread preparer_;  // started by the first preparation
-  std::mutex publish_mutex_;  // answers_ (its sequence numbers)
+  Mutex publish_mutex_;   // answers_ (its sequence numbers)
 };
 
 }  // namespace dyad

@@ -34,13 +34,16 @@ void ClockSync::Start(double period_s) {
     const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(period_s));
     auto next_ask = std::chrono::steady_clock::now();
     auto next_publish = next_ask + period / 2;  // half a period after asking, the answers are in
-    std::unique_lock<std::mutex> lock(mutex_);
+    UniqueLock lock(mutex_);
     while (!stop_) {
-      cv_.wait_until(lock, std::min(next_ask, next_publish), [&] { return stop_ || !to_answer_.empty(); });
+      cv_.wait_until(lock.native(), std::min(next_ask, next_publish), [&] {
+        mutex_.AssertHeld();  // the wait calls its predicate with the lock held
+        return stop_ || !to_answer_.empty();
+      });
       if (stop_) break;
       std::vector<msg::ClockProbe> answers;
       answers.swap(to_answer_);
-      lock.unlock();
+      lock.Unlock();
       for (auto& a : answers) {
         a.t3_ns(WallNowNs());
         a.header().stamp_ns(a.t3_ns());
@@ -55,14 +58,14 @@ void ClockSync::Start(double period_s) {
         Publish();
         next_publish += period;
       }
-      lock.lock();
+      lock.Lock();
     }
   });
 }
 
 void ClockSync::Stop() {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     stop_ = true;
   }
   cv_.notify_all();
@@ -74,7 +77,7 @@ void ClockSync::Stop() {
 // during the callback, and a write there delivering to this process's own reader while another
 // thread writes deadlocks the two (seen: a best-effort writer and reader, lock order inverted).
 void ClockSync::Ask() {
-  std::unique_lock<std::mutex> lock(mutex_);
+  UniqueLock lock(mutex_);
   msg::ClockProbe p;
   p.graph_name(graph_.name);
   p.asker(process_);
@@ -87,13 +90,13 @@ void ClockSync::Ask() {
   p.header().stamp_ns(t1);
   p.t1_ns(t1);
   asked_[next_id_++] = t1;
-  lock.unlock();
+  lock.Unlock();
   probe_writer_->Write(&p).IgnoreError();  // a lost probe: the next period probes again
 }
 
 void ClockSync::OnProbes() {
   const int64_t received = WallNowNs();  // t2 or t4: before anything else
-  std::unique_lock<std::mutex> lock(mutex_);
+  UniqueLock lock(mutex_);
   const size_t answers_before = to_answer_.size();
   msg::ClockProbe p;
   while (probe_reader_->TakeNext(&p)) {
@@ -115,12 +118,12 @@ void ClockSync::OnProbes() {
     }
   }
   const bool wake = to_answer_.size() > answers_before;
-  lock.unlock();
+  lock.Unlock();
   if (wake) cv_.notify_all();
 }
 
 std::vector<msg::ClockOffset> ClockSync::Offsets() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(mutex_);
   std::vector<msg::ClockOffset> out;
   for (const auto& [name, peer] : peers_) {
     // A peer that has not answered the last kWindow requests is gone: its offset is stale.
@@ -143,7 +146,7 @@ std::vector<msg::ClockOffset> ClockSync::Offsets() const {
 void ClockSync::Publish() {
   const double bound_ms = graph_.network.max_clock_offset_ms;
   for (msg::ClockOffset o : Offsets()) {
-    std::unique_lock<std::mutex> lock(mutex_);
+    UniqueLock lock(mutex_);
     o.header().source("dyad/" + process_);
     o.header().sequence_number(++offset_sequence_);
     o.header().stamp_ns(WallNowNs());
@@ -159,7 +162,7 @@ void ClockSync::Publish() {
       warn_(text);
     }
     peer.warned = std::abs(offset_ms) > bound_ms;
-    lock.unlock();
+    lock.Unlock();
     offset_writer_->Write(&o).IgnoreError();  // reported again each period
   }
 }

@@ -31,6 +31,7 @@
 #include <dyad/graph.hpp>
 #include <dyad/msg/types.hpp>
 #include <dyad/status.hpp>
+#include <dyad/thread_annotations.hpp>
 
 #include "dds/transport.hpp"
 
@@ -63,9 +64,9 @@ class ClockSync {
     uint64_t last_answered = 0;  // id of the newest request it answered
     bool warned = false;
   };
-  void OnProbes();  // the dyad/clock reader's callback: takes, notes t2/t4, never writes
-  void Ask();
-  void Publish();
+  void OnProbes() EXCLUDES(mutex_);  // the dyad/clock reader's callback: takes, notes t2/t4, never writes
+  void Ask() EXCLUDES(mutex_);
+  void Publish() EXCLUDES(mutex_);
 
   const Graph& graph_;
   std::string process_, host_;
@@ -73,13 +74,17 @@ class ClockSync {
   TypedWriter* probe_writer_ = nullptr;
   TypedReader* probe_reader_ = nullptr;
   TypedWriter* offset_writer_ = nullptr;
-  mutable std::mutex mutex_;  // guards everything below, and the writers
-  uint64_t next_id_ = 1, probe_sequence_ = 0, offset_sequence_ = 0;
-  std::map<uint64_t, int64_t> asked_;  // request id -> t1
-  std::map<std::string, Peer> peers_;  // process -> what we measured
-  std::vector<msg::ClockProbe> to_answer_;  // requests received, answered by the thread
+  // Guards everything below. The writers are written outside it (clock_sync.cpp, Ask()); the
+  // probe reader is taken from under it.
+  mutable Mutex mutex_;
+  uint64_t next_id_ GUARDED_BY(mutex_) = 1;
+  uint64_t probe_sequence_ GUARDED_BY(mutex_) = 0;
+  uint64_t offset_sequence_ GUARDED_BY(mutex_) = 0;
+  std::map<uint64_t, int64_t> asked_ GUARDED_BY(mutex_);       // request id -> t1
+  std::map<std::string, Peer> peers_ GUARDED_BY(mutex_);       // process -> what we measured
+  std::vector<msg::ClockProbe> to_answer_ GUARDED_BY(mutex_);  // requests received, answered by the thread
   std::condition_variable cv_;
-  bool stop_ = false;
+  bool stop_ GUARDED_BY(mutex_) = false;
   std::thread thread_;
 };
 

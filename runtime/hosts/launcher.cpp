@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "dyad/interrupt.hpp"
+#include "dyad/thread_annotations.hpp"
 #include "hosts/launcher_link.hpp"
 #include "hosts/output_relay.hpp"
 #include "hosts/run_arguments.hpp"
@@ -67,7 +68,8 @@ bool RunsServerHere(const Graph& graph, const RunOptions& options) {
 
 // One launch: the children of this host (and the discovery server, first: the processes retry
 // until it answers anyway), supervised until the last one exited. The signal thread (interrupt_)
-// and the loop share children_ and stopping_ under mutex_; everything else is the loop's.
+// and the loop share children_ and stopping_ under mutex_ (GUARDED_BY: clang checks it); everything
+// else is the loop's.
 class Supervision {
  public:
   Supervision(const RunOptions& options, const Graph& graph, std::vector<std::string> names, bool runs_server,
@@ -86,17 +88,18 @@ class Supervision {
     SteadyTime due;
   };
 
-  void ForwardSignal(int sig);
+  void ForwardSignal(int sig) EXCLUDES(mutex_);
   void OpenLink();
-  bool StartAll();
-  bool Spawn(const std::string& name, std::vector<std::string> args, int restarts);  // REQUIRES: mutex_ held
+  bool StartAll() EXCLUDES(mutex_);
+  bool Spawn(const std::string& name, std::vector<std::string> args, int restarts) REQUIRES(mutex_);
   std::vector<std::string> ChildArguments(const std::string& process, int restarts) const;
-  void OnExit(pid_t pid, int status, std::unique_lock<std::mutex>& lock);
-  void StopAfterFailure(const ExitDecision& d, pid_t pid, const Child& child, std::unique_lock<std::mutex>& lock);
-  void StartDueRestarts(SteadyTime now);
-  void StopServerWhenDone();
-  void HearOtherHosts();
-  void StopAll(pid_t except);
+  void OnExit(pid_t pid, int status) REQUIRES(mutex_);
+  // Releases mutex_ while it tells the other hosts, and takes it again.
+  void StopAfterFailure(const ExitDecision& d, pid_t pid, const Child& child) REQUIRES(mutex_);
+  void StartDueRestarts(SteadyTime now) REQUIRES(mutex_);
+  void StopServerWhenDone() REQUIRES(mutex_);
+  void HearOtherHosts() REQUIRES(mutex_);
+  void StopAll(pid_t except) REQUIRES(mutex_);
   int ExitCode();
   void Say(const std::string& line) { relay_.Say(line); }
 
@@ -105,9 +108,9 @@ class Supervision {
   const std::string host_;
   const std::vector<std::string> names_;  // the processes of this host
   const bool runs_server_;
-  std::mutex mutex_;
-  std::map<pid_t, Child> children_;
-  bool stopping_ = false;  // the user's signal was forwarded, or every child was told to stop
+  Mutex mutex_;
+  std::map<pid_t, Child> children_ GUARDED_BY(mutex_);
+  bool stopping_ GUARDED_BY(mutex_) = false;  // the user's signal was forwarded, or every child was told to stop
   std::vector<PendingRestart> pending_;  // restarts waiting for their back-off
   pid_t server_ = 0;
   int first_failure_ = 0;  // the exit code of the first required process that failed for good
@@ -134,7 +137,7 @@ Supervision::Supervision(const RunOptions& options, const Graph& graph, std::vec
       spawner_(options.executable, &relay_, host_) {}
 
 void Supervision::ForwardSignal(int sig) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(mutex_);
   if (stopping_) return;  // already told to stop (SIGTERM): a second signal would mean "exit now"
   stopping_ = true;
   for (const auto& [pid, _] : children_) kill(pid, sig);
@@ -145,17 +148,17 @@ int Supervision::Run() {
   if (!StartAll()) return 1;
   for (;;) {
     // Reaped under the lock: the signal thread never kill()s a pid already reaped (and reused).
-    std::unique_lock<std::mutex> lock(mutex_);
+    UniqueLock lock(mutex_);
     int status = 0;
     if (const pid_t pid = waitpid(-1, &status, WNOHANG); pid > 0) {
-      OnExit(pid, status, lock);
+      OnExit(pid, status);
       continue;
     }
     StartDueRestarts(std::chrono::steady_clock::now());
     StopServerWhenDone();
     if (children_.empty() && pending_.empty()) break;
     HearOtherHosts();
-    lock.unlock();
+    lock.Unlock();
     std::this_thread::sleep_for(kPollPeriod);
   }
   return ExitCode();
@@ -169,7 +172,7 @@ void Supervision::OpenLink() {
 }
 
 bool Supervision::StartAll() {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(mutex_);
   if (runs_server_) {
     const NetworkConfig& net = graph_.network;
     const std::string listen = net.server_address + ":" + std::to_string(net.server_port);
@@ -202,7 +205,7 @@ std::vector<std::string> Supervision::ChildArguments(const std::string& process,
   return args;
 }
 
-void Supervision::OnExit(pid_t pid, int status, std::unique_lock<std::mutex>& lock) {
+void Supervision::OnExit(pid_t pid, int status) {
   const auto found = children_.find(pid);
   if (found == children_.end()) return;  // not ours (a process a plugin started, reparented to us)
   const Child child = found->second;
@@ -221,18 +224,21 @@ void Supervision::OnExit(pid_t pid, int status, std::unique_lock<std::mutex>& lo
                           std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                                   std::chrono::duration<double>(d.backoff_s))});
       return;
-    case ExitDecision::Action::kStopAll: StopAfterFailure(d, pid, child, lock); return;
+    case ExitDecision::Action::kStopAll:
+      StopAfterFailure(d, pid, child);
+      return;
   }
 }
 
 // One required process failing ends the experiment: on the other hosts (told first, while this
 // host's discovery server, if any, still runs), then here.
-void Supervision::StopAfterFailure(const ExitDecision& d, pid_t pid, const Child& child, std::unique_lock<std::mutex>& lock) {
+void Supervision::StopAfterFailure(const ExitDecision& d, pid_t pid, const Child& child) {
   if (first_failure_ == 0) first_failure_ = d.exit_code;
   if (d.announce && link_ != nullptr) {
-    lock.unlock();
+    // The caller's lock is released for the announcement and held again on return.
+    mutex_.Unlock();
     link_->AnnounceFailure(child.name, child.restarts);  // milliseconds; at most 2 s
-    lock.lock();
+    mutex_.Lock();
     if (stopping_) return;  // a signal came meanwhile and was forwarded: no second one
   }
   StopAll(pid);
@@ -271,7 +277,7 @@ void Supervision::HearOtherHosts() {
   }
 }
 
-// SIGTERM to every child but `except` (the one that failed); no restart after it. REQUIRES: mutex_ held.
+// SIGTERM to every child but `except` (the one that failed); no restart after it.
 void Supervision::StopAll(pid_t except) {
   stopping_ = stopped_others_ = true;
   pending_.clear();

@@ -39,7 +39,7 @@ OutputRelay::OutputRelay(std::ostream& out, std::ostream& err) : out_(out), err_
 
 OutputRelay::~OutputRelay() {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     closing_ = true;
   }
   if (wake_[1] >= 0) (void)!write(wake_[1], "x", 1);
@@ -59,7 +59,7 @@ StatusOr<OutputRelay::Pipes> OutputRelay::Add(const std::string& name, const std
   }
   std::shared_ptr<LogFile> log;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     if (!log_path.empty()) {
       auto& open = logs_[log_path];
       if (!open) {
@@ -84,7 +84,7 @@ void OutputRelay::CloseWriteEnds(const Pipes& pipes) {
 }
 
 void OutputRelay::Say(const std::string& line) {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(mutex_);
   err_ << line << (line.empty() || line.back() != '\n' ? "\n" : "") << std::flush;
 }
 
@@ -100,7 +100,7 @@ void OutputRelay::Run() {
   for (;;) {
     fds.clear();
     {
-      std::lock_guard<std::mutex> lock(mutex_);
+      MutexLock lock(mutex_);
       if (closing_ && sources_.empty()) return;
       // Every child has exited; a pipe still open is held by something a child left behind
       // (a process a component started): what it says after kCloseGraceMs is not waited for.
@@ -120,7 +120,7 @@ void OutputRelay::Run() {
     if (poll(fds.data(), fds.size(), 200) < 0 && errno != EINTR) {
       // Cannot happen with valid descriptors; say so rather than let the children block on
       // full pipes unnoticed.
-      std::lock_guard<std::mutex> lock(mutex_);
+      MutexLock lock(mutex_);
       err_ << "dyad run: the output relay failed (poll: " << std::strerror(errno) << "); children's output is lost\n";
       return;
     }
@@ -128,7 +128,7 @@ void OutputRelay::Run() {
     for (size_t i = 1; i < fds.size(); ++i) {
       if (fds[i].revents == 0) continue;
       const ssize_t n = read(fds[i].fd, buf, sizeof(buf));
-      std::lock_guard<std::mutex> lock(mutex_);
+      MutexLock lock(mutex_);
       Source& s = sources_[fds[i].fd];
       if (n > 0) {
         s.partial.append(buf, static_cast<size_t>(n));

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include <dyad/status.hpp>
+#include <dyad/thread_annotations.hpp>
 
 namespace dyad {
 
@@ -63,15 +64,16 @@ class OutputRelay {
     std::shared_ptr<LogFile> log;
   };
   void Run();
-  void Emit(const Source& s, const std::string& line);  // REQUIRES: mutex_ held
+  void Emit(const Source& s, const std::string& line) REQUIRES(mutex_);
 
   std::ostream& out_;
   std::ostream& err_;
-  std::mutex mutex_;  // guards sources_, logs_, the streams
-  std::map<int, Source> sources_;                          // read end -> its child
-  std::map<std::string, std::shared_ptr<LogFile>> logs_;  // log path -> open file
+  // Guards sources_, logs_, closing_ and the streams (out_, err_: by convention, not checked).
+  Mutex mutex_;
+  std::map<int, Source> sources_ GUARDED_BY(mutex_);                         // read end -> its child
+  std::map<std::string, std::shared_ptr<LogFile>> logs_ GUARDED_BY(mutex_);  // log path -> open file
   int wake_[2] = {-1, -1};  // a byte here makes the thread re-read sources_
-  bool closing_ = false;
+  bool closing_ GUARDED_BY(mutex_) = false;
   std::thread thread_;
 };
 

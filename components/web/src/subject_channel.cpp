@@ -29,7 +29,7 @@ std::string SubjectChannel::TaskJson() const {
 void SubjectChannel::SendToAll(uint32_t channel, const std::string& frame) {
   std::vector<ClientId> pages;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     pages = pages_;
   }
   if (WebServer* server = server_.load())
@@ -39,7 +39,7 @@ void SubjectChannel::SendToAll(uint32_t channel, const std::string& frame) {
 void SubjectChannel::SetTask(const Task& task) {
   std::string frame;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     task_ = task;
     frame = TaskJson();
   }
@@ -60,7 +60,7 @@ std::string SubjectChannel::QuestionJson() const {
 }
 
 void SubjectChannel::EndSteering() {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(mutex_);
   EndSteeringLocked();
 }
 
@@ -73,7 +73,7 @@ void SubjectChannel::EndSteeringLocked() {
 void SubjectChannel::AskAfterTrial(std::vector<Question> questions) {
   std::string frame;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     if (asking_) return;
     EndSteeringLocked();
     asking_ = true;
@@ -85,12 +85,12 @@ void SubjectChannel::AskAfterTrial(std::vector<Question> questions) {
 }
 
 size_t SubjectChannel::pages() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(mutex_);
   return pages_.size();
 }
 
 SubjectChannel::PointerDelays SubjectChannel::pointer_delays() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(mutex_);
   return delays_;
 }
 
@@ -105,7 +105,7 @@ void SubjectChannel::BroadcastState(double x, double y) {
   if (server == nullptr) return;
   std::vector<ClientId> pages;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     pages = pages_;
   }
   if (pages.empty()) return;
@@ -122,7 +122,7 @@ void SubjectChannel::OnOpen(ClientId client, Role role) {
   ClientId demoted = 0;
   std::string task;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     task = TaskJson();
     pages_.push_back(client);
     roles_[client] = role;
@@ -162,7 +162,7 @@ void SubjectChannel::OnOpen(ClientId client, Role role) {
   // sent to this page before it (by AskAfterTrial meanwhile) is sent again after it.
   std::string question;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     if (asking_) question = QuestionJson();
   }
   if (!question.empty()) server->SendLatest(client, kQuestionChannel, question, /*binary=*/false);
@@ -193,7 +193,7 @@ Status SubjectChannel::OnPointer(ClientId client, const json& j, double handler_
   // The page clamps to the workspace; a position outside it is clamped here too.
   const double h = options_.half_width;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("pointer: a viewer's token may not steer");
     if (client != steering_) return Status::OK();  // a watching page: ignored
     last_x_ = std::clamp(px, -h, h);
@@ -219,7 +219,7 @@ Status SubjectChannel::OnPointer(ClientId client, const json& j, double handler_
 Status SubjectChannel::OnSteer(ClientId client) {
   ClientId previous;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("steer: a viewer's token may not steer");
     previous = steering_;
     if (previous == client) return Status::OK();
@@ -245,7 +245,7 @@ Status SubjectChannel::OnSelfReport(ClientId client, const json& j) {
   std::string next;
   bool stale = false;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("self_report: a viewer's token may not answer");
     if (client != steering_ || !report_) return Status::OK();  // nobody asked this page
     if (!trial_over_) {
@@ -278,7 +278,7 @@ Status SubjectChannel::OnBinary(ClientId, std::span<const uint8_t>) {
 void SubjectChannel::OnClose(ClientId client) {
   ClientId promoted = 0;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(mutex_);
     std::erase(pages_, client);
     roles_.erase(client);
     if (client != steering_) return;

@@ -42,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include <dyad/thread_annotations.hpp>
 #include <nlohmann/json_fwd.hpp>
 
 #include "web_server.hpp"
@@ -114,25 +115,27 @@ class SubjectChannel final : public ClientHandler {
   Status OnSteer(ClientId client);
   Status OnSelfReport(ClientId client, const nlohmann::json& j);
   void SendRole(ClientId client, bool steering);
-  std::string TaskJson() const;      // with mutex_ held
-  std::string QuestionJson() const;  // with mutex_ held
-  void EndSteeringLocked();          // with mutex_ held
+  std::string TaskJson() const REQUIRES(mutex_);
+  std::string QuestionJson() const REQUIRES(mutex_);
+  void EndSteeringLocked() REQUIRES(mutex_);
   void SendToAll(uint32_t channel, const std::string& frame);
   const Options options_;
   const PointerSink sink_;
   const ReportSink report_;
   std::atomic<WebServer*> server_{nullptr};
-  mutable std::mutex mutex_;  // guards the members below and serialises sink_ calls
-  std::vector<ClientId> pages_;  // in connection order
-  std::map<ClientId, Role> roles_;
-  ClientId steering_ = 0;        // 0: none
-  double last_x_ = 0, last_y_ = 0;
-  Task task_;
-  bool trial_over_ = false;  // EndSteering came: no more steering
-  bool asking_ = false;      // AskAfterTrial came: questions_ are asked
-  std::vector<Question> questions_;
-  size_t asked_ = 0;         // the question shown; questions_.size(): all answered
-  PointerDelays delays_;
+  // Guards the members below and serialises sink_ calls.
+  mutable Mutex mutex_;
+  std::vector<ClientId> pages_ GUARDED_BY(mutex_);  // in connection order
+  std::map<ClientId, Role> roles_ GUARDED_BY(mutex_);
+  ClientId steering_ GUARDED_BY(mutex_) = 0;  // 0: none
+  double last_x_ GUARDED_BY(mutex_) = 0;
+  double last_y_ GUARDED_BY(mutex_) = 0;
+  Task task_ GUARDED_BY(mutex_);
+  bool trial_over_ GUARDED_BY(mutex_) = false;  // EndSteering came: no more steering
+  bool asking_ GUARDED_BY(mutex_) = false;      // AskAfterTrial came: questions_ are asked
+  std::vector<Question> questions_ GUARDED_BY(mutex_);
+  size_t asked_ GUARDED_BY(mutex_) = 0;  // the question shown; questions_.size(): all answered
+  PointerDelays delays_ GUARDED_BY(mutex_);
 };
 
 }  // namespace dyad::web
