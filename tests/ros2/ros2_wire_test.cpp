@@ -89,9 +89,13 @@ TEST_F(Ros2WireTest, CycloneSamplesDecodeInDyadAndDyadSamplesDecodeInCyclone) {
                        std::to_string(domain_), "--timeout-s", "60"},
                       dir_, "peer_listen");
   ASSERT_TRUE(listen.WaitForOutput("ready", 20)) << listen.err();
+  // The graph has ended: `dyad pub --graph` waits --wait seconds for its recorder (a reader the
+  // graph declares, dyad/topic_readers.hpp) and then publishes to the readers it has matched, the
+  // Cyclone listener. 2 s each keeps the 13 publications well inside the listener's minute (at
+  // the default 5 s they took 65 s).
   for (const auto& t : kTypes) {
-    ChildProcess p({DYAD_EXE, "pub", "--graph", (dir_ / "wire.yaml").string(), TopicOf(t), sent.at(t).dump()}, dir_,
-                   "pub_" + TopicOf(t));
+    ChildProcess p({DYAD_EXE, "pub", "--graph", (dir_ / "wire.yaml").string(), TopicOf(t), sent.at(t).dump(), "--wait", "2"},
+                   dir_, "pub_" + TopicOf(t));
     ASSERT_EQ(p.Wait(30), 0) << t << ": " << p.err();
   }
   ASSERT_EQ(listen.Wait(30), 0) << listen.err();
