@@ -193,6 +193,18 @@ int RunOnPage(const study::Study& s, const RunOptions& o, const study::Session& 
 // The participant's trials in their order, each not yet complete run; a trial that did not
 // complete is run again, with the experimenter's reason, before the next. kOk when every trial is
 // complete (said on stdout) or the experimenter stopped at a prompt (q, end of input).
+// A session stopped by SIGINT or SIGTERM (the trial under way was stopped and kept as it is):
+// what is not complete, and how to go on; 130 as for any run ended by a signal.
+int StoppedBySignal(const study::Study& s, const RunOptions& o, const std::vector<study::Trial>& trials) {
+  const study::Session now = study::ReadSession(s, o.participant);
+  std::string missing;
+  for (const study::Trial& t : trials)
+    if (!now.Complete(t.number)) missing += (missing.empty() ? "" : ", ") + std::to_string(t.number);
+  std::cerr << "dyad study run: stopped by a signal; " << o.participant << "'s trials not complete: " << missing
+            << " (dyad study run again goes on from trial " << missing.substr(0, missing.find(',')) << ")\n";
+  return 130;
+}
+
 int RunInOrder(const study::Study& s, const RunOptions& o, const std::vector<study::Trial>& trials) {
   study::Attempt a;
   auto why_again = [&](const study::Attempt& last) {
@@ -215,7 +227,7 @@ int RunInOrder(const study::Study& s, const RunOptions& o, const std::vector<stu
     }
     if (!RunOne(s, o, t, trials.size(), reason, &a)) return 1;
     while (a.outcome != "complete") {  // with --yes (or Ctrl-C then no reason): stop here, not at the next trial
-      if ((reason = why_again(a)).empty()) return 1;
+      if ((reason = why_again(a)).empty()) return a.interrupted ? StoppedBySignal(s, o, trials) : 1;
       if (!RunOne(s, o, t, trials.size(), reason, &a)) return 1;
     }
   }
