@@ -208,7 +208,7 @@ Status Ros2Cartesian::Step(const StepInfo& info) {
     WarnOnce(&watchdog_logged_, [] { return std::string("no command for watchdog_s: holding"); });
   if (!stale_command) watchdog_logged_ = false;
   const bool move = !stale_pose && !stale_command && !holding_ && goal_.has_value();
-  if (Status s = move ? Move(dt, now) : StayPut(now); !s.ok()) return s;
+  if (Status s = move ? Move(dt, now) : StayPut(now, dt, stale_pose); !s.ok()) return s;
   moving_ = move;
   if (pose_) return PublishState(now, stale_pose || stale_command);
   return no_pose_logged_ ? PublishState(now, true) : Status::OK();
@@ -258,11 +258,22 @@ Status Ros2Cartesian::Move(double dt, int64_t now_ns) {
   return SendPose(*setpoint_, now_ns);
 }
 
-Status Ros2Cartesian::StayPut(int64_t now_ns) {
-  motion_->Reset();  // Servo stops on a zero twist; the next motion starts at rest
-  if (twist_mode_) return SendTwist(Vec3{0, 0, 0}, now_ns);
-  if (!pose_) return Status::OK();  // nothing to stay at yet: nothing is sent
-  setpoint_ = plane_->Clamp(*pose_, nullptr);
+Status Ros2Cartesian::StayPut(int64_t now_ns, double dt, bool stale_pose) {
+  if (twist_mode_) {
+    // A hold or the watchdog with the arm in view brakes at max_acceleration (a velocity step can
+    // trip an arm's reflexes); without a fresh pose, and at the end (dt 0), the twist is zero at once.
+    const bool brake = !stale_pose && dt > 0;
+    const Vec3 v = brake ? motion_->Brake(dt) : Vec3{0, 0, 0};
+    if (!brake) motion_->Reset();
+    return SendTwist(v, now_ns);
+  }
+  motion_->Reset();  // the next motion starts at rest, from where the arm is
+  // Pose mode: the target becomes the measured pose once, when the stay begins with a fresh pose
+  // (the arm stops where it is, not where the setpoint ran ahead to); then it is kept. Taking the
+  // measured pose every step would let a sagging or pushed arm creep away, and a stale pose can be
+  // far behind the arm: with no fresh pose the last target is kept, or nothing is sent.
+  if (!stale_pose && pose_ && (moving_ || !setpoint_)) setpoint_ = plane_->Clamp(*pose_, nullptr);
+  if (!setpoint_) return Status::OK();  // nothing to stay at yet: nothing is sent
   return SendPose(*setpoint_, now_ns);
 }
 
@@ -310,7 +321,9 @@ Status Ros2Cartesian::PublishState(int64_t now_ns, bool stopped) {
 }
 
 Status Ros2Cartesian::Deactivate() {
-  const Status last = last_step_ns_ >= 0 ? StayPut(ctx_->clock().now_ns()) : Status::OK();
+  const int64_t end_ns = ctx_->clock().now_ns();
+  const bool stale_at_end = last_pose_ns_ < 0 || end_ns - last_pose_ns_ > pose_timeout_ns_;
+  const Status last = last_step_ns_ >= 0 ? StayPut(end_ns, 0, stale_at_end) : Status::OK();
   if (last_pose_ns_ < 0 && last_step_ns_ >= 0) {
     ctx_->log().Error("no pose from the arm on '" + arm_pose_->topic() + "' in the whole run: the arm was never driven" +
                       WhyNoPose());

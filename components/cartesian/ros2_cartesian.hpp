@@ -13,9 +13,12 @@
 /// once, counted).
 /// Staying put: a hold command (`hold: true`) means "stay where you are", its position is never
 /// a goal; so do the watchdog (no fresh command for watchdog_s), a stale pose (none for
-/// pose_timeout_s: stopped) and Deactivate. Staying put sends a zero twist (twist mode) or the
-/// arm's newest measured pose, clamped into the box (pose mode; nothing before the first pose);
-/// motion after it starts from the measured pose, at rest.
+/// pose_timeout_s: stopped) and Deactivate. Staying put, twist mode: braking at max_acceleration
+/// to a zero twist while the arm's pose is fresh, a zero twist at once without a fresh pose and at
+/// Deactivate. Pose mode: the measured pose (clamped into the box) taken once, when the stay
+/// begins with a fresh pose, and re-sent unchanged after (a sagging or pushed arm does not creep
+/// away; a stale pose never becomes the target); nothing before the first pose. Motion after it
+/// starts from the measured pose, at rest.
 /// A silent arm: no pose within pose_timeout_s of activation is an error (logged once, stopped
 /// states published every step from then on, named again by Deactivate); with require_arm it
 /// fails the run instead. Poses whose header.frame_id is not pose_frame (default: frame_id) are
@@ -64,7 +67,8 @@ class Ros2Cartesian final : public Component {
   // The silent arm (no first pose in time) and the pose outages; an error only with require_arm.
   Status WatchArm(int64_t now_ns, bool stale_pose);
   Status Move(double dt, int64_t now_ns);
-  Status StayPut(int64_t now_ns);
+  // A hold, the watchdog, a stale pose, the end (dt 0): see the .cpp for what each mode sends.
+  Status StayPut(int64_t now_ns, double dt, bool stale_pose);
   Status SendTwist(const Vec3& v, int64_t now_ns);
   Status SendPose(const Vec3& p, int64_t now_ns);
   Status PublishState(int64_t now_ns, bool stopped);

@@ -65,7 +65,8 @@ void VirtualRobot::Hold(int64_t now_ns) {
     state_.position = {(o_.x_min + o_.x_max) / 2, (o_.y_min + o_.y_max) / 2};
     started_ = true;
   }
-  if (!has_target_) target_ = state_.position;
+  // Stay where it is: a target the watchdog abandoned (braked short of it) is not taken up again.
+  if (!has_target_ || state_.stopped) target_ = state_.position;
   has_target_ = true;
   target_ns_ = now_ns;
   state_.clamped = false;

@@ -157,7 +157,12 @@ Status ComplianceMixer::Step(const StepInfo& info) {
   }
   if (const msg::CartesianState* s = state_->latest()) {
     in.state = {{s->x(), s->y()}, received_at(state_)};
-    in.stopped = s->stopped();
+    // A stop the driver reported between two of our steps counts, even if its newest state moves
+    // again: the outage happened, and the first motion after it must start from where the arm is.
+    // (It is seen when robot/state's depth keeps the states between two steps: docs/components.md.)
+    in.stopped = false;
+    for (const msg::CartesianState& each : state_->received()) in.stopped = in.stopped || each.stopped();
+    in.stopped = in.stopped || (state_->new_count() == 0 && s->stopped());
   }
 
   const Params& p = ctx_->params();  // live: a change takes effect at this step

@@ -108,9 +108,47 @@ TEST(Ros2CartesianHold, AHoldIsNeverAGoalInTwistMode) {
   const msg::CartesianCommand go = Command(5, false);  // 5 units = 10 mm along -y
   for (int k = 0; k < 10; ++k) ASSERT_TRUE(rig.Step(&rest, &go).ok());
   EXPECT_LT(rig.twists.samples.back().twist().linear().y(), -0.01);
-  // A hold in the middle of a motion: zero again at once.
-  ASSERT_TRUE(rig.Step(&rest, &hold).ok());
+  // A hold in the middle of a motion brakes at max_acceleration (2 m/s^2: 0.02 m/s per 10 ms step)
+  // to zero: no velocity step (an arm's reflexes may trip on one), never a step towards the hold.
+  double speed = LinearNorm(rig.twists.samples.back());
+  for (int k = 0; k < 100; ++k) {
+    ASSERT_TRUE(rig.Step(&rest, &hold).ok());
+    const double now = LinearNorm(rig.twists.samples.back());
+    ASSERT_LE(now, speed + 1e-12) << "step " << k;
+    ASSERT_GE(now, speed - 2.0 * 0.01 - 1e-12) << "step " << k;
+    speed = now;
+  }
+  EXPECT_EQ(speed, 0.0);
+  // Without a fresh pose a hold is a zero twist at once.
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(rig.Step(&rest, &go).ok());
+  ASSERT_GT(LinearNorm(rig.twists.samples.back()), 0.0);
+  for (int k = 0; k < 60; ++k) ASSERT_TRUE(rig.Step(nullptr, &hold).ok());  // pose_timeout_s 0.5 s passes
   EXPECT_EQ(LinearNorm(rig.twists.samples.back()), 0.0);
+}
+
+// Pose mode: the target is the measured pose taken when the stay begins, then kept. A pose that
+// drifts during the hold (an arm sagging, or pushed) does not drag the target along, and a stale
+// pose (far behind the arm once the stream stops) never becomes the target.
+TEST(Ros2CartesianHold, APoseModeHoldKeepsTheTargetItStoppedAt) {
+  Rig rig({{"mode", std::string("pose")}});
+  ASSERT_TRUE(rig.Configure().ok());
+  const PoseStamped_ at = Pose(0.4, 0, 0.3);
+  const msg::CartesianCommand go = Command(-40, false), hold = Command(1000, true);
+  for (int k = 0; k < 30; ++k) ASSERT_TRUE(rig.Step(&at, &go).ok());
+  ASSERT_TRUE(rig.Step(&at, &hold).ok());
+  EXPECT_EQ(Position(rig.targets.samples.back()), Position(at)) << "the stay begins where the arm is";
+  for (int k = 1; k <= 50; ++k) {
+    const PoseStamped_ sagging = Pose(0.4, 0, 0.3 - 0.001 * k);
+    ASSERT_TRUE(rig.Step(&sagging, &hold).ok());
+    ASSERT_EQ(Position(rig.targets.samples.back()), Position(at)) << "step " << k;
+  }
+  // Moving again, then the poses stop: the target stays the last one sent, never the old pose.
+  for (int k = 0; k < 30; ++k) ASSERT_TRUE(rig.Step(&at, &go).ok());
+  const auto last = Position(rig.targets.samples.back());
+  ASSERT_NE(last, Position(at));
+  for (int k = 0; k < 80; ++k) ASSERT_TRUE(rig.Step(nullptr, &go).ok());
+  EXPECT_TRUE(rig.states.samples.back().stopped());
+  EXPECT_NE(Position(rig.targets.samples.back()), Position(at)) << "a stale pose became the target";
 }
 
 // Pose mode: nothing is sent before the first pose; then each hold re-sends the measured pose

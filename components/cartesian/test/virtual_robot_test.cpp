@@ -234,5 +234,27 @@ TEST(VirtualRobot, WithoutAPositionAHoldStartsItAtTheBoxCentreAndTheFirstMotionM
   EXPECT_NEAR(s.position.x, 25, 1e-9);
 }
 
+// After the watchdog braked the robot short of its target, a hold keeps it where it stopped: the
+// abandoned target is not taken up again (a hold is never a goal, not even an old one).
+TEST(VirtualRobot, AHoldAfterTheWatchdogStopKeepsTheRobotWhereItStopped) {
+  VirtualRobotOptions o;
+  o.initial = Vec2{0, 0};
+  o.max_velocity = 10;  // 1 unit per 100 ms step: the target 50 away is far from reached
+  VirtualRobot r(o);
+  ASSERT_TRUE(r.SetTarget({50, 0}, 0));
+  for (int64_t k = 1; k <= 3; ++k) r.Advance(k * kStep);
+  int64_t t = 3 * kStep;
+  for (int k = 0; k < 10; ++k) r.Advance(t += kStep);  // no command for 1 s: the watchdog brakes it
+  const VirtualRobot::State stopped = r.Advance(t += kStep);
+  ASSERT_TRUE(stopped.stopped);
+  ASSERT_LT(stopped.position.x, 45);
+  for (int k = 0; k < 20; ++k) {
+    r.Hold(t += kStep);
+    const auto& s = r.Advance(t);
+    ASSERT_FALSE(s.stopped);
+    ASSERT_NEAR(s.position.x, stopped.position.x, 1e-9) << "step " << k;
+  }
+}
+
 }  // namespace
 }  // namespace dyad::cartesian

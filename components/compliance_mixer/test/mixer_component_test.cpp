@@ -124,6 +124,31 @@ TEST(MixerComponent, TheArmsOutageIsSaidAndSummarised) {
       << m.Warnings().back();
 }
 
+// A stop shorter than the mixer's step (the driver publishes faster): a stopped state between two
+// steps is an outage even when the newest state moves again; the next motion starts from the arm.
+TEST(MixerComponent, AStopBetweenTwoStepsIsAnOutage) {
+  Mixer m;
+  msg::Intention far;
+  far.x(1000);
+  auto step = [&] {
+    m.robot.queue.push_back(far);
+    m.Step(false, true);
+  };
+  step();
+  step();
+  ASSERT_DOUBLE_EQ(m.out.samples.back().x(), 10);
+  msg::CartesianState blip;
+  blip.stopped(true);
+  m.state.queue.push_back(blip);  // then Step queues m.arm (moving, at 3): both arrive before one step
+  m.arm.x(3);
+  step();
+  EXPECT_TRUE(m.out.samples.back().hold()) << "the stop between the steps was missed";
+  EXPECT_DOUBLE_EQ(m.out.samples.back().x(), 10);
+  step();
+  EXPECT_FALSE(m.out.samples.back().hold());
+  EXPECT_DOUBLE_EQ(m.out.samples.back().x(), 8) << "the first motion after it starts from the measured 3";
+}
+
 // An arm that never reports where it is: every command is a hold, and the summary says so.
 TEST(MixerComponent, AnArmThatNeverReportsIsNotSilent) {
   Mixer m;
