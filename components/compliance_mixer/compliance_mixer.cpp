@@ -7,27 +7,11 @@
 #include <string>
 #include <vector>
 
-#include <fastdds/rtps/common/SerializedPayload.h>
-
-#include <dyad/msg/types_support.hpp>  // MessageTraits<T>::PubSubType, complete
+#include <dyad/encode_sample.hpp>
 
 namespace dyad::mixer {
 
 namespace {
-// A message as CDR with its encapsulation header (SerializedWriter::Write); empty if it cannot be.
-// Builds the type support each call: for an event now and then, not a hot loop.
-template <class T>
-std::vector<uint8_t> Encode(const T& sample) {
-  typename MessageTraits<T>::PubSubType support;
-  void* data = const_cast<T*>(&sample);  // Fast DDS 2's serialize takes void*; it only reads
-  try {
-    eprosima::fastrtps::rtps::SerializedPayload_t payload(support.getSerializedSizeProvider(data)());
-    if (!support.serialize(data, &payload)) return {};
-    return std::vector<uint8_t>(payload.data, payload.data + payload.length);
-  } catch (...) {  // fastcdr throws when the buffer is short: cannot happen with the size asked for
-    return {};
-  }
-}
 std::string Fixed(double v, const char* format = "%.1f") {
   char buf[32];
   std::snprintf(buf, sizeof buf, format, v);
@@ -123,7 +107,7 @@ void ComplianceMixer::ReportOutage(const char* action, int64_t lost_ns, int64_t 
   health_event_.action(action);
   health_event_.starved_s(lost_ns * 1e-9);
   health_event_.renewals(static_cast<uint32_t>(core_->arm_outages().count));
-  const std::vector<uint8_t> cdr = Encode(health_event_);
+  const std::vector<uint8_t> cdr = EncodeSample(health_event_);
   if (cdr.empty() || !health_->Write(cdr, now_ns).ok()) ctx_->log().Warn(std::string("dyad/health: '") + action + "' not published");
 }
 

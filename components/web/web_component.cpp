@@ -16,13 +16,13 @@
 #include <nlohmann/json.hpp>
 
 #include <dyad/decode_sample.hpp>
+#include <dyad/encode_sample.hpp>
 #include <dyad/graph.hpp>
 #include <dyad/on_demand_subscription.hpp>
 #include <dyad/private_file.hpp>
 #include <dyad/pvrnn/dataset.hpp>
 #include <dyad/topic_select.hpp>
 
-#include "encode_sample.hpp"
 #include "pages.hpp"
 #include "web_human.hpp"
 

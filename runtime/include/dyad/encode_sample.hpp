@@ -2,7 +2,8 @@
 // SerializedWriter::Write takes: the counterpart of dyad/decode_sample.hpp's DecodeSample, through
 // the same generated type support (MessageTraits<T>::PubSubType). Empty when it cannot be
 // encoded (it always can for a message of a dyad IDL type). Thread-safe; builds the type support
-// afresh each call: fine for a sample now and then (a live parameter request), not a hot loop.
+// afresh each call: fine for a sample now and then (a live parameter request, a health event),
+// not a hot loop. Used by components that write a runtime topic through a SerializedWriter.
 #pragma once
 
 #include <cstdint>
@@ -13,7 +14,7 @@
 #include <dyad/message_traits.hpp>
 #include <dyad/msg/types_support.hpp>  // MessageTraits<T>::PubSubType, complete
 
-namespace dyad::web {
+namespace dyad {
 
 template <class T>
 std::vector<uint8_t> EncodeSample(const T& sample) {
@@ -28,4 +29,4 @@ std::vector<uint8_t> EncodeSample(const T& sample) {
   }
 }
 
-}  // namespace dyad::web
+}  // namespace dyad
