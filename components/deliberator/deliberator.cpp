@@ -122,9 +122,13 @@ void Deliberator::Describe(ComponentSpec& spec) {
   spec.RequiredParam("model", ParamType::kString).Path().Live()
       .Doc(".dpvrnn model file (2 DOF: x, y); set live, swapped in at a step boundary once loaded and checked");
   spec.Param("start_primitive", int64_t{0}).Min(0).Doc("primitive the robot starts drawing");
-  spec.Param("preset", "vcbot").OneOf({"vcbot", "reference"})
-      .Doc("vcbot: W 5, 15 it, Adam lr 0.3 b1 0.1 b2 0.95, w 1e-5; reference: W 15, 15 it, Adam lr 0.1; "
-           "the params below override it");
+  spec.Param("preset", "vcbot")
+      .OneOf({"vcbot", "reference", "nrl"})
+      .Doc(
+          "vcbot: W 5, 15 it, Adam lr 0.3 b1 0.1 b2 0.95, w 1e-5; reference: W 15, 15 it, Adam lr 0.1; "
+          "nrl: NRL's own error regression step by step with the vcbot numbers and Adam epsilon 1e-20 "
+          "(reproduces results published with NRL; a_init and ceres unused, noise off or resample); "
+          "the params below override it");
   spec.Param("window", int64_t{0}).Range(0, 1000).Unit("steps").Doc("sliding window W (0: the preset's)");
   spec.Param("iterations", int64_t{0}).Range(0, 100000).Live().Doc("optimiser iterations per step (0: the preset's)");
   spec.Param("optimizer", "adam").OneOf({"adam", "ceres"}).Doc("adam or ceres (LBFGS, Wolfe line search)");

@@ -26,6 +26,12 @@ std::optional<OptimizerKind> ParseOptimizerKind(std::string_view s) {
   if (s == "ceres") return OptimizerKind::kCeres;
   return std::nullopt;
 }
+std::optional<Engine> ParseEngine(std::string_view s) {
+  if (s == "dyad") return Engine::kDyad;
+  if (s == "nrl") return Engine::kNrl;
+  return std::nullopt;
+}
+const char* ToString(Engine v) { return v == Engine::kDyad ? "dyad" : "nrl"; }
 const char* ToString(AInit v) { return v == AInit::kZero ? "zero" : v == AInit::kCopy ? "copy" : "prior"; }
 const char* ToString(NoiseMode v) {
   return v == NoiseMode::kOff ? "off" : v == NoiseMode::kFixed ? "fixed" : "resample";
@@ -43,9 +49,19 @@ ErrorRegressionOptions ErrorRegressionOptions::Reference() {
   return o;
 }
 
+ErrorRegressionOptions ErrorRegressionOptions::Nrl() {
+  ErrorRegressionOptions o;  // the VCBot settings
+  o.engine = Engine::kNrl;
+  o.adam.epsilon = 1e-20;  // NRL's NON_ZERO
+  o.a_init = AInit::kZero;
+  o.noise = NoiseMode::kResample;
+  return o;
+}
+
 std::optional<ErrorRegressionOptions> ErrorRegressionOptions::Preset(std::string_view name) {
   if (name == "vcbot") return Vcbot();
   if (name == "reference") return Reference();
+  if (name == "nrl") return Nrl();
   return std::nullopt;
 }
 
@@ -65,6 +81,10 @@ std::vector<FieldProblem> ErrorRegressionOptions::Problems(int num_layers) const
       s << "must be finite and >= 0, got " << meta_prior[k];
       add("meta_prior[" + std::to_string(k) + "]", s.str());
     }
+  if (engine == Engine::kNrl && optimizer != OptimizerKind::kAdam)
+    add("optimizer", "the nrl engine is NRL's Adam: must be adam, got " + std::string(ToString(optimizer)));
+  if (engine == Engine::kNrl && noise == NoiseMode::kFixed)
+    add("noise", "the nrl engine draws NRL's noise anew in every pass: must be off or resample, got fixed");
   for (auto& p : adam.Problems()) out.push_back(p);
   for (auto& p : ceres.Problems()) out.push_back(p);
   return out;
@@ -133,6 +153,7 @@ Status ErrorRegression<Scalar>::Retune(int iterations, const std::vector<double>
   meta_prior_ = meta_prior;
   if (meta_prior_.empty())
     for (const auto& layer : spec_.layers) meta_prior_.push_back(layer.w);
+  if (nrl_) nrl_->Retune(iterations, meta_prior_);
   return Status::OK();
 }
 
@@ -175,6 +196,7 @@ ErrorRegression<Scalar>::ErrorRegression(const Model& model, const ErrorRegressi
   executed_code_ = VectorT<Scalar>::Zero(l.output_units());
   result_.loss.kl_per_layer.assign(spec_.num_layers(), 0.0);
   result_.intention = intention_.data();
+  if (options.engine == Engine::kNrl) nrl_ = std::make_unique<NrlRegression>(model, options, meta_prior_);
 }
 
 template <typename Scalar>
@@ -200,6 +222,12 @@ Status ErrorRegression<Scalar>::Reset(int start_primitive, uint64_t seed) {
   result_.loss.kl_per_layer = std::move(kl);
   std::fill(result_.loss.kl_per_layer.begin(), result_.loss.kl_per_layer.end(), 0.0);
   result_.intention = intention_.data();
+  if (nrl_) {
+    nrl_->Reset(start_primitive, seed);
+    for (int k = 0; k < spec_.num_dofs(); ++k) intention_[k] = nrl_->intention()[k];
+    result_.regressed = false;
+    return Status::OK();
+  }
   GenerateIntention(0);
   return Status::OK();
 }
@@ -272,6 +300,7 @@ void ErrorRegression<Scalar>::GenerateIntention(int64_t t) {
 
 template <typename Scalar>
 const StepResult& ErrorRegression<Scalar>::Step(const double* executed, SteadyClock::time_point deadline) {
+  if (nrl_) return NrlStep(executed, deadline);
   const auto t0 = SteadyClock::now();
   const int W = options_.window;
   if (fill_ == W) {
@@ -320,6 +349,27 @@ const StepResult& ErrorRegression<Scalar>::Step(const double* executed, SteadyCl
   result_.optimisation_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
   ++t_;
   GenerateIntention(t_);
+  return result_;
+}
+
+template <typename Scalar>
+const StepResult& ErrorRegression<Scalar>::NrlStep(const double* executed, SteadyClock::time_point deadline) {
+  const auto t0 = SteadyClock::now();
+  const NrlRegression::Outcome& o = nrl_->Step(executed, deadline);
+  for (int k = 0; k < spec_.num_dofs(); ++k) intention_[k] = nrl_->intention()[k];
+  fill_ = nrl_->window_fill();
+  result_.step = t_++;
+  result_.window_fill = fill_;
+  result_.regressed = o.regressed;
+  result_.loss.loss = o.loss;
+  result_.loss.reconstruction = o.reconstruction;
+  result_.loss.regulation = o.regulation;
+  for (size_t k = 0; k < o.kl_per_layer.size(); ++k) result_.loss.kl_per_layer[k] = o.kl_per_layer[k];
+  result_.initial_loss = 0;
+  result_.iterations = o.iterations;
+  result_.evaluations = o.iterations;  // one forward and backward pass each
+  result_.stopped_by_deadline = o.stopped_by_deadline;
+  result_.optimisation_s = std::chrono::duration<double>(SteadyClock::now() - t0).count();
   return result_;
 }
 

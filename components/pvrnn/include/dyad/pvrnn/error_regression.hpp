@@ -32,6 +32,12 @@
 // - No allocation in Step with Adam once every window size up to W has been seen (tested);
 //   Ceres allocates inside its solver.
 //
+// - Engine: `dyad` (the above) or `nrl`: NRL's own online ER, step by step (nrl_regression.hpp:
+//   free generation until W positions are held, A from 0, Adam's state kept across steps, NRL's
+//   prior path and gradient, its kept-A bug); for reproducing results published with NRL. With
+//   `nrl` the options a_init and ceres are not used, optimizer must be adam and noise off or
+//   resample (NRL's N(0,1) every pass); the StepResult's initial_loss is 0, evaluations = iterations.
+//
 // Example (VCBot settings, MacawBot, start on the head):
 //   auto er = ErrorRegression<float>::Create(model, ErrorRegressionOptions::Vcbot()).value();
 //   er->Reset(/*start_primitive=*/1, /*seed=*/1);
@@ -50,6 +56,7 @@
 #include "dyad/pvrnn/adam.hpp"
 #include "dyad/pvrnn/ceres_window_optimizer.hpp"
 #include "dyad/pvrnn/model.hpp"
+#include "dyad/pvrnn/nrl_regression.hpp"
 #include "dyad/pvrnn/prior_generator.hpp"
 #include "dyad/pvrnn/window_objective.hpp"
 #include "dyad/pvrnn/window_optimizer.hpp"
@@ -59,14 +66,17 @@ namespace dyad::pvrnn {
 enum class AInit { kZero, kCopy, kPrior };
 enum class NoiseMode { kOff, kFixed, kResample };
 enum class OptimizerKind { kAdam, kCeres };
+enum class Engine { kDyad, kNrl };
 
 // Parse/print the YAML spellings: "zero|copy|prior", "off|fixed|resample", "adam|ceres".
 std::optional<AInit> ParseAInit(std::string_view s);
 std::optional<NoiseMode> ParseNoiseMode(std::string_view s);
 std::optional<OptimizerKind> ParseOptimizerKind(std::string_view s);
+std::optional<Engine> ParseEngine(std::string_view s);  // "dyad|nrl"
 const char* ToString(AInit v);
 const char* ToString(NoiseMode v);
 const char* ToString(OptimizerKind v);
+const char* ToString(Engine v);
 
 struct ErrorRegressionOptions {
   int window = 5;                  // W, steps; REQUIRES 1..1000
@@ -80,6 +90,7 @@ struct ErrorRegressionOptions {
   OptimizerKind optimizer = OptimizerKind::kAdam;
   AdamOptions adam{0.3, 0.1, 0.95, 1e-8};
   CeresOptions ceres;
+  Engine engine = Engine::kDyad;
 
   // The interactive VCBot settings: W 5, 15 iterations, Adam lr 0.3, beta1 0.1, beta2 0.95,
   // w 1e-5 (these are also the defaults above).
@@ -87,7 +98,12 @@ struct ErrorRegressionOptions {
   // The reference implementation's defaults: W 15, 15 iterations, Adam lr 0.1 (beta1 0.9,
   // beta2 0.999), w = the model's training meta-prior (meta_prior empty; 0.01 for MacawBot).
   static ErrorRegressionOptions Reference();
-  // "vcbot" or "reference"; nullopt otherwise.
+  // NRL's own ER (engine nrl) with the study's VCBot settings as they were run on NRL: W 5, 15
+  // iterations, Adam lr 0.3, beta1 0.1, beta2 0.95, NRL's epsilon 1e-20, w 1e-5, the first 3
+  // intentions on the start primitive's trained A, NRL's noise (resample; off for a
+  // deterministic run).
+  static ErrorRegressionOptions Nrl();
+  // "vcbot", "reference" or "nrl"; nullopt otherwise.
   static std::optional<ErrorRegressionOptions> Preset(std::string_view name);
 
   // Every broken constraint (fields as in YAML: "window", "meta_prior", "adam.lr", ...);
@@ -100,6 +116,7 @@ struct ErrorRegressionOptions {
 struct StepResult {
   int64_t step = -1;          // index of the executed step just taken in (-1 after Reset)
   int window_fill = 0;        // steps in the window (grows to W)
+  bool regressed = true;      // false while the nrl engine generates freely (window not yet full)
   LossTerms loss;             // of the best iterate (NRL normalisation; `loss` is the N-ELBO)
   double initial_loss = 0;    // at the start point of the solve
   int iterations = 0;
@@ -147,6 +164,7 @@ class ErrorRegression {
 
  private:
   class Function;
+  const StepResult& NrlStep(const double* executed, SteadyClock::time_point deadline);
   ErrorRegression(const Model& model, const ErrorRegressionOptions& options);
   void DrawNoise(Eigen::Ref<MatrixT<Scalar>> eps);
   void InitNewColumn(int col, int64_t t);
@@ -176,6 +194,7 @@ class ErrorRegression {
   Eigen::VectorXd intention_, executed_code_d_;
   VectorT<Scalar> executed_code_;
   StepResult result_;
+  std::unique_ptr<NrlRegression> nrl_;  // engine nrl only
 };
 
 }  // namespace dyad::pvrnn
