@@ -271,7 +271,7 @@ StatusOr<std::vector<std::array<double, 2>>> ReadTrajectory(const std::string& p
 struct RegressArgs {
   std::string model, trajectory, out, preset = "vcbot", optimizer, a_init, noise;
   std::optional<int> window, iterations;
-  std::optional<double> lr, beta1, beta2;
+  std::optional<double> lr, beta1, beta2, epsilon;
   int start_primitive = 0;
   double budget_ms = 0;
   std::vector<double> meta_prior;
@@ -280,7 +280,7 @@ struct RegressArgs {
 
 int Regress(const RegressArgs& a) {
   auto o = ErrorRegressionOptions::Preset(a.preset);
-  if (!o) return Fail(kBadInput, "--preset " + a.preset + ": must be vcbot or reference");
+  if (!o) return Fail(kBadInput, "--preset " + a.preset + ": must be vcbot, reference or nrl");
   if (a.window) o->window = *a.window;
   if (a.iterations) o->iterations = *a.iterations;
   if (!a.optimizer.empty()) {
@@ -301,6 +301,7 @@ int Regress(const RegressArgs& a) {
   if (a.lr) o->adam.lr = *a.lr;
   if (a.beta1) o->adam.beta1 = *a.beta1;
   if (a.beta2) o->adam.beta2 = *a.beta2;
+  if (a.epsilon) o->adam.epsilon = *a.epsilon;
   if (!a.meta_prior.empty()) o->meta_prior = a.meta_prior;
   if (a.budget_ms < 0) return Fail(kBadInput, "--budget-ms: must be >= 0 (0: no cap)");
   auto model = LoadModel(a.model);
@@ -331,6 +332,11 @@ int Regress(const RegressArgs& a) {
                                                          std::chrono::duration<double, std::milli>(a.budget_ms))
                               : SteadyClock::time_point::max();
     const StepResult& r = (*er)->Step(xy.data(), deadline);
+    if (!r.regressed) {  // nrl: free generation until the window is full, no loss yet
+      std::fprintf(f, "%lld,%.9g,%.9g,%.9g,%.9g,,,,0,0,%.6f\n", static_cast<long long>(r.step), xy[0], xy[1], r.intention[0],
+                   r.intention[1], 1e3 * r.optimisation_s);
+      continue;
+    }
     std::fprintf(f, "%lld,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d,%d,%.6f\n", static_cast<long long>(r.step), xy[0], xy[1],
                  r.intention[0], r.intention[1], r.loss.loss, r.loss.reconstruction, r.loss.regulation, r.iterations,
                  r.evaluations, 1e3 * r.optimisation_s);
@@ -398,16 +404,19 @@ void AddPvrnnCommands(CLI::App& app, int& exit_code) {
     cmd->add_option("model", a->model, "Model file (.dpvrnn)")->required();
     cmd->add_option("trajectory", a->trajectory, "Executed positions: x,y rows, or a CSV with columns named x and y (dyad bag export)")->required();
     cmd->add_option("-o,--output", a->out, "Per-step CSV (default: stdout)");
-    cmd->add_option("--preset", a->preset, "vcbot (W 5, 15 it, Adam 0.3/0.1/0.95, w 1e-5) or reference (W 15, 15 it, Adam 0.1, training w)");
+    cmd->add_option("--preset", a->preset,
+                    "vcbot (W 5, 15 it, Adam 0.3/0.1/0.95, w 1e-5), reference (W 15, 15 it, Adam 0.1, training w) or nrl "
+                    "(NRL's own error regression with the vcbot numbers, Adam epsilon 1e-20; docs/pvrnn.md)");
     cmd->add_option("--window", a->window, "Window W (default: the preset's)");
     cmd->add_option("--iterations", a->iterations, "Optimiser iterations per step (default: the preset's)");
     cmd->add_option("--optimizer", a->optimizer, "adam or ceres");
     cmd->add_option("--lr", a->lr, "Adam step size");
     cmd->add_option("--beta1", a->beta1, "Adam beta1");
     cmd->add_option("--beta2", a->beta2, "Adam beta2");
+    cmd->add_option("--epsilon", a->epsilon, "Adam epsilon (default: the preset's; nrl 1e-20)");
     cmd->add_option("--meta-prior", a->meta_prior, "Online meta-prior per layer, e.g. --meta-prior 1e-5 1e-5")->expected(1, 100);
     cmd->add_option("--a-init", a->a_init, "A of the newest window step: zero, copy or prior (default prior)");
-    cmd->add_option("--noise", a->noise, "off, fixed or resample (default off)");
+    cmd->add_option("--noise", a->noise, "off, fixed or resample (default: the preset's: off; nrl: resample, NRL's N(0,1))");
     cmd->add_option("--start-primitive", a->start_primitive, "Primitive the robot starts on (default 0)");
     cmd->add_option("--seed", a->seed, "Noise seed (default 1)");
     cmd->add_option("--budget-ms", a->budget_ms, "Wall-time cap per step in ms (default: none)");

@@ -89,6 +89,24 @@ TEST_F(RegressCommand, ReadsTheColumnsNamedXAndYOfABagExport) {
   EXPECT_NE(r.out.find("\n2,2.5,3.5,"), std::string::npos) << r.out;
 }
 
+// NRL's error regression (issue 44): free generation until the window holds W executed positions
+// (no loss, no iterations), then 15 iterations per step.
+TEST_F(RegressCommand, NrlPresetGeneratesFreelyUntilTheWindowIsFull) {
+  const std::string traj = Write("t.csv", Circle(8));
+  const Result r = Run(model_ + " " + traj + " --preset nrl --noise off");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  std::getline(lines, line);  // header
+  std::getline(lines, line);  // the intention before step 0
+  for (int step = 0; step < 8; ++step) {
+    ASSERT_TRUE(std::getline(lines, line));
+    EXPECT_EQ(line.rfind(std::to_string(step) + ",", 0), 0u) << line;
+    if (step < 4) EXPECT_NE(line.find(",,,,0,0,"), std::string::npos) << line;
+    else EXPECT_NE(line.find(",15,15,"), std::string::npos) << line;
+  }
+}
+
 struct BadCase {
   std::string name, trajectory_text, extra_args, message;
 };
@@ -105,7 +123,10 @@ TEST_F(RegressCommand, BadInputsExitWith2AndSayWhy) {
       {"optimizer", "", "--optimizer lbfgs", "--optimizer lbfgs: must be adam or ceres"},
       {"meta-prior", "", "--meta-prior 1e-5", "--meta-prior: needs one value per layer (2), got 1"},
       {"lr", "", "--lr -2", "--lr: must be finite and > 0, got -2"},
-      {"preset", "", "--preset fast", "--preset fast: must be vcbot or reference"},
+      {"preset", "", "--preset fast", "--preset fast: must be vcbot, reference or nrl"},
+      {"epsilon", "", "--epsilon 0", "--epsilon: must be finite and > 0, got 0"},
+      {"nrl with ceres", "", "--preset nrl --optimizer ceres", "--optimizer: the nrl engine is NRL's Adam: must be adam"},
+      {"nrl with fixed noise", "", "--preset nrl --noise fixed", "--noise: the nrl engine draws NRL's noise anew"},
       {"primitive", "", "--start-primitive 7", "--start-primitive 7: "},
   };
   for (const auto& c : cases) {
