@@ -4,30 +4,16 @@
 #include <string>
 #include <vector>
 
-#include "dyad/catalog.hpp"
 #include "dyad/graph.hpp"
 #include "dyad/validate.hpp"
+#include "fuzz_catalog.hpp"
 #include "fuzz_support.hpp"
-
-namespace {
-
-const dyad::Catalog& BuiltinCatalog() {
-  static const dyad::Catalog* catalog = [] {
-    auto* c = new dyad::Catalog();
-    const dyad::Status s = c->LoadDefault({});
-    dyad::fuzz::Require(s.ok() && c->Find("human_synthetic") != nullptr, "built-in plugins: " + s.ToString());
-    return c;
-  }();
-  return *catalog;
-}
-
-}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   std::vector<dyad::Diagnostic> diagnostics;
   dyad::Graph graph = dyad::ParseGraph(text, "fuzz.yaml", {}, &diagnostics);
-  if (diagnostics.empty()) dyad::ValidateGraph(graph, BuiltinCatalog(), &diagnostics);
+  if (diagnostics.empty()) dyad::ValidateGraph(graph, dyad::fuzz::BuiltinCatalog(), &diagnostics);
   for (const dyad::Diagnostic& d : diagnostics) {
     const std::string line = d.ToString();
     dyad::fuzz::Require(line.rfind("fuzz.yaml", 0) == 0 && !d.message.empty(), "diagnostic without its file: " + line);

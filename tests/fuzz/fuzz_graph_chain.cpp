@@ -16,24 +16,14 @@
 #include <string>
 #include <vector>
 
-#include "dyad/catalog.hpp"
 #include "dyad/graph.hpp"
 #include "dyad/validate.hpp"
+#include "fuzz_catalog.hpp"
 #include "fuzz_support.hpp"
 
 namespace {
 
 constexpr size_t kMaxBases = 5, kMaxSets = 8;
-
-const dyad::Catalog& BuiltinCatalog() {
-  static const dyad::Catalog* catalog = [] {
-    auto* c = new dyad::Catalog();
-    const dyad::Status s = c->LoadDefault({});
-    dyad::fuzz::Require(s.ok() && c->Find("human_synthetic") != nullptr, "built-in plugins: " + s.ToString());
-    return c;
-  }();
-  return *catalog;
-}
 
 std::string FolderName() {
   const char* tmp = std::getenv("TMPDIR");
@@ -81,7 +71,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<dyad::Diagnostic> diagnostics;
   const std::string path = dir + "/fuzz.yaml";
   dyad::Graph graph = dyad::ParseGraph(std::string(sections[0]), path, overrides, &diagnostics);
-  if (diagnostics.empty()) dyad::ValidateGraph(graph, BuiltinCatalog(), &diagnostics);
+  if (diagnostics.empty()) dyad::ValidateGraph(graph, dyad::fuzz::BuiltinCatalog(), &diagnostics);
   for (const dyad::Diagnostic& d : diagnostics) {
     const std::string line = d.ToString();
     // The file that wrote the key: the graph, a file of its chain (an absolute path: what an

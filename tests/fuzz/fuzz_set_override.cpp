@@ -5,22 +5,12 @@
 #include <string>
 #include <vector>
 
-#include "dyad/catalog.hpp"
 #include "dyad/graph.hpp"
 #include "dyad/validate.hpp"
+#include "fuzz_catalog.hpp"
 #include "fuzz_support.hpp"
 
 namespace {
-
-const dyad::Catalog& BuiltinCatalog() {
-  static const dyad::Catalog* catalog = [] {
-    auto* c = new dyad::Catalog();
-    const dyad::Status s = c->LoadDefault({});
-    dyad::fuzz::Require(s.ok() && c->Find("human_synthetic") != nullptr, "built-in plugins: " + s.ToString());
-    return c;
-  }();
-  return *catalog;
-}
 
 const std::string& BaseGraph() {
   static const std::string text = [] {
@@ -44,7 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   std::vector<dyad::Diagnostic> diagnostics;
   dyad::Graph graph = dyad::ParseGraph(BaseGraph(), "demo.yaml", overrides, &diagnostics);
-  if (diagnostics.empty()) dyad::ValidateGraph(graph, BuiltinCatalog(), &diagnostics);
+  if (diagnostics.empty()) dyad::ValidateGraph(graph, dyad::fuzz::BuiltinCatalog(), &diagnostics);
   for (const dyad::Diagnostic& d : diagnostics) {
     dyad::fuzz::Require(!d.message.empty() && !d.ToString().empty(), "empty diagnostic");
     dyad::fuzz::Require(!dyad::fuzz::IsLoaderFallback(d.message), "a yaml-cpp exception reached the loader's catch: " + d.ToString());
