@@ -110,10 +110,27 @@ GuestOptions OneComponentGuest(const GuestState& st, const std::string& label, c
   return go;
 }
 
+// `dyad record` as the graph's guest: what it records must be granted by security.guests.subscribe.
+// With no topics named: every topic the graph writes that the grant covers (the others named on
+// stderr). False, having said why, when a named topic is not granted or nothing is.
+bool GuestTopics(const Graph& graph, GuestState* st) {
+  if (!st->topics.empty()) return GuestMayRead(graph, st->graph, st->topics, "dyad record");
+  std::vector<std::string> left_out;
+  for (const std::string& t : BoundTopics(graph, true))
+    (TopicGranted(graph.security.guest_subscribe, t) ? st->topics : left_out).push_back(t);
+  if (st->topics.empty()) return GuestMayRead(graph, st->graph, left_out, "dyad record");
+  for (const std::string& t : left_out)
+    std::cerr << "dyad record: not recording '" << t << "': the graph's guests may not read it (security.guests.subscribe)\n";
+  return true;
+}
+
 int Record(GuestState& st) {
   Catalog catalog;
   std::optional<Graph> graph;
-  if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph)) return 2;
+  bool as_guest = false;
+  if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph, &as_guest))
+    return 2;
+  if (as_guest && !GuestTopics(*graph, &st)) return 2;
   if (st.topics.empty() && !graph) {
     std::cerr << "dyad record: name the topics to record, or give --graph G to record every topic of G\n";
     return 2;
@@ -137,7 +154,9 @@ int Record(GuestState& st) {
 int Play(GuestState& st) {
   Catalog catalog;
   std::optional<Graph> graph;
-  if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph)) return 2;
+  bool as_guest = false;  // (they publish as the guest anywhere: PublishAsGuest)
+  if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph, &as_guest))
+    return 2;
   // The topics to play, chosen here as the replay will: to know which readers to wait for. The
   // runtime's own topics (dyad/...) are left out unless named: a recorded dyad/processes played
   // into a live graph would tell its watchers of processes that are not there.
@@ -226,7 +245,9 @@ SampleMaker YamlSamples(const std::string& fields) {
 int Pub(GuestState& st) {
   Catalog catalog;
   std::optional<Graph> graph;
-  if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph)) return 2;
+  bool as_guest = false;  // (they publish as the guest anywhere: PublishAsGuest)
+  if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph, &as_guest))
+    return 2;
   if (!PublishAsGuest(graph, {st.topic}, "dyad pub", &st)) return 2;
   PublishOptions po;
   po.watch = st.opts;

@@ -63,8 +63,13 @@ struct WatchState {
 
   // The catalog, domain and network a watcher joins with, and the --graph it watches; false
   // (exit 2) when the graph cannot be read, having said why.
-  bool Join(Catalog* catalog, std::optional<Graph>* watched) {
-    return LoadWatcherCatalog(graph, plugins, catalog, &opts, domain_given(), host, watched);
+  // A watcher of one topic (`reads_topic`: echo, hz) on a machine that is none of a secured
+  // graph's hosts joins as its guest, if the graph grants its guests that topic.
+  bool Join(Catalog* catalog, std::optional<Graph>* watched, const char* reads_topic = nullptr) {
+    bool as_guest = false;
+    if (!LoadWatcherCatalog(graph, plugins, catalog, &opts, domain_given(), host, watched, reads_topic ? &as_guest : nullptr))
+      return false;
+    return !as_guest || GuestMayRead(**watched, graph, {topic}, reads_topic);
   }
 
   // The topic a watcher reads: a ROS 2 topic of the --graph by its ROS 2 name (what it is on the
@@ -116,7 +121,7 @@ void AddTopicCommands(CLI::App& app, const std::shared_ptr<WatchState>& st, int&
   echo->callback([st, &exit_code] {
     Catalog catalog;
     std::optional<Graph> graph;
-    if (!st->Join(&catalog, &graph)) {
+    if (!st->Join(&catalog, &graph, "dyad echo")) {
       exit_code = 2;
       return;
     }
@@ -132,7 +137,7 @@ void AddTopicCommands(CLI::App& app, const std::shared_ptr<WatchState>& st, int&
   hz->callback([st, &exit_code] {
     Catalog catalog;
     std::optional<Graph> graph;
-    if (!st->Join(&catalog, &graph)) {
+    if (!st->Join(&catalog, &graph, "dyad hz")) {
       exit_code = 2;
       return;
     }
