@@ -1,0 +1,302 @@
+#!/usr/bin/env node
+// A simulated participant: a headless client of the subject's page (/subject/ws) that does what a
+// person does on components/web/pages/subject.html, speaking the same protocol at the same rates
+// (src/subject_channel.hpp), for bench/capacity and for tests of studies run online:
+//   - connects with its token (reconnects a second after a close, as the page does; a 1008 close
+//     is final), sends a pointer sample on each pointer event (a browser's pointermove, about
+//     60 Hz here, at most one per 4 ms as the page), on each press and release, and every 50 ms
+//     while engaged (the page's keepalive), each stamped "t" (the ack's round trip) and "wall"
+//     (the event's wall-clock time: the server keeps the event -> published delay);
+//   - draws the data set's primitives (an NRL folder: primitive_<id>_<sample>.csv, x,y rows at
+//     100 ms; the experimenter's task target when one is set, else one at random), each as one
+//     hold of the mouse button: its own pace (0.8 to 1.3 times the data set's), a small rotation,
+//     scale and offset per hold, hand tremor, the events' timing jitter; between holds it rests
+//     1 to 3 s and moves to the next start, released;
+//   - answers "What were you drawing?" (after each hold of at least the page's minimum, and each
+//     question after the trial) with what it drew, 1 to 3 s later, wrong with probability
+//     `report_error`.
+// Without a data set folder it draws generated shapes (a circle, a figure eight, a square), so it
+// works from a clean clone. `speed` > 1 (tests) divides every duration of its behaviour (rests,
+// holds, answers), never the pointer's event rate.
+//
+//   node sim_participant.mjs [--dataset DIR] [--seconds S] [--report-error P] [--speed F] [--chromium K]
+//                            SESSIONS_FILE
+//     SESSIONS_FILE: one participant per line, "URL TOKEN" (URL: http://127.0.0.1:PORT); all run
+//     in this one process for S seconds (default 30), then each prints one JSON line: pointer
+//     samples sent, acks, round trip median/p99 (ms), holds, answers, closes, errors; the last
+//     line is this process's CPU time (Node's alone: Chromium's own processes are not in it).
+//     --chromium K: the first K participants in the real page in Chromium (ChromiumParticipant).
+import fs from "node:fs";
+import path from "node:path";
+import WebSocket from "ws";
+
+// A small seeded generator (mulberry32), so a participant's behaviour can be replayed.
+export function rng(seed) {
+  let a = seed >>> 0;
+  const next = () => {
+    a = (a + 0x6d2b79f5) >>> 0;
+    let t = a;
+    t = Math.imul(t ^ (t >>> 15), t | 1);
+    t ^= t + Math.imul(t ^ (t >>> 7), t | 61);
+    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
+  };
+  next.uniform = (lo, hi) => lo + (hi - lo) * next();
+  next.gauss = () => Math.sqrt(-2 * Math.log(next() + 1e-12)) * Math.cos(2 * Math.PI * next());
+  return next;
+}
+
+// The primitives of an NRL data set folder (the first sample of each), or null when absent.
+export function loadPrimitives(dir) {
+  if (!dir || !fs.existsSync(dir)) return null;
+  const prims = [];
+  for (const f of fs.readdirSync(dir)) {
+    const m = /^primitive_(\d+)_0\.csv$/.exec(f);
+    if (!m) continue;
+    const rows = fs.readFileSync(path.join(dir, f), "utf8").trim().split("\n");
+    const pts = rows.map((r) => r.split(",").slice(0, 2).map(Number));
+    if (pts.some((p) => p.length < 2 || !p.every(Number.isFinite))) throw new Error(`${dir}/${f}: rows must be x,y numbers`);
+    prims[Number(m[1])] = pts;
+  }
+  if (prims.length === 0) throw new Error(`${dir}: no primitive_<id>_0.csv files (an NRL data set folder)`);
+  if (prims.some((p) => !p)) throw new Error(`${dir}: primitive ids are not 0..${prims.length - 1}`);
+  return prims;
+}
+
+// Three shapes of 72 steps of 100 ms, radius 30: a circle, a figure eight, a square.
+export function generatedPrimitives() {
+  const n = 72, r = 30, out = [[], [], []];
+  for (let i = 0; i < n; i++) {
+    const a = (2 * Math.PI * i) / (n - 1);
+    out[0].push([r * Math.cos(a), r * Math.sin(a)]);
+    out[1].push([r * Math.sin(a), (r / 2) * Math.sin(2 * a)]);
+    const s = (4 * i) / (n - 1), side = Math.min(3, Math.floor(s)), f = s - side;
+    const corners = [[-r, -r], [r, -r], [r, r], [-r, r], [-r, -r]];
+    const [a0, a1] = [corners[side], corners[side + 1]];
+    out[2].push([a0[0] + f * (a1[0] - a0[0]), a0[1] + f * (a1[1] - a0[1])]);
+  }
+  return out;
+}
+
+// The point `u` (0..1) along a path of points, linearly between them.
+function along(pts, u) {
+  const s = Math.max(0, Math.min(1, u)) * (pts.length - 1), i = Math.min(pts.length - 2, Math.floor(s)), f = s - i;
+  return [pts[i][0] + f * (pts[i + 1][0] - pts[i][0]), pts[i][1] + f * (pts[i + 1][1] - pts[i][1])];
+}
+
+const wallMs = () => performance.timeOrigin + performance.now();
+const pct = (a, p) => { const s = [...a].sort((x, y) => x - y); return s.length ? s[Math.min(s.length - 1, Math.floor(p * s.length))] : null; };
+
+export class SimParticipant {
+  // url: http://HOST:PORT; token: the subject's; primitives: [[x,y],...] each; seed: its behaviour.
+  constructor({ url, token, primitives, seed = 1, reportError = 0.1, speed = 1 }) {
+    this.wsUrl = url.replace(/^http/, "ws") + "/subject/ws?token=" + encodeURIComponent(token);
+    this.origin = url;
+    this.prims = primitives;
+    this.r = rng(seed);
+    this.reportError = reportError;
+    this.speed = speed;
+    this.stats = { sent: 0, acks: 0, rtts: [], holds: 0, answers: 0, closes: 0, errors: [] };
+    this.half = 50, this.steering = false, this.ask = false, this.askAfterMs = 1000, this.target = -1;
+    this.cursor = [0, 0], this.down = false, this.lastSent = 0, this.timers = new Set();
+    this.drawn = [];  // the primitive drawn in each hold long enough to be asked about
+  }
+  later(ms, fn) {  // fn after ms of its behaviour's time
+    const t = setTimeout(() => { this.timers.delete(t); if (!this.stopped) fn(); }, ms / this.speed);
+    this.timers.add(t);
+  }
+  start() { this.connect(); this.rest(); this.keepalive = setInterval(() => { if (this.down) this.send(true); }, 50); }
+  stop() {
+    this.stopped = true;
+    clearInterval(this.keepalive);
+    for (const t of this.timers) clearTimeout(t);
+    this.ws?.close();
+  }
+  connect() {
+    this.ws = new WebSocket(this.wsUrl, { headers: { Origin: this.origin } });
+    this.ws.on("message", (data) => this.onMessage(JSON.parse(String(data))));
+    this.ws.on("error", (e) => { if (this.stats.errors.length < 5) this.stats.errors.push(String(e.message)); });
+    this.ws.on("close", (code) => {
+      this.stats.closes++, this.steering = false, this.down = false;
+      if (!this.stopped && code !== 1008) this.later(1000, () => this.connect());
+    });
+  }
+  onMessage(m) {
+    if (m.op === "hello") {
+      this.half = m.half_width, this.steering = m.steering, this.ask = !!m.ask, this.askAfterMs = 1000 * (m.ask_after_hold_s ?? 1);
+      this.drawn = [];  // a new graph: a new trial (as the page, which forgets the last one's question)
+    } else if (m.op === "role") {
+      this.steering = m.steering;
+    } else if (m.op === "task") {
+      this.target = m.target;
+    } else if (m.op === "ack") {
+      this.stats.acks++;
+      if (this.stats.rtts.length < 100000) this.stats.rtts.push(performance.now() - m.t);
+    } else if (m.op === "question" && m.segment >= 0 && this.steering) {
+      this.later(this.r.uniform(1000, 3000), () => this.answer(this.drawn[m.segment] ?? 0, m.segment));
+    }
+  }
+  // The page's send(): at most one sample per 4 ms unless forced (a press, a release, the keepalive).
+  send(force) {
+    if (this.ws?.readyState !== WebSocket.OPEN) return;
+    const now = performance.now();
+    if (!force && now - this.lastSent < 4) return;
+    this.lastSent = now;
+    const clamp = (v) => Math.max(-this.half, Math.min(this.half, v));
+    this.ws.send(JSON.stringify({ op: "pointer", x: clamp(this.cursor[0]), y: clamp(this.cursor[1]), engaged: this.down && this.steering,
+                                  t: now, wall: wallMs() }));
+    this.stats.sent++;
+  }
+  // The page's pointer events: a move, the mouse button's press and release.
+  moved() { this.send(false); }
+  press() { this.down = true; this.send(true); }
+  release() { this.down = false; this.send(true); }
+  choose(drawn) {
+    if (this.r() >= this.reportError) return drawn;
+    return this.r() < 0.3 ? -1 : Math.floor(this.r() * this.prims.length);
+  }
+  answer(drawn, segment) {
+    if (this.ws?.readyState !== WebSocket.OPEN) return;
+    const choice = this.choose(drawn);
+    this.ws.send(JSON.stringify(segment === undefined ? { op: "self_report", choice } : { op: "self_report", choice, segment }));
+    this.stats.answers++;
+  }
+  // Pointer events about every 16.7 ms (a 60 Hz display), each 1-3 ms late or early.
+  moveEvery(durationMs, at, done) {
+    const t0 = performance.now();
+    const step = () => {
+      const u = (this.speed * (performance.now() - t0)) / durationMs;
+      this.cursor = at(Math.min(1, u));
+      this.moved();
+      if (u >= 1) return done();
+      this.later(this.speed * (16.7 + this.r.uniform(-2, 2)), step);
+    };
+    step();
+  }
+  // Released: rests, then moves the pointer to the next primitive's start and draws it.
+  rest() {
+    const k = this.target >= 0 && this.target < this.prims.length ? this.target : Math.floor(this.r() * this.prims.length);
+    const p = this.prims[k], ang = this.r.uniform(-0.08, 0.08), sc = this.r.uniform(0.9, 1.1);
+    const off = [this.r.uniform(-3, 3), this.r.uniform(-3, 3)];
+    const shape = p.map(([x, y]) => [sc * (x * Math.cos(ang) - y * Math.sin(ang)) + off[0], sc * (x * Math.sin(ang) + y * Math.cos(ang)) + off[1]]);
+    const from = [...this.cursor], to = shape[0];
+    this.later(this.r.uniform(1000, 3000), () =>
+      this.moveEvery(this.r.uniform(400, 900), (u) => [from[0] + u * (to[0] - from[0]), from[1] + u * (to[1] - from[1])],
+                     () => this.draw(k, shape)));
+  }
+  // One hold: the shape at its own pace with tremor (a slowly varying offset plus jitter).
+  draw(k, shape) {
+    const ms = shape.length * 100 * this.r.uniform(0.8, 1.3), held = performance.now();
+    let tremor = [0, 0];
+    this.press();
+    this.moveEvery(ms, (u) => {
+      tremor = tremor.map((v) => 0.9 * v + 0.15 * this.r.gauss());
+      const [x, y] = along(shape, u);
+      return [x + tremor[0] + 0.1 * this.r.gauss(), y + tremor[1] + 0.1 * this.r.gauss()];
+    }, () => {
+      this.release();
+      this.stats.holds++;
+      if (performance.now() - held >= this.askAfterMs) {  // real time: the page's minimum hold
+        this.drawn.push(k);
+        if (this.ask && this.steering) this.later(this.r.uniform(1000, 3000), () => this.answer(k));
+      }
+      this.rest();
+    });
+  }
+  summary() {
+    const s = this.stats;
+    return { sent: s.sent, acks: s.acks, rtt_median_ms: pct(s.rtts, 0.5), rtt_p99_ms: pct(s.rtts, 0.99), holds: s.holds, answers: s.answers,
+             closes: s.closes, errors: s.errors };
+  }
+}
+
+// The same person in the real subject's page, in Debian's Chromium (playwright-core): the same
+// behaviour, its pointer events given to the page as mouse events (the page then sends what it
+// sends), its answers as the question's keys (1..n, 0: something else). For checking that the
+// headless client is faithful; the page keeps its round trips (window.dyadStats).
+export class ChromiumParticipant extends SimParticipant {
+  constructor(options, browser) {
+    super(options);
+    this.browser = browser;
+    this.pageUrl = options.url + "/subject?token=" + encodeURIComponent(options.token);
+    this.queue = Promise.resolve(), this.pendingMove = null;
+  }
+  async open() {
+    this.context = await this.browser.newContext({ viewport: { width: 800, height: 800 } });
+    this.page = await this.context.newPage();
+    await this.page.goto(this.pageUrl);
+    await this.page.waitForFunction(() => document.getElementById("role").textContent === "you steer", null, { timeout: 20000 });
+    await this.locate();
+  }
+  async locate() {  // the workspace's place on the screen, and what the page said in its hello
+    Object.assign(this, await this.page.evaluate(() => {
+      const r = document.getElementById("canvas").getBoundingClientRect(), v = view();  // eslint-disable-line no-undef
+      return { map: { x0: r.left + v.cx, y0: r.top + v.cy, scale: v.scale }, ask, steering, half: H };  // eslint-disable-line no-undef
+    }));
+  }
+  start() { this.rest(); }
+  async stop() {
+    this.stopped = true;
+    for (const t of this.timers) clearTimeout(t);
+    await this.queue.catch(() => {});
+    this.rtts = (await this.page.evaluate(() => window.dyadStats()).catch(() => ({ rtts: [] }))).rtts;
+    await this.context.close();
+  }
+  then_(fn) { this.queue = this.queue.then(fn).catch((e) => { if (this.stats.errors.length < 5) this.stats.errors.push(String(e.message)); }); }
+  moved() {  // the newest position only, when the page is still busy with the last one
+    const first = this.pendingMove === null;
+    this.pendingMove = [this.map.x0 + this.map.scale * this.cursor[0], this.map.y0 - this.map.scale * this.cursor[1]];
+    if (first) this.then_(() => { const [x, y] = this.pendingMove; this.pendingMove = null; return this.page.mouse.move(x, y); });
+  }
+  press() { this.down = true; this.moved(); this.then_(() => this.page.mouse.down()); }
+  release() { this.down = false; this.then_(() => this.page.mouse.up()); this.then_(() => this.locate()); }
+  answer(drawn) {
+    const choice = this.choose(drawn);
+    this.then_(() => this.page.keyboard.press(String(choice < 0 ? 0 : choice + 1)));
+    this.stats.answers++;
+  }
+  summary() {
+    const r = this.rtts ?? [];
+    return { chromium: true, acks: r.length, rtt_median_ms: pct(r, 0.5), rtt_p99_ms: pct(r, 0.99), holds: this.stats.holds,
+             answers: this.stats.answers, errors: this.stats.errors };
+  }
+}
+
+async function main(argv) {
+  const opts = { dataset: "", seconds: 30, reportError: 0.1, speed: 1, chromium: 0 };
+  const files = [];
+  for (let i = 0; i < argv.length; i++) {
+    if (argv[i] === "--dataset") opts.dataset = argv[++i];
+    else if (argv[i] === "--seconds") opts.seconds = Number(argv[++i]);
+    else if (argv[i] === "--report-error") opts.reportError = Number(argv[++i]);
+    else if (argv[i] === "--speed") opts.speed = Number(argv[++i]);
+    else if (argv[i] === "--chromium") opts.chromium = Number(argv[++i]);
+    else files.push(argv[i]);
+  }
+  if (files.length !== 1 || !(opts.seconds > 0) || !(opts.reportError >= 0 && opts.reportError <= 1) || !(opts.speed > 0) || !Number.isInteger(opts.chromium) || opts.chromium < 0) {
+    console.error("usage: node sim_participant.mjs [--dataset DIR] [--seconds S > 0] [--report-error P in 0..1] [--speed F > 0] [--chromium K >= 0] SESSIONS_FILE");
+    process.exit(2);
+  }
+  const prims = loadPrimitives(opts.dataset) ?? generatedPrimitives();
+  const lines = fs.readFileSync(files[0], "utf8").split("\n").filter((l) => l.trim());
+  const browser = opts.chromium > 0
+    ? await (await import("playwright-core")).chromium.launch({ executablePath: "/usr/bin/chromium", args: ["--headless", "--no-sandbox", "--disable-gpu"] })
+    : null;
+  const people = lines.map((line, i) => {
+    const [url, token] = line.trim().split(/\s+/);
+    if (!/^https?:\/\//.test(url ?? "") || !token) throw new Error(`${files[0]}:${i + 1}: expected "URL TOKEN", got '${line}'`);
+    const o = { url, token, primitives: prims, seed: i + 1, reportError: opts.reportError, speed: opts.speed };
+    return i < opts.chromium ? new ChromiumParticipant(o, browser) : new SimParticipant(o);
+  });
+  for (const p of people) if (p.open) await p.open();
+  const cpu0 = process.cpuUsage();
+  people.forEach((p) => p.start());
+  await new Promise((r) => setTimeout(r, opts.seconds * 1000));
+  await Promise.all(people.map((p) => p.stop()));
+  await browser?.close();
+  await new Promise((r) => setTimeout(r, 200));
+  for (const p of people) console.log(JSON.stringify(p.summary()));
+  const cpu = process.cpuUsage(cpu0);
+  console.log(JSON.stringify({ clients_cpu_s: (cpu.user + cpu.system) / 1e6, seconds: opts.seconds }));
+}
+
+if (import.meta.url === `file://${process.argv[1]}`) main(process.argv.slice(2)).catch((e) => { console.error(String(e.message ?? e)); process.exit(1); });
