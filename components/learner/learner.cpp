@@ -1,13 +1,13 @@
 #include "learner.hpp"
 
 #include <signal.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <filesystem>
+#include <future>
 #include <thread>
 
 #include <yaml-cpp/yaml.h>
@@ -254,19 +254,24 @@ void Learner::StartTrainer() {
   ctx_->log().Info("run " + std::to_string(run_) + ": training on " + std::to_string(run.chosen.size()) + " demonstration(s): " +
                    tools::ShellQuoted(args) + " (log " + log_path_ + ")");
   trainer_ended_ = false;
-  trainer_pid_ = -1;
+  trainer_child_.reset();
   Enter(Phase::kTraining);
   // Under the stepped clock the step waits for the trainer (the same run learns at the same step
   // every time); it stays in our process group there, so a Ctrl-C stops it too (it saves its
   // checkpoint and the run fails as interrupted), and the graph with it.
-  const bool own_group = !ctx_->stepped();
-  trainer_thread_ = std::thread([this, args, own_group, log = log_path_] {
-    const int pid = tools::StartProcess(args, log, own_group);
-    if (pid > 0) setpriority(PRIO_PROCESS, static_cast<id_t>(pid), 10);  // the graph's steps come first
-    trainer_pid_ = pid;
-    trainer_status_ = pid < 0 ? 127 : tools::WaitProcess(pid);
+  tools::ChildOptions options;
+  options.log = log_path_;
+  options.own_group = !ctx_->stepped();
+  options.nice = 10;  // the graph's steps come first
+  std::promise<void> started;
+  std::future<void> running = started.get_future();
+  trainer_thread_ = std::thread([this, args, options, started = std::move(started)]() mutable {
+    trainer_child_ = std::make_unique<tools::ChildProcess>(args, options);
+    started.set_value();
+    trainer_status_ = trainer_child_->Wait();
     trainer_ended_ = true;
   });
+  running.wait();  // its pid known (or that it never started) before we return
   if (ctx_->stepped()) trainer_thread_.join();
 }
 
@@ -276,10 +281,10 @@ void Learner::WatchTrainer() {
   status_msg_.loss(log_.loss);
   if (!trainer_ended_) return;
   if (trainer_thread_.joinable()) trainer_thread_.join();
-  const int status = trainer_status_;
-  if (status == 127 && log_.last_line.empty()) return Fail("could not run the trainer " + trainer_);
-  if (status != 0 || !fs::exists(trained_model_))
-    return Fail("the trainer exited with status " + std::to_string(status) + ": " +
+  const tools::ExitStatus status = trainer_status_;
+  if (status.never_started()) return Fail("could not run the trainer " + trainer_ + ": " + status.ToString());
+  if (!status.ok() || !fs::exists(trained_model_))
+    return Fail("the trainer " + std::string(status.signaled() ? "was " : "") + status.ToString() + ": " +
                 (log_.last_error.empty() ? log_.last_line : log_.last_error) + " (log " + log_path_ + ")");
   status_msg_.model(trained_model_);
   Enter(Phase::kTrained);
@@ -381,12 +386,9 @@ Status Learner::Step(const StepInfo& info) {
 
 Status Learner::Deactivate() {
   if (!trainer_thread_.joinable()) return Status::OK();
-  const int pid = trainer_pid_;
-  if (!trainer_ended_ && pid > 0) {
+  if (!trainer_ended_) {
     // Stopped as by Ctrl-C (the trainer saves its checkpoint), killed if it does not end in 5 s.
-    ::kill(-pid, SIGINT);
-    for (int i = 0; i < 50 && !trainer_ended_; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    if (!trainer_ended_) ::kill(-pid, SIGKILL);
+    trainer_child_->Stop(std::chrono::seconds(5), SIGINT);
     ctx_->log().Info("run " + std::to_string(run_) + ": training stopped with the graph at epoch " + std::to_string(log_.epoch));
   }
   trainer_thread_.join();
@@ -396,7 +398,7 @@ Status Learner::Deactivate() {
 Learner::~Learner() {
   // A graph that never activated, or a test: the trainer is not left behind.
   if (!trainer_thread_.joinable()) return;
-  if (!trainer_ended_ && trainer_pid_ > 0) ::kill(-trainer_pid_, SIGKILL);
+  if (!trainer_ended_) trainer_child_->Stop(std::chrono::milliseconds(0), SIGKILL);
   trainer_thread_.join();
 }
 

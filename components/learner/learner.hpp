@@ -42,6 +42,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -51,6 +52,7 @@
 #include <dyad/msg/types.hpp>
 #include <dyad/thread_annotations.hpp>
 
+#include "child_process.hpp"
 #include "demonstrations.hpp"
 #include "training_log.hpp"
 
@@ -111,10 +113,13 @@ class Learner final : public Component {
 
   // The trainer: started and waited for by a thread of its own, which lives exactly as long as the
   // trainer (a child's PR_SET_PDEATHSIG follows the thread that forked it, not the process).
+  // trainer_child_ is set before StartTrainer returns (so a Deactivate right after stops it) and
+  // stays until the next run starts; trainer_status_ is written by trainer_thread_ before
+  // trainer_ended_ is set, and read after.
   std::thread trainer_thread_;
-  std::atomic<int> trainer_pid_{-1};
+  std::unique_ptr<tools::ChildProcess> trainer_child_;
   std::atomic<bool> trainer_ended_{false};
-  std::atomic<int> trainer_status_{0};
+  tools::ExitStatus trainer_status_;
 
   // The step thread's own.
   std::vector<analyze::HumanSample> holding_;  // the segment being drawn (not a demonstration yet)

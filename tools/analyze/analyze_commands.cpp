@@ -76,9 +76,9 @@ int RunAnalyze(const Options& o) {
                 << " is not a folder from here; plots drawn without the watermark (pass --dataset)\n";
     }
   }
-  const int code = tools::RunDyadScript("plot_report.py", args);
-  if (code != 0) {
-    std::cerr << "dyad analyze: " << script << " failed (exit " << code
+  const tools::ExitStatus code = tools::RunDyadScript("plot_report.py", args);
+  if (!code.ok()) {
+    std::cerr << "dyad analyze: " << script << " failed (" << code.ToString()
               << "); is python3-matplotlib installed (tools/setup.sh)?\n";
     return kFailure;
   }
@@ -117,8 +117,8 @@ int DrawPreview(const FromRecordingOptions& o, const analyze::Demonstrations& d)
     if (s.laps > 1) label += "\n(" + std::to_string(s.laps) + " laps!)";
     args.insert(args.end(), {"--label", std::to_string(k) + "=" + label});
   }
-  if (int code = tools::RunDyadScript("plot_dataset.py", args); code != 0) {
-    std::cerr << "dyad dataset from-recording: the preview was not drawn (exit " << code << "; python3-matplotlib: tools/setup.sh)\n";
+  if (tools::ExitStatus code = tools::RunDyadScript("plot_dataset.py", args); !code.ok()) {
+    std::cerr << "dyad dataset from-recording: the preview was not drawn (" << code.ToString() << "; python3-matplotlib: tools/setup.sh)\n";
     return kFailure;
   }
   std::cout << "preview: " << o.preview << "\n";

@@ -1,5 +1,7 @@
 #include "runtime_commands.hpp"
 
+#include <errno.h>
+
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -68,13 +70,13 @@ int EmitDot(const std::string& dot, const std::string& svg) {
   }
   const std::string dot_file = svg + ".dot";
   std::ofstream(dot_file) << dot;
-  const int rc = tools::RunProcess({"dot", "-Tsvg", "-o", svg, dot_file});
-  if (rc == 127) {
+  const tools::ExitStatus rc = tools::RunProcess({"dot", "-Tsvg", "-o", svg, dot_file});
+  if (rc.never_started() && rc.error() == ENOENT) {
     std::cerr << "dyad graph --svg: Graphviz's dot is not on PATH (Debian: apt install graphviz); the DOT text is in " << dot_file << "\n";
     return 1;
   }
-  if (rc != 0) {
-    std::cerr << "dyad graph --svg: dot -Tsvg " << dot_file << " failed (exit " << rc << ")\n";
+  if (!rc.ok()) {
+    std::cerr << "dyad graph --svg: dot -Tsvg " << dot_file << " failed (" << rc.ToString() << ")\n";
     return 1;
   }
   std::filesystem::remove(dot_file);

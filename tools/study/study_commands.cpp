@@ -360,8 +360,8 @@ bool WriteAnalysis(const study::Study& s, const study::StudyAnalysis& a, const s
   std::vector<std::string> args = {dir};
   if (a.include_incomplete) args.push_back("--include-incomplete");
   if (plots && !a.trials.empty())
-    if (int rc = tools::RunDyadScript("plot_study.py", args); rc != 0)
-      std::cerr << command << ": warning: the plots were not drawn (python3 with matplotlib; exit " << rc << ")\n";
+    if (tools::ExitStatus rc = tools::RunDyadScript("plot_study.py", args); !rc.ok())
+      std::cerr << command << ": warning: the plots were not drawn (python3 with matplotlib; " << rc.ToString() << ")\n";
   return true;
 }
 

@@ -13,11 +13,13 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include "child_process.hpp"
 #include "dyad/mcap/reader.hpp"
 #include "dyad/private_file.hpp"
 #include "recording_tables.hpp"
@@ -378,27 +380,27 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   double first_stop_s = 0;  // when the first was sent, from the graph's start
   {
     StopSignals signals;
-    const int pid = tools::StartProcess(AttemptCommand(s, r), r.run_log, true);
-    a.exit = 127;
+    tools::ChildOptions options;
+    options.log = r.run_log;
+    options.own_group = true;
+    tools::ChildProcess graph(AttemptCommand(s, r), options);
     // One stop is forwarded as one SIGINT: the graph finishes its recording. A second stop (a
     // graph that hangs while ending) is forwarded too: dyad then exits at once, losing at most
-    // its last chunk.
-    // A graph still there kStopGrace after the second stop is killed, with its process group.
-    std::chrono::steady_clock::time_point second_stop;
-    bool killed = false;
-    while (pid >= 0 && !tools::ProcessEnded(pid, &a.exit)) {
+    // its last chunk; a graph still there kStopGrace after it is killed, with its process group.
+    std::optional<tools::ExitStatus> end;
+    while (!(end = graph.Poll())) {
       const int signals_now = g_stop_signals.load();
       const int wanted = std::min(2, signals_now + (r.stop && r.stop->load() ? 1 : 0));
       a.interrupted = a.interrupted || signals_now > 0;
       if (forwarded == 0 && wanted > 0) first_stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      for (; forwarded < wanted; ++forwarded) ::kill(pid, SIGINT);
-      if (forwarded == 2 && second_stop == std::chrono::steady_clock::time_point{}) second_stop = std::chrono::steady_clock::now();
-      if (forwarded == 2 && !killed && std::chrono::steady_clock::now() - second_stop > kStopGrace) {
-        ::kill(-pid, SIGKILL);
-        killed = true;
+      for (; forwarded < wanted; ++forwarded) graph.Signal(SIGINT);
+      if (forwarded == 2) {
+        end = graph.Stop(kStopGrace, 0);
+        break;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
+    a.exit = end->ShellCode();
   }
   a.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // A trial without a duration ends when the experimenter stops it (the graph then exits 0, or

@@ -31,7 +31,7 @@ struct Options {
   sweep::SlurmOptions slurm_options;
 };
 
-int Plot(const std::string& csv, const std::string& dir) { return tools::RunDyadScript("plot_sweep.py", {csv, dir}); }
+tools::ExitStatus Plot(const std::string& csv, const std::string& dir) { return tools::RunDyadScript("plot_sweep.py", {csv, dir}); }
 
 // Back to the folder it started in, whatever happens (the command may run inside a test binary).
 struct RestoreCwd {
@@ -44,8 +44,8 @@ struct RestoreCwd {
 
 void Plots(const Options& o, const fs::path& out) {
   if (!o.plots) return;
-  if (int rc = Plot((out / "sweep.csv").string(), (out / "plots").string()); rc != 0)
-    std::cerr << "dyad sweep: warning: the plots were not drawn (python3 with matplotlib; exit " << rc << ")\n";
+  if (tools::ExitStatus rc = Plot((out / "sweep.csv").string(), (out / "plots").string()); !rc.ok())
+    std::cerr << "dyad sweep: warning: the plots were not drawn (python3 with matplotlib; " << rc.ToString() << ")\n";
   else
     std::cout << "plots: " << (out / "plots").string() << "/\n";
 }

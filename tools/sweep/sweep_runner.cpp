@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <system_error>
 #include <sstream>
 #include <thread>
@@ -18,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "build_report.hpp"
+#include "job_end.hpp"
 #include "run_process.hpp"
 #include "text_output.hpp"
 
@@ -39,41 +41,28 @@ std::string Tail(const std::string& path, size_t lines) {
   return out;
 }
 
-enum class Outcome { kOk, kSkipped, kFailed, kStopped };
-
-// How a job ended; `why`: a failure's reason when it could not be written to its file.
-struct JobEnd {
-  Outcome outcome;
-  std::string why;
-};
-
 std::atomic<int> g_stop_signal{0};  // lock-free: set in a handler, read by the workers
 static_assert(std::atomic<int>::is_always_lock_free);
 extern "C" void OnSweepStopSignal(int signal) { g_stop_signal.store(signal); }
 
 // `args` with its output in `log`, in a process group of its own (SIGINT when we die); a stop
-// signal sends its group SIGINT, then SIGKILL after kStopGraceS. False when a stop came before
-// it ended (*rc is then how it ended, for nobody).
-bool RunChild(const std::vector<std::string>& args, const std::string& log, int* rc) {
-  *rc = 127;
-  if (g_stop_signal.load() != 0) return false;
-  const int pid = tools::StartProcess(args, log, true);
-  if (pid < 0) return true;
-  bool stopped = false, killed = false;
-  Clock::time_point stop_sent;
-  while (!tools::ProcessEnded(pid, rc)) {
-    if (!stopped && g_stop_signal.load() != 0) {
-      ::kill(-pid, SIGINT);
-      stopped = true;
-      stop_sent = Clock::now();
-    }
-    if (stopped && !killed && Clock::now() - stop_sent > std::chrono::duration<double>(kStopGraceS)) {
-      ::kill(-pid, SIGKILL);
-      killed = true;
+// signal stops it (ChildProcess::Stop: SIGINT to its group, SIGKILL after kStopGraceS).
+// *stopped: a stop came before it ended (how it ended is then for nobody).
+tools::ExitStatus RunChild(const std::vector<std::string>& args, const std::string& log, bool* stopped) {
+  *stopped = g_stop_signal.load() != 0;
+  if (*stopped) return {};
+  tools::ChildOptions options;
+  options.log = log;
+  options.own_group = true;
+  tools::ChildProcess child(args, options);
+  for (;;) {
+    if (std::optional<tools::ExitStatus> end = child.Poll()) return *end;
+    if (g_stop_signal.load() != 0) {
+      *stopped = true;
+      return child.Stop(std::chrono::milliseconds(static_cast<int64_t>(kStopGraceS * 1000)), SIGINT);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  return !stopped;
 }
 
 // `dyad analyze --no-plots --duration planned_s`, in this process (a second process per run cost
@@ -94,8 +83,8 @@ JobEnd Failed(const fs::path& file, const std::string& text) {
   std::ofstream out(file);
   out << text;
   out.close();
-  if (out) return {Outcome::kFailed, ""};
-  return {Outcome::kFailed, text.substr(0, text.find('\n')) + " (and " + file.string() + " cannot be written)"};
+  if (out) return {JobOutcome::kFailed, ""};
+  return {JobOutcome::kFailed, text.substr(0, text.find('\n')) + " (and " + file.string() + " cannot be written)"};
 }
 
 // `dir` made (or there) and `stale` gone; else why not.
@@ -112,8 +101,8 @@ std::string PrepareFolder(const fs::path& dir, const fs::path& stale) {
 JobEnd DoRun(const SweepPlan& plan, const SweepRun& run, const RunnerOptions& o) {
   const fs::path dir = fs::path(o.out) / "runs" / run.id;
   std::error_code ec;
-  if (fs::exists(dir / "metrics.json", ec)) return {Outcome::kSkipped, ""};
-  if (std::string why = PrepareFolder(dir, dir / "failed.txt"); !why.empty()) return {Outcome::kFailed, why};
+  if (fs::exists(dir / "metrics.json", ec)) return {JobOutcome::kSkipped, ""};
+  if (std::string why = PrepareFolder(dir, dir / "failed.txt"); !why.empty()) return {JobOutcome::kFailed, why};
   std::vector<std::string> run_args = {o.dyad, "run", plan.graph, "--quiet", "--duration", std::to_string(plan.duration_s)};
   for (const auto& s : run.sets) run_args.insert(run_args.end(), {"--set", s});
   run_args.insert(run_args.end(), {"--set", plan.recorder + ".file=" + (dir / "rec.mcap").string()});
@@ -125,17 +114,19 @@ JobEnd DoRun(const SweepPlan& plan, const SweepRun& run, const RunnerOptions& o)
       return Failed(dir / "failed.txt", "its model " + model + " was not trained (see " +
                                             (fs::path(o.out) / "models" / (training.id + ".log")).string() + ")\n");
   }
-  int rc = 0;
-  if (!RunChild(run_args, (dir / "run.log").string(), &rc)) return {Outcome::kStopped, ""};
-  if (rc != 0)
-    return Failed(dir / "failed.txt", tools::ShellQuoted(run_args) + "\nexited " + std::to_string(rc) + "; the end of run.log:\n" +
+  bool stopped = false;
+  const tools::ExitStatus exit = RunChild(run_args, (dir / "run.log").string(), &stopped);
+  const JobEnd end = ClassifyRunChild(stopped, exit);
+  if (end.outcome == JobOutcome::kStopped) return end;
+  if (end.outcome == JobOutcome::kFailed)
+    return Failed(dir / "failed.txt", tools::ShellQuoted(run_args) + "\n" + end.why + "; the end of run.log:\n" +
                                           Tail((dir / "run.log").string(), 20));
   if (Status s = Analyze((dir / "rec.mcap").string(), (dir / "report").string(), plan.duration_s); !s.ok())
     return Failed(dir / "failed.txt", "dyad analyze " + (dir / "rec.mcap").string() + ": " + s.message() + "\n");
   fs::copy_file(dir / "report" / "metrics.json", dir / "metrics.json.new", fs::copy_options::overwrite_existing, ec);
   if (!ec) fs::rename(dir / "metrics.json.new", dir / "metrics.json", ec);
   if (ec) return Failed(dir / "failed.txt", "cannot keep the metrics: " + ec.message() + "\n");
-  return {Outcome::kOk, ""};
+  return {JobOutcome::kOk, ""};
 }
 
 std::string Duration(double s) {
@@ -157,20 +148,20 @@ struct PoolProgress {
   Clock::time_point t0 = Clock::now();
 
   void Line(std::ostream& log, const std::string& what, const JobEnd& end, const std::string& why_file, double secs) {
-    const Outcome outcome = end.outcome;
+    const JobOutcome outcome = end.outcome;
     ++finished;
-    if (outcome != Outcome::kSkipped) ++executed;
-    std::string how = outcome == Outcome::kOk ? "ok" : outcome == Outcome::kSkipped ? "done before" : "stopped";
-    if (outcome == Outcome::kFailed) how = "FAILED (" + (end.why.empty() ? why_file : end.why) + ")";
+    if (outcome != JobOutcome::kSkipped) ++executed;
+    std::string how = OutcomeName(outcome);
+    if (outcome == JobOutcome::kFailed) how += " (" + (end.why.empty() ? why_file : end.why) + ")";
     const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
     const size_t left = count - finished;
     log << "[" << finished << "/" << count << "] " << what << ": " << how;
-    if (outcome != Outcome::kSkipped) {
+    if (outcome != JobOutcome::kSkipped) {
       char s[32];
       std::snprintf(s, sizeof s, " in %.1f s", secs);
       log << s;
     }
-    if (left > 0 && executed > 0 && outcome != Outcome::kStopped)
+    if (left > 0 && executed > 0 && outcome != JobOutcome::kStopped)
       log << ", about " << Duration(elapsed / static_cast<double>(executed) * static_cast<double>(left)) << " left";
     log << "\n" << std::flush;
   }
@@ -192,10 +183,10 @@ RunnerResult Pool(size_t count, int workers, std::ostream& log, const PoolJobs& 
       const JobEnd end = jobs.run(i);
       const double secs = std::chrono::duration<double>(Clock::now() - start).count();
       std::lock_guard<std::mutex> lock(mutex);
-      if (end.outcome == Outcome::kSkipped) ++result.skipped;
-      else if (end.outcome == Outcome::kOk) ++result.ran;
-      else if (end.outcome == Outcome::kFailed) ++result.failed;
-      done[i] = end.outcome != Outcome::kStopped;
+      if (end.outcome == JobOutcome::kSkipped) ++result.skipped;
+      else if (end.outcome == JobOutcome::kOk) ++result.ran;
+      else if (end.outcome == JobOutcome::kFailed) ++result.failed;
+      done[i] = end.outcome != JobOutcome::kStopped;
       progress.Line(log, jobs.what(i), end, jobs.why_file(i), secs);
     }
   };
@@ -213,19 +204,19 @@ JobEnd Train(const SweepPlan& plan, const SweepTraining& training, const RunnerO
   const std::string model = ModelPath(o.out, training);
   const fs::path dir = fs::path(model).parent_path();
   std::error_code ec;
-  if (fs::exists(model, ec)) return {Outcome::kSkipped, ""};
-  if (std::string why = PrepareFolder(dir, dir / (training.id + ".failed.txt")); !why.empty()) return {Outcome::kFailed, why};
+  if (fs::exists(model, ec)) return {JobOutcome::kSkipped, ""};
+  if (std::string why = PrepareFolder(dir, dir / (training.id + ".failed.txt")); !why.empty()) return {JobOutcome::kFailed, why};
   std::vector<std::string> args = {o.dyad, "train", plan.train_config};
   for (const auto& s : training.sets) args.insert(args.end(), {"--set", s});
   args.insert(args.end(), {"--set", "output=" + model});
   // Workers already fill the cores: one thread per training (same bits whatever the count).
   if (o.workers > 1) args.insert(args.end(), {"--set", "threads=1"});
   const std::string log = (dir / (training.id + ".log")).string();
-  int rc = 0;
-  if (!RunChild(args, log, &rc)) return {Outcome::kStopped, ""};
-  if (rc == 0 && fs::exists(model, ec)) return {Outcome::kOk, ""};
-  return Failed(dir / (training.id + ".failed.txt"),
-                tools::ShellQuoted(args) + "\nexited " + std::to_string(rc) + "; the end of its log:\n" + Tail(log, 20));
+  bool stopped = false;
+  const tools::ExitStatus exit = RunChild(args, log, &stopped);
+  const JobEnd end = ClassifyTraining(stopped, exit, fs::exists(model, ec));
+  if (end.outcome != JobOutcome::kFailed) return end;
+  return Failed(dir / (training.id + ".failed.txt"), tools::ShellQuoted(args) + "\n" + end.why + "; the end of its log:\n" + Tail(log, 20));
 }
 
 std::string Params(const std::vector<std::pair<std::string, std::string>>& params) {

@@ -1,5 +1,7 @@
 #include "sweep_slurm.hpp"
 
+#include <errno.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -54,13 +56,15 @@ Status WriteScript(const fs::path& path, const std::string& text) {
 StatusOr<std::string> Sbatch(std::vector<std::string> args, const fs::path& script, const fs::path& said) {
   args.insert(args.begin(), {"sbatch", "--parsable"});
   args.push_back(script.string());
-  const int rc = tools::RunProcess(args, said.string());
+  const tools::ExitStatus rc = tools::RunProcess(args, said.string());
   const std::string out = Slurped(said);
-  if (rc == 127 && out.empty())
+  if (rc.never_started() && rc.error() == ENOENT)
     return Status::FailedPrecondition("sbatch is not on PATH: run --slurm on a machine that submits Slurm jobs (a login node; Debian: slurm-client)");
+  if (rc.never_started()) return Status::FailedPrecondition(tools::ShellQuoted(args) + ": " + rc.ToString());
   const std::string id = out.substr(out.find_last_of('\n') + 1);  // sbatch warns on lines before the id
-  if (rc != 0 || id.empty() || id.find_first_not_of("0123456789;_abcdefghijklmnopqrstuvwxyz") != std::string::npos)
-    return Status::FailedPrecondition(tools::ShellQuoted(args) + " failed (exit " + std::to_string(rc) + "): " + out);
+  if (!rc.ok() || id.empty() || id.find_first_not_of("0123456789;_abcdefghijklmnopqrstuvwxyz") != std::string::npos)
+    return Status::FailedPrecondition(tools::ShellQuoted(args) + " failed (" +
+                                      (rc.exited() ? "exit " + std::to_string(rc.code()) : rc.ToString()) + "): " + out);
   return id.substr(0, id.find(';'));  // "id;cluster" on a federation
 }
 

@@ -196,7 +196,7 @@ TEST_F(LearnerTest, AFailingTrainerIsSaidAndNothingIsSwapped) {
   DrawOneAndLearnIt(learner, *ctx);
   const msg::LearnerStatus& failed = status_->samples.back();
   EXPECT_EQ(failed.state(), "failed");
-  EXPECT_NE(failed.message().find("the trainer exited with status 2: error: "), std::string::npos) << failed.message();
+  EXPECT_NE(failed.message().find("the trainer exited with code 2: error: "), std::string::npos) << failed.message();
   EXPECT_NE(failed.message().find("bogus_key"), std::string::npos) << failed.message();
   EXPECT_TRUE(requests_->samples.empty());
   // The next run may start (and fails the same way).
@@ -240,6 +240,24 @@ TEST_F(LearnerTest, OnTheWallClockTheTrainingRunsBesideTheStepsAndStopsWithTheGr
   std::string log;
   std::getline(std::ifstream(training.folder() + "/train.log"), log, '\0');
   EXPECT_NE(log.find("interrupted"), std::string::npos) << log;  // stopped as by Ctrl-C: its checkpoint saved
+}
+
+// Stopping the graph right after a run started stops its trainer. The trainer's pid used to be
+// set by the thread that started it, and a Deactivate before that skipped the stop and waited
+// the whole training out (here: a trainer that would take 20 s, and says so when it ends).
+TEST_F(LearnerTest, ADeactivateRightAfterTheStartStopsTheTraining) {
+  const fs::path trainer = dir_ / "slow-trainer", finished = dir_ / "finished";
+  std::ofstream(trainer) << "#!/bin/sh\nsleep 20\ntouch '" << finished.string() << "'\n";
+  fs::permissions(trainer, fs::perms::owner_all);
+  auto ctx = MakeContext({{"trainer", trainer.string()}});
+  ctx->stepped_clock = false;
+  Learner learner;
+  ASSERT_TRUE(learner.Configure(*ctx).ok());
+  Draw(0, 10, 20);
+  StepOnce(learner, *ctx);
+  ASSERT_TRUE(ctx->SetLive("learn", std::string("all")).ok());
+  EXPECT_TRUE(learner.Deactivate().ok());
+  EXPECT_FALSE(fs::exists(finished)) << "the training was waited out, not stopped";
 }
 
 // The deliberator refuses the model (on dyad/params, answering the learner's request): the run

@@ -1,7 +1,8 @@
-// dyad/testing/child_process.hpp: a child process for process-level tests (test code only).
+// dyad/testing/child_process.hpp: a child process for process-level tests (test code only), on
+// the house's child-process type (support/child_process.hpp, tools::ChildProcess).
 //
-// Starts `args[0]` (a path, not searched on PATH) with stdout and stderr in DIR/TAG.out and
-// DIR/TAG.err, optionally with extra environment entries ("NAME=value", added to the test's
+// Starts `args[0]` (a path, or a name looked up in PATH) with stdout and stderr in DIR/TAG.out
+// and DIR/TAG.err, optionally with extra environment entries ("NAME=value", added to the test's
 // own) and another working directory. A child still running when the object dies is SIGKILLed
 // and reaped, so a failing test never leaves processes behind.
 //
@@ -10,10 +11,7 @@
 //   ASSERT_EQ(run.Wait(30), 0) << run.err();
 #pragma once
 
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
+#include <sys/types.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -24,7 +22,7 @@
 #include <thread>
 #include <vector>
 
-extern char** environ;
+#include <child_process.hpp>  // support/child_process.hpp (quoted, this file would include itself)
 
 namespace dyad::testing {
 
@@ -40,44 +38,18 @@ class ChildProcess {
  public:
   ChildProcess(std::vector<std::string> args, const std::filesystem::path& dir, const std::string& tag,
                std::vector<std::string> env = {}, const std::filesystem::path& cwd = {})
-      : out_(dir / (tag + ".out")), err_(dir / (tag + ".err")) {
-    for (char** e = environ; *e != nullptr; ++e) env.push_back(*e);
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int o = open(out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      const int e = open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(o, 1);
-      dup2(e, 2);
-      if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
-      std::vector<char*> argv, envp;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      for (auto& v : env) envp.push_back(v.data());
-      envp.push_back(nullptr);
-      execve(argv[0], argv.data(), envp.data());
-      _exit(127);
-    }
-  }
-  ~ChildProcess() {
-    if (pid_ > 0 && !done_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
+      : out_(dir / (tag + ".out")), err_(dir / (tag + ".err")), child_(args, Options(out_, err_, std::move(env), cwd)) {}
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
 
-  pid_t pid() const { return pid_; }
-  void Signal(int sig) { kill(pid_, sig); }
-  // Exit code (128 + signal if killed by one), or -1 if still running after `timeout_s`.
+  pid_t pid() const { return child_.pid(); }
+  void Signal(int sig) { child_.Signal(sig); }
+  // Exit code (128 + signal if killed by one, 127 when it never started), or -1 if still running
+  // after `timeout_s`.
   int Wait(double timeout_s) {
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
     while (std::chrono::steady_clock::now() < end) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        done_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
+      if (auto status = child_.Poll()) return status->ShellCode();
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     return -1;
@@ -97,7 +69,7 @@ class ChildProcess {
   // For a child that did not end in time: every thread's stack of it and of its descendants
   // (gdb in batch mode, when installed), so that a rare hang in CI says where it hangs.
   std::string Stacks() const {
-    std::vector<pid_t> pids = {pid_};
+    std::vector<pid_t> pids = {pid()};
     for (size_t i = 0; i < pids.size(); ++i) {  // descendants, breadth first, from /proc
       for (const auto& e : std::filesystem::directory_iterator("/proc")) {
         const std::string name = e.path().filename().string();
@@ -128,9 +100,18 @@ class ChildProcess {
   }
 
  private:
-  pid_t pid_ = -1;
-  bool done_ = false;
-  std::filesystem::path out_, err_;
+  static tools::ChildOptions Options(const std::filesystem::path& out, const std::filesystem::path& err,
+                                     std::vector<std::string> env, const std::filesystem::path& cwd) {
+    tools::ChildOptions o;
+    o.log = out.string();
+    o.err_log = err.string();
+    o.env = std::move(env);
+    o.folder = cwd.string();
+    return o;
+  }
+
+  std::filesystem::path out_, err_;  // before child_: its options are made of them
+  tools::ChildProcess child_;
 };
 
 }  // namespace dyad::testing
