@@ -160,7 +160,7 @@ PY
   head -1 "$level/row"
   read -r state misses c r < <(tail -1 "$level/row")
   if [ -z "$knee" ] && [ "$misses" -gt 0 ]; then knee=$n; fi
-  if [ "$misses" = 0 ] && [ "$state" = UP ]; then cost="$c% of a core and $r MB per session (at $n participants)"; fi
+  if [ "$misses" = 0 ] && [ "$state" = UP ]; then cost="$c% of a core and $r MB per session (at N = $n)"; fi
   [ "$state" = UP ] || { echo; echo "stopped: $n participants fell over (a session did not start, or the deliberator's p99 passed its period)"; break; }
 done
 echo
