@@ -158,7 +158,7 @@ class ErrorRegression {
   int window_fill() const { return fill_; }
   // The window problem of the last Step (benchmarks, tests: to solve it again from the same
   // start): its objective (window data as set) and the A the optimiser started from.
-  // REQUIRES at least one Step.
+  // REQUIRES at least one Step, engine dyad (the nrl engine has its own window).
   const WindowObjective<Scalar>& last_objective() const { return *objectives_[fill_ - 1]; }
   const AdaptiveVariables<Scalar>& last_start_a() const { return start_a_[fill_ - 1]; }
 
