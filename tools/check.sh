@@ -18,6 +18,10 @@
 #   bash tools/check.sh tsan       ./build-tsan: ThreadSanitizer build of the runtime's threaded
 #                                  wall-clock paths (dyad_runtime_threads_test: executor, ports)
 #   bash tools/check.sh replay     only the fuzz replay, in ./build-san
+#   bash tools/check.sh build      only the two builds (./build-san, ./build-tsan), no test: .ci/run
+#                                  starts it in the background at SCHED_IDLE beside the Release
+#                                  build and tests, so that it takes only the CPU they leave idle;
+#                                  `sanitize` afterwards finds both built and runs the tests
 # Extra arguments go to ctest (e.g. -R mcap). Builds and tests run under `nice`, 2 jobs.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -50,14 +54,18 @@ export LSAN_OPTIONS="suppressions=$here/tools/sanitizers/lsan.supp:print_suppres
 export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$here/tools/sanitizers/tsan.supp${TSAN_OPTIONS:+:$TSAN_OPTIONS}"
 export ASAN_SYMBOLIZER_PATH=/usr/bin/llvm-symbolizer-14
 
-asan() {
+asan_build() {
   local dir=$here/build-san
   configure "$dir" "address,undefined" -DDYAD_FUZZ=ON
   local t0=$SECONDS
   nice -n 10 cmake --build "$dir" -j2
   echo "check asan: build $((SECONDS - t0)) s"
-  t0=$SECONDS
-  (cd "$dir" && nice -n 10 ctest --output-on-failure -j2 --timeout 1800 "$@")
+}
+
+asan() {
+  asan_build
+  local t0=$SECONDS
+  (cd "$here/build-san" && nice -n 10 ctest --output-on-failure -j2 --timeout 1800 "$@")
   echo "check asan: tests and fuzz replay $((SECONDS - t0)) s"
 }
 
@@ -68,14 +76,18 @@ replay() {
   (cd "$dir" && nice -n 10 ctest --output-on-failure -L fuzz "$@")
 }
 
-tsan() {
+tsan_build() {
   local dir=$here/build-tsan
   configure "$dir" "thread"
   local t0=$SECONDS
   nice -n 10 cmake --build "$dir" -j2 --target dyad_runtime_threads_test
   echo "check tsan: build $((SECONDS - t0)) s"
-  t0=$SECONDS
-  nice -n 10 "$dir/bin/dyad_runtime_threads_test" "$@"
+}
+
+tsan() {
+  tsan_build
+  local t0=$SECONDS
+  nice -n 10 "$here/build-tsan/bin/dyad_runtime_threads_test" "$@"
   echo "check tsan: tests $((SECONDS - t0)) s"
 }
 
@@ -83,6 +95,7 @@ case "$mode" in
   sanitize) asan -LE e2e -E "^TrainClassifier.SeparatesNoisyTraces|^TrainObserver.MacawBotConfusion|^ros2.Ros2DriverTest" "$@"; tsan ;;
   asan) asan "$@" ;;
   tsan) tsan "$@" ;;
+  build) asan_build; tsan_build ;;
   replay) replay "$@" ;;
-  *) echo "usage: tools/check.sh [sanitize|asan|tsan|replay] [ctest args...]" >&2; exit 2 ;;
+  *) echo "usage: tools/check.sh [sanitize|asan|tsan|replay|build] [ctest args...]" >&2; exit 2 ;;
 esac
