@@ -14,6 +14,7 @@
 #include "build_report.hpp"
 #include "demonstrations.hpp"
 #include "dyad/mcap/reader.hpp"
+#include "exit_code.hpp"
 #include "experiment_analysis.hpp"
 #include "losses.hpp"
 #include "recording_tables.hpp"
@@ -23,7 +24,8 @@
 namespace dyad::cli {
 namespace {
 
-constexpr int kOk = 0, kFailure = 1, kBadInput = 2;
+using tools::ExitCode;
+using enum tools::ExitCode;
 
 struct Options {
   std::string recording, out, dataset;
@@ -31,7 +33,7 @@ struct Options {
   bool plots = true;
 };
 
-int RunAnalyze(const Options& o) {
+ExitCode RunAnalyze(const Options& o) {
   if (!o.dataset.empty() && !std::filesystem::is_directory(o.dataset)) {
     std::cerr << "dyad analyze: --dataset " << o.dataset << ": not a folder\n";
     return kBadInput;
@@ -109,7 +111,7 @@ void SayWhatWasCut(const analyze::Demonstrations& d, std::ostream& out, std::ost
 }
 
 // --preview: the primitives drawn, each titled with its segment (and its first warning).
-int DrawPreview(const FromRecordingOptions& o, const analyze::Demonstrations& d) {
+ExitCode DrawPreview(const FromRecordingOptions& o, const analyze::Demonstrations& d) {
   std::vector<std::string> args = {o.out, o.preview};
   for (size_t k = 0; k < d.chosen.size(); ++k) {
     std::string label = "primitive " + std::to_string(k) + " <- segment " + std::to_string(d.chosen[k]);
@@ -125,7 +127,7 @@ int DrawPreview(const FromRecordingOptions& o, const analyze::Demonstrations& d)
   return kOk;
 }
 
-int RunFromRecording(const FromRecordingOptions& o) {
+ExitCode RunFromRecording(const FromRecordingOptions& o) {
   auto reader = mcap::Reader::Open(o.recording);
   if (!reader.ok()) {
     std::cerr << "dyad dataset from-recording: " << reader.status().message() << "\n";
@@ -183,7 +185,7 @@ void AddAnalyzeCommands(CLI::App& app, int& exit_code) {
     fr->add_option("--names", o->names, "the primitives' names, in order, e.g. circle,star (names.txt: pages and reports use them)")
         ->delimiter(',');
     fr->add_option("--preview", o->preview, "PNG file: the primitives drawn, each with its segment");
-    fr->callback([o, &exit_code] { exit_code = RunFromRecording(*o); });
+    fr->callback([o, &exit_code] { exit_code = tools::Code(RunFromRecording(*o)); });
   }
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("analyze", "Write a report folder (tables, PNG plots) for an experiment recording");
@@ -194,7 +196,7 @@ void AddAnalyzeCommands(CLI::App& app, int& exit_code) {
                   "the run's planned seconds: a recording under 95% of them is reported incomplete (as a cut-short file is)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("!--no-plots", options->plots, "write tables only");
-  cmd->callback([options, &exit_code] { exit_code = RunAnalyze(*options); });
+  cmd->callback([options, &exit_code] { exit_code = tools::Code(RunAnalyze(*options)); });
 }
 
 }  // namespace dyad::cli

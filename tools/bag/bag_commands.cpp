@@ -15,13 +15,13 @@
 #include "losses.hpp"
 #include "csv_export.hpp"
 #include "dyad/mcap/reader.hpp"
+#include "exit_code.hpp"
 
 namespace dyad::cli {
 namespace {
 
-constexpr int kOk = 0;
-constexpr int kFailure = 1;
-constexpr int kBadInput = 2;
+using tools::ExitCode;
+using enum tools::ExitCode;
 
 // Opens a recording; prints why not and returns null when it cannot be read at all.
 std::unique_ptr<mcap::Reader> OpenRecording(const std::string& path, bool scan) {
@@ -35,7 +35,7 @@ std::unique_ptr<mcap::Reader> OpenRecording(const std::string& path, bool scan) 
   return std::make_unique<mcap::Reader>(std::move(reader).value());
 }
 
-int RunInfo(const std::string& path, bool scan) {
+ExitCode RunInfo(const std::string& path, bool scan) {
   auto reader = OpenRecording(path, scan);
   if (!reader) return kBadInput;
   std::cout << bag::FormatInfo(*reader);
@@ -73,7 +73,7 @@ std::optional<bag::PayloadDecoder> CdrDecoder(const mcap::Schema* schema, std::s
   return decoder;
 }
 
-int RunExport(const std::string& path, const std::string& dir, const std::vector<std::string>& topics) {
+ExitCode RunExport(const std::string& path, const std::string& dir, const std::vector<std::string>& topics) {
   auto reader = OpenRecording(path, false);
   if (!reader) return kBadInput;
   if (reader->recovery().truncated) std::cerr << "dyad bag: " << path << ": " << reader->recovery().Describe() << "\n";
@@ -103,7 +103,7 @@ int RunExport(const std::string& path, const std::string& dir, const std::vector
     std::cerr << "dyad bag: " << status.message() << "\n";
     return kFailure;
   }
-  int code = kOk;
+  ExitCode code = kOk;
   for (const std::string& problem : schema_problems) {
     std::cerr << "dyad bag: " << path << ": " << problem << "\n";
     code = kFailure;
@@ -122,7 +122,7 @@ int RunExport(const std::string& path, const std::string& dir, const std::vector
   return code;
 }
 
-int RunFilter(const std::string& in, const std::string& out, const bag::FilterOptions& options) {
+ExitCode RunFilter(const std::string& in, const std::string& out, const bag::FilterOptions& options) {
   if (options.end_s >= 0 && options.end_s < options.start_s) {
     std::cerr << "dyad bag filter: --end " << options.end_s << " is before --start " << options.start_s << "\n";
     return kBadInput;
@@ -152,7 +152,7 @@ void AddBagCommands(CLI::App& app, int& exit_code) {
   CLI::App* info = bag->add_subcommand("info", "Channels, counts, time range, chunks and metadata of a recording");
   info->add_option("FILE", info_args->file, "MCAP file")->required();
   info->add_flag("--scan", info_args->scan, "Ignore the summary and scan the file record by record");
-  info->callback([info_args, &exit_code] { exit_code = RunInfo(info_args->file, info_args->scan); });
+  info->callback([info_args, &exit_code] { exit_code = tools::Code(RunInfo(info_args->file, info_args->scan)); });
 
   struct ExportArgs {
     std::string file;
@@ -165,7 +165,7 @@ void AddBagCommands(CLI::App& app, int& exit_code) {
   exp->add_option("--csv", export_args->csv_dir, "Output directory (created if missing)")->required();
   exp->add_option("--topic", export_args->topics, "Only this topic (repeatable)");
   exp->callback([export_args, &exit_code] {
-    exit_code = RunExport(export_args->file, export_args->csv_dir, export_args->topics);
+    exit_code = tools::Code(RunExport(export_args->file, export_args->csv_dir, export_args->topics));
   });
 
   struct FilterArgs {
@@ -181,7 +181,8 @@ void AddBagCommands(CLI::App& app, int& exit_code) {
       ->check(CLI::NonNegativeNumber);
   filter->add_option("--end", filter_args->options.end_s, "Seconds after the first message to end at (default: the end)")
       ->check(CLI::NonNegativeNumber);
-  filter->callback([filter_args, &exit_code] { exit_code = RunFilter(filter_args->in, filter_args->out, filter_args->options); });
+  filter->callback(
+      [filter_args, &exit_code] { exit_code = tools::Code(RunFilter(filter_args->in, filter_args->out, filter_args->options)); });
 }
 
 }  // namespace dyad::cli

@@ -25,9 +25,12 @@
 #include <dyad/security.hpp>
 #include <dyad/topic_select.hpp>
 
+#include "exit_code.hpp"
 #include "watcher_catalog.hpp"
 
 namespace dyad::cli {
+
+using enum tools::ExitCode;
 namespace {
 
 // Owned by one registration (one per CLI::App), not function statics.
@@ -129,11 +132,11 @@ int Record(GuestState& st) {
   std::optional<Graph> graph;
   bool as_guest = false;
   if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph, &as_guest))
-    return 2;
-  if (as_guest && !GuestTopics(*graph, &st)) return 2;
+    return tools::Code(kBadInput);
+  if (as_guest && !GuestTopics(*graph, &st)) return tools::Code(kBadInput);
   if (st.topics.empty() && !graph) {
     std::cerr << "dyad record: name the topics to record, or give --graph G to record every topic of G\n";
-    return 2;
+    return tools::Code(kBadInput);
   }
   YAML::Node params;
   params["file"] = std::filesystem::absolute(st.output).string();
@@ -156,14 +159,14 @@ int Play(GuestState& st) {
   std::optional<Graph> graph;
   bool as_guest = false;  // (they publish as the guest anywhere: PublishAsGuest)
   if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph, &as_guest))
-    return 2;
+    return tools::Code(kBadInput);
   // The topics to play, chosen here as the replay will: to know which readers to wait for. The
   // runtime's own topics (dyad/...) are left out unless named: a recorded dyad/processes played
   // into a live graph would tell its watchers of processes that are not there.
   auto reader = mcap::Reader::Open(st.file);
   if (!reader.ok()) {
     std::cerr << "dyad bag play: " << reader.status().message() << "\n";
-    return 2;
+    return tools::Code(kBadInput);
   }
   std::vector<std::string> recorded, runtime_topics;
   for (const auto& [id, ch] : reader->channels())
@@ -174,11 +177,11 @@ int Play(GuestState& st) {
   auto chosen = SelectTopics(st.topics, recorded, "--topics", runtime_topics);
   if (!chosen.ok()) {
     std::cerr << "dyad bag play: " << st.file << ": " << chosen.status().message() << "\n";
-    return 2;
+    return tools::Code(kBadInput);
   }
   if (chosen->empty()) {
     std::cerr << "dyad bag play: " << st.file << ": no topic to play (its topics: " << recorded.size() << ", all of the runtime's)\n";
-    return 2;
+    return tools::Code(kBadInput);
   }
   YAML::Node params;
   params["file"] = std::filesystem::absolute(st.file).string();
@@ -188,7 +191,7 @@ int Play(GuestState& st) {
   params["loop"] = st.loop;
   params["start_s"] = st.start;
   // 1000 Hz: each sample within a millisecond of its recorded spacing.
-  if (!PublishAsGuest(graph, *chosen, "dyad bag play", &st)) return 2;
+  if (!PublishAsGuest(graph, *chosen, "dyad bag play", &st)) return tools::Code(kBadInput);
   GuestOptions go = OneComponentGuest(st, "dyad bag play", "play", "replay", 1000, params);
   go.watched = graph ? &*graph : nullptr;
   // A reader of each played topic: a component's input, a recorder's subscription, a watcher's.
@@ -247,8 +250,8 @@ int Pub(GuestState& st) {
   std::optional<Graph> graph;
   bool as_guest = false;  // (they publish as the guest anywhere: PublishAsGuest)
   if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph, &as_guest))
-    return 2;
-  if (!PublishAsGuest(graph, {st.topic}, "dyad pub", &st)) return 2;
+    return tools::Code(kBadInput);
+  if (!PublishAsGuest(graph, {st.topic}, "dyad pub", &st)) return tools::Code(kBadInput);
   PublishOptions po;
   po.watch = st.opts;
   po.watched = graph ? &*graph : nullptr;
@@ -269,15 +272,16 @@ int Param(GuestState& st, bool set) {
   if ((set && eq == std::string::npos) || dot == std::string::npos || dot == 0 || dot + 1 == name.size()) {
     std::cerr << "dyad param: '" << text << "': expected COMPONENT.PARAM" << (set ? "=VALUE" : "") << " (e.g. mixer.gain"
               << (set ? "=0.5" : "") << ")\n";
-    return 2;
+    return tools::Code(kBadInput);
   }
   if (st.graph.empty()) {
     std::cerr << "dyad param: --graph is required (it names the component's process and its parameters)\n";
-    return 2;
+    return tools::Code(kBadInput);
   }
   Catalog catalog;
   std::optional<Graph> graph;
-  if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph)) return 2;
+  if (!LoadWatcherCatalog(st.graph, st.plugins, &catalog, &st.opts, st.domain->count() > 0, st.host, &graph))
+    return tools::Code(kBadInput);
   ParamRequest r;
   r.watch = st.opts;
   r.watched = &*graph;

@@ -14,7 +14,11 @@
 #include <dyad/graph.hpp>
 #include <dyad/introspect.hpp>
 
+#include "exit_code.hpp"
+
 namespace dyad::cli {
+
+using enum tools::ExitCode;
 namespace {
 
 // Prints samples as JSON, decoded with each type's own IDL text (parsed once per type); as hex
@@ -89,7 +93,7 @@ void AddDomainCommands(CLI::App& app, const std::shared_ptr<WatchState>& st, int
     Catalog catalog;
     std::optional<Graph> graph;
     if (!st->Join(&catalog, &graph)) {
-      exit_code = 2;
+      exit_code = tools::Code(kBadInput);
       return;
     }
     exit_code = ListTopics(st->opts, std::cout, graph ? &*graph : nullptr);
@@ -102,7 +106,7 @@ void AddDomainCommands(CLI::App& app, const std::shared_ptr<WatchState>& st, int
     Catalog catalog;
     std::optional<Graph> graph;
     if (!st->Join(&catalog, &graph)) {
-      exit_code = 2;
+      exit_code = tools::Code(kBadInput);
       return;
     }
     exit_code = ShowStatus(st->opts, graph ? &*graph : nullptr, std::cout, std::cerr);
@@ -122,7 +126,7 @@ void AddTopicCommands(CLI::App& app, const std::shared_ptr<WatchState>& st, int&
     Catalog catalog;
     std::optional<Graph> graph;
     if (!st->Join(&catalog, &graph, "dyad echo")) {
-      exit_code = 2;
+      exit_code = tools::Code(kBadInput);
       return;
     }
     exit_code = EchoTopic(st->opts, catalog, st->WatchedTopic(graph), st->count, st->duration, JsonPrinter(), std::cout, std::cerr);
@@ -138,7 +142,7 @@ void AddTopicCommands(CLI::App& app, const std::shared_ptr<WatchState>& st, int&
     Catalog catalog;
     std::optional<Graph> graph;
     if (!st->Join(&catalog, &graph, "dyad hz")) {
-      exit_code = 2;
+      exit_code = tools::Code(kBadInput);
       return;
     }
     exit_code = TopicHz(st->opts, catalog, st->WatchedTopic(graph), st->duration, std::cout, std::cerr);

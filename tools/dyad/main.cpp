@@ -11,6 +11,7 @@
 
 #include "analyze_commands.hpp"
 #include "bag_commands.hpp"
+#include "exit_code.hpp"
 #include "introspection_commands.hpp"
 #include "guest_commands.hpp"
 #include "observer_commands.hpp"
@@ -57,7 +58,7 @@ int main(int argc, char** argv) {
   CLI::App app{"dyad: human-robot interaction experiments as graphs of components over DDS"};
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Show every subcommand's help");
-  int exit_code = 0;
+  int exit_code = dyad::tools::Code(dyad::tools::ExitCode::kOk);  // each command sets its own (exit_code.hpp)
   dyad::cli::AddRuntimeCommands(app, exit_code);
   dyad::cli::AddIntrospectionCommands(app, exit_code);
   dyad::cli::AddSecurityCommands(app, exit_code);
@@ -72,7 +73,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
-    return code == 0 ? 0 : 2;  // usage errors are bad input
+    using enum dyad::tools::ExitCode;
+    return dyad::tools::Code(code == 0 ? kOk : kBadInput);  // --help is ok; a usage error is bad input
   }
   return QuickExit(exit_code);
 }

@@ -21,12 +21,15 @@
 
 #include <dyad/validate.hpp>
 
+#include "exit_code.hpp"
 #include "graph_dot.hpp"
 #include "watcher_catalog.hpp"
 #include "reference_markdown.hpp"
 #include "run_process.hpp"
 
 namespace dyad::cli {
+
+using enum tools::ExitCode;
 namespace {
 
 // `--set` of validate and run (docs/runtime.md, "Composing graphs").
@@ -66,22 +69,22 @@ void PrintType(const std::string& name, const CatalogEntry& e, std::ostream& out
 int EmitDot(const std::string& dot, const std::string& svg) {
   if (svg.empty()) {
     std::cout << dot;
-    return 0;
+    return tools::Code(kOk);
   }
   const std::string dot_file = svg + ".dot";
   std::ofstream(dot_file) << dot;
   const tools::ExitStatus rc = tools::RunProcess({"dot", "-Tsvg", "-o", svg, dot_file});
   if (rc.never_started() && rc.error() == ENOENT) {
     std::cerr << "dyad graph --svg: Graphviz's dot is not on PATH (Debian: apt install graphviz); the DOT text is in " << dot_file << "\n";
-    return 1;
+    return tools::Code(kFailure);
   }
   if (!rc.ok()) {
     std::cerr << "dyad graph --svg: dot -Tsvg " << dot_file << " failed (" << rc.ToString() << ")\n";
-    return 1;
+    return tools::Code(kFailure);
   }
   std::filesystem::remove(dot_file);
   std::cout << "wrote " << svg << "\n";
-  return 0;
+  return tools::Code(kOk);
 }
 
 // `dyad graph`: the graph checked against the component types (not configured: a picture needs
@@ -101,7 +104,7 @@ int DrawGraph(const std::string& path, const std::vector<std::string>& sets, con
   for (const auto& d : diags) std::cerr << d.ToString() << "\n";
   if (!diags.empty()) {
     std::cerr << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", nothing was drawn\n";
-    return 2;
+    return tools::Code(kBadInput);
   }
   return EmitDot(GraphDot(graph, resolved), svg);
 }
@@ -110,7 +113,7 @@ int DrawGraph(const std::string& path, const std::vector<std::string>& sets, con
 int DrawLiveGraph(const std::string& path, IntrospectOptions options, bool domain_given, double listen_s, const std::string& svg) {
   Catalog catalog;
   std::optional<Graph> graph;
-  if (!LoadWatcherCatalog(path, {}, &catalog, &options, domain_given, "", &graph)) return 2;
+  if (!LoadWatcherCatalog(path, {}, &catalog, &options, domain_given, "", &graph)) return tools::Code(kBadInput);
   LiveGraph live;
   if (int rc = DiscoverLiveGraph(options, catalog, graph ? &*graph : nullptr, listen_s, &live, std::cerr); rc != 0) return rc;
   return EmitDot(LiveGraphDot(live, graph ? &*graph : nullptr), svg);
@@ -142,7 +145,7 @@ void AddGraphCommand(CLI::App& app, int& exit_code) {
       exit_code = DrawLiveGraph(st->graph_path, st->watch, domain->count() > 0, st->listen_s, st->svg);
     } else if (st->graph_path.empty()) {
       std::cerr << "dyad graph: name the graph file (or --live for the running graph as discovered)\n";
-      exit_code = 2;
+      exit_code = tools::Code(kBadInput);
     } else {
       exit_code = DrawGraph(st->graph_path, st->sets, st->plugins, st->svg);
     }
@@ -195,7 +198,7 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
     Catalog catalog;
     Status s = catalog.LoadDefault(st->plugins);
     if (!s.ok()) std::cerr << "warning: " << s.message() << "\n";
-    exit_code = 0;
+    exit_code = tools::Code(kOk);
     if (st->messages) {
       if (st->markdown) {
         std::cout << MessageReferenceMarkdown(catalog);
@@ -207,10 +210,10 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
     for (const std::string& n : st->type_names) {
       if (catalog.Find(n) == nullptr) {
         std::cerr << "dyad types: no component type '" << n << "' (dyad types lists them)\n";
-        exit_code = 2;
+        exit_code = tools::Code(kBadInput);
       }
     }
-    if (exit_code != 0) return;
+    if (exit_code != tools::Code(kOk)) return;
     std::ostringstream listed;
     for (const auto& [name, e] : catalog.entries()) {
       if (!st->type_names.empty() && std::find(st->type_names.begin(), st->type_names.end(), name) == st->type_names.end())
@@ -219,7 +222,7 @@ void AddRuntimeCommands(CLI::App& app, int& exit_code) {
       else PrintType(name, e, listed);
     }
     std::cout << listed.str();
-    exit_code = catalog.entries().empty() ? 1 : 0;
+    exit_code = tools::Code(catalog.entries().empty() ? kFailure : kOk);
   });
 }
 

@@ -11,9 +11,12 @@
 #include <dyad/security.hpp>
 #include <dyad/validate.hpp>
 
+#include "exit_code.hpp"
 #include "keystore.hpp"
 
 namespace dyad::cli {
+
+using enum tools::ExitCode;
 namespace {
 
 // The graph, validated as `dyad validate` does (plugins included: permissions come from what
@@ -38,9 +41,9 @@ int LoadForKeystore(const std::string& path, const std::vector<std::string>& set
     if (diags.empty()) *access = TopicAccessByProcess(*graph, resolved, catalog, &diags);
   }
   for (const auto& d : diags) std::cerr << d.ToString() << "\n";
-  if (diags.empty()) return 0;
+  if (diags.empty()) return tools::Code(kOk);
   std::cerr << path << ": " << diags.size() << " problem" << (diags.size() == 1 ? "" : "s") << ", no keystore was made\n";
-  return 2;
+  return tools::Code(kBadInput);
 }
 
 }  // namespace
@@ -79,18 +82,18 @@ void AddSecurityCommands(CLI::App& app, int& exit_code) {
         std::cerr << "dyad security init: --renew " << r << ": not an identity of graph '" << graph.name << "' (";
         for (size_t i = 0; i < identities.size(); ++i) std::cerr << (i ? ", " : "") << identities[i];
         std::cerr << ")\n";
-        exit_code = 2;
+        exit_code = tools::Code(kBadInput);
         return;
       }
     st->keystore.renew = {st->renew.begin(), st->renew.end()};
     if (Status s = InitKeystore(graph, access, st->keystore, std::cout); !s.ok()) {
       std::cerr << "dyad security init: " << s.message() << "\n";
-      exit_code = 1;
+      exit_code = tools::Code(kFailure);
       return;
     }
     std::cout << "keystore " << st->keystore.dir << ": " << identities.size()
               << " identities; the graph uses it with `security: {keystore: " << st->keystore.dir << "}`\n";
-    exit_code = 0;
+    exit_code = tools::Code(kOk);
   });
 }
 

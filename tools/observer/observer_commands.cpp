@@ -15,14 +15,16 @@
 #include "dyad/observer/training.hpp"
 #include "dyad/pvrnn/dataset.hpp"
 #include "dyad/pvrnn/model_file.hpp"
+#include "exit_code.hpp"
 
 namespace dyad::cli {
 namespace {
 
 using namespace dyad::observer;
-constexpr int kOk = 0, kFailure = 1, kBadInput = 2;
+using tools::ExitCode;
+using enum tools::ExitCode;
 
-int Fail(int code, const std::string& msg) {
+ExitCode Fail(ExitCode code, const std::string& msg) {
   std::fprintf(stderr, "error: %s\n", msg.c_str());
   return code;
 }
@@ -43,7 +45,7 @@ struct TrainObserverArgs {
   double min_diagonal = 0;
 };
 
-int TrainObserver(const TrainObserverArgs& a) {
+ExitCode TrainObserver(const TrainObserverArgs& a) {
   using Clock = std::chrono::steady_clock;
   auto model = pvrnn::LoadModel(a.model);
   if (!model.ok()) return Fail(kBadInput, model.status().message());
@@ -128,7 +130,7 @@ struct EvaluateArgs {
 
 // The confusion matrix of the data set's primitives traced as a synthetic human would (looped,
 // with noise): how the observer will see a human who follows the data set.
-int EvaluateObserver(const EvaluateArgs& a) {
+ExitCode EvaluateObserver(const EvaluateArgs& a) {
   for (double noise : a.noise) {  // all checked before the first table is printed
     if (!(noise >= 0)) {
       char buf[64];
@@ -172,7 +174,7 @@ void AddObserverCommands(CLI::App& app, int& exit_code) {
   cmd->add_option("--window", a->window, "Steps per classified window (default 5)")->check(CLI::Range(1, 1000));
   cmd->add_option("--min-diagonal", a->min_diagonal,
                   "Exit 1 (after writing the file) when the validation diagonal's minimum is below this");
-  cmd->callback([&exit_code, a] { exit_code = TrainObserver(*a); });
+  cmd->callback([&exit_code, a] { exit_code = tools::Code(TrainObserver(*a)); });
 
   auto* ev = app.add_subcommand("evaluate-observer",
                                 "Confusion matrix of an observer on a data set's primitives traced like a human (looped, noisy)");
@@ -183,7 +185,7 @@ void AddObserverCommands(CLI::App& app, int& exit_code) {
   ev->add_option("--noise", e->noise, "Noise std per axis, workspace units; a list gives one table each (default 0)")
       ->delimiter(',');
   ev->add_option("--seed", e->seed, "Noise seed (default 1)");
-  ev->callback([&exit_code, e] { exit_code = EvaluateObserver(*e); });
+  ev->callback([&exit_code, e] { exit_code = tools::Code(EvaluateObserver(*e)); });
 }
 
 }  // namespace dyad::cli

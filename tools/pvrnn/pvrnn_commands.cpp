@@ -26,6 +26,7 @@
 #include "dyad/pvrnn/prior_generator.hpp"
 #include "dyad/pvrnn/train_config.hpp"
 #include "dyad/pvrnn/trainer.hpp"
+#include "exit_code.hpp"
 #include "text_output.hpp"
 
 namespace dyad::cli {
@@ -34,9 +35,10 @@ namespace {
 using namespace dyad::pvrnn;
 using Clock = std::chrono::steady_clock;
 
-constexpr int kOk = 0, kFailure = 1, kBadInput = 2;
+using tools::ExitCode;
+using enum tools::ExitCode;
 
-int Fail(int code, const std::string& msg) {
+ExitCode Fail(ExitCode code, const std::string& msg) {
   std::fprintf(stderr, "error: %s\n", msg.c_str());
   return code;
 }
@@ -51,7 +53,7 @@ std::string Duration(double s) {
 
 // The model training starts from: the checkpoint (--resume), else a new one of the config's
 // shape; with its provenance. kOk, or the exit code having said why.
-int StartingModel(const TrainConfig& c, const std::string& config_path, const Dataset& data, bool resume, Model* init) {
+ExitCode StartingModel(const TrainConfig& c, const std::string& config_path, const Dataset& data, bool resume, Model* init) {
   if (resume) {
     auto ck = LoadModel(c.checkpoint);
     if (!ck.ok()) return Fail(kBadInput, "--resume: " + ck.status().message());
@@ -70,7 +72,7 @@ int StartingModel(const TrainConfig& c, const std::string& config_path, const Da
 
 // The folders of the outputs made, and the log CSV opened (appended to on --resume) with its
 // header when new. kOk, or the exit code having said why.
-int OpenTrainingLog(const TrainConfig& c, bool resume, std::ofstream* csv) {
+ExitCode OpenTrainingLog(const TrainConfig& c, bool resume, std::ofstream* csv) {
   for (const std::string& f : {c.output, c.checkpoint, c.log_csv}) {
     const auto dir = std::filesystem::path(f).parent_path();
     std::error_code ec;
@@ -88,9 +90,9 @@ int OpenTrainingLog(const TrainConfig& c, bool resume, std::ofstream* csv) {
 }
 
 template <typename Scalar>
-int RunTraining(const TrainConfig& c, const std::string& config_path, const Dataset& data, bool resume) {
+ExitCode RunTraining(const TrainConfig& c, const std::string& config_path, const Dataset& data, bool resume) {
   Model init;
-  if (int code = StartingModel(c, config_path, data, resume, &init); code != kOk) return code;
+  if (ExitCode code = StartingModel(c, config_path, data, resume, &init); code != kOk) return code;
   TrainerOptions opts;
   opts.adam = c.adam;
   opts.seed = c.seed;
@@ -104,7 +106,7 @@ int RunTraining(const TrainConfig& c, const std::string& config_path, const Data
     return Fail(kBadInput, c.checkpoint + ": already at epoch " + std::to_string(start_epoch) + " of " + std::to_string(c.epochs));
 
   std::ofstream csv;
-  if (int code = OpenTrainingLog(c, resume, &csv); code != kOk) return code;
+  if (ExitCode code = OpenTrainingLog(c, resume, &csv); code != kOk) return code;
   const bool tty = isatty(fileno(stdout));
   std::printf("training %s (%d sequences x %d steps) from epoch %lld to %lld, %s, seed %llu\n", c.dataset.c_str(),
               data.size(), data.steps(), static_cast<long long>(start_epoch), static_cast<long long>(c.epochs),
@@ -154,7 +156,7 @@ int RunTraining(const TrainConfig& c, const std::string& config_path, const Data
     if (interrupted) {
       std::printf("\ninterrupted (%s) at epoch %lld: checkpoint saved to %s (continue with --resume)\n",
                   SignalName(interrupt.signal()), static_cast<long long>(e), c.checkpoint.c_str());
-      return ExitCodeForSignal(interrupt.signal());  // stopped by a person: neither done nor failed
+      return tools::ForSignal(interrupt.signal());  // stopped by a person: neither done nor failed
     }
   }
   if (tty) std::printf("\n");
@@ -166,7 +168,7 @@ int RunTraining(const TrainConfig& c, const std::string& config_path, const Data
   return kOk;
 }
 
-int Train(const std::string& config_path, bool resume, const std::vector<std::string>& sets) {
+ExitCode Train(const std::string& config_path, bool resume, const std::vector<std::string>& sets) {
   auto c = LoadTrainConfig(config_path, sets);
   if (!c.ok()) return Fail(kBadInput, c.status().message());
   auto data = LoadNrlDataset(c->dataset);
@@ -180,7 +182,7 @@ int Train(const std::string& config_path, bool resume, const std::vector<std::st
                                : RunTraining<float>(c.value(), config_path, data.value(), resume);
 }
 
-int ImportNrl(const NrlImportOptions& o, const std::string& out) {
+ExitCode ImportNrl(const NrlImportOptions& o, const std::string& out) {
   auto m = ImportNrlModel(o);
   if (!m.ok()) return Fail(kBadInput, m.status().message());
   if (Status s = SaveModel(m.value(), out); !s.ok()) return Fail(kFailure, s.message());
@@ -189,7 +191,7 @@ int ImportNrl(const NrlImportOptions& o, const std::string& out) {
   return kOk;
 }
 
-int GenerateModel(const std::string& path, int primitive, int steps, const std::string& out, uint64_t seed, bool no_noise) {
+ExitCode GenerateModel(const std::string& path, int primitive, int steps, const std::string& out, uint64_t seed, bool no_noise) {
   auto m = LoadModel(path);
   if (!m.ok()) return Fail(kBadInput, m.status().message());
   if (primitive < 0 || primitive >= m->sequences())
@@ -278,7 +280,7 @@ struct RegressArgs {
   uint64_t seed = 1;
 };
 
-int Regress(const RegressArgs& a) {
+ExitCode Regress(const RegressArgs& a) {
   auto o = ErrorRegressionOptions::Preset(a.preset);
   if (!o) return Fail(kBadInput, "--preset " + a.preset + ": must be vcbot, reference or nrl");
   if (a.window) o->window = *a.window;
@@ -356,7 +358,7 @@ void AddPvrnnCommands(CLI::App& app, int& exit_code) {
     cmd->add_option("config", *config, "Training config (YAML)")->required();
     cmd->add_flag("--resume", *resume, "Continue from the config's checkpoint file");
     cmd->add_option("--set", *sets, "Override a config value, e.g. --set adam.lr=0.002 (repeatable)");
-    cmd->callback([&exit_code, config, resume, sets] { exit_code = Train(*config, *resume, *sets); });
+    cmd->callback([&exit_code, config, resume, sets] { exit_code = tools::Code(Train(*config, *resume, *sets)); });
   }
   {
     auto* cmd = app.add_subcommand("import-nrl", "Convert an NRL/VCBot model folder into a dyad model file");
@@ -366,7 +368,7 @@ void AddPvrnnCommands(CLI::App& app, int& exit_code) {
     cmd->add_option("--properties", o->properties_file, "properties_*.d of the model")->required();
     cmd->add_option("--dataset", o->dataset_dir, "Data set folder the model was trained on")->required();
     cmd->add_option("-o,--output", *out, "Output model file (.dpvrnn)")->required();
-    cmd->callback([&exit_code, o, out] { exit_code = ImportNrl(*o, *out); });
+    cmd->callback([&exit_code, o, out] { exit_code = tools::Code(ImportNrl(*o, *out)); });
   }
   {
     auto* gen = app.add_subcommand("generate", "Generate trajectories or data sets");
@@ -387,14 +389,14 @@ void AddPvrnnCommands(CLI::App& app, int& exit_code) {
     auto* nn = model->add_flag("--no-noise", a->no_noise, "Means only (reproducible)");
     seed->excludes(nn);
     model->callback([&exit_code, a] {
-      exit_code = GenerateModel(a->path, a->primitive, a->steps, a->out, a->seed, a->no_noise);
+      exit_code = tools::Code(GenerateModel(a->path, a->primitive, a->steps, a->out, a->seed, a->no_noise));
     });
     auto* ds = gen->add_subcommand("dataset", "Write the built-in analytic data set (7 closed shapes, 72 steps, 2 DOF)");
     auto dir = std::make_shared<std::string>();
     ds->add_option("--out", *dir, "Output folder (NRL layout)")->required();
     ds->callback([&exit_code, dir] {
       Status s = WriteNrlDataset(MakeAnalyticDataset(), *dir);
-      exit_code = s.ok() ? kOk : Fail(kFailure, s.message());
+      exit_code = tools::Code(s.ok() ? kOk : Fail(kFailure, s.message()));
       if (s.ok()) std::printf("wrote 7 primitives x 72 steps to %s\n", dir->c_str());
     });
   }
@@ -420,7 +422,7 @@ void AddPvrnnCommands(CLI::App& app, int& exit_code) {
     cmd->add_option("--start-primitive", a->start_primitive, "Primitive the robot starts on (default 0)");
     cmd->add_option("--seed", a->seed, "Noise seed (default 1)");
     cmd->add_option("--budget-ms", a->budget_ms, "Wall-time cap per step in ms (default: none)");
-    cmd->callback([&exit_code, a] { exit_code = Regress(*a); });
+    cmd->callback([&exit_code, a] { exit_code = tools::Code(Regress(*a)); });
   }
 }
 

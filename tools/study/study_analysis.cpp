@@ -375,16 +375,18 @@ Chosen ChooseAttempt(const Session& session, const Trial& t) {
   c.file = t.file;
   const Attempt* done = session.Complete(t.number);
   // None complete, the last whole but nobody took part (outcome incomplete): analysed, and marked.
-  if (const Attempt* last = session.Last(t.number); !done && last && last->outcome == "incomplete") done = last;
+  if (const Attempt* last = session.Last(t.number); !done && last && last->outcome == AttemptOutcome::kIncomplete) done = last;
   auto add = [&c](const Attempt& a, const std::string& fate) {
     c.repeated += (c.repeated.empty() ? "" : "; ") + ("attempt " + std::to_string(a.attempt) + " " + fate) +
                   (a.reason.empty() ? "" : ", repeated because: " + a.reason);
   };
   for (const Attempt& a : session.attempts) {
     if (a.trial != t.number) continue;
-    if (&a == done) add(a, a.outcome == "incomplete" ? "analysed, incomplete: " + a.incomplete : "analysed");
-    else add(a, a.outcome.empty() ? "interrupted (the session ended during it)"
-                                  : a.outcome + (a.incomplete.empty() ? "" : ": " + a.incomplete));
+    if (&a == done) add(a, a.outcome == AttemptOutcome::kIncomplete ? "analysed, incomplete: " + a.incomplete : "analysed");
+    else
+      add(a, a.outcome == AttemptOutcome::kUnended
+                 ? "interrupted (the session ended during it)"
+                 : std::string(ToString(a.outcome)) + (a.incomplete.empty() ? "" : ": " + a.incomplete));
   }
   if (done) {
     // The plan names the file (the log's path is what it was then: the folder may have moved).

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 
+#include "exit_code.hpp"
 #include "run_process.hpp"
 #include "study_analysis.hpp"
 #include "study_file.hpp"
@@ -19,7 +20,8 @@
 namespace dyad::cli {
 namespace {
 
-constexpr int kOk = 0, kBadInput = 2;
+using tools::ExitCode;
+using enum tools::ExitCode;
 
 // The study file, or false after listing its problems.
 bool Load(const std::string& file, const std::vector<std::string>& plugins, study::Study* s) {
@@ -37,7 +39,7 @@ struct PlanOptions {
 };
 
 // `dyad study plan`: the study checked, and who does which condition when.
-int Plan(const PlanOptions& o) {
+ExitCode Plan(const PlanOptions& o) {
   study::Study s;
   if (!Load(o.file, o.plugins, &s)) return kBadInput;
   const size_t n = s.participants.size();
@@ -79,10 +81,11 @@ std::string TrialLine(const study::Study& s, const study::Trial& t, size_t of) {
 std::string Ended(const study::Attempt& a) {
   char secs[32];
   std::snprintf(secs, sizeof secs, "%.1f s", a.seconds);
-  if (a.outcome == "complete") return std::string("complete (") + secs + ")";
-  if (a.outcome == "stopped") return std::string("stopped after ") + secs + ": incomplete";
-  if (a.outcome == "incomplete") return std::string("incomplete after ") + secs + ": " + a.incomplete;
-  if (a.outcome.empty()) return "interrupted: the session ended during it";
+  using study::AttemptOutcome;
+  if (a.outcome == AttemptOutcome::kComplete) return std::string("complete (") + secs + ")";
+  if (a.outcome == AttemptOutcome::kStopped) return std::string("stopped after ") + secs + ": incomplete";
+  if (a.outcome == AttemptOutcome::kIncomplete) return std::string("incomplete after ") + secs + ": " + a.incomplete;
+  if (a.outcome == AttemptOutcome::kUnended) return "interrupted: the session ended during it";
   return "failed: the graph exited " + std::to_string(a.exit) + " after " + secs + (a.exit == 0 ? " and left no whole recording" : "");
 }
 
@@ -119,9 +122,10 @@ std::optional<std::string> ConsentGiven(const study::Study& s, const RunOptions&
   return std::nullopt;
 }
 
-// Runs one attempt at `t` and says how it ended; false when it could not start.
-bool RunOne(const study::Study& s, const RunOptions& o, const study::Trial& t, size_t of, const std::string& reason,
-            study::Attempt* out) {
+// Runs one attempt at `t` and says how it ended (kOk); kBadInput when the plan's order refuses
+// it, kFailure when it could not start (both said).
+ExitCode RunOne(const study::Study& s, const RunOptions& o, const study::Trial& t, size_t of, const std::string& reason,
+                study::Attempt* out) {
   const study::Session session = study::ReadSession(s, o.participant);
   const study::Attempt* last = session.Last(t.number);
   study::AttemptRequest r;
@@ -136,25 +140,26 @@ bool RunOne(const study::Study& s, const RunOptions& o, const study::Trial& t, s
   if (s.blind) r.run_log = std::filesystem::path(study::AttemptFile(t, r.attempt)).replace_extension(".log").string();
   if (std::string why = study::WhyNotStart(session, s.TrialsOf(o.participant), t.number, reason); !why.empty()) {
     std::cerr << "dyad study run: " << why << "\n";
-    return false;
+    return kBadInput;
   }
   std::cout << TrialLine(s, t, of) << (r.attempt > 1 ? ", attempt " + std::to_string(r.attempt) : "") << " -> "
             << study::AttemptFile(t, r.attempt) << "\n"
-            << (s.self_reports == "after_trial"
+            << (s.self_reports == study::SelfReports::kAfterTrial
                     ? (s.duration_s > 0 ? "  running for " + std::to_string(static_cast<int>(s.duration_s)) + " s"
                                         : std::string("  running until the experimenter's page ends it")) +
                           ", then the subject is asked about each hold and the trial ends once they answer (Ctrl-C stops it)"
-                    : s.duration_s > 0 ? "  running for " + std::to_string(static_cast<int>(s.duration_s)) + " s (Ctrl-C stops it early)"
-                                       : std::string("  running (Ctrl-C ends it)"))
+                : s.duration_s > 0
+                    ? "  running for " + std::to_string(static_cast<int>(s.duration_s)) + " s (Ctrl-C stops it early)"
+                    : std::string("  running (Ctrl-C ends it)"))
             << std::endl;
   auto a = study::RunAttempt(s, r);
   if (!a.ok()) {
     std::cerr << "dyad study run: " << a.status().ToString() << "\n";
-    return false;
+    return kFailure;
   }
   std::cout << "  trial " << t.number << ": " << Ended(*a) << (r.run_log.empty() ? "" : " (its output: " + r.run_log + ")") << "\n";
   *out = *a;
-  return true;
+  return kOk;
 }
 
 // The study and the participant, or false after saying what is wrong.
@@ -178,16 +183,16 @@ StatusOr<study::SessionLock> LockSession(const study::Study& s, const std::strin
 }
 
 // `dyad study run --page`: the experimenter's study page instead of the terminal.
-int RunOnPage(const study::Study& s, const RunOptions& o, const study::Session& before) {
+ExitCode RunOnPage(const study::Study& s, const RunOptions& o, const study::Session& before) {
   auto held = LockSession(s, o.participant);
   if (!held.ok()) return kBadInput;
   if (Status st = o.consent && !before.consent ? study::MarkConsent(s, o.participant, "--consent") : Status::OK(); !st.ok()) {
     std::cerr << "dyad study run: " << st.ToString() << "\n";
-    return 1;
+    return kFailure;
   }
   study::PageOptions po = o.page_options;
   po.dyad = tools::ThisExecutable();
-  return study::RunStudyPage(s, o.participant, po);
+  return static_cast<ExitCode>(study::RunStudyPage(s, o.participant, po));  // a code of the table
 }
 
 // The participant's trials in their order, each not yet complete run; a trial that did not
@@ -195,17 +200,17 @@ int RunOnPage(const study::Study& s, const RunOptions& o, const study::Session& 
 // complete (said on stdout) or the experimenter stopped at a prompt (q, end of input).
 // A session stopped by SIGINT or SIGTERM (the trial under way was stopped and kept as it is):
 // what is not complete, and how to go on; 130 as for any run ended by a signal.
-int StoppedBySignal(const study::Study& s, const RunOptions& o, const std::vector<study::Trial>& trials) {
+ExitCode StoppedBySignal(const study::Study& s, const RunOptions& o, const std::vector<study::Trial>& trials) {
   const study::Session now = study::ReadSession(s, o.participant);
   std::string missing;
   for (const study::Trial& t : trials)
     if (!now.Complete(t.number)) missing += (missing.empty() ? "" : ", ") + std::to_string(t.number);
   std::cerr << "dyad study run: stopped by a signal; " << o.participant << "'s trials not complete: " << missing
             << " (dyad study run again goes on from trial " << missing.substr(0, missing.find(',')) << ")\n";
-  return 130;
+  return kInterrupted;  // for SIGTERM too: its trial was stopped as by Ctrl-C
 }
 
-int RunInOrder(const study::Study& s, const RunOptions& o, const std::vector<study::Trial>& trials) {
+ExitCode RunInOrder(const study::Study& s, const RunOptions& o, const std::vector<study::Trial>& trials) {
   study::Attempt a;
   auto why_again = [&](const study::Attempt& last) {
     if (o.yes) {
@@ -220,15 +225,16 @@ int RunInOrder(const study::Study& s, const RunOptions& o, const std::vector<stu
     const study::Session now = study::ReadSession(s, o.participant);
     if (now.Complete(t.number)) continue;
     std::string reason;
-    if (const study::Attempt* last = now.Last(t.number); last && (reason = why_again(*last)).empty()) return 1;
+    if (const study::Attempt* last = now.Last(t.number); last && (reason = why_again(*last)).empty()) return kFailure;
     if (!o.yes) {
       const auto answer = Ask(TrialLine(s, t, trials.size()) + ". Enter starts it, q stops here: ");
       if (!answer || *answer == "q") return kOk;  // the end of input starts nothing
     }
-    if (!RunOne(s, o, t, trials.size(), reason, &a)) return 1;
-    while (a.outcome != "complete") {  // with --yes (or Ctrl-C then no reason): stop here, not at the next trial
-      if ((reason = why_again(a)).empty()) return a.interrupted ? StoppedBySignal(s, o, trials) : 1;
-      if (!RunOne(s, o, t, trials.size(), reason, &a)) return 1;
+    if (ExitCode c = RunOne(s, o, t, trials.size(), reason, &a); c != kOk) return c;
+    // With --yes (or Ctrl-C then no reason): stop here, not at the next trial.
+    while (a.outcome != study::AttemptOutcome::kComplete) {
+      if ((reason = why_again(a)).empty()) return a.interrupted ? StoppedBySignal(s, o, trials) : kFailure;
+      if (ExitCode c = RunOne(s, o, t, trials.size(), reason, &a); c != kOk) return c;
     }
   }
   std::cout << o.participant << ": every trial complete (session log " << study::SessionLogPath(s, o.participant) << ")\n";
@@ -236,7 +242,7 @@ int RunInOrder(const study::Study& s, const RunOptions& o, const std::vector<stu
 }
 
 // `dyad study run`: the participant's trials in their order, from the first not yet complete.
-int RunSession(const RunOptions& o) {
+ExitCode RunSession(const RunOptions& o) {
   study::Study s;
   if (!LoadParticipant(o.file, o.plugins, o.participant, "dyad study run", &s)) return kBadInput;
   const std::vector<study::Trial> trials = s.TrialsOf(o.participant);
@@ -259,7 +265,7 @@ int RunSession(const RunOptions& o) {
   if (!consent->empty()) {
     if (Status st = study::MarkConsent(s, o.participant, *consent); !st.ok()) {
       std::cerr << "dyad study run: " << st.ToString() << "\n";
-      return 1;
+      return kFailure;
     }
     std::cout << "consent marked for " << o.participant << " (" << *consent << ")\n";
   }
@@ -269,8 +275,8 @@ int RunSession(const RunOptions& o) {
       return kBadInput;
     }
     study::Attempt a;
-    if (!RunOne(s, o, trials[static_cast<size_t>(o.trial - 1)], trials.size(), o.reason, &a)) return kBadInput;
-    return a.outcome == "complete" ? kOk : 1;
+    if (ExitCode c = RunOne(s, o, trials[static_cast<size_t>(o.trial - 1)], trials.size(), o.reason, &a); c != kOk) return c;
+    return a.outcome == study::AttemptOutcome::kComplete ? kOk : kFailure;
   }
   return RunInOrder(s, o, trials);
 }
@@ -283,25 +289,25 @@ struct ParticipantOptions {
 
 
 // `dyad study note`: a line in the participant's session log (the study's report lists them).
-int Note(const ParticipantOptions& o) {
+ExitCode Note(const ParticipantOptions& o) {
   study::Study s;
   if (!LoadParticipant(o.file, o.plugins, o.participant, "dyad study note", &s)) return kBadInput;
   if (Status st = study::AddNote(s, o.participant, o.text); !st.ok()) {
     std::cerr << "dyad study note: " << st.ToString() << "\n";
-    return st.code() == Status::Code::kInvalidArgument ? kBadInput : 1;
+    return st.code() == Status::Code::kInvalidArgument ? kBadInput : kFailure;
   }
   std::cout << "noted in " << study::SessionLogPath(s, o.participant) << "\n";
   return kOk;
 }
 
 // `dyad study exclude` / `include`: the researcher's decision about a participant, with its reason.
-int Exclude(const ParticipantOptions& o) {
+ExitCode Exclude(const ParticipantOptions& o) {
   const char* command = o.include ? "dyad study include" : "dyad study exclude";
   study::Study s;
   if (!LoadParticipant(o.file, o.plugins, o.participant, command, &s)) return kBadInput;
   if (Status st = study::ExcludeParticipant(s, o.participant, !o.include, o.reason); !st.ok()) {
     std::cerr << command << ": " << st.ToString() << "\n";
-    return st.code() == Status::Code::kInvalidArgument ? kBadInput : 1;
+    return st.code() == Status::Code::kInvalidArgument ? kBadInput : kFailure;
   }
   std::cout << o.participant << (o.include ? " is analysed again" : " is left out of the analysis") << " (logged in "
             << study::SessionLogPath(s, o.participant) << "; run dyad study analyze again)\n";
@@ -309,7 +315,7 @@ int Exclude(const ParticipantOptions& o) {
 }
 
 // `dyad study withdraw`: the participant withdraws consent; with --delete-data their files go.
-int Withdraw(const ParticipantOptions& o) {
+ExitCode Withdraw(const ParticipantOptions& o) {
   study::Study s;
   if (!LoadParticipant(o.file, o.plugins, o.participant, "dyad study withdraw", &s)) return kBadInput;
   auto lock = study::SessionLock::Acquire(s, o.participant);
@@ -328,7 +334,7 @@ int Withdraw(const ParticipantOptions& o) {
   auto deleted = study::WithdrawConsent(s, o.participant, o.delete_data, "dyad study withdraw");
   if (!deleted.ok()) {
     std::cerr << "dyad study withdraw: " << deleted.status().ToString() << "\n";
-    return 1;
+    return kFailure;
   }
   std::cout << o.participant << " withdrew consent: nothing more is recorded for them, and the analysis leaves them out";
   if (o.delete_data) std::cout << "; " << *deleted << " files deleted from " << folder;
@@ -372,7 +378,7 @@ study::Study AsRehearsal(study::Study s) {
 }
 
 // `dyad study rehearse`: every participant's trials, a synthetic human each, then the analysis.
-int Rehearse(const AnalyzeOptions& o) {
+ExitCode Rehearse(const AnalyzeOptions& o) {
   study::Study s;
   if (!Load(o.file, o.plugins, &s)) return kBadInput;
   const study::Study r = AsRehearsal(s);
@@ -401,9 +407,9 @@ int Rehearse(const AnalyzeOptions& o) {
       ++ran;
       if (a.ok() && a->interrupted) {
         std::cerr << "dyad study rehearse: interrupted during " << p << " trial " << t.number << " (a new rehearse resumes)\n";
-        return 1;
+        return kInterrupted;  // as dyad study run and dyad sweep (it exited 1, as for a failure)
       }
-      if (!a.ok() || a->outcome != "complete") {
+      if (!a.ok() || a->outcome != study::AttemptOutcome::kComplete) {
         ++failed;
         std::cerr << p << " " << TrialLine(r, t, r.TrialsOf(p).size()) << ": "
                   << (a.ok() ? Ended(*a) + " (see " + req.run_log + ")" : a.status().ToString()) << "\n";
@@ -416,20 +422,20 @@ int Rehearse(const AnalyzeOptions& o) {
   // Rehearsed before anyone comes, seen by the experimenter: a blind study's stays blind.
   a.unblinded = !s.blind || o.unblind;
   const std::string dir = o.out.empty() ? r.data + "/analysis" : o.out;
-  if (!WriteAnalysis(r, a, dir, o.plots, "dyad study rehearse")) return 1;
+  if (!WriteAnalysis(r, a, dir, o.plots, "dyad study rehearse")) return kFailure;
   std::cout << "analysis: " << dir << "/report.md (" << a.trials.size() << " trials analysed, " << a.missing.size() << " missing)\n";
-  return failed == 0 ? kOk : 1;
+  return failed == 0 ? kOk : kFailure;
 }
 
 // `dyad study analyze`: every recording of the plan, one table across everyone.
-int Analyze(const AnalyzeOptions& o) {
+ExitCode Analyze(const AnalyzeOptions& o) {
   study::Study s;
   if (!Load(o.file, o.plugins, &s)) return kBadInput;
   if (o.rehearsal) s = AsRehearsal(s);
   study::StudyAnalysis a = study::AnalyzeStudy(s, std::cerr, o.rehearsal, o.include_incomplete);
   a.unblinded = !s.blind || !o.rehearsal || o.unblind;
   const std::string dir = o.out.empty() ? s.data + "/analysis" : o.out;
-  if (!WriteAnalysis(s, a, dir, o.plots, "dyad study analyze")) return 1;
+  if (!WriteAnalysis(s, a, dir, o.plots, "dyad study analyze")) return kFailure;
   std::cout << "study " << s.name << ": " << a.trials.size() << " trial" << (a.trials.size() == 1 ? "" : "s") << " analysed, "
             << a.missing.size() << " missing";
   int incomplete = 0;
@@ -456,7 +462,7 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   plan->add_option("study", o->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
   plan->add_option("--plugins", o->plugins, "Extra plugin file or folder (repeatable)");
   plan->add_flag("--unblind", o->unblind, "Name the conditions of a blind study (not for the experimenter's eyes)");
-  plan->callback([o, &exit_code] { exit_code = Plan(*o); });
+  plan->callback([o, &exit_code] { exit_code = tools::Code(Plan(*o)); });
   auto a = std::make_shared<AnalyzeOptions>();
   auto* analyze = study->add_subcommand(
       "analyze", "Analyse every recording of a study: one row per trial and per event, per condition a mean with a 95% bootstrap interval");
@@ -468,7 +474,7 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   analyze->add_flag("--include-incomplete", a->include_incomplete,
                     "Count trials whose recording is cut short or shorter than planned in the summary and plots (they are left out)");
   analyze->add_flag("--rehearsal", a->rehearsal, "Analyse the rehearsal's recordings (DATA/rehearsal) instead of the participants'");
-  analyze->callback([a, &exit_code] { exit_code = Analyze(*a); });
+  analyze->callback([a, &exit_code] { exit_code = tools::Code(Analyze(*a)); });
   auto r = std::make_shared<RunOptions>();
   auto* run = study->add_subcommand("run", "Run a participant's trials in their planned order, recording each with the study's metadata");
   run->add_option("study", r->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
@@ -482,14 +488,14 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   run->add_option("--page-port", r->page_options.port, "The study page's port (0: any free one)")->check(CLI::Range(0, 65535))->needs(page);
   run->add_option("--page-port-file", r->page_options.port_file, "Write the study page's port here")->needs(page);
   page->excludes("--yes")->excludes("--trial");
-  run->callback([r, &exit_code] { exit_code = RunSession(*r); });
+  run->callback([r, &exit_code] { exit_code = tools::Code(RunSession(*r)); });
   auto n = std::make_shared<ParticipantOptions>();
   auto* note = study->add_subcommand("note", "Add a note to a participant's session log (the study's report lists the notes)");
   note->add_option("study", n->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
   note->add_option("--participant", n->participant, "The participant's ID")->required();
   note->add_option("text", n->text, "The note")->required();
   note->add_option("--plugins", n->plugins, "Extra plugin file or folder (repeatable)");
-  note->callback([n, &exit_code] { exit_code = Note(*n); });
+  note->callback([n, &exit_code] { exit_code = tools::Code(Note(*n)); });
   for (const bool include : {false, true}) {
     auto e = std::make_shared<ParticipantOptions>();
     e->include = include;
@@ -500,7 +506,7 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
     c->add_option("--participant", e->participant, "The participant's ID")->required();
     c->add_option("--reason", e->reason, "Why (kept in the session log and the report)")->required();
     c->add_option("--plugins", e->plugins, "Extra plugin file or folder (repeatable)");
-    c->callback([e, &exit_code] { exit_code = Exclude(*e); });
+    c->callback([e, &exit_code] { exit_code = tools::Code(Exclude(*e)); });
   }
   auto w = std::make_shared<ParticipantOptions>();
   auto* withdraw = study->add_subcommand(
@@ -511,7 +517,7 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
                      "Also delete every file of theirs (recordings, logs, notes); the session log keeps one line saying so");
   withdraw->add_flag("--yes", w->yes, "With --delete-data: do not ask");
   withdraw->add_option("--plugins", w->plugins, "Extra plugin file or folder (repeatable)");
-  withdraw->callback([w, &exit_code] { exit_code = Withdraw(*w); });
+  withdraw->callback([w, &exit_code] { exit_code = tools::Code(Withdraw(*w)); });
   auto h = std::make_shared<AnalyzeOptions>();
   auto* rehearse = study->add_subcommand(
       "rehearse", "Run the whole study stepped with synthetic participants (the rehearsal graph), then analyse it, into DATA/rehearsal");
@@ -522,7 +528,8 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   rehearse->add_flag("--include-incomplete", h->include_incomplete,
                      "Count trials whose recording is cut short or shorter than planned in the summary and plots");
   rehearse->add_flag("--unblind", h->unblind, "Name a blind study's conditions in the rehearsal's analysis (not for the experimenter's eyes)");
-  rehearse->callback([h, &exit_code] { exit_code = Rehearse(*h); });
+  rehearse->callback([h, &exit_code] { exit_code = tools::Code(Rehearse(*h)); });
+  study::AddLinksCommand(study, exit_code);
 }
 
 }  // namespace dyad::cli

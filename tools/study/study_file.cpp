@@ -46,9 +46,10 @@ void ReadScalars(StrictYaml& y, const YAML::Node& root, const std::string& path,
     y.Error(root["duration"], "duration", "must be >= 0 (0: until the experimenter stops the trial)");
   y.Get(root, "blind", "blind", &s->blind, "true or false");
   y.Get(root, "consent_required", "consent_required", &s->consent_required, "true or false");
-  if (y.Get(root, "self_reports", "self_reports", &s->self_reports, "a word") && s->self_reports != "after_event" &&
-      s->self_reports != "after_trial" && s->self_reports != "off")
-    y.Error(root["self_reports"], "self_reports", "must be after_event, after_trial or off");
+  if (std::string word; y.Get(root, "self_reports", "self_reports", &word, "a word")) {
+    if (auto when = ParseSelfReports(word); when.ok()) s->self_reports = *when;
+    else y.Error(root["self_reports"], "self_reports", when.status().message());
+  }
 }
 
 void ReadParticipants(StrictYaml& y, const YAML::Node& root, Study* s) {
@@ -133,9 +134,9 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
         webs.push_back(c.name);
         for (const PortBinding& out : c.outputs)
           if (out.port == "self_report" && !out.topic.empty()) answering.push_back(c.name);
-        s->page_sets.push_back(c.name + ".self_reports=" + s->self_reports);
+        s->page_sets.push_back(c.name + ".self_reports=" + std::string(ToString(s->self_reports)));
         // After the trial the page asks, then ends the run: at the trial's duration.
-        if (s->self_reports == "after_trial" && s->duration_s > 0)
+        if (s->self_reports == SelfReports::kAfterTrial && s->duration_s > 0)
           s->page_sets.push_back(c.name + ".ask_after_s=" + tools::SetText(YAML::Node(s->duration_s)));
         // The same tokens for every trial of a participant (each participant their own), so the
         // pages reconnect to the next trial's graph.
@@ -143,7 +144,7 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
       }
     }
     // The one page that asks after the trial also ends it: two would end it at the first's end.
-    if (s->self_reports == "after_trial" && (webs.size() != 1 || answering.size() != 1))
+    if (s->self_reports == SelfReports::kAfterTrial && (webs.size() != 1 || answering.size() != 1))
       y.Error(root["self_reports"], "self_reports",
               "after_trial needs the graph's one `web` component (its subject's page asks, then ends the trial) with its "
               "self_report output bound; " + s->graph + " has " +
@@ -151,7 +152,7 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
                                 : std::to_string(webs.size()) + " (" + JoinList(webs) + "), " +
                                       std::to_string(answering.size()) + " binding self_report"));
     // A component's end of the run ends its own process only: the others would run on.
-    else if (s->self_reports == "after_trial" && processes.size() > 1)
+    else if (s->self_reports == SelfReports::kAfterTrial && processes.size() > 1)
       y.Error(root["self_reports"], "self_reports",
               "after_trial needs the graph in one process (the page ends the run of its own process only); " + s->graph +
                   " has " + std::to_string(processes.size()) + " (" + JoinList(processes) + ")");

@@ -12,7 +12,7 @@
 //   duration: 120                        # seconds per trial (default 0: until the experimenter stops it)
 //   blind: true                          # the experimenter sees "condition A", not its name (default false)
 //   consent_required: true               # no trial records before consent is marked (default true)
-//   self_reports: after_event            # after_event | off: the subject's page asks after each release (default after_event)
+//   self_reports: after_event            # when the subject's page asks about the holds: SelfReports (self_reports.hpp)
 //   recorder: recorder                   # the graph's recorder component (default recorder)
 //   rehearsal:                           # `dyad study rehearse`: synthetic participants instead of people
 //     graph: ../demo.yaml                # the graph they are run on, stepped (default: the study's graph)
@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "dyad/diagnostic.hpp"
+#include "self_reports.hpp"
 
 namespace dyad::study {
 
@@ -60,7 +61,7 @@ struct Study {
   int trials = 1;
   double duration_s = 0;
   bool blind = false, consent_required = true;
-  std::string self_reports = "after_event";
+  SelfReports self_reports = SelfReports::kAfterEvent;
   std::string recorder = "recorder";  // the component whose `file` and `metadata` each trial sets
   std::vector<std::string> page_sets;  // "WEB.self_reports=MODE" for each `web` component of the graph
   std::vector<std::string> token_file_webs;  // web components without a token_file: one per participant is given

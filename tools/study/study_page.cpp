@@ -135,7 +135,9 @@ class StudyChannel final : public web::ClientHandler {
     worker_ = std::thread([this, r] {
       auto a = RunAttempt(study_, r);
       std::cout << "  trial " << r.trial.number << ": "
-                << (a.ok() ? a->outcome + " (" + std::to_string(static_cast<int>(std::lround(a->seconds))) + " s)" : a.status().ToString())
+                << (a.ok() ? std::string(ToString(a->outcome)) + " (" +
+                                 std::to_string(static_cast<int>(std::lround(a->seconds))) + " s)"
+                           : a.status().ToString())
                 << std::endl;
       {
         std::lock_guard<std::mutex> lock(error_mutex_);
@@ -159,8 +161,9 @@ class StudyChannel final : public web::ClientHandler {
       const bool now_running = running_.load() && current_trial_.load() == t.number;
       if (session.Complete(t.number)) status = "complete";
       else if (now_running) status = "running";
-      else if (last && last->outcome == "incomplete" && last->incomplete.rfind("no subject", 0) == 0) status = "no subject: repeat?";
-      else if (last) status = last->outcome.empty() ? "interrupted" : last->outcome;
+      else if (last && last->outcome == AttemptOutcome::kIncomplete && last->incomplete.rfind("no subject", 0) == 0)
+        status = "no subject: repeat?";
+      else if (last) status = last->outcome == AttemptOutcome::kUnended ? "interrupted" : std::string(ToString(last->outcome));
       done = done && session.Complete(t.number);
       trials.push_back({{"number", t.number},
                         {"shown", study_.Shown(study_.conditions[static_cast<size_t>(t.condition)])},
@@ -189,7 +192,7 @@ class StudyChannel final : public web::ClientHandler {
             {"withdrawn", session.withdrawn},
             {"notes", notes},
             {"duration_s", study_.duration_s},
-            {"after_trial", study_.self_reports == "after_trial"},
+            {"after_trial", study_.self_reports == SelfReports::kAfterTrial},
             {"trials", trials},
             {"running", running},
             {"done", done},

@@ -70,7 +70,7 @@ std::vector<std::string> RunSets(const Study& s, const AttemptRequest& r) {
   return sets;
 }
 
-bool AskedAfterTrial(const Study& s) { return s.self_reports == "after_trial"; }
+bool AskedAfterTrial(const Study& s) { return s.self_reports == SelfReports::kAfterTrial; }
 
 std::string GraphHash(const std::string& graph, const std::vector<std::string>& sets) {
   std::ifstream in(graph, std::ios::binary);
@@ -122,7 +122,7 @@ const Attempt* Session::Last(int trial) const {
 const Attempt* Session::Complete(int trial) const {
   const Attempt* done = nullptr;
   for (const Attempt& a : attempts)
-    if (a.trial == trial && a.outcome == "complete") done = &a;
+    if (a.trial == trial && a.outcome == AttemptOutcome::kComplete) done = &a;
   return done;
 }
 
@@ -178,7 +178,9 @@ Session ReadSession(const Study& s, const std::string& participant) {
                                  ", which never started");
           continue;
         }
-        a->outcome = j.at("outcome").get<std::string>();
+        auto outcome = ParseAttemptOutcome(j.at("outcome").get<std::string>());
+        if (!outcome.ok()) out.problems.push_back(where + outcome.status().message() + " (taken as failed)");
+        a->outcome = outcome.ok() ? *outcome : AttemptOutcome::kFailed;
         a->incomplete = j.value("incomplete", "");
         a->seconds = j.value("seconds", 0.0);
         a->exit = j.value("exit", 0);
@@ -245,7 +247,7 @@ Status AddNote(const Study& s, const std::string& participant, const std::string
   // The trial under way, as ReadSession places notes: the last attempt started and not ended.
   const Session now = ReadSession(s, participant);
   Json note = {{"event", "note"}, {"text", text}};
-  if (!now.attempts.empty() && now.attempts.back().outcome.empty()) note["trial"] = now.attempts.back().trial;
+  if (!now.attempts.empty() && now.attempts.back().outcome == AttemptOutcome::kUnended) note["trial"] = now.attempts.back().trial;
   return AppendSessionEvent(s, participant, Dump(note));
 }
 
@@ -411,14 +413,15 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   const bool stopped = forwarded > 0;
   const bool ended_well = a.exit == 0 || (stopped && a.exit == 128 + SIGINT);
   const bool asking = !r.rehearsal && AskedAfterTrial(s) && first_stop_s >= s.duration_s;
-  if (stopped && s.duration_s > 0 && !asking) a.outcome = "stopped";
-  else a.outcome = ended_well ? "complete" : "failed";
-  if (a.outcome == "complete") {
+  if (stopped && s.duration_s > 0 && !asking) a.outcome = AttemptOutcome::kStopped;
+  else a.outcome = ended_well ? AttemptOutcome::kComplete : AttemptOutcome::kFailed;
+  if (a.outcome == AttemptOutcome::kComplete) {
     auto recording = mcap::Reader::Open(a.file);
-    if (!recording.ok() || recording->recovery().truncated) a.outcome = "failed";
+    if (!recording.ok() || recording->recovery().truncated) a.outcome = AttemptOutcome::kFailed;
   }
-  if (a.outcome == "complete" && !(a.incomplete = NoSubject(a.file)).empty()) a.outcome = "incomplete";
-  Json end = {{"event", "end"}, {"trial", a.trial}, {"attempt", a.attempt}, {"outcome", a.outcome},
+  if (a.outcome == AttemptOutcome::kComplete && !(a.incomplete = NoSubject(a.file)).empty())
+    a.outcome = AttemptOutcome::kIncomplete;
+  Json end = {{"event", "end"}, {"trial", a.trial}, {"attempt", a.attempt}, {"outcome", std::string(ToString(a.outcome))},
               {"seconds", std::round(a.seconds * 10) / 10}, {"exit", a.exit}};
   if (!a.incomplete.empty()) end["incomplete"] = a.incomplete;
   if (Status st = AppendSessionEvent(s, r.participant, Dump(end)); !st.ok()) return st;

@@ -14,10 +14,9 @@
 // Consent and withdrawal: the later line holds. Exclusion and inclusion: the later line holds.
 // Each line is on disk (fdatasync, and the folder's entry when the log is new) before the call
 // that wrote it returns: a trial never starts on a consent a power cut could lose.
-// outcome: complete | stopped (the experimenter ended a timed trial early) | failed (the graph
-// exited non-zero other than after a stop, was killed, or left a recording cut short or none) |
-// incomplete (the run ended well, but nobody took part: NoSubject; "incomplete" says why).
-// A start without its end: the session itself ended mid-trial ("interrupted").
+// outcome: one word of AttemptOutcome (attempt_outcome.hpp says what each means); with
+// incomplete, "incomplete" says why (NoSubject). A start without its end: the session itself
+// ended mid-trial ("interrupted", AttemptOutcome::kUnended).
 //
 // Contract:
 //   - AttemptFile: attempt 1 of a trial records into Trial::file (DATA/P01/03-B.mcap), attempt k
@@ -58,6 +57,7 @@
 #include <vector>
 
 #include "dyad/status.hpp"
+#include "attempt_outcome.hpp"
 #include "study_file.hpp"
 
 namespace dyad::study {
@@ -65,7 +65,7 @@ namespace dyad::study {
 struct Attempt {
   int trial = 0, attempt = 0;
   std::string file, reason;  // reason: why this attempt repeats the trial (empty for the first)
-  std::string outcome;       // complete | stopped | failed | incomplete | "" (started, never ended)
+  AttemptOutcome outcome = AttemptOutcome::kUnended;  // kUnended: started, never ended
   std::string incomplete;    // outcome incomplete: why (NoSubject)
   double seconds = 0;
   int exit = 0;

@@ -10,6 +10,7 @@
 #include <memory>
 #include <thread>
 
+#include "exit_code.hpp"
 #include "run_process.hpp"
 #include "sweep_plan.hpp"
 #include "sweep_runner.hpp"
@@ -19,7 +20,8 @@ namespace dyad::cli {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr int kOk = 0, kFailure = 1, kBadInput = 2, kStopped = 130;
+using tools::ExitCode;
+using enum tools::ExitCode;
 
 struct Options {
   std::string file, out;
@@ -52,16 +54,16 @@ void Plots(const Options& o, const fs::path& out) {
 
 // A stop signal ended the jobs: what is missing, and how to finish them. `what(i)` names job i.
 template <typename What>
-int Stopped(const std::string& name, const sweep::RunnerResult& r, const std::string& jobs, What what) {
+ExitCode Stopped(const std::string& name, const sweep::RunnerResult& r, const std::string& jobs, What what) {
   std::cout << "sweep " << name << ": stopped by " << (r.signal == SIGINT ? "SIGINT" : "SIGTERM") << ": " << r.ran << " ran, "
             << r.skipped << " done before, " << r.failed << " failed, " << r.not_done.size() << " " << jobs << " missing:\n";
   for (size_t i : r.not_done) std::cout << "  " << what(i) << "\n";
   std::cout << "the finished ones are kept: the same command again runs the missing ones\n" << std::flush;
-  return kStopped;
+  return kInterrupted;  // for SIGTERM too: its runs were stopped as by Ctrl-C
 }
 
 // The runs of `plan` here, `workers` at once; with `table`, then sweep.csv and the plots.
-int RunHere(const Options& o, const sweep::SweepPlan& plan, const fs::path& out, int workers, bool table) {
+ExitCode RunHere(const Options& o, const sweep::SweepPlan& plan, const fs::path& out, int workers, bool table) {
   sweep::StopOnSignals stop_on_signals;
   std::error_code ec;
   if (fs::create_directories(out / "runs", ec); ec) {
@@ -102,7 +104,7 @@ int RunHere(const Options& o, const sweep::SweepPlan& plan, const fs::path& out,
 }
 
 // --collect: the table of what the runs left in OUT (the Slurm array's last job, or by hand).
-int Collect(const Options& o, const sweep::SweepPlan& plan, const fs::path& out) {
+ExitCode Collect(const Options& o, const sweep::SweepPlan& plan, const fs::path& out) {
   if (!fs::is_directory(out / "runs")) {
     std::cerr << "dyad sweep --collect: " << out.string() << ": no runs in this folder (none has started yet, or -o names another)\n";
     return kFailure;
@@ -126,7 +128,7 @@ int Collect(const Options& o, const sweep::SweepPlan& plan, const fs::path& out)
 }
 
 // --train-only: the models (this task's chunk of them), no runs: a Slurm training task.
-int TrainOnly(const Options& o, const sweep::SweepPlan& plan, const fs::path& out, int workers, sweep::TaskSlice task) {
+ExitCode TrainOnly(const Options& o, const sweep::SweepPlan& plan, const fs::path& out, int workers, sweep::TaskSlice task) {
   sweep::StopOnSignals stop_on_signals;
   const auto trainings = o.task.empty() ? plan.trainings : sweep::TaskChunk(plan.trainings, task);
   std::cout << "sweep " << plan.name << ": " << trainings.size() << " of " << plan.trainings.size() << " models into "
@@ -137,7 +139,7 @@ int TrainOnly(const Options& o, const sweep::SweepPlan& plan, const fs::path& ou
   return r.failed > 0 ? kFailure : kOk;
 }
 
-int Submit(const Options& o, const sweep::SweepPlan& plan, const fs::path& file, const fs::path& out) {
+ExitCode Submit(const Options& o, const sweep::SweepPlan& plan, const fs::path& file, const fs::path& out) {
   auto job = sweep::SubmitToSlurm(plan, file.string(), out.string(), tools::ThisExecutable(), o.plugins, o.plots, o.slurm_options);
   if (!job.ok()) {
     std::cerr << "dyad sweep --slurm: " << job.status().message() << "\n";
@@ -153,7 +155,7 @@ int Submit(const Options& o, const sweep::SweepPlan& plan, const fs::path& file,
   return kOk;
 }
 
-int RunSweepCommand(Options o) {
+ExitCode RunSweepCommand(Options o) {
   std::error_code ec;
   const fs::path file = fs::absolute(o.file, ec);
   // Paths in the sweep file (its graph, its set: values) are relative to it, as a graph's are.
@@ -231,7 +233,7 @@ void AddSweepCommands(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(1, 1024))->group(group)->needs(slurm);
   cmd->add_option("--sbatch-arg", o->slurm_options.sbatch_args, "Another #SBATCH line, e.g. --sbatch-arg=--account=lab (repeatable)")
       ->group(group)->needs(slurm);
-  cmd->callback([o, &exit_code] { exit_code = RunSweepCommand(*o); });
+  cmd->callback([o, &exit_code] { exit_code = tools::Code(RunSweepCommand(*o)); });
 }
 
 }  // namespace dyad::cli

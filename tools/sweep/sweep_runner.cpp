@@ -21,6 +21,7 @@
 #include "build_report.hpp"
 #include "job_end.hpp"
 #include "run_process.hpp"
+#include "run_status.hpp"
 #include "text_output.hpp"
 
 namespace dyad::sweep {
@@ -264,7 +265,7 @@ RunnerResult TrainModels(const SweepPlan& plan, const std::vector<SweepTraining>
 Status WriteSweepCsv(const SweepPlan& plan, const std::string& out) {
   std::vector<std::string> metric_names;
   std::vector<nlohmann::ordered_json> metrics(plan.runs.size());
-  std::vector<std::string> status(plan.runs.size(), "missing");
+  std::vector<RunStatus> status(plan.runs.size(), RunStatus::kMissing);
   for (size_t i = 0; i < plan.runs.size(); ++i) {
     const fs::path dir = fs::path(out) / "runs" / plan.runs[i].id;
     std::ifstream in(dir / "metrics.json");
@@ -274,11 +275,11 @@ Status WriteSweepCsv(const SweepPlan& plan, const std::string& out) {
       // A recording cut short or shorter than planned: its numbers are in the table, marked, and
       // out of the plots (which take the `ok` rows).
       std::error_code ec;
-      status[i] = fs::exists(dir / "report" / "incomplete.txt", ec) ? "incomplete" : "ok";
+      status[i] = fs::exists(dir / "report" / "incomplete.txt", ec) ? RunStatus::kIncomplete : RunStatus::kOk;
       if (metric_names.empty())
         for (const auto& [name, value] : metrics[i].items()) metric_names.push_back(name);
     } else if (std::error_code ec; fs::exists(dir / "failed.txt", ec)) {
-      status[i] = "failed";
+      status[i] = RunStatus::kFailed;
     }
   }
   std::ostringstream csv;
@@ -289,7 +290,7 @@ Status WriteSweepCsv(const SweepPlan& plan, const std::string& out) {
   csv << '\n';
   for (size_t i = 0; i < plan.runs.size(); ++i) {
     const SweepRun& run = plan.runs[i];
-    csv << run.id << ',' << status[i];
+    csv << run.id << ',' << ToString(status[i]);
     for (const auto& p : plan.parameters) {
       std::string v;
       for (const auto& [k, value] : run.params)

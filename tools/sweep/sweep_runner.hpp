@@ -26,7 +26,7 @@
 // <id>.log, and <id>.failed.txt when it failed). The model file appears whole or not at all
 // (dyad train writes it by rename), so its presence means it trained.
 // Contract of WriteSweepCsv: OUT/sweep.csv, one row per run in the plan's order (not the order
-// they finished): run, status (ok, failed, missing), each swept key, seed, then every metric of
+// they finished): run, status (RunStatus, run_status.hpp), each swept key, seed, then every metric of
 // metrics.json in its order (empty where a run has none). The same runs give the same file
 // whatever the workers, and after a resume.
 #pragma once

@@ -239,7 +239,7 @@ TEST_F(StudySession, TrialsWithoutASubjectsPageAreIncompleteInTheLogAndTheAnalys
     auto a = RunAttempt(s, r);
     ASSERT_TRUE(a.ok()) << a.status().ToString();
     EXPECT_EQ(a->exit, 0) << r.run_log;
-    EXPECT_EQ(a->outcome, "incomplete") << r.run_log;
+    EXPECT_EQ(a->outcome, AttemptOutcome::kIncomplete) << r.run_log;
     EXPECT_EQ(a->incomplete, kNoEngagedStep);
   }
   const auto log = LogLines(SessionLogPath(s, "P01"));

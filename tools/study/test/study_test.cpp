@@ -18,6 +18,7 @@
 
 #include <dyad/msg/types.hpp>
 
+#include "attempt_outcome.hpp"
 #include "bootstrap.hpp"
 #include "dyad/testing/cli.hpp"
 #include "dyad/testing/csv.hpp"
@@ -26,6 +27,7 @@
 #include "dyad/pvrnn/dataset.hpp"
 #include "dyad/testing/mcap_channel.hpp"
 #include "latin_square.hpp"
+#include "self_reports.hpp"
 #include "study_commands.hpp"
 #include "study_analysis.hpp"
 #include "study_file.hpp"
@@ -715,6 +717,71 @@ TEST_F(StudyFile, BlindListingsAreSortedByLabelNotInTheFilesOrder) {
   std::ifstream md(dir_ / "out" / "report.md");
   const std::string report((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
   EXPECT_TRUE(in_order(report, {"| condition A |", "| condition B |", "| condition C |"})) << report;
+}
+
+// The closed sets of a study, one table each: every value has its word, the word reads back to
+// it, and a word outside says which are allowed (the words the study file's error lists).
+TEST(ClosedSets, EveryValueReadsBackFromItsWordAndOthersAreRefusedWithTheList) {
+  for (const AttemptOutcome o :
+       {AttemptOutcome::kComplete, AttemptOutcome::kStopped, AttemptOutcome::kFailed, AttemptOutcome::kIncomplete}) {
+    auto back = ParseAttemptOutcome(ToString(o));
+    ASSERT_TRUE(back.ok()) << ToString(o);
+    EXPECT_EQ(*back, o) << ToString(o);
+  }
+  EXPECT_EQ(ToString(AttemptOutcome::kUnended), "");  // never written: a start without its end
+  EXPECT_FALSE(ParseAttemptOutcome("").ok());
+  EXPECT_EQ(ParseAttemptOutcome("done").status().message(), "outcome \"done\": must be complete, stopped, failed or incomplete");
+  for (const SelfReports w : {SelfReports::kAfterEvent, SelfReports::kAfterTrial, SelfReports::kOff}) {
+    auto back = ParseSelfReports(ToString(w));
+    ASSERT_TRUE(back.ok()) << ToString(w);
+    EXPECT_EQ(*back, w) << ToString(w);
+  }
+  EXPECT_EQ(ParseSelfReports("sometimes").status().message(), "must be after_event, after_trial or off");
+}
+
+// A session log whose end line has a word that is no outcome: said (file:line), and the attempt
+// is not complete (it is run again), where it used to be taken as it was, silently.
+TEST_F(StudyFile, AnOutcomeThatIsNoOutcomeIsAProblemOfTheLog) {
+  const std::string f = Write("study: gain\ngraph: g.yaml\nparticipants: [P01]\nconditions:\n  low: {src.start: 1}\n");
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy(f, {}, &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"start","trial":1,"attempt":1,"file":"x.mcap"})").ok());
+  ASSERT_TRUE(AppendSessionEvent(s, "P01", R"({"event":"end","trial":1,"attempt":1,"outcome":"Complete","seconds":1})").ok());
+  const Session read = ReadSession(s, "P01");
+  ASSERT_EQ(read.problems.size(), 1u);
+  EXPECT_NE(read.problems[0].find("session.log:2: outcome \"Complete\": must be complete, stopped, failed or incomplete"),
+            std::string::npos)
+      << read.problems[0];
+  ASSERT_EQ(read.attempts.size(), 1u);
+  EXPECT_EQ(read.attempts[0].outcome, AttemptOutcome::kFailed);
+  EXPECT_EQ(read.Complete(1), nullptr);
+}
+
+// One failure, one exit code (tools/support/exit_code.hpp): a trial that cannot start for want of
+// a session log it can write (here a folder where the log should be) is a failure (1), whether
+// the trial comes in its order or is repeated with --trial; the --trial path said bad input (2).
+// A trial the plan's order refuses is bad input (2) either way.
+TEST_F(StudyFile, ATrialThatCannotStartExitsOneInOrderAndWithTrial) {
+  const std::string f = Write(
+      "study: gain\ngraph: g.yaml\nparticipants: [P01]\nconditions:\n  low: {src.start: 1}\n"
+      "  high: {src.start: 3}\nconsent_required: false\n");
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy(f, {}, &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  fs::create_directories(SessionLogPath(s, "P01"));  // no file can be appended to there
+  auto in_order = dyad::testing::RunCommand(dyad::cli::AddStudyCommands, {"study", "run", f, "--participant", "P01", "--yes"});
+  EXPECT_EQ(in_order.code, 1) << in_order.err;
+  EXPECT_NE(in_order.err.find("session.log"), std::string::npos) << in_order.err;
+  auto repeated = dyad::testing::RunCommand(dyad::cli::AddStudyCommands,
+                                            {"study", "run", f, "--participant", "P01", "--trial", "1", "--reason", "again"});
+  EXPECT_EQ(repeated.code, 1) << repeated.err;
+  EXPECT_NE(repeated.err.find("session.log"), std::string::npos) << repeated.err;
+  fs::remove(SessionLogPath(s, "P01"));
+  auto out_of_order = dyad::testing::RunCommand(dyad::cli::AddStudyCommands,
+                                                {"study", "run", f, "--participant", "P01", "--trial", "2", "--reason", "first"});
+  EXPECT_EQ(out_of_order.code, 2) << out_of_order.err;
+  EXPECT_NE(out_of_order.err.find("trial 1 comes first"), std::string::npos) << out_of_order.err;
 }
 
 }  // namespace
