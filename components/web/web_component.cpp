@@ -9,6 +9,7 @@
 #include <mutex>
 #include <optional>
 #include <set>
+#include <thread>
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -162,6 +163,12 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Param("task_countdown_s", 0.0).Range(0, 3600).Unit("s").Live().Doc(
       "subject's page: setting it starts a countdown of that many seconds, then \"go\" (the same value again restarts it)");
   spec.Param("practice", false).Live().Doc("subject's page says \"practice\"; dyad analyze leaves the events meanwhile out (the `task` output recorded)");
+  spec.Param("wait_for_subject_s", 0.0)
+      .Range(0, 3600)
+      .Unit("s")
+      .Doc(
+          "the run's clock starts only once a page steers (the subject's, reconnecting), waiting at most this long; 0: no wait "
+          "(dyad study run sets it for each trial of a session)");
   spec.Input<msg::CartesianState>("robot").Optional().Doc("robot state shown on the subject's page");
   spec.Output<msg::SubjectTask>("task").Optional().Doc(
       "what the subject's page shows besides the robot (target, message, countdown, practice): at the start and each change; "
@@ -576,7 +583,22 @@ Status WebComponent::Activate() {
     f << server_->port() << "\n";
     if (!f) return Status::IOError("params.port_file = '" + port_file_ + "': cannot write");
   }
+  WaitForSubject(ctx_->params().Double("wait_for_subject_s"));
   return Status::OK();
+}
+
+// In Activate, so the run's clock (which starts once every component is active) and the
+// trial's first step wait for the subject's page: a page already open (a study's session-long
+// link) reconnects within a second of the server starting.
+void WebComponent::WaitForSubject(double seconds) {
+  if (seconds <= 0) return;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!subject_->steered() && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  if (subject_->steered()) ctx_->log().Info("the subject's page is there: the run starts");
+  else
+    ctx_->log().Warn("no subject's page steers after " + std::to_string(std::lround(seconds)) +
+                     " s (params.wait_for_subject_s): the run starts without one");
 }
 
 Status WebComponent::Step(const StepInfo& info) {

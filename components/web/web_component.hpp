@@ -76,6 +76,7 @@ class WebComponent final : public Component {
   Status ChooseTokens(const Params& p);
   Status ChooseTls(const Params& p);
   void LogUrls() const;
+  void WaitForSubject(double seconds);    // params.wait_for_subject_s
   std::string token_file_;                // params.token_file
   std::map<Role, std::string> shown_;     // what the printed URLs show for each token (see ChooseTokens)
   std::string token_file_text_;           // what Activate writes to a token_file that did not exist; empty: none

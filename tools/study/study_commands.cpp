@@ -487,6 +487,7 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   auto* page = run->add_flag("--page", r->page, "Run the session from the experimenter's study page (its URL is printed) instead of the terminal");
   run->add_option("--page-port", r->page_options.port, "The study page's port (0: any free one)")->check(CLI::Range(0, 65535))->needs(page);
   run->add_option("--page-port-file", r->page_options.port_file, "Write the study page's port here")->needs(page);
+  run->add_option("--subject-port", r->page_options.subject_port, "The subject's port")->check(CLI::Range(0, 65535))->needs(page);
   page->excludes("--yes")->excludes("--trial");
   run->callback([r, &exit_code] { exit_code = tools::Code(RunSession(*r)); });
   auto n = std::make_shared<ParticipantOptions>();

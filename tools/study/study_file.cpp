@@ -114,6 +114,23 @@ void ReadConditions(StrictYaml& y, const YAML::Node& root, const std::vector<std
   }
 }
 
+// The session-long subject's link (subject_lobby.hpp): the graph's one web component, when a
+// person steers from its page, the runner gives it its token file and it speaks plain HTTP.
+void ChooseSubjectWeb(const Graph& graph, const std::vector<std::string>& webs, bool subject_steers, Study* s) {
+  if (webs.size() != 1 || !subject_steers || s->token_file_webs.size() != 1) return;
+  for (const ComponentConfig& c : graph.components) {
+    if (c.name != webs[0]) continue;
+    if (c.params && c.params["tls_certificate"]) return;
+    s->subject_web = c.name;
+    try {
+      if (c.params && c.params["address"]) s->subject_address = c.params["address"].as<std::string>();
+      if (c.params && c.params["port"]) s->subject_port = c.params["port"].as<int>();
+    } catch (const YAML::Exception&) {
+      s->subject_web.clear();  // the graph's own check says what is wrong
+    }
+  }
+}
+
 // `recorder` and `rehearsal`, after the conditions: the rehearsal graph is checked against each.
 void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& path, const std::vector<std::string>& plugins,
                    const std::set<std::string>& bad_conditions, Study* s) {
@@ -127,6 +144,7 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
     std::vector<Diagnostic> ignored;  // the graph's own problems were said above
     std::vector<std::string> webs, answering;  // the web components; those whose answers are recorded
     std::set<std::string> processes;
+    bool subject_steers = false;  // a web_human: a person steers from the subject's page
     const Graph graph = LoadGraph(s->graph, {}, &ignored);
     for (const ComponentConfig& c : graph.components) {
       processes.insert(graph.ProcessOf(c));
@@ -142,7 +160,9 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
         // pages reconnect to the next trial's graph.
         if (!c.params || !c.params["token_file"]) s->token_file_webs.push_back(c.name);
       }
+      subject_steers = subject_steers || c.type == "web_human";
     }
+    ChooseSubjectWeb(graph, webs, subject_steers, s);
     // The one page that asks after the trial also ends it: two would end it at the first's end.
     if (s->self_reports == SelfReports::kAfterTrial && (webs.size() != 1 || answering.size() != 1))
       y.Error(root["self_reports"], "self_reports",

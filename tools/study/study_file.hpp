@@ -65,6 +65,11 @@ struct Study {
   std::string recorder = "recorder";  // the component whose `file` and `metadata` each trial sets
   std::vector<std::string> page_sets;  // "WEB.self_reports=MODE" for each `web` component of the graph
   std::vector<std::string> token_file_webs;  // web components without a token_file: one per participant is given
+  // The web component whose subject's page a person steers from (the graph's one `web`, with a
+  // `web_human`, given a token file, without TLS): `dyad study run --page` serves that page
+  // between trials on its address and port (subject_lobby.hpp). Empty: none.
+  std::string subject_web, subject_address = "127.0.0.1";
+  int subject_port = 8765;            // its params.port (the web component's default)
   std::string rehearsal_graph;        // absolute; the study's graph unless the file names another
   std::vector<std::string> rehearsal_sets;
   int square_rows = 1;  // rows of the Latin square: participants in multiples of it are balanced

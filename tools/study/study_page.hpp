@@ -35,6 +35,9 @@ struct PageOptions {
   std::string address = "127.0.0.1";
   int port = 8770;                   // 0: any free port
   std::string port_file;             // written with the bound port (tests, scripts)
+  // The subject's page between trials (subject_lobby.hpp) binds the graph's web component's
+  // port, which each trial's graph is then given: -1 its params.port (8765 by default), 0 any free one.
+  int subject_port = -1;
 };
 
 // Serves the page until SIGINT/SIGTERM between trials; returns the process exit code.

@@ -67,6 +67,9 @@ std::vector<std::string> RunSets(const Study& s, const AttemptRequest& r) {
   sets.insert(sets.end(), s.page_sets.begin(), s.page_sets.end());
   for (const std::string& web : s.token_file_webs)
     sets.push_back(web + ".token_file=" + tools::YamlQuoted((fs::path(s.data) / r.participant / (web + "-tokens")).string()));
+  if (!s.subject_web.empty() && r.subject_port > 0) sets.push_back(s.subject_web + ".port=" + std::to_string(r.subject_port));
+  if (!s.subject_web.empty() && r.wait_for_subject_s > 0)
+    sets.push_back(s.subject_web + ".wait_for_subject_s=" + tools::SetText(YAML::Node(r.wait_for_subject_s)));
   return sets;
 }
 
@@ -375,6 +378,7 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   if (Status st = CreatePrivateDirectories(fs::path(a.file).parent_path().string()); !st.ok()) return st;
   Json start = {{"event", "start"}, {"trial", a.trial}, {"attempt", a.attempt}, {"file", a.file}};
   if (!a.reason.empty()) start["reason"] = a.reason;
+  if (r.start_anyway) start["start_anyway"] = "without the subject's page";
   if (Status st = AppendSessionEvent(s, r.participant, Dump(start)); !st.ok()) return st;
 
   const auto t0 = std::chrono::steady_clock::now();

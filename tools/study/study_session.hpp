@@ -5,6 +5,7 @@
 // (created 0600):
 //   {"time":"2026-11-26T20:31:05Z","event":"consent","how":"..."}
 //   {"time":...,"event":"start","trial":3,"attempt":2,"file":"/abs/03-B.try2.mcap","reason":"..."}
+//   {"time":...,"event":"start",...,"start_anyway":"without the subject's page"}  the experimenter's choice
 //   {"time":...,"event":"end","trial":3,"attempt":2,"outcome":"complete","seconds":120.0,"exit":0}
 //   {"time":...,"event":"end",...,"outcome":"incomplete","incomplete":"no subject: ..."}  nobody took part
 //   {"time":...,"event":"note","text":"...","trial":3}       the experimenter's (dyad study note, the page);
@@ -116,6 +117,11 @@ struct AttemptRequest {
   std::vector<std::string> extra_sets;  // after the condition's (a rehearsal's seed)
   std::string run_log;      // the graph's output; empty: the terminal
   const std::atomic<bool>* stop = nullptr;  // set: stop the trial as SIGINT does (the study page's Stop)
+  // The session's subject's link (subject_lobby.hpp): the study's subject_web binds this port
+  // (> 0), and its clock waits up to wait_for_subject_s for the page (0: no wait).
+  int subject_port = 0;
+  double wait_for_subject_s = 0;
+  bool start_anyway = false;  // started without the subject's page: the start line says so
 };
 
 // Why a trial's whole recording is no data ("" when someone took part): its graph has a subject's

@@ -89,6 +89,11 @@ size_t SubjectChannel::pages() const {
   return pages_.size();
 }
 
+bool SubjectChannel::steered() const {
+  MutexLock lock(mutex_);
+  return steering_ != 0;
+}
+
 SubjectChannel::PointerDelays SubjectChannel::pointer_delays() const {
   MutexLock lock(mutex_);
   return delays_;

@@ -83,6 +83,8 @@ class SubjectChannel final : public ClientHandler {
   // Sends it to every page, and to every page that opens later.
   void SetTask(const Task& task);
   size_t pages() const;
+  // Whether a page steers now (the web component's wait_for_subject_s waits for one).
+  bool steered() const;
   // After the trial (see the file comment). EndSteering: no page steers any more (a hold under
   // way ends now, through the PointerSink). AskAfterTrial: ends the steering if not yet, then
   // asks about each hold in turn (none: thanks at once). Each acts once per channel.

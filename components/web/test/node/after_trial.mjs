@@ -111,7 +111,7 @@ try {
     out.titles.push(await title());
     await page.screenshot({ path: `${shotDir}/after_trial_thanks.png` });
     // The graph ends by itself; the thanks stay on the page after it is gone.
-    await page.waitForFunction(() => document.getElementById("role").textContent.startsWith("disconnected"), null, { timeout: 20000 });
+    await page.waitForFunction(() => document.body.dataset.link === "closed", null, { timeout: 20000 });
     out.thanks_after_end = await title();
   } else {
     const experimenter = await context.newPage();
@@ -129,7 +129,7 @@ try {
     out.experimenter_says = await experimenter.evaluate(() => document.getElementById("subject").textContent);
     out.button_disabled = await experimenter.evaluate(() => document.getElementById("asknow").disabled);
     // Unanswered: the timeout ends the run; the question goes with it.
-    await page.waitForFunction(() => document.getElementById("role").textContent.startsWith("disconnected"), null, { timeout: 20000 });
+    await page.waitForFunction(() => document.body.dataset.link === "closed", null, { timeout: 20000 });
     out.asking_after_end = await asking();
   }
 } finally {
