@@ -4,6 +4,7 @@
 // its permissions do not grant; and on the wire (loopback, captured as root) the component name
 // every sample carries is never in clear, while the same run without security shows it.
 #include <csignal>
+#include <tuple>
 
 #include "process_fixture.hpp"
 
@@ -150,6 +151,64 @@ TEST_F(SecurityTest, NothingOnTheWireIsInClear) {
   };
   EXPECT_GT(marked(open), 50) << "without security the marker is on the wire (the check can fail)";
   EXPECT_EQ(marked(secured), 0) << "with security no packet carries the marker in clear";
+  EXPECT_GT(ReadSink(dir_ / "sink.txt").size(), 100u);
+}
+
+// Nothing named in clear (dyad/wire_names.hpp, docs/security.md "Names on the wire"): a secured
+// run placed on a host of its own, over UDP on loopback, with a stranger (an identity of another
+// CA) trying to join it all along, captured as root: no frame carries the graph's name, a
+// process's or the host's; the same run unsecured does (so the check can fail). The graph's own
+// watcher still reads its peers' names (the start barrier and dyad status match by them).
+TEST_F(SecurityTest, NoFrameNamesTheGraphItsProcessesOrItsHost) {
+  if (geteuid() != 0) GTEST_SKIP() << "capturing loopback packets needs root (AF_PACKET)";
+  const std::string tag = std::to_string(getpid());
+  const std::string name = "hush" + tag, pa = "alpha" + tag, pb = "bravo" + tag, host = "lab" + tag;
+  auto graph = [&](const std::string& graph_name, const std::string& keystore) {
+    std::string g = "graph: " + graph_name + "\ndomain_id: " + std::to_string(domain_) + "\n";
+    g += "network: {transport: udp, hosts: {" + host + ": 127.0.0.1}}\n";
+    if (!keystore.empty()) g += "security: {keystore: " + keystore + "}\n";
+    g += "processes:\n  " + pa + ": {host: " + host + "}\n  " + pb + ": {host: " + host + "}\ncomponents:\n";
+    g += "  src: {type: counter_source, rate_hz: 50, process: " + pa + ", outputs: {out: ca}}\n";
+    g += "  sink: {type: counter_sink, trigger: in, process: " + pb + ", params: {file: " + (dir_ / "sink.txt").string() + "}, ";
+    return g + "inputs: {in: ca}}\n";
+  };
+  const fs::path secured = Write("g.yaml", graph(name, "keys")), open = Write("open.yaml", graph(name, ""));
+  const fs::path stranger = Write("stranger.yaml", graph("stranger" + tag, "stranger_keys"));
+  ASSERT_EQ(Init(dir_ / "keys", secured), 0);
+  ASSERT_EQ(Init(dir_ / "stranger_keys", stranger), 0);
+  const std::string markers = name + "," + pa + "," + pb + "," + host;
+  // Frames naming any of them, over 10 s around a 7 s run; the stranger knocks all along.
+  auto naming = [&](const fs::path& g, const std::string& label) {
+    Child capture({"/usr/bin/python3", DYAD_CAPTURE_MARKER, markers, "10"}, dir_, "capture_" + label);
+    EXPECT_TRUE(capture.WaitForOutput("capturing", 10)) << capture.err();
+    Child run(Dyad({"run", g.string(), "--host", host, "--duration", "7", "--quiet"}), dir_, "run_" + label);
+    // The graph's own watcher lists the writer of ca by its participant's name, read back.
+    Child topics(Dyad({"topics", "--graph", g.string(), "--host", host, "--wait", "4"}), dir_, "topics_" + label);
+    for (int i = 0; i < 3; ++i) {
+      Child knock(Dyad({"echo", "ca", "--graph", stranger.string(), "--host", host, "--count", "1", "--wait", "1.5"}), dir_,
+                  "knock_" + label + std::to_string(i));
+      EXPECT_NE(knock.Wait(60), 0) << "the stranger heard the graph:\n" << knock.out();
+    }
+    topics.Wait(60);
+    const std::string heard = topics.out() + topics.err();
+    EXPECT_EQ(run.Wait(60), 0) << run.err();
+    EXPECT_EQ(capture.Wait(30), 0) << capture.err();
+    std::istringstream words(capture.out().substr(capture.out().find("packets")));
+    std::string w1, w2;
+    int packets = -1, count = -1;
+    words >> w1 >> packets >> w2 >> count;
+    EXPECT_GT(packets, 100) << capture.out();
+    return std::make_tuple(count, capture.out(), heard);
+  };
+  const auto [open_count, open_out, open_topics] = naming(open, "open");
+  EXPECT_GT(open_count, 20) << "without security the names are on the wire (the check can fail):\n" << open_out;
+  for (const std::string& m : {name, pa, pb, host})
+    EXPECT_EQ(open_out.find("marker " + m + " 0\n"), std::string::npos) << m << " not seen unsecured:\n" << open_out;
+  const auto [secured_count, secured_out, secured_topics] = naming(secured, "secured");
+  EXPECT_EQ(secured_count, 0) << "a secured run names something of the graph in clear:\n" << secured_out;
+  // Its own watcher reads the names back from the opaque ones.
+  EXPECT_NE(secured_topics.find("dyad/" + name + "/" + pa), std::string::npos) << secured_topics;
+  EXPECT_NE(open_topics.find("dyad/" + name + "/" + pa), std::string::npos) << open_topics;
   EXPECT_GT(ReadSink(dir_ / "sink.txt").size(), 100u);
 }
 

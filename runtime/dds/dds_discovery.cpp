@@ -1,5 +1,6 @@
 // Discovery and its reports (DdsParticipant::DiscoveryListener, dds_internal.hpp): the endpoints
-// discovered on the domain (Discovered()), the names of their participants, and the problems that
+// discovered on the domain (Discovered()), the names of their participants (a secured graph's read
+// back from their opaque names on the wire: dyad/wire_names.hpp), and the problems that
 // stop data where it should flow, reported through Options::on_problem: a remote endpoint on one
 // of our topics with another type (same IDL name, other hash: a layout change, which Fast DDS
 // would match silently or never match and say nothing), an incompatible QoS; and, through
@@ -9,6 +10,7 @@
 #include "dds/dds_internal.hpp"
 
 #include <dyad/ros2_names.hpp>
+#include <dyad/wire_names.hpp>
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -68,8 +70,12 @@ std::string PartitionText(const std::vector<std::string>& names) {
 
 void DdsParticipant::DiscoveryListener::on_participant_discovery(fdds::DomainParticipant*,
                                                                  rtps::ParticipantDiscoveryInfo&& info) {
+  // In a secured graph a peer's name on the wire is opaque; ours read back, others' kept as they are.
+  std::string name = info.info.m_participantName.to_string();
+  if (!names_key_.empty())
+    if (std::string readable = ReadableName(names_key_, name); !readable.empty()) name = readable;
   std::lock_guard<std::mutex> lock(mutex_);
-  names_[GuidPrefixString(info.info.m_guid.guidPrefix)] = info.info.m_participantName.to_string();
+  names_[GuidPrefixString(info.info.m_guid.guidPrefix)] = name;
 }
 
 // Remote endpoints are named by their DDS topic; ours by the graph's topic (a ROS 2 topic's

@@ -34,7 +34,9 @@ StatusOr<std::unique_ptr<DdsParticipant>> DdsParticipant::Create(int domain_id, 
   qos.name(name);
   p->scope_ = scope;
   p->secured_ = options.security.enabled();
-  ApplySecurity(options.security, &qos);
+  auto names_key = ApplySecurity(options.security, &qos);  // in a secured graph, qos's name is opaque
+  if (!names_key.ok()) return names_key.status().WithContext("DDS participant '" + name + "'");
+  p->listener_->ReadNamesWith(names_key.value());
   // A stepped run stays inside its process: the network section does not concern it.
   if (scope != Scope::kProcessOnly)
     if (Status s = ApplyNetwork(network, scope == Scope::kWatcher, &qos, process); !s.ok()) return s;

@@ -2,15 +2,24 @@
 
 #include "dds/dds_participant.hpp"
 
+#include <filesystem>
 #include <string>
+
+#include <dyad/wire_names.hpp>
 
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 
 namespace dyad {
 
-void ApplySecurity(const IdentityFiles& identity, eprosima::fastdds::dds::DomainParticipantQos* qos) {
-  if (!identity.enabled()) return;
+StatusOr<std::string> ApplySecurity(const IdentityFiles& identity, eprosima::fastdds::dds::DomainParticipantQos* qos) {
+  if (!identity.enabled()) return std::string();
+  auto key = ReadNamesKey((std::filesystem::path(identity.identity_ca).parent_path() / kNamesKeyFile).string());
+  if (!key.ok()) return key.status();
+  qos->name(WireName(key.value(), qos->name().to_string()));
   auto& p = qos->properties().properties();
+  // Fast DDS fills these (when present and empty) with the host's and user's names and the pid,
+  // and announces them in clear.
+  std::erase_if(p, [](const eprosima::fastrtps::rtps::Property& x) { return x.name().rfind("fastdds.physical_data.", 0) == 0; });
   auto set = [&p](const std::string& name, const std::string& value) { p.emplace_back(name, value); };
   const std::string uri = "file://";
   set("dds.sec.auth.plugin", "builtin.PKI-DH");
@@ -22,6 +31,7 @@ void ApplySecurity(const IdentityFiles& identity, eprosima::fastdds::dds::Domain
   set("dds.sec.access.builtin.Access-Permissions.governance", uri + identity.governance);
   set("dds.sec.access.builtin.Access-Permissions.permissions", uri + identity.permissions);
   set("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+  return key;
 }
 
 // The security room of DdsParticipant (dds_internal.hpp): what an endpoint refused on a secured

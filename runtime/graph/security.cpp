@@ -1,5 +1,7 @@
 #include <dyad/security.hpp>
 
+#include <dyad/wire_names.hpp>
+
 #include <fnmatch.h>
 #include <sys/stat.h>
 
@@ -136,6 +138,10 @@ std::vector<std::string> CheckKeystore(const Graph& graph, int64_t now_s) {
                        graph.security.keystore + " --graph " + graph.file + "`)");
     return problems;
   }
+  // Every participant's name on the wire is made with it (dyad/wire_names.hpp).
+  if (std::string problem = CheckFile(FileIn(graph.security.keystore, kNamesKeyFile), true); !problem.empty())
+    problems.push_back(problem + " (the keystore's names key: make it with `dyad security init " + graph.security.keystore +
+                       " --graph " + graph.file + "`)");
   std::set<std::string> checked;
   for (const std::string& identity : GraphIdentities(graph)) {
     const IdentityFiles f = IdentityOf(graph, identity);

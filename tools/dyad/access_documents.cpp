@@ -68,7 +68,7 @@ std::string GovernanceXml() {
   return x.str();
 }
 
-std::string PermissionsXml(const Graph& graph, const std::string& identity,
+std::string PermissionsXml(const Graph& graph, const std::string& identity, const std::string& subject,
                            const std::map<std::string, TopicAccess>& access, const std::string& not_before,
                            const std::string& not_after) {
   std::set<std::string> publish, subscribe;
@@ -88,16 +88,14 @@ std::string PermissionsXml(const Graph& graph, const std::string& identity,
     publish = kLauncherWrites;
     subscribe = {"*"};
   }
-  const std::string partition = "dyad/" + graph.name + "/*";
+  // Sent in clear in every handshake: it names nothing of the graph (access_documents.hpp).
+  const std::string partition = "dyad/*";
   std::ostringstream x;
   x << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-       "<!-- dyad security init: what "
-    << Escaped(identity) << " of graph " << Escaped(graph.name)
-    << " may publish and subscribe -->\n"
        "<dds xmlns:xsi=\"http://www.w3.org/2001/XMLSchema-instance\" "
        "xsi:noNamespaceSchemaLocation=\"http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_permissions.xsd\">\n"
-       "  <permissions>\n    <grant name=\""
-    << Escaped(identity) << "\">\n      <subject_name>" << Escaped(IdentitySubject(graph, identity)) << "</subject_name>\n"
+       "  <permissions>\n    <grant name=\"grant\">\n      <subject_name>"
+    << Escaped(subject) << "</subject_name>\n"
     << "      <validity>\n        <not_before>" << not_before << "</not_before>\n        <not_after>" << not_after
     << "</not_after>\n      </validity>\n      <allow_rule>\n        " << kDomains << "\n";
   Criteria(x, "publish", publish, partition);

@@ -25,6 +25,7 @@
 
 #include <dyad/private_file.hpp>
 #include <dyad/security.hpp>
+#include <dyad/wire_names.hpp>
 
 #include "access_documents.hpp"
 
@@ -321,14 +322,14 @@ void RemoveStaleStaging(const fs::path& identities, const std::string& identity)
 // identity as it was (nothing, or the old pair): never a key without its certificate, never a
 // renewed key beside the old certificate.
 Status IssueIdentity(const Graph& graph, const std::map<std::string, TopicAccess>& access, const KeystoreOptions& options,
-                     const std::string& identity, Authority& identity_ca, Authority& permissions_ca, std::ostream& out) {
+                     const std::string& identity, const std::string& subject, Authority& identity_ca, Authority& permissions_ca,
+                     std::ostream& out) {
   const fs::path identities = fs::path(options.dir) / "identities", own = identities / identity;
   auto ca_key = identity_ca.key("issue identity " + identity);
   if (!ca_key.ok()) return ca_key.status();
   auto k = NewKey();
   if (!k.ok()) return k.status();
-  auto c = Issue(k.value().get(), IdentitySubject(graph, identity), identity_ca.cert(), ca_key.value(), options.identity_days,
-                 Use::kIdentity);
+  auto c = Issue(k.value().get(), subject, identity_ca.cert(), ca_key.value(), options.identity_days, Use::kIdentity);
   if (!c.ok()) return c.status();
   RemoveStaleStaging(identities, identity);
   const fs::path staging = identities / ("." + identity + ".new-" + std::to_string(getpid()));
@@ -339,7 +340,7 @@ Status IssueIdentity(const Graph& graph, const std::map<std::string, TopicAccess
     const auto [from, to] = Validity(c.value().get());
     std::ostringstream quiet;  // the staging folder's name is not what the user should read
     return SignDocument((staging / "permissions.xml").string(), (staging / "permissions.p7s").string(),
-                        PermissionsXml(graph, identity, access, from, to), permissions_ca, quiet);
+                        PermissionsXml(graph, identity, subject, access, from, to), permissions_ca, quiet);
   }();
   std::error_code ec;
   if (!made.ok()) {
@@ -358,6 +359,59 @@ Status IssueIdentity(const Graph& graph, const std::map<std::string, TopicAccess
   return Status::OK();
 }
 
+// The keystore's names key (dyad/wire_names.hpp): made once, 0600, then kept.
+StatusOr<std::string> NamesKey(const fs::path& dir, std::ostream& out) {
+  const std::string path = (dir / kNamesKeyFile).string();
+  if (!fs::exists(fs::symlink_status(path))) {
+    auto text = NewNamesKeyText();
+    if (!text.ok()) return text.status();
+    if (Status s = WritePrivateFile(path, text.value(), CreateMode::kNew); !s.ok()) return s;
+    out << "made     " << path << " (the names on the wire)\n";
+  }
+  return ReadNamesKey(path);
+}
+
+std::string CommonName(X509* cert) {
+  char cn[256] = {0};
+  if (cert == nullptr || X509_NAME_get_text_by_NID(X509_get_subject_name(cert), NID_commonName, cn, sizeof cn) < 0) return "";
+  return cn;
+}
+
+// A CA kept from a keystore made before names were opaque: its subject names the graph, and every
+// handshake carries it (in each certificate it issued). Say so; only a new keystore changes it.
+void NoteNamedCa(const Graph& graph, const Authority& ca, const std::string& path, std::ostream& out) {
+  const std::string cn = CommonName(ca.cert());
+  if (cn.find(graph.name) != std::string::npos)
+    out << "note     " << path << ": its subject (CN=" << cn
+        << ") names the graph, and every handshake shows it to anyone listening: a new keystore hides it\n";
+}
+
+// Issues or renews `identity` when asked, when it is missing, or when its certificate's subject
+// is not its opaque one (a keystore made before names were opaque); else keeps it and signs its
+// permissions again when their text changed.
+Status InitIdentity(const Graph& graph, const std::map<std::string, TopicAccess>& access, const KeystoreOptions& options,
+                    const std::string& identity, const std::string& names_key, Authority& identity_ca, Authority& permissions_ca,
+                    std::ostream& out) {
+  const fs::path own = fs::path(options.dir) / "identities" / identity;
+  const std::string cert_path = (own / "cert.pem").string(), key_path = (own / "key.pem").string();
+  const std::string readable = IdentitySubject(graph, identity);
+  const std::string subject = "CN=" + WireSubject(names_key, readable.substr(readable.find('=') + 1));
+  const bool renew = options.renew.count("all") > 0 || options.renew.count(identity) > 0;
+  const bool have = fs::exists(fs::symlink_status(cert_path)) && fs::exists(fs::symlink_status(key_path));
+  if (!have || renew) return IssueIdentity(graph, access, options, identity, subject, identity_ca, permissions_ca, out);
+  auto cert = ReadCert(cert_path);
+  if (!cert.ok()) return cert.status();
+  if ("CN=" + CommonName(cert.value().get()) != subject) {
+    out << "renewing " << identity << ": its certificate's subject names it in clear\n";
+    return IssueIdentity(graph, access, options, identity, subject, identity_ca, permissions_ca, out);
+  }
+  out << "kept     " << identity << ": " << cert_path << "\n";
+  // The grant is valid as long as the certificate.
+  const auto [from, to] = Validity(cert.value().get());
+  const std::string xml = PermissionsXml(graph, identity, subject, access, from, to);
+  return SignDocument((own / "permissions.xml").string(), (own / "permissions.p7s").string(), xml, permissions_ca, out);
+}
+
 }  // namespace
 
 Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>& access, const KeystoreOptions& options,
@@ -369,32 +423,20 @@ Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>
   Authority identity_ca("identity CA", (dir / "identity_ca.cert.pem").string(), (ca_dir / "identity_ca.key.pem").string());
   Authority permissions_ca("permissions CA", (dir / "permissions_ca.cert.pem").string(),
                            (ca_dir / "permissions_ca.key.pem").string());
-  if (Status s = identity_ca.Open("CN=dyad identity CA " + graph.name, options.ca_days, out); !s.ok()) return s;
-  if (Status s = permissions_ca.Open("CN=dyad permissions CA " + graph.name, options.ca_days, out); !s.ok()) return s;
+  // The CAs' subjects name nothing: every handshake shows them (dyad/wire_names.hpp).
+  if (Status s = identity_ca.Open("CN=dyad identity CA", options.ca_days, out); !s.ok()) return s;
+  if (Status s = permissions_ca.Open("CN=dyad permissions CA", options.ca_days, out); !s.ok()) return s;
+  NoteNamedCa(graph, identity_ca, (dir / "identity_ca.cert.pem").string(), out);
+  NoteNamedCa(graph, permissions_ca, (dir / "permissions_ca.cert.pem").string(), out);
   if (Status s = SignDocument((dir / "governance.xml").string(), (dir / "governance.p7s").string(), GovernanceXml(),
                               permissions_ca, out);
       !s.ok())
     return s;
-
-  for (const std::string& identity : GraphIdentities(graph)) {
-    const fs::path own = identities / identity;
-    const std::string cert_path = (own / "cert.pem").string(), key_path = (own / "key.pem").string();
-    const bool renew = options.renew.count("all") > 0 || options.renew.count(identity) > 0;
-    const bool have = fs::exists(fs::symlink_status(cert_path)) && fs::exists(fs::symlink_status(key_path));
-    if (!have || renew) {
-      if (Status s = IssueIdentity(graph, access, options, identity, identity_ca, permissions_ca, out); !s.ok()) return s;
-      continue;
-    }
-    auto cert = ReadCert(cert_path);
-    if (!cert.ok()) return cert.status();
-    out << "kept     " << identity << ": " << cert_path << "\n";
-    // The grant is valid as long as the certificate.
-    const auto [from, to] = Validity(cert.value().get());
-    const std::string xml = PermissionsXml(graph, identity, access, from, to);
-    if (Status s = SignDocument((own / "permissions.xml").string(), (own / "permissions.p7s").string(), xml, permissions_ca, out);
-        !s.ok())
+  auto names_key = NamesKey(dir, out);
+  if (!names_key.ok()) return names_key.status();
+  for (const std::string& identity : GraphIdentities(graph))
+    if (Status s = InitIdentity(graph, access, options, identity, names_key.value(), identity_ca, permissions_ca, out); !s.ok())
       return s;
-  }
   if (!options.web_hosts.empty()) return InitWebCertificate(graph, options, ca_dir, out);
   return Status::OK();
 }

@@ -12,6 +12,7 @@
 #include <string>
 
 #include <dyad/security.hpp>
+#include <dyad/wire_names.hpp>
 
 #include "dyad/testing/child_process.hpp"
 #include "dyad/testing/cli.hpp"
@@ -70,6 +71,13 @@ class KeystoreTest : public ::testing::Test {
     return out;
   }
   fs::path Identity(const std::string& id, const std::string& file) { return keys_ / "identities" / id / file; }
+  // The opaque subject "CN=dyad~..." of the readable `name` (dyad/wire_names.hpp), with the
+  // keystore's names key.
+  std::string Subject(const std::string& name) {
+    auto key = ReadNamesKey((keys_ / kNamesKeyFile).string());
+    EXPECT_TRUE(key.ok()) << key.status().message();
+    return "CN=" + WireSubject(key.ok() ? key.value() : "", name);
+  }
 
   fs::path dir_, keys_, graph_;
   int runs_ = 0;
@@ -95,10 +103,12 @@ TEST_F(KeystoreTest, OpenSslVerifiesTheIdentitiesAndTheSignedDocuments) {
     OpenSsl({"verify", "-CAfile", (keys_ / "permissions_ca.cert.pem").string(), Identity(id, "cert.pem").string()}, &code);
     EXPECT_NE(code, 0) << id;
     const std::string subject = OpenSsl({"x509", "-noout", "-subject", "-nameopt", "RFC2253", "-in", Identity(id, "cert.pem").string()}, &code);
-    EXPECT_NE(subject.find("subject=" + std::string(id[0] == 'h' ? "CN=dyad/sec/host/local" : "CN=dyad/sec/") +
-                           (id[0] == 'h' ? "" : std::string(id).substr(8))),
-              std::string::npos)
-        << subject;
+    // Opaque: every handshake shows it (dyad/wire_names.hpp).
+    const std::string readable = id[0] == 'h' ? "dyad/sec/host/local" : "dyad/sec/" + std::string(id).substr(8);
+    EXPECT_NE(subject.find("subject=" + Subject(readable) + "\n"), std::string::npos) << subject;
+    EXPECT_EQ(subject.find("sec"), std::string::npos) << subject;
+    const std::string issuer = OpenSsl({"x509", "-noout", "-issuer", "-in", Identity(id, "cert.pem").string()}, &code);
+    EXPECT_EQ(issuer.find("sec"), std::string::npos) << "the CA's subject names the graph: " << issuer;
     // The signed permissions verify against the permissions CA and carry exactly the XML.
     const std::string content = OpenSsl({"smime", "-verify", "-text", "-in", Identity(id, "permissions.p7s").string(), "-CAfile",
                                          (keys_ / "permissions_ca.cert.pem").string()},
@@ -158,7 +168,14 @@ TEST_F(KeystoreTest, PermissionsGrantWhatEachProcessWritesAndReads) {
   const std::string pub = ReadFile(Identity("process.pub", "permissions.xml"));
   const std::string rec = ReadFile(Identity("process.rec", "permissions.xml"));
   const std::string host = ReadFile(Identity("host.local", "permissions.xml"));
-  EXPECT_NE(pub.find("<subject_name>CN=dyad/sec/pub</subject_name>"), std::string::npos) << pub;
+  EXPECT_NE(pub.find("<subject_name>" + Subject("dyad/sec/pub") + "</subject_name>"), std::string::npos) << pub;
+  // The document travels in clear in every handshake: it names neither the graph nor the process.
+  for (const std::string& doc : {pub, rec, host}) {
+    EXPECT_EQ(doc.find("dyad/sec/"), std::string::npos) << doc;
+    EXPECT_EQ(doc.find("process."), std::string::npos) << doc;
+    EXPECT_EQ(doc.find("host.local"), std::string::npos) << doc;
+  }
+  EXPECT_EQ(ReadFile(keys_ / "governance.xml").find("dyad/sec/"), std::string::npos);
   EXPECT_NE(Section(pub, "publish").find("<topic>ca</topic>"), std::string::npos) << pub;
   EXPECT_NE(Section(pub, "publish").find("<topic>cb</topic>"), std::string::npos) << pub;
   EXPECT_EQ(Section(pub, "subscribe").find("<topic>ca</topic>"), std::string::npos) << pub;
@@ -166,7 +183,7 @@ TEST_F(KeystoreTest, PermissionsGrantWhatEachProcessWritesAndReads) {
   EXPECT_EQ(Section(rec, "subscribe").find("<topic>cb</topic>"), std::string::npos) << "the recorder records ca only:\n" << rec;
   EXPECT_EQ(Section(rec, "publish").find("<topic>ca</topic>"), std::string::npos) << rec;
   EXPECT_NE(Section(rec, "publish").find("<topic>dyad/stats</topic>"), std::string::npos) << rec;
-  EXPECT_NE(pub.find("<partition>dyad/sec/*</partition>"), std::string::npos) << pub;
+  EXPECT_NE(pub.find("<partition>dyad/*</partition>"), std::string::npos) << pub;
   EXPECT_NE(pub.find("<default>DENY</default>"), std::string::npos);
   EXPECT_NE(Section(host, "publish").find("<topic>dyad/launchers</topic>"), std::string::npos) << host;
   EXPECT_NE(Section(host, "subscribe").find("<topic>*</topic>"), std::string::npos) << host;
@@ -178,7 +195,7 @@ TEST_F(KeystoreTest, TheGuestIdentityIsGrantedExactlyTheGraphsGuestsSection) {
   ASSERT_EQ(init.code, 0) << init.err;
   EXPECT_NE(init.out.find("issued   guest"), std::string::npos) << init.out;
   const std::string guest = ReadFile(Identity("guest", "permissions.xml"));
-  EXPECT_NE(guest.find("<subject_name>CN=dyad/sec/guest/tools</subject_name>"), std::string::npos) << guest;
+  EXPECT_NE(guest.find("<subject_name>" + Subject("dyad/sec/guest/tools") + "</subject_name>"), std::string::npos) << guest;
   const std::string publish = Section(guest, "publish"), subscribe = Section(guest, "subscribe");
   EXPECT_NE(publish.find("<topic>cb</topic>"), std::string::npos) << guest;
   EXPECT_NE(publish.find("<topic>robot/*</topic>"), std::string::npos) << guest;
@@ -191,7 +208,7 @@ TEST_F(KeystoreTest, TheGuestIdentityIsGrantedExactlyTheGraphsGuestsSection) {
   const std::string subject =
       OpenSsl({"x509", "-noout", "-subject", "-in", Identity("guest", "cert.pem").string()}, &code);
   EXPECT_EQ(code, 0);
-  EXPECT_NE(subject.find("dyad/sec/guest/tools"), std::string::npos) << subject;
+  EXPECT_NE(subject.find(Subject("dyad/sec/guest/tools").substr(3)), std::string::npos) << subject;
   // No section, no guest identity.
   ASSERT_EQ(Init().code, 0);
   EXPECT_TRUE(fs::exists(Identity("guest", "cert.pem")));  // kept from before, unused by this graph

@@ -1,0 +1,44 @@
+// dyad/wire_names.hpp — what a secured graph's participants are called where anyone can read it.
+//
+// DDS sends a participant's name, and the subject of its certificate, in clear: in every
+// discovery announcement and every authentication handshake, to anyone who can reach the graph,
+// a stranger with a certificate of another CA included. In a graph with `security:` neither
+// names the graph, a process or a host: they are made with the keystore's names key
+// (`names.key` beside `identity_ca.cert.pem`, 32 random bytes as 64 hex digits, mode 0600,
+// written once by `dyad security init`). Every identity of the graph holds it; a stranger does
+// not, so to a stranger the names are random-looking and only equal to themselves.
+//
+//   WireSubject(key, name)  "dyad~" + 32 hex digits: HMAC-SHA256(key, name) cut to 128 bits.
+//                           A certificate's subject (CN=...): nothing needs to read it back.
+//   WireName(key, name)     WireSubject(key, name) + "." + the name encrypted (AES-256-CTR, the
+//                           HMAC as its IV: a synthetic IV, so the same name gives the same
+//                           text), padded with zero bytes to 48 or 96 bytes so that its length
+//                           says little. A participant's name: the graph's participants read it
+//                           back (ReadableName) to report and match their peers by name. A name
+//                           of 96 bytes or more gets its WireSubject only (not readable back).
+//   ReadableName(key, wire) the name, when `wire` is a WireName made with this key; "" for
+//                           anything else (another graph's, a forgery, a plain name).
+//
+// Both are the same for every run of the graph (docs/security.md, "Names on the wire", says
+// why). The key is derived into two (one for the HMAC, one for AES) by HMAC with fixed labels.
+#pragma once
+
+#include <string>
+
+#include <dyad/status.hpp>
+
+namespace dyad {
+
+inline constexpr const char* kNamesKeyFile = "names.key";
+
+// The key in the file at `path` (64 hex digits, then an optional newline): 32 raw bytes. An
+// error names the file and says to run `dyad security init` when it is missing.
+StatusOr<std::string> ReadNamesKey(const std::string& path);
+// A new key file's text: 64 hex digits from the system's random source, and a newline.
+StatusOr<std::string> NewNamesKeyText();
+
+std::string WireSubject(const std::string& key, const std::string& name);
+std::string WireName(const std::string& key, const std::string& name);
+std::string ReadableName(const std::string& key, const std::string& wire);
+
+}  // namespace dyad
