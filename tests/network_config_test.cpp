@@ -379,6 +379,25 @@ TEST(NetworkQos, ParticipantsAnnounceEveryTenthOfTheLeaseWithADiscoveryServer) {
             eprosima::fastrtps::Duration_t(0.5));
 }
 
+// A secured participant leases at least kSecuredLeaseS (Fast DDS 2.9 cannot authenticate again a
+// peer that dropped it while it still holds that peer: network_qos.hpp), announcing as lease_s says.
+TEST(NetworkQos, ASecuredParticipantLeasesAtLeastTwentySecondsAndAnnouncesAsBefore) {
+  NetworkConfig net;
+  net.lease_s = 5;
+  eprosima::fastdds::dds::DomainParticipantQos open, secured, long_lease;
+  secured.properties().properties().emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
+  long_lease.properties().properties().emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
+  ASSERT_TRUE(ApplyNetwork(net, false, &open).ok());
+  ASSERT_TRUE(ApplyNetwork(net, false, &secured).ok());
+  const auto& s = secured.wire_protocol().builtin.discovery_config;
+  EXPECT_EQ(open.wire_protocol().builtin.discovery_config.leaseDuration, eprosima::fastrtps::Duration_t(5.0));
+  EXPECT_EQ(s.leaseDuration, eprosima::fastrtps::Duration_t(kSecuredLeaseS));
+  EXPECT_EQ(s.leaseDuration_announcementperiod, eprosima::fastrtps::Duration_t(1.25));
+  net.lease_s = 30;  // longer than the floor: kept
+  ASSERT_TRUE(ApplyNetwork(net, false, &long_lease).ok());
+  EXPECT_EQ(long_lease.wire_protocol().builtin.discovery_config.leaseDuration, eprosima::fastrtps::Duration_t(30.0));
+}
+
 TEST(NetworkQos, AnAddressThatDoesNotResolveNamesItsKey) {
   std::vector<Diagnostic> diags;
   const Graph g = Parse(Replace(kSplit, "mind: 10.77.0.2", "mind: no-such-host.invalid"), &diags);

@@ -12,12 +12,13 @@
 #include <string>
 #include <vector>
 
-#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/rtps/attributes/PropertyPolicy.h>
 #include <fastdds/rtps/attributes/ServerAttributes.h>
 #include <fastdds/rtps/transport/TCPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
 #include <fastrtps/utils/IPLocator.h>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 
 namespace rtps = eprosima::fastrtps::rtps;
 
@@ -115,7 +116,10 @@ Status ApplyNetwork(const NetworkConfig& net, bool udp_only, eprosima::fastdds::
   transport.use_builtin_transports = false;
   transport.user_transports.clear();
   auto& builtin = qos->wire_protocol().builtin;
-  builtin.discovery_config.leaseDuration = eprosima::fastrtps::Duration_t(net.lease_s);
+  const bool secured =
+      eprosima::fastrtps::rtps::PropertyPolicyHelper::find_property(qos->properties(), "dds.sec.auth.plugin") != nullptr;
+  builtin.discovery_config.leaseDuration =
+      eprosima::fastrtps::Duration_t(secured ? std::max(net.lease_s, kSecuredLeaseS) : net.lease_s);
   builtin.discovery_config.leaseDuration_announcementperiod = eprosima::fastrtps::Duration_t(AnnouncementPeriodS(net));
   if (net.transport == NetTransport::kTcp) {
     auto tcp = std::make_shared<eprosima::fastdds::rtps::TCPv4TransportDescriptor>();

@@ -15,6 +15,8 @@
 //                        (one connection per pair); a watcher only connects, to all.
 //                        `interfaces` is the allow-list.
 //   lease_s:             the participant lease; announcements every lease/4 (lease/10 with a discovery server).
+//                        A participant with DDS Security (ApplySecurity before ApplyNetwork) leases
+//                        at least kSecuredLeaseS, announcing as often as lease_s says (see below).
 #pragma once
 
 #include <string>
@@ -34,6 +36,17 @@ inline constexpr int kPeerParticipants = 12;
 // network.scope local: participant ids announced to on 127.0.0.1 (every process and watcher of
 // this machine on the domain; one beyond them is still found, as it announces to these).
 inline constexpr int kLocalParticipants = 32;
+
+// The shortest lease a secured participant announces. Fast DDS 2.9 cannot authenticate a peer
+// again while that peer still holds it as authenticated: a peer that dropped us when our lease
+// ran out (and rediscovered us at our next announcement) sends a handshake request the other side
+// ignores (SecurityManager: a request for a participant in AUTHENTICATION_OK is "not mine"), or
+// waits for one it never sends; neither sees the other again until our lease runs out there too,
+// which our announcements prevent. Under load a participant can go a few seconds without reading
+// its socket (its handshakes' ECDSA and Diffie-Hellman run on the thread that reads it), long
+// enough for lease_s: 5 to run out. 20 s is Fast DDS's default lease. dyad's own notice of a
+// process that is gone does not wait for it (dyad/processes, the launchers' link).
+inline constexpr double kSecuredLeaseS = 20;
 
 // The discovery server's GUID prefix (Fast DDS's convention for server id 0, the one
 // `fast-discovery-server -i 0` uses too).
