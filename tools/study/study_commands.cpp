@@ -13,6 +13,7 @@
 #include "run_process.hpp"
 #include "study_analysis.hpp"
 #include "study_file.hpp"
+#include "study_links.hpp"
 #include "study_page.hpp"
 #include "study_session.hpp"
 #include "yaml_file.hpp"
