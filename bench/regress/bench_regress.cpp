@@ -7,6 +7,7 @@
 //   median and p99 over `--runs` repetitions of the 200 human + release steps, for W 5 and 15
 //   with 15 iterations, Adam (the presets' settings: W 5 = vcbot, W 15 = reference) and Ceres
 //   LBFGS, in float and double; and the mean window loss along each one's own (closed-loop) run.
+//   Last row: the NRL mode (preset nrl, noise off; issue 44), W 5.
 // Table 2: equal wall time on the same problems. Along one closed-loop Adam run, each step's
 //   window is solved again from the same start A by Adam and by Ceres, each capped at 1, 2 and 4
 //   times Adam's median step time (15 iterations, float) with no iteration cap, and with 15
@@ -169,6 +170,22 @@ int main(int argc, char** argv) {
                     evals / static_cast<double>(ms.size()), med / 100 * 100, loss);
       }
     }
+  }
+  {  // The NRL mode (preset nrl, noise off): NRL's own error regression step by step (issue 44).
+    ErrorRegressionOptions o = ErrorRegressionOptions::Preset("nrl").value();
+    o.noise = NoiseMode::kOff;
+    std::vector<double> ms;
+    double its = 0, loss = 0;
+    for (int r = 0; r < runs; ++r) {
+      const Trace tr = Run<float>(*model, beak, o, nullptr, 0);
+      ms.insert(ms.end(), tr.step_ms.begin(), tr.step_ms.end());
+      for (int it : tr.iterations) its += it;
+      loss += Mean(tr.loss) / runs;
+    }
+    const double med = Percentile(ms, 0.5);
+    std::printf("%-6d %-6s %-7s %10.4f %10.4f %8.1f %9.1f %11.2f%% %11.5f   (preset nrl: NRL's ER, its loss)\n", o.window,
+                "float", "nrl", med, Percentile(ms, 0.99), its / static_cast<double>(ms.size()),
+                its / static_cast<double>(ms.size()), med / 100 * 100, loss);
   }
   std::printf("\nEqual wall time, same problems: along one closed-loop Adam run (float), every step's window is solved\n"
               "again from the same start A by both optimisers, each capped at k x Adam's float median step time above\n"
