@@ -14,6 +14,7 @@
 
 #include "dyad/testing/child_process.hpp"
 #include "dyad/testing/cli.hpp"
+#include "run_status.hpp"
 #include "sweep_commands.hpp"
 #include "sweep_slurm.hpp"
 
@@ -507,6 +508,19 @@ TEST_F(SweepTest, SlurmNotReachableIsSaidInItsOwnWords) {
   EXPECT_NE(out.find("failed (exit 1): sbatch: error: Batch job submission failed: Unable to contact slurm controller"), std::string::npos) << out;
   EXPECT_EQ(Sweep({file.string(), "--partition", "p"}, &out), 2) << "an option of --slurm without it";
   EXPECT_NE(out.find("--partition requires --slurm"), std::string::npos) << out;
+}
+
+// sweep.csv's status words, one table: each reads back to its value; another word is refused
+// with the list (the plots pick rows by these words).
+TEST(RunStatusWords, EveryStatusReadsBackAndOthersAreRefusedWithTheList) {
+  using sweep::RunStatus;
+  for (const RunStatus st : {RunStatus::kOk, RunStatus::kIncomplete, RunStatus::kFailed, RunStatus::kMissing}) {
+    auto back = sweep::ParseRunStatus(sweep::ToString(st));
+    ASSERT_TRUE(back.ok()) << sweep::ToString(st);
+    EXPECT_EQ(*back, st);
+  }
+  EXPECT_EQ(sweep::ToString(RunStatus::kOk), "ok");  // what plot_sweep.py draws
+  EXPECT_EQ(sweep::ParseRunStatus("done").status().message(), "must be ok, incomplete, failed or missing");
 }
 
 }  // namespace
