@@ -27,7 +27,7 @@ components:
 YAML
 "$build/bin/dyad" run graph.yaml --duration 60 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
+for _ in $(seq 300); do [ -s web.port ] && break; sleep 0.1; done  # 30 s: a cold start on a loaded machine
 [ -s web.port ] || { cat run.err; kill $pid; fail "web.port never written"; }
 echo "http://127.0.0.1:$(cat web.port) subject-token-000001" > sessions
 node "$node_dir/sim_participant.mjs" --dataset data --seconds 9 --speed 3 --report-error 0 sessions > client.json \

@@ -57,7 +57,7 @@ grep -q "^P03,https://study.example.org/dyad/subject?token=" data/links.csv || f
 # The graph, given P01's token file as dyad study run gives it, opens the subject's page to P01's link only.
 "$dyad" run graph.yaml --set web.token_file=data/P01/web-tokens --set recorder.file=run.mcap --duration 20 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
+for _ in $(seq 300); do [ -s web.port ] && break; sleep 0.1; done  # 30 s: a cold start on a loaded machine
 [ -s web.port ] || { kill $pid; cat run.err; fail "web.port never written"; }
 link=$(sed -n 's/^P01,https:\/\/study.example.org\/dyad//p' data/links.csv)
 other=$(sed -n 's/^P02,https:\/\/study.example.org\/dyad//p' data/links.csv)
