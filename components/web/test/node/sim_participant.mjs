@@ -117,13 +117,13 @@ export class SimParticipant {
     this.ws.on("error", (e) => { if (this.stats.errors.length < 5) this.stats.errors.push(String(e.message)); });
     this.ws.on("close", (code) => {
       this.stats.closes++, this.steering = false, this.down = false;
-      if (!this.stopped && code !== 1008) this.later(1000, () => this.connect());
+      if (!this.stopped && code !== 1008) this.later(1000 * this.speed, () => this.connect());  // the page's second, at any speed
     });
   }
   onMessage(m) {
     if (m.op === "hello") {
       this.half = m.half_width, this.steering = m.steering, this.ask = !!m.ask, this.askAfterMs = 1000 * (m.ask_after_hold_s ?? 1);
-      this.drawn = [];  // a new graph: a new trial (as the page, which forgets the last one's question)
+      this.drawn = [], this.trialOver = false, this.answering = -1;  // a new graph: a new trial (the page forgets the last one's question)
     } else if (m.op === "role") {
       this.steering = m.steering;
     } else if (m.op === "task") {
@@ -131,7 +131,10 @@ export class SimParticipant {
     } else if (m.op === "ack") {
       this.stats.acks++;
       if (this.stats.rtts.length < 100000) this.stats.rtts.push(performance.now() - m.t);
-    } else if (m.op === "question" && m.segment >= 0 && this.steering) {
+    } else if (m.op === "question") {  // after the trial: nobody steers; the steering page answers
+      this.trialOver = true;
+      if (!(m.segment >= 0 && this.steering) || this.answering === m.segment) return;  // each question answered once
+      this.answering = m.segment;
       this.later(this.r.uniform(1000, 3000), () => this.answer(this.drawn[m.segment] ?? 0, m.segment));
     }
   }
@@ -142,7 +145,7 @@ export class SimParticipant {
     if (!force && now - this.lastSent < 4) return;
     this.lastSent = now;
     const clamp = (v) => Math.max(-this.half, Math.min(this.half, v));
-    this.ws.send(JSON.stringify({ op: "pointer", x: clamp(this.cursor[0]), y: clamp(this.cursor[1]), engaged: this.down && this.steering,
+    this.ws.send(JSON.stringify({ op: "pointer", x: clamp(this.cursor[0]), y: clamp(this.cursor[1]), engaged: this.down && this.steering && !this.trialOver,
                                   t: now, wall: wallMs() }));
     this.stats.sent++;
   }
@@ -174,6 +177,7 @@ export class SimParticipant {
   }
   // Released: rests, then moves the pointer to the next primitive's start and draws it.
   rest() {
+    if (this.trialOver) return this.later(1000, () => this.rest());  // the trial is over: the person stops drawing
     const k = this.target >= 0 && this.target < this.prims.length ? this.target : Math.floor(this.r() * this.prims.length);
     const p = this.prims[k], ang = this.r.uniform(-0.08, 0.08), sc = this.r.uniform(0.9, 1.1);
     const off = [this.r.uniform(-3, 3), this.r.uniform(-3, 3)];
