@@ -139,6 +139,28 @@ TEST(Deliberator, CeresIsSelectedByParam) {
   EXPECT_GE(ctx.writer.samples[2].iterations(), 1u);
 }
 
+// Preset nrl (issue 44): NRL's own error regression; it generates freely until its window holds
+// W (5) executed positions, then regresses with Adam (15 iterations per step).
+TEST(Deliberator, NrlPresetIsNrlsErrorRegression) {
+  FakeContext ctx({{"model", RandomModelFile()}, {"preset", std::string("nrl")}});
+  Deliberator d;
+  ASSERT_TRUE(d.Configure(ctx).ok());
+  for (int t = 0; t < 7; ++t) {
+    msg::CartesianState s;
+    s.x(1.0 * t);
+    s.y(0);
+    if (t > 0) ctx.reader.queue.push_back(s);
+    ctx.Poll();
+    ASSERT_TRUE(d.Step(StepInfo{0, static_cast<uint64_t>(t), 100'000'000}).ok());
+  }
+  EXPECT_EQ(ctx.writer.samples[3].iterations(), 0u);  // 3 executed positions: free generation
+  EXPECT_GE(ctx.writer.samples[6].iterations(), 1u);  // 6 held: regressing (15 unless the time cap stops it)
+  FakeContext ceres({{"model", RandomModelFile()}, {"preset", std::string("nrl")}, {"optimizer", std::string("ceres")}});
+  Deliberator bad;
+  const Status st = bad.Configure(ceres);
+  EXPECT_NE(st.message().find("params.optimizer: the nrl engine is NRL's Adam"), std::string::npos) << st.message();
+}
+
 struct BadParam {
   std::map<std::string, ParamValue> params;
   std::string message_start;
