@@ -163,6 +163,12 @@ void WebComponent::Describe(ComponentSpec& spec) {
   spec.Param("task_countdown_s", 0.0).Range(0, 3600).Unit("s").Live().Doc(
       "subject's page: setting it starts a countdown of that many seconds, then \"go\" (the same value again restarts it)");
   spec.Param("practice", false).Live().Doc("subject's page says \"practice\"; dyad analyze leaves the events meanwhile out (the `task` output recorded)");
+  spec.Param("task_time_s", 0.0)
+      .Range(0, 86400)
+      .Unit("s")
+      .Doc(
+          "subject's page: the time left of a trial this long from the run's first step (0: not shown; dyad study run sets the "
+          "study's duration)");
   spec.Param("wait_for_subject_s", 0.0)
       .Range(0, 3600)
       .Unit("s")
@@ -338,6 +344,10 @@ void WebComponent::StepTask() {
     t.countdown_s = p.Double("task_countdown_s");
     t.countdown_start = std::chrono::steady_clock::now();
     countdown_asked_ = false;
+  }
+  if (!task_sent_ && p.Double("task_time_s") > 0) {  // the first step: the trial's clock
+    t.time_s = p.Double("task_time_s");
+    t.time_start = std::chrono::steady_clock::now();
   }
   if (task_sent_ && !countdown && t.target == task_.target && t.message == task_.message && t.practice == task_.practice) return;
   task_ = t;

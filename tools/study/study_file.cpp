@@ -93,9 +93,13 @@ void ReadConditions(StrictYaml& y, const YAML::Node& root, const std::vector<std
     if (!IsName(name)) y.Error(kv.first, where, "a condition's name is letters, digits, '_' and '-'");
     if (!y.Map(kv.second, where, {})) continue;
     if (kv.second.size() == 0) y.Error(kv.second, where, "overrides nothing: name the keys it changes");
-    Condition c{name, "", {}};
+    Condition c{name, "", {}, s->task};
     bool bad = false;
     for (const auto& o : kv.second) {
+      if (o.first.Scalar() == "task") {  // not an override: what the subject's page shows (study_task.hpp)
+        bad = !ReadTask(y, o.second, where + ".task", &c.task) || bad;
+        continue;
+      }
       const std::string set = o.first.Scalar() + "=" + tools::SetText(o.second);
       if (s->graph.empty()) continue;
       if (std::string why = tools::GraphProblems(s->graph, {"clock=stepped", set}, plugins); !why.empty()) {
@@ -251,14 +255,23 @@ Study LoadStudy(const std::string& path, const std::vector<std::string>& plugins
   YAML::Node root;
   if (!tools::LoadYamlFile(path, "study", &root, problems)) return s;
   StrictYaml y(StrictYaml::InFile(path, {}), problems);
-  if (!y.Map(root, "", {"study", "graph", "data", "participants", "conditions", "trials", "duration", "blind", "consent_required",
-                        "self_reports", "recorder", "rehearsal"}))
+  if (!y.Map(root, "",
+             {"study", "graph", "data", "participants", "conditions", "trials", "duration", "blind", "consent_required",
+              "self_reports", "recorder", "rehearsal", "task"}))
     return s;
   ReadScalars(y, root, path, &s);
   ReadParticipants(y, root, &s);
   std::set<std::string> bad_conditions;
+  if (root["task"]) ReadTask(y, root["task"], "task", &s.task);
   ReadConditions(y, root, plugins, &s, &bad_conditions);  // checked against the graph when it was found
   ReadRehearsal(y, root, path, plugins, bad_conditions, &s);
+  for (const Condition& c : s.conditions)
+    if (c.task.any && s.subject_web.empty() && !s.graph.empty()) {
+      y.Error(root["task"] ? root["task"] : root["conditions"], "task",
+              "the graph has no subject's page to show it on (one `web` component and a `web_human`, as in "
+              "configs/interactive.yaml)");
+      break;
+    }
   GiveLabels(&s);
   s.square_rows = static_cast<int>(BalancedLatinSquare(std::max(1, static_cast<int>(s.conditions.size()))).size());
   return s;

@@ -39,12 +39,14 @@
 
 #include "dyad/diagnostic.hpp"
 #include "self_reports.hpp"
+#include "study_task.hpp"
 
 namespace dyad::study {
 
 struct Condition {
   std::string name, label;  // label: "A", "B", ... (what a blind experimenter sees)
   std::vector<std::string> sets;  // "KEY=VALUE", as `dyad run --set` takes them
+  StudyTask task;                 // what the subject's page shows (the file's `task`, then its own)
 };
 
 struct Trial {
@@ -69,6 +71,7 @@ struct Study {
   // `web_human`, given a token file, without TLS): `dyad study run --page` serves that page
   // between trials on its address and port (subject_lobby.hpp). Empty: none.
   std::string subject_web, subject_address = "127.0.0.1";
+  StudyTask task;                     // the file's `task` (each condition starts from it)
   int subject_port = 8765;            // its params.port (the web component's default)
   std::string rehearsal_graph;        // absolute; the study's graph unless the file names another
   std::vector<std::string> rehearsal_sets;

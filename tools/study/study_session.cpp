@@ -56,6 +56,10 @@ std::vector<std::string> ExperimentSets(const Study& s, const AttemptRequest& r)
   std::vector<std::string> sets = ConditionOf(s, r.trial).sets;
   if (r.rehearsal) sets.insert(sets.end(), s.rehearsal_sets.begin(), s.rehearsal_sets.end());
   sets.insert(sets.end(), r.extra_sets.begin(), r.extra_sets.end());
+  if (!r.rehearsal) {  // the task on the subject's page (study_task.hpp)
+    const std::vector<std::string> task = TaskSets(s.subject_web, ConditionOf(s, r.trial).task, r.trial.repetition);
+    sets.insert(sets.end(), task.begin(), task.end());
+  }
   return sets;
 }
 
@@ -67,6 +71,8 @@ std::vector<std::string> RunSets(const Study& s, const AttemptRequest& r) {
   sets.insert(sets.end(), s.page_sets.begin(), s.page_sets.end());
   for (const std::string& web : s.token_file_webs)
     sets.push_back(web + ".token_file=" + tools::YamlQuoted((fs::path(s.data) / r.participant / (web + "-tokens")).string()));
+  if (!s.subject_web.empty() && s.duration_s > 0)  // the time left on the subject's page
+    sets.push_back(s.subject_web + ".task_time_s=" + tools::SetText(YAML::Node(s.duration_s)));
   if (!s.subject_web.empty() && r.subject_port > 0) sets.push_back(s.subject_web + ".port=" + std::to_string(r.subject_port));
   if (!s.subject_web.empty() && r.wait_for_subject_s > 0)
     sets.push_back(s.subject_web + ".wait_for_subject_s=" + tools::SetText(YAML::Node(r.wait_for_subject_s)));

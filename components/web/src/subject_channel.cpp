@@ -22,8 +22,12 @@ std::string SubjectChannel::TaskJson() const {
   double left = 0;
   if (task_.countdown_s > 0)
     left = std::max(0.0, task_.countdown_s - std::chrono::duration<double>(std::chrono::steady_clock::now() - task_.countdown_start).count());
-  return json{{"op", "task"}, {"target", task_.target}, {"message", task_.message}, {"countdown_s", left}, {"practice", task_.practice}}
-      .dump(-1, ' ', false, json::error_handler_t::replace);
+  json j{
+      {"op", "task"}, {"target", task_.target}, {"message", task_.message}, {"countdown_s", left}, {"practice", task_.practice}};
+  if (task_.time_s > 0)  // added for #46: the trial's time left (a page that does not know it ignores it)
+    j["time_left_s"] =
+        std::max(0.0, task_.time_s - std::chrono::duration<double>(std::chrono::steady_clock::now() - task_.time_start).count());
+  return j.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
 void SubjectChannel::SendToAll(uint32_t channel, const std::string& frame) {

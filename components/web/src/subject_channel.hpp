@@ -79,6 +79,8 @@ class SubjectChannel final : public ClientHandler {
     double countdown_s = 0;   // a countdown of this length started at `countdown_start` (0: none)
     std::chrono::steady_clock::time_point countdown_start{};
     bool practice = false;
+    double time_s = 0;  // the trial's length from `time_start`: the page shows the time left (0: none)
+    std::chrono::steady_clock::time_point time_start{};
   };
   // Sends it to every page, and to every page that opens later.
   void SetTask(const Task& task);

@@ -43,6 +43,13 @@ try {
     await subject.mouse.move(400, 300);
     await subject.mouse.down();
     out.holds.push(Date.now());
+    if (k === 1) {  // the study file's task, with the trial's time left
+      await subject.waitForFunction(() => document.getElementById("timeleft").textContent.startsWith("time left: "), null, { timeout: 3000 });
+      out.task = await subject.evaluate(() => ({ message: document.getElementById("taskmsg").textContent,
+                                                 time_left: document.getElementById("timeleft").textContent }));
+      await subject.mouse.move(420, 280);
+      await subject.screenshot({ path: `${shotDir}/subject_task.png` });
+    }
     if (k === 1 && (await study.textContent("#message")) !== "") throw new Error("a warning while trial 1 runs: " + (await study.textContent("#message")));
     for (let i = 0; !(await subject.evaluate(() => document.body.dataset.link === "closed")); i++) {
       if (i > 400) throw new Error("trial " + k + "'s graph did not end");

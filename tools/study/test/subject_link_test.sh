@@ -16,6 +16,7 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 rm -rf "$work"; mkdir -p "$work"; cd "$work"
 ln -s "$node_modules" node_modules  # the script imports playwright-core from beside itself
 cp "$(dirname "$0")/subject_link.mjs" .
+"$build/bin/dyad" generate dataset --out data > /dev/null
 cat > g.yaml <<YAML
 graph: g
 clock: wall
@@ -23,9 +24,9 @@ domain_id: $(( 1 + $$ % 200 ))
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
 components:
-  web: {type: web, rate_hz: 30, params: {port: 0}, outputs: {pointer: web/pointer}}
+  web: {type: web, rate_hz: 30, params: {port: 0, dataset: data}, outputs: {pointer: web/pointer, task: subject/task}}
   human: {type: web_human, rate_hz: 20, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
-  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input]}}
+  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input, subject/task]}}
 YAML
 cat > s.yaml <<YAML
 study: link_test
@@ -33,7 +34,8 @@ graph: g.yaml
 participants: [P01]
 conditions:
   low: {human.engage_timeout_s: 0.3}
-  high: {human.engage_timeout_s: 0.4}
+  high: {human.engage_timeout_s: 0.4, task: {target: 5, practice: true}}
+task: {message: Draw the yellow shape, target: 2}
 duration: 3
 blind: true
 consent_required: false
@@ -56,7 +58,7 @@ for f in link_test-data/P01/0[12]-*.mcap; do
   "$build/bin/dyad" bag export "$f" --csv "csv-$(basename "$f" .mcap)" > /dev/null
 done
 python3 - link_test-data/P01/session.log csv-0[12]-*/human_input.csv <<'PY'
-import csv, json, sys
+import csv, json, sys, glob
 lines = [json.loads(l) for l in open(sys.argv[1])]
 def fail(why): sys.exit("FAIL: " + why + "\n" + "\n".join(map(str, lines)))
 ends = [(l["trial"], l["attempt"], l["outcome"]) for l in lines if l["event"] == "end"]
@@ -72,5 +74,13 @@ for path in sys.argv[2:]:
     engaged = sum(r["engaged"] in ("1", "true") for r in rows) / len(rows)
     if engaged < 0.7: fail("%s: engaged on %.0f%% of %d steps (the page held throughout)" % (path, 100 * engaged, len(rows)))
     print("%s: engaged %.2f s after the first step, on %.0f%% of %d steps" % (path, (first - t0) / 1e9, 100 * engaged, len(rows)))
-print("PASS: two trials complete with the subject's page opened before trial 1 and kept across both")
+# The study file's task, on subject/task: the file's for one condition, the condition's own for the other.
+tasks = sorted(tuple((r["target"], r["message"], r["practice"] in ("1", "true")) for r in csv.DictReader(open(f)))
+               for f in sorted(glob.glob("csv-0[12]-*/subject_task.csv")))
+want = [(("2", "Draw the yellow shape", False),), (("5", "Draw the yellow shape", True),)]
+if tasks != want: fail("subject/task recorded %s, want %s" % (tasks, want))
+b = json.load(open("browser.json"))
+if b["task"]["message"] != "Draw the yellow shape" or not b["task"]["time_left"].startswith("time left: "):
+    fail("the subject's page during trial 1 showed %s" % b["task"])
+print("PASS: two trials complete with the subject's page opened before trial 1 and kept across both; the study file's task on it")
 PY
