@@ -3,7 +3,14 @@
 // one run. Prints median and p99 of each and their ratio.
 //
 //   build/bin/bench_pingpong [--rounds N] [--repeats R] [--payload BYTES]
-//                            [--processes [--pong-prefix "ip netns exec NS"]] [--security]
+//                            [--processes [--pong-prefix "ip netns exec NS"]] [--security] [--only bare|dyad]
+//
+// --only runs one contender (no ratio), for a profile of its path alone; e.g. instructions per
+// round trip under callgrind, which a loaded machine does not disturb (docs/runtime.md,
+// "Benchmark: a hop through dyad vs bare Fast DDS"):
+//   valgrind --tool=callgrind build-cg/bin/bench_pingpong --only dyad --rounds 2000 --repeats 1
+// and again with --rounds 4000: the difference over 2000 is one round trip's (set-up cancels).
+// (callgrind needs a build without -march=native: cmake -DDYAD_NATIVE=OFF.)
 //
 // --security adds a third contender, alternating with the others: the same dyad graph with a
 // `security:` keystore (`dyad security init`: authentication, access control, everything
@@ -321,6 +328,7 @@ int main(int argc, char** argv) {
   int rounds = 20000, repeats = 5;
   size_t payload = 0;
   bool processes = false, security = false;
+  std::string only;  // "bare" or "dyad": that contender alone
   std::vector<std::string> pong_prefix;
   for (int i = 1; i < argc; ++i) {
     const bool has_value = i + 1 < argc;
@@ -332,7 +340,13 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--repeats")) repeats = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--payload")) payload = static_cast<size_t>(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--pong-prefix")) pong_prefix = Words(argv[++i]);
+    else if (!std::strcmp(argv[i], "--only")) only = argv[++i];
   }
+  if (!only.empty() && only != "bare" && only != "dyad") {
+    std::cerr << "bench_pingpong: --only " << only << ": expected bare or dyad\n";
+    return 2;
+  }
+  const bool run_bare = only != "dyad", run_dyad = only != "bare";
   const int domain = 1 + static_cast<int>(getpid() % 200);
   const std::string dir = std::filesystem::temp_directory_path() / ("dyad_pingpong_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
@@ -348,10 +362,13 @@ int main(int argc, char** argv) {
     Stop(bare_pong);
     return 1;
   }
-  bare.Run(1000);  // warm-up
+  if (run_bare) bare.Run(1000);        // warm-up
   for (int r = 0; r < repeats; ++r) {  // alternate, so drift on a shared machine hits both alike
-    auto b = bare.Run(rounds);
-    bare_all.insert(bare_all.end(), b.begin() + b.size() / 10, b.end());
+    if (run_bare) {
+      auto b = bare.Run(rounds);
+      bare_all.insert(bare_all.end(), b.begin() + b.size() / 10, b.end());
+    }
+    if (!run_dyad) continue;
     auto d = RunDyad(domain + 1, rounds, payload, dir, processes, pong_prefix);
     dyad_all.insert(dyad_all.end(), d.begin() + d.size() / 10, d.end());
     if (security) {
@@ -368,9 +385,9 @@ int main(int argc, char** argv) {
               payload, repeats, rounds);
   const double ba = Mean(bare_all), da = Mean(dyad_all);
   std::printf("%-22s %12s %12s %12s\n", "", "median_us", "p99_us", "mean_us");
-  std::printf("%-22s %12.2f %12.2f %12.2f\n", "bare Fast DDS", bm, bp, ba);
-  std::printf("%-22s %12.2f %12.2f %12.2f\n", "dyad components", dm, dp, da);
-  std::printf("%-22s %12.3f %12.3f %12.3f\n", "ratio dyad/bare", dm / bm, dp / bp, da / ba);
+  if (run_bare) std::printf("%-22s %12.2f %12.2f %12.2f\n", "bare Fast DDS", bm, bp, ba);
+  if (run_dyad) std::printf("%-22s %12.2f %12.2f %12.2f\n", "dyad components", dm, dp, da);
+  if (run_bare && run_dyad) std::printf("%-22s %12.3f %12.3f %12.3f\n", "ratio dyad/bare", dm / bm, dp / bp, da / ba);
   if (security) {
     const double sm = Percentile(secured_all, 0.5), sp = Percentile(secured_all, 0.99), sa = Mean(secured_all);
     std::printf("%-22s %12.2f %12.2f %12.2f\n", "dyad with security", sm, sp, sa);
