@@ -112,16 +112,15 @@ DdsReader::~DdsReader() {
   destroy_(reader_);
 }
 
+// One taker at a time (the port's component, whose steps never overlap; the runtime's own
+// readers under their owner's lock): seen_ needs no lock of its own.
 bool DdsReader::TakeNext(void* sample) {
   std::shared_lock<std::shared_mutex> lock(entities_);
-  fdds::SampleInfo info;
+  fdds::SampleInfo& info = *info_;
   for (fdds::DataReader* r : {retired_, reader_}) {  // the retired one's samples are older
     if (r == nullptr) continue;
-    while (r->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
-      std::lock_guard<std::mutex> seen(seen_mutex_);
-      if (FreshSample(seen_, info)) return true;
-    }
+    while (r->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK)
+      if (info.valid_data && FreshSample(seen_, info)) return true;
   }
   return false;
 }
@@ -238,6 +237,7 @@ StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, co
   ApplyQos(rq, qos);
   std::unique_ptr<DdsReader> r(new DdsReader());
   r->topic_ = topic;
+  r->info_ = std::make_unique<fdds::SampleInfo>();
   if (scope_ == Scope::kWatcher) rq.data_sharing().off();
   r->listener_ = std::make_unique<DdsReader::Listener>(std::move(on_data), qos.liveliness_ms > 0);
   fdds::StatusMask mask = fdds::StatusMask::data_available();

@@ -37,6 +37,7 @@ class Subscriber;
 class Topic;
 class DataReader;
 class DataWriter;
+struct SampleInfo;
 }  // namespace eprosima::fastdds::dds
 
 namespace dyad {
@@ -96,8 +97,11 @@ class DdsReader final : public TypedReader {
   eprosima::fastdds::dds::DataReader* retired_ = nullptr;  // renewed away, still taken from
   std::chrono::steady_clock::time_point retired_at_;
   std::vector<eprosima::fastdds::dds::DataReader*> graveyard_;  // retired for good, deleted with this
-  std::mutex seen_mutex_;
+  // TakeNext's alone: a reader has one taker at a time (its port's component, whose steps never
+  // overlap, or the runtime object that owns it, each under its own lock where several threads
+  // take), so they need no lock of their own. info_ is made once, not at every take.
   SeenWriters seen_;
+  std::unique_ptr<eprosima::fastdds::dds::SampleInfo> info_;
   std::unique_ptr<Listener> listener_;
   std::function<eprosima::fastdds::dds::DataReader*()> make_;
   std::function<void(eprosima::fastdds::dds::DataReader*)> destroy_;

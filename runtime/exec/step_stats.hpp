@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <mutex>
 
@@ -22,6 +23,7 @@ class StepStats {
   };
 
   // duration: step wall time; jitter: |actual start - scheduled start| (0 for triggered steps).
+  // One caller at a time (a component's steps never overlap): no lock, see seq_.
   void Record(int64_t duration_ns, int64_t jitter_ns, bool missed_deadline);
   // duration of one serialized-subscription callback of this component.
   void RecordDelivery(int64_t duration_ns);
@@ -34,11 +36,16 @@ class StepStats {
  private:
   static constexpr int kSub = 16;
   static constexpr int kBuckets = 64 * kSub;
-  mutable std::mutex mutex_;
-  std::array<uint64_t, kBuckets> histogram_{};
-  uint64_t steps_ = 0, misses_ = 0;
-  double sum_ns_ = 0, jitter_sum_ns_ = 0;
-  int64_t max_ns_ = 0, jitter_max_ns_ = 0;
+  // The steps' figures have one writer and are read by Get() as a sequence lock: seq_ is odd
+  // while Record writes, and Get() retries a read that a Record overlapped (no lock on the step
+  // path; every field atomic, relaxed, so the race is defined). Deliveries come from several
+  // threads and keep the mutex.
+  std::atomic<uint64_t> seq_{0};
+  std::array<std::atomic<uint64_t>, kBuckets> histogram_{};
+  std::atomic<uint64_t> steps_{0}, misses_{0};
+  std::atomic<double> sum_ns_{0}, jitter_sum_ns_{0};
+  std::atomic<int64_t> max_ns_{0}, jitter_max_ns_{0};
+  mutable std::mutex mutex_;  // the deliveries' figures
   uint64_t deliveries_ = 0;
   double delivery_sum_ns_ = 0;
   int64_t delivery_max_ns_ = 0;

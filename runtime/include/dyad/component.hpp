@@ -92,6 +92,7 @@
 // The plugin ABI's version and its history: kPluginAbiVersion below (the one place that says it).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -213,29 +214,38 @@ class Input final : public InputBase {
   // The newest sample ever received; nullptr before the first.
   const T* latest() const {
     if (!received_.empty()) return &received_.back();
-    return has_latest_ ? &latest_ : nullptr;
+    return previous_.empty() ? nullptr : &previous_.back();
   }
 
+  // Takes each sample into an object of an earlier poll, so its strings and sequences keep their
+  // storage: once they have grown to the samples' sizes a poll allocates nothing and moves
+  // nothing. previous_ holds the last poll that received anything (latest()); objects no poll
+  // holds wait in spare_.
   size_t Poll(int64_t now_ns) override {
-    // Keep the newest sample for latest() before the vector is reused; moves, no copies.
-    if (!received_.empty()) {
-      latest_ = std::move(received_.back());
-      has_latest_ = true;
-    }
-    received_.clear();
     new_count_ = 0;
     if (endpoint_ == nullptr) return 0;
     PollHealth();
-    while (endpoint_->TakeNext(&scratch_)) received_.push_back(std::move(scratch_));
+    if (!received_.empty()) std::swap(received_, previous_);  // received_: previous_'s old objects
+    size_t n = 0;
+    while (n < received_.size() && endpoint_->TakeNext(&received_[n])) ++n;
+    if (n < received_.size()) {
+      for (size_t i = n; i < received_.size(); ++i) spare_.push_back(std::move(received_[i]));
+      received_.erase(received_.begin() + static_cast<std::ptrdiff_t>(n), received_.end());
+    } else {
+      for (;;) {
+        if (spare_.empty()) spare_.emplace_back();
+        if (!endpoint_->TakeNext(&spare_.back())) break;
+        received_.push_back(std::move(spare_.back()));
+        spare_.pop_back();
+      }
+    }
     new_count_ = received_.size();
     if (new_count_ > 0) last_receive_ns_ = now_ns;
     return new_count_;
   }
 
  private:
-  std::vector<T> received_;
-  T latest_{}, scratch_{};
-  bool has_latest_ = false;
+  std::vector<T> received_, previous_, spare_;
 };
 
 class OutputBase {
@@ -271,7 +281,7 @@ class Output final : public OutputBase {
     ++sequence_;
     if constexpr (MessageTraits<T>::kDyadHeader) {
       auto& h = sample.header();
-      h.source(source_);
+      if (h.source() != source_) h.source(source_);  // a reused sample has it: no copy
       h.sequence_number(sequence_);
       h.stamp_ns(now);
     }

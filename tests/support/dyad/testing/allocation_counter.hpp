@@ -12,6 +12,9 @@ namespace dyad::testing {
 
 // Allocations made by this process so far (all threads).
 long AllocationCount();
+// Allocations made by the calling thread so far: a hot path's own, while other threads (a
+// middleware's, a logger's) allocate as they please.
+long AllocationCountOnThisThread();
 
 // Allocations made while f() runs.
 template <typename F>
