@@ -43,6 +43,23 @@ for n in $ns; do [[ $n =~ ^[1-9][0-9]*$ ]] && [ "$n" -le 120 ] || { echo "bench_
 [ "$chromium" = 0 ] || [ -x /usr/bin/chromium ] || { echo "bench_capacity: CAPACITY_CHROMIUM=$chromium needs Debian's chromium (or CAPACITY_CHROMIUM=0)" >&2; exit 2; }
 [[ $seconds =~ ^[1-9][0-9]*$ ]] || { echo "bench_capacity: CAPACITY_SECONDS: '$seconds' is not a whole number of seconds > 0" >&2; exit 2; }
 
+# A snapshot of the build (dyad, its libraries and plugins, found beside libdyad_runtime.so): a
+# shared build tree that someone rebuilds meanwhile would otherwise stop sessions from starting.
+work=$(mktemp -d)
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill -INT "$p" 2> /dev/null || true; done
+  wait 2> /dev/null || true
+  if [ "${CAPACITY_KEEP:-0}" = 1 ]; then echo "kept: $work (nN/sI: each session's run.out, run.err, rec.mcap)"; else rm -rf "$work"; fi
+}
+trap cleanup EXIT
+mkdir -p "$work/build/bin" "$work/build/lib"
+cp "$dyad" "$work/build/bin/"
+cp -a "$build"/lib/*.so* "$work/build/lib/" 2> /dev/null || true
+cp -a "$build/plugins" "$build/share" "$work/build/" 2> /dev/null || true
+dyad=$work/build/bin/dyad
+export LD_LIBRARY_PATH=$work/build/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+
 cache=$build/bench-capacity
 mkdir -p "$cache"
 dataset=$build/data/analytic model=$build/models/demo.dpvrnn observer=$build/models/demo.dobs
@@ -56,14 +73,6 @@ fi
 drawn=${CAPACITY_DATASET:-$here/../shared/data/vcbot/dataset/Macaw}
 [ -d "$drawn" ] || drawn=$dataset
 
-work=$(mktemp -d)
-pids=()
-cleanup() {
-  for p in "${pids[@]}"; do kill -INT "$p" 2> /dev/null || true; done
-  wait 2> /dev/null || true
-  if [ "${CAPACITY_KEEP:-0}" = 1 ]; then echo "kept: $work (nN/sI: each session's run.out, run.err, rec.mcap)"; else rm -rf "$work"; fi
-}
-trap cleanup EXIT
 base=$(( 100 + $$ % 60 ))  # domains base+1 .. base+N (<= 232)
 
 start_session() {  # start_session DIR I
