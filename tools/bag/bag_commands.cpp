@@ -12,10 +12,10 @@
 
 #include "bag_filter.hpp"
 #include "bag_info.hpp"
-#include "losses.hpp"
 #include "csv_export.hpp"
 #include "dyad/mcap/reader.hpp"
 #include "exit_code.hpp"
+#include "losses.hpp"
 
 namespace dyad::cli {
 namespace {

@@ -23,9 +23,9 @@
 
 #include "exit_code.hpp"
 #include "graph_dot.hpp"
-#include "watcher_catalog.hpp"
 #include "reference_markdown.hpp"
 #include "run_process.hpp"
+#include "watcher_catalog.hpp"
 
 namespace dyad::cli {
 
