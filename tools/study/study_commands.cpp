@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 
+#include "attempt_end.hpp"
 #include "exit_code.hpp"
 #include "run_process.hpp"
 #include "study_analysis.hpp"
@@ -87,7 +88,7 @@ std::string Ended(const study::Attempt& a) {
   if (a.outcome == AttemptOutcome::kStopped) return std::string("stopped after ") + secs + ": incomplete";
   if (a.outcome == AttemptOutcome::kIncomplete) return std::string("incomplete after ") + secs + ": " + a.incomplete;
   if (a.outcome == AttemptOutcome::kUnended) return "interrupted: the session ended during it";
-  return "failed: the graph exited " + std::to_string(a.exit) + " after " + secs + (a.exit == 0 ? " and left no whole recording" : "");
+  return study::FailedLine(a.ended, a.exit, a.seconds);
 }
 
 // One line from the experimenter; nothing at the end of input (no answer is never a yes).

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include "attempt_end.hpp"
 #include "child_process.hpp"
 #include "dyad/mcap/reader.hpp"
 #include "dyad/private_file.hpp"
@@ -193,6 +194,7 @@ Session ReadSession(const Study& s, const std::string& participant) {
         a->incomplete = j.value("incomplete", "");
         a->seconds = j.value("seconds", 0.0);
         a->exit = j.value("exit", 0);
+        a->ended = j.value("ended", "");
         if (running == trial) running = 0;
       }  // other events are for people
     } catch (const std::exception& e) {
@@ -390,6 +392,7 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   const auto t0 = std::chrono::steady_clock::now();
   int forwarded = 0;  // SIGINTs sent to the graph
   double first_stop_s = 0;  // when the first was sent, from the graph's start
+  tools::ExitStatus exit;   // how the graph ended
   {
     StopSignals signals;
     tools::ChildOptions options;
@@ -412,27 +415,26 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    a.exit = end->ShellCode();
+    exit = *end;
   }
+  a.exit = exit.ShellCode();
+  a.ended = exit.ToString();
   a.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // A trial without a duration ends when the experimenter stops it (the graph then exits 0, or
-  // 130 for the signal); a timed one stopped early is incomplete. A recording cut short (a
-  // crash, a second stop) is never complete.
-  // Stopped while the subject answered, after a full trial: the trial was complete. (The graph's
-  // start-up, a second or two, counts in first_stop_s: a stop that much before the end counts too.)
-  const bool stopped = forwarded > 0;
-  const bool ended_well = a.exit == 0 || (stopped && a.exit == 128 + SIGINT);
+  // A trial without a duration ends when the experimenter stops it; a timed one stopped early is
+  // stopped, unless the subject was answering after a full trial (the graph's start-up, a second
+  // or two, counts in first_stop_s: a stop that much before the end counts too). A recording cut
+  // short (a crash, a second stop) is never complete (attempt_end.hpp).
   const bool asking = !r.rehearsal && AskedAfterTrial(s) && first_stop_s >= s.duration_s;
-  if (stopped && s.duration_s > 0 && !asking) a.outcome = AttemptOutcome::kStopped;
-  else a.outcome = ended_well ? AttemptOutcome::kComplete : AttemptOutcome::kFailed;
+  a.outcome = ClassifyGraphEnd({exit, forwarded > 0, s.duration_s > 0, asking});
   if (a.outcome == AttemptOutcome::kComplete) {
-    auto recording = mcap::Reader::Open(a.file);
-    if (!recording.ok() || recording->recovery().truncated) a.outcome = AttemptOutcome::kFailed;
+    bool whole = false;
+    if (auto recording = mcap::Reader::Open(a.file); recording.ok()) whole = !recording->recovery().truncated;
+    const std::string no_subject = whole ? NoSubject(a.file) : "";
+    a.outcome = ClassifyRecording(whole, no_subject);
+    if (a.outcome == AttemptOutcome::kIncomplete) a.incomplete = no_subject;
   }
-  if (a.outcome == AttemptOutcome::kComplete && !(a.incomplete = NoSubject(a.file)).empty())
-    a.outcome = AttemptOutcome::kIncomplete;
   Json end = {{"event", "end"}, {"trial", a.trial}, {"attempt", a.attempt}, {"outcome", std::string(ToString(a.outcome))},
-              {"seconds", std::round(a.seconds * 10) / 10}, {"exit", a.exit}};
+              {"seconds", std::round(a.seconds * 10) / 10}, {"exit", a.exit}, {"ended", a.ended}};
   if (!a.incomplete.empty()) end["incomplete"] = a.incomplete;
   if (Status st = AppendSessionEvent(s, r.participant, Dump(end)); !st.ok()) return st;
   return a;

@@ -6,7 +6,9 @@
 //   {"time":"2026-11-26T20:31:05Z","event":"consent","how":"..."}
 //   {"time":...,"event":"start","trial":3,"attempt":2,"file":"/abs/03-B.try2.mcap","reason":"..."}
 //   {"time":...,"event":"start",...,"start_anyway":"without the subject's page"}  the experimenter's choice
-//   {"time":...,"event":"end","trial":3,"attempt":2,"outcome":"complete","seconds":120.0,"exit":0}
+//   {"time":...,"event":"end","trial":3,"attempt":2,"outcome":"complete","seconds":120.0,"exit":0,
+//    "ended":"exited with code 0"}   exit: the shell's number; ended: how the graph ended, in words
+//    (child_process.hpp's ExitStatus: "killed by signal 9 (Killed)", "never started: ...")
 //   {"time":...,"event":"end",...,"outcome":"incomplete","incomplete":"no subject: ..."}  nobody took part
 //   {"time":...,"event":"note","text":"...","trial":3}       the experimenter's (dyad study note, the page);
 //                                                             trial: the one under way (none between trials)
@@ -69,7 +71,8 @@ struct Attempt {
   AttemptOutcome outcome = AttemptOutcome::kUnended;  // kUnended: started, never ended
   std::string incomplete;    // outcome incomplete: why (NoSubject)
   double seconds = 0;
-  int exit = 0;
+  int exit = 0;              // the shell's number (128 + signal, 127 never started): for the log and old logs
+  std::string ended;         // how the graph ended, in words ("" in logs written before it was kept)
   bool interrupted = false;  // RunAttempt: SIGINT/SIGTERM reached the runner (a person wants it all to stop)
 };
 
