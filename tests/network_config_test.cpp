@@ -398,6 +398,20 @@ TEST(NetworkQos, ASecuredParticipantLeasesAtLeastTwentySecondsAndAnnouncesAsBefo
   EXPECT_EQ(long_lease.wire_protocol().builtin.discovery_config.leaseDuration, eprosima::fastrtps::Duration_t(30.0));
 }
 
+// ...and without a topic's liveliness_ms its endpoints get an AUTOMATIC lease of lease_s, so a
+// dead writer stops counting as alive as soon as in an open graph (not when its match ends).
+TEST(NetworkQos, ASecuredEndpointWithoutLivelinessGetsTheNetworksLease) {
+  NetworkConfig net;
+  net.lease_s = 5;
+  TopicQos plain, own, ros2;
+  own.liveliness_ms = 200;
+  ros2.ros2_name = "/joint_states";
+  EXPECT_EQ(WithLeaseLiveliness(plain, true, net).liveliness_ms, 5000);
+  EXPECT_EQ(WithLeaseLiveliness(plain, false, net).liveliness_ms, 0);  // open: as before
+  EXPECT_EQ(WithLeaseLiveliness(own, true, net).liveliness_ms, 200);   // the topic's own kept
+  EXPECT_EQ(WithLeaseLiveliness(ros2, true, net).liveliness_ms, 0);    // a ROS 2 writer offers none
+}
+
 TEST(NetworkQos, AnAddressThatDoesNotResolveNamesItsKey) {
   std::vector<Diagnostic> diags;
   const Graph g = Parse(Replace(kSplit, "mind: 10.77.0.2", "mind: no-such-host.invalid"), &diags);

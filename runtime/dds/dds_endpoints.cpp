@@ -7,6 +7,7 @@
 // it first and each sample once; a writer switches at once. Matches, Renew, Reap and
 // MatchedReadersOf/WritersOf cover every endpoint, serialized ones too (dds_serialized.cpp).
 #include "dds/dds_internal.hpp"
+#include "dds/network_qos.hpp"
 
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
@@ -234,12 +235,13 @@ StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, co
                                                     std::function<void()> on_data) {
   if (Status st = GetTopic(topic, type, qos.ros2_name); !st.ok()) return st;
   fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
-  ApplyQos(rq, qos);
+  const TopicQos q = WithLeaseLiveliness(qos, secured_ && scope_ != Scope::kProcessOnly, network_);
+  ApplyQos(rq, q);
   std::unique_ptr<DdsReader> r(new DdsReader());
   r->topic_ = topic;
   r->info_ = std::make_unique<fdds::SampleInfo>();
   if (scope_ == Scope::kWatcher) rq.data_sharing().off();
-  r->listener_ = std::make_unique<DdsReader::Listener>(std::move(on_data), qos.liveliness_ms > 0);
+  r->listener_ = std::make_unique<DdsReader::Listener>(std::move(on_data), q.liveliness_ms > 0);
   fdds::StatusMask mask = fdds::StatusMask::data_available();
   mask << fdds::StatusMask::subscription_matched() << fdds::StatusMask::liveliness_changed()
        << fdds::StatusMask::requested_deadline_missed();
@@ -262,7 +264,7 @@ StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, co
 StatusOr<TypedWriter*> DdsParticipant::CreateWriter(const std::string& topic, const TypeInfo& type, const TopicQos& qos) {
   if (Status st = GetTopic(topic, type, qos.ros2_name); !st.ok()) return st;
   fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
-  ApplyQos(wq, qos);
+  ApplyQos(wq, WithLeaseLiveliness(qos, secured_ && scope_ != Scope::kProcessOnly, network_));
   if (scope_ == Scope::kWatcher) KeepForLateMatches(wq);
   std::unique_ptr<DdsWriter> w(new DdsWriter());
   w->topic_ = topic;

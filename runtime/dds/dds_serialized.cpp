@@ -6,6 +6,7 @@
 // reader's callback runs on the delivering thread under its mutex_; renewal as the typed
 // reader's (dds_endpoints.cpp, kRetireS), retired readers drained before they go.
 #include "dds/dds_internal.hpp"
+#include "dds/network_qos.hpp"
 
 #include <dyad/decode_sample.hpp>
 
@@ -273,7 +274,7 @@ StatusOr<DdsSerializedReader*> DdsParticipant::MakeSerializedReader(const std::s
                                                                     SerializedCallback callback, bool on_demand) {
   if (Status st = GetTopic(topic, type, qos.ros2_name); !st.ok()) return st;
   fdds::DataReaderQos rq = fdds::DATAREADER_QOS_DEFAULT;
-  ApplyQos(rq, qos);
+  ApplyQos(rq, WithLeaseLiveliness(qos, secured_ && scope_ != Scope::kProcessOnly, network_));
   if (qos.keep_all) {
     // KEEP_ALL alone still caps the history (5000 samples, 400 per instance by default): samples
     // that pile up while the callback waits (a full recorder queue) must not be refused.
@@ -313,7 +314,7 @@ StatusOr<SerializedWriter*> DdsParticipant::CreateSerializedWriter(const std::st
                                                                                       const Clock* clock) {
   if (Status st = GetTopic(topic, type, qos.ros2_name); !st.ok()) return st;
   fdds::DataWriterQos wq = fdds::DATAWRITER_QOS_DEFAULT;
-  ApplyQos(wq, qos);
+  ApplyQos(wq, WithLeaseLiveliness(qos, secured_ && scope_ != Scope::kProcessOnly, network_));
   if (scope_ == Scope::kWatcher) KeepForLateMatches(wq);
   std::unique_ptr<DdsSerializedWriter> w(new DdsSerializedWriter());
   w->topic_ = topic;

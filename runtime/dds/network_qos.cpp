@@ -48,6 +48,12 @@ double AnnouncementPeriodS(const NetworkConfig& net) {
   return net.discovery == Discovery::kServer ? net.lease_s / 10 : net.lease_s / 4;
 }
 
+TopicQos WithLeaseLiveliness(const TopicQos& qos, bool secured, const NetworkConfig& net) {
+  TopicQos q = qos;
+  if (secured && q.liveliness_ms <= 0 && q.ros2_name.empty()) q.liveliness_ms = net.lease_s * 1000;
+  return q;
+}
+
 bool NetworkUp(const NetworkConfig& net) {
   ifaddrs* list = nullptr;
   if (getifaddrs(&list) != 0) return true;  // cannot tell: do not hold anything back

@@ -24,6 +24,8 @@
 #include <dyad/graph.hpp>
 #include <dyad/status.hpp>
 
+#include "graph/topic_qos.hpp"
+
 namespace eprosima::fastdds::dds {
 class DomainParticipantQos;
 }
@@ -47,6 +49,12 @@ inline constexpr int kLocalParticipants = 32;
 // enough for lease_s: 5 to run out. 20 s is Fast DDS's default lease. dyad's own notice of a
 // process that is gone does not wait for it (dyad/processes, the launchers' link).
 inline constexpr double kSecuredLeaseS = 20;
+
+// What a secured participant's endpoint of a topic without `liveliness_ms` gets instead: an
+// AUTOMATIC liveliness lease of lease_s, so that a writer whose process died still stops counting
+// as alive after lease_s (not after kSecuredLeaseS, when its match ends). ROS 2 topics are left
+// as they are (a ROS 2 writer offers no lease: a reader asking for one would not match it).
+TopicQos WithLeaseLiveliness(const TopicQos& qos, bool secured, const NetworkConfig& network);
 
 // The discovery server's GUID prefix (Fast DDS's convention for server id 0, the one
 // `fast-discovery-server -i 0` uses too).
