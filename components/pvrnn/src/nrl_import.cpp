@@ -43,6 +43,8 @@ class NrlMatrixFile {
     *out = Eigen::Map<const Eigen::MatrixXd>(values_.data(), rows, cols);
     return Status::OK();
   }
+  size_t size() const { return lines_.size(); }
+  const std::string& name() const { return name_; }
 
  private:
   std::string path_, name_;
@@ -83,7 +85,10 @@ StatusOr<NrlProperties> ReadProperties(const std::string& pf) {
   for (const char* key : {"d", "z", "t", "w", "activejoints"})
     if (!num.count(key)) return Status::DataLoss(pf + ": property '" + key + "' missing");
   if (text.count("network") && text["network"] != "pvrnn")
-    return Status::Unimplemented(pf + ": network=" + text["network"] + ", only pvrnn can be imported");
+    return Status::Unimplemented(pf + ": network=" + text["network"] + ", only pvrnn can be imported" +
+                                 (text["network"] == "pvrnnbeta"
+                                      ? " (NRL's PV-RNN Beta: top-down only, other prior and KL at the first step; docs/pvrnn.md)"
+                                      : ""));
   if (text.count("robot") && text["robot"] != "cartesian")
     return Status::Unimplemented(pf + ": robot=" + text["robot"] + ", only the cartesian robot (joints -50..50) is supported");
   const size_t K = num["d"].size();
@@ -121,6 +126,11 @@ Status ReadWeights(const fs::path& dir, const NetworkLayout& layout, Model* m) {
     std::vector<Item> items = {{"W_dh", d, d}, {"W_zh", d, z}, {"W_mu_p", z, d}, {"W_ls_p", z, d}, {"W_mu_q", z, d}, {"W_ls_q", z, d}};
     if (k > 0) items.push_back({"W_below", d, spec.layers[k - 1].d});
     if (k + 1 < K) items.push_back({"W_above", d, spec.layers[k + 1].d});
+    // NRL's Beta network (network=pvrnnbeta) writes no W_below: every layer above the lowest is one line short.
+    if (k > 0 && wf->size() + 1 == items.size())
+      return Status::DataLoss(wf->name() + ": " + std::to_string(wf->size()) + " lines, a layer above the lowest needs " +
+                              std::to_string(items.size()) + " (with W_below); NRL's PV-RNN Beta network " +
+                              "(network=pvrnnbeta) writes no W_below: a Beta model cannot be imported, only network=pvrnn");
     for (const auto& it : items) {
       if (Status s = wf->Next(it.rows, it.cols, it.name, &buf); !s.ok()) return s;
       group(static_cast<int>(k), it.name) = buf;

@@ -2,6 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
 
 #include "dyad/pvrnn/nrl_import.hpp"
 #include "dyad/pvrnn/posterior_pass.hpp"
@@ -78,6 +82,52 @@ TEST(NrlImport, MissingFileIsNamed) {
   auto model = ImportNrlModel(o);
   ASSERT_FALSE(model.ok());
   EXPECT_NE(model.status().message().find("L0_w_p.d: cannot open"), std::string::npos) << model.status().message();
+}
+
+// NRL's Beta network (network=pvrnnbeta) is another model (top-down only, unit Gaussian prior
+// and meta-prior w1 at the first step): its properties are refused, naming the file and key.
+TEST(NrlImport, RefusesTheBetaNetworkByItsProperties) {
+  DYAD_REQUIRE_VCBOT();
+  NrlImportOptions o = MacawOptions();
+  o.properties_file = testing::TempPath("beta_properties.d");
+  {
+    std::ifstream in(MacawOptions().properties_file);
+    std::ofstream out(o.properties_file);
+    for (std::string line; std::getline(in, line);) out << (line == "network=pvrnn" ? "network=pvrnnbeta" : line) << "\n";
+  }
+  auto model = ImportNrlModel(o);
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.status().code(), Status::Code::kUnimplemented);
+  EXPECT_NE(model.status().message().find(o.properties_file + ": network=pvrnnbeta"), std::string::npos)
+      << model.status().message();
+  std::filesystem::remove(o.properties_file);
+}
+
+// A Beta model's weights given with a plain properties file: its upper layer has no W_below
+// (bottom-up) line. The import must fail and say why, not read the next matrix as W_below.
+TEST(NrlImport, BetaWeightFilesAreNamedNotMisread) {
+  DYAD_REQUIRE_VCBOT();
+  NrlImportOptions o = MacawOptions();
+  o.model_dir = testing::TempPath("beta_model");
+  std::filesystem::remove_all(o.model_dir);
+  std::filesystem::copy(MacawOptions().model_dir, o.model_dir);
+  const std::string l1 = o.model_dir + "/L1_w_p.d";
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(l1);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+  }
+  ASSERT_EQ(lines.size(), 7u);  // W_dh, W_zh, 4 prior/posterior, W_below (10 x 40)
+  {
+    std::ofstream out(l1, std::ios::trunc);
+    for (size_t i = 0; i < 6; ++i) out << lines[i] << "\n";  // what LayerPvrnnBeta::save writes for the top layer
+  }
+  auto model = ImportNrlModel(o);
+  ASSERT_FALSE(model.ok());
+  const std::string& msg = model.status().message();
+  EXPECT_NE(msg.find("L1_w_p.d: 6 lines, a layer above the lowest needs 7"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("network=pvrnnbeta"), std::string::npos) << msg;
+  std::filesystem::remove_all(o.model_dir);
 }
 
 }  // namespace

@@ -9,7 +9,9 @@
 // line per primitive and step (primitive-major). The Cartesian robot's joints range -50..50.
 //
 // Errors name the file (and line) and the mismatch, e.g. "L0_w_p.d:3: expected 160 values
-// (4 x 40: W_mu_p), found 150".
+// (4 x 40: W_mu_p), found 150". Only NRL's plain PV-RNN (network=pvrnn, or no network key:
+// NRL before its Beta network) is imported; network=pvrnnbeta is refused, and a Beta model's
+// weight files (no W_below) fail with an error that says so.
 #pragma once
 
 #include <string>
