@@ -116,7 +116,7 @@ DdsReader::~DdsReader() {
 // One taker at a time (the port's component, whose steps never overlap; the runtime's own
 // readers under their owner's lock): seen_ needs no lock of its own.
 bool DdsReader::TakeNext(void* sample) {
-  std::shared_lock<std::shared_mutex> lock(entities_);
+  std::shared_lock<EntityLock> lock(entities_);
   fdds::SampleInfo& info = *info_;
   for (fdds::DataReader* r : {retired_, reader_}) {  // the retired one's samples are older
     if (r == nullptr) continue;
@@ -127,7 +127,7 @@ bool DdsReader::TakeNext(void* sample) {
 }
 
 uint64_t DdsReader::Unread() const {
-  std::shared_lock<std::shared_mutex> lock(entities_);
+  std::shared_lock<EntityLock> lock(entities_);
   return reader_->get_unread_count() + (retired_ != nullptr ? retired_->get_unread_count() : 0);
 }
 
@@ -135,12 +135,12 @@ int DdsReader::Matched() const { return listener_->matched(); }
 
 bool DdsReader::Renew() {
   {
-    std::shared_lock<std::shared_mutex> lock(entities_);
+    std::shared_lock<EntityLock> lock(entities_);
     if (retired_ != nullptr) return false;  // one renewal at a time: its retired reader may hold samples
   }
   fdds::DataReader* fresh = make_();  // counted by the listener from now on
   if (fresh == nullptr) return false;
-  std::unique_lock<std::shared_mutex> lock(entities_);
+  std::unique_lock<EntityLock> lock(entities_);
   retired_ = reader_;
   reader_ = fresh;
   retired_at_ = std::chrono::steady_clock::now();
@@ -149,11 +149,11 @@ bool DdsReader::Renew() {
 
 bool DdsReader::Reap(bool force) {
   {
-    std::shared_lock<std::shared_mutex> lock(entities_);
+    std::shared_lock<EntityLock> lock(entities_);
     if (retired_ == nullptr) return true;
     if (!force && !RetiredDone(retired_, retired_at_)) return false;
   }
-  std::unique_lock<std::shared_mutex> lock(entities_);
+  std::unique_lock<EntityLock> lock(entities_);
   graveyard_.push_back(std::exchange(retired_, nullptr));  // deleted with this reader (kRetireS)
   return true;
 }
@@ -166,7 +166,7 @@ void AwaitAcks(fdds::DataWriter* w) {
 }
 
 bool DdsWriter::AwaitAcknowledged(double timeout_s) {
-  std::shared_lock<std::shared_mutex> lock(entities_);
+  std::shared_lock<EntityLock> lock(entities_);
   return writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(timeout_s)) == ReturnCode_t::RETCODE_OK;
 }
 
@@ -180,7 +180,7 @@ bool DdsWriter::Renew() {
   if (fresh == nullptr) return false;
   fdds::DataWriter* old = nullptr;
   {
-    std::unique_lock<std::shared_mutex> lock(entities_);
+    std::unique_lock<EntityLock> lock(entities_);
     old = std::exchange(writer_, fresh);
   }
   destroy_(old);
@@ -188,21 +188,21 @@ bool DdsWriter::Renew() {
 }
 
 Status DdsWriter::Write(const void* sample) {
-  std::shared_lock<std::shared_mutex> lock(entities_);
+  std::shared_lock<EntityLock> lock(entities_);
   if (!writer_->write(const_cast<void*>(sample)))
     return Status::IOError("topic '" + topic_ + "': DDS write failed");
   return Status::OK();
 }
 
 Status DdsWriter::WriteStamped(const void* sample, int64_t stamp_ns) {
-  std::shared_lock<std::shared_mutex> lock(entities_);
+  std::shared_lock<EntityLock> lock(entities_);
   if (writer_->write_w_timestamp(const_cast<void*>(sample), fdds::HANDLE_NIL, TimeOfNs(stamp_ns)) != ReturnCode_t::RETCODE_OK)
     return Status::IOError("topic '" + topic_ + "': DDS write failed");
   return Status::OK();
 }
 
 int DdsWriter::matched() const {
-  std::shared_lock<std::shared_mutex> lock(entities_);
+  std::shared_lock<EntityLock> lock(entities_);
   return WriterMatched(writer_);
 }
 

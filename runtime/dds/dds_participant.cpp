@@ -134,7 +134,7 @@ DdsParticipant::~DdsParticipant() {
   // typed readers' listeners detached. Then endpoints, then the participant.
   for (auto& r : serialized_readers_) r->Close();
   for (auto& r : readers_) {
-    std::unique_lock<std::shared_mutex> lock(r->entities_);
+    std::unique_lock<EntityLock> lock(r->entities_);
     for (fdds::DataReader* d : r->graveyard_) d->set_listener(nullptr);
     for (fdds::DataReader* d : {r->reader_, r->retired_})
       if (d != nullptr) d->set_listener(nullptr);
