@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace dyad {
@@ -34,10 +35,10 @@ TEST(WireNames, AParticipantNameIsOpaqueStableAndReadBackOnlyWithItsKey) {
 }
 
 TEST(WireNames, LengthSaysLittleAndASubjectIsShort) {
-  // Names up to 47 bytes look alike; a longer one takes the second size; 96 bytes or more: the
+  // Names up to 47 bytes look alike; a longer one takes the second size; 144 bytes or more: the
   // subject alone (not readable back).
   EXPECT_EQ(WireName(kKey, "dyad/g/a").size(), WireName(kKey, "dyad/a_much_longer_graph_name/process").size());
-  const std::string longer(60, 'x'), longest(120, 'y');
+  const std::string longer(60, 'x'), longest(150, 'y');
   EXPECT_GT(WireName(kKey, longer).size(), WireName(kKey, "dyad/g/a").size());
   EXPECT_EQ(ReadableName(kKey, WireName(kKey, longer)), longer);
   EXPECT_EQ(WireName(kKey, longest), WireSubject(kKey, longest));
@@ -45,6 +46,19 @@ TEST(WireNames, LengthSaysLittleAndASubjectIsShort) {
   // A certificate's common name holds 64 characters.
   EXPECT_LE(WireSubject(kKey, longest).size(), 64u);
   EXPECT_EQ(WireName(kKey, "dyad/g/a").rfind(WireSubject(kKey, "dyad/g/a"), 0), 0u);
+}
+
+TEST(WireNames, TheLongestParticipantNameIsReadBack) {
+  // A graph name and a process name may each have 64 characters: dyad/<graph>/<process> is 134
+  // bytes, and its peers must still read it back (dyad param, pub's wait, topics --graph).
+  const std::string name = "dyad/" + std::string(64, 'g') + "/" + std::string(64, 'p');
+  const std::string wire = WireName(kKey, name);
+  EXPECT_LT(wire.size(), 256u) << "a DDS participant name holds 255 characters";
+  EXPECT_EQ(ReadableName(kKey, wire), name);
+  EXPECT_EQ(wire.find("ggg"), std::string::npos) << wire;
+  const std::string largest(143, 'z');
+  EXPECT_LT(WireName(kKey, largest).size(), 256u);
+  EXPECT_EQ(ReadableName(kKey, WireName(kKey, largest)), largest);
 }
 
 TEST(WireNames, TheKeyFileIsReadOrRefusedNamingIt) {
@@ -55,16 +69,48 @@ TEST(WireNames, TheKeyFileIsReadOrRefusedNamingIt) {
   EXPECT_EQ(text.value().size(), 65u);
   EXPECT_NE(NewNamesKeyText().value(), text.value()) << "drawn, not fixed";
   std::ofstream(dir / "names.key") << text.value();
+  std::filesystem::permissions(dir / "names.key", std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
   auto key = ReadNamesKey((dir / "names.key").string());
   ASSERT_TRUE(key.ok()) << key.status().message();
   EXPECT_EQ(key.value().size(), 32u);
   std::ofstream(dir / "bad.key") << "not hex at all";
+  std::filesystem::permissions(dir / "bad.key", std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
   auto bad = ReadNamesKey((dir / "bad.key").string());
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.status().message().find((dir / "bad.key").string() + ": not a names key"), std::string::npos);
   auto missing = ReadNamesKey((dir / "none.key").string());
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.status().message().find("run `dyad security init`"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+// Read as a private file: never through a link (a link to /dev/zero would never end), never a
+// special file, never one others can read, never more than a key's length.
+TEST(WireNames, TheKeyFileIsPrivateAndSmall) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("wire_names_private_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const auto owner_only = std::filesystem::perms::owner_read | std::filesystem::perms::owner_write;
+  auto refusal = [&](const std::string& file) {
+    auto key = ReadNamesKey((dir / file).string());
+    return key.ok() ? std::string("read") : key.status().message();
+  };
+  const std::string text = NewNamesKeyText().value();
+  std::ofstream(dir / "open.key") << text;
+  std::filesystem::permissions(dir / "open.key", owner_only | std::filesystem::perms::group_read);
+  EXPECT_NE(refusal("open.key").find((dir / "open.key").string() + ": the names key readable by others (mode 0640"),
+            std::string::npos)
+      << refusal("open.key");
+  std::filesystem::create_symlink("/dev/zero", dir / "zero.key");
+  EXPECT_NE(refusal("zero.key").find((dir / "zero.key").string() + ": a symbolic link"), std::string::npos)
+      << refusal("zero.key");
+  std::filesystem::create_symlink(dir / "open.key", dir / "link.key");
+  EXPECT_NE(refusal("link.key").find("a symbolic link"), std::string::npos) << refusal("link.key");
+  ASSERT_EQ(mkfifo((dir / "fifo.key").c_str(), 0600), 0);
+  EXPECT_NE(refusal("fifo.key").find((dir / "fifo.key").string() + ": not a regular file"), std::string::npos)
+      << refusal("fifo.key");
+  std::ofstream(dir / "long.key") << text << std::string(1 << 20, 'a');
+  std::filesystem::permissions(dir / "long.key", owner_only);
+  EXPECT_NE(refusal("long.key").find(": not a names key"), std::string::npos) << refusal("long.key");
   std::filesystem::remove_all(dir);
 }
 

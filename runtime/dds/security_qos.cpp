@@ -15,7 +15,10 @@ StatusOr<std::string> ApplySecurity(const IdentityFiles& identity, eprosima::fas
   if (!identity.enabled()) return std::string();
   auto key = ReadNamesKey((std::filesystem::path(identity.identity_ca).parent_path() / kNamesKeyFile).string());
   if (!key.ok()) return key.status();
-  qos->name(WireName(key.value(), qos->name().to_string()));
+  const std::string wire_name = WireName(key.value(), qos->name().to_string());
+  if (wire_name.empty())
+    return Status::Internal("cannot make the opaque name of '" + qos->name().to_string() + "' (libcrypto failed)");
+  qos->name(wire_name);
   auto& p = qos->properties().properties();
   // Fast DDS fills these (when present and empty) with the host's and user's names and the pid,
   // and announces them in clear.

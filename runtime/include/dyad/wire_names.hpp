@@ -12,12 +12,15 @@
 //                           A certificate's subject (CN=...): nothing needs to read it back.
 //   WireName(key, name)     WireSubject(key, name) + "." + the name encrypted (AES-256-CTR, the
 //                           HMAC as its IV: a synthetic IV, so the same name gives the same
-//                           text), padded with zero bytes to 48 or 96 bytes so that its length
-//                           says little. A participant's name: the graph's participants read it
-//                           back (ReadableName) to report and match their peers by name. A name
-//                           of 96 bytes or more gets its WireSubject only (not readable back).
+//                           text), padded with zero bytes to 48 or 144 bytes so that its length
+//                           says little, in base64url (64 or 192 characters: at most 230 in all,
+//                           under Fast DDS's 255). A participant's name: the graph's participants
+//                           read it back (ReadableName) to report and match their peers by name.
+//                           Every dyad/<graph>/<process> fits (names of 64 characters each); a
+//                           name of 144 bytes or more gets its WireSubject only (not readable back).
 //   ReadableName(key, wire) the name, when `wire` is a WireName made with this key; "" for
 //                           anything else (another graph's, a forgery, a plain name).
+// WireSubject and WireName return "" when libcrypto fails (callers refuse to go on).
 //
 // Both are the same for every run of the graph (docs/security.md, "Names on the wire", says
 // why). The key is derived into two (one for the HMAC, one for AES) by HMAC with fixed labels.
@@ -32,7 +35,8 @@ namespace dyad {
 inline constexpr const char* kNamesKeyFile = "names.key";
 
 // The key in the file at `path` (64 hex digits, then an optional newline): 32 raw bytes. An
-// error names the file and says to run `dyad security init` when it is missing.
+// error names the file and says to run `dyad security init` when it is missing. The file must be
+// a regular file (a symbolic link or a special file is refused) that only its owner can read.
 StatusOr<std::string> ReadNamesKey(const std::string& path);
 // A new key file's text: 64 hex digits from the system's random source, and a newline.
 StatusOr<std::string> NewNamesKeyText();
