@@ -381,7 +381,8 @@ std::string CommonName(X509* cert) {
 // handshake carries it (in each certificate it issued). Say so; only a new keystore changes it.
 void NoteNamedCa(const Graph& graph, const Authority& ca, const std::string& path, std::ostream& out) {
   const std::string cn = CommonName(ca.cert());
-  if (cn.find(graph.name) != std::string::npos)
+  // The exact subjects such a keystore gave its CAs ("dyad identity CA" alone is today's).
+  if (cn == "dyad identity CA " + graph.name || cn == "dyad permissions CA " + graph.name)
     out << "note     " << path << ": its subject (CN=" << cn
         << ") names the graph, and every handshake shows it to anyone listening: a new keystore hides it\n";
 }
@@ -395,14 +396,17 @@ Status InitIdentity(const Graph& graph, const std::map<std::string, TopicAccess>
   const fs::path own = fs::path(options.dir) / "identities" / identity;
   const std::string cert_path = (own / "cert.pem").string(), key_path = (own / "key.pem").string();
   const std::string readable = IdentitySubject(graph, identity);
-  const std::string subject = "CN=" + WireSubject(names_key, readable.substr(readable.find('=') + 1));
+  const std::string opaque = WireSubject(names_key, readable.substr(readable.find('=') + 1));
+  if (opaque.empty()) return Status::Internal("cannot make the opaque subject of " + identity + " (libcrypto failed)");
+  const std::string subject = "CN=" + opaque;
   const bool renew = options.renew.count("all") > 0 || options.renew.count(identity) > 0;
   const bool have = fs::exists(fs::symlink_status(cert_path)) && fs::exists(fs::symlink_status(key_path));
   if (!have || renew) return IssueIdentity(graph, access, options, identity, subject, identity_ca, permissions_ca, out);
   auto cert = ReadCert(cert_path);
   if (!cert.ok()) return cert.status();
   if ("CN=" + CommonName(cert.value().get()) != subject) {
-    out << "renewing " << identity << ": its certificate's subject names it in clear\n";
+    out << "renewing " << identity << ": its subject is not this keystore's opaque one (CN=" << CommonName(cert.value().get())
+        << "; a keystore made before names were opaque, a renamed graph or a new names.key)\n";
     return IssueIdentity(graph, access, options, identity, subject, identity_ca, permissions_ca, out);
   }
   out << "kept     " << identity << ": " << cert_path << "\n";

@@ -256,6 +256,23 @@ TEST_F(KeystoreTest, ARerunKeepsKeysAndRenewReplacesOnlyTheNamedIdentity) {
       << bad.err;
 }
 
+// A graph called "dyad" is not named by the CAs' subject "dyad identity CA" (no note); a new
+// names.key makes every subject another, so a rerun reissues each identity and says why.
+TEST_F(KeystoreTest, ANewNamesKeyReissuesEveryIdentityAndAShortGraphNameIsNoCaSubject) {
+  std::string text = ReadFile(graph_);
+  text.replace(text.find("graph: sec"), 10, "graph: dyad");
+  std::ofstream(dir_ / "short.yaml") << text;
+  auto first = Init({}, dir_ / "short.yaml");
+  ASSERT_EQ(first.code, 0) << first.err;
+  EXPECT_EQ(first.out.find("note"), std::string::npos) << first.out;
+  fs::remove(keys_ / kNamesKeyFile);
+  auto again = Init({}, dir_ / "short.yaml");
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_NE(again.out.find("renewing process.pub: its subject is not this keystore's opaque one"), std::string::npos)
+      << again.out;
+  EXPECT_EQ(again.out.find("note"), std::string::npos) << again.out;
+}
+
 TEST_F(KeystoreTest, CaKeysKeptOfflineAreNeededOnlyToIssue) {
   ASSERT_EQ(Init().code, 0);
   fs::rename(keys_ / "ca", dir_ / "offline_ca");
