@@ -18,12 +18,14 @@
 //                                                   issue identities; runs do not (keep them off
 //                                                   the experiment machines)
 //   identities/<identity>/cert.pem, key.pem, permissions.xml, permissions.p7s
-// Identities: "process.<p>" for each process of the graph (its participant is dyad/<graph>/<p>,
-// subject CN=dyad/<graph>/<p>) and "host.<h>" for each host's launcher and watchers (subject
-// CN=dyad/<graph>/host/<h>; "host.local" when the graph places nothing on hosts), and "guest"
-// when the graph has `security.guests` (subject CN=dyad/<graph>/guest/tools: no process or host
-// subject has that shape): the identity of `dyad pub` and `dyad bag play` in a secured graph,
-// allowed to publish `guests.publish` and read `guests.subscribe`, nothing else of the graph's.
+// Identities: "process.<p>" for each process of the graph (its participant is dyad/<graph>/<p>)
+// and "host.<h>" for each host's launcher and watchers ("host.local" when the graph places
+// nothing on hosts), and "guest" when the graph has `security.guests`: the identity of `dyad pub`
+// and `dyad bag play` in a secured graph, allowed to publish `guests.publish` and read
+// `guests.subscribe`, nothing else of the graph's. IdentitySubject gives each its readable
+// subject (CN=dyad/<graph>/<p>, CN=dyad/<graph>/host/<h>, CN=dyad/<graph>/guest/tools: no
+// process or host has that shape); its certificate and permissions grant carry the opaque form,
+// CN=WireSubject(key, the name after CN=), with the keystore's names.key (dyad/wire_names.hpp).
 //
 // Loading a graph checks the keystore (CheckKeystore): every identity the graph needs is there,
 // no private key is readable by others or a symbolic link, every certificate is valid now. Fast
@@ -63,7 +65,8 @@ std::string HostIdentity(const std::string& host);        // "host.<h>"
 std::vector<std::string> IdentityHosts(const Graph& graph);
 // Every identity the graph needs: its processes', then its hosts', then the guest's (if any).
 std::vector<std::string> GraphIdentities(const Graph& graph);
-// The subject name of an identity's certificate and of its permissions grant.
+// The readable subject of an identity ("CN=dyad/<graph>/..."); its certificate and permissions
+// grant carry its opaque form (dyad/wire_names.hpp), never this.
 std::string IdentitySubject(const Graph& graph, const std::string& identity);
 
 // The files of `identity` in the graph's keystore (nothing when the graph has no security).
