@@ -120,7 +120,8 @@ ExitCode DrawPreview(const FromRecordingOptions& o, const analyze::Demonstration
     args.insert(args.end(), {"--label", std::to_string(k) + "=" + label});
   }
   if (tools::ExitStatus code = tools::RunDyadScript("plot_dataset.py", args); !code.ok()) {
-    std::cerr << "dyad dataset from-recording: the preview was not drawn (" << code.ToString() << "; python3-matplotlib: tools/setup.sh)\n";
+    std::cerr << "dyad dataset from-recording: the preview was not drawn (" << code.ToString()
+              << "; python3-matplotlib: tools/setup.sh)\n";
     return kFailure;
   }
   std::cout << "preview: " << o.preview << "\n";

@@ -7,14 +7,14 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <cmath>
-#include <thread>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
@@ -433,8 +433,13 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
     a.outcome = ClassifyRecording(whole, no_subject);
     if (a.outcome == AttemptOutcome::kIncomplete) a.incomplete = no_subject;
   }
-  Json end = {{"event", "end"}, {"trial", a.trial}, {"attempt", a.attempt}, {"outcome", std::string(ToString(a.outcome))},
-              {"seconds", std::round(a.seconds * 10) / 10}, {"exit", a.exit}, {"ended", a.ended}};
+  Json end = {{"event", "end"},
+              {"trial", a.trial},
+              {"attempt", a.attempt},
+              {"outcome", std::string(ToString(a.outcome))},
+              {"seconds", std::round(a.seconds * 10) / 10},
+              {"exit", a.exit},
+              {"ended", a.ended}};
   if (!a.incomplete.empty()) end["incomplete"] = a.incomplete;
   if (Status st = AppendSessionEvent(s, r.participant, Dump(end)); !st.ok()) return st;
   return a;

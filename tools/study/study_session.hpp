@@ -59,8 +59,8 @@
 #include <string>
 #include <vector>
 
-#include "dyad/status.hpp"
 #include "attempt_outcome.hpp"
+#include "dyad/status.hpp"
 #include "study_file.hpp"
 
 namespace dyad::study {

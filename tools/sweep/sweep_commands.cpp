@@ -33,7 +33,9 @@ struct Options {
   sweep::SlurmOptions slurm_options;
 };
 
-tools::ExitStatus Plot(const std::string& csv, const std::string& dir) { return tools::RunDyadScript("plot_sweep.py", {csv, dir}); }
+tools::ExitStatus Plot(const std::string& csv, const std::string& dir) {
+  return tools::RunDyadScript("plot_sweep.py", {csv, dir});
+}
 
 // Back to the folder it started in, whatever happens (the command may run inside a test binary).
 struct RestoreCwd {

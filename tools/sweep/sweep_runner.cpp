@@ -7,13 +7,13 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
-#include <functional>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <optional>
-#include <system_error>
 #include <sstream>
+#include <system_error>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -217,7 +217,8 @@ JobEnd Train(const SweepPlan& plan, const SweepTraining& training, const RunnerO
   const tools::ExitStatus exit = RunChild(args, log, &stopped);
   const JobEnd end = ClassifyTraining(stopped, exit, fs::exists(model, ec));
   if (end.outcome != JobOutcome::kFailed) return end;
-  return Failed(dir / (training.id + ".failed.txt"), tools::ShellQuoted(args) + "\n" + end.why + "; the end of its log:\n" + Tail(log, 20));
+  return Failed(dir / (training.id + ".failed.txt"),
+                tools::ShellQuoted(args) + "\n" + end.why + "; the end of its log:\n" + Tail(log, 20));
 }
 
 std::string Params(const std::vector<std::pair<std::string, std::string>>& params) {
