@@ -9,7 +9,15 @@
 #                                  the observer's two training-quality tests (accuracy after 100
 #                                  and 50 epochs: 124 s under ASan, 10 s in Release; the same
 #                                  training code runs under ASan in the observer's other tests),
-#                                  and ros2.Ros2DriverTest.* (e2e, by name: see tests/ros2/)
+#                                  and ros2.Ros2DriverTest.* (e2e, by name: see tests/ros2/), and
+#                                  SecurityTest.NoFrameNamesTheGraphItsProcessesOrItsHost: a packet
+#                                  capture of a secured run while a stranger of another CA knocks;
+#                                  under ASan its processes fail on a leak inside Fast DDS 2.9
+#                                  (PKIDH::begin_handshake_reply keeps the stranger's parsed
+#                                  certificate, 201 leaks in a run; not instrumented, so default
+#                                  LSan stacks stop in libcrypto and no narrow suppression matches).
+#                                  What it checks is the wire; wire_names' code runs under ASan in
+#                                  WireNames.* and the other SecurityTest cases
 #   bash tools/check.sh asan       ./build-san: clang 14, ASan + UBSan (-fno-sanitize-recover=all:
 #                                  any report fails the test), libFuzzer coverage instrumentation
 #                                  too, so the fuzz targets of tests/fuzz are built there as well;
@@ -92,7 +100,7 @@ tsan() {
 }
 
 case "$mode" in
-  sanitize) asan -LE e2e -E "^TrainClassifier.SeparatesNoisyTraces|^TrainObserver.MacawBotConfusion|^ros2.Ros2DriverTest" "$@"; tsan ;;
+  sanitize) asan -LE e2e -E "^TrainClassifier.SeparatesNoisyTraces|^TrainObserver.MacawBotConfusion|^ros2.Ros2DriverTest|^SecurityTest.NoFrameNamesTheGraphItsProcessesOrItsHost$" "$@"; tsan ;;
   asan) asan "$@" ;;
   tsan) tsan "$@" ;;
   build) asan_build; tsan_build ;;
