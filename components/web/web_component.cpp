@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -175,6 +176,12 @@ void WebComponent::Describe(ComponentSpec& spec) {
       .Doc(
           "the run's clock starts only once a page steers (the subject's, reconnecting), waiting at most this long; 0: no wait "
           "(dyad study run sets it for each trial of a session)");
+  spec.Param("pause_without_subject", false)
+      .Doc(
+          "while no page steers (the subject's page is gone, e.g. a participant's lost connection) the trial pauses: `pointer` "
+          "carries the pause marker (x = y = NaN) on which web_human stops publishing, so the mixer holds the robot; `notes` "
+          "marks it (author web, \"paused: ...\" / \"resumed: ...\"). Not during the questions after the trial (dyad study "
+          "serve sets it)");
   spec.Input<msg::CartesianState>("robot").Optional().Doc("robot state shown on the subject's page");
   spec.Output<msg::SubjectTask>("task").Optional().Doc(
       "what the subject's page shows besides the robot (target, message, countdown, practice): at the start and each change; "
@@ -187,7 +194,8 @@ void WebComponent::Describe(ComponentSpec& spec) {
       "experimenter's page: a learner's status; the page then offers \"learn from this session\" (its demonstrations, "
       "the training's loss, the swap)");
   spec.Output<msg::Annotation>("notes").Doc("experimenter's notes (record this topic to align them with the run)");
-  spec.Output<msg::HumanInput>("pointer").Doc("the steering page's pointer, at the browser's event rate (to web_human)");
+  spec.Output<msg::HumanInput>("pointer").Doc(
+      "the steering page's pointer, at the browser's event rate (to web_human); x = y = NaN: paused (pause_without_subject)");
   spec.Output<msg::SelfReport>("self_report").Optional().Doc(
       "the subject's answers: choice, response time (from the release; after the trial from its question), the hold's start "
       "and end (runtime clock)");
@@ -206,6 +214,7 @@ Status WebComponent::Configure(Context& ctx) {
   if (Status s = ChooseTokens(p); !s.ok()) return s;
   if (Status s = ChooseTls(p); !s.ok()) return s;
   port_file_ = p.String("port_file");
+  pause_without_subject_ = p.Bool("pause_without_subject");
   if (Status s = ConfigureBridge(ctx, p); !s.ok()) return s;
   if (Status s = ConfigureSubject(ctx, p); !s.ok()) return s;
   if (Status s = ConfigureTask(ctx, p); !s.ok()) return s;
@@ -298,6 +307,8 @@ Status WebComponent::ConfigureSubject(Context& ctx, const Params& p) {
   subject_ = std::make_unique<SubjectChannel>(
       so,
       [this](double x, double y, bool engaged) {
+        std::lock_guard<std::mutex> lock(pointer_mutex_);
+        pointed_since_pause_ = true;
         const int64_t now = ctx_->clock().now_ns();
         if (engaged && !holding_) hold_start_ns_ = now;
         if (!engaged && holding_) hold_end_ns_ = now, answerable_ = true;
@@ -509,6 +520,7 @@ Status WebComponent::ConfigureExperimenter(Context& ctx) {
   param_requests_ = *requests;
   experimenter_ = std::make_unique<ExperimenterChannel>(
       [this](const std::string& text) {
+        std::lock_guard<std::mutex> lock(notes_mutex_);
         note_.author("experimenter");
         note_.text(text);
         // Serialised by ExperimenterChannel.
@@ -611,8 +623,46 @@ void WebComponent::WaitForSubject(double seconds) {
                      " s (params.wait_for_subject_s): the run starts without one");
 }
 
+// params.pause_without_subject: when no page steers, the pause marker on `pointer` (web_human
+// then publishes a release and nothing more: the mixer's human input goes stale and it holds)
+// and a mark in the recording; when a page steers again, a released sample where the pointer was
+// (unless the page's own came first: web_human publishes again) and the resume mark. After the
+// trial (the questions) nothing steers on purpose: no pause then.
+void WebComponent::StepPause(int64_t now) {
+  if (!pause_without_subject_ || (after_trial_ && asking_)) return;
+  const bool there = subject_->steered();
+  {
+    std::lock_guard<std::mutex> lock(pointer_mutex_);
+    if (there != paused_) return;
+    paused_ = !there;
+    msg::HumanInput sample = pointer_sample_;
+    sample.engaged(false);
+    if (paused_) {
+      sample.x(std::numeric_limits<double>::quiet_NaN());
+      sample.y(std::numeric_limits<double>::quiet_NaN());
+      pointed_since_pause_ = false;
+    }
+    if (paused_ || !pointed_since_pause_) {
+      if (Status s = pointer_->Publish(sample); !s.ok()) ctx_->log().Warn("pointer: the pause's sample: " + s.ToString());
+    }
+  }
+  if (!there) ++pauses_, pause_start_ns_ = now;
+  else paused_ns_ += now - pause_start_ns_;
+  Mark(there ? "resumed: the subject's page is back" : "paused: the subject's page is gone");
+}
+
+void WebComponent::Mark(const std::string& text) {
+  ctx_->log().Info(text + " (params.pause_without_subject)");
+  std::lock_guard<std::mutex> lock(notes_mutex_);
+  msg::Annotation mark;
+  mark.author("web");
+  mark.text(text);
+  if (Status s = notes_->Publish(mark); !s.ok()) ctx_->log().Warn("notes: the mark '" + text + "' was lost: " + s.ToString());
+}
+
 Status WebComponent::Step(const StepInfo& info) {
   StepTask();
+  StepPause(info.now_ns);
   if (after_trial_) StepAfterTrial(ctx_->clock().now_ns(), robot_->new_count() > 0);
   if (robot_->new_count() > 0) {
     const msg::CartesianState* r = robot_->latest();
@@ -671,6 +721,13 @@ Status WebComponent::Deactivate() {
   experimenter_->SetServer(nullptr);
   server_.reset();
   ctx_->log().Info(std::to_string(bridge_->samples_sent()) + " samples sent to clients");
+  if (pauses_ > 0) {
+    const int64_t paused_ns = paused_ns_ + (paused_ ? ctx_->clock().now_ns() - pause_start_ns_ : 0);
+    char text[160];
+    std::snprintf(text, sizeof text, "paused %d times without the subject's page, %.1f s in all%s", pauses_,
+                  static_cast<double>(paused_ns) * 1e-9, paused_ ? " (still paused at the end)" : "");
+    ctx_->log().Info(text);
+  }
   LogPointerDelays();
   return Status::OK();
 }

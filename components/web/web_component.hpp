@@ -77,6 +77,8 @@ class WebComponent final : public Component {
   Status ChooseTls(const Params& p);
   void LogUrls() const;
   void WaitForSubject(double seconds);    // params.wait_for_subject_s
+  void StepPause(int64_t now);            // params.pause_without_subject
+  void Mark(const std::string& text);     // a note by "web" on `notes` (the pause marks)
   std::string token_file_;                // params.token_file
   std::map<Role, std::string> shown_;     // what the printed URLs show for each token (see ChooseTokens)
   std::string token_file_text_;           // what Activate writes to a token_file that did not exist; empty: none
@@ -99,7 +101,16 @@ class WebComponent final : public Component {
   std::unique_ptr<FoxgloveBridge> bridge_;
   std::unique_ptr<SubjectChannel> subject_;
   std::unique_ptr<WebServer> server_;
+  // The pointer's sink (civetweb threads) and StepPause (the step thread) both publish on
+  // `pointer`: this serialises them and guards the members below.
+  std::mutex pointer_mutex_;
   msg::HumanInput pointer_sample_;
+  bool pause_without_subject_ = false;  // params.pause_without_subject
+  bool paused_ = false;                 // no page steers: the pause marker was published
+  bool pointed_since_pause_ = false;    // a page's sample was published since the pause began
+  int pauses_ = 0;                      // step thread only, with paused_ns_ and pause_start_ns_
+  int64_t paused_ns_ = 0, pause_start_ns_ = 0;
+  std::mutex notes_mutex_;  // notes_'s Publish calls: the experimenter's notes (civetweb) and the pause marks (Step)
   Output<msg::SelfReport>* reports_ = nullptr;  // owned by the runtime; may be unbound
   Output<msg::SubjectTask>* task_out_ = nullptr;  // owned by the runtime; may be unbound
   int primitives_ = 0;                            // of params.dataset (0: none)

@@ -8,7 +8,9 @@ void WebHuman::Describe(ComponentSpec& spec) {
   spec.Summary("The subject's pointer from the web page, sampled at the experiment's rate, as HumanInput.");
   spec.Param("engage_timeout_s", 0.3).Min(1e-3).Unit("s").Doc(
       "an engaged pointer silent for longer counts as released (the page sends a keepalive every 50 ms)");
-  spec.Input<msg::HumanInput>("pointer").Doc("raw pointer samples from the web component (browser event rate)");
+  spec.Input<msg::HumanInput>("pointer").Doc(
+      "raw pointer samples from the web component (browser event rate); its pause marker (x = y = NaN): one released sample, "
+      "then nothing until the page is back (the mixer holds)");
   spec.Output<msg::HumanInput>("input").Doc("the newest pointer at each step; engaged only while the subject holds");
 }
 
@@ -21,6 +23,15 @@ Status WebHuman::Configure(Context& ctx) {
 
 Status WebHuman::Step(const StepInfo& info) {
   const msg::HumanInput* p = pointer_->latest();
+  // The web component's pause marker (pause_without_subject: no page steers): one release, then
+  // nothing, so the mixer's human input goes stale and it holds the robot.
+  if (p != nullptr && !(std::isfinite(p->x()) && std::isfinite(p->y()))) {
+    if (paused_) return Status::OK();
+    paused_ = true;
+    sample_.engaged(false);
+    return out_->Publish(sample_);
+  }
+  paused_ = false;
   if (p != nullptr) {
     sample_.x(p->x());
     sample_.y(p->y());

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# params.pause_without_subject (dyad study serve's trials): the subject's page leaves during the
+# trial and comes back. The recording must hold the web component's two marks on experiment/notes
+# (author web: "paused: the subject's page is gone", then "resumed: the subject's page is back"),
+# hold commands from the mixer between them (web_human went silent after one release, so the
+# mixer's human input went stale), motion commands before the pause and after the resume, and
+# no human/input sample inside the pause but the one release.
+#   pause_test.sh BUILD_DIR WORK_DIR TEST_PLUGIN
+set -euo pipefail
+build=$1
+work=$2
+plugin=$3
+node_dir=$(cd "$(dirname "$0")" && pwd)/node
+if [ ! -d "$node_dir/node_modules" ]; then echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node)"; exit 77; fi
+fail() { echo "FAIL: $*" >&2; exit 1; }
+rm -rf "$work"; mkdir -p "$work"; cd "$work"
+cat > graph.yaml <<YAML
+graph: pause_test
+clock: wall
+domain_id: $(( 1 + $$ % 200 ))
+plugins: [$plugin]
+topics:
+  web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
+components:
+  web: {type: web, rate_hz: 30, params: {port: 0, port_file: web.port, token: experimenter-token-0001, subject_token: subject-token-000001,
+        viewer_token: viewer-token-0000001, pause_without_subject: true, wait_for_subject_s: 30},
+        inputs: {robot: robot/state}, outputs: {pointer: web/pointer, notes: experiment/notes}}
+  human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
+  mind: {type: intention_hold, rate_hz: 10, outputs: {intention: robot/intention}}
+  mixer: {type: compliance_mixer, trigger: robot, params: {gain: 0.9, max_step: 5}, inputs: {human: human/input, robot: robot/intention}, outputs: {command: robot/command}}
+  robot: {type: virtual_cartesian, trigger: command, inputs: {command: robot/command}, outputs: {state: robot/state}}
+  recorder: {type: recorder, rate_hz: 10, params: {file: rec.mcap, topics: [human/input, robot/command, experiment/notes]}}
+YAML
+"$build/bin/dyad" run graph.yaml --duration 60 > run.out 2> run.err &
+pid=$!
+for _ in $(seq 300); do [ -s web.port ] && break; sleep 0.1; done  # 30 s: a cold start on a loaded machine
+[ -s web.port ] || { cat run.err; kill $pid; fail "web.port never written"; }
+node "$node_dir/pause_client.mjs" "ws://127.0.0.1:$(cat web.port)/subject/ws?token=subject-token-000001" 2500 > client.json \
+  || { kill $pid; cat run.err; fail "the client"; }
+kill -INT $pid
+wait $pid || true
+grep -q "paused 1 times without the subject's page" run.err || { cat run.err; fail "no pause counted at the end"; }
+"$build/bin/dyad" bag export rec.mcap --csv csv > /dev/null
+python3 - csv <<'PY'
+import csv, os, sys
+def fail(why): sys.exit("FAIL: " + why)
+def rows(name): return list(csv.DictReader(open(os.path.join(sys.argv[1], name))))
+notes = [(int(r["header.stamp_ns"]), r["author"], r["text"]) for r in rows("experiment_notes.csv")]
+want = [("web", "paused: the subject's page is gone"), ("web", "resumed: the subject's page is back")]
+if [n[1:] for n in notes] != want: fail("experiment/notes holds %s, want %s" % (notes, want))
+paused, resumed = notes[0][0], notes[1][0]
+away = (resumed - paused) * 1e-9
+if not 2.0 <= away <= 4.5: fail("paused for %.2f s; the page was away 2.5 s" % away)
+truth = lambda v: v in ("1", "true")
+commands = [(int(r["header.stamp_ns"]), truth(r["hold"])) for r in rows("robot_command.csv")]
+# The mixer's human input goes stale 0.5 s (its stale_timeout_s) after web_human's last sample.
+inside = [h for t, h in commands if paused + 0.7e9 <= t <= resumed]
+before = [h for t, h in commands if paused - 1.5e9 <= t <= paused]
+after = [h for t, h in commands if resumed + 0.5e9 <= t]
+if len(inside) < 10 or not all(inside): fail("%d of the %d commands in the pause are holds" % (sum(inside), len(inside)))
+if len(before) < 5 or any(before): fail("%d of the %d commands before the pause are holds" % (sum(before), len(before)))
+if len(after) < 5 or any(after): fail("%d of the %d commands after the resume are holds" % (sum(after), len(after)))
+human = [(int(r["header.stamp_ns"]), truth(r["engaged"])) for r in rows("human_input.csv")]
+during = [e for t, e in human if paused < t < resumed]
+if during != [False]: fail("human/input in the pause: %s (want one release, then nothing)" % during)
+print("PASS: paused %.2f s; %d hold commands inside, none in the %d before or the %d after" % (away, len(inside), len(before), len(after)))
+PY
