@@ -250,6 +250,29 @@ TEST(GraphValidation, OverrideSetsTheGraphsOwnScalars) {
   }
 }
 
+// A process's host names its launcher's DDS participant, dyad/launcher/<host>, which a secured
+// graph's participants must read back from its opaque wire name (dyad/wire_names.hpp): a host of
+// 64 characters (a machine name's most) is taken, a longer one refused at its line, never left to
+// be silently unreadable on the wire.
+TEST(GraphValidation, AHostNameLongerThanAMachinesIsRefusedAtItsLine) {
+  auto graph = [](const std::string& host) {
+    return "graph: hosts\nprocesses:\n  a: {host: " + host + "}\n  b: {host: " + host + "}\n" +
+           "components:\n  src: {type: counter_source, rate_hz: 10, process: a, outputs: {out: count}}\n" +
+           "  sink: {type: counter_sink, trigger: in, process: b, inputs: {in: count}}\n";
+  };
+  const std::string edge = "lab-" + std::string(56, 'm') + ".org";  // 64: a machine name may have dots
+  ASSERT_EQ(edge.size(), 64u);
+  for (const auto& d : Check(graph(edge))) ADD_FAILURE() << d.ToString();
+  ASSERT_EQ(LauncherParticipantName(edge).size(), 78u);
+  const std::string longer = edge + "x";
+  const auto diags = Check(graph(longer));
+  ASSERT_EQ(diags.size(), 2u) << (diags.empty() ? "" : diags[0].ToString());
+  EXPECT_EQ(diags[0].ToString().rfind("g.yaml:3:13: processes.a.host:", 0), 0u) << diags[0].ToString();
+  EXPECT_NE(diags[0].message.find("has 65 characters: a host name has at most 64"), std::string::npos) << diags[0].ToString();
+  EXPECT_NE(diags[0].message.find("dyad/launcher/<host>"), std::string::npos) << diags[0].ToString();
+  EXPECT_EQ(diags[1].key, "processes.b.host");
+}
+
 // Legal holes in the wiring are warnings, at their lines; the graph stays valid.
 TEST(GraphValidation, AnUnboundOutputAndADeclaredTopicNoComponentWritesAreWarnings) {
   std::vector<Diagnostic> diags;

@@ -2,6 +2,8 @@
 // key, the graph's participants read it back, nobody else does, and nothing of the name shows.
 #include <dyad/wire_names.hpp>
 
+#include "dds/dds_participant.hpp"
+
 #include <filesystem>
 #include <fstream>
 
@@ -35,14 +37,14 @@ TEST(WireNames, AParticipantNameIsOpaqueStableAndReadBackOnlyWithItsKey) {
 }
 
 TEST(WireNames, LengthSaysLittleAndASubjectIsShort) {
-  // Names up to 47 bytes look alike; a longer one takes the second size; 144 bytes or more: the
-  // subject alone (not readable back).
+  // Names up to 47 bytes look alike; a longer one takes the second size; one over 143 bytes has
+  // no wire name at all (its participant is refused: never a name its peers cannot read).
   EXPECT_EQ(WireName(kKey, "dyad/g/a").size(), WireName(kKey, "dyad/a_much_longer_graph_name/process").size());
   const std::string longer(60, 'x'), longest(150, 'y');
   EXPECT_GT(WireName(kKey, longer).size(), WireName(kKey, "dyad/g/a").size());
   EXPECT_EQ(ReadableName(kKey, WireName(kKey, longer)), longer);
-  EXPECT_EQ(WireName(kKey, longest), WireSubject(kKey, longest));
-  EXPECT_EQ(ReadableName(kKey, WireName(kKey, longest)), "");
+  EXPECT_EQ(WireName(kKey, longest), "");
+  EXPECT_EQ(WireName(kKey, std::string(kMaxReadableName + 1, 'y')), "");
   // A certificate's common name holds 64 characters.
   EXPECT_LE(WireSubject(kKey, longest).size(), 64u);
   EXPECT_EQ(WireName(kKey, "dyad/g/a").rfind(WireSubject(kKey, "dyad/g/a"), 0), 0u);
@@ -56,9 +58,31 @@ TEST(WireNames, TheLongestParticipantNameIsReadBack) {
   EXPECT_LT(wire.size(), 256u) << "a DDS participant name holds 255 characters";
   EXPECT_EQ(ReadableName(kKey, wire), name);
   EXPECT_EQ(wire.find("ggg"), std::string::npos) << wire;
-  const std::string largest(143, 'z');
+  // dyad/launcher/<host> with a host of 64 characters, the longest a graph takes (graph.cpp).
+  const std::string launcher = "dyad/launcher/" + std::string(64, 'h');
+  EXPECT_EQ(ReadableName(kKey, WireName(kKey, launcher)), launcher);
+  const std::string largest(kMaxReadableName, 'z');
   EXPECT_LT(WireName(kKey, largest).size(), 256u);
   EXPECT_EQ(ReadableName(kKey, WireName(kKey, largest)), largest);
+}
+
+// A participant whose name has no wire name is refused when it is made, saying why, never made
+// with a name its peers cannot read (the graph's own names always fit: graph.cpp asserts it).
+TEST(WireNames, ASecuredParticipantWithANameTooLongIsRefused) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("wire_names_long_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / kNamesKeyFile) << NewNamesKeyText().value();
+  std::filesystem::permissions(dir / kNamesKeyFile, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  DdsParticipant::Options options;
+  options.scope = DdsParticipant::Scope::kProcessOnly;
+  options.security.identity_ca = (dir / "identity_ca.cert.pem").string();  // its folder holds names.key
+  options.security.certificate = (dir / "never_read.cert.pem").string();
+  const std::string name = "dyad/launcher/" + std::string(kMaxReadableName + 1 - 14, 'h');
+  auto p = DdsParticipant::Create(0, name, options);
+  ASSERT_FALSE(p.ok()) << "made with a name its peers cannot read back";
+  EXPECT_NE(p.status().message().find("has 144 bytes: a secured graph's peers read back names of at most 143"), std::string::npos)
+      << p.status().message();
+  std::filesystem::remove_all(dir);
 }
 
 TEST(WireNames, TheKeyFileIsReadOrRefusedNamingIt) {

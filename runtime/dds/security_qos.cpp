@@ -15,9 +15,13 @@ StatusOr<std::string> ApplySecurity(const IdentityFiles& identity, eprosima::fas
   if (!identity.enabled()) return std::string();
   auto key = ReadNamesKey((std::filesystem::path(identity.identity_ca).parent_path() / kNamesKeyFile).string());
   if (!key.ok()) return key.status();
-  const std::string wire_name = WireName(key.value(), qos->name().to_string());
-  if (wire_name.empty())
-    return Status::Internal("cannot make the opaque name of '" + qos->name().to_string() + "' (libcrypto failed)");
+  const std::string name = qos->name().to_string();
+  if (name.size() > kMaxReadableName)  // the graph's names never are (graph.cpp): a caller's bug
+    return Status::InvalidArgument("participant name '" + name + "' has " + std::to_string(name.size()) +
+                                   " bytes: a secured graph's peers read back names of at most " +
+                                   std::to_string(kMaxReadableName) + " (dyad/wire_names.hpp)");
+  const std::string wire_name = WireName(key.value(), name);
+  if (wire_name.empty()) return Status::Internal("cannot make the opaque name of '" + name + "' (libcrypto failed)");
   qos->name(wire_name);
   auto& p = qos->properties().properties();
   // Fast DDS fills these (when present and empty) with the host's and user's names and the pid,

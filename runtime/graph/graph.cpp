@@ -3,6 +3,7 @@
 #include "dyad/join_list.hpp"
 #include "dyad/ros2_names.hpp"
 #include "dyad/strict_yaml.hpp"
+#include "dyad/wire_names.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -29,11 +30,25 @@ const std::string kGraphNameRule = "must be 1 to 64 of the characters A-Z a-z 0-
 // DDS participant names: no '/', no '.', nothing a shell or a path would read twice.
 const std::string kPlaceNameRule =
     "must be 1 to 64 of the characters A-Z a-z 0-9 _ -, not starting with - (it names a log file and a DDS participant)";
+constexpr size_t kMaxPlaceName = 64;
 bool IsPlaceName(const std::string& s) {
-  if (s.empty() || s.size() > 64 || s[0] == '-') return false;
+  if (s.empty() || s.size() > kMaxPlaceName || s[0] == '-') return false;
   return std::all_of(s.begin(), s.end(), [](char c) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
   });
+}
+
+// Every participant name the graph makes is read back by its secured peers (dyad/wire_names.hpp):
+// dyad/<graph>/<process> and dyad/launcher/<host>, each name at most 64 characters.
+static_assert(5 + 64 + 1 + kMaxPlaceName <= kMaxReadableName, "dyad/<graph>/<process> must fit a wire name");
+static_assert(sizeof("dyad/launcher/") - 1 + kMaxPlaceName <= kMaxReadableName, "dyad/launcher/<host> must fit a wire name");
+
+// A process's host outside network.hosts (whose names are place names) may be any machine name
+// (dots included), of at most 64 characters as Linux's (HOST_NAME_MAX).
+std::string LongHostProblem(const std::string& host) {
+  return "'" + host.substr(0, 20) + "...' has " + std::to_string(host.size()) + " characters: a host name has at most " +
+         std::to_string(kMaxPlaceName) + " (as a machine's name; its launcher's DDS participant dyad/launcher/<host> must fit " +
+         std::to_string(kMaxReadableName) + " bytes, the longest name a secured graph's participants read back)";
 }
 
 std::string Names(const std::map<std::string, std::string>& m) {
@@ -456,6 +471,7 @@ void ReadProcesses(StrictYaml& r, const YAML::Node& procs, Graph* g) {
       if (spec["host"] && r.String(spec["host"], key + ".host", &p.host) && !g->network.hosts.empty() &&
           !g->network.hosts.count(p.host))
         r.Error(spec["host"], key + ".host", "'" + p.host + "' is not one of network.hosts (" + Names(g->network.hosts) + ")");
+      else if (spec["host"] && p.host.size() > kMaxPlaceName) r.Error(spec["host"], key + ".host", LongHostProblem(p.host));
       std::string policy;
       if (spec["restart"] && r.String(spec["restart"], key + ".restart", &policy)) {
         if (policy == "never") p.restart = RestartPolicy::kNever;

@@ -167,8 +167,9 @@ std::string WireSubject(const std::string& key, const std::string& name) {
 std::string WireName(const std::string& key, const std::string& name) {
   std::array<unsigned char, kTagBytes> tag{};
   if (!Tag(key, name, &tag)) return "";
+  static_assert(kMaxReadableName < kMaxPadded, "a zero byte of padding ends the longest name");
+  if (name.size() > kMaxReadableName) return "";
   const std::string subject = kPrefix + Hex(tag.data(), tag.size());
-  if (name.size() >= kMaxPadded) return subject;
   std::string padded = name;
   padded.resize(name.size() < kBlock ? kBlock : kMaxPadded, '\0');
   const std::string sealed = Ctr(key, tag, padded);

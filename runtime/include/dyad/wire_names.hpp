@@ -16,8 +16,13 @@
 //                           says little, in base64url (64 or 192 characters: at most 230 in all,
 //                           under Fast DDS's 255). A participant's name: the graph's participants
 //                           read it back (ReadableName) to report and match their peers by name.
-//                           Every dyad/<graph>/<process> fits (names of 64 characters each); a
-//                           name of 144 bytes or more gets its WireSubject only (not readable back).
+//                           A name has at most kMaxReadableName bytes (143, so that the padding
+//                           ends it): every dyad/<graph>/<process> and dyad/launcher/<host> fits
+//                           (names of 64 characters each; graph.cpp asserts it), and WireName
+//                           returns "" for a longer one: its participant is refused, never left
+//                           unreadable. (Fast DDS keeps a participant's name in a string_255 and
+//                           cuts a longer one silently: the largest bucket under it would be 162
+//                           bytes, 38 + 216 characters; nothing the graph names needs it.)
 //   ReadableName(key, wire) the name, when `wire` is a WireName made with this key; "" for
 //                           anything else (another graph's, a forgery, a plain name).
 // WireSubject and WireName return "" when libcrypto fails (callers refuse to go on).
@@ -26,6 +31,7 @@
 // why). The key is derived into two (one for the HMAC, one for AES) by HMAC with fixed labels.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include <dyad/status.hpp>
@@ -33,6 +39,8 @@
 namespace dyad {
 
 inline constexpr const char* kNamesKeyFile = "names.key";
+// The longest participant name a WireName holds (and its peers read back), in bytes.
+inline constexpr size_t kMaxReadableName = 143;
 
 // The key in the file at `path` (64 hex digits, then an optional newline): 32 raw bytes. An
 // error names the file and says to run `dyad security init` when it is missing. The file must be
