@@ -5,16 +5,14 @@
 set -euo pipefail
 build=$1
 work=$2
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ]; then
-  echo "SKIP: run tools/setup.sh (npm ci in components/web/test/node)"; exit 77
-fi
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_node
+fresh_dir "$work"
 experimenter=experimenter-s3cret-0001 subject=subject-s3cret-00001 viewer=viewer-s3cret-000001
 cat > graph.yaml <<YAML
 graph: admission
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 components:
   web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port, token: $experimenter, subject_token: $subject, viewer_token: $viewer}, outputs: {pointer: web/pointer}}
   human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
@@ -23,8 +21,7 @@ topics:
 YAML
 "$build/bin/dyad" run graph.yaml --duration 15 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-[ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
+wait_port_file web.port $pid
 status=0
 node "$node_dir/admission.mjs" "ws://127.0.0.1:$(cat web.port)" $experimenter $subject $viewer || status=1
 kill -INT $pid; wait $pid || true

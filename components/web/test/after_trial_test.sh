@@ -13,12 +13,9 @@ set -euo pipefail
 build=$1
 work=$2
 plugin=$3
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ] || [ ! -x /usr/bin/chromium ]; then
-  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
-fi
-fail() { echo "FAIL: $*" >&2; exit 1; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_browser
+fresh_dir "$work"
 "$build/bin/dyad" generate dataset --out data > /dev/null
 
 run() {  # run MODE ASK_AFTER_S: the graph and the browser; the graph must end by itself
@@ -27,7 +24,7 @@ run() {  # run MODE ASK_AFTER_S: the graph and the browser; the graph must end b
   cat > "$mode/graph.yaml" <<YAML
 graph: after_trial_test
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 plugins: [$plugin]
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
@@ -45,8 +42,7 @@ YAML
   date +%s%3N > started_ms
   "$build/bin/dyad" run graph.yaml > run.out 2> run.err &
   local pid=$!
-  for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-  [ -s web.port ] || { cat run.err; kill $pid; fail "$mode: web.port never written"; }
+  wait_port_file web.port $pid
   # A backstop only: the graph ends by itself well before (if not, the test fails below).
   ( sleep 90; kill -INT $pid 2>/dev/null && echo "backstop" > backstop ) > /dev/null 2>&1 &
   local backstop=$!

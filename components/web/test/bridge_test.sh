@@ -7,16 +7,13 @@
 set -euo pipefail
 build=$1
 work=$2
-here=$(cd "$(dirname "$0")" && pwd)
-node_dir=$here/node
-if [ ! -d "$node_dir/node_modules" ]; then
-  echo "SKIP: run tools/setup.sh (npm ci in components/web/test/node)"; exit 77
-fi
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_node
 rm -rf "$work"; mkdir -p "$work"
 cat > "$work/graph.yaml" <<YAML
 graph: bridge_test
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 topics:
   robot/command: {type: CartesianCommand, reliability: reliable, depth: 4}
   robot/state: {type: CartesianState, reliability: reliable, depth: 4}
@@ -29,8 +26,7 @@ YAML
 cd "$work"
 "$build/bin/dyad" run graph.yaml --duration 6 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-[ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
+wait_port_file web.port $pid
 port=$(cat web.port)
 # The experimenter's token: only it may try to publish (and be told robot/state is not writable).
 node "$node_dir/foxglove_client.mjs" watch "ws://127.0.0.1:$port/?token=experimenter-token-0001" robot/state 3 client.json &

@@ -9,16 +9,14 @@ set -euo pipefail
 build=$1
 work=$2
 plugin=$3
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ] || [ ! -x /usr/bin/chromium ]; then
-  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
-fi
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_browser
+fresh_dir "$work"
 # The mixer between fixed inputs (human at x = 10, robot at x = 0): its command's x is 10 * gain.
 cat > graph.yaml <<YAML
 graph: experimenter_params
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 plugins: [$plugin]
 components:
   web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port, token: experimenter-token-0001, subject_token: subject-token-000001, viewer_token: viewer-token-0000001}, inputs: {recording: recorder/status}, outputs: {pointer: web/pointer}}
@@ -30,8 +28,7 @@ topics:
 YAML
 "$build/bin/dyad" run graph.yaml --duration 30 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-[ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
+wait_port_file web.port $pid
 node "$node_dir/experimenter_params.mjs" "http://127.0.0.1:$(cat web.port)" "$work" || { kill -INT $pid; wait $pid || true; cat run.err; exit 1; }
 kill -INT $pid
 wait $pid || true

@@ -8,15 +8,13 @@
 set -euo pipefail
 build=$1
 work=$2
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ]; then
-  echo "SKIP: run tools/setup.sh (npm ci in components/web/test/node)"; exit 77
-fi
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_node
+fresh_dir "$work"
 cat > graph.yaml <<YAML
 graph: hostile
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 topics:
   robot/command: {type: CartesianCommand, reliability: reliable, depth: 4}
   robot/state: {type: CartesianState, reliability: reliable, depth: 4}
@@ -28,8 +26,7 @@ YAML
 duration=20
 "$build/bin/dyad" run graph.yaml --duration $duration > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-[ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
+wait_port_file web.port $pid
 node "$node_dir/hostile_clients.mjs" "ws://127.0.0.1:$(cat web.port)/?token=viewer-token-0000001" 1000 3 | tee clients.json
 rss_kb=$(ps -o rss= -p $pid)
 wait $pid || { echo "FAIL: dyad run exited non-zero"; cat run.err; exit 1; }

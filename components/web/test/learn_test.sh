@@ -14,12 +14,9 @@
 set -euo pipefail
 build=$1
 work=$2
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ] || [ ! -x /usr/bin/chromium ]; then
-  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
-fi
-fail() { echo "FAIL: $*" >&2; exit 1; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_browser
+fresh_dir "$work"
 # A small model to start from (the robot draws the analytic shapes), and the learner's settings.
 "$build/bin/dyad" generate dataset --out data > /dev/null
 choice=${LEARN_CHOICE:-2,0}
@@ -46,7 +43,7 @@ fi
 cat > graph.yaml <<YAML
 graph: learn_test
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
 components:
@@ -63,8 +60,7 @@ components:
 YAML
 "$build/bin/dyad" run graph.yaml --duration 120 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-[ -s web.port ] || { cat run.err; kill $pid; fail "web.port never written"; }
+wait_port_file web.port $pid
 node "$node_dir/learn_page.mjs" "http://127.0.0.1:$(cat web.port)" browser.json "$work" "$choice" || { kill $pid; cat run.err; fail "the browser"; }
 kill -INT $pid
 rc=0; wait $pid || rc=$?

@@ -7,15 +7,13 @@
 set -euo pipefail
 build=$1
 work=$2
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ]; then
-  echo "SKIP: run tools/setup.sh (npm ci in components/web/test/node)"; exit 77
-fi
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_node
+fresh_dir "$work"
 cat > graph.yaml <<YAML
 graph: run_events
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 processes:
   ui: {}
   worker: {restart: on-failure, backoff_s: 0.2}
@@ -27,8 +25,7 @@ topics:
 YAML
 "$build/bin/dyad" run graph.yaml --duration 40 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 200); do [ -s web.port ] && break; sleep 0.1; done
-[ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
+wait_port_file web.port $pid 20
 sleep 2  # the worker's process is up (the graph's processes start together)
 worker=$(pgrep -f -- "run graph.yaml --process worker" | head -1)
 [ -n "$worker" ] || { echo "no worker process"; cat run.err; kill $pid; exit 1; }

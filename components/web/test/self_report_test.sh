@@ -8,17 +8,14 @@ set -euo pipefail
 build=$1
 work=$2
 plugin=$3
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ] || [ ! -x /usr/bin/chromium ]; then
-  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
-fi
-fail() { echo "FAIL: $*" >&2; exit 1; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_browser
+fresh_dir "$work"
 "$build/bin/dyad" generate dataset --out data > /dev/null
 cat > graph.yaml <<YAML
 graph: self_report_test
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 plugins: [$plugin]
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
@@ -33,8 +30,7 @@ components:
 YAML
 "$build/bin/dyad" run graph.yaml --duration 40 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-[ -s web.port ] || { cat run.err; kill $pid; fail "web.port never written"; }
+wait_port_file web.port $pid
 start_ms=$(date +%s%3N)
 node "$node_dir/self_report.mjs" "http://127.0.0.1:$(cat web.port)" browser.json "$work" || { kill $pid; cat run.err; fail "the browser"; }
 kill -INT $pid

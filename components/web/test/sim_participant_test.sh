@@ -8,15 +8,14 @@
 set -euo pipefail
 build=$1
 work=$2
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ]; then echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node)"; exit 77; fi
-fail() { echo "FAIL: $*" >&2; exit 1; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_node
+fresh_dir "$work"
 "$build/bin/dyad" generate dataset --out data > /dev/null
 cat > graph.yaml <<YAML
 graph: sim_participant_test
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
 components:
@@ -27,8 +26,7 @@ components:
 YAML
 "$build/bin/dyad" run graph.yaml --duration 60 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 300); do [ -s web.port ] && break; sleep 0.1; done  # 30 s: a cold start on a loaded machine
-[ -s web.port ] || { cat run.err; kill $pid; fail "web.port never written"; }
+wait_port_file web.port $pid 30
 echo "http://127.0.0.1:$(cat web.port) subject-token-000001" > sessions
 node "$node_dir/sim_participant.mjs" --dataset data --seconds 9 --speed 3 --report-error 0 sessions > client.json \
   || { kill $pid; cat run.err; fail "the client"; }

@@ -6,15 +6,13 @@ set -euo pipefail
 build=$1
 work=$2
 plugin=$3
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ] || [ ! -x /usr/bin/chromium ]; then
-  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
-fi
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_browser
+fresh_dir "$work"
 cat > graph.yaml <<YAML
 graph: subject_page_test
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 plugins: [$plugin]
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
@@ -28,8 +26,7 @@ components:
 YAML
 "$build/bin/dyad" run graph.yaml --duration 20 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-[ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
+wait_port_file web.port $pid
 node "$node_dir/subject_page.mjs" "http://127.0.0.1:$(cat web.port)" browser.json "$work" || { kill $pid; exit 1; }
 kill -INT $pid
 wait $pid || true

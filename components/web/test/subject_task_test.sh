@@ -6,17 +6,14 @@
 set -euo pipefail
 build=$1
 work=$2
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ] || [ ! -x /usr/bin/chromium ]; then
-  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
-fi
-fail() { echo "FAIL: $*" >&2; exit 1; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_browser
+fresh_dir "$work"
 "$build/bin/dyad" generate dataset --out data > /dev/null
 cat > graph.yaml <<YAML
 graph: subject_task_test
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 components:
   web: {type: web, rate_hz: 30, params: {port: 0, port_file: web.port, token: experimenter-token-0001, subject_token: subject-token-000001, viewer_token: viewer-token-0000001, dataset: data},
         outputs: {pointer: web/pointer, task: subject/task}}
@@ -27,8 +24,7 @@ if "$build/bin/dyad" run graph.yaml --duration 1 --set web.task_target=7 > bad.o
 grep -q "params.task_target: the data set has 7 primitives (0..6), got 7" bad.out || { cat bad.out; fail "the refusal does not say why"; }
 "$build/bin/dyad" run graph.yaml --duration 60 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-[ -s web.port ] || { cat run.err; kill $pid; fail "web.port never written"; }
+wait_port_file web.port $pid
 node "$node_dir/subject_task.mjs" "http://127.0.0.1:$(cat web.port)" browser.json "$work" || { kill $pid; cat run.err; fail "the browser"; }
 # ... and while it runs (the experimenter's page offers only the data set's primitives).
 "$build/bin/dyad" param set web.task_target=9 --graph graph.yaml > param.out 2>&1 || true

@@ -8,15 +8,14 @@
 set -euo pipefail
 build=$1
 work=$2
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ] || [ ! -x /usr/bin/chromium ] || ! command -v certutil > /dev/null; then
-  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium, libnss3-tools)"; exit 77
-fi
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_browser
+command -v certutil > /dev/null || { echo "SKIP: needs tools/setup.sh (libnss3-tools)"; exit 77; }
+fresh_dir "$work"
 cat > graph.yaml <<YAML
 graph: tls_browser
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
 components:
@@ -42,8 +41,7 @@ certutil -d "sql:$HOME/.pki/nssdb" -N --empty-password
 certutil -d "sql:$HOME/.pki/nssdb" -A -t "C,," -n "dyad web CA" -i keys/web_ca.cert.pem
 "$build/bin/dyad" run graph.yaml --duration 30 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-[ -s web.port ] || { echo "web.port never written"; cat run.err; kill $pid; exit 1; }
+wait_port_file web.port $pid
 port=$(cat web.port)
 grep -q "subject's page: https://127.0.0.1:$port/subject?token=<params.subject_token>" run.err ||
   { cat run.err; kill $pid; echo "FAIL: the printed URLs are not https"; exit 1; }

@@ -8,11 +8,10 @@
 set -euo pipefail
 build=$1
 work=$2
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-[ -d "$node_dir/node_modules" ] || { echo "SKIP: run tools/setup.sh (npm ci in components/web/test/node)"; exit 77; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
-fail() { echo "FAIL: $*"; exit 1; }
-domain=$(( 1 + $$ % 200 ))
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_node
+fresh_dir "$work"
+domain=$(test_domain)
 graph() {  # graph NAME WEB_PARAMS
   cat > "$1" <<YAML
 graph: tokens
@@ -40,8 +39,7 @@ run_and_probe() {  # run_and_probe GRAPH TOKEN_OR_EMPTY: runs 4 s; the token (if
   rm -f web.port
   "$build/bin/dyad" run "$1" --duration 4 > "${1%.yaml}.out" 2> "${1%.yaml}.err" &
   local pid=$!
-  for _ in $(seq 100); do [ -s web.port ] && break; sleep 0.1; done
-  [ -s web.port ] || { cat "${1%.yaml}.err"; kill $pid; fail "web.port never written"; }
+  wait_port_file web.port $pid 10 "${1%.yaml}.err"
   if [ -n "$2" ]; then
     admitted "ws://127.0.0.1:$(cat web.port)/?token=$2" || fail "the token of the file was refused"
     ! admitted "ws://127.0.0.1:$(cat web.port)/?token=wrong$2" || fail "a wrong token was admitted"

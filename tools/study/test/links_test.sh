@@ -7,13 +7,13 @@
 #   links_test.sh REPO BUILD_DIR WORK_DIR
 set -euo pipefail
 repo=$1 build=$2 work=$3
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
 dyad=$build/bin/dyad
-fail() { echo "FAIL: $*" >&2; exit 1; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+fresh_dir "$work"
 cat > graph.yaml <<YAML
 graph: links_test
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 components:
   web: {type: web, rate_hz: 10, params: {port: 0, port_file: web.port}, outputs: {pointer: web/pointer}}
   human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
@@ -57,8 +57,7 @@ grep -q "^P03,https://study.example.org/dyad/subject?token=" data/links.csv || f
 # The graph, given P01's token file as dyad study run gives it, opens the subject's page to P01's link only.
 "$dyad" run graph.yaml --set web.token_file=data/P01/web-tokens --set recorder.file=run.mcap --duration 20 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 300); do [ -s web.port ] && break; sleep 0.1; done  # 30 s: a cold start on a loaded machine
-[ -s web.port ] || { kill $pid; cat run.err; fail "web.port never written"; }
+wait_port_file web.port $pid 30
 link=$(sed -n 's/^P01,https:\/\/study.example.org\/dyad//p' data/links.csv)
 other=$(sed -n 's/^P02,https:\/\/study.example.org\/dyad//p' data/links.csv)
 ok=$(curl -s -o /dev/null -w '%{http_code}' "http://127.0.0.1:$(cat web.port)$link")

@@ -7,9 +7,9 @@
 #   rehearsal_test.sh REPO BUILD_DIR WORK_DIR
 set -euo pipefail
 repo=$1 build=$2 work=$3
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
 dyad=$build/bin/dyad
-fail() { echo "FAIL: $*" >&2; exit 1; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+fresh_dir "$work"
 bash "$repo/tools/sweep/test/demo_models.sh" "$repo" "$dyad" "$work"
 cat > graph.yaml <<YAML
 extends: $repo/configs/demo.yaml

@@ -8,19 +8,16 @@
 #   subject_link_test.sh REPO BUILD_DIR WORK_DIR
 set -euo pipefail
 repo=$1 build=$2 work=$3
-node_modules=$repo/components/web/test/node/node_modules
-if [ ! -d "$node_modules" ] || [ ! -x /usr/bin/chromium ]; then
-  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
-fi
-fail() { echo "FAIL: $*" >&2; exit 1; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_browser
+fresh_dir "$work"
 ln -s "$node_modules" node_modules  # the script imports playwright-core from beside itself
 cp "$(dirname "$0")/subject_link.mjs" .
 "$build/bin/dyad" generate dataset --out data > /dev/null
 cat > g.yaml <<YAML
 graph: g
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
 components:

@@ -1,0 +1,39 @@
+# tests/support/web_test.sh: what the web and study test scripts share (source it; bash, set -e).
+# They run a graph with a web component and drive its pages from node (components/web/test/node:
+# `ws`, playwright-core over Debian's chromium). Each function says what it does when it cannot:
+#   require_node           exit 77 (ctest's SKIP) unless tools/setup.sh installed the node modules
+#   require_browser        the same, and Debian's chromium
+#   fail MESSAGE...        "FAIL: MESSAGE" on stderr, exit 1
+#   fresh_dir DIR          DIR emptied (made) and entered
+#   test_domain            a DDS domain id from this shell's pid (tests running at once differ)
+#   wait_port_file FILE PID [SECONDS [LOG]]
+#                          waits until FILE (a port_file) is written, by default 10 s; if not,
+#                          shows LOG (default run.err), stops PID and fails naming FILE
+# Sets node_dir (the node scripts and their node_modules) and node_modules.
+web_test_repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+node_dir=$web_test_repo/components/web/test/node
+node_modules=$node_dir/node_modules
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+require_node() {
+  [ -d "$node_modules" ] || { echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node)"; exit 77; }
+}
+
+require_browser() {
+  if [ ! -d "$node_modules" ] || [ ! -x /usr/bin/chromium ]; then
+    echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
+  fi
+}
+
+fresh_dir() { rm -rf "$1"; mkdir -p "$1"; cd "$1"; }
+
+test_domain() { echo $(( 1 + $$ % 200 )); }
+
+wait_port_file() {
+  local file=$1 pid=$2 seconds=${3:-10} log=${4:-run.err}
+  for _ in $(seq $(( seconds * 10 ))); do [ -s "$file" ] && return 0; sleep 0.1; done
+  [ -f "$log" ] && cat "$log" >&2
+  kill "$pid" 2> /dev/null || true
+  fail "$file never written (${seconds} s)"
+}
