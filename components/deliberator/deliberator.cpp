@@ -200,8 +200,10 @@ Status Deliberator::Configure(Context& ctx) {
   intention_ = &ctx.output<msg::Intention>("intention");
   model_info_ = &ctx.output<msg::ModelInfo>("model");
   std::ostringstream info;
-  info << "model " << model_path_ << " (sha256 " << hash->substr(0, 12) << "), start primitive " << start_primitive_ << ", window "
-       << o.window << ", " << o.iterations << " iterations of " << pvrnn::ToString(o.optimizer);
+  // The preset names the engine too (nrl: NRL's own regression), so a run's log says which ran.
+  info << "model " << model_path_ << " (sha256 " << hash->substr(0, 12) << "), start primitive " << start_primitive_
+       << ", preset " << p.String("preset") << ", window " << o.window << ", " << o.iterations << " iterations of "
+       << pvrnn::ToString(o.optimizer);
   if (stepped_)
     info << ", no time cap (stepped clock: simulated time stands still during a step)";
   else

@@ -25,7 +25,9 @@
 ///     thread, then switched at a step boundary; a bad file is refused and the old model steers on.
 ///   start_primitive (int, 0): the primitive the robot starts drawing
 ///   preset (string, vcbot): vcbot (W 5, 15 it, Adam 0.3/0.1/0.95, w 1e-5) | reference (W 15,
-///     15 it, Adam 0.1/0.9/0.999, w = the model's training meta-prior); the params below override it
+///     15 it, Adam 0.1/0.9/0.999, w = the model's training meta-prior) | nrl (NRL's own error
+///     regression step by step with the vcbot numbers, docs/pvrnn.md "The NRL mode"); the params
+///     below override it. The start log names it (a run's log says which regression ran).
 ///   window (int, 0 = preset), iterations (int, 0 = preset)
 ///   optimizer (string, adam): adam | ceres
 ///   adam (map, {}): lr, beta1, beta2, epsilon (keys override the preset)

@@ -8,7 +8,7 @@ bool SendQueue::PushControl(std::string json) {
   bool queued = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (closed_) return false;
+    if (closed_ || finishing_) return false;
     if (control_bytes_ + json.size() > limit_) {
       closed_ = overflowed_ = true;
     } else {
@@ -41,7 +41,7 @@ void SendQueue::PushLatest(uint32_t channel, std::string bytes, bool binary) {
   {
     // One lock hold: two producers of the channel cannot both leave a frame queued.
     std::lock_guard<std::mutex> lock(mutex_);
-    if (closed_) return;
+    if (closed_ || finishing_) return;
     if (auto it = data_.find(channel); it != data_.end()) {
       for (const auto& f : it->second) bytes_ -= f.size();
       it->second.clear();
@@ -53,7 +53,7 @@ void SendQueue::PushLatest(uint32_t channel, std::string bytes, bool binary) {
 }
 
 bool SendQueue::PushDataLocked(uint32_t channel, Frame frame, bool* wake) {
-  if (closed_) return false;
+  if (closed_ || finishing_) return false;
   const size_t size = frame.size();
   if (size > limit_) {
     ++drops_[channel];
@@ -90,6 +90,11 @@ bool SendQueue::PopAll(std::vector<Frame>* out) {
     for (;;) {
       if (closed_) return false;
       if (!control_.empty()) break;
+      if (finishing_) {  // what is left goes at once; then the end
+        if (HasData()) break;
+        closed_ = true;
+        return false;
+      }
       const auto due = last_flush_ + flush_interval_;
       if (std::chrono::steady_clock::now() < due) {
         // The quiet time after a flush: data collects without waking anyone.
@@ -140,6 +145,14 @@ void SendQueue::Close() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     closed_ = true;
+  }
+  cv_.notify_all();
+}
+
+void SendQueue::Finish() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    finishing_ = true;
   }
   cv_.notify_all();
 }

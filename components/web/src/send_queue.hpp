@@ -71,9 +71,12 @@ class SendQueue {
   void PushLatest(uint32_t channel, std::string bytes, bool binary = true);
   // Waits until there is something to send (see "Waking the consumer"), then moves every queued
   // frame to `out` (replacing its contents): control frames first, then data in push order.
-  // False once closed (frames still queued are discarded).
+  // False once closed (frames still queued are discarded), or finished with nothing left.
   bool PopAll(std::vector<Frame>* out);
   void Close();
+  // Closes after what is queued: pushes are refused from now on, PopAll hands out the frames
+  // still queued at once (no flush interval) and then returns false.
+  void Finish();
   // Whether PushControl closed the queue (the client's fault, not the server's).
   bool overflowed() const;
 
@@ -93,7 +96,7 @@ class SendQueue {
   const std::chrono::steady_clock::duration flush_interval_;
   mutable std::mutex mutex_;
   std::condition_variable cv_;
-  bool closed_ = false, overflowed_ = false;
+  bool closed_ = false, overflowed_ = false, finishing_ = false;
   size_t control_bytes_ = 0;
   bool consumer_idle_ = false;  // the consumer waits with nothing queued: the next push wakes it
   uint64_t wakeups_by_producers_ = 0, idle_waits_ = 0;

@@ -55,6 +55,31 @@ int WriteResponse(mg_connection* conn, int status, const char* reason, const std
   return status;
 }
 
+// The reason phrase of an HTTP status a Refusal may carry.
+const char* ReasonPhrase(int status) {
+  switch (status) {
+    case 400:
+      return "Bad Request";
+    case 401:
+      return "Unauthorized";
+    case 403:
+      return "Forbidden";
+    case 404:
+      return "Not Found";
+    case 409:
+      return "Conflict";
+    case 410:
+      return "Gone";
+    case 429:
+      return "Too Many Requests";
+    case 500:
+      return "Internal Server Error";
+    case 503:
+      return "Service Unavailable";
+  }
+  return "Refused";
+}
+
 // The address of a socket's end as "ip" and port.
 bool AddressOf(const sockaddr_storage& a, std::string* ip, int* port) {
   char text[INET6_ADDRSTRLEN] = {0};
@@ -229,15 +254,23 @@ struct WebServer::EndpointState {
 struct WebServer::Client {
   ClientId id = 0;
   mg_connection* conn = nullptr;
+  Admission admission;
+  std::string remote_address;
   SendQueue queue;
   std::mutex write_mutex;  // held while writing; closing takes it, so no write outlives the connection
   bool closed = false;
+  // Close(): the close frame the sender writes after the queued frames.
+  std::mutex close_mutex;  // guards the three below
+  bool closing = false;
+  int close_code = 1000;
+  std::string close_reason;
   std::thread sender;
   Client(size_t limit, std::chrono::steady_clock::duration flush_interval) : queue(limit, flush_interval) {}
 };
 
 StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
-  if (options.tokens.empty()) return Status::InvalidArgument("web server: no token for any role (every client needs one)");
+  if (options.tokens.empty() && !options.admit)
+    return Status::InvalidArgument("web server: no token for any role (every client needs one)");
   for (const auto& [role, token] : options.tokens) {
     if (token.empty()) return Status::InvalidArgument(std::string("web server: the ") + RoleName(role) + "'s token is empty");
     for (const auto& [other, other_token] : options.tokens)
@@ -316,12 +349,12 @@ int WebServer::OnPage(mg_connection* conn, void* page_ptr) {
   // Exact URIs only: civetweb matches prefixes ("/" would answer every path).
   // Answered here: civetweb's own file handling is off (no document_root) and must not run.
   if (info->local_uri == nullptr || page->uri != info->local_uri) return WriteResponse(conn, 404, "Not Found", "not found\n");
-  const std::optional<Role> role = self->RoleOf(info->query_string);
-  if (!role)
-    return WriteResponse(conn, 401, "Unauthorized",
-                         "This page needs the link dyad printed, with its ?token=... (no token, or not this server's).\n");
-  if (!page->roles.count(*role))
-    return WriteResponse(conn, 403, "Forbidden", std::string("The ") + RoleName(*role) + "'s token does not open this page.\n");
+  const std::variant<Admission, Refusal> admission = self->AdmissionOf(info);
+  if (const auto* refusal = std::get_if<Refusal>(&admission))
+    return WriteResponse(conn, refusal->status, ReasonPhrase(refusal->status), refusal->body);
+  const Role role = std::get<Admission>(admission).role;
+  if (!page->roles.count(role))
+    return WriteResponse(conn, 403, "Forbidden", std::string("The ") + RoleName(role) + "'s token does not open this page.\n");
   mg_printf(conn,
             "HTTP/1.1 200 OK\r\nContent-Type: %s\r\nContent-Length: %zu\r\nCache-Control: no-store\r\n"
             "Referrer-Policy: no-referrer\r\nX-Frame-Options: DENY\r\nX-Content-Type-Options: nosniff\r\n"
@@ -337,6 +370,17 @@ std::optional<Role> WebServer::RoleOf(const char* query_string) const {
   for (const auto& [r, token] : options_.tokens)  // no early exit: every comparison is made
     if (TokenMatches(given, token)) role = r;
   return role;
+}
+
+std::variant<Admission, Refusal> WebServer::AdmissionOf(const mg_request_info* info) const {
+  if (options_.admit) {
+    std::variant<Admission, Refusal> answer = options_.admit(QueryValue(info->query_string, "token"), info->remote_addr);
+    if (auto* refusal = std::get_if<Refusal>(&answer); refusal != nullptr && (refusal->status < 400 || refusal->status > 599))
+      refusal->status = 500;  // a success status would read as admitted
+    return answer;
+  }
+  if (const std::optional<Role> role = RoleOf(info->query_string)) return Admission{*role, ""};
+  return Refusal{401, "This page needs the link dyad printed, with its ?token=... (no token, or not this server's).\n"};
 }
 
 void WebServer::Disconnect(Client& c) {
@@ -417,11 +461,19 @@ int WebServer::OnConnect(const mg_connection* conn, void* endpoint) {
   if (mg_get_header(conn, "Sec-WebSocket-Protocol") == nullptr)
     const_cast<mg_request_info*>(info)->acceptedWebSocketSubprotocol = nullptr;
   if (const char* origin = mg_get_header(conn, "Origin"); origin != nullptr && !self->OriginAllowed(origin)) return 1;
-  const std::optional<Role> role = self->RoleOf(info->query_string);
-  if (!role || !static_cast<EndpointState*>(endpoint)->roles.count(*role)) return 1;
+  std::variant<Admission, Refusal> admission = self->AdmissionOf(info);
+  if (const auto* refusal = std::get_if<Refusal>(&admission)) {
+    // With `admit` the handshake is answered with the refusal (civetweb sends nothing when this
+    // returns non-zero, and closes the connection: the answer is ours to write); with `tokens`
+    // it is closed unanswered, as it always was.
+    if (self->options_.admit)
+      WriteResponse(const_cast<mg_connection*>(conn), refusal->status, ReasonPhrase(refusal->status), refusal->body);
+    return 1;
+  }
+  if (!static_cast<EndpointState*>(endpoint)->roles.count(std::get<Admission>(admission).role)) return 1;
   std::lock_guard<std::mutex> lock(self->mutex_);
   if (static_cast<int>(self->admitted_.size()) >= self->options_.max_clients) return 1;
-  self->admitted_[conn] = *role;
+  self->admitted_[conn] = std::move(std::get<Admission>(admission));
   return 0;
 }
 
@@ -432,10 +484,10 @@ void WebServer::OnReady(mg_connection* conn, void* endpoint) {
   auto c = std::make_shared<Client>(self->options_.client_buffer_bytes,
                                     viewers ? SendQueue::kDefaultFlushInterval : std::chrono::steady_clock::duration::zero());
   c->conn = conn;
-  Role role = Role::kViewer;
+  if (const mg_request_info* info = mg_get_request_info(conn)) c->remote_address = info->remote_addr;
   {
     std::lock_guard<std::mutex> lock(self->mutex_);
-    role = self->admitted_.at(conn);
+    c->admission = self->admitted_.at(conn);
     c->id = self->next_id_++;
     self->clients_[c->id] = c;
     self->by_conn_[conn] = {c->id, handler};
@@ -468,11 +520,19 @@ void WebServer::OnReady(mg_connection* conn, void* endpoint) {
         }
       }
     }
-    // Closed: by OnClosed (nothing to do) or by the queue itself (its control frames overflowed).
+    // Closed: by OnClosed (nothing to do), by Close() (after what was queued: the close frame,
+    // then the end) or by the queue itself (its control frames overflowed).
     std::lock_guard<std::mutex> lock(raw->write_mutex);
-    if (!raw->closed && raw->queue.overflowed()) self->Disconnect(*raw);
+    if (raw->closed) return;
+    std::unique_lock<std::mutex> close_lock(raw->close_mutex);
+    if (raw->closing) {
+      WriteClose(raw->conn, raw->close_code, raw->close_reason);
+      self->Disconnect(*raw);
+    } else if (raw->queue.overflowed()) {
+      self->Disconnect(*raw);
+    }
   });
-  handler->OnOpen(c->id, role);
+  handler->OnOpen(c->id, c->admission.role);
 }
 
 int WebServer::OnData(mg_connection* conn, int bits, char* data, size_t len, void* endpoint) {
@@ -566,6 +626,29 @@ void WebServer::SendLatest(ClientId client, uint32_t channel, std::string frame,
 std::map<uint32_t, uint64_t> WebServer::TakeDrops(ClientId client) {
   if (auto c = Find(client)) return c->queue.TakeDrops();
   return {};
+}
+
+std::string WebServer::who(ClientId client) const {
+  if (auto c = Find(client)) return c->admission.who;
+  return "";
+}
+
+std::string WebServer::remote_address(ClientId client) const {
+  if (auto c = Find(client)) return c->remote_address;
+  return "";
+}
+
+void WebServer::Close(ClientId client, int code, std::string reason) {
+  auto c = Find(client);
+  if (!c) return;
+  {
+    std::lock_guard<std::mutex> lock(c->close_mutex);
+    if (c->closing) return;
+    c->closing = true;
+    c->close_code = code;
+    c->close_reason = std::move(reason);
+  }
+  c->queue.Finish();  // the sender writes what is queued, then the close frame (see OnReady)
 }
 
 std::vector<ClientId> WebServer::clients() const {

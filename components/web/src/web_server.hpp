@@ -13,7 +13,11 @@
 /// Admission, for pages and WebSocket clients alike: every request carries `?token=<token>`,
 /// and the token says its role (`tokens`, one per role, compared in constant time); each page
 /// and endpoint names the roles it admits (401 without a known token, 403 for a role it does
-/// not admit). At most `max_clients` WebSocket clients. A request carrying an Origin header must
+/// not admit). Or, with `admit` (Options::admit), a callback decides every page request and
+/// WebSocket handshake from the token and the peer's address: it admits with a role and a `who`
+/// (the participant, say), or refuses with an HTTP status and a plain-text body, which a page
+/// request and a WebSocket handshake both get as their answer.
+/// At most `max_clients` WebSocket clients. A request carrying an Origin header must
 /// name an allowed origin (`allowed_origins`, entries "scheme://host[:port]" or "*"; localhost
 /// origins are always allowed when the server binds a loopback address). Pages are sent with
 /// `Referrer-Policy: no-referrer` (their URL holds the token), `Cache-Control: no-store` and
@@ -37,6 +41,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <variant>
 #include <vector>
 
 #include <dyad/status.hpp>
@@ -46,6 +51,7 @@
 struct mg_context;
 struct mg_connection;
 struct mg_websocket_subprotocols;
+struct mg_request_info;
 
 namespace dyad::web {
 
@@ -59,6 +65,23 @@ bool IsLoopback(const std::string& address);
 // do on an endpoint is the handler's to enforce.
 enum class Role { kViewer, kSubject, kExperimenter };
 const char* RoleName(Role role);
+
+// Options::admit's answers. A request admitted: its role (what it may open, as with `tokens`) and
+// who it is (e.g. the participant's pseudonym; WebServer::who() gives it back for a client).
+struct Admission {
+  Role role = Role::kViewer;
+  std::string who;
+};
+// A request refused: answered with `status` (an HTTP error status, 400-599: 404, 409, 429, 503
+// ...) and `body` (plain text, UTF-8), a page request and a WebSocket handshake alike.
+struct Refusal {
+  int status = 404;
+  std::string body;
+};
+// Decides one page request or WebSocket handshake from its `token` (the query's `token`, "" when
+// it has none) and `remote_address` (the peer's IP, e.g. "127.0.0.1"). Runs on civetweb's worker
+// threads, several at once: it must be thread-safe and quick (it holds a worker).
+using Admit = std::function<std::variant<Admission, Refusal>(std::string_view token, std::string_view remote_address)>;
 
 // Whether a client's token is the expected one, in time that does not depend on where they
 // differ (OpenSSL's CRYPTO_memcmp; only the length can be learnt). An empty `expected` matches
@@ -116,7 +139,11 @@ class WebServer {
     std::map<std::string, Page> pages;  // by exact URI
     std::vector<Endpoint> endpoints;
     std::vector<std::string> allowed_origins;
-    std::map<Role, std::string> tokens;  // at least one; each distinct and non-empty
+    std::map<Role, std::string> tokens;  // at least one unless `admit`; each distinct and non-empty
+    // When set, decides every page request and WebSocket handshake instead of `tokens` (which may
+    // then be empty and is not consulted). The Origin check, the pages' and endpoints' roles and
+    // max_clients still apply to what it admits.
+    Admit admit;
     std::string tls_certificate;         // PEM: key and certificate chain; empty: plain HTTP
     int max_clients = 8;
     int write_timeout_ms = 5000;  // a write blocked this long disconnects the client
@@ -125,7 +152,8 @@ class WebServer {
   };
 
   // Starts listening; fails (IOError) when the address/port cannot be bound or the certificate
-  // cannot be used, InvalidArgument when the tokens are missing, empty or not distinct.
+  // cannot be used, InvalidArgument when the tokens are missing (and no `admit`), empty or not
+  // distinct.
   static StatusOr<std::unique_ptr<WebServer>> Start(const Options& options);
   ~WebServer();  // closes every client, stops the server, joins every thread
   WebServer(const WebServer&) = delete;
@@ -142,6 +170,18 @@ class WebServer {
   // Per-channel drops of a client since the last call.
   std::map<uint32_t, uint64_t> TakeDrops(ClientId client);
   std::vector<ClientId> clients() const;
+  // A connected client's Admission::who ("" with `tokens`, or once the client is gone).
+  std::string who(ClientId client) const;
+  // A connected client's IP address ("" once it is gone).
+  std::string remote_address(ClientId client) const;
+  // Ends a client from any thread (a handler's OnText included): the frames queued before this
+  // call are sent, then a close frame with `code` (e.g. 1000, 1008, 1012) and `reason` (cut to
+  // 120 bytes), then the connection is shut down and the handler's OnClose runs on the client's
+  // worker thread (after Close returns, not within it: frames already received may still reach
+  // OnText meanwhile). Frames queued after the call are dropped. Nothing for a client that is
+  // gone or closing already. A peer that has stopped reading gets its close frame after the
+  // write timeout's wait, at worst (the sender's, never the caller's).
+  void Close(ClientId client, int code, std::string reason);
   // Inside OnText/OnBinary only (the handler thread): the wall-clock time (ns since the epoch)
   // civetweb's worker received the message; the handler's own start minus this is the wait for
   // the handler thread (bench/web prints it).
@@ -160,6 +200,9 @@ class WebServer {
   bool OriginAllowed(const std::string& origin) const;
   // The role whose token the request's query carries (every token compared: constant time).
   std::optional<Role> RoleOf(const char* query_string) const;
+  // The request's admission: by `admit` when set, else by `tokens` (a Refusal of 401 when no
+  // token matches).
+  std::variant<Admission, Refusal> AdmissionOf(const mg_request_info* info) const;
   // Ends `c`'s connection from any thread (its socket shut down). REQUIRES: c->write_mutex held
   // and c->closed false, so the connection is still open.
   void Disconnect(Client& c);
@@ -176,7 +219,7 @@ class WebServer {
   std::map<ClientId, std::shared_ptr<Client>> clients_;
   std::map<const mg_connection*, std::pair<ClientId, ClientHandler*>> by_conn_;
   ClientId next_id_ = 1;
-  std::map<const mg_connection*, Role> admitted_;  // past OnConnect, not yet closed
+  std::map<const mg_connection*, Admission> admitted_;  // past OnConnect, not yet closed
 };
 
 }  // namespace dyad::web

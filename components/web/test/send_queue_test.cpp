@@ -33,6 +33,25 @@ TEST(SendQueue, KeepsPushOrderAcrossChannelsAndControlFirst) {
   EXPECT_EQ(q.queued_bytes(), 0u);
 }
 
+// Finish (WebServer::Close): what was queued still goes out, at once (no flush interval), then
+// the end; nothing pushed after it is queued.
+TEST(SendQueue, FinishHandsOutWhatIsQueuedThenEnds) {
+  SendQueue q(1000, std::chrono::seconds(10));
+  q.PushData(1, "a1");
+  q.PushControl("{c}");
+  q.Finish();
+  EXPECT_FALSE(q.PushControl("{late}"));
+  EXPECT_FALSE(q.PushData(1, "late"));
+  q.PushLatest(2, "late");
+  std::vector<Frame> batch;
+  const auto start = Clock::now();
+  ASSERT_TRUE(q.PopAll(&batch));
+  EXPECT_EQ(Texts(batch), (std::vector<std::string>{"{c}", "a1"}));
+  EXPECT_FALSE(q.PopAll(&batch));
+  EXPECT_LT(Clock::now() - start, std::chrono::seconds(5)) << "the flush interval was waited for";
+  EXPECT_FALSE(q.overflowed());
+}
+
 TEST(SendQueue, DropsTheBusiestChannelsOldestFramesWhenFull) {
   SendQueue q(100);
   const std::string big(30, 'x'), small(5, 's');

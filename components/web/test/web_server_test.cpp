@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
 #include <thread>
 
 namespace dyad::web {
@@ -104,6 +105,16 @@ std::string Get(int port, const std::string& target) {
   return r;
 }
 
+// The whole response, up to the server's end of the connection.
+std::string GetWhole(int port, const std::string& target) {
+  const int fd = Connect(port);
+  std::string r = Exchange(fd, "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n");
+  char buf[4096];
+  for (ssize_t n; (n = recv(fd, buf, sizeof(buf), 0)) > 0;) r.append(buf, static_cast<size_t>(n));
+  close(fd);
+  return r;
+}
+
 std::string Upgrade(const std::string& target) {
   return "GET " + target +
          " HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
@@ -161,6 +172,69 @@ TEST(WebServer, AWebSocketNeedsATokenOfARoleItsEndpointAdmits) {
   ASSERT_TRUE(WaitFor([&] { return handler.opens == 1; }, std::chrono::seconds(5)));
   EXPECT_EQ(handler.last_role.load(), Role::kSubject);
   close(fd);
+}
+
+// Options::admit decides pages and WebSockets instead of tokens: its Refusal is the HTTP answer
+// (status and body), its Admission's role is checked against the page's and endpoint's roles,
+// and its `who` and the peer's address are the client's.
+TEST(WebServer, AnAdmitCallbackDecidesPagesAndWebSocketsAndNamesTheClient) {
+  RecordingHandler handler;
+  WebServer::Options o = TestOptions(&handler);
+  o.tokens.clear();
+  std::mutex seen_mutex;
+  std::vector<std::pair<std::string, std::string>> seen;  // token, remote address
+  o.admit = [&](std::string_view token, std::string_view remote) -> std::variant<Admission, Refusal> {
+    {
+      std::lock_guard<std::mutex> lock(seen_mutex);
+      seen.emplace_back(token, remote);
+    }
+    if (token == "p07") return Admission{Role::kSubject, "P07"};
+    if (token == "watcher") return Admission{Role::kViewer, ""};
+    if (token == "knocker") return Refusal{429, "Too many unknown links from your address; try again in a minute.\n"};
+    if (token == "full") return Refusal{503, "Please come back later.\n"};
+    if (token == "ok-status") return Refusal{200, "not a refusal status\n"};
+    return Refusal{404, "This link is not known here.\n"};
+  };
+  auto server = WebServer::Start(o);
+  ASSERT_TRUE(server.ok()) << server.status().ToString();
+  const int port = (*server)->port();
+  const std::string unknown = GetWhole(port, "/watch?token=nope");
+  EXPECT_EQ(unknown.rfind("HTTP/1.1 404 Not Found\r\n", 0), 0u) << unknown;
+  EXPECT_NE(unknown.find("\r\n\r\nThis link is not known here.\n"), std::string::npos) << unknown;
+  EXPECT_EQ(Get(port, "/watch").rfind("HTTP/1.1 404", 0), 0u) << "no token is the callback's too";
+  const std::string knocker = GetWhole(port, "/watch?token=knocker");
+  EXPECT_EQ(knocker.rfind("HTTP/1.1 429 Too Many Requests\r\n", 0), 0u) << knocker;
+  EXPECT_NE(knocker.find("try again in a minute"), std::string::npos) << knocker;
+  EXPECT_EQ(Get(port, "/watch?token=full").rfind("HTTP/1.1 503 Service Unavailable\r\n", 0), 0u);
+  EXPECT_EQ(Get(port, "/watch?token=ok-status").rfind("HTTP/1.1 500", 0), 0u) << "a refusal never reads as a success";
+  EXPECT_EQ(Get(port, "/watch?token=p07").rfind("HTTP/1.1 403", 0), 0u) << "the page admits viewers only";
+  EXPECT_EQ(Get(port, "/watch?token=watcher").rfind("HTTP/1.1 200", 0), 0u);
+  {
+    std::lock_guard<std::mutex> lock(seen_mutex);
+    ASSERT_FALSE(seen.empty());
+    EXPECT_EQ(seen.front(), (std::pair<std::string, std::string>{"nope", "127.0.0.1"}));
+    EXPECT_EQ(seen[1].first, "");
+  }
+
+  int fd = Connect(port);
+  const std::string refused = Exchange(fd, Upgrade("/ws?token=full"));
+  EXPECT_EQ(refused.rfind("HTTP/1.1 503 Service Unavailable\r\n", 0), 0u) << "a refused handshake gets the status: " << refused;
+  close(fd);
+  fd = Connect(port);
+  EXPECT_EQ(Exchange(fd, Upgrade("/ws?token=watcher")).find("101"), std::string::npos) << "the endpoint admits no viewer";
+  close(fd);
+  EXPECT_EQ(handler.opens, 0);
+  fd = Connect(port);
+  ASSERT_NE(Exchange(fd, Upgrade("/ws?token=p07")).find("101 Switching Protocols"), std::string::npos);
+  ASSERT_TRUE(WaitFor([&] { return handler.opens == 1; }, std::chrono::seconds(5)));
+  const ClientId client = handler.last_client;
+  EXPECT_EQ(handler.last_role.load(), Role::kSubject);
+  EXPECT_EQ((*server)->who(client), "P07");
+  EXPECT_EQ((*server)->remote_address(client), "127.0.0.1");
+  close(fd);
+  ASSERT_TRUE(WaitFor([&] { return handler.closes == 1; }, std::chrono::seconds(5)));
+  EXPECT_EQ((*server)->who(client), "") << "gone";
+  EXPECT_EQ((*server)->remote_address(client), "");
 }
 
 TEST(WebServer, TokensMustBeGivenAndDistinct) {

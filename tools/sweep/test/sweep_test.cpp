@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -417,6 +418,48 @@ TEST_F(TrainingSweepTest, ARunWhoseModelDidNotTrainFailsSayingSo) {
   ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--train-only", "--task", "0/1"}, &out), 0) << out;
   EXPECT_NE(out.find("1 trained, 0 there before, 0 failed"), std::string::npos) << out;
   EXPECT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--task", "0/1", "--no-plots"}, &out), 0) << out;
+}
+
+// The deliberator's preset is a parameter like any other: a sweep over dyad's error regression
+// and NRL's (issue 44) runs both, and they are different robots (their N-ELBO, their following).
+// A preset the deliberator lacks is refused at its line before anything runs.
+TEST_F(TrainingSweepTest, APresetSweepRunsDyadsAndNrlsRegressionSideBySide) {
+  const std::string repo = DYAD_SOURCE_DIR;
+  const std::string head =
+      "sweep: p\ngraph: " + repo + "/configs/demo.yaml\nduration: 10\nset: {human.dataset: " + (dir_ / "data").string() +
+      ", observer.model: " + (dir_ / "o.dobs").string() + ", mind.model: " + (dir_ / "m.dpvrnn").string() + "}\n";
+  std::string out;
+  EXPECT_EQ(Sweep({Write(head + "grid:\n  mind.preset: [vcbot, nrl2]\n").string(), "--dry-run"}, &out), 2) << out;
+  EXPECT_NE(out.find("s.yaml:6:24: grid.mind.preset: does not validate"), std::string::npos) << out;
+  EXPECT_NE(out.find("must be one of: vcbot, reference, nrl, got 'nrl2'"), std::string::npos) << out;
+  const fs::path file = Write(head + "grid:\n  mind.preset: [vcbot, nrl]\n");
+  ASSERT_EQ(Sweep({file.string(), "-o", (dir_ / "o").string(), "--no-plots"}, &out), 0) << out;
+  EXPECT_NE(out.find("2 ran, 0 done before, 0 failed"), std::string::npos) << out;
+  std::istringstream csv(ReadFile(dir_ / "o" / "sweep.csv"));
+  std::string header, line;
+  std::getline(csv, header);
+  ASSERT_EQ(header.rfind("run,status,mind.preset,seed,", 0), 0u) << header;
+  std::map<std::string, std::vector<std::string>> metrics;  // preset -> its metrics (the cells after the seed)
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cells;
+    std::istringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    ASSERT_GT(cells.size(), 5u) << line;
+    EXPECT_EQ(cells[1], "ok") << line;
+    metrics[cells[2]].assign(cells.begin() + 4, cells.end());
+  }
+  ASSERT_EQ(metrics.size(), 2u);
+  ASSERT_TRUE(metrics.count("vcbot") && metrics.count("nrl"));
+  EXPECT_NE(metrics["vcbot"], metrics["nrl"]) << "the two presets ran the same robot";
+  // Each run's log says which regression ran.
+  int nrl = 0, vcbot = 0;
+  for (const auto& run : fs::directory_iterator(dir_ / "o" / "runs")) {
+    const std::string log = ReadFile(run.path() / "run.log");
+    nrl += log.find(", preset nrl, window 5,") != std::string::npos;
+    vcbot += log.find(", preset vcbot, window 5,") != std::string::npos;
+  }
+  EXPECT_EQ(nrl, 1);
+  EXPECT_EQ(vcbot, 1);
 }
 
 TEST(SweepTask, ChunksHoldEveryRunOnceInOrder) {
