@@ -124,10 +124,11 @@ StatusOr<std::string> HostIdentityFor(const Graph& graph, const std::string& hos
   for (const std::string& h : hosts)
     if (h == host) return HostIdentity(h);
   if (hosts.size() == 1) return HostIdentity(hosts.front());
-  std::string names;
-  for (const std::string& h : hosts) names += (names.empty() ? "" : ", ") + h;
-  return Status::NotFound("this machine ('" + host + "') is none of the graph's hosts (" + names +
-                          "): say which one it is with --host");
+  std::string flags;  // "--host a, --host b or --host c"
+  for (size_t i = 0; i < hosts.size(); ++i)
+    flags += (i == 0 ? "" : i + 1 == hosts.size() ? " or " : ", ") + std::string("--host ") + hosts[i];
+  return Status::NotFound("this machine ('" + host + "') is none of the graph's hosts: pass the host it is, or whose " +
+                          "identity it may use here: " + flags);
 }
 
 std::vector<std::string> CheckKeystore(const Graph& graph, int64_t now_s) {

@@ -110,10 +110,11 @@ int DrawGraph(const std::string& path, const std::vector<std::string>& sets, con
 }
 
 // `dyad graph --live`: the graphs on the domain as discovered, with measured rates.
-int DrawLiveGraph(const std::string& path, IntrospectOptions options, bool domain_given, double listen_s, const std::string& svg) {
+int DrawLiveGraph(const std::string& path, IntrospectOptions options, bool domain_given, double listen_s, const std::string& svg,
+                  const std::string& host) {
   Catalog catalog;
   std::optional<Graph> graph;
-  if (!LoadWatcherCatalog(path, {}, &catalog, &options, domain_given, "", &graph)) return tools::Code(kBadInput);
+  if (!LoadWatcherCatalog(path, {}, &catalog, &options, domain_given, host, &graph)) return tools::Code(kBadInput);
   LiveGraph live;
   if (int rc = DiscoverLiveGraph(options, catalog, graph ? &*graph : nullptr, listen_s, &live, std::cerr); rc != 0) return rc;
   return EmitDot(LiveGraphDot(live, graph ? &*graph : nullptr), svg);
@@ -122,7 +123,7 @@ int DrawLiveGraph(const std::string& path, IntrospectOptions options, bool domai
 // `dyad graph`: the graph file's picture, or (--live) the running graph's.
 void AddGraphCommand(CLI::App& app, int& exit_code) {
   struct State {
-    std::string graph_path, svg;
+    std::string graph_path, svg, host;
     std::vector<std::string> sets, plugins;
     bool dot = false, live = false;
     IntrospectOptions watch;
@@ -136,13 +137,16 @@ void AddGraphCommand(CLI::App& app, int& exit_code) {
   graph->add_option("--wait", st->watch.wait_s, "--live: seconds of discovery at most (default 5; with a graph it ends once all is found)")
       ->check(CLI::NonNegativeNumber);
   graph->add_option("--listen", st->listen_s, "--live: seconds to measure the rates (default 2)")->check(CLI::PositiveNumber);
+  graph->add_option(
+      "--host", st->host,
+      "--live, with a secured graph: this machine's host in the graph, whose identity it uses (default: the machine's name)");
   graph->add_option("--set", st->sets, kSetHelp);
   graph->add_option("--plugins", st->plugins, "Extra plugin file or folder (repeatable)");
   auto* svg = graph->add_option("--svg", st->svg, "Render into this SVG file with Graphviz's dot (Debian: graphviz)");
   graph->add_flag("--dot", st->dot, "Print the DOT text (the default)")->excludes(svg);
   graph->callback([st, domain, &exit_code] {
     if (st->live) {
-      exit_code = DrawLiveGraph(st->graph_path, st->watch, domain->count() > 0, st->listen_s, st->svg);
+      exit_code = DrawLiveGraph(st->graph_path, st->watch, domain->count() > 0, st->listen_s, st->svg, st->host);
     } else if (st->graph_path.empty()) {
       std::cerr << "dyad graph: name the graph file (or --live for the running graph as discovered)\n";
       exit_code = tools::Code(kBadInput);

@@ -23,7 +23,12 @@ StatusOr<std::string> JoiningIdentity(const Graph& graph, const std::string& gra
                                       bool* as_guest) {
   const std::string machine = host.empty() ? MachineName() : host;
   auto identity = HostIdentityFor(graph, machine);
-  if (identity.ok() || as_guest == nullptr || !host.empty()) return identity;
+  if (identity.ok() || !host.empty()) return identity;
+  if (as_guest == nullptr && graph.security.guests)  // status, topics, param, graph --live
+    return Status::NotFound(identity.status().message() +
+                            " (not as the graph's guest: this tool reads the runtime's own topics, which only a host's "
+                            "identity may read)");
+  if (as_guest == nullptr) return identity;
   if (!graph.security.guests)
     return Status::NotFound(identity.status().message() +
                             ", or let tools visit it as the graph's guest: add `guests: {subscribe: [...], "

@@ -73,7 +73,7 @@ std::string IdentitySubject(const Graph& graph, const std::string& identity);
 IdentityFiles IdentityOf(const Graph& graph, const std::string& identity);
 // The identity a watcher or a launcher on `host` uses: host.<host> when the graph knows that
 // host, else host.local when it places nothing on hosts, else the only host identity there is;
-// NotFound naming the hosts otherwise.
+// NotFound otherwise, saying exactly what to pass ("--host lab or --host robot").
 StatusOr<std::string> HostIdentityFor(const Graph& graph, const std::string& host);
 
 // The keystore's files for every identity of the graph exist as regular files (not symbolic

@@ -16,6 +16,7 @@
 
 #include "dyad/testing/child_process.hpp"
 #include "dyad/testing/cli.hpp"
+#include "introspection_commands.hpp"
 #include "runtime_commands.hpp"
 #include "security_commands.hpp"
 
@@ -384,6 +385,42 @@ TEST_F(KeystoreTest, ValidateRefusesAKeystoreThatIsIncompleteLeakyOrExpired) {
   const auto earlier = CheckKeystore(g, static_cast<int64_t>(std::time(nullptr)) - 86400);
   ASSERT_FALSE(earlier.empty());
   EXPECT_NE(earlier[0].find("not valid yet"), std::string::npos) << earlier[0];
+}
+
+// `dyad status`, `topics`, `param` and `graph --live` read the runtime's own topics, which only a
+// host's identity may: on a machine that is none of a secured graph's hosts (this one: its name is
+// neither 'lab' nor 'robot') they are refused before joining, saying exactly what to pass (and, in
+// a graph with guests, why the guest identity does not do).
+TEST_F(KeystoreTest, AWatcherOnAMachineThatIsNoneOfTheHostsIsToldWhatToPass) {
+  const std::string placed =
+      "graph: sec\nprocesses:\n  pub: {host: lab}\n  rec: {host: robot}\nsecurity: {keystore: keys}\n"
+      "components:\n  a: {type: counter_source, rate_hz: 10, process: pub, outputs: {out: ca}}\n"
+      "  s: {type: counter_sink, trigger: in, process: rec, inputs: {in: ca}}\n";
+  std::ofstream(dir_ / "hosts.yaml") << placed;
+  std::ofstream(dir_ / "guests.yaml") << std::string(placed).replace(placed.find("keystore: keys}"), 15,
+                                                                     "keystore: keys, guests: {subscribe: [ca]}}");
+  ASSERT_EQ(Init({}, dir_ / "guests.yaml").code, 0);
+  char machine[256] = {0};
+  gethostname(machine, sizeof machine - 1);
+  ASSERT_NE(std::string(machine), "lab");
+  const std::string told = "this machine ('" + std::string(machine) +
+                           "') is none of the graph's hosts: pass the host it is, or whose identity it may use here: --host lab "
+                           "or --host robot";
+  for (const char* tool : {"status", "topics"}) {
+    const std::string graph = (dir_ / "hosts.yaml").string();
+    auto r = dyad::testing::RunCommand(AddIntrospectionCommands, {tool, "--graph", graph, "--wait", "0"});
+    EXPECT_EQ(r.code, 2) << tool;
+    EXPECT_NE(r.err.find(graph + ": " + told + "\n"), std::string::npos) << tool << ": " << r.err;
+    auto g =
+        dyad::testing::RunCommand(AddIntrospectionCommands, {tool, "--graph", (dir_ / "guests.yaml").string(), "--wait", "0"});
+    EXPECT_EQ(g.code, 2) << tool;
+    EXPECT_NE(g.err.find(told + " (not as the graph's guest: this tool reads the runtime's own topics"), std::string::npos)
+        << tool << ": " << g.err;
+  }
+  auto live =
+      dyad::testing::RunCommand(AddRuntimeCommands, {"graph", "--live", (dir_ / "hosts.yaml").string(), "--host", "nowhere"});
+  EXPECT_EQ(live.code, 2);
+  EXPECT_NE(live.err.find("this machine ('nowhere') is none of the graph's hosts"), std::string::npos) << live.err;
 }
 
 TEST_F(KeystoreTest, SecurityWithADiscoveryServerIsRefused) {
