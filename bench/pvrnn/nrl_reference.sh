@@ -12,6 +12,9 @@
 # beta2 0.95, meta-prior 1e-5 per layer):
 #   OUT_DIR/nrl_er_fixed.csv   fixed executed trajectory (the same input for every engine)
 #   OUT_DIR/nrl_er_closed.csv  closed loop (the executed positions follow NRL's intentions)
+#   OUT_DIR/nrl_train.csv      NRL's training from its initial state (bench/pvrnn/nrl_train_harness.cpp:
+#                              the study's properties_MacawBot.d on the Macaw data set), loss terms
+#                              per epoch for NRL_TRAIN_EPOCHS epochs
 # OUT_DIR defaults to components/pvrnn/test/data/nrl.
 #
 # Environment:
@@ -21,7 +24,11 @@
 #              (std::default_random_engine seeded 0)
 #   NRL_REPRO  1: also measure NRL's reproducibility: build it with its CMake defaults (no flags)
 #              and with -O3 -march=native, run the fixed trajectory with both, print the first
-#              step where the intentions differ by more than 5e-5 (and at 1e-3, 1e-1)
+#              step where the intentions differ by more than 5e-5 (and at 1e-3, 1e-1); train
+#              with both and print, per pair of the three builds, the first epoch where a loss
+#              term differs by more than 1e-5, 1e-4, 1e-3 relative and the largest difference
+#              through NRL_TRAIN_HORIZON (default 52)
+#   NRL_TRAIN_EPOCHS  epochs of the training trace (default 200)
 #   NRL_ENSEMBLE  N > 0: also run the closed loop N times with 1e-5 jitter on the executed
 #              positions (seeds 1..N, reference build) and print switching figures per run
 #              (bench/pvrnn/nrl_switch_figures.py; needs python3)
@@ -42,6 +49,10 @@ noise="${NRL_NOISE:-0}"
 [[ -f "$nrl_src/src/lib/LibNRL.h" ]] || { echo "error: $nrl_src: not an NRL checkout (no src/lib/LibNRL.h)" >&2; exit 2; }
 [[ -d "$data/model/MacawBot" ]] || { echo "error: $data/model/MacawBot: the study's trained model is missing" >&2; exit 2; }
 [[ "$noise" == 0 || "$noise" == 1 ]] || { echo "error: NRL_NOISE must be 0 or 1, got '$noise'" >&2; exit 2; }
+train_epochs="${NRL_TRAIN_EPOCHS:-200}"
+[[ "$train_epochs" =~ ^[1-9][0-9]*$ ]] || { echo "error: NRL_TRAIN_EPOCHS must be a count > 0, got '$train_epochs'" >&2; exit 2; }
+train_horizon="${NRL_TRAIN_HORIZON:-52}"
+[[ "$train_horizon" =~ ^[1-9][0-9]*$ ]] || { echo "error: NRL_TRAIN_HORIZON must be a count > 0, got '$train_horizon'" >&2; exit 2; }
 ensemble="${NRL_ENSEMBLE:-0}"
 [[ "$ensemble" =~ ^[0-9]+$ ]] || { echo "error: NRL_ENSEMBLE must be a count, got '$ensemble'" >&2; exit 2; }
 mkdir -p "$out"
@@ -72,6 +83,22 @@ build() {
   ${CXX:-c++} -std=c++17 $cflags -Wall -Wextra -isystem "$eigen" -isystem "$work/src" \
     "$here/nrl_er_harness.cpp" -o "$b/nrl_er_harness" -L"$b" -lNRL -Wl,-rpath,"$b" 2>>"$work/$name.log" ||
     { tail -30 "$work/$name.log" >&2; exit 1; }
+  ${CXX:-c++} -std=c++17 $cflags -Wall -Wextra -isystem "$eigen" -isystem "$work/src" \
+    "$here/nrl_train_harness.cpp" -o "$b/nrl_train_harness" -L"$b" -lNRL -Wl,-rpath,"$b" 2>>"$work/$name.log" ||
+    { tail -30 "$work/$name.log" >&2; exit 1; }
+}
+
+# train NAME CSV [harness options]: NRL's training from its initial state (a fresh process: NRL's
+# initial weights come from rand() in its default state), the study's properties file.
+train() {
+  local name="$1" csv="$2"
+  shift 2
+  local r="$work/train-$name"
+  mkdir -p "$r"
+  ln -sfn "$(cd "$data/dataset/Macaw" && pwd)" "$r/Macaw"
+  sed 's/^modelpath=.*/modelpath=unused/' "$data/config/properties_MacawBot.d" >"$r/props.d"
+  (cd "$r" && "$work/build-$name/nrl_train_harness" props.d "$csv" --epochs "$train_epochs" "$@") >"$r/log" 2>&1 ||
+    { cat "$r/log" >&2; exit 1; }
 }
 
 # run NAME CSV [harness options]: NRL reads modelpath/datapath relative to the working directory.
@@ -90,7 +117,8 @@ run() {
 build ref "$flags"
 run ref "$out/nrl_er_fixed.csv"
 run ref "$out/nrl_er_closed.csv" --closed-loop
-echo "wrote $out/nrl_er_fixed.csv and $out/nrl_er_closed.csv (NRL $(git -C "$nrl_src" rev-parse --short HEAD 2>/dev/null || echo '?'), flags '$flags', noise $noise)"
+train ref "$out/nrl_train.csv"
+echo "wrote $out/nrl_er_fixed.csv, $out/nrl_er_closed.csv and $out/nrl_train.csv (NRL $(git -C "$nrl_src" rev-parse --short HEAD 2>/dev/null || echo '?'), flags '$flags', noise $noise)"
 
 if [[ "${NRL_REPRO:-0}" == 1 ]]; then
   build default ""
@@ -108,6 +136,28 @@ if [[ "${NRL_REPRO:-0}" == 1 ]]; then
     END {
       for (k = 1; k <= 3; k++) printf "NRL default vs -O3 -march=native: intentions first differ by > %s at step %s (lead-in steps negative)\n", tols[k], (k in first ? first[k] : "never")
       printf "largest difference over the run: %g\n", max
+    }'
+  train default "$work/train-default.csv"
+  train native "$work/train-native.csv"
+  # Per pair of builds: the first epoch where loss, reconstruction or regulation (columns 2-4)
+  # differ by more than tol relative, and the largest difference through the horizon.
+  paste -d, "$out/nrl_train.csv" "$work/train-default.csv" "$work/train-native.csv" | awk -F, -v h="$train_horizon" '
+    NR > 1 {
+      for (k = 0; k < 3; k++) {
+        a = $(2 + k); b = $(6 + k); c = $(10 + k)
+        r[1] = (a - b) / a; r[2] = (a - c) / a; r[3] = (b - c) / b
+        for (j = 1; j <= 3; j++) {
+          x = r[j] < 0 ? -r[j] : r[j]
+          for (t = 1; t <= 3; t++) if (!((j, t) in first) && x > 10 ^ (-6 + t)) first[j, t] = $1
+          if ($1 <= h && x > worst[j, k]) worst[j, k] = x
+        }
+      }
+    }
+    END {
+      split("-O3/defaults -O3/-O3-march=native defaults/-O3-march=native", name, " ")
+      for (j = 1; j <= 3; j++)
+        printf "NRL training %s: a loss term first differs by > 1e-5 at epoch %s, > 1e-4 at %s, > 1e-3 at %s; largest through epoch %d: loss %g, reconstruction %g, regulation %g\n",
+          name[j], first[j, 1], first[j, 2], first[j, 3], h, worst[j, 0], worst[j, 1], worst[j, 2]
     }'
 fi
 
