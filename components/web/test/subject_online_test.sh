@@ -6,10 +6,7 @@
 #   subject_online_test.sh WORK_DIR
 set -euo pipefail
 work=$1
-here=$(cd "$(dirname "$0")" && pwd)
-node_dir=$here/node
-if [ ! -d "$node_dir/node_modules" ] || [ ! -x /usr/bin/chromium ]; then
-  echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node, Debian chromium)"; exit 77
-fi
-rm -rf "$work"; mkdir -p "$work"
-node "$node_dir/subject_online.mjs" "$here/../pages/subject.html" "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_browser
+fresh_dir "$work"
+node "$node_dir/subject_online.mjs" "$web_test_repo/components/web/pages/subject.html" "$work"

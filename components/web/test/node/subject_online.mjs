@@ -3,7 +3,8 @@
 // (headless, playwright-core), against a small server here that speaks the front's side of the
 // protocol (docs/components.md#web, "Between trials"; the page file itself, not a build's copy):
 //   node subject_online.mjs PAGE_FILE SCREENSHOT_DIR
-// Participant 1: a ping is answered with its id; the consent text is shown as written, "I agree"
+// Participant 1: a ping is answered with its id; the consent text is shown as written (the mouse
+//   moving over it sends no pointer samples: no graph said hello), "I agree"
 //   answers {"op":"consent","agree":true}; each 1012 close is followed by a new socket at once
 //   (well under the page's one-second retry); "Start trial 1 of 1" is a button that answers
 //   {"op":"ready"} once; the trial's hello makes the page steer, a ping meanwhile is answered;
@@ -97,6 +98,10 @@ try {
   await page.waitForSelector("#consent.on", { timeout: 3000 });
   if ((await page.$eval("#consent-text", (e) => e.innerText)) !== consent) throw new Error("the consent text is not shown as written");
   await page.screenshot({ path: `${shotDir}/online_consent.png` });
+  // No graph on this socket: the mouse moving over the page sends nothing to the front.
+  for (const [x, y] of [[100, 100], [300, 200], [500, 600]]) await page.mouse.move(x, y);
+  await sleep(100);
+  if (c.inbox.some((m) => m.op === "pointer")) throw new Error("pointer samples to the front between trials");
   await page.click("#agree");
   if ((await nextMessage(c, "consent")).agree !== true) throw new Error("I agree did not answer agree: true");
   let t = Date.now();
