@@ -19,12 +19,21 @@
 // works from a clean clone. `speed` > 1 (tests) divides every duration of its behaviour (rests,
 // holds, answers), never the pointer's event rate.
 //
+// --online: a participant of `dyad study serve` (the page's ops between trials, docs/components.md
+// #web): on consent it agrees; on waiting with a Ready button it presses it 0.5 to 1.5 s later (its
+// behaviour's time); it draws only during a trial (from a hello to the next close or waiting, as a
+// person does not draw while a message covers the page); it answers each ping with its pong; after
+// a close with code 1012 it reconnects at once; on done it keeps the completion code and stops, on
+// refused it keeps the message and stops (the page's: no retry).
+//
 //   node sim_participant.mjs [--dataset DIR] [--seconds S] [--report-error P] [--speed F] [--chromium K]
-//                            SESSIONS_FILE
+//                            [--online] SESSIONS_FILE
 //     SESSIONS_FILE: one participant per line, "URL TOKEN" (URL: http://127.0.0.1:PORT); all run
-//     in this one process for S seconds (default 30), then each prints one JSON line: pointer
-//     samples sent, acks, round trip median/p99 (ms), holds, answers, closes, errors; the last
-//     line is this process's CPU time (Node's alone: Chromium's own processes are not in it).
+//     in this one process for S seconds (default 30; --online: until each is done or refused, S at
+//     most), then each prints one JSON line: pointer samples sent, acks, round trip median/p99 (ms),
+//     holds, answers, closes, errors (--online also: trials started, the completion code or null,
+//     refused: the message or null, pongs); the last line is this process's CPU time (Node's alone:
+//     Chromium's own processes are not in it).
 //     --chromium K: the first K participants in the real page in Chromium (ChromiumParticipant).
 import fs from "node:fs";
 import path from "node:path";
@@ -88,7 +97,7 @@ const pct = (a, p) => { const s = [...a].sort((x, y) => x - y); return s.length 
 
 export class SimParticipant {
   // url: http://HOST:PORT; token: the subject's; primitives: [[x,y],...] each; seed: its behaviour.
-  constructor({ url, token, primitives, seed = 1, reportError = 0.1, speed = 1 }) {
+  constructor({ url, token, primitives, seed = 1, reportError = 0.1, speed = 1, online = false }) {
     this.wsUrl = url.replace(/^http/, "ws") + "/subject/ws?token=" + encodeURIComponent(token);
     this.origin = url;
     this.prims = primitives;
@@ -99,6 +108,10 @@ export class SimParticipant {
     this.half = 50, this.steering = false, this.ask = false, this.askAfterMs = 1000, this.target = -1;
     this.cursor = [0, 0], this.down = false, this.lastSent = 0, this.timers = new Set();
     this.drawn = [];  // the primitive drawn in each hold long enough to be asked about
+    // --online: between trials (consent, waiting) or in one; what the front said at the end.
+    this.online = online, this.inTrial = !online;
+    this.trials = 0, this.code = null, this.refused = null, this.pongs = 0;
+    this.finished = new Promise((r) => { this.finish = r; });  // resolves on done or refused
   }
   later(ms, fn) {  // fn after ms of its behaviour's time
     const t = setTimeout(() => { this.timers.delete(t); if (!this.stopped) fn(); }, ms / this.speed);
@@ -116,12 +129,35 @@ export class SimParticipant {
     this.ws.on("message", (data) => this.onMessage(JSON.parse(String(data))));
     this.ws.on("error", (e) => { if (this.stats.errors.length < 5) this.stats.errors.push(String(e.message)); });
     this.ws.on("close", (code) => {
-      this.stats.closes++, this.steering = false, this.down = false;
-      if (!this.stopped && code !== 1008) this.later(1000 * this.speed, () => this.connect());  // the page's second, at any speed
+      this.stats.closes++, this.steering = false, this.down = false, this.inTrial = !this.online;
+      // The page's second, at any speed; after 1012 (the front's next phase) at once.
+      if (!this.stopped && code !== 1008) this.later(code === 1012 ? 0 : 1000 * this.speed, () => this.connect());
     });
   }
+  // --online: the front's ops between trials (and its ping at any time); true when `m` was one.
+  onFrontMessage(m) {
+    const reply = (r) => { if (this.ws?.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify(r)); };
+    if (m.op === "ping") reply({ op: "pong", id: m.id }), this.pongs++;
+    else if (m.op === "consent") this.inTrial = false, reply({ op: "consent", agree: true });
+    else if (m.op === "waiting") {
+      this.inTrial = false, this.down = false;
+      if (m.ready) {
+        const ws = this.ws;  // a Ready pressed on the socket it was shown on (a new one shows it again)
+        this.later(this.r.uniform(500, 1500), () => { if (this.ws === ws) reply({ op: "ready" }); });
+      }
+    } else if (m.op === "done" || m.op === "refused") {
+      if (m.op === "done") this.code = m.code ?? "";
+      else this.refused = m.message;
+      this.stop();
+      this.finish();
+    } else return false;
+    return true;
+  }
   onMessage(m) {
+    if (this.online && this.onFrontMessage(m)) return;
     if (m.op === "hello") {
+      if (this.online && !this.inTrial) this.trials++;
+      this.inTrial = true;
       this.half = m.half_width, this.steering = m.steering, this.ask = !!m.ask, this.askAfterMs = 1000 * (m.ask_after_hold_s ?? 1);
       this.drawn = [], this.trialOver = false, this.answering = -1;  // a new graph: a new trial (the page forgets the last one's question)
     } else if (m.op === "role") {
@@ -140,7 +176,7 @@ export class SimParticipant {
   }
   // The page's send(): at most one sample per 4 ms unless forced (a press, a release, the keepalive).
   send(force) {
-    if (this.ws?.readyState !== WebSocket.OPEN) return;
+    if (this.ws?.readyState !== WebSocket.OPEN || !this.inTrial) return;
     const now = performance.now();
     if (!force && now - this.lastSent < 4) return;
     this.lastSent = now;
@@ -167,6 +203,7 @@ export class SimParticipant {
   moveEvery(durationMs, at, done) {
     const t0 = performance.now();
     const step = () => {
+      if (!this.inTrial) { if (this.down) this.release(); return this.rest(); }  // --online: the trial ended (a hold is let go)
       const u = (this.speed * (performance.now() - t0)) / durationMs;
       this.cursor = at(Math.min(1, u));
       this.moved();
@@ -177,7 +214,8 @@ export class SimParticipant {
   }
   // Released: rests, then moves the pointer to the next primitive's start and draws it.
   rest() {
-    if (this.trialOver) return this.later(1000, () => this.rest());  // the trial is over: the person stops drawing
+    // The trial is over, or not begun (--online): the person does not draw.
+    if (this.trialOver || !this.inTrial) return this.later(1000, () => this.rest());
     const k = this.target >= 0 && this.target < this.prims.length ? this.target : Math.floor(this.r() * this.prims.length);
     const p = this.prims[k], ang = this.r.uniform(-0.08, 0.08), sc = this.r.uniform(0.9, 1.1);
     const off = [this.r.uniform(-3, 3), this.r.uniform(-3, 3)];
@@ -208,8 +246,9 @@ export class SimParticipant {
   }
   summary() {
     const s = this.stats;
+    const online = this.online ? { trials: this.trials, code: this.code, refused: this.refused, pongs: this.pongs } : {};
     return { sent: s.sent, acks: s.acks, rtt_median_ms: pct(s.rtts, 0.5), rtt_p99_ms: pct(s.rtts, 0.99), holds: s.holds, answers: s.answers,
-             closes: s.closes, errors: s.errors };
+             closes: s.closes, errors: s.errors, ...online };
   }
 }
 
@@ -228,8 +267,34 @@ export class ChromiumParticipant extends SimParticipant {
     this.context = await this.browser.newContext({ viewport: { width: 800, height: 800 } });
     this.page = await this.context.newPage();
     await this.page.goto(this.pageUrl);
+    if (this.online) return;  // the front's views first: poll() answers them
     await this.page.waitForFunction(() => document.getElementById("role").textContent === "you steer", null, { timeout: 20000 });
     await this.locate();
+  }
+  // --online: what the page shows, every 200 ms: its buttons pressed as the headless client
+  // answers the ops (consent: I agree; Ready 0.5 to 1.5 s later), a trial from the page steering to
+  // its not steering, the end (the code, or the refusal) read off the page.
+  async poll() {
+    const v = await this.page.evaluate(() => {
+      const on = (id) => document.getElementById(id).classList.contains("on"), el = (id) => document.getElementById(id);
+      return { consent: on("consent") && !el("agree").disabled, ready: on("waiting") && el("ready").textContent !== "" && !el("ready").disabled,
+               done: on("done") ? el("done-code").textContent : null, refused: final && !on("done") ? el("waiting").textContent : null,  // eslint-disable-line no-undef
+               steer: el("role").textContent === "you steer" };
+    });
+    if (v.steer && !this.inTrial) this.trials++, this.inTrial = true, this.then_(() => this.locate());
+    if (!v.steer) this.inTrial = false;
+    // A button gone before its click (its socket closed) is not an error: the front shows it again.
+    const click = (sel) => this.page.click(sel, { timeout: 2000 }).catch(() => {});
+    if (v.consent && !this.pending) this.pending = true, this.then_(() => click("#agree").finally(() => { this.pending = false; }));
+    if (v.ready && !this.pending) {
+      this.pending = true;
+      this.later(this.r.uniform(500, 1500), () => this.then_(() => click("#ready").finally(() => { this.pending = false; })));
+    }
+    if (v.done !== null || v.refused !== null) {
+      this.code = v.done, this.refused = v.refused, this.stopped = true;
+      return this.finish();
+    }
+    this.later(200 * this.speed, () => this.poll().catch((e) => { if (this.stats.errors.length < 5) this.stats.errors.push(String(e.message)); }));
   }
   async locate() {  // the workspace's place on the screen, and what the page said in its hello
     Object.assign(this, await this.page.evaluate(() => {
@@ -237,7 +302,7 @@ export class ChromiumParticipant extends SimParticipant {
       return { map: { x0: r.left + v.cx, y0: r.top + v.cy, scale: v.scale }, ask, steering, half: H };  // eslint-disable-line no-undef
     }));
   }
-  start() { this.rest(); }
+  start() { this.rest(); if (this.online) this.poll(); }
   async stop() {
     this.stopped = true;
     for (const t of this.timers) clearTimeout(t);
@@ -260,13 +325,14 @@ export class ChromiumParticipant extends SimParticipant {
   }
   summary() {
     const r = this.rtts ?? [];
+    const online = this.online ? { trials: this.trials, code: this.code, refused: this.refused } : {};
     return { chromium: true, acks: r.length, rtt_median_ms: pct(r, 0.5), rtt_p99_ms: pct(r, 0.99), holds: this.stats.holds,
-             answers: this.stats.answers, errors: this.stats.errors };
+             answers: this.stats.answers, errors: this.stats.errors, ...online };
   }
 }
 
 async function main(argv) {
-  const opts = { dataset: "", seconds: 30, reportError: 0.1, speed: 1, chromium: 0 };
+  const opts = { dataset: "", seconds: 30, reportError: 0.1, speed: 1, chromium: 0, online: false };
   const files = [];
   for (let i = 0; i < argv.length; i++) {
     if (argv[i] === "--dataset") opts.dataset = argv[++i];
@@ -274,10 +340,11 @@ async function main(argv) {
     else if (argv[i] === "--report-error") opts.reportError = Number(argv[++i]);
     else if (argv[i] === "--speed") opts.speed = Number(argv[++i]);
     else if (argv[i] === "--chromium") opts.chromium = Number(argv[++i]);
+    else if (argv[i] === "--online") opts.online = true;
     else files.push(argv[i]);
   }
   if (files.length !== 1 || !(opts.seconds > 0) || !(opts.reportError >= 0 && opts.reportError <= 1) || !(opts.speed > 0) || !Number.isInteger(opts.chromium) || opts.chromium < 0) {
-    console.error("usage: node sim_participant.mjs [--dataset DIR] [--seconds S > 0] [--report-error P in 0..1] [--speed F > 0] [--chromium K >= 0] SESSIONS_FILE");
+    console.error("usage: node sim_participant.mjs [--dataset DIR] [--seconds S > 0] [--report-error P in 0..1] [--speed F > 0] [--chromium K >= 0] [--online] SESSIONS_FILE");
     process.exit(2);
   }
   const prims = loadPrimitives(opts.dataset) ?? generatedPrimitives();
@@ -288,13 +355,17 @@ async function main(argv) {
   const people = lines.map((line, i) => {
     const [url, token] = line.trim().split(/\s+/);
     if (!/^https?:\/\//.test(url ?? "") || !token) throw new Error(`${files[0]}:${i + 1}: expected "URL TOKEN", got '${line}'`);
-    const o = { url, token, primitives: prims, seed: i + 1, reportError: opts.reportError, speed: opts.speed };
+    const o = { url, token, primitives: prims, seed: i + 1, reportError: opts.reportError, speed: opts.speed, online: opts.online };
     return i < opts.chromium ? new ChromiumParticipant(o, browser) : new SimParticipant(o);
   });
   for (const p of people) if (p.open) await p.open();
   const cpu0 = process.cpuUsage();
   people.forEach((p) => p.start());
-  await new Promise((r) => setTimeout(r, opts.seconds * 1000));
+  // --online: until each is done or refused (S seconds at most); else S seconds.
+  let timer;
+  const ended = opts.online ? Promise.all(people.map((p) => p.finished)) : new Promise(() => {});
+  await Promise.race([ended, new Promise((r) => { timer = setTimeout(r, opts.seconds * 1000); })]);
+  clearTimeout(timer);
   await Promise.all(people.map((p) => p.stop()));
   await browser?.close();
   await new Promise((r) => setTimeout(r, 200));
