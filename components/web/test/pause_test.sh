@@ -10,14 +10,13 @@ set -euo pipefail
 build=$1
 work=$2
 plugin=$3
-node_dir=$(cd "$(dirname "$0")" && pwd)/node
-if [ ! -d "$node_dir/node_modules" ]; then echo "SKIP: needs tools/setup.sh (npm ci in components/web/test/node)"; exit 77; fi
-fail() { echo "FAIL: $*" >&2; exit 1; }
-rm -rf "$work"; mkdir -p "$work"; cd "$work"
+source "$(dirname "$0")/../../../tests/support/web_test.sh"
+require_node
+fresh_dir "$work"
 cat > graph.yaml <<YAML
 graph: pause_test
 clock: wall
-domain_id: $(( 1 + $$ % 200 ))
+domain_id: $(test_domain)
 plugins: [$plugin]
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
@@ -33,13 +32,13 @@ components:
 YAML
 "$build/bin/dyad" run graph.yaml --duration 60 > run.out 2> run.err &
 pid=$!
-for _ in $(seq 300); do [ -s web.port ] && break; sleep 0.1; done  # 30 s: a cold start on a loaded machine
-[ -s web.port ] || { cat run.err; kill $pid; fail "web.port never written"; }
+wait_port_file web.port $pid 30  # a cold start on a loaded machine
 node "$node_dir/pause_client.mjs" "ws://127.0.0.1:$(cat web.port)/subject/ws?token=subject-token-000001" 2500 > client.json \
   || { kill $pid; cat run.err; fail "the client"; }
 kill -INT $pid
 wait $pid || true
-grep -q "paused 1 times without the subject's page" run.err || { cat run.err; fail "no pause counted at the end"; }
+# The client's last close may come before the graph's end: a second pause then.
+grep -qE "paused [12] times without the subject's page" run.err || { cat run.err; fail "no pause counted at the end"; }
 "$build/bin/dyad" bag export rec.mcap --csv csv > /dev/null
 python3 - csv <<'PY'
 import csv, os, sys
@@ -47,7 +46,9 @@ def fail(why): sys.exit("FAIL: " + why)
 def rows(name): return list(csv.DictReader(open(os.path.join(sys.argv[1], name))))
 notes = [(int(r["header.stamp_ns"]), r["author"], r["text"]) for r in rows("experiment_notes.csv")]
 want = [("web", "paused: the subject's page is gone"), ("web", "resumed: the subject's page is back")]
-if [n[1:] for n in notes] != want: fail("experiment/notes holds %s, want %s" % (notes, want))
+# A third mark, a pause, when the client's last close came before the graph's end.
+if [n[1:] for n in notes[:2]] != want or [n[1:] for n in notes[2:]] not in ([], want[:1]):
+    fail("experiment/notes holds %s, want %s (and maybe a last pause)" % (notes, want))
 paused, resumed = notes[0][0], notes[1][0]
 away = (resumed - paused) * 1e-9
 if not 2.0 <= away <= 4.5: fail("paused for %.2f s; the page was away 2.5 s" % away)
