@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <regex>
 #include <set>
+#include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
@@ -206,6 +208,34 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
   }
 }
 
+// The `online:` map (`dyad study serve`): its keys, each checked at its line; the consent text read.
+void ReadOnline(StrictYaml& y, const YAML::Node& root, const std::string& path, Study* s) {
+  const YAML::Node o = root["online"];
+  if (!o || !y.Map(o, "online", {"reconnect_s", "max_sessions", "completion_code", "consent"})) return;
+  Online& on = s->online;
+  if (y.Get(o, "reconnect_s", "online.reconnect_s", &on.reconnect_s, "a number of seconds") && !(on.reconnect_s > 0))
+    y.Error(o["reconnect_s"], "online.reconnect_s", "must be > 0 (how long a page gone mid-trial may take to come back)");
+  if (y.Get(o, "max_sessions", "online.max_sessions", &on.max_sessions, "an integer") && on.max_sessions < 1)
+    y.Error(o["max_sessions"], "online.max_sessions", "must be >= 1");
+  static const std::regex code("[A-Za-z0-9_-]{1,64}");
+  if (y.Get(o, "completion_code", "online.completion_code", &on.completion_code, "a code") &&
+      !std::regex_match(on.completion_code, code)) {
+    y.Error(o["completion_code"], "online.completion_code", "a code is 1-64 letters, digits, '_' and '-'");
+    on.completion_code.clear();
+  }
+  std::string consent;
+  if (!y.Get(o, "consent", "online.consent", &consent, "a path")) return;
+  const std::string file = tools::PathBeside(path, consent);
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in || text.str().find_first_not_of(" \t\r\n") == std::string::npos)
+    return y.Error(o["consent"], "online.consent",
+                   in ? file + " is empty: it holds the consent page's text" : "cannot read " + file);
+  on.consent = file;
+  on.consent_text = text.str();
+}
+
 // Labels A, B, ... in an order drawn from the study's name (the same on every machine).
 void GiveLabels(Study* s) {
   uint64_t h = tools::Fnv1a(s->name);
@@ -257,7 +287,7 @@ Study LoadStudy(const std::string& path, const std::vector<std::string>& plugins
   StrictYaml y(StrictYaml::InFile(path, {}), problems);
   if (!y.Map(root, "",
              {"study", "graph", "data", "participants", "conditions", "trials", "duration", "blind", "consent_required",
-              "self_reports", "recorder", "rehearsal", "task"}))
+              "self_reports", "recorder", "rehearsal", "task", "online"}))
     return s;
   ReadScalars(y, root, path, &s);
   ReadParticipants(y, root, &s);
@@ -265,6 +295,7 @@ Study LoadStudy(const std::string& path, const std::vector<std::string>& plugins
   if (root["task"]) ReadTask(y, root["task"], "task", &s.task);
   ReadConditions(y, root, plugins, &s, &bad_conditions);  // checked against the graph when it was found
   ReadRehearsal(y, root, path, plugins, bad_conditions, &s);
+  ReadOnline(y, root, path, &s);
   for (const Condition& c : s.conditions)
     if (c.task.any && s.subject_web.empty() && !s.graph.empty()) {
       y.Error(root["task"] ? root["task"] : root["conditions"], "task",

@@ -17,6 +17,12 @@
 //   rehearsal:                           # `dyad study rehearse`: synthetic participants instead of people
 //     graph: ../demo.yaml                # the graph they are run on, stepped (default: the study's graph)
 //     set: {human.self_report_error: 0.2}   # its own overrides, under each condition's
+//   online:                              # `dyad study serve` (docs/study.md, "A study online")
+//     reconnect_s: 60                    # a page gone mid-trial may come back this long (default 60, > 0)
+//     max_sessions: 16                   # live sessions at once (default 16, >= 1; --max-sessions overrides)
+//     completion_code: C1A2B3            # one code for everyone (letters, digits, _ -; default: one each)
+//     consent: consent.txt               # the consent page's text, relative to this file (required
+//                                        # to serve a study with consent_required)
 //
 // Contract of LoadStudy:
 //   - Every problem of the file at once, each "file:line:col: key: message": unknown keys, wrong
@@ -56,6 +62,15 @@ struct Trial {
   std::string file;    // the recording: DATA/PARTICIPANT/NN-CONDITION.mcap (the label when blind)
 };
 
+// The `online:` map: what `dyad study serve` needs beyond the lab's keys.
+struct Online {
+  double reconnect_s = 60;      // > 0
+  int max_sessions = 16;        // >= 1
+  std::string completion_code;  // empty: a random code per participant (OnlineSession makes it)
+  std::string consent;          // the consent text's file, absolute; empty: none given
+  std::string consent_text;     // its text (read by LoadStudy: not empty)
+};
+
 struct Study {
   std::string name, file, graph, data;  // graph and data absolute
   std::vector<std::string> participants;
@@ -75,6 +90,7 @@ struct Study {
   int subject_port = 8765;            // its params.port (the web component's default)
   std::string rehearsal_graph;        // absolute; the study's graph unless the file names another
   std::vector<std::string> rehearsal_sets;
+  Online online;
   int square_rows = 1;  // rows of the Latin square: participants in multiples of it are balanced
 
   // The trials of `participant` (one of `participants`) in their order.

@@ -77,6 +77,7 @@ std::vector<std::string> RunSets(const Study& s, const AttemptRequest& r) {
   if (!s.subject_web.empty() && r.subject_port > 0) sets.push_back(s.subject_web + ".port=" + std::to_string(r.subject_port));
   if (!s.subject_web.empty() && r.wait_for_subject_s > 0)
     sets.push_back(s.subject_web + ".wait_for_subject_s=" + tools::SetText(YAML::Node(r.wait_for_subject_s)));
+  sets.insert(sets.end(), r.serve_sets.begin(), r.serve_sets.end());
   return sets;
 }
 
@@ -365,6 +366,37 @@ std::vector<std::string> AttemptCommand(const Study& s, const AttemptRequest& r)
   return args;
 }
 
+namespace {
+
+// How attempt `a` ended, from its graph's end (`stopped`: a stop was forwarded to it, the first
+// `first_stop_s` after it started) and its recording; the caller's reason may make it incomplete.
+void SetOutcome(const Study& s, const AttemptRequest& r, const tools::ExitStatus& exit, bool stopped, double first_stop_s,
+                Attempt* out) {
+  Attempt& a = *out;
+  a.exit = exit.ShellCode();
+  a.ended = exit.ToString();
+  // A trial without a duration ends when the experimenter stops it; a timed one stopped early is
+  // stopped, unless the subject was answering after a full trial (the graph's start-up, a second
+  // or two, counts in first_stop_s: a stop that much before the end counts too). A recording cut
+  // short (a crash, a second stop) is never complete (attempt_end.hpp).
+  const bool asking = !r.rehearsal && AskedAfterTrial(s) && first_stop_s >= s.duration_s;
+  a.outcome = ClassifyGraphEnd({exit, stopped, s.duration_s > 0, asking});
+  if (a.outcome == AttemptOutcome::kComplete) {
+    bool whole = false;
+    if (auto recording = mcap::Reader::Open(a.file); recording.ok()) whole = !recording->recovery().truncated;
+    const std::string no_subject = whole ? NoSubject(a.file) : "";
+    a.outcome = ClassifyRecording(whole, no_subject);
+    if (a.outcome == AttemptOutcome::kIncomplete) a.incomplete = no_subject;
+  }
+  const std::string reason = r.incomplete_reason ? r.incomplete_reason() : "";
+  if (!reason.empty() && (a.outcome == AttemptOutcome::kComplete || a.outcome == AttemptOutcome::kStopped)) {
+    a.outcome = AttemptOutcome::kIncomplete;
+    a.incomplete = reason;
+  }
+}
+
+}  // namespace
+
 StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   const std::string who = r.participant + " trial " + std::to_string(r.trial.number);
   const Session session = ReadSession(s, r.participant);
@@ -394,7 +426,8 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   double first_stop_s = 0;  // when the first was sent, from the graph's start
   tools::ExitStatus exit;   // how the graph ended
   {
-    StopSignals signals;
+    std::optional<StopSignals> signals;
+    if (r.own_signals) signals.emplace();
     tools::ChildOptions options;
     options.log = r.run_log;
     options.own_group = true;
@@ -404,7 +437,7 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
     // its last chunk; a graph still there kStopGrace after it is killed, with its process group.
     std::optional<tools::ExitStatus> end;
     while (!(end = graph.Poll())) {
-      const int signals_now = g_stop_signals.load();
+      const int signals_now = r.own_signals ? g_stop_signals.load() : 0;
       const int wanted = std::min(2, signals_now + (r.stop && r.stop->load() ? 1 : 0));
       a.interrupted = a.interrupted || signals_now > 0;
       if (forwarded == 0 && wanted > 0) first_stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -417,22 +450,8 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
     }
     exit = *end;
   }
-  a.exit = exit.ShellCode();
-  a.ended = exit.ToString();
   a.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // A trial without a duration ends when the experimenter stops it; a timed one stopped early is
-  // stopped, unless the subject was answering after a full trial (the graph's start-up, a second
-  // or two, counts in first_stop_s: a stop that much before the end counts too). A recording cut
-  // short (a crash, a second stop) is never complete (attempt_end.hpp).
-  const bool asking = !r.rehearsal && AskedAfterTrial(s) && first_stop_s >= s.duration_s;
-  a.outcome = ClassifyGraphEnd({exit, forwarded > 0, s.duration_s > 0, asking});
-  if (a.outcome == AttemptOutcome::kComplete) {
-    bool whole = false;
-    if (auto recording = mcap::Reader::Open(a.file); recording.ok()) whole = !recording->recovery().truncated;
-    const std::string no_subject = whole ? NoSubject(a.file) : "";
-    a.outcome = ClassifyRecording(whole, no_subject);
-    if (a.outcome == AttemptOutcome::kIncomplete) a.incomplete = no_subject;
-  }
+  SetOutcome(s, r, exit, forwarded > 0, first_stop_s, &a);
   Json end = {{"event", "end"},
               {"trial", a.trial},
               {"attempt", a.attempt},

@@ -18,7 +18,7 @@
 // Each line is on disk (fdatasync, and the folder's entry when the log is new) before the call
 // that wrote it returns: a trial never starts on a consent a power cut could lose.
 // outcome: one word of AttemptOutcome (attempt_outcome.hpp says what each means); with
-// incomplete, "incomplete" says why (NoSubject). A start without its end: the session itself
+// incomplete, "incomplete" says why (NoSubject, or the caller's incomplete_reason). A start without its end: the session itself
 // ended mid-trial ("interrupted", AttemptOutcome::kUnended).
 //
 // Contract:
@@ -56,6 +56,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -125,6 +126,16 @@ struct AttemptRequest {
   int subject_port = 0;
   double wait_for_subject_s = 0;
   bool start_anyway = false;  // started without the subject's page: the start line says so
+  // Set: asked once the graph has ended; a reason ("" for none) makes an attempt that ended
+  // stopped or complete incomplete, with that reason (`dyad study serve`: "the participant's
+  // connection was lost for more than 60 s"). A failed attempt stays failed.
+  std::function<std::string()> incomplete_reason;
+  // False: SIGINT and SIGTERM are the caller's, who stops the trial through `stop` (`dyad study
+  // serve` runs several attempts at once; their handlers would overwrite each other).
+  bool own_signals = true;
+  // After every other override and outside the graph hash: how the trial is served, not what it
+  // is (`dyad study serve`: the subject's web component on loopback, paused without its page).
+  std::vector<std::string> serve_sets;
 };
 
 // Why a trial's whole recording is no data ("" when someone took part): its graph has a subject's

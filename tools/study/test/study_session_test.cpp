@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -15,6 +16,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -312,6 +314,42 @@ TEST_F(StudySession, AStoppedOrKilledTrialIsIncompleteAndItsRecordingStaysReadab
                               "): incomplete (attempt 1 stopped; attempt 2 interrupted (the session ended during it), repeated because: stopped by mistake)");
 }
 
+// `dyad study serve`'s hook: a trial its caller stopped (the participant's page gone too long)
+// ends incomplete with the caller's reason, in the log and in the analysis, which leaves it out.
+TEST_F(StudySession, ACallersIncompleteReasonMakesAStoppedTrialIncomplete) {
+  const Study s = Make("wall", 30);
+  const auto trials = s.TrialsOf("P01");
+  ASSERT_TRUE(MarkConsent(s, "P01", "test").ok());
+  std::atomic<bool> stop{false};
+  AttemptRequest r;
+  r.dyad = DYAD_EXE;
+  r.participant = "P01";
+  r.trial = trials[0];
+  r.stop = &stop;
+  r.own_signals = false;
+  r.run_log = (dir_ / "run.log").string();
+  r.incomplete_reason = [] { return std::string("the participant's connection was lost for more than 5 s"); };
+  std::thread stopper([&] {
+    for (int i = 0; i < 3000 && !fs::exists(trials[0].file); ++i) usleep(10000);
+    usleep(1'000'000);
+    stop.store(true);
+  });
+  auto a = RunAttempt(s, r);
+  stopper.join();
+  ASSERT_TRUE(a.ok()) << a.status().message();
+  EXPECT_EQ(a->outcome, AttemptOutcome::kIncomplete);
+  EXPECT_EQ(a->incomplete, "the participant's connection was lost for more than 5 s");
+  const auto log = LogLines(SessionLogPath(s, "P01"));
+  ASSERT_EQ(log.size(), 3u);
+  EXPECT_EQ(log[2]["outcome"], "incomplete");
+  EXPECT_EQ(log[2]["incomplete"], "the participant's connection was lost for more than 5 s");
+  const StudyAnalysis analysis = AnalyzeStudy(s, std::cerr);
+  // Analysed and marked incomplete with the reason: left out of the summary unless --include-incomplete.
+  const auto analysed = std::find_if(analysis.trials.begin(), analysis.trials.end(),
+                                     [](const TrialResult& t) { return t.participant == "P01" && t.trial.number == 1; });
+  ASSERT_NE(analysed, analysis.trials.end());
+  EXPECT_FALSE(analysed->incomplete.empty()) << "counted in the summary";
+}
 
 // The experimenter's notes, a participant excluded (and included again) by the researcher, and
 // one who withdraws consent with their data deleted: all in the session log, the analysis leaves

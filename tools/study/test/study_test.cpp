@@ -159,6 +159,44 @@ TEST_F(StudyFile, BadRecorderRehearsalAndSelfReportsAreSaidAtTheirLine) {
   }
 }
 
+// The `online:` map of `dyad study serve`: its defaults, its values read, and each bad one at its line.
+TEST_F(StudyFile, OnlineKeysAreReadAndEachBadOneIsSaidAtItsLine) {
+  const std::string head = "study: gain\ngraph: g.yaml\nparticipants: [P01]\nconditions:\n  low: {src.start: 1}\n";
+  std::vector<Diagnostic> problems;
+  const Study defaults = LoadStudy(Write(head), {}, &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  EXPECT_EQ(defaults.online.reconnect_s, 60);
+  EXPECT_EQ(defaults.online.max_sessions, 16);
+  EXPECT_EQ(defaults.online.completion_code, "");
+  EXPECT_EQ(defaults.online.consent, "");
+  std::ofstream(dir_ / "consent.txt") << "I agree to take part.\n";
+  const Study s = LoadStudy(
+      Write(head + "online:\n  reconnect_s: 5\n  max_sessions: 3\n  completion_code: C0DE-42\n  consent: consent.txt\n"), {},
+      &problems);
+  ASSERT_TRUE(problems.empty()) << problems.front().ToString();
+  EXPECT_EQ(s.online.reconnect_s, 5);
+  EXPECT_EQ(s.online.max_sessions, 3);
+  EXPECT_EQ(s.online.completion_code, "C0DE-42");
+  EXPECT_EQ(s.online.consent, (dir_ / "consent.txt").string());
+  EXPECT_EQ(s.online.consent_text, "I agree to take part.\n");
+  std::ofstream(dir_ / "empty.txt") << "  \n";
+  for (const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"online:\n  reconnect_s: 0\n", "s.yaml:7:16: online.reconnect_s: must be > 0"},
+           {"online:\n  reconnect_s: soon\n", "s.yaml:7:16: online.reconnect_s: must be a number of seconds, got 'soon'"},
+           {"online:\n  max_sessions: 0\n", "s.yaml:7:17: online.max_sessions: must be >= 1"},
+           {"online:\n  completion_code: a b\n", "s.yaml:7:20: online.completion_code: a code is 1-64 letters, digits"},
+           {"online:\n  consent: missing.txt\n", "s.yaml:7:12: online.consent: cannot read " + (dir_ / "missing.txt").string()},
+           {"online:\n  consent: empty.txt\n", "s.yaml:7:12: online.consent: " + (dir_ / "empty.txt").string() + " is empty"},
+           {"online:\n  colour: blue\n", "s.yaml:7:3: online.colour: unknown key"},
+           {"online: 3\n", "s.yaml:6:9: online: must be a mapping"}}) {
+    problems.clear();
+    LoadStudy(Write(head + text), {}, &problems);
+    std::string all;
+    for (const auto& p : problems) all += p.ToString() + "\n";
+    EXPECT_NE(all.find(expected), std::string::npos) << "no '" << expected << "' in\n" << all;
+  }
+}
+
 // `dyad study plan s.yaml` in the file's own folder: a bare file name has no parent folder (it
 // used to throw from std::filesystem::absolute("")).
 TEST_F(StudyFile, AFileNamedWithoutItsFolderIsReadInTheWorkingFolder) {
