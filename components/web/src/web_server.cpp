@@ -416,6 +416,17 @@ void WakeListener(const std::string& address, int port) {
 }
 
 WebServer::~WebServer() {
+  // Every client's socket shut down first: its worker, polling 2 s at a time, sees the end at
+  // once (mg_stop alone waited up to 2 s for each connected WebSocket's worker).
+  std::vector<std::shared_ptr<Client>> open;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [id, c] : clients_) open.push_back(c);
+  }
+  for (const auto& c : open) {
+    std::lock_guard<std::mutex> write(c->write_mutex);
+    if (!c->closed) Disconnect(*c);
+  }
   if (ctx_ != nullptr) {
     std::atomic<bool> stopped{false};
     std::thread waker([&] {

@@ -237,6 +237,60 @@ TEST(WebServer, AnAdmitCallbackDecidesPagesAndWebSocketsAndNamesTheClient) {
   EXPECT_EQ((*server)->remote_address(client), "");
 }
 
+// Reads one unmasked server frame from `fd`: its opcode and payload (-1 when the link ended).
+int ReadFrame(int fd, std::string* buffer, std::string* payload) {
+  char chunk[4096];
+  for (;;) {
+    if (buffer->size() >= 2) {
+      const auto* b = reinterpret_cast<const unsigned char*>(buffer->data());
+      size_t length = b[1] & 0x7f, head = 2;
+      if (length == 126 && buffer->size() >= 4) length = (size_t{b[2]} << 8) | b[3], head = 4;
+      if (length < 126 || head == 4) {
+        if (buffer->size() >= head + length) {
+          *payload = buffer->substr(head, length);
+          const int opcode = b[0] & 0x0f;
+          buffer->erase(0, head + length);
+          return opcode;
+        }
+      }
+    }
+    const ssize_t n = recv(fd, chunk, sizeof(chunk), 0);
+    if (n <= 0) return -1;
+    buffer->append(chunk, static_cast<size_t>(n));
+  }
+}
+
+// Close(): the frames queued before it, then a close frame with the code and reason, then the
+// end of the connection (OnClose); frames queued after it are not sent.
+TEST(WebServer, CloseSendsWhatWasQueuedThenTheCodeAndReason) {
+  RecordingHandler handler;
+  auto server = WebServer::Start(TestOptions(&handler));
+  ASSERT_TRUE(server.ok()) << server.status().ToString();
+  const int fd = Connect((*server)->port());
+  std::string buffer = Exchange(fd, Upgrade("/ws?token=" + kSubject));
+  ASSERT_NE(buffer.find("101 Switching Protocols"), std::string::npos);
+  buffer.erase(0, buffer.find("\r\n\r\n") + 4);
+  ASSERT_TRUE(WaitFor([&] { return handler.opens == 1; }, std::chrono::seconds(5)));
+  const ClientId client = handler.last_client;
+  (*server)->SendText(client, "{\"op\":\"refused\"}");
+  (*server)->SendData(client, 3, "data");
+  (*server)->Close(client, 1012, "the phase changed");
+  (*server)->SendText(client, "too late");
+  std::string payload;
+  EXPECT_EQ(ReadFrame(fd, &buffer, &payload), 0x1);
+  EXPECT_EQ(payload, "{\"op\":\"refused\"}");
+  EXPECT_EQ(ReadFrame(fd, &buffer, &payload), 0x2);
+  EXPECT_EQ(payload, "data");
+  ASSERT_EQ(ReadFrame(fd, &buffer, &payload), 0x8);
+  ASSERT_GE(payload.size(), 2u);
+  EXPECT_EQ((static_cast<unsigned char>(payload[0]) << 8) | static_cast<unsigned char>(payload[1]), 1012);
+  EXPECT_EQ(payload.substr(2), "the phase changed");
+  EXPECT_EQ(ReadFrame(fd, &buffer, &payload), -1) << "nothing after the close frame";
+  EXPECT_TRUE(WaitFor([&] { return handler.closes == 1; }, std::chrono::seconds(5)));
+  (*server)->Close(client, 1000, "gone already");  // nothing
+  close(fd);
+}
+
 TEST(WebServer, TokensMustBeGivenAndDistinct) {
   RecordingHandler handler;
   WebServer::Options o = TestOptions(&handler);

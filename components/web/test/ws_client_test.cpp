@@ -12,6 +12,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <map>
 #include <mutex>
 #include <thread>
 
@@ -219,6 +220,233 @@ TEST(WsClient, TheServerClosingRunsOnCloseOnceAfterTheQueuedFrames) {
   (*client)->Close();
   EXPECT_EQ(inbox.Closes(), 1);
   EXPECT_TRUE(server->clients().empty());
+}
+
+// A server that listens but never answers: the handshake's wait ends at the timeout.
+TEST(WsClient, AServerThatNeverAnswersTimesOut) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)), 0);
+  ASSERT_EQ(listen(fd, 4), 0);  // the kernel completes connections; nobody reads them
+  socklen_t len = sizeof(a);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  Inbox inbox;
+  const auto start = std::chrono::steady_clock::now();
+  auto client = WsClient::Connect("127.0.0.1", ntohs(a.sin_port), "/ws", inbox.Callbacks(), milliseconds(300));
+  const auto took = std::chrono::steady_clock::now() - start;
+  close(fd);
+  ASSERT_FALSE(client.ok());
+  EXPECT_EQ(client.status().code(), Status::Code::kIOError) << client.status().ToString();
+  EXPECT_GE(took, milliseconds(250));
+  EXPECT_LT(took, seconds(5)) << "the timeout was not kept";
+}
+
+// The peer's process going away (its sockets closed, no close frame): on_close, once.
+TEST(WsClient, APeerThatGoesAwayRunsOnCloseOnce) {
+  EchoHandler handler;
+  auto server = StartEcho(&handler, EchoOptions(&handler));
+  ASSERT_NE(server, nullptr);
+  Inbox inbox;
+  auto client = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, inbox.Callbacks(), seconds(5));
+  ASSERT_TRUE(client.ok()) << client.status().ToString();
+  ASSERT_EQ(inbox.Next(), "hello");
+  server.reset();
+  ASSERT_TRUE(inbox.WaitClosed());
+  EXPECT_NE((*client)->SendText("anyone?").code(), Status::Code::kOk);
+  (*client)->Close();
+  EXPECT_EQ(inbox.Closes(), 1);
+}
+
+// Close() from another thread while the server floods the client and the client sends: once it
+// returns, no callback runs (checked over many rounds, each closing at a different moment), and
+// a SendText racing it fails cleanly.
+TEST(WsClient, CloseFromAnotherThreadWhileFramesFlowEndsEveryCallback) {
+  EchoHandler handler;
+  auto server = StartEcho(&handler, EchoOptions(&handler));
+  ASSERT_NE(server, nullptr);
+  for (int round = 0; round < 20; ++round) {
+    std::atomic<bool> returned{false};
+    std::atomic<int> received{0}, late{0}, closes{0};
+    WsClient::Callbacks callbacks{[&](std::string_view) {
+                                    if (returned) ++late;
+                                    ++received;
+                                  },
+                                  [&] { ++closes; }};  // the server never closes here
+    auto client = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, std::move(callbacks), seconds(5));
+    ASSERT_TRUE(client.ok()) << client.status().ToString();
+    ASSERT_TRUE(Eventually([&] { return handler.Opened() == static_cast<size_t>(round + 1); }));
+    const ClientId id = handler.Last();
+    std::atomic<bool> stop{false};
+    // Paced (about 10k frames/s each way): a flood faster than the link would outgrow the
+    // server's buffer for control frames, which disconnects the client (another test's case).
+    std::thread flood([&] {
+      for (int i = 0; !stop; ++i) {
+        server->SendText(id, std::string(100, 'f'));
+        if (i % 10 == 0) std::this_thread::sleep_for(milliseconds(1));
+      }
+    });
+    std::thread sender([&] {
+      for (int i = 0; !stop; ++i) {
+        (void)(*client)->SendText("x");  // errors once closed: expected
+        if (i % 10 == 0) std::this_thread::sleep_for(milliseconds(1));
+      }
+    });
+    ASSERT_TRUE(Eventually([&] { return received > 10 + round * 5; }));
+    (*client)->Close();
+    returned = true;
+    std::this_thread::sleep_for(milliseconds(20));
+    stop = true;
+    flood.join();
+    sender.join();
+    EXPECT_EQ(late, 0) << "round " << round << ": on_text ran after Close() returned";
+    EXPECT_EQ(closes, 0) << "round " << round << ": on_close ran (after Close(), or the server dropped the client)";
+    EXPECT_EQ((*client)->SendText("after").code(), Status::Code::kFailedPrecondition);
+    client->reset();
+    ASSERT_TRUE(Eventually([&] { return handler.closes == round + 1; })) << "round " << round;
+  }
+}
+
+// Closing and destroying a client inside its own callbacks (the relay does both).
+TEST(WsClient, ACallbackMayCloseOrDestroyItsOwnClient) {
+  EchoHandler handler;
+  auto server = StartEcho(&handler, EchoOptions(&handler));
+  ASSERT_NE(server, nullptr);
+  std::unique_ptr<WsClient> client;
+  std::mutex mutex;
+  std::atomic<int> texts{0}, closes{0};
+  WsClient::Callbacks closes_itself{[&](std::string_view) {
+                                      ++texts;
+                                      client->Close();  // on the client's own thread
+                                    },
+                                    [&] { ++closes; }};
+  auto c = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, std::move(closes_itself), seconds(5));
+  ASSERT_TRUE(c.ok()) << c.status().ToString();
+  client = std::move(*c);
+  server->SendText(handler.Last(), "more");
+  ASSERT_TRUE(Eventually([&] { return handler.closes == 1; })) << "the server saw the close";
+  EXPECT_EQ(texts, 1) << "nothing after the callback that closed it";
+  EXPECT_EQ(closes, 0);
+  client.reset();
+
+  std::atomic<bool> destroyed{false};
+  WsClient::Callbacks destroys_itself{nullptr, [&] {
+                                        std::lock_guard<std::mutex> lock(mutex);
+                                        client.reset();  // ~WsClient on the client's own thread
+                                        destroyed = true;
+                                      }};
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    c = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, std::move(destroys_itself), seconds(5));
+    ASSERT_TRUE(c.ok()) << c.status().ToString();
+    client = std::move(*c);
+  }
+  ASSERT_TRUE(Eventually([&] { return handler.Opened() == 2; }));
+  server->Close(handler.Last(), 1012, "the phase changed");
+  ASSERT_TRUE(Eventually([&] { return destroyed.load(); }));
+  std::lock_guard<std::mutex> lock(mutex);
+  EXPECT_EQ(client, nullptr);
+}
+
+// Frames at the server's max_frame_bytes pass; one byte more and the server ends the link
+// (1009), which the client hears as on_close. A large frame from the server arrives whole.
+TEST(WsClient, FramesUpToTheServersLimitPassAndLargerOnesEndTheLink) {
+  EchoHandler handler;
+  WebServer::Options o = EchoOptions(&handler);
+  o.max_frame_bytes = 256 << 10;
+  auto server = StartEcho(&handler, o);
+  ASSERT_NE(server, nullptr);
+  Inbox inbox;
+  auto client = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, inbox.Callbacks(), seconds(5));
+  ASSERT_TRUE(client.ok()) << client.status().ToString();
+  ASSERT_EQ(inbox.Next(), "hello");
+  const std::string at_limit(o.max_frame_bytes, 'a');
+  ASSERT_TRUE((*client)->SendText(at_limit).ok());
+  EXPECT_EQ(inbox.Next(), "echo:" + at_limit);
+  const std::string big(3 << 20, 'b');  // server -> client: past the server's own receive limit
+  server->SendText(handler.Last(), big);
+  EXPECT_EQ(inbox.Next(), big);
+  ASSERT_TRUE((*client)->SendText(at_limit + "!").ok());
+  ASSERT_TRUE(inbox.WaitClosed()) << "the server kept a client whose frame exceeded its limit";
+  EXPECT_EQ(handler.texts, 1);
+  EXPECT_TRUE(Eventually([&] { return handler.closes == 1; }));
+}
+
+// The relay's shape (dyad study serve): a page connects to the front; the front connects a
+// WsClient to the graph's server and relays text both ways; either side leaving ends the other.
+class Relay final : public ClientHandler {
+ public:
+  void OnOpen(ClientId page, Role) override {
+    WsClient::Callbacks up{[this, page](std::string_view text) { front->SendText(page, std::string(text)); },
+                           [this, page] { front->Close(page, 1012, "the trial's page is gone"); }};
+    auto c = WsClient::Connect("127.0.0.1", graph_port, "/ws?token=" + kToken, std::move(up), seconds(5));
+    std::lock_guard<std::mutex> lock(mutex);
+    if (c.ok()) upstream[page] = std::move(*c);
+    else errors.push_back(c.status().ToString());
+  }
+  Status OnText(ClientId page, std::string_view text) override {
+    std::lock_guard<std::mutex> lock(mutex);
+    auto it = upstream.find(page);
+    return it == upstream.end() ? Status::FailedPrecondition("no upstream") : it->second->SendText(text);
+  }
+  Status OnBinary(ClientId, std::span<const uint8_t>) override { return Status::OK(); }
+  void OnClose(ClientId page) override {
+    std::unique_ptr<WsClient> up;
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      auto it = upstream.find(page);
+      if (it == upstream.end()) return;
+      up = std::move(it->second);
+      upstream.erase(it);
+    }
+    up.reset();  // outside the lock: Close() waits for a callback that may want it
+  }
+  WebServer* front = nullptr;
+  int graph_port = 0;
+  std::mutex mutex;
+  std::map<ClientId, std::unique_ptr<WsClient>> upstream;
+  std::vector<std::string> errors;
+};
+
+TEST(WsClient, RelaysAPageThroughOneServerToAnother) {
+  EchoHandler graph_handler;
+  auto graph = StartEcho(&graph_handler, EchoOptions(&graph_handler));
+  ASSERT_NE(graph, nullptr);
+  Relay relay;
+  relay.graph_port = graph->port();
+  WebServer::Options fo;
+  fo.port = 0;
+  fo.admit = [](std::string_view token, std::string_view) -> std::variant<Admission, Refusal> {
+    if (token == kToken) return Admission{Role::kSubject, "P01"};
+    return Refusal{404, "unknown link\n"};
+  };
+  fo.endpoints = {WebServer::Endpoint{"/ws", {}, &relay, {Role::kSubject}, false}};
+  auto front = WebServer::Start(fo);
+  ASSERT_TRUE(front.ok()) << front.status().ToString();
+  relay.front = front->get();
+
+  Inbox page;
+  auto client = WsClient::Connect("127.0.0.1", (*front)->port(), "/ws?token=" + kToken, page.Callbacks(), seconds(5));
+  ASSERT_TRUE(client.ok()) << client.status().ToString();
+  EXPECT_EQ(page.Next(), "hello") << "the graph's first frame, relayed";
+  for (int i = 0; i < 50; ++i) ASSERT_TRUE((*client)->SendText("p" + std::to_string(i)).ok());
+  for (int i = 0; i < 50; ++i) ASSERT_EQ(page.Next(), "echo:p" + std::to_string(i)) << "in order, both ways";
+  (*client)->Close();
+  EXPECT_TRUE(Eventually([&] { return graph_handler.closes == 1; })) << "the page leaving ends the upstream";
+
+  Inbox second;
+  client = WsClient::Connect("127.0.0.1", (*front)->port(), "/ws?token=" + kToken, second.Callbacks(), seconds(5));
+  ASSERT_TRUE(client.ok()) << client.status().ToString();
+  ASSERT_EQ(second.Next(), "hello");
+  graph->Close(graph_handler.Last(), 1001, "the trial ended");
+  EXPECT_TRUE(second.WaitClosed()) << "the graph leaving ends the page's link";
+  EXPECT_TRUE(Eventually([&] {
+    std::lock_guard<std::mutex> lock(relay.mutex);
+    return relay.upstream.empty();
+  }));
+  std::lock_guard<std::mutex> lock(relay.mutex);
+  EXPECT_TRUE(relay.errors.empty()) << relay.errors.front();
 }
 
 }  // namespace
