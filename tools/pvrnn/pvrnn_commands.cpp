@@ -23,6 +23,7 @@
 #include "dyad/pvrnn/error_regression.hpp"
 #include "dyad/pvrnn/model_file.hpp"
 #include "dyad/pvrnn/nrl_import.hpp"
+#include "dyad/pvrnn/nrl_trainer.hpp"
 #include "dyad/pvrnn/prior_generator.hpp"
 #include "dyad/pvrnn/train_config.hpp"
 #include "dyad/pvrnn/trainer.hpp"
@@ -168,6 +169,56 @@ ExitCode RunTraining(const TrainConfig& c, const std::string& config_path, const
   return kOk;
 }
 
+// `prior: nrl`: NRL's training (NrlTrainer) from NRL's initial state, in one run (no checkpoints,
+// no --resume); the log's reconstruction_p is left empty (NRL's RE_P is not computed).
+ExitCode RunNrlTraining(const TrainConfig& c, const std::string& config_path, const Dataset& data, bool resume) {
+  if (resume)
+    return Fail(kBadInput, "--resume: " + config_path + " has prior: nrl, which trains in one run from NRL's initial state");
+  NrlTrainerOptions opts;
+  opts.adam = c.adam;
+  opts.noise = c.noise;
+  opts.seed = c.seed;
+  auto made = NrlTrainer::Create(NrlTrainer::InitialModel(c.spec, data.steps(), data.size()), data, opts);
+  if (!made.ok()) return Fail(kBadInput, made.status().message());
+  NrlTrainer& trainer = *made.value();
+  std::ofstream csv;
+  if (ExitCode code = OpenTrainingLog(c, false, &csv); code != kOk) return code;
+  std::printf("training %s (%d sequences x %d steps) NRL's way (prior: nrl) for %lld epochs, noise %s, seed %llu\n",
+              c.dataset.c_str(), data.size(), data.steps(), static_cast<long long>(c.epochs), c.noise ? "on" : "off",
+              static_cast<unsigned long long>(c.seed));
+  InterruptWatcher interrupt;  // Ctrl-C: the model so far is written and the run stops
+  const auto t0 = Clock::now();
+  LossTerms l;
+  while (trainer.epoch() < c.epochs && !interrupt.interrupted()) {
+    l = trainer.Epoch();
+    const int64_t e = trainer.epoch();
+    if (!std::isfinite(l.loss))
+      return Fail(kFailure, "training diverged at epoch " + std::to_string(e) + " (loss " + std::to_string(l.loss) + ")");
+    if (e % c.log_every != 0 && e != c.epochs) continue;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - t0).count();
+    std::printf("epoch %lld/%lld  RE_Q %.4g  Regulation %.4g  loss %.4g  %.3f ms/epoch\n", static_cast<long long>(e),
+                static_cast<long long>(c.epochs), l.reconstruction, l.regulation, l.loss, 1e3 * elapsed / static_cast<double>(e));
+    std::fflush(stdout);
+    using tools::CsvNumber;
+    csv << e << ',' << CsvNumber(l.reconstruction) << ",," << CsvNumber(l.regulation) << ',' << CsvNumber(l.loss);
+    for (double kl : l.kl_per_layer) csv << ',' << CsvNumber(kl);
+    csv << ',' << CsvNumber(elapsed) << '\n';
+    csv.flush();
+  }
+  Model m = trainer.Snapshot();
+  m.provenance.source = "dyad train " + config_path + " (prior: nrl)";
+  m.provenance.dataset = c.dataset;
+  m.provenance.seed = c.seed;
+  m.provenance.scalar = "float";
+  m.provenance.final_loss = l.loss;
+  m.provenance.final_reconstruction = l.reconstruction;
+  m.provenance.final_regulation = l.regulation;
+  if (Status s = SaveModel(m, c.output); !s.ok()) return Fail(kFailure, s.message());
+  std::printf("%s: %lld epochs, loss %.4f; model written to %s\n", interrupt.interrupted() ? "interrupted" : "done",
+              static_cast<long long>(trainer.epoch()), l.loss, c.output.c_str());
+  return interrupt.interrupted() ? tools::ForSignal(interrupt.signal()) : kOk;
+}
+
 ExitCode Train(const std::string& config_path, bool resume, const std::vector<std::string>& sets) {
   auto c = LoadTrainConfig(config_path, sets);
   if (!c.ok()) return Fail(kBadInput, c.status().message());
@@ -178,6 +229,7 @@ ExitCode Train(const std::string& config_path, bool resume, const std::vector<st
   if (data->dofs() != c->spec.num_dofs())
     return Fail(kBadInput, config_path + ": encoding.dofs lists " + std::to_string(c->spec.num_dofs()) +
                                " DOFs, the data set " + c->dataset + " has " + std::to_string(data->dofs()));
+  if (c->prior == "nrl") return RunNrlTraining(c.value(), config_path, data.value(), resume);
   return c->scalar == "double" ? RunTraining<double>(c.value(), config_path, data.value(), resume)
                                : RunTraining<float>(c.value(), config_path, data.value(), resume);
 }

@@ -188,8 +188,9 @@ void ReadAdam(StrictYaml& r, const YAML::Node& root, AdamOptions* adam) {
 
 TrainConfig Read(StrictYaml& r, const std::string& file, const YAML::Node& root) {
   TrainConfig c;
-  if (!r.Map(root, "", {"dataset", "loops", "layers", "encoding", "epochs", "adam", "seed", "scalar", "noise",
-                        "threads", "log_every", "checkpoint_every", "output", "checkpoint", "log_csv"}))
+  if (!r.Map(root, "",
+             {"dataset", "loops", "layers", "encoding", "epochs", "adam", "seed", "scalar", "noise", "prior", "threads",
+              "log_every", "checkpoint_every", "output", "checkpoint", "log_csv"}))
     return c;
   ReadPath(r, file, root, "dataset", &c.dataset, true);
   if (r.Get(root, "loops", "loops", &c.loops, "an integer"))
@@ -203,6 +204,15 @@ TrainConfig Read(StrictYaml& r, const std::string& file, const YAML::Node& root)
   if (r.Get(root, "scalar", "scalar", &c.scalar, "a string"))
     Check(r, c.scalar == "float" || c.scalar == "double", root, "scalar", "must be float or double", c.scalar);
   r.Get(root, "noise", "noise", &c.noise, "true or false");
+  if (r.Get(root, "prior", "prior", &c.prior, "a string")) {
+    Check(r, c.prior == "dyad" || c.prior == "nrl", root, "prior", "must be dyad or nrl", c.prior);
+    if (c.prior == "nrl") {
+      Check(r, c.scalar == "float", root, "scalar", "must be float with prior: nrl (NRL trains in float)", c.scalar);
+      const YAML::Node adam = static_cast<const YAML::Node&>(root)["adam"];
+      const bool epsilon_given = adam && adam.IsMap() && static_cast<const YAML::Node&>(adam)["epsilon"];
+      if (!epsilon_given) c.adam.epsilon = 1.0e-20;  // NRL's NON_ZERO
+    }
+  }
   if (r.Get(root, "threads", "threads", &c.threads, "an integer"))
     Check(r, c.threads >= 0 && c.threads <= 256, root, "threads", "must be in 0..256", c.threads);
   if (r.Get(root, "log_every", "log_every", &c.log_every, "an integer"))

@@ -62,7 +62,7 @@ TEST(TrainConfig, EveryInvalidGoldenFileGivesExactlyItsExpectedErrors) {
 
 // The configs shipped in configs/train load (they are the documentation's examples).
 TEST(TrainConfig, ShippedConfigsAreValid) {
-  for (const char* name : {"demo.yaml", "macaw.yaml"}) {
+  for (const char* name : {"demo.yaml", "macaw.yaml", "macaw_nrl.yaml"}) {
     auto c = LoadTrainConfig(std::string(DYAD_PVRNN_CONFIG_DIR) + "/" + name);
     EXPECT_TRUE(c.ok()) << name << ": " << c.status().message();
   }
@@ -86,6 +86,28 @@ TEST(TrainConfig, LoopsDefaultsToOneAndIsRangeChecked) {
   auto zero = LoadTrainConfig(kDir + "/valid_train.yaml", {"loops=0"});
   ASSERT_FALSE(zero.ok());
   EXPECT_EQ(zero.status().message(), "--set loops=0: loops: must be in 1..100, got 0");
+}
+
+// prior: nrl (NrlTrainer): NRL's epsilon unless the file sets one; float only.
+TEST(TrainConfig, PriorNrlTakesNrlsEpsilonAndFloat) {
+  auto c = LoadTrainConfig(kDir + "/valid_train.yaml");
+  ASSERT_TRUE(c.ok()) << c.status().message();
+  EXPECT_EQ(c->prior, "dyad");
+  EXPECT_EQ(c->adam.epsilon, 1e-8);
+  auto nrl = LoadTrainConfig(kDir + "/valid_train.yaml", {"prior=nrl"});
+  ASSERT_TRUE(nrl.ok()) << nrl.status().message();
+  EXPECT_EQ(nrl->prior, "nrl");
+  EXPECT_EQ(nrl->adam.epsilon, 1e-20);
+  auto given = LoadTrainConfig(kDir + "/valid_train.yaml", {"prior=nrl", "adam.epsilon=1e-7"});
+  ASSERT_TRUE(given.ok()) << given.status().message();
+  EXPECT_EQ(given->adam.epsilon, 1e-7);
+  auto dbl = LoadTrainConfig(kDir + "/valid_train.yaml", {"prior=nrl", "scalar=double"});
+  ASSERT_FALSE(dbl.ok());
+  EXPECT_EQ(dbl.status().message(),
+            "--set scalar=double: scalar: must be float with prior: nrl (NRL trains in float), got 'double'");
+  auto bad = LoadTrainConfig(kDir + "/valid_train.yaml", {"prior=ceres"});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().message(), "--set prior=ceres: prior: must be dyad or nrl, got 'ceres'");
 }
 
 TEST(TrainConfig, ThreadsDefaultToTheCoresAndAreRangeChecked) {

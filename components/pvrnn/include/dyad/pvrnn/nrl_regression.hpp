@@ -41,7 +41,7 @@
 #include <Eigen/Core>
 #include <chrono>
 #include <cstdint>
-#include <random>
+#include <memory>
 #include <vector>
 
 #include "dyad/pvrnn/model.hpp"
@@ -49,6 +49,9 @@
 namespace dyad::pvrnn {
 
 struct ErrorRegressionOptions;
+namespace nrl {
+class Noise;
+}
 
 class NrlRegression {
  public:
@@ -86,7 +89,7 @@ class NrlRegression {
   const Eigen::VectorXf& kept_mu(int layer, int slot) const;
   const Eigen::VectorXf& kept_log_sigma(int layer, int slot) const;
 
-  struct Layer;  // one NRL layer: weights and ER state (nrl_regression.cpp)
+  struct Layer;  // one NRL layer (nrl_network.hpp): weights and ER state (nrl_regression.cpp)
 
  private:
   void Encode(std::vector<std::vector<Eigen::VectorXf>>* y) const;
@@ -97,13 +100,11 @@ class NrlRegression {
   void OverwriteParam();
   void Postdict(std::chrono::steady_clock::time_point deadline);
   void Generate();
-  void Softmax(Eigen::VectorXf* x) const;
   float Decode(const Eigen::VectorXf& x, int dof) const;
-  void Draw(Eigen::VectorXf* n);
 
   int window_, iterations_, a_steps_, primitive_ = 0, total_z_ = 0;
   float lr_, beta1_, beta2_, epsilon_, sigma_;
-  bool noise_;
+  bool noise_on_;
   std::vector<Layer> layers_;
   AdaptiveVariables<float> trained_a_;
   std::vector<float> w_;                          // meta-prior per layer
@@ -115,8 +116,7 @@ class NrlRegression {
   std::vector<std::vector<Eigen::VectorXf>> x_;  // outputs of the last forward pass, per step and DOF
   std::vector<std::vector<float>> buffer_;       // the last W executed positions (float), oldest first
   int64_t adam_step_ = 1;
-  std::default_random_engine engine_;
-  std::normal_distribution<float> n01_{0.0f, 1.0f};
+  std::unique_ptr<nrl::Noise> noise_;  // NRL's N(0,1) or 0
   Eigen::VectorXd intention_;
   Outcome outcome_;
   std::vector<float> outcome_kl_;  // KL per layer of the last evaluation

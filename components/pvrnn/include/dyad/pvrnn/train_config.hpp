@@ -12,6 +12,7 @@
 //   scalar: float                              # float | double
 //   threads: 0                                 # 0: the hardware's cores (same result for any)
 //   noise: true                                # sample eps during training
+//   prior: dyad                                # dyad | nrl: NRL's training (below)
 //   log_every: 100                             # progress line + CSV row
 //   checkpoint_every: 5000                     # 0 = only at the end / on Ctrl-C
 //   output: macaw.dpvrnn                       # relative to this file's folder
@@ -22,6 +23,10 @@
 // "file:line:col: key: message" (1-based), all of them at once. `overrides` ("adam.lr=0.002")
 // replace values before validation and are reported as "--set KEY=VALUE: key: message"
 // (dyad/strict_yaml.hpp, the reader the graph file uses too).
+// `prior: nrl` trains NRL's way (NrlTrainer, dyad/pvrnn/nrl_trainer.hpp): NRL's initial state,
+// its free-running prior in the KL with its gradient, its Adam, float; adam.epsilon defaults to
+// NRL's 1e-20 there (written in the file, it is kept), scalar must be float, `seed` seeds NRL's
+// noise engine (NRL: 0), `threads` and `checkpoint_every` are not used.
 // Paths (dataset, output, checkpoint, log_csv) come back absolute: written in the file, relative
 // to the file's folder; given as an override, relative to the working folder.
 #pragma once
@@ -46,6 +51,7 @@ struct TrainConfig {
   uint64_t seed = 1;
   std::string scalar = "float";    // "float" | "double"
   bool noise = true;
+  std::string prior = "dyad";  // "dyad" | "nrl"
   // Threads of the trainer (TrainerOptions::threads): the result is the same for any; 1 is
   // faster when other processes keep every core busy.
   int64_t threads = 0;             // REQUIRES 0..256 (0: the hardware's cores)
