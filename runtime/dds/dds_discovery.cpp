@@ -70,12 +70,27 @@ std::string PartitionText(const std::vector<std::string>& names) {
 
 void DdsParticipant::DiscoveryListener::on_participant_discovery(fdds::DomainParticipant*,
                                                                  rtps::ParticipantDiscoveryInfo&& info) {
+  const std::string prefix = GuidPrefixString(info.info.m_guid.guidPrefix);
+  // A peer that left (REMOVED) or whose lease ran out (DROPPED) is forgotten, so that peers
+  // coming and going (restarts, watchers, a stranger knocking with a new GUID each time) do not
+  // grow the map. Fast DDS reports its endpoints' removal before its own.
+  if (info.status == rtps::ParticipantDiscoveryInfo::REMOVED_PARTICIPANT ||
+      info.status == rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    names_.erase(prefix);
+    return;
+  }
   // In a secured graph a peer's name on the wire is opaque; ours read back, others' kept as they are.
   std::string name = info.info.m_participantName.to_string();
   if (!names_key_.empty())
     if (std::string readable = ReadableName(names_key_, name); !readable.empty()) name = readable;
   std::lock_guard<std::mutex> lock(mutex_);
-  names_[GuidPrefixString(info.info.m_guid.guidPrefix)] = name;
+  names_[prefix] = name;
+}
+
+size_t DdsParticipant::DiscoveryListener::KnownPeers() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return names_.size();
 }
 
 // Remote endpoints are named by their DDS topic; ours by the graph's topic (a ROS 2 topic's
@@ -238,5 +253,6 @@ void DdsParticipant::DiscoveryListener::Track(bool writer, bool gone, const std:
 }
 
 std::vector<DiscoveredEndpoint> DdsParticipant::Discovered() const { return listener_->Snapshot(); }
+size_t DdsParticipant::KnownPeerNames() const { return listener_->KnownPeers(); }
 
 }  // namespace dyad

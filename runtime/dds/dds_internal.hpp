@@ -54,6 +54,7 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
   void on_publisher_discovery(fdds::DomainParticipant*, rtps::WriterDiscoveryInfo&& info) override;
   void on_subscriber_discovery(fdds::DomainParticipant*, rtps::ReaderDiscoveryInfo&& info) override;
   std::vector<DiscoveredEndpoint> Snapshot();
+  size_t KnownPeers();
   // A secured graph's names key (dyad/wire_names.hpp): peers' opaque names are read back with it.
   // Called before the participant exists.
   void ReadNamesWith(std::string key) { names_key_ = std::move(key); }
@@ -74,7 +75,7 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
   ProblemHandler on_problem_, on_foreign_;
   std::mutex mutex_;
   std::set<std::string> foreign_reported_;  // writer guids
-  std::map<std::string, std::string> names_;             // guid prefix -> participant name (read back)
+  std::map<std::string, std::string> names_;             // guid prefix -> name (read back), of peers present
   std::string names_key_;                                // "" without security
   std::map<std::string, DiscoveredEndpoint> endpoints_;  // by guid; participant holds the prefix
 };

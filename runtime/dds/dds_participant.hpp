@@ -323,6 +323,10 @@ class DdsParticipant final : public Transport {
   const std::string& name() const { return name_; }
   // Every remote (or local) endpoint discovered so far that is still alive.
   std::vector<DiscoveredEndpoint> Discovered() const;
+  // How many peers' names it keeps (read back from a secured graph's wire names): those of the
+  // participants discovered and not since removed or dropped, so it stays as small as the domain
+  // however many peers come and go.
+  size_t KnownPeerNames() const;
   // The most readers one of this participant's writers of `topic` is matched with, and the most
   // writers one of its readers of `topic` is matched with; 0 when it has none there. Discovery
   // comes before matching: a guest waits on these before its first sample (from the thread that
