@@ -10,8 +10,10 @@
 ///       IOError   the server answered the handshake with another status (the status and the
 ///                 first line of its body in the message), or closed it unanswered, or the
 ///                 host cannot be resolved.
-///   - After Connect, one thread of the client's own reads: `on_text` runs on it for each text
-///     frame, in order; binary frames are ignored; pings are answered. `on_close` runs on it
+///   - After the handshake, one thread of the client's own reads: `on_text` runs on it for each
+///     text frame, in order, possibly before Connect has returned (a server's first frame): a
+///     callback that uses the returned WsClient must wait for it (a mutex held around Connect and
+///     storing its result, say). Binary frames are ignored; pings are answered. `on_close` runs on it
 ///     once when the link ends without Close(): the peer's close frame (answered), the peer
 ///     closing the socket, a read error, a frame larger than kMaxFrameBytes or fragmented (then
 ///     the client sends 1009/1003 first).
@@ -21,7 +23,8 @@
 ///   - Close(): idempotent, from any thread (a callback included). Sends a close frame (1000),
 ///     shuts the socket down, and when called from another thread waits for the reading thread:
 ///     no callback runs after it returns, and none starts during it. From a callback of its own
-///     the reading thread ends after that callback returns, and runs none after it.
+///     the reading thread ends after that callback returns, and runs none after it. Do not hold,
+///     while calling Close() or ~WsClient from another thread, a lock the callbacks take.
 ///   - ~WsClient(): Close(). A WsClient may be destroyed inside its own callback.
 ///
 /// Why not civetweb's mg_connect_websocket_client (libcivetweb 1.15): it has no timeout for the

@@ -316,19 +316,28 @@ TEST(WsClient, ACallbackMayCloseOrDestroyItsOwnClient) {
   std::unique_ptr<WsClient> client;
   std::mutex mutex;
   std::atomic<int> texts{0}, closes{0};
+  // The server's hello may come before Connect returns: `client` is set under the mutex.
   WsClient::Callbacks closes_itself{[&](std::string_view) {
                                       ++texts;
+                                      std::lock_guard<std::mutex> lock(mutex);
                                       client->Close();  // on the client's own thread
                                     },
                                     [&] { ++closes; }};
-  auto c = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, std::move(closes_itself), seconds(5));
-  ASSERT_TRUE(c.ok()) << c.status().ToString();
-  client = std::move(*c);
+  StatusOr<std::unique_ptr<WsClient>> c = Status::NotFound("not yet");
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    c = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, std::move(closes_itself), seconds(5));
+    ASSERT_TRUE(c.ok()) << c.status().ToString();
+    client = std::move(*c);
+  }
   server->SendText(handler.Last(), "more");
   ASSERT_TRUE(Eventually([&] { return handler.closes == 1; })) << "the server saw the close";
   EXPECT_EQ(texts, 1) << "nothing after the callback that closed it";
   EXPECT_EQ(closes, 0);
-  client.reset();
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    client.reset();
+  }
 
   std::atomic<bool> destroyed{false};
   WsClient::Callbacks destroys_itself{nullptr, [&] {
