@@ -16,6 +16,7 @@
 #include "study_file.hpp"
 #include "study_links.hpp"
 #include "study_page.hpp"
+#include "study_serve.hpp"
 #include "study_session.hpp"
 #include "yaml_file.hpp"
 
@@ -533,6 +534,7 @@ void AddStudyCommands(CLI::App& app, int& exit_code) {
   rehearse->add_flag("--unblind", h->unblind, "Name a blind study's conditions in the rehearsal's analysis (not for the experimenter's eyes)");
   rehearse->callback([h, &exit_code] { exit_code = tools::Code(Rehearse(*h)); });
   study::AddLinksCommand(study, exit_code);
+  study::AddServeCommand(study, exit_code);
 }
 
 }  // namespace dyad::cli

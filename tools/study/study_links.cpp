@@ -35,9 +35,6 @@ Status CheckBaseUrl(const std::string& url) {
   return Status::OK();
 }
 
-namespace {
-
-// The subject token of an existing token file (the web component's format), or why not.
 StatusOr<std::string> ReadSubjectToken(const std::string& path) {
   struct stat st {};
   if (lstat(path.c_str(), &st) != 0) return Status::Internal(path + ": vanished");
@@ -57,8 +54,6 @@ StatusOr<std::string> ReadSubjectToken(const std::string& path) {
   }
   return Status::InvalidArgument(path + ": no 'subject TOKEN' line");
 }
-
-}  // namespace
 
 StatusOr<Links> WriteLinks(const Study& s, const std::string& base_url) {
   if (Status b = CheckBaseUrl(base_url); !b.ok()) return b;

@@ -36,6 +36,10 @@ struct Links {
   int kept = 0;     // token files that existed
 };
 
+// The subject token of an existing token file (the web component's format), or why not (the
+// refusals above, naming the file). `dyad study serve` reads the participants' tokens with it.
+StatusOr<std::string> ReadSubjectToken(const std::string& path);
+
 Status CheckBaseUrl(const std::string& url);
 StatusOr<Links> WriteLinks(const Study& s, const std::string& base_url);
 

@@ -1,0 +1,59 @@
+// tools/study/front_admission.hpp: who a request to `dyad study serve` is (docs/study.md, "A study
+// online"): each participant's subject token, from their token file DATA/P/<web>-tokens (what
+// `dyad study links` writes and each trial's web component reads), maps to that participant.
+//
+// Contract of Admit (WebServer's Options::admit: thread-safe):
+//   - A participant's token: Admission{kSubject, participant}. Tokens are compared in constant
+//     time (web::TokenMatches), every known token each time.
+//   - Any other token (or none): Refusal 404 "not found". Before answering, the token files that
+//     were missing are read again, at most once a second (links made while the front runs).
+//   - An address with more than 10 unknown tokens within a minute (from its first) gets 429
+//     "too many unknown links: wait a minute" for every request, known tokens included, until
+//     that minute is over: guessing costs a minute per 10 guesses.
+//   - A token file that cannot be used (not a regular 0600 file, no subject line) is said once,
+//     on `problems` at load, and that participant has no link.
+#pragma once
+
+#include <chrono>
+#include <map>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "dyad/thread_annotations.hpp"
+#include "study_file.hpp"
+#include "web_server.hpp"
+
+namespace dyad::study {
+
+class FrontAdmission {
+ public:
+  using Clock = std::chrono::steady_clock;
+  static constexpr int kUnknownPerMinute = 10;
+
+  // Reads every participant's token file now; what is wrong with one goes to `problems`.
+  FrontAdmission(const Study& s, std::vector<std::string>* problems);
+
+  std::variant<web::Admission, web::Refusal> Admit(std::string_view token, std::string_view remote_address,
+                                                   Clock::time_point now);
+  // How many participants have a link (a usable token file).
+  int with_links() const;
+
+ private:
+  void ReadMissing(std::vector<std::string>* problems) REQUIRES(mutex_);
+  struct Window {
+    Clock::time_point start;
+    int unknown = 0;
+  };
+
+  const Study& study_;
+  mutable Mutex mutex_;
+  std::vector<std::pair<std::string, std::string>> tokens_ GUARDED_BY(mutex_);  // (token, participant)
+  std::vector<std::string> missing_ GUARDED_BY(mutex_);                         // participants without one
+  Clock::time_point last_read_ GUARDED_BY(mutex_);
+  std::map<std::string, Window, std::less<>> by_address_ GUARDED_BY(mutex_);
+};
+
+}  // namespace dyad::study

@@ -1,0 +1,374 @@
+#include "online_front.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "online_session.hpp"
+#include "study_links.hpp"
+#include "ws_client.hpp"
+
+namespace dyad::study {
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr const char* kOpenTwice = "This link is already open in another window.";
+constexpr const char* kComeBack =
+    "Please come back later: the study has as many participants as it can take right now. Your link stays valid.";
+constexpr const char* kHeldElsewhere =
+    "Please come back later: your session is open elsewhere right now (the lab). Your link stays valid.";
+constexpr std::chrono::milliseconds kRelayRetry{200};
+
+// A free loopback port (bound to port 0, then closed) for a trial's web component; 0 if none.
+int FreeLoopbackPort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return 0;
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t n = sizeof a;
+  int port = 0;
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 && ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n) == 0)
+    port = ntohs(a.sin_port);
+  ::close(fd);
+  return port;
+}
+
+std::string Refused(const std::string& message) { return Json{{"op", "refused"}, {"message", message}}.dump(); }
+
+std::string Seconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", s);
+  return text;
+}
+
+}  // namespace
+
+struct OnlineFront::Participant {
+  Participant(const Study& s, const std::string& id) : id(id), session(s, id) {}
+  const std::string id;
+  OnlineSession session;
+  std::atomic<bool> stop{false};
+  std::mutex worker_mutex;  // StartTrial (the handler thread) and StopAll (the server's loop)
+  std::thread worker;       // the running or last trial (under worker_mutex)
+  // Under OnlineFront::mutex_:
+  std::optional<SessionLock> lock;
+  web::ClientId page = 0;                   // the page connected now (0: none)
+  std::shared_ptr<web::WsClient> upstream;  // the relay to the trial's graph, while a trial runs
+  bool running = false;
+  int port = 0;
+  std::string token, lost_reason;
+  int ping_id = 0;
+  Clock::time_point ping_sent{};
+  double rtt_ms = -1;
+};
+
+OnlineFront::OnlineFront(const Study& s, FrontOptions o) : study_(s), options_(std::move(o)) {
+  for (const std::string& p : s.participants) participants_.emplace(p, std::make_unique<Participant>(s, p));
+}
+
+OnlineFront::~OnlineFront() { StopAll(); }
+
+void OnlineFront::Send(web::ClientId client, std::string text) {
+  if (web::WebServer* server = server_.load()) server->SendText(client, std::move(text));
+}
+
+void OnlineFront::Close(web::ClientId client, int code, const std::string& reason) {
+  if (web::WebServer* server = server_.load()) server->Close(client, code, reason);
+}
+
+OnlineFront::Participant* OnlineFront::Of(web::ClientId client) {
+  MutexLock lock(mutex_);
+  const auto it = clients_.find(client);
+  return it == clients_.end() ? nullptr : it->second;
+}
+
+int OnlineFront::LiveLocked(Clock::time_point now) const {
+  int n = 0;
+  for (const auto& [id, p] : participants_) n += p->session.Live(now, p->running);
+  return n;
+}
+
+int OnlineFront::live(Clock::time_point now) const {
+  MutexLock lock(mutex_);
+  return LiveLocked(now);
+}
+
+int OnlineFront::running() const {
+  MutexLock lock(mutex_);
+  int n = 0;
+  for (const auto& [id, p] : participants_) n += p->running;
+  return n;
+}
+
+std::string OnlineFront::Take(Participant& p, web::ClientId client, Clock::time_point now) {
+  if (p.page != 0) return kOpenTwice;
+  if (!p.session.Live(now, p.running) && LiveLocked(now) >= options_.max_sessions) return kComeBack;
+  if (!p.lock) {
+    auto lock = SessionLock::Acquire(study_, p.id);
+    if (!lock.ok()) return kHeldElsewhere;
+    p.lock.emplace(std::move(*lock));
+  }
+  p.page = client;
+  p.session.PageOpened();
+  clients_[client] = &p;
+  return "";
+}
+
+void OnlineFront::OnOpen(web::ClientId client, web::Role) {
+  web::WebServer* server = server_.load();
+  const auto it = server ? participants_.find(server->who(client)) : participants_.end();
+  if (it == participants_.end()) return Close(client, 1008, "not a participant");
+  Participant& p = *it->second;
+  std::string refused;
+  bool running = false;
+  {
+    MutexLock lock(mutex_);
+    refused = Take(p, client, Clock::now());
+    running = p.running;
+  }
+  if (!refused.empty()) {
+    std::cout << p.id << ": a page refused: " << refused << std::endl;
+    Send(client, Refused(refused));
+    return Close(client, 1008, "refused");
+  }
+  if (!running) return Send(client, p.session.PageFrame());
+  // Connecting may take seconds (the graph starting) and more stack than civetweb's workers
+  // have: a thread of its own. The page sends nothing but pongs before the graph's hello.
+  relays_.fetch_add(1);
+  std::thread([this, &p, client] {
+    Relay(p, client);
+    relays_.fetch_sub(1);
+  }).detach();
+}
+
+// Connects the page to the trial's graph (retrying while it starts), or, when the trial has
+// ended meanwhile, tells the page what comes next.
+void OnlineFront::Relay(Participant& p, web::ClientId client) {
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.wait_for_subject_s));
+  web::WebServer* server = server_.load();
+  while (true) {
+    int port = 0;
+    std::string token;
+    {
+      MutexLock lock(mutex_);
+      if (!p.running || p.page != client) break;
+      port = p.port;
+      token = p.token;
+    }
+    web::WsClient::Callbacks cb;
+    cb.on_text = [server, client](std::string_view text) { server->SendText(client, std::string(text)); };
+    cb.on_close = [server, client] { server->Close(client, 1012, "the trial's page closed"); };
+    auto up = web::WsClient::Connect("127.0.0.1", port, "/subject/ws?token=" + token, std::move(cb), std::chrono::seconds(2));
+    if (up.ok()) {
+      std::shared_ptr<web::WsClient> relay(std::move(*up));
+      MutexLock lock(mutex_);
+      if (p.running && p.page == client) {
+        p.upstream = relay;
+        return;
+      }
+      break;  // the page or the trial left meanwhile (the relay closes as it goes)
+    }
+    // Nothing listens yet (the graph starting), or it is ending: again until the trial ends.
+    if (Clock::now() > deadline) {
+      std::cerr << "dyad study serve: " << p.id << ": cannot relay the page to its trial: " << up.status().ToString()
+                << std::endl;
+      break;
+    }
+    std::this_thread::sleep_for(kRelayRetry);
+  }
+  bool here = false, running = false;
+  {
+    MutexLock lock(mutex_);
+    here = p.page == client;
+    running = p.running;
+  }
+  if (here && !running) Send(client, p.session.PageFrame());
+  else if (here) Close(client, 1012, "the trial is not reachable: retry");
+}
+
+// A pong to the front's ping: its round trip kept, not relayed.
+bool OnlineFront::Pong(Participant& p, std::string_view text) {
+  if (text.find("\"pong\"") == std::string_view::npos) return false;
+  const Json j = Json::parse(text.begin(), text.end(), nullptr, false);
+  if (!j.is_object() || j.value("op", "") != "pong") return false;
+  MutexLock lock(mutex_);
+  if (j.contains("id") && j["id"].is_number_integer() && j["id"].get<int>() == p.ping_id)
+    p.rtt_ms = std::chrono::duration<double, std::milli>(Clock::now() - p.ping_sent).count();
+  return true;
+}
+
+Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
+  Participant* p = Of(client);
+  if (p == nullptr || Pong(*p, text)) return Status::OK();
+  std::shared_ptr<web::WsClient> up;
+  bool running = false;
+  {
+    MutexLock lock(mutex_);
+    if (p->page != client) return Status::OK();  // a page being closed
+    up = p->upstream;
+    running = p->running;
+  }
+  if (up) {
+    if (Status st = up->SendText(text); !st.ok()) Close(client, 1012, "the trial's page closed");
+    return Status::OK();
+  }
+  if (!running) Answer(*p, client, text);
+  return Status::OK();
+}
+
+// The page's answers between trials.
+void OnlineFront::Answer(Participant& p, web::ClientId client, std::string_view text) {
+  const Json j = Json::parse(text.begin(), text.end(), nullptr, false);
+  const std::string op = j.is_object() ? j.value("op", "") : "";
+  if (op == "consent" && j.contains("agree") && j["agree"].is_boolean()) {
+    if (p.session.phase() != OnlineSession::Phase::kConsent) return Send(client, p.session.PageFrame());
+    const bool agree = j["agree"].get<bool>();
+    if (Status st = p.session.Consent(agree); !st.ok())
+      std::cerr << "dyad study serve: " << p.id << ": " << st.ToString() << std::endl;
+    std::cout << p.id << (agree ? ": consent given on the consent page" : ": declined on the consent page") << std::endl;
+    return Send(client, p.session.PageFrame());
+  }
+  if (op == "ready" && p.session.phase() == OnlineSession::Phase::kWaiting) return StartTrial(p);
+}
+
+void OnlineFront::StartTrial(Participant& p) {
+  const std::optional<OnlineSession::Planned> next = p.session.Next();
+  if (!next || closing_.load()) return;
+  const std::string token_file = (std::filesystem::path(study_.data) / p.id / (study_.subject_web + "-tokens")).string();
+  auto token = ReadSubjectToken(token_file);
+  const int port = FreeLoopbackPort();
+  if (!token.ok() || port == 0) {
+    std::cerr << "dyad study serve: " << p.id << ": trial " << next->trial.number
+              << " cannot start: " << (token.ok() ? "no free loopback port" : token.status().ToString()) << std::endl;
+    return;
+  }
+  AttemptRequest r;
+  r.dyad = options_.dyad;
+  r.participant = p.id;
+  r.trial = next->trial;
+  r.attempt = next->attempt;
+  r.reason = next->reason;
+  r.stop = &p.stop;
+  r.own_signals = false;
+  r.subject_port = port;
+  r.wait_for_subject_s = options_.wait_for_subject_s;
+  r.run_log = std::filesystem::path(AttemptFile(r.trial, r.attempt)).replace_extension(".log").string();
+  r.serve_sets = {study_.subject_web + ".address=127.0.0.1", study_.subject_web + ".pause_without_subject=true"};
+  r.incomplete_reason = [this, &p] {
+    MutexLock lock(mutex_);
+    return p.lost_reason;
+  };
+  std::lock_guard<std::mutex> worker(p.worker_mutex);
+  if (closing_.load()) return;
+  if (p.worker.joinable()) p.worker.join();  // the last trial's thread, ended (running is false)
+  web::ClientId page = 0;
+  {
+    MutexLock lock(mutex_);
+    if (p.running) return;
+    p.running = true;
+    p.stop.store(false);
+    p.lost_reason.clear();
+    p.port = port;
+    p.token = *token;
+    std::swap(page, p.page);
+    p.session.PageClosed(Clock::now());  // it comes back at once, to the trial
+  }
+  if (page != 0) Close(page, 1012, "the trial starts");
+  p.worker = std::thread([this, &p, r] { RunTrial(p, r); });
+}
+
+void OnlineFront::RunTrial(Participant& p, AttemptRequest r) {
+  const size_t of = study_.TrialsOf(p.id).size();
+  std::cout << p.id << ": trial " << r.trial.number << " of " << of << ": "
+            << study_.Shown(study_.conditions[static_cast<size_t>(r.trial.condition)])
+            << (r.attempt > 1 ? ", attempt " + std::to_string(r.attempt) + " (" + r.reason + ")" : "") << " -> "
+            << AttemptFile(r.trial, r.attempt) << std::endl;
+  auto a = RunAttempt(study_, r);
+  std::cout << p.id << ": trial " << r.trial.number << ": "
+            << (a.ok() ? std::string(ToString(a->outcome)) + (a->incomplete.empty() ? "" : " (" + a->incomplete + ")") + ", " +
+                             std::to_string(static_cast<int>(std::lround(a->seconds))) + " s"
+                       : a.status().ToString())
+            << std::endl;
+  web::ClientId page = 0;
+  std::shared_ptr<web::WsClient> up;
+  {
+    MutexLock lock(mutex_);
+    p.running = false;
+    std::swap(page, p.page);
+    up = std::move(p.upstream);
+    if (page != 0) p.session.PageClosed(Clock::now());
+  }
+  if (up) up->Close();
+  if (page != 0) Close(page, 1012, "the trial ended");  // the page comes back at once and hears what is next
+}
+
+void OnlineFront::OnClose(web::ClientId client) {
+  std::shared_ptr<web::WsClient> up;
+  {
+    MutexLock lock(mutex_);
+    const auto it = clients_.find(client);
+    if (it == clients_.end()) return;
+    Participant& p = *it->second;
+    clients_.erase(it);
+    if (p.page != client) return;  // closed by the front already (a phase change)
+    p.page = 0;
+    p.session.PageClosed(Clock::now());
+    up = std::move(p.upstream);
+  }
+  if (up) up->Close();  // the graph sees its subject gone (and pauses)
+}
+
+void OnlineFront::Tick(Clock::time_point now) {
+  std::vector<std::pair<web::ClientId, std::string>> pings;
+  {
+    MutexLock lock(mutex_);
+    const auto reconnect = std::chrono::duration<double>(study_.online.reconnect_s);
+    for (auto& [id, p] : participants_) {
+      if (p->running && p->page == 0 && p->lost_reason.empty() && p->session.LostFor(now) > reconnect) {
+        p->lost_reason = "the participant's connection was lost for more than " + Seconds(study_.online.reconnect_s) + " s";
+        p->stop.store(true);
+        std::cout << id << ": " << p->lost_reason << ": the trial is stopped" << std::endl;
+      }
+      if (!p->running && p->page == 0 && p->lock && !p->session.Live(now, false)) p->lock.reset();
+      if (p->page != 0 && now - p->ping_sent >= options_.ping_interval) {
+        p->ping_sent = now;
+        pings.emplace_back(p->page, Json{{"op", "ping"}, {"id", ++p->ping_id}}.dump());
+      }
+    }
+  }
+  for (auto& [client, text] : pings) Send(client, std::move(text));
+}
+
+void OnlineFront::StopAll() {
+  closing_.store(true);
+  for (auto& [id, p] : participants_) p->stop.store(true);
+  for (auto& [id, p] : participants_) {
+    std::lock_guard<std::mutex> worker(p->worker_mutex);
+    p->stop.store(true);  // a trial started before closing_ was seen
+    if (p->worker.joinable()) p->worker.join();
+  }
+  std::vector<std::shared_ptr<web::WsClient>> ups;
+  {
+    MutexLock lock(mutex_);
+    for (auto& [id, p] : participants_)
+      if (p->upstream) ups.push_back(std::move(p->upstream));
+  }
+  for (auto& up : ups) up->Close();
+  while (relays_.load() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));  // each ends within its connect timeout
+}
+
+}  // namespace dyad::study

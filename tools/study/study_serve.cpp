@@ -1,0 +1,138 @@
+#include "study_serve.hpp"
+
+#include <signal.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <thread>
+
+#include "front_admission.hpp"
+#include "online_front.hpp"
+#include "pages.hpp"
+#include "run_process.hpp"
+#include "study_file.hpp"
+#include "web_server.hpp"
+
+namespace dyad::study {
+namespace {
+
+std::atomic<int> g_quit{0};  // lock-free: set by the handler, read by the loop
+extern "C" void OnServeSignal(int) { g_quit.store(1); }
+
+// Why the study cannot be served ("" when it can): each names its key or flag.
+std::string WhyNotServed(const Study& s, const ServeOptions& o) {
+  if (s.subject_web.empty())
+    return s.file + ": graph: " + s.graph +
+           " has no subject's page to serve: one `web` component (without its own token_file or TLS) and a `web_human`, as "
+           "configs/interactive.yaml";
+  if (s.consent_required && s.online.consent.empty())
+    return s.file + ": online.consent: required to serve a study with consent_required (the consent page's text, a file)";
+  if (!web::IsLoopback(o.address) && o.tls_certificate.empty())
+    return "--tls-certificate: required off loopback (--address " + o.address +
+           "): participants' tokens cross the network (dyad security init makes one, or give your own PEM)";
+  return "";
+}
+
+web::WebServer::Options ServerOptions(const ServeOptions& o, FrontAdmission* admission, OnlineFront* front, int max_sessions) {
+  web::WebServer::Options so;
+  so.address = o.address;
+  so.port = o.port;
+  so.tls_certificate = o.tls_certificate;
+  so.admit = [admission](std::string_view token, std::string_view remote) {
+    return admission->Admit(token, remote, FrontAdmission::Clock::now());
+  };
+  so.pages["/subject"] = web::WebServer::Page{"text/html; charset=utf-8", web::kSubjectHtml, {web::Role::kSubject}, ""};
+  so.endpoints.push_back(web::WebServer::Endpoint{"/subject/ws", {}, front, {web::Role::kSubject}, /*viewers=*/false});
+  so.max_clients = 4 * max_sessions + 16;  // the refused pages are told so over their socket
+  so.allowed_origins = o.origins;
+  const std::string scheme = o.tls_certificate.empty() ? "http://" : "https://";
+  for (const std::string& host : web::UrlHosts(o.address))
+    so.allowed_origins.push_back(scheme + host + (o.port > 0 ? ":" + std::to_string(o.port) : ""));
+  return so;
+}
+
+void Serving(const Study& s, const ServeOptions& o, int port, int with_links, int max_sessions) {
+  const std::string scheme = o.tls_certificate.empty() ? "http://" : "https://";
+  for (const std::string& host : web::UrlHosts(o.address))
+    std::cout << "dyad study serve: " << s.name << " at " << scheme << host << ":" << port << "/subject?token=..." << std::endl;
+  std::cout << "participants with links: " << with_links << " of " << s.participants.size()
+            << (with_links < static_cast<int>(s.participants.size()) ? " (dyad study links " + s.file + " --base-url " + scheme +
+                                                                           "HOST:" + std::to_string(port) + " makes the others')"
+                                                                     : std::string())
+            << "; max_sessions " << max_sessions << ", reconnect_s " << s.online.reconnect_s << std::endl;
+}
+
+}  // namespace
+
+int Serve(const ServeOptions& o) {
+  std::vector<Diagnostic> problems;
+  const Study s = LoadStudy(o.file, o.plugins, &problems);
+  for (const auto& p : problems) std::cerr << p.ToString() << "\n";
+  if (!problems.empty()) {
+    std::cerr << o.file << ": " << problems.size() << " problem" << (problems.size() == 1 ? "" : "s") << "\n";
+    return 2;
+  }
+  if (std::string why = WhyNotServed(s, o); !why.empty()) {
+    std::cerr << "dyad study serve: " << why << "\n";
+    return 2;
+  }
+  const int max_sessions = o.max_sessions > 0 ? o.max_sessions : s.online.max_sessions;
+  std::vector<std::string> token_problems;
+  FrontAdmission admission(s, &token_problems);
+  for (const std::string& p : token_problems) std::cerr << "dyad study serve: " << p << " (that participant has no link)\n";
+  struct sigaction sa {
+  }, old_int{}, old_term{};
+  sa.sa_handler = OnServeSignal;
+  sa.sa_flags = SA_RESTART;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &old_int);
+  sigaction(SIGTERM, &sa, &old_term);
+  OnlineFront front(s, FrontOptions{tools::ThisExecutable(), max_sessions});
+  auto server = web::WebServer::Start(ServerOptions(o, &admission, &front, max_sessions));
+  if (!server.ok()) {
+    std::cerr << "dyad study serve: " << server.status().ToString() << "\n";
+    sigaction(SIGINT, &old_int, nullptr);
+    sigaction(SIGTERM, &old_term, nullptr);
+    return 1;
+  }
+  front.SetServer(server->get());
+  if (!o.port_file.empty()) std::ofstream(o.port_file) << (*server)->port() << "\n";
+  Serving(s, o, (*server)->port(), admission.with_links(), max_sessions);
+  while (!g_quit.load()) {
+    front.Tick(OnlineFront::Clock::now());
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const int running = front.running();
+  std::cout << "dyad study serve: stopping" << (running ? " (" + std::to_string(running) + " trials running are stopped)" : "")
+            << std::endl;
+  front.StopAll();
+  front.SetServer(nullptr);
+  server->reset();
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
+  std::cout << "dyad study serve: stopped" << std::endl;
+  return 0;
+}
+
+void AddServeCommand(CLI::App* study, int& exit_code) {
+  auto o = std::make_shared<ServeOptions>();
+  auto* serve = study->add_subcommand(
+      "serve",
+      "Serve a study online: each participant opens their link (dyad study links) and does their trials from their browser");
+  serve->add_option("study", o->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
+  serve->add_option("--address", o->address, "Listen address (off loopback: with --tls-certificate)");
+  serve->add_option("--port", o->port, "Port (0: any free one)")->check(CLI::Range(0, 65535));
+  serve->add_option("--tls-certificate", o->tls_certificate, "PEM file: private key and certificate chain (HTTPS, WSS)")
+      ->check(CLI::ExistingFile);
+  serve->add_option("--max-sessions", o->max_sessions, "Live sessions at once (default: the study file's online.max_sessions)")
+      ->check(CLI::Range(1, 100000));
+  serve->add_option("--port-file", o->port_file, "Write the bound port here");
+  serve->add_option("--origin", o->origins, "Another origin participants' pages come from (scheme://host[:port], repeatable)");
+  serve->add_option("--plugins", o->plugins, "Extra plugin file or folder (repeatable)");
+  serve->callback([o, &exit_code] { exit_code = Serve(*o); });
+}
+
+}  // namespace dyad::study
