@@ -2,9 +2,10 @@
 # sim_participant.mjs --online (the clients of dyad study serve's tests and capacity bench)
 # against node/online_front.mjs, a stand-in for the front: three headless participants and one
 # in the real page in Chromium go through consent, two trials each started with Ready, and done;
-# a fourth headless one is refused. Each must end with its code (or the refusal), have started
-# both trials, answered every ping with its id, and sent pointer samples only during trials, some
-# of them engaged (it drew).
+# a fourth headless one is refused; a fifth loses its connection 1 s into its first trial (no close
+# frame) and is back 1 s later, in the same trial. Each must end with its code (or the refusal),
+# have started both trials (a return is no new trial), answered every ping with its id, and sent
+# pointer samples only during trials, some of them engaged (it drew).
 #   sim_online_test.sh WORK_DIR
 set -euo pipefail
 work=$1
@@ -16,8 +17,8 @@ front=$!
 trap 'kill $front 2> /dev/null || true' EXIT
 wait_port_file front.port $front 10 front.err
 url=http://127.0.0.1:$(cat front.port)
-printf "%s chromium-one-token\n%s sim-two-token\n%s sim-three-token\n%s sim-four-token\n%s refused-five-token\n" \
-  "$url" "$url" "$url" "$url" "$url" > sessions
+printf "%s chromium-one-token\n%s sim-two-token\n%s sim-three-token\n%s sim-four-token\n%s refused-five-token\n%s sim-six-token drop:1:1\n" \
+  "$url" "$url" "$url" "$url" "$url" "$url" > sessions
 node "$node_dir/sim_participant.mjs" --online --chromium 1 --speed 2 --seconds 60 sessions > clients.json || fail "the clients"
 kill -TERM $front; wait $front || true
 python3 - clients.json front.json <<'PY'
@@ -25,8 +26,8 @@ import json, sys
 def fail(why): sys.exit("FAIL: " + why)
 clients = [json.loads(l) for l in open(sys.argv[1]) if l.strip()][:-1]
 front = {p["token"]: p for p in (json.loads(l) for l in open(sys.argv[2]) if l.strip())}
-tokens = ["chromium-one-token", "sim-two-token", "sim-three-token", "sim-four-token", "refused-five-token"]
-if len(clients) != 5: fail("%d client lines" % len(clients))
+tokens = ["chromium-one-token", "sim-two-token", "sim-three-token", "sim-four-token", "refused-five-token", "sim-six-token"]
+if len(clients) != 6: fail("%d client lines" % len(clients))
 for token, c in zip(tokens, clients):
     f = front.get(token)
     if f is None: fail(token + ": never reached the front")
@@ -42,7 +43,10 @@ for token, c in zip(tokens, clients):
     # The headless client draws only in trials; the page may send a sample between them (a mouse
     # moving over it), but the Chromium participant's mouse rests then too.
     if f["between"]: fail(token + ": %d pointer samples between trials" % f["between"])
+    lost = token == "sim-six-token"
+    if (c.get("dropped") is not None) != lost or f["returns"] != int(lost): fail(token + ": dropped %s, came back %d times in a trial" % (c.get("dropped"), f["returns"]))
+    if lost and not 1000 <= f["away_ms"] <= 1800: fail(token + ": away %d ms (drop:1:1)" % f["away_ms"])
 print("PASS: " + "; ".join("%s: %d trials, code %s, %d samples in trials (%d engaged), %d pongs"
                            % (t, front[t]["trials"], c["code"], front[t]["in_trial"], front[t]["engaged"], front[t]["pongs"])
-                           for t, c in zip(tokens[:4], clients)))
+                           for t, c in zip(tokens[:4], clients)) + "; sim-six-token away %d ms" % front["sim-six-token"]["away_ms"])
 PY

@@ -24,15 +24,19 @@
 // behaviour's time); it draws only during a trial (from a hello to the next close or waiting, as a
 // person does not draw while a message covers the page); it answers each ping with its pong; after
 // a close with code 1012 it reconnects at once; on done it keeps the completion code and stops, on
-// refused it keeps the message and stops (the page's: no retry).
+// refused it keeps the message and stops (the page's: no retry). A participant's line may ask for
+// a lost connection: "drop:AT:AWAY" (seconds of real time, --speed aside) ends its socket AT s into
+// its first trial without a close frame (a network gone, a closed laptop) and reconnects only AWAY
+// s later (then as the page does).
 //
 //   node sim_participant.mjs [--dataset DIR] [--seconds S] [--report-error P] [--speed F] [--chromium K]
 //                            [--online] SESSIONS_FILE
-//     SESSIONS_FILE: one participant per line, "URL TOKEN" (URL: http://127.0.0.1:PORT); all run
+//     SESSIONS_FILE: one participant per line, "URL TOKEN [drop:AT:AWAY]" (URL: http://127.0.0.1:PORT); all run
 //     in this one process for S seconds (default 30; --online: until each is done or refused, S at
 //     most), then each prints one JSON line: pointer samples sent, acks, round trip median/p99 (ms),
 //     holds, answers, closes, errors (--online also: trials started, the completion code or null,
-//     refused: the message or null, pongs); the last line is this process's CPU time (Node's alone:
+//     refused: the message or null, pongs, dropped: when its connection was lost, ms since the
+//     epoch, or null); the last line is this process's CPU time (Node's alone:
 //     Chromium's own processes are not in it).
 //     --chromium K: the first K participants in the real page in Chromium (ChromiumParticipant).
 import fs from "node:fs";
@@ -97,7 +101,7 @@ const pct = (a, p) => { const s = [...a].sort((x, y) => x - y); return s.length 
 
 export class SimParticipant {
   // url: http://HOST:PORT; token: the subject's; primitives: [[x,y],...] each; seed: its behaviour.
-  constructor({ url, token, primitives, seed = 1, reportError = 0.1, speed = 1, online = false }) {
+  constructor({ url, token, primitives, seed = 1, reportError = 0.1, speed = 1, online = false, drop = null }) {
     this.wsUrl = url.replace(/^http/, "ws") + "/subject/ws?token=" + encodeURIComponent(token);
     this.origin = url;
     this.prims = primitives;
@@ -111,6 +115,8 @@ export class SimParticipant {
     // --online: between trials (consent, waiting) or in one; what the front said at the end.
     this.online = online, this.inTrial = !online;
     this.trials = 0, this.code = null, this.refused = null, this.pongs = 0;
+    this.betweenSeen = true;  // a hello after consent or waiting starts a trial (after a reconnect it does not)
+    this.drop = drop, this.dropped = null, this.backAt = 0;  // drop: {at, away} s; dropped: when (ms since the epoch)
     this.finished = new Promise((r) => { this.finish = r; });  // resolves on done or refused
   }
   later(ms, fn) {  // fn after ms of its behaviour's time
@@ -131,16 +137,26 @@ export class SimParticipant {
     this.ws.on("close", (code) => {
       this.stats.closes++, this.steering = false, this.down = false, this.inTrial = !this.online;
       // The page's second, at any speed; after 1012 (the front's next phase) at once.
-      if (!this.stopped && code !== 1008) this.later(code === 1012 ? 0 : 1000 * this.speed, () => this.connect());
+      const wait = Math.max(code === 1012 ? 0 : 1000, this.backAt - Date.now());  // real ms (later() divides by speed)
+      if (!this.stopped && code !== 1008) this.later(wait * this.speed, () => this.connect());
     });
+  }
+  // drop:AT:AWAY: AT s from now the socket ends without a close frame; no new one for AWAY s.
+  loseConnection() {
+    this.dropped = 0;
+    setTimeout(() => {
+      if (this.stopped) return;
+      this.dropped = Date.now(), this.backAt = this.dropped + 1000 * this.drop.away;
+      this.ws.terminate();
+    }, 1000 * this.drop.at);
   }
   // --online: the front's ops between trials (and its ping at any time); true when `m` was one.
   onFrontMessage(m) {
     const reply = (r) => { if (this.ws?.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify(r)); };
     if (m.op === "ping") reply({ op: "pong", id: m.id }), this.pongs++;
-    else if (m.op === "consent") this.inTrial = false, reply({ op: "consent", agree: true });
+    else if (m.op === "consent") this.inTrial = false, this.betweenSeen = true, reply({ op: "consent", agree: true });
     else if (m.op === "waiting") {
-      this.inTrial = false, this.down = false;
+      this.inTrial = false, this.down = false, this.betweenSeen = true;
       if (m.ready) {
         const ws = this.ws;  // a Ready pressed on the socket it was shown on (a new one shows it again)
         this.later(this.r.uniform(500, 1500), () => { if (this.ws === ws) reply({ op: "ready" }); });
@@ -156,8 +172,9 @@ export class SimParticipant {
   onMessage(m) {
     if (this.online && this.onFrontMessage(m)) return;
     if (m.op === "hello") {
-      if (this.online && !this.inTrial) this.trials++;
+      if (this.online && this.betweenSeen) this.trials++, this.betweenSeen = false;
       this.inTrial = true;
+      if (this.drop && this.dropped === null) this.loseConnection();
       this.half = m.half_width, this.steering = m.steering, this.ask = !!m.ask, this.askAfterMs = 1000 * (m.ask_after_hold_s ?? 1);
       this.drawn = [], this.trialOver = false, this.answering = -1;  // a new graph: a new trial (the page forgets the last one's question)
     } else if (m.op === "role") {
@@ -246,7 +263,7 @@ export class SimParticipant {
   }
   summary() {
     const s = this.stats;
-    const online = this.online ? { trials: this.trials, code: this.code, refused: this.refused, pongs: this.pongs } : {};
+    const online = this.online ? { trials: this.trials, code: this.code, refused: this.refused, pongs: this.pongs, dropped: this.dropped || null } : {};
     return { sent: s.sent, acks: s.acks, rtt_median_ms: pct(s.rtts, 0.5), rtt_p99_ms: pct(s.rtts, 0.99), holds: s.holds, answers: s.answers,
              closes: s.closes, errors: s.errors, ...online };
   }
@@ -353,9 +370,12 @@ async function main(argv) {
     ? await (await import("playwright-core")).chromium.launch({ executablePath: "/usr/bin/chromium", args: ["--headless", "--no-sandbox", "--disable-gpu"] })
     : null;
   const people = lines.map((line, i) => {
-    const [url, token] = line.trim().split(/\s+/);
-    if (!/^https?:\/\//.test(url ?? "") || !token) throw new Error(`${files[0]}:${i + 1}: expected "URL TOKEN", got '${line}'`);
-    const o = { url, token, primitives: prims, seed: i + 1, reportError: opts.reportError, speed: opts.speed, online: opts.online };
+    const [url, token, extra, more] = line.trim().split(/\s+/);
+    const drop = /^drop:(\d+(?:\.\d+)?):(\d+(?:\.\d+)?)$/.exec(extra ?? "");
+    if (!/^https?:\/\//.test(url ?? "") || !token || (extra && !drop) || more || (drop && i < opts.chromium))
+      throw new Error(`${files[0]}:${i + 1}: expected "URL TOKEN" or "URL TOKEN drop:AT:AWAY" (seconds; not for a --chromium participant), got '${line}'`);
+    const o = { url, token, primitives: prims, seed: i + 1, reportError: opts.reportError, speed: opts.speed, online: opts.online,
+                drop: drop ? { at: Number(drop[1]), away: Number(drop[2]) } : null };
     return i < opts.chromium ? new ChromiumParticipant(o, browser) : new SimParticipant(o);
   });
   for (const p of people) if (p.open) await p.open();
