@@ -5,11 +5,12 @@
 ///   - Connect() resolves `host`, connects, sends the upgrade request for `path_and_query` (e.g.
 ///     "/subject/ws?token=T") and checks the server's 101 answer, all within `timeout`. Errors
 ///     name host:port and the path without its query (the query holds a token):
-///       NotFound  nothing listens there (connection refused, or no answer within the timeout),
-///                 the case to retry while a graph starts;
-///       IOError   the server answered the handshake with another status (the status and the
-///                 first line of its body in the message), or closed it unanswered, or the
-///                 host cannot be resolved.
+///       NotFound  nothing listens there (connection refused, or no TCP connection within the
+///                 timeout): the case to retry while a graph starts;
+///       IOError   the server answered the handshake with another status than 101 (the status
+///                 and the first line of its body in the message), closed it unanswered (a
+///                 WebServer with `tokens` refusing), gave no whole answer within the timeout,
+///                 or the host cannot be resolved.
 ///   - After the handshake, one thread of the client's own reads: `on_text` runs on it for each
 ///     text frame, in order, possibly before Connect has returned (a server's first frame): a
 ///     callback that uses the returned WsClient must wait for it (a mutex held around Connect and
@@ -22,14 +23,14 @@
 ///     A write blocks while the peer's receive window is full, at most kWriteTimeout.
 ///   - Close(): idempotent, from any thread (a callback included). Sends a close frame (1000),
 ///     shuts the socket down, and when called from another thread waits for the reading thread:
-///     no callback runs after it returns, and none starts during it. From a callback of its own
+///     no callback runs after it returns. From a callback of its own
 ///     the reading thread ends after that callback returns, and runs none after it. Do not hold,
 ///     while calling Close() or ~WsClient from another thread, a lock the callbacks take.
 ///   - ~WsClient(): Close(). A WsClient may be destroyed inside its own callback.
 ///
 /// Why not civetweb's mg_connect_websocket_client (libcivetweb 1.15): it has no timeout for the
 /// connection or the handshake, mg_close_connection waits for its reading thread's poll quantum
-/// (up to 2 s per close), and it cannot be closed from its own callback (it would join itself,
+/// (SOCKET_TIMEOUT_QUANTUM, 2 s, per close), and it cannot be closed from its own callback (it would join itself,
 /// then free the connection its thread still uses). The protocol a client needs (RFC 6455: the
 /// upgrade, masked frames out, unmasked frames in) is small; this is it.
 #pragma once
