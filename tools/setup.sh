@@ -15,6 +15,7 @@ packages=(
   gdb  # the stacks of a process a test finds hung (tests' ChildProcess::Stacks, multihost_test.sh)
   slurm-wlm munge  # `dyad sweep --slurm` tested against a single-node Slurm (tools/sweep/test)
   graphviz  # `dyad graph --svg`
+  haproxy  # two `dyad study serve` instances behind one address (tools/study/test/serve_haproxy_test.sh)
   clang-format-14  # tools/format_check.sh (.clang-format on changed lines, first in .ci/run)
   cyclonedds-dev cyclonedds-tools  # the fake ROS 2 arm and wire peer (tests/ros2), as rmw_cyclonedds speaks
 )
