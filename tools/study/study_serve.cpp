@@ -3,6 +3,7 @@
 #include <signal.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <fstream>
@@ -90,7 +91,9 @@ int Serve(const ServeOptions& o) {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, &old_int);
   sigaction(SIGTERM, &sa, &old_term);
-  OnlineFront front(s, FrontOptions{tools::ThisExecutable(), max_sessions});
+  // A trial's graph waits for the page (it comes back at once after the 1012), at most
+  // reconnect_s: the web component's wait does not end on SIGINT, so a stop waits for it too.
+  OnlineFront front(s, FrontOptions{tools::ThisExecutable(), max_sessions, std::min(15.0, s.online.reconnect_s)});
   auto server = web::WebServer::Start(ServerOptions(o, &admission, &front, max_sessions));
   if (!server.ok()) {
     std::cerr << "dyad study serve: " << server.status().ToString() << "\n";

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# What goes wrong online (#45 item 3), through `dyad study serve` with scripted pages
+# (serve_cases.mjs): unknown tokens (404, an address guessing 429), a link open twice (1008),
+# max_sessions (come back later), a page lost for less and more than reconnect_s mid-trial, and
+# the front restarted by SIGTERM and by SIGKILL mid-trial. Trials of 4 s on a small graph.
+#   serve_test.sh REPO BUILD_DIR WORK_DIR
+set -euo pipefail
+repo=$1 build=$2 work=$3
+source "$repo/tests/support/web_test.sh"
+require_node
+fresh_dir "$work"
+ln -s "$node_modules" node_modules  # the script imports ws from beside itself
+cp "$repo/tools/study/test/serve_cases.mjs" .
+cat > g.yaml <<YAML
+graph: g
+clock: wall
+domain_id: $(test_domain)
+topics:
+  web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
+components:
+  web: {type: web, rate_hz: 30, params: {port: 0}, outputs: {pointer: web/pointer}}
+  human: {type: web_human, rate_hz: 20, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
+  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input]}}
+YAML
+echo "I agree to take part in this test study." > consent.txt
+cat > s.yaml <<YAML
+study: serve_test
+graph: g.yaml
+participants: [P01, P02, P03, P04]
+conditions:
+  low: {human.engage_timeout_s: 0.3}
+  high: {human.engage_timeout_s: 0.4}
+duration: 4
+blind: true
+online: {reconnect_s: 2, max_sessions: 2, consent: consent.txt}
+YAML
+"$build/bin/dyad" study links s.yaml --base-url http://127.0.0.1:8443 > /dev/null
+node serve_cases.mjs "$build/bin/dyad" s.yaml serve_test-data
+# Killed or stopped, the front leaves no trial's graph behind (each ends by its parent-death signal).
+for _ in $(seq 50); do pgrep -f "$work/serve_test-data" > /dev/null || break; sleep 0.2; done
+if pgrep -fa "$work/serve_test-data"; then fail "a trial's graph outlived dyad study serve"; fi
+echo "serve_test: every case passed"
