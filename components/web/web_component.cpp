@@ -631,10 +631,13 @@ void WebComponent::WaitForSubject(double seconds) {
 void WebComponent::StepPause(int64_t now) {
   if (!pause_without_subject_ || (after_trial_ && asking_)) return;
   const bool there = subject_->steered();
+  const std::string text = there ? "resumed: the subject's page is back" : "paused: the subject's page is gone";
   {
     std::lock_guard<std::mutex> lock(pointer_mutex_);
     if (there != paused_) return;
     paused_ = !there;
+    // The mark first: what web_human does on the sample below comes after it in the recording.
+    Mark(text);
     msg::HumanInput sample = pointer_sample_;
     sample.engaged(false);
     if (paused_) {
@@ -648,11 +651,11 @@ void WebComponent::StepPause(int64_t now) {
   }
   if (!there) ++pauses_, pause_start_ns_ = now;
   else paused_ns_ += now - pause_start_ns_;
-  Mark(there ? "resumed: the subject's page is back" : "paused: the subject's page is gone");
+  ctx_->log().Info(text + " (params.pause_without_subject)");
 }
 
+// A note by "web" on `notes` (recorded beside the experimenter's).
 void WebComponent::Mark(const std::string& text) {
-  ctx_->log().Info(text + " (params.pause_without_subject)");
   std::lock_guard<std::mutex> lock(notes_mutex_);
   msg::Annotation mark;
   mark.author("web");

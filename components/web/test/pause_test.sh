@@ -4,7 +4,8 @@
 # (author web: "paused: the subject's page is gone", then "resumed: the subject's page is back"),
 # hold commands from the mixer between them (web_human went silent after one release, so the
 # mixer's human input went stale), motion commands before the pause and after the resume, and
-# no human/input sample inside the pause but the one release.
+# no human/input sample inside the pause but the release (web_human's step may also have taken
+# the page's own last release just before the marker arrived: then two, both in the first 0.5 s).
 #   pause_test.sh BUILD_DIR WORK_DIR TEST_PLUGIN
 set -euo pipefail
 build=$1
@@ -54,15 +55,18 @@ away = (resumed - paused) * 1e-9
 if not 2.0 <= away <= 4.5: fail("paused for %.2f s; the page was away 2.5 s" % away)
 truth = lambda v: v in ("1", "true")
 commands = [(int(r["header.stamp_ns"]), truth(r["hold"])) for r in rows("robot_command.csv")]
-# The mixer's human input goes stale 0.5 s (its stale_timeout_s) after web_human's last sample.
-inside = [h for t, h in commands if paused + 0.7e9 <= t <= resumed]
+# The mixer's human input goes stale 0.5 s (its stale_timeout_s) after web_human's last sample,
+# which comes within its next step or two (10 Hz); margins for a loaded machine.
+inside = [h for t, h in commands if paused + 1.0e9 <= t <= resumed]
 before = [h for t, h in commands if paused - 1.5e9 <= t <= paused]
-after = [h for t, h in commands if resumed + 0.5e9 <= t]
+after = [h for t, h in commands if resumed + 0.8e9 <= t]
 if len(inside) < 10 or not all(inside): fail("%d of the %d commands in the pause are holds" % (sum(inside), len(inside)))
 if len(before) < 5 or any(before): fail("%d of the %d commands before the pause are holds" % (sum(before), len(before)))
 if len(after) < 5 or any(after): fail("%d of the %d commands after the resume are holds" % (sum(after), len(after)))
 human = [(int(r["header.stamp_ns"]), truth(r["engaged"])) for r in rows("human_input.csv")]
-during = [e for t, e in human if paused < t < resumed]
-if during != [False]: fail("human/input in the pause: %s (want one release, then nothing)" % during)
+during = [(t - paused) * 1e-9 for t, e in human if paused < t < resumed]
+engaged = [e for t, e in human if paused < t < resumed and e]
+if not 1 <= len(during) <= 2 or engaged or max(during) > 0.5:
+    fail("human/input in the pause at %s s (want a release in its first 0.5 s, then nothing)" % during)
 print("PASS: paused %.2f s; %d hold commands inside, none in the %d before or the %d after" % (away, len(inside), len(before), len(after)))
 PY

@@ -45,7 +45,8 @@ for token, c in zip(tokens, clients):
     if f["between"]: fail(token + ": %d pointer samples between trials" % f["between"])
     lost = token == "sim-six-token"
     if (c.get("dropped") is not None) != lost or f["returns"] != int(lost): fail(token + ": dropped %s, came back %d times in a trial" % (c.get("dropped"), f["returns"]))
-    if lost and not 1000 <= f["away_ms"] <= 1800: fail(token + ": away %d ms (drop:1:1)" % f["away_ms"])
+    # Measured at the front: from its socket's close event (a few ms after the client's end).
+    if lost and not 900 <= f["away_ms"] <= 2000: fail(token + ": away %d ms (drop:1:1)" % f["away_ms"])
 print("PASS: " + "; ".join("%s: %d trials, code %s, %d samples in trials (%d engaged), %d pongs"
                            % (t, front[t]["trials"], c["code"], front[t]["in_trial"], front[t]["engaged"], front[t]["pongs"])
                            for t, c in zip(tokens[:4], clients)) + "; sim-six-token away %d ms" % front["sim-six-token"]["away_ms"])
