@@ -116,6 +116,50 @@ TEST_F(SecurityTest, AGuestPublishesWhatTheGraphGrantsItAndNothingElse) {
   EXPECT_TRUE(ReadSink(dir_ / "sink2.txt").empty());
 }
 
+// `dyad security export`: each host runs from its own subset (its host identity and its
+// processes' only) and the secured graph delivers across the two; a host that starts with the
+// other host's subset is refused before anything starts, naming the identity it lacks, the host
+// the subset is for and the export that would give it.
+TEST_F(SecurityTest, EachHostRunsFromItsOwnExportAndNotFromAnothers) {
+  auto graph = [&](const std::string& keystore) {
+    return "graph: subsets\nclock: wall\ndomain_id: " + std::to_string(domain_) +
+           "\nnetwork:\n  discovery: peers\n  hosts: {h1: 127.0.0.1, h2: 127.0.0.1}\n  start_timeout_s: 30\n"
+           "security: {keystore: " +
+           keystore +
+           "}\n"
+           "processes: {a: {host: h1}, b: {host: h2}}\ncomponents:\n"
+           "  src: {type: counter_source, rate_hz: 50, process: a, outputs: {out: count}}\n"
+           "  sink: {type: counter_sink, trigger: in, process: b, params: {file: " +
+           (dir_ / "sink.txt").string() + "}, inputs: {in: count}}\n";
+  };
+  const fs::path whole = Write("g.yaml", graph("keys"));
+  ASSERT_EQ(Init(dir_ / "keys", whole), 0);
+  for (const char* host : {"h1", "h2"}) {
+    Child e(Dyad({"security", "export", (dir_ / "keys").string(), "--graph", whole.string(), "--host", host,
+                  (dir_ / (std::string(host) + "_keys")).string()}),
+            dir_, std::string("export_") + host);
+    ASSERT_EQ(e.Wait(60), 0) << e.err();
+  }
+  ASSERT_FALSE(fs::exists(dir_ / "h1_keys" / "identities" / "process.b"));
+  const fs::path on_h1 = Write("h1.yaml", graph("h1_keys")), on_h2 = Write("h2.yaml", graph("h2_keys"));
+  Child a(Dyad({"run", on_h1.string(), "--host", "h1", "--steps", "40"}), dir_, "a");
+  Child b(Dyad({"run", on_h2.string(), "--host", "h2", "--steps", "40"}), dir_, "b");
+  EXPECT_EQ(a.Wait(90), 0) << a.err();
+  EXPECT_EQ(b.Wait(90), 0) << b.err();
+  EXPECT_GE(ReadSink(dir_ / "sink.txt").size(), 30u) << a.err() << b.err();
+
+  Child wrong(Dyad({"run", on_h2.string(), "--host", "h1", "--steps", "5"}), dir_, "wrong");
+  EXPECT_EQ(wrong.Wait(60), 2);
+  EXPECT_NE(wrong.err().find("identity 'process.a' is not in keystore " + (dir_ / "h2_keys").string() +
+                             ": it is the subset for host 'h2' (" + (dir_ / "h2_keys" / "subset.yaml").string() +
+                             "), which holds only process.b, host.h2; on the machine with the whole keystore, "
+                             "`dyad security export " +
+                             (dir_ / "keys").string() + " --graph " + whole.string() + " --host h1 OUT`"),
+            std::string::npos)
+      << wrong.err();
+  EXPECT_NE(wrong.err().find("identity 'host.h1' is not in keystore"), std::string::npos) << wrong.err();
+}
+
 TEST_F(SecurityTest, AProcessCannotPublishWhatItsPermissionsDoNotGrant) {
   const fs::path graph = Write("g.yaml", Graph("keys"));
   ASSERT_EQ(Init(dir_ / "keys", graph), 0);

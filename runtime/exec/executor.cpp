@@ -7,6 +7,7 @@
 #include <set>
 
 #include <dyad/msg/types.hpp>
+#include <dyad/security.hpp>
 
 #include "dds/dds_participant.hpp"
 #include "graph/graph_topics.hpp"
@@ -336,6 +337,8 @@ Status Executor::CreateTransport() {
   po.network = graph_.network;
   po.process = options_.process;
   po.partitions = {RunPartition(graph_)};
+  // A keystore subset of another machine does not hold this process's identity: say which does.
+  if (Status s = CheckIdentityHeld(graph_, ProcessIdentity(options_.process)); !s.ok()) return s;
   po.security = IdentityOf(graph_, ProcessIdentity(options_.process));
   po.on_problem = [this](const std::string& msg) {
     ++problems_;

@@ -5,6 +5,7 @@
 #include <fnmatch.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include <openssl/evp.h>
 #include <openssl/pem.h>
 #include <openssl/x509.h>
+#include <yaml-cpp/yaml.h>
 
 namespace dyad {
 namespace {
@@ -70,7 +72,82 @@ std::string CheckKeyMatchesCertificate(const std::string& cert_path, const std::
   return key_path + ": not the key of " + cert_path + " (renew the pair: dyad security init --renew)";
 }
 
+// Whom the subset is for, for messages: "host 'robot'", "the guest", "host 'lab' and the guest".
+std::string SubsetFor(const KeystoreSubset& s) {
+  const std::string host = s.host.empty() ? "" : "host '" + s.host + "'";
+  if (!s.guest) return host;
+  return host.empty() ? "the guest" : host + " and the guest";
+}
+
+// The export option that gives `identity`: "--host lab" or "--guest".
+std::string ExportOptionFor(const Graph& graph, const std::string& identity) {
+  if (identity == kGuestIdentity) return "--guest";
+  const std::string host = "host.", process = "process.";
+  if (identity.rfind(host, 0) == 0) return "--host " + identity.substr(host.size());
+  const std::string name = identity.substr(identity.rfind(process, 0) == 0 ? process.size() : 0);
+  if (const ProcessConfig* p = graph.FindProcess(name); p != nullptr && !p->host.empty()) return "--host " + p->host;
+  return "--host " + IdentityHosts(graph).front();  // a process on no host runs on every one
+}
+
 }  // namespace
+
+StatusOr<KeystoreSubset> ReadKeystoreSubset(const std::string& keystore) {
+  KeystoreSubset subset;
+  const std::string path = FileIn(keystore, kSubsetFile);
+  struct stat st {};
+  if (lstat(path.c_str(), &st) != 0) return subset;
+  if (std::string problem = CheckFile(path, false); !problem.empty()) return Status::InvalidArgument(problem);
+  const std::string made = " (made by `dyad security export`: export again, or remove it from a whole keystore)";
+  try {
+    const YAML::Node doc = YAML::LoadFile(path);
+    if (!doc.IsMap()) return Status::InvalidArgument(path + ": not a map of host, guest, graph and from" + made);
+    for (const auto& kv : doc) {
+      const std::string key = kv.first.as<std::string>();
+      if (key == "host") subset.host = kv.second.as<std::string>();
+      else if (key == "guest") subset.guest = kv.second.as<bool>();
+      else if (key == "graph") subset.graph_file = kv.second.as<std::string>();
+      else if (key == "from") subset.source = kv.second.as<std::string>();
+      else return Status::InvalidArgument(path + ": unknown key '" + key + "' (host, guest, graph, from)" + made);
+    }
+  } catch (const YAML::Exception& e) {
+    return Status::InvalidArgument(path + ": " + e.what() + made);
+  }
+  if (subset.host.empty() && !subset.guest) return Status::InvalidArgument(path + ": says neither a host nor guest: true" + made);
+  subset.whole = false;
+  return subset;
+}
+
+std::vector<std::string> SubsetIdentities(const Graph& graph, const KeystoreSubset& subset) {
+  if (subset.whole) return GraphIdentities(graph);
+  std::vector<std::string> out;
+  if (!subset.host.empty()) {
+    for (const std::string& p : graph.ProcessNames()) {  // sorted
+      const ProcessConfig* config = graph.FindProcess(p);
+      const std::string where = config == nullptr ? "" : config->host;
+      if (where == subset.host || where.empty()) out.push_back(ProcessIdentity(p));
+    }
+    out.push_back(HostIdentity(subset.host));
+  }
+  if (subset.guest) out.push_back(kGuestIdentity);
+  return out;
+}
+
+Status CheckIdentityHeld(const Graph& graph, const std::string& identity) {
+  if (!graph.security.enabled()) return Status::OK();
+  auto subset = ReadKeystoreSubset(graph.security.keystore);
+  if (!subset.ok()) return subset.status();
+  const std::vector<std::string> held = SubsetIdentities(graph, subset.value());
+  if (std::find(held.begin(), held.end(), identity) != held.end()) return Status::OK();
+  std::string list;
+  for (const std::string& h : held) list += (list.empty() ? "" : ", ") + h;
+  const KeystoreSubset& s = subset.value();
+  return Status::FailedPrecondition(
+      "identity '" + identity + "' is not in keystore " + graph.security.keystore + ": it is the subset for " + SubsetFor(s) +
+      " (" + FileIn(graph.security.keystore, kSubsetFile) + "), which holds only " + list +
+      "; on the machine with the whole keystore, `dyad security export " + (s.source.empty() ? "KEYSTORE" : s.source) +
+      " --graph " + (s.graph_file.empty() ? graph.file : s.graph_file) + " " + ExportOptionFor(graph, identity) +
+      " OUT` makes the subset that holds it (copy OUT here as the keystore)");
+}
 
 std::string ProcessIdentity(const std::string& process) { return "process." + process; }
 std::string HostIdentity(const std::string& host) { return "host." + host; }
@@ -143,8 +220,23 @@ std::vector<std::string> CheckKeystore(const Graph& graph, int64_t now_s) {
   if (std::string problem = CheckFile(FileIn(graph.security.keystore, kNamesKeyFile), true); !problem.empty())
     problems.push_back(problem + " (the keystore's names key: make it with `dyad security init " + graph.security.keystore +
                        " --graph " + graph.file + "`)");
+  auto subset = ReadKeystoreSubset(graph.security.keystore);
+  if (!subset.ok()) {
+    problems.push_back(subset.status().message());
+    return problems;
+  }
+  if (!subset.value().whole) {
+    const std::vector<std::string> hosts = IdentityHosts(graph);
+    const std::string file = FileIn(graph.security.keystore, kSubsetFile);
+    if (!subset.value().host.empty() && std::find(hosts.begin(), hosts.end(), subset.value().host) == hosts.end())
+      problems.push_back(file + ": the subset for host '" + subset.value().host + "', which is none of graph '" + graph.name +
+                         "''s hosts (export the subset of this machine's host from the whole keystore)");
+    if (subset.value().guest && !graph.security.guests)
+      problems.push_back(file + ": the guest's subset, and the graph has no security.guests");
+    if (!problems.empty()) return problems;
+  }
   std::set<std::string> checked;
-  for (const std::string& identity : GraphIdentities(graph)) {
+  for (const std::string& identity : SubsetIdentities(graph, subset.value())) {
     const IdentityFiles f = IdentityOf(graph, identity);
     for (const auto& [path, secret, certificate] : {std::tuple{f.identity_ca, false, true}, {f.permissions_ca, false, true},
                                                     {f.governance, false, false}, {f.certificate, false, true},

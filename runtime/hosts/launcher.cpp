@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "dyad/interrupt.hpp"
+#include "dyad/security.hpp"
 #include "dyad/thread_annotations.hpp"
 #include "hosts/launcher_link.hpp"
 #include "hosts/output_relay.hpp"
@@ -59,6 +60,23 @@ std::vector<std::string> ProcessesHere(const RunOptions& options, const Graph& g
     names.push_back(p);
   }
   return names;
+}
+
+// In a secured graph, whether the keystore holds the identities of this host's launcher and of
+// `names`: a subset exported for another machine does not (dyad/security.hpp); says each one
+// missing, and the export that gives it, before anything starts.
+bool IdentitiesHeld(const RunOptions& options, const Graph& graph, const std::vector<std::string>& names, std::ostream& err) {
+  if (!graph.security.enabled()) return true;
+  std::vector<std::string> needed;
+  if (auto host = HostIdentityFor(graph, ThisHost(options)); host.ok()) needed.push_back(host.value());
+  for (const std::string& p : names) needed.push_back(ProcessIdentity(p));
+  bool ok = true;
+  for (const std::string& identity : needed)
+    if (Status s = CheckIdentityHeld(graph, identity); !s.ok()) {
+      err << options.graph_path << ": " << s.message() << "\n";
+      ok = false;
+    }
+  return ok;
 }
 
 bool RunsServerHere(const Graph& graph, const RunOptions& options) {
@@ -320,6 +338,7 @@ int LaunchChildren(const RunOptions& options, const Graph& graph, std::ostream& 
     err << options.graph_path << ": no process of the graph is placed on host '" << ThisHost(options) << "'\n";
     return 2;
   }
+  if (!IdentitiesHeld(options, graph, names, err)) return 2;
   Supervision supervision(options, graph, std::move(names), runs_server, out, err);
   return supervision.Run();
 }

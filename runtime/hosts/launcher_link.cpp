@@ -7,9 +7,10 @@
 #include <set>
 #include <thread>
 
-#include <dyad/message_traits.hpp>
 #include <dyad/join_list.hpp>
+#include <dyad/message_traits.hpp>
 #include <dyad/msg/types.hpp>
+#include <dyad/security.hpp>
 
 #include "graph/run_partition.hpp"
 #include "dds/dds_participant.hpp"
@@ -36,6 +37,7 @@ StatusOr<std::unique_ptr<LauncherLink>> LauncherLink::Open(const Graph& graph, c
   if (graph.security.enabled()) {
     auto identity = HostIdentityFor(graph, host);
     if (!identity.ok()) return identity.status();
+    if (Status s = CheckIdentityHeld(graph, identity.value()); !s.ok()) return s;
     po.security = IdentityOf(graph, identity.value());
   }
   auto p = DdsParticipant::Create(graph.domain_id, LauncherParticipantName(host), std::move(po));

@@ -92,6 +92,10 @@ bool PublishAsGuest(const std::optional<Graph>& graph, const std::vector<std::st
                 << sec.guests_mark.ToString() << "), then " << init << "\n";
       ok = false;
     }
+  if (Status s = CheckIdentityHeld(*graph, kGuestIdentity); ok && !s.ok()) {
+    std::cerr << tool << ": " << s.message() << "\n";
+    ok = false;
+  }
   if (ok) st->opts.security = IdentityOf(*graph, kGuestIdentity);
   return ok;
 }

@@ -13,6 +13,7 @@
 
 #include "exit_code.hpp"
 #include "keystore.hpp"
+#include "keystore_export.hpp"
 
 namespace dyad::cli {
 
@@ -46,6 +47,45 @@ int LoadForKeystore(const std::string& path, const std::vector<std::string>& set
   return tools::Code(kBadInput);
 }
 
+// `dyad security export KEYSTORE --graph G (--host H | --guest) OUT` (keystore_export.hpp).
+void AddExportCommand(CLI::App& security, int& exit_code) {
+  struct State {
+    ExportOptions options;
+    std::string graph;
+    std::vector<std::string> sets;
+  };
+  auto st = std::make_shared<State>();
+  auto* cmd = security.add_subcommand(
+      "export",
+      "Write OUT, the part of KEYSTORE one machine needs: CA certificates (no CA key), governance, names.key "
+      "and only its identities (--host H: H's launcher and watchers and the processes on H; --guest: the guest's)");
+  cmd->add_option("keystore", st->options.keystore, "The whole keystore (dyad security init's)")->required();
+  cmd->add_option("out", st->options.out, "The new folder to write (must not exist); copy it to the machine as its keystore")
+      ->required();
+  cmd->add_option("--graph", st->graph, "The graph")->required();
+  cmd->add_option("--host", st->options.host, "The host whose identities to export");
+  cmd->add_flag("--guest", st->options.guest, "The guest identity (security.guests), for a machine that is none of the hosts");
+  cmd->add_option("--set", st->sets, "Change a key of the graph, as `dyad run --set` does");
+  cmd->callback([st, &exit_code] {
+    std::vector<Diagnostic> diags;
+    std::vector<Override> overrides;
+    for (const std::string& s : st->sets) overrides.push_back(Override{s});
+    const Graph graph = LoadGraph(st->graph, overrides, &diags);
+    for (const auto& d : diags) std::cerr << d.ToString() << "\n";
+    if (!diags.empty()) {
+      exit_code = tools::Code(kBadInput);
+      return;
+    }
+    if (Status s = ExportKeystore(graph, st->options, std::cout); !s.ok()) {
+      std::cerr << "dyad security export: " << s.message() << "\n";
+      exit_code = tools::Code(kBadInput);
+      return;
+    }
+    std::cout << "subset " << st->options.out << ": copy it to the machine and name it in the graph's security.keystore there\n";
+    exit_code = tools::Code(kOk);
+  });
+}
+
 }  // namespace
 
 void AddSecurityCommands(CLI::App& app, int& exit_code) {
@@ -73,6 +113,12 @@ void AddSecurityCommands(CLI::App& app, int& exit_code) {
                    "valid for this DNS name or address (repeatable)");
   init->add_option("--ca-days", st->keystore.ca_days, "Validity of new CAs, days (default 3650)")->check(CLI::Range(1, 36500));
   init->callback([st, &exit_code] {
+    if (auto subset = ReadKeystoreSubset(st->keystore.dir); subset.ok() && !subset.value().whole) {
+      std::cerr << "dyad security init: " << st->keystore.dir << " is a subset (" << kSubsetFile
+                << ", made by `dyad security export`): init works on the whole keystore; run it there, then export again\n";
+      exit_code = tools::Code(kBadInput);
+      return;
+    }
     Graph graph;
     std::map<std::string, TopicAccess> access;
     if ((exit_code = LoadForKeystore(st->graph, st->sets, st->plugins, &graph, &access)) != 0) return;
@@ -95,6 +141,7 @@ void AddSecurityCommands(CLI::App& app, int& exit_code) {
               << " identities; the graph uses it with `security: {keystore: " << st->keystore.dir << "}`\n";
     exit_code = tools::Code(kOk);
   });
+  AddExportCommand(*security, exit_code);
 }
 
 }  // namespace dyad::cli

@@ -19,8 +19,12 @@ std::string MachineName() {
 
 // The identity a visitor of the secured `graph` joins with: its host's; on a machine that is none
 // of the graph's hosts (no --host), the guest's for a tool that may be one (`as_guest`).
-StatusOr<std::string> JoiningIdentity(const Graph& graph, const std::string& graph_path, const std::string& host,
+// A keystore subset made for host H (dyad security export) says this machine is H unless --host
+// says otherwise.
+StatusOr<std::string> JoiningIdentity(const Graph& graph, const std::string& graph_path, const std::string& given_host,
                                       bool* as_guest) {
+  std::string host = given_host;
+  if (auto subset = ReadKeystoreSubset(graph.security.keystore); host.empty() && subset.ok()) host = subset.value().host;
   const std::string machine = host.empty() ? MachineName() : host;
   auto identity = HostIdentityFor(graph, machine);
   if (identity.ok() || !host.empty()) return identity;
@@ -83,6 +87,10 @@ bool LoadWatcherCatalog(const std::string& graph_path, std::vector<std::string> 
       auto identity = JoiningIdentity(graph, graph_path, host, as_guest);
       if (!identity.ok()) std::cerr << graph_path << ": " << identity.status().message() << "\n";
       if (!identity.ok()) return false;
+      if (Status s = CheckIdentityHeld(graph, identity.value()); !s.ok()) {
+        std::cerr << graph_path << ": " << s.message() << "\n";
+        return false;
+      }
       options->security = IdentityOf(graph, identity.value());
     }
   }

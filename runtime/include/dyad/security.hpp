@@ -30,6 +30,15 @@
 // Loading a graph checks the keystore (CheckKeystore): every identity the graph needs is there,
 // no private key is readable by others or a symbolic link, every certificate is valid now. Fast
 // DDS 2.9 has no secure discovery server, so `discovery: server` with security is refused.
+//
+// A keystore subset (`dyad security export`, tools/dyad/keystore_export.hpp) is what one machine
+// of the graph holds: the CA certificates (no CA key), the governance, names.key and only that
+// machine's identities, with subset.yaml saying whom it is for (`host: H`: H's host identity and
+// the processes the graph places on H or on no host; `guest: true`: the guest identity; both
+// together: both). CheckKeystore then checks only those identities, and whatever needs another
+// identity (a process, a launcher, a tool) is refused by CheckIdentityHeld, naming the identity,
+// whom the subset is for, and the export that would give it. A keystore without subset.yaml is
+// whole: every identity is checked, as before.
 #pragma once
 
 #include <cstdint>
@@ -76,7 +85,28 @@ IdentityFiles IdentityOf(const Graph& graph, const std::string& identity);
 // NotFound otherwise, saying exactly what to pass ("--host lab or --host robot").
 StatusOr<std::string> HostIdentityFor(const Graph& graph, const std::string& host);
 
-// The keystore's files for every identity of the graph exist as regular files (not symbolic
+inline constexpr const char* kSubsetFile = "subset.yaml";
+
+// What a keystore holds: everything (whole), or one machine's identities (subset.yaml).
+struct KeystoreSubset {
+  bool whole = true;
+  std::string host;        // the host whose identities it holds; empty: none
+  bool guest = false;      // it holds the guest identity
+  std::string source;      // the whole keystore it was exported from (on the machine that did it)
+  std::string graph_file;  // the graph file export was given
+};
+// The keystore's subset.yaml (whole when there is none); an unreadable or malformed one, or one
+// that is a symbolic link, is an error naming the file.
+StatusOr<KeystoreSubset> ReadKeystoreSubset(const std::string& keystore);
+// The identities a subset of `graph`'s keystore holds (GraphIdentities for a whole one).
+std::vector<std::string> SubsetIdentities(const Graph& graph, const KeystoreSubset& subset);
+// OK when the graph is not secured or its keystore holds `identity`; else FailedPrecondition:
+// "identity 'process.arm' is not in keystore K: it is the subset for host 'robot' (K/subset.yaml)
+// ...; `dyad security export SOURCE --graph G --host lab OUT` on the machine with the whole
+// keystore makes the one that holds it".
+Status CheckIdentityHeld(const Graph& graph, const std::string& identity);
+
+// The keystore's files for every identity of the graph (of its subset: SubsetIdentities) exist as regular files (not symbolic
 // links), private keys are not readable by group or others, certificates are valid at
 // `now_s` (Unix seconds). Returns the problems, each naming its file.
 std::vector<std::string> CheckKeystore(const Graph& graph, int64_t now_s);

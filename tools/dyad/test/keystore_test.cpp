@@ -9,6 +9,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 
 #include <dyad/security.hpp>
@@ -421,6 +422,156 @@ TEST_F(KeystoreTest, AWatcherOnAMachineThatIsNoneOfTheHostsIsToldWhatToPass) {
       dyad::testing::RunCommand(AddRuntimeCommands, {"graph", "--live", (dir_ / "hosts.yaml").string(), "--host", "nowhere"});
   EXPECT_EQ(live.code, 2);
   EXPECT_NE(live.err.find("this machine ('nowhere') is none of the graph's hosts"), std::string::npos) << live.err;
+}
+
+// A graph on two hosts (pub on lab, rec on robot) with guests, for `dyad security export`.
+constexpr char kPlacedGraph[] =
+    "graph: sec\nprocesses:\n  pub: {host: lab}\n  rec: {host: robot}\n"
+    "security: {keystore: keys, guests: {subscribe: [ca]}}\n"
+    "components:\n  a: {type: counter_source, rate_hz: 10, process: pub, outputs: {out: ca}}\n"
+    "  s: {type: counter_sink, trigger: in, process: rec, inputs: {in: ca}}\n";
+
+// Every file and folder under `dir`, relative, with its mode ("0600 identities/host.lab/key.pem").
+std::set<std::string> Listing(const fs::path& dir) {
+  std::set<std::string> out;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", Mode(e.path()));
+    out.insert(std::string(mode) + " " + fs::relative(e.path(), dir).string());
+  }
+  return out;
+}
+
+// What every subset holds beside its identities: the CA certificates, governance, names.key and
+// subset.yaml; never a CA key.
+std::set<std::string> SubsetBase(const std::vector<std::string>& identities) {
+  std::set<std::string> out = {"0600 identity_ca.cert.pem",
+                               "0600 permissions_ca.cert.pem",
+                               "0600 governance.xml",
+                               "0600 governance.p7s",
+                               "0600 names.key",
+                               "0600 subset.yaml",
+                               "0700 identities"};
+  for (const std::string& id : identities) {
+    out.insert("0700 identities/" + id);
+    for (const char* f : {"cert.pem", "key.pem", "permissions.xml", "permissions.p7s"})
+      out.insert("0600 identities/" + id + "/" + f);
+  }
+  return out;
+}
+
+// `dyad security export --host robot`: exactly robot's identities (its host's and its process's),
+// the CA certificates and no CA key, each file 0600 and the same bytes as the whole keystore's
+// (openssl reads each certificate's subject alike); never over an existing folder, never from a
+// subset, never for a host the graph does not have.
+TEST_F(KeystoreTest, ExportForAHostHoldsExactlyItsIdentitiesAndNoCaKey) {
+  std::ofstream(dir_ / "hosts.yaml") << kPlacedGraph;
+  const std::string graph = (dir_ / "hosts.yaml").string();
+  ASSERT_EQ(Init({}, dir_ / "hosts.yaml").code, 0);
+  ASSERT_TRUE(fs::exists(keys_ / "ca" / "identity_ca.key.pem"));
+  const fs::path out = dir_ / "robot_keys";
+  auto r = dyad::testing::RunCommand(AddSecurityCommands,
+                                     {"security", "export", keys_.string(), "--graph", graph, "--host", "robot", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(Mode(out), 0700u);
+  EXPECT_EQ(Listing(out), SubsetBase({"host.robot", "process.rec"}));
+  EXPECT_NE(ReadFile(out / "subset.yaml").find("host: robot\n"), std::string::npos) << ReadFile(out / "subset.yaml");
+  for (const char* cert :
+       {"identity_ca.cert.pem", "permissions_ca.cert.pem", "identities/host.robot/cert.pem", "identities/process.rec/cert.pem"}) {
+    int a = -1, b = -1;
+    const std::string exported = OpenSsl({"x509", "-noout", "-subject", "-in", (out / cert).string()}, &a);
+    EXPECT_EQ(a, 0) << exported;
+    EXPECT_EQ(exported, OpenSsl({"x509", "-noout", "-subject", "-in", (keys_ / cert).string()}, &b)) << cert;
+  }
+  EXPECT_EQ(ReadFile(out / "identities/process.rec/key.pem"), ReadFile(Identity("process.rec", "key.pem")));
+  EXPECT_EQ(ReadFile(out / "names.key"), ReadFile(keys_ / kNamesKeyFile));
+
+  auto again = dyad::testing::RunCommand(AddSecurityCommands,
+                                         {"security", "export", keys_.string(), "--graph", graph, "--host", "lab", out.string()});
+  EXPECT_EQ(again.code, 2);
+  EXPECT_NE(again.err.find(out.string() + ": exists (a folder): export makes a new folder"), std::string::npos) << again.err;
+  EXPECT_FALSE(fs::exists(out / "identities" / "host.lab"));
+  auto nested = dyad::testing::RunCommand(
+      AddSecurityCommands, {"security", "export", out.string(), "--graph", graph, "--host", "robot", (dir_ / "again").string()});
+  EXPECT_EQ(nested.code, 2);
+  EXPECT_NE(nested.err.find("a subset itself"), std::string::npos) << nested.err;
+  auto stranger = dyad::testing::RunCommand(
+      AddSecurityCommands, {"security", "export", keys_.string(), "--graph", graph, "--host", "nowhere", (dir_ / "x").string()});
+  EXPECT_EQ(stranger.code, 2);
+  EXPECT_NE(stranger.err.find("--host nowhere: not a host of graph 'sec' (its hosts: lab, robot)"), std::string::npos)
+      << stranger.err;
+  EXPECT_FALSE(fs::exists(dir_ / "again"));
+  EXPECT_FALSE(fs::exists(dir_ / "x"));
+}
+
+// --guest: the guest identity only; a graph without security.guests has none to export.
+TEST_F(KeystoreTest, AGuestSubsetHoldsOnlyTheGuestIdentity) {
+  std::ofstream(dir_ / "hosts.yaml") << kPlacedGraph;
+  ASSERT_EQ(Init({}, dir_ / "hosts.yaml").code, 0);
+  const fs::path out = dir_ / "guest_keys";
+  auto r = dyad::testing::RunCommand(AddSecurityCommands, {"security", "export", keys_.string(), "--graph",
+                                                           (dir_ / "hosts.yaml").string(), "--guest", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(Listing(out), SubsetBase({"guest"}));
+  EXPECT_NE(ReadFile(out / "subset.yaml").find("guest: true\n"), std::string::npos) << ReadFile(out / "subset.yaml");
+
+  const fs::path open = dir_ / "no_guests.yaml";
+  std::ofstream(open) << std::string(kPlacedGraph).replace(std::string(kPlacedGraph).find(", guests: {subscribe: [ca]}"), 27, "");
+  auto none = dyad::testing::RunCommand(
+      AddSecurityCommands, {"security", "export", keys_.string(), "--graph", open.string(), "--guest", (dir_ / "none").string()});
+  EXPECT_EQ(none.code, 2);
+  EXPECT_NE(none.err.find("--guest: graph 'sec' has no security.guests, so no guest identity"), std::string::npos) << none.err;
+  EXPECT_FALSE(fs::exists(dir_ / "none"));
+}
+
+// On a machine that holds only its subset, `dyad validate` checks that machine's identities (a
+// whole keystore would have to hold every one), a problem of one of them is still found, and a
+// tool that needs an identity the subset does not hold is refused naming it, the host the subset
+// was made for, and the export that would give it. `dyad security init` works only on the whole.
+TEST_F(KeystoreTest, ValidateOnASubsetChecksItsIdentitiesAndAnotherHostsIsRefused) {
+  std::ofstream(dir_ / "hosts.yaml") << kPlacedGraph;
+  ASSERT_EQ(Init({}, dir_ / "hosts.yaml").code, 0);
+  const fs::path out = dir_ / "robot_keys";
+  ASSERT_EQ(dyad::testing::RunCommand(AddSecurityCommands, {"security", "export", keys_.string(), "--graph",
+                                                            (dir_ / "hosts.yaml").string(), "--host", "robot", out.string()})
+                .code,
+            0);
+  std::string on_robot = kPlacedGraph;
+  on_robot.replace(on_robot.find("keystore: keys"), 14, "keystore: robot_keys");
+  const fs::path graph = dir_ / "robot.yaml";
+  std::ofstream(graph) << on_robot;
+  auto ok = dyad::testing::RunCommand(AddRuntimeCommands, {"validate", graph.string()});
+  EXPECT_EQ(ok.code, 0) << ok.err;
+
+  auto status =
+      dyad::testing::RunCommand(AddIntrospectionCommands, {"status", "--graph", graph.string(), "--host", "lab", "--wait", "0"});
+  EXPECT_EQ(status.code, 2);
+  EXPECT_NE(status.err.find("identity 'host.lab' is not in keystore " + out.string() + ": it is the subset for host 'robot' (" +
+                            (out / "subset.yaml").string() +
+                            "), which holds only process.rec, host.robot; on the machine "
+                            "with the whole keystore, `dyad security export " +
+                            keys_.string() + " --graph " + (dir_ / "hosts.yaml").string() +
+                            " --host lab OUT` makes the subset that holds it"),
+            std::string::npos)
+      << status.err;
+  auto here = dyad::testing::RunCommand(AddIntrospectionCommands, {"status", "--graph", graph.string(), "--wait", "0"});
+  EXPECT_EQ(here.err.find("none of the graph's hosts"), std::string::npos) << "the subset says which host this is: " << here.err;
+  EXPECT_EQ(here.err.find("is not in keystore"), std::string::npos) << here.err;
+
+  fs::remove(out / "identities" / "process.rec" / "permissions.p7s");
+  auto broken = dyad::testing::RunCommand(AddRuntimeCommands, {"validate", graph.string()});
+  EXPECT_EQ(broken.code, 2);
+  EXPECT_NE(broken.err.find("identity 'process.rec': " + (out / "identities/process.rec/permissions.p7s").string() + ": missing"),
+            std::string::npos)
+      << broken.err;
+  EXPECT_EQ(broken.err.find("process.pub"), std::string::npos) << broken.err;
+
+  auto init = dyad::testing::RunCommand(AddSecurityCommands, {"security", "init", out.string(), "--graph", graph.string()});
+  EXPECT_EQ(init.code, 2);
+  EXPECT_NE(init.err.find("is a subset (subset.yaml, made by `dyad security export`): init works on the whole keystore"),
+            std::string::npos)
+      << init.err;
+  EXPECT_FALSE(fs::exists(out / "identities" / "process.pub"));
 }
 
 TEST_F(KeystoreTest, SecurityWithADiscoveryServerIsRefused) {
