@@ -2,7 +2,8 @@
 # docs/security.md's walk-through "Admitting a new machine with the CA on a USB key", run as
 # written (the sh block after its marker), then what it promises checked from outside: the CA
 # keys are off the keystore, the new host's identity verifies against the identity CA (openssl),
-# an init with nothing to issue made no empty ca/, and without --ca the same step is refused
+# an init with nothing to issue made no empty ca/, each machine's export holds its identities
+# only and no CA key, and without --ca the same step is refused
 # naming the key file and --ca, leaving nothing half made; a restored `mv` is not nested.
 #   offline_ca_walkthrough_test.sh SOURCE_DIR BUILD_DIR
 set -euo pipefail
@@ -50,6 +51,14 @@ for id in host.rec process.p_rec; do
     fail "$id's certificate does not verify against the identity CA"
 done
 ! ls -a keys/lab/identities | grep -q '\.new-' || fail "a staging folder was left in keys/lab/identities"
+
+echo "--- each machine's export holds its identities only, and no CA key"
+[ "$(ls keys_lab/identities | tr '\n' ' ')" = "host.lab process.p_lab " ] || fail "keys_lab holds $(ls keys_lab/identities)"
+[ "$(ls keys_rec/identities | tr '\n' ' ')" = "host.rec process.p_rec " ] || fail "keys_rec holds $(ls keys_rec/identities)"
+! find keys_lab keys_rec -name '*.key.pem' | grep -q . || fail "an export holds a CA key"
+grep -q "^host: rec$" keys_rec/subset.yaml || fail "keys_rec/subset.yaml does not say host: rec"
+openssl verify -CAfile keys_rec/identity_ca.cert.pem keys_rec/identities/host.rec/cert.pem > /dev/null ||
+  fail "the exported host.rec certificate does not verify against the exported identity CA"
 
 echo "--- without --ca, a new machine is refused and nothing is made"
 set +e
