@@ -73,10 +73,18 @@ struct OnlineFront::Participant {
   int ping_id = 0;
   Clock::time_point ping_sent{};
   double rtt_ms = -1;
+  // For the experimenter's overview: the running attempt, the page's engagement, the end.
+  int trial = 0, attempt = 0;
+  std::string file, ended;
+  std::optional<bool> engaged;
 };
 
 OnlineFront::OnlineFront(const Study& s, FrontOptions o) : study_(s), options_(std::move(o)) {
-  for (const std::string& p : s.participants) participants_.emplace(p, std::make_unique<Participant>(s, p));
+  for (const std::string& p : s.participants) {
+    auto participant = std::make_unique<Participant>(s, p);
+    participant->ended = ReadOnlineEvents(SessionLogPath(s, p)).ended;  // ended before a restart: shown, and resumable
+    participants_.emplace(p, std::move(participant));
+  }
 }
 
 OnlineFront::~OnlineFront() { StopAll(); }
@@ -171,7 +179,7 @@ void OnlineFront::Relay(Participant& p, web::ClientId client) {
     }
     web::WsClient::Callbacks cb;
     cb.on_text = [server, client](std::string_view text) { server->SendText(client, std::string(text)); };
-    cb.on_close = [server, client] { server->Close(client, 1012, "the trial's page closed"); };
+    cb.on_close = [this, &p, client] { NextPhase(p, client, "the trial's page closed"); };
     auto up = web::WsClient::Connect("127.0.0.1", port, "/subject/ws?token=" + token, std::move(cb), std::chrono::seconds(2));
     if (up.ok()) {
       std::shared_ptr<web::WsClient> relay(std::move(*up));
@@ -197,7 +205,17 @@ void OnlineFront::Relay(Participant& p, web::ClientId client) {
     running = p.running;
   }
   if (here && !running) Send(client, p.session.PageFrame());
-  else if (here) Close(client, 1012, "the trial is not reachable: retry");
+  else if (here) NextPhase(p, client, "the trial is not reachable: retry");
+}
+
+void OnlineFront::NextPhase(Participant& p, web::ClientId client, const std::string& reason) {
+  {
+    MutexLock lock(mutex_);
+    if (p.page != client) return;
+    p.page = 0;  // before the close: the page's next socket may come before this one's OnClose
+    p.session.PageClosed(Clock::now());
+  }
+  Close(client, 1012, reason);
 }
 
 // A pong to the front's ping: its round trip kept, not relayed.
@@ -209,6 +227,15 @@ bool OnlineFront::Pong(Participant& p, std::string_view text) {
   if (j.contains("id") && j["id"].is_number_integer() && j["id"].get<int>() == p.ping_id)
     p.rtt_ms = std::chrono::duration<double, std::milli>(Clock::now() - p.ping_sent).count();
   return true;
+}
+
+// A relayed pointer sample: whether the person holds (the overview's "engaged").
+void OnlineFront::Pointer(Participant& p, std::string_view text) {
+  if (text.find("\"pointer\"") == std::string_view::npos) return;
+  const Json j = Json::parse(text.begin(), text.end(), nullptr, false);
+  if (!j.is_object() || j.value("op", "") != "pointer" || !j.contains("engaged") || !j["engaged"].is_boolean()) return;
+  MutexLock lock(mutex_);
+  p.engaged = j["engaged"].get<bool>();
 }
 
 Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
@@ -223,7 +250,8 @@ Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
     running = p->running;
   }
   if (up) {
-    if (Status st = up->SendText(text); !st.ok()) Close(client, 1012, "the trial's page closed");
+    Pointer(*p, text);
+    if (Status st = up->SendText(text); !st.ok()) NextPhase(*p, client, "the trial's page closed");
     return Status::OK();
   }
   if (!running) Answer(*p, client, text);
@@ -278,8 +306,12 @@ void OnlineFront::StartTrial(Participant& p) {
   web::ClientId page = 0;
   {
     MutexLock lock(mutex_);
-    if (p.running) return;
+    if (p.running || !p.ended.empty()) return;
     p.running = true;
+    p.trial = r.trial.number;
+    p.attempt = r.attempt;
+    p.file = AttemptFile(r.trial, r.attempt);
+    p.engaged.reset();
     p.stop.store(false);
     p.lost_reason.clear();
     p.port = port;
@@ -351,6 +383,108 @@ void OnlineFront::Tick(Clock::time_point now) {
     }
   }
   for (auto& [client, text] : pings) Send(client, std::move(text));
+}
+
+// The running trial's or the next one's place in the plan and condition, from the log.
+static void PlanOf(const Study& s, OnlineSession& session, OnlineFront::SessionView& v) {
+  const std::vector<Trial> trials = s.TrialsOf(v.participant);
+  v.of = static_cast<int>(trials.size());
+  if (v.trial == 0)
+    if (const std::optional<OnlineSession::Planned> next = session.Next()) {
+      v.trial = next->trial.number;
+      v.attempt = next->attempt;
+    }
+  for (const Trial& t : trials)
+    if (t.number == v.trial) v.shown = s.Shown(s.conditions[static_cast<size_t>(t.condition)]);
+}
+
+std::vector<OnlineFront::SessionView> OnlineFront::Snapshot(Clock::time_point now) const {
+  std::vector<SessionView> out;
+  {
+    MutexLock lock(mutex_);
+    for (const auto& [id, p] : participants_) {
+      if (!p->session.Live(now, p->running) && p->ended.empty()) continue;
+      SessionView v;
+      v.participant = id;
+      v.rtt_ms = p->rtt_ms;
+      v.ended = p->ended;
+      if (p->page == 0) v.gone_s = std::chrono::duration<double>(p->session.LostFor(now)).count();
+      if (p->running) {
+        v.phase = p->page == 0 ? "paused" : "trial";
+        v.trial = p->trial;
+        v.attempt = p->attempt;
+        v.file = p->file;
+        v.port = p->port;
+        v.engaged = p->engaged;
+      } else if (p->page == 0) {
+        v.phase = "away";
+      }
+      out.push_back(std::move(v));
+    }
+  }
+  // Between trials the phase and the next trial come from the log: read outside the lock.
+  for (SessionView& v : out) {
+    OnlineSession& session = participants_.at(v.participant)->session;
+    if (v.file.empty()) {
+      static constexpr const char* kNames[] = {"consent", "waiting", "done", "refused"};
+      const OnlineSession::Phase ph = session.phase();
+      const bool between = ph == OnlineSession::Phase::kConsent || ph == OnlineSession::Phase::kWaiting;
+      if (!v.ended.empty()) v.phase = "ended";
+      else if (v.phase != "away" || !between) v.phase = kNames[static_cast<int>(ph)];
+    }
+    PlanOf(study_, session, v);
+  }
+  return out;
+}
+
+Status OnlineFront::StopSession(const std::string& participant, const std::string& reason) {
+  const auto it = participants_.find(participant);
+  if (it == participants_.end()) return Status::NotFound("no participant '" + participant + "' in " + study_.file);
+  if (reason.find_first_not_of(" \t\r\n") == std::string::npos)
+    return Status::InvalidArgument("stopping " + participant + "'s session needs the reason (kept in their session log)");
+  Participant& p = *it->second;
+  {
+    MutexLock lock(mutex_);
+    if (!p.ended.empty()) return Status::FailedPrecondition(participant + "'s session has ended already: " + p.ended);
+    p.ended = reason;
+  }
+  const Json line = {{"event", "session_ended"}, {"reason", reason}, {"how", "the experimenter's overview (dyad study serve)"}};
+  if (Status st = AppendSessionEvent(study_, participant, line.dump()); !st.ok()) {
+    MutexLock lock(mutex_);
+    p.ended.clear();
+    return st;
+  }
+  web::ClientId page = 0;
+  bool running = false;
+  {
+    MutexLock lock(mutex_);
+    running = p.running;
+    if (running && p.lost_reason.empty()) p.lost_reason = "stopped by the experimenter: " + reason;
+    if (running) p.stop.store(true);  // its end closes the page, which comes back to hear the session ended
+    else page = p.page;
+  }
+  std::cout << participant << ": the session is ended by the experimenter: " << reason
+            << (running ? " (its trial is stopped)" : "") << std::endl;
+  if (page != 0) {
+    Send(page, p.session.PageFrame());
+    Close(page, 1008, "the session has ended");
+  }
+  return Status::OK();
+}
+
+Status OnlineFront::ResumeSession(const std::string& participant) {
+  const auto it = participants_.find(participant);
+  if (it == participants_.end()) return Status::NotFound("no participant '" + participant + "' in " + study_.file);
+  if (ReadOnlineEvents(SessionLogPath(study_, participant)).ended.empty())
+    return Status::FailedPrecondition(participant + "'s session has not been ended");
+  const Json line = {{"event", "session_resumed"}, {"how", "the experimenter's overview (dyad study serve)"}};
+  if (Status st = AppendSessionEvent(study_, participant, line.dump()); !st.ok()) return st;
+  {
+    MutexLock lock(mutex_);
+    it->second->ended.clear();
+  }
+  std::cout << participant << ": the session is resumed by the experimenter (their link opens it again)" << std::endl;
+  return Status::OK();
 }
 
 void OnlineFront::StopAll() {

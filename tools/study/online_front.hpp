@@ -23,6 +23,13 @@
 //     page left between trials.
 //   - Mid-trial, a page gone more than reconnect_s stops the trial, which ends incomplete: "the
 //     participant's connection was lost for more than N s" (AttemptRequest::incomplete_reason).
+//   - StopSession (the experimenter's overview, overview_channel.hpp): {"event":"session_ended",
+//     "reason":...} logged, a running trial stopped and ended incomplete ("stopped by the
+//     experimenter: REASON"), no trial starts for the participant any more and their page is told
+//     the session has ended (OnlineSession's refused), also after a restart (the log holds it),
+//     until ResumeSession logs {"event":"session_resumed"}: the link then opens the session where
+//     it was (the stopped trial repeated with its reason).
+//   - Snapshot: every live session, and those ended during this serve, for the overview.
 //   - StopAll (SIGINT/SIGTERM): no trial starts any more, every running one is stopped as `dyad
 //     study run` stops it, and this returns once they have ended and every relay is closed.
 //
@@ -35,7 +42,9 @@
 #include <chrono>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "dyad/thread_annotations.hpp"
 #include "study_file.hpp"
@@ -54,6 +63,19 @@ struct FrontOptions {
 class OnlineFront final : public web::ClientHandler {
  public:
   using Clock = std::chrono::steady_clock;
+  // One session as the experimenter's overview shows it.
+  struct SessionView {
+    std::string participant;
+    std::string phase;  // consent, waiting, trial, paused (a trial, the page gone), away (between trials), done, refused, ended
+    double gone_s = 0;  // paused or away: the page gone this long
+    int trial = 0, of = 0, attempt = 0;  // the running trial, else the next one (0: none)
+    std::string shown;                   // its condition as the experimenter may see it (Study::Shown)
+    std::string file;                    // the running attempt's recording ("" between trials)
+    int port = 0;                        // the running trial's web component (0: none)
+    std::optional<bool> engaged;         // the relayed page's last pointer sample this trial (none yet: nullopt)
+    double rtt_ms = -1;                  // the page's last ping round trip (-1: none yet)
+    std::string ended;                   // the experimenter's reason, when ended
+  };
   OnlineFront(const Study& s, FrontOptions o);
   ~OnlineFront() override;  // StopAll()
 
@@ -64,6 +86,10 @@ class OnlineFront final : public web::ClientHandler {
   void StopAll();
   int running() const;  // trials running now
   int live(Clock::time_point now) const;
+  std::vector<SessionView> Snapshot(Clock::time_point now) const;
+  // See the contract; NotFound for an unknown participant, InvalidArgument without a reason.
+  Status StopSession(const std::string& participant, const std::string& reason);
+  Status ResumeSession(const std::string& participant);
 
   void OnOpen(web::ClientId client, web::Role role) override;
   Status OnText(web::ClientId client, std::string_view text) override;
@@ -76,7 +102,10 @@ class OnlineFront final : public web::ClientHandler {
   std::string Take(Participant& p, web::ClientId client, Clock::time_point now) REQUIRES(mutex_);
   int LiveLocked(Clock::time_point now) const REQUIRES(mutex_);
   void Relay(Participant& p, web::ClientId client);
+  // Closes p's page `client` with 1012 (it reconnects at once): no longer p's page from now on.
+  void NextPhase(Participant& p, web::ClientId client, const std::string& reason);
   bool Pong(Participant& p, std::string_view text);
+  void Pointer(Participant& p, std::string_view text);
   void Answer(Participant& p, web::ClientId client, std::string_view text);
   void StartTrial(Participant& p);
   void RunTrial(Participant& p, AttemptRequest r);
