@@ -11,6 +11,11 @@
 #              robot/secret and `dyad pub` of robot/state are refused (exit 2) naming the key of
 #              the graph to change; `dyad echo` with the same graph without `security:` (an
 #              unsecured tool) hears nothing. About 35 s.
+#   exports    the same as guests, but each machine holds only its export (`dyad security export`:
+#              lab's, rec's and the guest's, each in a folder of its own beside a copy of the
+#              graph, as copied to that machine), never the whole keystore; and from guest,
+#              `dyad echo --host lab` is refused naming the identity host.lab and the export that
+#              would give it. About 35 s.
 #   starts[:N] secured against open starts under load (issue #43 item 5): N rounds (default 20) of
 #              a secured three-host graph (a ring of counter_source -> counter_sink, one process
 #              on each of lab, mind, rec; the three launchers started at the same instant), then
@@ -24,17 +29,17 @@
 #              first sample, secured against open. Fails unless every round of both passed.
 #              For experiments: SECURE_HOSTS_KINDS="secured" (or "open") runs one kind only;
 #              SECURE_HOSTS_NETWORK="lease_s: 2" adds keys to the graph's network section.
-#   secure_hosts_test.sh REPO BUILD_DIR WORK_DIR [guests|starts[:N]...]   (default: guests)
+#   secure_hosts_test.sh REPO BUILD_DIR WORK_DIR [guests|exports|starts[:N]...]   (default: guests)
 # Needs root and `ip netns` (skipped, exit 77, otherwise). Leaves nothing behind: the EXIT trap
 # kills every process in its namespaces and deletes them.
 set -euo pipefail
-[ $# -ge 3 ] || { echo "usage: secure_hosts_test.sh REPO BUILD_DIR WORK_DIR [guests|starts[:N]...]" >&2; exit 2; }
+[ $# -ge 3 ] || { echo "usage: secure_hosts_test.sh REPO BUILD_DIR WORK_DIR [guests|exports|starts[:N]...]" >&2; exit 2; }
 repo=$(cd "$1" && pwd) build=$(cd "$2" && pwd) work=$3
 shift 3
 modes=("$@")
 [ ${#modes[@]} -gt 0 ] || modes=(guests)
 for mode in "${modes[@]}"; do
-  [[ $mode =~ ^(guests|starts(:[0-9]+)?)$ ]] || { echo "unknown mode '$mode' (guests, starts[:N])" >&2; exit 2; }
+  [[ $mode =~ ^(guests|exports|starts(:[0-9]+)?)$ ]] || { echo "unknown mode '$mode' (guests, exports, starts[:N])" >&2; exit 2; }
 done
 dyad=$build/bin/dyad
 skip() { echo "SKIP: secure_hosts: $*"; exit 77; }
@@ -107,8 +112,10 @@ on() {
 now_ms() { echo $(($(date +%s%N) / 1000000)); }
 
 # --- guests ---------------------------------------------------------------------------------------
+# run_guests guests|exports (exports: each machine holds only its own export of the keystore).
 run_guests() {
-  local out=$work/guests sec g lab_pid rec_pid pids=() ok=1
+  local mode=$1
+  local out=$work/$mode sec g lab_pid rec_pid pids=() ok=1
   mkdir -p "$out"
   for g in secured open; do
     sec=()
@@ -129,24 +136,42 @@ run_guests() {
   "$dyad" security init "$out/keys" --graph "$out/visit_secured.yaml" > "$out/init.log" 2>&1 ||
     { cat "$out/init.log"; fail "guests: dyad security init failed"; }
   local G=$out/visit_secured.yaml
-  on lab "$dyad" run "$G" --host lab --duration 25 --quiet > "$out/lab.log" 2>&1 &
+  declare -A at=([lab]=$G [rec]=$G [guest]=$G)  # the graph file each machine uses
+  if [ "$mode" = exports ]; then
+    local m opt
+    for m in lab rec guest; do
+      opt=(--host "$m")
+      [ $m = guest ] && opt=(--guest)
+      mkdir -p "$out/$m"
+      "$dyad" security export "$out/keys" --graph "$G" "${opt[@]}" "$out/$m/keys" > "$out/export_$m.log" 2>&1 ||
+        { cat "$out/export_$m.log"; fail "exports: dyad security export ${opt[*]} failed"; }
+      cp "$G" "$out/$m/visit_secured.yaml"  # keystore: keys, relative: its own export
+      at[$m]=$out/$m/visit_secured.yaml
+    done
+  fi
+  on lab "$dyad" run "${at[lab]}" --host lab --duration 25 --quiet > "$out/lab.log" 2>&1 &
   lab_pid=$!; started+=($!)
-  on rec "$dyad" run "$G" --host rec --duration 25 --quiet > "$out/rec.log" 2>&1 &
+  on rec "$dyad" run "${at[rec]}" --host rec --duration 25 --quiet > "$out/rec.log" 2>&1 &
   rec_pid=$!; started+=($!)
   # The visitors, all on guest, while the graph starts and runs. Each waits for the graph itself.
-  on guest "$dyad" echo robot/state --graph "$G" --count 1 --wait 15 > "$out/echo.txt" 2>&1 &
+  on guest "$dyad" echo robot/state --graph "${at[guest]}" --count 1 --wait 15 > "$out/echo.txt" 2>&1 &
   pids+=($!); started+=($!)
-  on guest "$dyad" record robot/state --graph "$G" -o "$out/guest.mcap" --duration 4 --wait 15 > "$out/record.txt" 2>&1 &
+  on guest "$dyad" record robot/state --graph "${at[guest]}" -o "$out/guest.mcap" --duration 4 --wait 15 > "$out/record.txt" 2>&1 &
   pids+=($!); started+=($!)
-  on guest "$dyad" pub human/input --graph "$G" '{value: 4242}' --rate 5 --count 10 --wait 15 > "$out/pub.txt" 2>&1 &
+  on guest "$dyad" pub human/input --graph "${at[guest]}" '{value: 4242}' --rate 5 --count 10 --wait 15 > "$out/pub.txt" 2>&1 &
   pids+=($!); started+=($!)
-  on guest "$dyad" bag play "$out/bag.mcap" --graph "$G" --wait 15 > "$out/play.txt" 2>&1 &
+  on guest "$dyad" bag play "$out/bag.mcap" --graph "${at[guest]}" --wait 15 > "$out/play.txt" 2>&1 &
   pids+=($!); started+=($!)
   on guest "$dyad" echo robot/state --graph "$out/visit_open.yaml" --count 1 --wait 12 > "$out/open_echo.txt" 2>&1 &
   pids+=($!); started+=($!)
   local refused_echo=0 refused_pub=0
-  on guest "$dyad" echo robot/secret --graph "$G" --count 1 --wait 2 > "$out/refused_echo.txt" 2>&1 || refused_echo=$?
-  on guest "$dyad" pub robot/state --graph "$G" '{value: 1}' --wait 2 > "$out/refused_pub.txt" 2>&1 || refused_pub=$?
+  on guest "$dyad" echo robot/secret --graph "${at[guest]}" --count 1 --wait 2 > "$out/refused_echo.txt" 2>&1 || refused_echo=$?
+  on guest "$dyad" pub robot/state --graph "${at[guest]}" '{value: 1}' --wait 2 > "$out/refused_pub.txt" 2>&1 || refused_pub=$?
+  local refused_host=0
+  if [ "$mode" = exports ]; then
+    on guest "$dyad" echo robot/state --graph "${at[guest]}" --host lab --count 1 --wait 2 > "$out/refused_host.txt" 2>&1 ||
+      refused_host=$?
+  fi
   local codes=() p
   for p in "${pids[@]}"; do
     c=0; wait "$p" || c=$?
@@ -155,8 +180,8 @@ run_guests() {
   local code_lab=0 code_rec=0
   wait "$lab_pid" || code_lab=$?
   wait "$rec_pid" || code_rec=$?
-  echo "secure_hosts guests: launchers exit $code_lab (lab) $code_rec (rec); tools exit: echo ${codes[0]}, record ${codes[1]}, pub ${codes[2]}, bag play ${codes[3]}, unsecured echo ${codes[4]}; refused: echo $refused_echo, pub $refused_pub"
-  check() { if ! eval "$2"; then echo "secure_hosts guests: NOT: $1"; ok=0; else echo "secure_hosts guests: ok: $1"; fi; }
+  echo "secure_hosts $mode: launchers exit $code_lab (lab) $code_rec (rec); tools exit: echo ${codes[0]}, record ${codes[1]}, pub ${codes[2]}, bag play ${codes[3]}, unsecured echo ${codes[4]}; refused: echo $refused_echo, pub $refused_pub"
+  check() { if ! eval "$2"; then echo "secure_hosts $mode: NOT: $1"; ok=0; else echo "secure_hosts $mode: ok: $1"; fi; }
   check "both launchers exit 0" '[ $code_lab = 0 ] && [ $code_rec = 0 ]'
   check "dyad echo (guest) received robot/state" 'grep -q "\"value\"" "$out/echo.txt"'
   check "dyad record (guest) recorded robot/state" \
@@ -170,13 +195,23 @@ run_guests() {
   check "dyad pub robot/state refused (exit 2), naming security.guests.publish and the graph file" \
     '[ $refused_pub = 2 ] && grep -q "security.guests.publish (.*visit_secured.yaml:" "$out/refused_pub.txt"'
   check "an unsecured tool heard nothing" '! grep -q "\"value\"" "$out/open_echo.txt"'
-  if [ $ok = 0 ]; then
-    for f in echo record pub play open_echo refused_echo refused_pub lab rec; do
-      echo "----- $f:"; tail -5 "$out/$f".*
-    done
-    failures+=(guests); return 0
+  if [ "$mode" = exports ]; then
+    check "each machine holds only its identities, and no CA key" \
+      '[ "$(ls "$out/lab/keys/identities" | tr "\n" " ")" = "host.lab process.arm " ] &&
+       [ "$(ls "$out/rec/keys/identities" | tr "\n" " ")" = "host.rec process.ctl " ] &&
+       [ "$(ls "$out/guest/keys/identities" | tr "\n" " ")" = "guest " ] &&
+       ! find "$out/lab" "$out/rec" "$out/guest" -name "*.key.pem" | grep -q .'
+    check "dyad echo --host lab on guest refused (exit 2), naming host.lab and the export that gives it" \
+      '[ $refused_host = 2 ] && grep -q "identity .host.lab. is not in keystore .*--host lab OUT" "$out/refused_host.txt"'
   fi
-  echo "PASS: secure_hosts guests: from a machine that is none of the graph's hosts, echo, record, pub and bag play visit as its guest within its grant; outside it they are refused naming the key; an unsecured tool hears nothing"
+  if [ $ok = 0 ]; then
+    for f in echo record pub play open_echo refused_echo refused_pub refused_host lab rec; do
+      echo "----- $f:"; tail -5 "$out/$f".* 2> /dev/null || true
+    done
+    failures+=("$mode"); return 0
+  fi
+  [ "$mode" = exports ] && echo "PASS: secure_hosts exports: each machine holding only its own export of the keystore, the graph ran and the guest visited it as in guests; another's identity was refused naming the export"
+  echo "PASS: secure_hosts $mode: from a machine that is none of the graph's hosts, echo, record, pub and bag play visit as its guest within its grant; outside it they are refused naming the key; an unsecured tool hears nothing"
 }
 
 # --- starts ---------------------------------------------------------------------------------------
@@ -294,7 +329,7 @@ PY
 failures=()
 for mode in "${modes[@]}"; do
   case $mode in
-    guests) run_guests ;;
+    guests | exports) run_guests "$mode" ;;
     starts*) run_starts "${mode#starts}" ;;
   esac
 done
