@@ -244,11 +244,12 @@ serve_level() {
     mkdir -p "$level/s$i"
     ln -sf "$d/data/$(printf 'P%03d' "$i")/01-capacity.log" "$level/s$i/run.out"
     ln -sf "$d/data/$(printf 'P%03d' "$i")/01-capacity.log" "$level/s$i/run.err"
+    "$dyad" bag export "$d/data/$(printf 'P%03d' "$i")/01-capacity.mcap" --csv "$level/s$i/stats" --topic dyad/stats > /dev/null 2>&1 || true
   done
 }
 
 if [ "$mode" = serve ]; then
-  echo "| participants | started | mind step p99, ms (median / worst session; period 100) | deadline misses (sessions with any) | pointer -> published p99, ms (median / worst) | clients' ack round trip p99 through the front, ms (median) | RSS per session, MB (mean) | CPU per session, % of a core (mean) | front: RSS, MB; CPU, % of a core (per participant) | Ready -> trial's hello, s (median / worst) | done with a code | clients' CPU, % of a core | machine busy, % of 2 cores (load avg) | Chromium participants: pointer -> published p99, samples/s (simulated: median samples/s) |"
+  echo "| participants | started | mind step p99, ms (median / worst session; period 100) | deadline misses (sessions with any; of them in the trials' first second) | pointer -> published p99, ms (median / worst) | clients' ack round trip p99 through the front, ms (median) | RSS per session, MB (mean) | CPU per session, % of a core (mean) | front: RSS, MB; CPU, % of a core (per participant) | Ready -> trial's hello, s (median / worst) | done with a code | clients' CPU, % of a core | machine busy, % of 2 cores (load avg) | Chromium participants: pointer -> published p99, samples/s (simulated: median samples/s) |"
   echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
 else
   echo "| participants | started | mind step p99, ms (median / worst session; period 100) | deadline misses (sessions with any) | pointer -> published p99, ms (median / worst) | clients' ack round trip p99, ms (median) | RSS per session, MB (mean) | CPU per session, % of a core (mean) | clients' CPU, % of a core | machine busy, % of 2 cores (load avg) | Chromium participants: pointer -> published p99, samples/s (simulated: median samples/s) |"
@@ -300,6 +301,19 @@ med = lambda a: statistics.median(a) if a else None
 mean = lambda a: statistics.mean(a) if a else None
 busy = 100 * (busy1 - busy0) / (all1 - all0) if all1 > all0 else float("nan")
 front, notes = "", []
+def start_misses(i):  # serve: a trial's misses in its first second (its first dyad/stats per component)
+    first = {}
+    try:
+        with open(f"{level}/s{i}/stats/dyad_stats.csv") as f:
+            header = f.readline().strip().split(",")
+            name, count = header.index("component_name"), header.index("deadline_misses")
+            for line in f:
+                row = line.strip().split(",")
+                first.setdefault(row[name], int(row[count]))
+    except (OSError, ValueError, IndexError):
+        return None
+    return sum(first.values())
+starts = [start_misses(i) for i in rows] if serve else []
 if serve:  # the front's own cost over the window, the arrivals, the codes
     (f0, c0), (f1, c1, front_rss, window_ms) = numbers("own0"), numbers("own1")
     front_cpu = 100 * (f1 - f0) / hz / seconds
@@ -314,21 +328,25 @@ if serve:  # the front's own cost over the window, the arrivals, the codes
         notes.append(f"{len(cpu)} graphs measured of {started}")
     front = (f"{fmt(front_rss)}; {fmt(front_cpu)} ({front_cpu / max(1, started):.2f}) | {fmt(med(hello))} / {fmt(max(hello) if hello else None)} | "
              f"{len(done)} of {n} | ")
-print(f"| {n} | {started} | {fmt(med(mind))} / {fmt(max(mind) if mind else None)} | {int(sum(misses))} ({sum(1 for m in misses if m)}) | "
+known = [m for m in starts if m is not None]
+at_start = f"; {sum(known)} in the trials' first second" + ("" if len(known) == len(starts) else f" of {len(known)}") if serve else ""
+print(f"| {n} | {started} | {fmt(med(mind))} / {fmt(max(mind) if mind else None)} | {int(sum(misses))} ({sum(1 for m in misses if m)}{at_start}) | "
       f"{fmt(med(pointer))} / {fmt(max(pointer) if pointer else None)} | {fmt(med(rtt))} | {fmt(mean(rss))} | {fmt(mean(cpu))} | "
       f"{front}{client_cpu:.1f} | {busy:.0f} ({load:.2f}) | "
       + (f"{k}: p99 {' '.join(fmt(v) for v in chr_p99)} ms, {' '.join(f'{v:.0f}' for v in chr_rate)}/s; simulated: {fmt(med(sim_rate))}/s |" if k else "- |")
       + "".join(f"\n  note: {x}" for x in notes))
 fell = started < n or not mind or max(mind) > 100 or len(pointer) < started or (serve and len(done) < n)
-print("FELL" if fell else "UP", int(sum(misses)), fmt(mean(cpu)), fmt(mean(rss)))
+# The knee's misses; serve: after each trial's first second (its start's are not the load's: above)
+relay = f"; the front {front_cpu / max(1, started):.2f}% of a core per participant, {fmt(front_rss)} MB in all" if serve else ""
+print("FELL" if fell else "UP", int(sum(misses)) - sum(known), fmt(mean(cpu)), fmt(mean(rss)), relay)
 PY
   sed '$d' "$level/row"
-  read -r state misses c r < <(tail -1 "$level/row")
+  read -r state misses c r relay < <(tail -1 "$level/row")
   if [ -z "$knee" ] && [ "$misses" -gt 0 ]; then knee=$n; fi
-  if [ "$misses" = 0 ] && [ "$state" = UP ]; then cost="$c% of a core and $r MB per session (at N = $n)"; fi
+  if [ "$misses" = 0 ] && [ "$state" = UP ]; then cost="$c% of a core and $r MB per session$relay (at N = $n)"; fi
   [ "$state" = UP ] || { echo; echo "stopped: $n participants fell over (a session did not start$([ "$mode" = direct ] || echo " or end with its code"), or the deliberator's p99 passed its period)"; break; }
 done
 echo
-echo "knee (the first N with a deadline miss): ${knee:-none up to the last level}"
+echo "knee (the first N with a deadline miss$([ "$mode" = direct ] || echo " after a trial's first second")): ${knee:-none up to the last level}"
 echo "cost: ${cost:-no level without misses}"
 echo "clients drew: $drawn; model: $model; each level's window: $seconds s; $(nproc) cores$([ "$mode" = direct ] || echo "; through one dyad study serve (trials of the window + N x $arrival s + 10 s)")"
