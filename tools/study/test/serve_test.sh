@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # What goes wrong online (#45 item 3), through `dyad study serve` with scripted pages
-# (serve_cases.mjs): unknown tokens (404, an address guessing 429), a link open twice (1008),
+# (serve_cases.mjs), and what it refuses to start with: unknown tokens (404, an address guessing 429), a link open twice (1008),
 # max_sessions (come back later), a page lost for less and more than reconnect_s mid-trial, and
 # the front restarted by SIGTERM and by SIGKILL mid-trial. Trials of 4 s on a small graph.
 #   serve_test.sh REPO BUILD_DIR WORK_DIR
@@ -35,6 +35,15 @@ blind: true
 online: {reconnect_s: 2, max_sessions: 2, consent: consent.txt}
 YAML
 "$build/bin/dyad" study links s.yaml --base-url http://127.0.0.1:8443 > /dev/null
+# Refused before anything listens, naming the flag or key: off loopback without TLS; consent
+# required without its text.
+rc=0; "$build/bin/dyad" study serve s.yaml --address 0.0.0.0 --port 0 > refused.out 2>&1 || rc=$?
+[ $rc = 2 ] && grep -q -- "--tls-certificate: required off loopback (--address 0.0.0.0)" refused.out ||
+  fail "off loopback without TLS: exit $rc: $(cat refused.out)"
+sed 's/, consent: consent.txt//' s.yaml > no_consent.yaml
+rc=0; "$build/bin/dyad" study serve no_consent.yaml --port 0 > refused.out 2>&1 || rc=$?
+[ $rc = 2 ] && grep -q "no_consent.yaml: online.consent: required to serve a study with consent_required" refused.out ||
+  fail "consent required without online.consent: exit $rc: $(cat refused.out)"
 node serve_cases.mjs "$build/bin/dyad" s.yaml serve_test-data
 # Killed or stopped, the front leaves no trial's graph behind (each ends by its parent-death signal).
 for _ in $(seq 50); do pgrep -f "$work/serve_test-data" > /dev/null || break; sleep 0.2; done
