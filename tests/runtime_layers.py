@@ -20,7 +20,7 @@ PUBLIC = {
     "graph.hpp": "graph", "validate.hpp": "graph", "catalog.hpp": "graph", "topic_select.hpp": "graph", "topic_readers.hpp": "graph",
     "diagnostic.hpp": "graph", "strict_yaml.hpp": "graph", "security.hpp": "graph", "ros2_names.hpp": "graph",
     "wire_names.hpp": "graph",
-    "on_demand_subscription.hpp": "graph",
+    "on_demand_subscription.hpp": "graph", "run_stopping.hpp": "graph",
     "decode_sample.hpp": "dds", "encode_sample.hpp": "dds",
     "interrupt.hpp": "exec", "private_file.hpp": "exec",
     "run.hpp": "hosts", "introspect.hpp": "hosts", "guest.hpp": "hosts", "discovery_server.hpp": "hosts",

@@ -23,6 +23,7 @@
 #include <dyad/on_demand_subscription.hpp>
 #include <dyad/private_file.hpp>
 #include <dyad/pvrnn/dataset.hpp>
+#include <dyad/run_stopping.hpp>
 #include <dyad/topic_select.hpp>
 
 #include "pages.hpp"
@@ -174,8 +175,8 @@ void WebComponent::Describe(ComponentSpec& spec) {
       .Range(0, 3600)
       .Unit("s")
       .Doc(
-          "the run's clock starts only once a page steers (the subject's, reconnecting), waiting at most this long; 0: no wait "
-          "(dyad study run sets it for each trial of a session)");
+          "the run's clock starts only once a page steers (the subject's, reconnecting), waiting at most this long (a stop "
+          "request ends the wait); 0: no wait (dyad study run sets it for each trial of a session)");
   spec.Param("pause_without_subject", false)
       .Doc(
           "while no page steers (the subject's page is gone, e.g. a participant's lost connection) the trial pauses: `pointer` "
@@ -611,13 +612,15 @@ Status WebComponent::Activate() {
 
 // In Activate, so the run's clock (which starts once every component is active) and the
 // trial's first step wait for the subject's page: a page already open (a study's session-long
-// link) reconnects within a second of the server starting.
+// link) reconnects within a second of the server starting. A run asked to stop meanwhile (Ctrl-C,
+// SIGTERM: a study's trial stopped) ends the wait at once.
 void WebComponent::WaitForSubject(double seconds) {
   if (seconds <= 0) return;
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (!subject_->steered() && std::chrono::steady_clock::now() < until)
+  while (!subject_->steered() && std::chrono::steady_clock::now() < until && !RunStopping(*ctx_))
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   if (subject_->steered()) ctx_->log().Info("the subject's page is there: the run starts");
+  else if (RunStopping(*ctx_)) ctx_->log().Info("the run is stopping: no more waiting for the subject's page");
   else
     ctx_->log().Warn("no subject's page steers after " + std::to_string(std::lround(seconds)) +
                      " s (params.wait_for_subject_s): the run starts without one");

@@ -7,6 +7,7 @@
 #include <set>
 
 #include <dyad/msg/types.hpp>
+#include <dyad/run_stopping.hpp>
 #include <dyad/security.hpp>
 
 #include "dds/dds_participant.hpp"
@@ -108,7 +109,7 @@ struct Executor::Instance {
   const std::string& name() const { return rc->config->name; }
 };
 
-class Executor::ContextImpl final : public Context, public detail::ContextExtensions {
+class Executor::ContextImpl final : public Context, public detail::ContextExtensions, public detail::RunStoppingQuery {
  public:
   ContextImpl(Executor* ex, Instance* inst)
       : ex_(ex), inst_(inst), logger_(inst->name()), seed_(ComponentSeed(ex->graph_.seed, inst->name())) {}
@@ -128,6 +129,7 @@ class Executor::ContextImpl final : public Context, public detail::ContextExtens
     // A run that ends by itself says why, once (the first reason is the one that holds).
     if (ex_->RequestStop(inst_->name() + ": " + reason)) logger_.Info("ends the run: " + reason);
   }
+  bool run_stopping() const override { return ex_->stopping(); }
 
   const std::string& graph_name() const override { return ex_->graph_.name; }
   const std::string& graph_yaml() const override { return ex_->graph_yaml_; }

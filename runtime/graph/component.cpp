@@ -2,6 +2,7 @@
 #include "dyad/component.hpp"
 
 #include <dyad/on_demand_subscription.hpp>
+#include <dyad/run_stopping.hpp>
 
 #include <cstdio>
 #include <cstdlib>
@@ -42,6 +43,11 @@ StatusOr<OnDemandSubscription*> SubscribeSerializedOnDemand(Context& ctx, const 
   auto* ext = dynamic_cast<detail::ContextExtensions*>(&ctx);
   if (ext == nullptr) return Status::Unimplemented("SubscribeSerializedOnDemand('" + topic + "'): this context has no DDS topics");
   return ext->SubscribeSerializedOnDemand(topic, std::move(callback));
+}
+
+bool RunStopping(const Context& ctx) {
+  const auto* query = dynamic_cast<const detail::RunStoppingQuery*>(&ctx);
+  return query != nullptr && query->run_stopping();
 }
 
 ParamSpec& ComponentSpec::AddParam(std::string name, ParamType type, std::optional<ParamValue> default_value) {
