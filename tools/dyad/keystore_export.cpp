@@ -41,13 +41,15 @@ StatusOr<std::string> ReadRegular(const std::string& path) {
 
 // The files of the subset, relative to the keystore: the CA certificates, the governance, the
 // names key and each identity's four files.
-std::vector<std::string> SubsetFiles(const std::string& keystore, const std::vector<std::string>& identities) {
+std::vector<std::string> SubsetFiles(const std::string& keystore, const std::vector<std::string>& identities, bool web) {
   std::vector<std::string> files = {"identity_ca.cert.pem", "permissions_ca.cert.pem", "governance.xml", "governance.p7s",
                                     kNamesKeyFile};
   if (fs::exists(fs::symlink_status(fs::path(keystore) / "web_ca.cert.pem"))) files.push_back("web_ca.cert.pem");
   for (const std::string& id : identities)
     for (const char* f : {"cert.pem", "key.pem", "permissions.xml", "permissions.p7s"})
       files.push_back((fs::path("identities") / id / f).string());
+  if (web)
+    for (const char* f : {"web/tls.pem", "web/cert.pem", "web/hosts"}) files.push_back(f);
   return files;
 }
 
@@ -80,6 +82,10 @@ Status CheckExport(const Graph& graph, const ExportOptions& options) {
     return Status::InvalidArgument("--guest: graph '" + graph.name + "' has no security.guests, so no guest identity (add " +
                                    "`guests: {subscribe: [...], publish: [...]}` under security: (" +
                                    graph.security.mark.ToString() + ") and rerun `dyad security init`)");
+  if (options.web && !fs::exists(fs::symlink_status(fs::path(options.keystore) / "web" / "tls.pem")))
+    return Status::NotFound((fs::path(options.keystore) / "web" / "tls.pem").string() +
+                            ": --web, and the keystore has no web certificate (make it with `dyad security init " +
+                            options.keystore + " --graph " + graph.file + " --web-host HOST`)");
   auto subset = ReadKeystoreSubset(options.keystore);
   if (!subset.ok()) return subset.status();
   if (!subset.value().whole)
@@ -115,10 +121,13 @@ Status ExportKeystore(const Graph& graph, const ExportOptions& options, std::ost
   staging_name.append(".export-").append(std::to_string(getpid()));
   const fs::path staging = target.parent_path() / staging_name;
   std::error_code ec;
+  const std::vector<std::string> files = SubsetFiles(options.keystore, identities, options.web);
   auto made = [&]() -> Status {
     for (const std::string& id : identities)
       if (Status s = CreatePrivateDirectories((staging / "identities" / id).string()); !s.ok()) return s;
-    for (const std::string& file : SubsetFiles(options.keystore, identities)) {
+    if (options.web)
+      if (Status s = CreatePrivateDirectories((staging / "web").string()); !s.ok()) return s;
+    for (const std::string& file : files) {
       auto text = ReadRegular((fs::path(options.keystore) / file).string());
       if (!text.ok()) return text.status();
       if (Status s = WritePrivateFile((staging / file).string(), text.value(), CreateMode::kNew); !s.ok()) return s;
@@ -132,8 +141,7 @@ Status ExportKeystore(const Graph& graph, const ExportOptions& options, std::ost
     return made;
   }
   if (Status s = SyncDirectory(target.parent_path().string()); !s.ok()) return s;
-  for (const std::string& file : SubsetFiles(options.keystore, identities))
-    out << "copied   " << (target / file).string() << "\n";
+  for (const std::string& file : files) out << "copied   " << (target / file).string() << "\n";
   out << "wrote    " << (target / kSubsetFile).string() << "\n";
   return Status::OK();
 }

@@ -13,6 +13,9 @@
 //     on H or on no host; guest: guest; both when both are asked); and subset.yaml, which says
 //     whom it is for, the graph file and the keystore it came from (absolute paths: what a refusal
 //     on that machine names in the export command that would help).
+//   - With `web`: also web/tls.pem, web/cert.pem and web/hosts (the web component's TLS key and
+//     certificate, `dyad security init --web-host`), for the machine that runs the web component;
+//     without it an export holds no web/ (refused when the keystore has no web/tls.pem).
 //   - --host H must be one of the graph's identity hosts; --guest needs security.guests (refused
 //     naming the key otherwise).
 // Each written file is reported on `out`.
@@ -31,6 +34,7 @@ struct ExportOptions {
   std::string out;       // the new folder
   std::string host;      // the host whose identities to export; empty: none
   bool guest = false;    // the guest identity too
+  bool web = false;      // the web component's TLS key and certificate (web/) too
 };
 
 Status ExportKeystore(const Graph& graph, const ExportOptions& options, std::ostream& out);

@@ -65,6 +65,8 @@ void AddExportCommand(CLI::App& security, int& exit_code) {
   cmd->add_option("--graph", st->graph, "The graph")->required();
   cmd->add_option("--host", st->options.host, "The host whose identities to export");
   cmd->add_flag("--guest", st->options.guest, "The guest identity (security.guests), for a machine that is none of the hosts");
+  cmd->add_flag("--web", st->options.web,
+                "Also the web component's TLS key and certificate (web/, from init --web-host), for the machine that runs it");
   cmd->add_option("--set", st->sets, "Change a key of the graph, as `dyad run --set` does");
   cmd->callback([st, &exit_code] {
     std::vector<Diagnostic> diags;

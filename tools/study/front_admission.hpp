@@ -5,6 +5,8 @@
 // Contract of Admit (WebServer's Options::admit: thread-safe):
 //   - A participant's token: Admission{kSubject, participant}. Tokens are compared in constant
 //     time (web::TokenMatches), every known token each time.
+//   - The serve's experimenter token (SetExperimenterToken; DATA/serve-tokens, overview_channel.hpp):
+//     Admission{kExperimenter, ""} (the experimenter's overview).
 //   - Any other token (or none): Refusal 404 "not found". Before answering, the token files that
 //     were missing are read again, at most once a second (links made while the front runs).
 //   - An address with more than 10 unknown tokens within a minute (from its first) gets 429
@@ -38,6 +40,8 @@ class FrontAdmission {
 
   std::variant<web::Admission, web::Refusal> Admit(std::string_view token, std::string_view remote_address,
                                                    Clock::time_point now);
+  // The experimenter's overview token (empty: none admitted).
+  void SetExperimenterToken(std::string token);
   // How many participants have a link (a usable token file).
   int with_links() const;
 
@@ -52,6 +56,7 @@ class FrontAdmission {
   mutable Mutex mutex_;
   std::vector<std::pair<std::string, std::string>> tokens_ GUARDED_BY(mutex_);  // (token, participant)
   std::vector<std::string> missing_ GUARDED_BY(mutex_);                         // participants without one
+  std::string experimenter_ GUARDED_BY(mutex_);                                 // the overview's token ("": none)
   Clock::time_point last_read_ GUARDED_BY(mutex_);
   std::map<std::string, Window, std::less<>> by_address_ GUARDED_BY(mutex_);
 };

@@ -15,6 +15,7 @@ using Json = nlohmann::json;
 
 constexpr const char* kDeclined = "You did not agree to take part, so the study ends here. Thank you for your time.";
 constexpr const char* kWithdrawn = "You have withdrawn from this study: nothing more is recorded. Thank you for your time.";
+constexpr const char* kEnded = "The experimenter has ended this session. Thank you for your time.";
 constexpr const char* kDone = "The study is complete. Thank you for taking part! Your completion code:";
 
 // 10 characters from A-Z and 2-9 (no 0/O, 1/I: a code read and typed by a person).
@@ -57,6 +58,8 @@ OnlineEvents ReadOnlineEvents(const std::string& log) {
     if (event == "declined") out.declined = true;
     else if (event == "consent") out.declined = false;
     else if (event == "completed" && j.contains("code") && j["code"].is_string()) out.code = j["code"];
+    else if (event == "session_ended") out.ended = j.contains("reason") && j["reason"].is_string() ? j["reason"] : "(no reason)";
+    else if (event == "session_resumed") out.ended.clear();
   }
   return out;
 }
@@ -64,8 +67,9 @@ OnlineEvents ReadOnlineEvents(const std::string& log) {
 OnlineSession::OnlineSession(const Study& s, std::string participant)
     : study_(s), participant_(std::move(participant)), trials_(s.TrialsOf(participant_)) {}
 
-OnlineSession::Phase OnlineSession::PhaseOf(const Session& session, bool declined) const {
-  if (session.withdrawn) return Phase::kRefused;
+OnlineSession::Phase OnlineSession::PhaseOf(const Session& session, const OnlineEvents& events) const {
+  const bool declined = events.declined;
+  if (session.withdrawn || !events.ended.empty()) return Phase::kRefused;
   if (study_.consent_required && !session.consent) return declined ? Phase::kRefused : Phase::kConsent;
   for (const Trial& t : trials_)
     if (!session.Complete(t.number)) return Phase::kWaiting;
@@ -73,16 +77,21 @@ OnlineSession::Phase OnlineSession::PhaseOf(const Session& session, bool decline
 }
 
 OnlineSession::Phase OnlineSession::phase() const {
-  return PhaseOf(ReadSession(study_, participant_), ReadOnlineEvents(SessionLogPath(study_, participant_)).declined);
+  return PhaseOf(ReadSession(study_, participant_), ReadOnlineEvents(SessionLogPath(study_, participant_)));
 }
 
 std::string OnlineSession::PageFrame() {
   const Session session = ReadSession(study_, participant_);
-  switch (PhaseOf(session, ReadOnlineEvents(session.log).declined)) {
+  const OnlineEvents events = ReadOnlineEvents(session.log);
+  switch (PhaseOf(session, events)) {
     case Phase::kConsent:
       return Json{{"op", "consent"}, {"text", study_.online.consent_text}}.dump();
     case Phase::kRefused:
-      return Json{{"op", "refused"}, {"message", session.withdrawn ? kWithdrawn : kDeclined}}.dump();
+      return Json{{"op", "refused"},
+                  {"message", session.withdrawn       ? kWithdrawn
+                              : !events.ended.empty() ? kEnded
+                                                      : kDeclined}}
+          .dump();
     case Phase::kDone:
       return DoneFrame();
     case Phase::kWaiting:

@@ -16,7 +16,8 @@
 //   - every trial complete: {"op":"done","message":...,"code":...}; the completion code is the
 //     study's online.completion_code, else one made for the participant (10 characters A-Z 2-9)
 //     the first time, logged once ({"event":"completed","code":...}) and read back after.
-//   - withdrawn, or declined: {"op":"refused","message":...} (nothing records for them).
+//   - withdrawn, declined, or ended by the experimenter (ReadOnlineEvents' ended):
+//     {"op":"refused","message":...} (nothing records for them).
 // The connection (times given by the caller, so tests need no clock): PageOpened/PageClosed;
 // LostFor(now) says, while the page is gone, how long; Live(now, trial_running): a page is
 // connected, a trial runs, or the page left less than reconnect_s ago (what max_sessions counts).
@@ -35,6 +36,16 @@
 #include "study_session.hpp"
 
 namespace dyad::study {
+
+// The events `dyad study serve` adds to a session log that ReadSession leaves to people:
+// whether the latest consent answer is "declined", the code of a "completed" event ("" if none),
+// and the reason of a {"event":"session_ended","reason":...} (the experimenter's overview
+// stopped the session) not followed by a {"event":"session_resumed"} ("" if none).
+struct OnlineEvents {
+  bool declined = false;
+  std::string code, ended;
+};
+OnlineEvents ReadOnlineEvents(const std::string& log);
 
 class OnlineSession {
  public:
@@ -69,7 +80,7 @@ class OnlineSession {
   bool Live(Clock::time_point now, bool trial_running) const;
 
  private:
-  Phase PhaseOf(const Session& session, bool declined) const;
+  Phase PhaseOf(const Session& session, const OnlineEvents& events) const;
   std::string DoneFrame();
 
   const Study& study_;
@@ -80,13 +91,5 @@ class OnlineSession {
   std::optional<Clock::time_point> gone_since_ GUARDED_BY(mutex_);  // unset: never connected
   Mutex code_mutex_;                                                // one code made and logged, however many pages ask at once
 };
-
-// The events `dyad study serve` adds to a session log that ReadSession leaves to people:
-// whether the latest consent answer is "declined", and the code of a "completed" event ("" if none).
-struct OnlineEvents {
-  bool declined = false;
-  std::string code;
-};
-OnlineEvents ReadOnlineEvents(const std::string& log);
 
 }  // namespace dyad::study

@@ -35,24 +35,29 @@ Status CheckBaseUrl(const std::string& url) {
   return Status::OK();
 }
 
-StatusOr<std::string> ReadSubjectToken(const std::string& path) {
+StatusOr<std::string> ReadRoleToken(const std::string& path, const std::string& role, const std::string& holds) {
   struct stat st {};
   if (lstat(path.c_str(), &st) != 0) return Status::Internal(path + ": vanished");
   if (S_ISLNK(st.st_mode) || !S_ISREG(st.st_mode))
     return Status::InvalidArgument(path + ": not a regular file (a link is refused)");
   if ((st.st_mode & 077) != 0)
-    return Status::InvalidArgument(path + ": holds a participant's tokens and is readable by others: chmod 600 it");
+    return Status::InvalidArgument(path + ": holds " + holds + " and is readable by others: chmod 600 it");
   std::ifstream in(path);
+  const std::string key = role + " ";
   for (std::string line; std::getline(in, line);) {
-    if (line.rfind("subject ", 0) != 0) continue;
-    const std::string token = line.substr(8);
+    if (line.rfind(key, 0) != 0) continue;
+    const std::string token = line.substr(key.size());
     if (token.size() < 16 || token.size() > 256 || !std::all_of(token.begin(), token.end(), [](char c) {
           return c > ' ' && c < 127 && c != '&' && c != '#' && c != '+' && c != '%' && c != ',';
         }))
-      return Status::InvalidArgument(path + ": the subject's token is not 16..256 characters fit for a link");
+      return Status::InvalidArgument(path + ": the " + role + "'s token is not 16..256 characters fit for a link");
     return token;
   }
-  return Status::InvalidArgument(path + ": no 'subject TOKEN' line");
+  return Status::InvalidArgument(path + ": no '" + role + " TOKEN' line");
+}
+
+StatusOr<std::string> ReadSubjectToken(const std::string& path) {
+  return ReadRoleToken(path, "subject", "a participant's tokens");
 }
 
 StatusOr<Links> WriteLinks(const Study& s, const std::string& base_url) {

@@ -39,6 +39,9 @@ struct Links {
 // The subject token of an existing token file (the web component's format), or why not (the
 // refusals above, naming the file). `dyad study serve` reads the participants' tokens with it.
 StatusOr<std::string> ReadSubjectToken(const std::string& path);
+// The token of `role` ("experimenter", "subject", "viewer") in a file of "ROLE TOKEN" lines, with
+// the same refusals; `holds` says what the file holds ("a participant's tokens").
+StatusOr<std::string> ReadRoleToken(const std::string& path, const std::string& role, const std::string& holds);
 
 Status CheckBaseUrl(const std::string& url);
 StatusOr<Links> WriteLinks(const Study& s, const std::string& base_url);

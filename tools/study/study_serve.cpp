@@ -12,12 +12,14 @@
 
 #include "front_admission.hpp"
 #include "online_front.hpp"
+#include "overview_channel.hpp"
 #include "pages.hpp"
 #include "run_process.hpp"
 #include "study_file.hpp"
 #include "web_server.hpp"
 
 namespace dyad::study {
+extern const char* const kOverviewHtml;  // overview.html, embedded at configure time
 namespace {
 
 std::atomic<int> g_quit{0};  // lock-free: set by the handler, read by the loop
@@ -37,7 +39,8 @@ std::string WhyNotServed(const Study& s, const ServeOptions& o) {
   return "";
 }
 
-web::WebServer::Options ServerOptions(const ServeOptions& o, FrontAdmission* admission, OnlineFront* front, int max_sessions) {
+web::WebServer::Options ServerOptions(const ServeOptions& o, FrontAdmission* admission, OnlineFront* front,
+                                      OverviewChannel* overview, int max_sessions) {
   web::WebServer::Options so;
   so.address = o.address;
   so.port = o.port;
@@ -47,6 +50,8 @@ web::WebServer::Options ServerOptions(const ServeOptions& o, FrontAdmission* adm
   };
   so.pages["/subject"] = web::WebServer::Page{"text/html; charset=utf-8", web::kSubjectHtml, {web::Role::kSubject}, ""};
   so.endpoints.push_back(web::WebServer::Endpoint{"/subject/ws", {}, front, {web::Role::kSubject}, /*viewers=*/false});
+  so.pages["/overview"] = web::WebServer::Page{"text/html; charset=utf-8", kOverviewHtml, {web::Role::kExperimenter}, ""};
+  so.endpoints.push_back(web::WebServer::Endpoint{"/overview/ws", {}, overview, {web::Role::kExperimenter}, /*viewers=*/false});
   so.max_clients = 4 * max_sessions + 16;  // the refused pages are told so over their socket
   so.allowed_origins = o.origins;
   const std::string scheme = o.tls_certificate.empty() ? "http://" : "https://";
@@ -55,10 +60,13 @@ web::WebServer::Options ServerOptions(const ServeOptions& o, FrontAdmission* adm
   return so;
 }
 
-void Serving(const Study& s, const ServeOptions& o, int port, int with_links, int max_sessions) {
+void Serving(const Study& s, const ServeOptions& o, int port, int with_links, int max_sessions, const std::string& token) {
   const std::string scheme = o.tls_certificate.empty() ? "http://" : "https://";
   for (const std::string& host : web::UrlHosts(o.address))
     std::cout << "dyad study serve: " << s.name << " at " << scheme << host << ":" << port << "/subject?token=..." << std::endl;
+  for (const std::string& host : web::UrlHosts(o.address))
+    std::cout << "experimenter's overview: " << scheme << host << ":" << port << "/overview?token=" << token
+              << " (the token is kept in " << s.data << "/serve-tokens)" << std::endl;
   std::cout << "participants with links: " << with_links << " of " << s.participants.size()
             << (with_links < static_cast<int>(s.participants.size()) ? " (dyad study links " + s.file + " --base-url " + scheme +
                                                                            "HOST:" + std::to_string(port) + " makes the others')"
@@ -84,6 +92,12 @@ int Serve(const ServeOptions& o) {
   std::vector<std::string> token_problems;
   FrontAdmission admission(s, &token_problems);
   for (const std::string& p : token_problems) std::cerr << "dyad study serve: " << p << " (that participant has no link)\n";
+  const auto overview_token = ServeExperimenterToken(s);
+  if (!overview_token.ok()) {
+    std::cerr << "dyad study serve: " << overview_token.status().message() << "\n";
+    return 2;
+  }
+  admission.SetExperimenterToken(*overview_token);
   struct sigaction sa {
   }, old_int{}, old_term{};
   sa.sa_handler = OnServeSignal;
@@ -94,7 +108,8 @@ int Serve(const ServeOptions& o) {
   // A trial's graph waits for the page (it comes back at once after the 1012), at most
   // reconnect_s: the web component's wait does not end on SIGINT, so a stop waits for it too.
   OnlineFront front(s, FrontOptions{tools::ThisExecutable(), max_sessions, std::min(15.0, s.online.reconnect_s)});
-  auto server = web::WebServer::Start(ServerOptions(o, &admission, &front, max_sessions));
+  OverviewChannel overview(s, &front, max_sessions);
+  auto server = web::WebServer::Start(ServerOptions(o, &admission, &front, &overview, max_sessions));
   if (!server.ok()) {
     std::cerr << "dyad study serve: " << server.status().ToString() << "\n";
     sigaction(SIGINT, &old_int, nullptr);
@@ -102,8 +117,10 @@ int Serve(const ServeOptions& o) {
     return 1;
   }
   front.SetServer(server->get());
+  overview.SetServer(server->get());
+  overview.Start();
   if (!o.port_file.empty()) std::ofstream(o.port_file) << (*server)->port() << "\n";
-  Serving(s, o, (*server)->port(), admission.with_links(), max_sessions);
+  Serving(s, o, (*server)->port(), admission.with_links(), max_sessions, *overview_token);
   while (!g_quit.load()) {
     front.Tick(OnlineFront::Clock::now());
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
@@ -111,6 +128,8 @@ int Serve(const ServeOptions& o) {
   const int running = front.running();
   std::cout << "dyad study serve: stopping" << (running ? " (" + std::to_string(running) + " trials running are stopped)" : "")
             << std::endl;
+  overview.Stop();
+  overview.SetServer(nullptr);
   front.StopAll();
   front.SetServer(nullptr);
   server->reset();

@@ -504,6 +504,32 @@ TEST_F(KeystoreTest, ExportForAHostHoldsExactlyItsIdentitiesAndNoCaKey) {
   EXPECT_FALSE(fs::exists(dir_ / "x"));
 }
 
+// --web: the web component's TLS key and certificate go only where asked (the machine that runs
+// it), as the same bytes, 0600; without them in the keystore, --web is refused naming the option.
+TEST_F(KeystoreTest, AnExportHoldsTheWebCertificateOnlyWithWeb) {
+  std::ofstream(dir_ / "hosts.yaml") << kPlacedGraph;
+  const std::string graph = (dir_ / "hosts.yaml").string();
+  ASSERT_EQ(Init({}, dir_ / "hosts.yaml").code, 0);
+  auto refused = dyad::testing::RunCommand(AddSecurityCommands, {"security", "export", keys_.string(), "--graph", graph, "--host",
+                                                                 "lab", "--web", (dir_ / "none").string()});
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_NE(refused.err.find("web/tls.pem: --web, and the keystore has no web certificate"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(dir_ / "none"));
+  ASSERT_EQ(Init({"--web-host", "127.0.0.1"}, dir_ / "hosts.yaml").code, 0);
+  for (const bool web : {false, true}) {
+    const fs::path out = dir_ / (web ? "with_web" : "without_web");
+    std::vector<std::string> args = {"security", "export", keys_.string(), "--graph", graph, "--host", "lab", out.string()};
+    if (web) args.push_back("--web");
+    auto r = dyad::testing::RunCommand(AddSecurityCommands, args);
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::set<std::string> expected = SubsetBase({"host.lab", "process.pub"});
+    expected.insert("0600 web_ca.cert.pem");
+    if (web) expected.insert({"0700 web", "0600 web/tls.pem", "0600 web/cert.pem", "0600 web/hosts"});
+    EXPECT_EQ(Listing(out), expected) << web;
+  }
+  EXPECT_EQ(ReadFile(dir_ / "with_web" / "web" / "tls.pem"), ReadFile(keys_ / "web" / "tls.pem"));
+}
+
 // --guest: the guest identity only; a graph without security.guests has none to export.
 TEST_F(KeystoreTest, AGuestSubsetHoldsOnlyTheGuestIdentity) {
   std::ofstream(dir_ / "hosts.yaml") << kPlacedGraph;
