@@ -166,7 +166,9 @@ std::string OverviewChannel::StateOf(const std::vector<OnlineFront::SessionView>
                         {"shown", v.shown},
                         {"file", v.file},
                         {"recording_bytes", v.file.empty() || ec ? Json(nullptr) : Json(bytes)},
-                        {"engaged", v.engaged ? Json(*v.engaged) : Json(nullptr)},
+                        {"engaged", v.phase == "paused" ? Json(false)
+                                    : v.engaged         ? Json(*v.engaged)
+                                                        : Json(nullptr)},
                         {"rtt_ms", OrNull(v.rtt_ms, v.rtt_ms >= 0)},
                         {"step_p99_ms", OrNull(stats ? stats->p99_ms : 0, stats.has_value())},
                         {"step_component", stats ? stats->component : ""},

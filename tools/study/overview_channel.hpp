@@ -17,11 +17,13 @@
 //     away (between trials, gone_s), done, refused, ended (ended: the experimenter's reason));
 //     trial of `of`: the running trial, else the next one; shown: its condition as the
 //     experimenter may see it (the label when the study is blind); recording_bytes: the running
-//     attempt's file now; engaged: the relayed page's last pointer sample; rtt_ms: the page's
-//     ping round trip; step_p99_ms and misses: the running trial's graph's own stats (the largest
-//     step p99 of its components, which one, and their deadline misses summed), from its web
-//     component's {"op":"stats"} once a second on /experimenter/ws (a WsClient per running trial,
-//     with the experimenter token of the participant's DATA/P/<web>-tokens). null: not known (yet).
+//     attempt's file now; engaged: the relayed page's last pointer sample (false while the page
+//     is gone); rtt_ms: the page's ping round trip; step_p99_ms and misses: the running trial's
+//     graph's own stats (the largest step p99 of its components, which one, and their deadline
+//     misses summed), from its web component's {"op":"stats"} once a second on /experimenter/ws
+//     (a WsClient per running trial, with the experimenter token of the participant's
+//     DATA/P/<web>-tokens; "ended" is set while a stopped session's trial ends too).
+//     null: not known (yet).
 //     {"op":"done","request","participant"} when a request was carried out; {"op":"error",
 //     "message"} when it was refused (the page stays).
 //   page -> server:
