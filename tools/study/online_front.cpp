@@ -72,6 +72,7 @@ struct OnlineFront::Participant {
   std::string token, lost_reason;
   int ping_id = 0;
   Clock::time_point ping_sent{};
+  Clock::time_point heard{};  // the page's last frame (its pongs included)
   double rtt_ms = -1;
   // For the experimenter's overview: the running attempt, the page's engagement, the end.
   int trial = 0, attempt = 0;
@@ -130,6 +131,7 @@ std::string OnlineFront::Take(Participant& p, web::ClientId client, Clock::time_
     p.lock.emplace(std::move(*lock));
   }
   p.page = client;
+  p.heard = now;
   p.session.PageOpened();
   clients_[client] = &p;
   return "";
@@ -142,11 +144,21 @@ void OnlineFront::OnOpen(web::ClientId client, web::Role) {
   Participant& p = *it->second;
   std::string refused;
   bool running = false;
+  web::ClientId silent = 0;  // p's page until now, silent too long: a connection dead without a close
+  std::shared_ptr<web::WsClient> silent_relay;
   {
     MutexLock lock(mutex_);
-    refused = Take(p, client, Clock::now());
+    const Clock::time_point now = Clock::now();
+    if (p.page != 0 && now - p.heard > 2 * options_.ping_interval + std::chrono::seconds(1)) {
+      std::swap(silent, p.page);
+      silent_relay = std::move(p.upstream);
+      p.session.PageClosed(now);
+    }
+    refused = Take(p, client, now);
     running = p.running;
   }
+  if (silent_relay) silent_relay->Close();
+  if (silent != 0) Close(silent, 1001, "replaced by a newer page of this link");
   if (!refused.empty()) {
     std::cout << p.id << ": a page refused: " << refused << std::endl;
     Send(client, Refused(refused));
@@ -240,7 +252,12 @@ void OnlineFront::Pointer(Participant& p, std::string_view text) {
 
 Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
   Participant* p = Of(client);
-  if (p == nullptr || Pong(*p, text)) return Status::OK();
+  if (p == nullptr) return Status::OK();
+  {
+    MutexLock lock(mutex_);
+    if (p->page == client) p->heard = Clock::now();
+  }
+  if (Pong(*p, text)) return Status::OK();
   std::shared_ptr<web::WsClient> up;
   bool running = false;
   {

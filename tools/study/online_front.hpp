@@ -14,7 +14,9 @@
 //
 // Contract:
 //   - One page per participant: a second one while the first is open gets {"op":"refused",
-//     "message":"This link is already open in another window."} and is closed with 1008.
+//     "message":"This link is already open in another window."} and is closed with 1008. A first
+//     page silent for 2 ping intervals + 1 s (no pong: a connection dead without a close, which
+//     TCP may take minutes to notice) is closed instead (1001), and the new one takes its place.
 //   - At most max_sessions live sessions (a page connected, a trial running, or the page gone
 //     less than reconnect_s between trials): a participant whose session is not live then gets
 //     {"op":"refused","message":"Please come back later: ..."}, closed with 1008; nothing starts.

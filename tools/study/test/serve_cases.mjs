@@ -41,7 +41,7 @@ class Front {
 
 // One subject's page: its frames in order (pings answered and not kept), its close code.
 class Page {
-  constructor(front, tok, options = {}) {
+  constructor(front, tok, options = {}, silent = false) {
     this.frames = [];
     this.waiters = [];
     this.ws = new WebSocket(`ws://127.0.0.1:${front.port}/subject/ws?token=${tok}`, options);
@@ -53,7 +53,7 @@ class Page {
     this.closed = new Promise((r) => this.ws.on("close", (code) => r(code)));
     this.ws.on("message", (d) => {
       const m = JSON.parse(String(d));
-      if (m.op === "ping") return this.send({ op: "pong", id: m.id });
+      if (m.op === "ping") return silent ? undefined : this.send({ op: "pong", id: m.id });
       this.frames.push(m);
       this.waiters = this.waiters.filter((w) => !w());
     });
@@ -132,6 +132,19 @@ async function openTwiceAndMaxSessions(front) {
   return first;
 }
 
+// A page whose connection died without a close answers no ping: a new page of its link replaces it.
+async function silentPage(front) {
+  const silent = new Page(front, token("P03"), {}, true);
+  await silent.next("consent");
+  check(await new Page(front, token("P03")).next("refused") !== undefined, "a live first page: the second is refused");
+  await sleep(5500);  // 2 ping intervals + 1 s without a pong
+  const fresh = new Page(front, token("P03"));
+  await fresh.next("consent");
+  check(await silent.closed === 1001, "the silent page is closed (1001)");
+  fresh.ws.close();
+  console.log("ok: a page silent for 5 s is replaced by a new page of its link");
+}
+
 async function lostAndBack(front, p01) {
   p01.send({ op: "consent", agree: true });
   const waiting = await p01.next("waiting");
@@ -204,6 +217,7 @@ try {
   await front.start();
   await unknownTokens(front);
   const p01 = await openTwiceAndMaxSessions(front);
+  await silentPage(front);
   await lostAndBack(front, p01);
   await restarts(front);
   check(await front.stop("SIGINT") === 0, "SIGINT: exit 0");
