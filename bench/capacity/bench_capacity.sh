@@ -77,11 +77,16 @@ work=$(mktemp -d)
 pids=()     # direct: each session's `dyad run` (a process group of its own)
 front=""    # serve: the level's `dyad study serve` (a process group of its own)
 client=""   # the level's Node process (a process group of its own: Chromium is in it)
-# Stops what runs: the clients (with Chromium), then the graphs (direct: SIGINT, they print their
-# timing) or the front (SIGTERM: it stops each trial as `dyad study run` does, then exits; still
-# there after 30 s: killed with its group, and each trial's group it had).
+# Stops what runs: the clients (SIGINT: Node closes Chromium and exits; still there after 10 s:
+# killed with its group), then the graphs (direct: SIGINT, they print their timing) or the front
+# (SIGTERM: it stops each trial as `dyad study run` does, then exits; still there after 30 s:
+# killed with its group, and each trial's group it had).
 stop_all() {
-  if [ -n "$client" ]; then kill -TERM -- "-$client" 2> /dev/null || true; fi
+  if [ -n "$client" ]; then
+    kill -INT -- "-$client" 2> /dev/null || true
+    for _ in $(seq 100); do kill -0 "$client" 2> /dev/null || break; sleep 0.1; done
+    kill -KILL -- "-$client" 2> /dev/null || true
+  fi
   for p in "${pids[@]}"; do kill -INT "$p" 2> /dev/null || true; done
   if [ -n "$front" ]; then
     local graphs

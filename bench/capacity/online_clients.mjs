@@ -93,10 +93,14 @@ async function arrived(p, ms) {
 
 async function main(argv) {
   const o = parse(argv);
+  // Stopped (the bench's cleanup, Ctrl-C): exit at once; playwright's exit hook kills Chromium's
+  // process group (its own SIGTERM handler would close the browser and leave this process running).
+  for (const [signal, code] of [["SIGINT", 130], ["SIGTERM", 143], ["SIGHUP", 129]]) process.on(signal, () => process.exit(code));
   const prims = loadPrimitives(o.dataset) ?? generatedPrimitives();
   const lines = fs.readFileSync(o.file, "utf8").split("\n").filter((l) => l.trim());
   const browser = o.chromium > 0
-    ? await createRequire(simPath)("playwright-core").chromium.launch({ executablePath: "/usr/bin/chromium", args: ["--headless", "--no-sandbox", "--disable-gpu"] })
+    ? await createRequire(simPath)("playwright-core").chromium.launch({ executablePath: "/usr/bin/chromium", args: ["--headless", "--no-sandbox", "--disable-gpu"],
+                                                         handleSIGINT: false, handleSIGTERM: false, handleSIGHUP: false })
     : null;
   const people = lines.map((line, i) => {
     const [url, token, more] = line.trim().split(/\s+/);
