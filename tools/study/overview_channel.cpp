@@ -30,8 +30,11 @@ StatusOr<std::string> ServeExperimenterToken(const Study& s) {
   if (!fs::exists(fs::symlink_status(file, ec))) {
     if (Status d = CreatePrivateDirectories(s.data); !d.ok()) return d;
     const std::string token = web::RandomToken();
-    if (Status w = WritePrivateFile(file, "experimenter " + token + "\n", CreateMode::kNew); !w.ok()) return w;
-    return token;
+    Status w = WritePrivateFile(file, "experimenter " + token + "\n", CreateMode::kNew);
+    if (w.ok()) return token;
+    if (w.code() != Status::Code::kFailedPrecondition) return w;
+    // Another instance on the same folder made it this instant: its token, once it is written.
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
   }
   return ReadRoleToken(file, "experimenter", "the experimenter's overview token");
 }

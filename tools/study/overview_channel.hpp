@@ -60,7 +60,8 @@ class WsClient;
 
 namespace dyad::study {
 
-// DATA/serve-tokens' experimenter token, the file made (0600, its folder 0700) when missing.
+// DATA/serve-tokens' experimenter token, the file made (0600, its folder 0700) when missing;
+// instances on one folder share it (one made at the same instant by another is read).
 StatusOr<std::string> ServeExperimenterToken(const Study& s);
 
 // A trial graph's step statistics from its web component's {"op":"stats","rows":[...]} frame
