@@ -2,7 +2,7 @@
 // the study): each case a scripted page, its frames and close codes checked, and the session log
 // read back. Throws (exit 1) at the first case that fails, naming it.
 //   node serve_cases.mjs DYAD STUDY_FILE DATA_DIR
-import { spawn } from "node:child_process";
+import { spawn, spawnSync } from "node:child_process";
 import fs from "node:fs";
 import http from "node:http";
 import WebSocket from "ws";
@@ -109,6 +109,18 @@ async function unknownTokens(front) {
   console.log("ok: unknown tokens 404, an address guessing 429");
 }
 
+// A participant whose session the lab holds (its session.lock, as `dyad study run` holds it) is asked to come back.
+async function heldByTheLab(front) {
+  const holder = spawn("flock", [`${data}/P04/session.lock`, "sleep", "1.5"]);
+  const exited = new Promise((r) => holder.on("exit", r));
+  await sleep(300);
+  const page = new Page(front, token("P04"));
+  const refused = await page.next("refused");
+  check(/open elsewhere/.test(refused.message) && await page.closed === 1008, `held by the lab: ${refused.message}`);
+  await exited;
+  console.log("ok: a session the lab holds is refused online, and the lab's study run while a page is live");
+}
+
 async function openTwiceAndMaxSessions(front) {
   const first = new Page(front, token("P01"));
   check((await first.next("consent")).text.includes("I agree"), "the consent page shows the study's text");
@@ -123,6 +135,10 @@ async function openTwiceAndMaxSessions(front) {
   check(full.message.startsWith("Please come back later"), `max_sessions: ${full.message}`);
   check(await p3.closed === 1008, "refused at max_sessions: 1008");
   check(log("P03").length === 0, "nothing logged for a participant refused at max_sessions");
+  // One runner per participant: the lab's `dyad study run` of P01 is refused while P01's page is live.
+  const lab = spawnSync(dyad, ["study", "run", studyFile, "--participant", "P01", "--consent", "--yes"], { encoding: "utf8" });
+  check(lab.status === 2 && lab.stderr.includes("holds P01's session"), `study run during the online session: ${lab.status} ${lab.stderr}`);
+  check(!log("P01").length, "the refused study run marked nothing");
   p2.ws.close();
   await sleep(2600);  // P02's session stays live reconnect_s (2 s) after its page left
   const p3again = new Page(front, token("P03"));
@@ -216,6 +232,7 @@ const front = new Front();
 try {
   await front.start();
   await unknownTokens(front);
+  await heldByTheLab(front);
   const p01 = await openTwiceAndMaxSessions(front);
   await silentPage(front);
   await lostAndBack(front, p01);

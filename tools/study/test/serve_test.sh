@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # What goes wrong online (#45 item 3), through `dyad study serve` with scripted pages
-# (serve_cases.mjs), and what it refuses to start with: unknown tokens (404, an address guessing 429), a link open twice (1008),
-# max_sessions (come back later), a page lost for less and more than reconnect_s mid-trial, and
-# the front restarted by SIGTERM and by SIGKILL mid-trial. Trials of 4 s on a small graph.
+# (serve_cases.mjs), and what it refuses to start with: unknown tokens (404, an address guessing
+# 429), a session the lab holds (and `dyad study run` of a participant online), a link open twice
+# (1008; a silent first page replaced), max_sessions (come back later), a page lost for less and
+# more than reconnect_s mid-trial, and the front restarted by SIGTERM and by SIGKILL mid-trial.
+# Trials of 4 s on a small graph.
 #   serve_test.sh REPO BUILD_DIR WORK_DIR
 set -euo pipefail
 repo=$1 build=$2 work=$3
