@@ -33,7 +33,7 @@ try {
     if (!/^condition [AB]$/.test(got.condition)) throw new Error(p + ": a blind study's condition shown as " + got.condition);
     if (!/^\d+\.\d\d ms \(\S+\)$/.test(got.p99) || got.p99.startsWith("0.00 ")) throw new Error(p + ": step p99 shown as " + got.p99);
     if (!/^\d+$/.test(got.misses)) throw new Error(p + ": misses shown as " + got.misses);
-    if (!/^\d+ ms$/.test(got.rtt)) throw new Error(p + ": round trip shown as " + got.rtt);
+    if (!/^\d+(\.\d)? ms$/.test(got.rtt)) throw new Error(p + ": round trip shown as " + got.rtt);
     if (!/^\d+(\.\d)? [KM]?B$/.test(got.recording)) throw new Error(p + ": recording shown as " + got.recording);
   }
   await page.screenshot({ path: `${shotDir}/overview_two_trials.png` });

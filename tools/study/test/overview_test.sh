@@ -8,7 +8,8 @@
 #     "stopped by the experimenter: REASON", no trial after it; P02's page was told (refused);
 #   - DATA/serve-tokens is 0600 and read again at the next start (the same link), one readable by
 #     others is refused naming it; after that restart P02's link is still refused (the log holds
-#     the end); a participant's token does not open the overview.
+#     the end) until the overview resumes it (then trial 1 again); a participant's token does not
+#     open the overview.
 #   overview_test.sh REPO BUILD_DIR WORK_DIR
 set -euo pipefail
 repo=$1 build=$2 work=$3
@@ -101,6 +102,24 @@ serve
 [ "$(sed -n "s/^experimenter's overview: \(http[^ ]*\).*/\1/p" serve.out | head -1)" = "$url" ] || fail "a new overview token at the restart"
 node "$node_dir/sim_participant.mjs" --online --seconds 10 p02.sessions > p02b.json 2> p02b.err || { cat p02b.err; fail "P02 again"; }
 grep -q '"refused":"The experimenter has ended this session.' p02b.json || { cat p02b.json; fail "P02's session open again after a restart"; }
+# Resumed from the overview's socket: P02's link opens the session again, the stopped trial next.
+cat > resume.mjs <<'JS'
+import WebSocket from "ws";
+const [base, token, p02] = process.argv.slice(2);
+const first = (url, send) => new Promise((resolve, reject) => {
+  const ws = new WebSocket(url);
+  ws.on("open", () => send && ws.send(JSON.stringify(send)));
+  ws.on("message", (d) => { const m = JSON.parse(String(d)); if (m.op !== "state" && m.op !== "ping") { ws.close(); resolve(m); } });
+  ws.on("error", reject);
+});
+console.log(JSON.stringify(await first(`${base}/overview/ws?token=${token}`, { op: "resume", participant: "P02" })));
+console.log(JSON.stringify(await first(`${base}/subject/ws?token=${p02}`)));
+JS
+overview_token=$(sed -n 's/^experimenter //p' sdata/serve-tokens)
+node resume.mjs "ws://127.0.0.1:$port" "$overview_token" "$(token P02)" > resume.out 2>&1 || { cat resume.out; fail "resume"; }
+grep -q '"op":"done","participant":"P02","request":"resume"' resume.out && grep '"op":"waiting"' resume.out | grep -q 'Trial 1 of 2 starts again' ||
+  { cat resume.out serve.out; fail "P02 resumed: not offered trial 1 again"; }
+tail -1 sdata/P02/session.log | grep -q '"event":"session_resumed"' || fail "no session_resumed in P02's log"
 kill -TERM "$serve_pid"
 wait "$serve_pid" || fail "dyad study serve's second SIGTERM exit: $?"
-echo "PASS: overview link kept across restarts; P02 still ended"
+echo "PASS: overview link kept across restarts; P02 still ended, then resumed"
