@@ -245,11 +245,14 @@ serve_level() {
   kill -TERM "$front" 2> /dev/null || true
   wait "$front" || true
   front=""
-  for i in $(seq "$n"); do
+  for i in $(seq "$n"); do  # a participant whose trial never started has no log
+    local trial
+    trial=$d/data/$(printf 'P%03d' "$i")/01-capacity
     mkdir -p "$level/s$i"
-    ln -sf "$d/data/$(printf 'P%03d' "$i")/01-capacity.log" "$level/s$i/run.out"
-    ln -sf "$d/data/$(printf 'P%03d' "$i")/01-capacity.log" "$level/s$i/run.err"
-    "$dyad" bag export "$d/data/$(printf 'P%03d' "$i")/01-capacity.mcap" --csv "$level/s$i/stats" --topic dyad/stats > /dev/null 2>&1 || true
+    [ -f "$trial.log" ] || continue
+    ln -sf "$trial.log" "$level/s$i/run.out"
+    ln -sf "$trial.log" "$level/s$i/run.err"
+    "$dyad" bag export "$trial.mcap" --csv "$level/s$i/stats" --topic dyad/stats > /dev/null 2>&1 || true
   done
 }
 
@@ -267,8 +270,9 @@ for n in $ns; do
   k=0; [ "$n" -lt 8 ] || k=$(( chromium < n ? chromium : n ))
   duration=$(( seconds + n * arrival + 10 ))  # serve: each trial's length
   if [ "$mode" = serve ]; then serve_level "$level" "$n" "$k"; else direct_level "$level" "$n" "$k"; fi
-  for i in $(seq "$started"); do
+  for i in $(seq "$([ "$mode" = serve ] && echo "$n" || echo "$started")"); do
     d=$level/s$i
+    [ -e "$d/run.out" ] || continue
     awk '$1 == "mind" && NF >= 8 { print $4 }' "$d/run.out" > "$d/mind_p99"
     awk '/^timing/ { t = 1; next } t && NF >= 8 && $2 ~ /^[0-9]+$/ { m += $8 } END { print m + 0 }' "$d/run.out" > "$d/misses"
     { grep -o "pointer event -> published: .*" "$d/run.err" || true; } | sed -E 's/.*p99 ([0-9.]+) ms \(([0-9]+) samples.*/\1 \2/' > "$d/pointer"
@@ -286,7 +290,7 @@ def read(i, name, field=0):
         return float(text[field]) if text else None
     except OSError:
         return None
-rows = range(1, started + 1)
+rows = range(1, (n if serve else started) + 1)  # serve: a participant without a trial reads as none
 mind = [v for v in (read(i, "mind_p99") for i in rows) if v is not None]
 misses = [read(i, "misses") or 0 for i in rows]
 pointer = [v for v in (read(i, "pointer") for i in rows) if v is not None]
