@@ -48,7 +48,10 @@
 # Ctrl-C included. A trial's deadline misses include its start's: its graph waits for the page
 # (wait_for_subject_s) in the web component's Activate, after the executor fixed its wall clock's
 # start (SoloSession::AwaitStart), so the first step of web, human and mind is late by that wait
-# (jitter_max_ms, 0.1-0.2 s) and each counts a miss.
+# (jitter_max_ms, 0.1-0.2 s) and each counts a miss: the row says how many fell in the trials'
+# first second (each recording's first dyad/stats), and the knee counts the others. Ready -> hello
+# moves in the front's relay retries (200 ms while the graph starts). A level also falls over when
+# a participant ends without their completion code.
 # Models: build/models/demo.{dpvrnn,dobs} when tools/demo.sh made them, else trained here for a few
 # epochs with the demo's settings into BUILD_DIR/bench-capacity (a step costs the same however long
 # the model was trained).
