@@ -89,9 +89,16 @@ void OverviewChannel::Stop() {
 
 void OverviewChannel::Loop() {
   while (!stopping_.load()) {
-    const std::vector<OnlineFront::SessionView> sessions = front_->Snapshot(Clock::now());
-    UpdateStats(sessions);
-    Broadcast(StateOf(sessions));
+    bool watched = false;
+    {
+      MutexLock lock(mutex_);
+      watched = !pages_.empty();
+    }
+    if (watched) {  // nobody watching: no log read, no stats link (a page that opens gets them within a second)
+      const std::vector<OnlineFront::SessionView> sessions = front_->Snapshot(Clock::now());
+      UpdateStats(sessions);
+      Broadcast(StateOf(sessions));
+    }
     for (int i = 0; i < 20 && !stopping_.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
 }

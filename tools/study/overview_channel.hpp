@@ -36,7 +36,7 @@
 //   A frame of another shape is answered with an error.
 //
 // Threads: the handler's calls come from the web server; Start() runs the once-a-second state and
-// the stats clients on a thread of its own, until Stop().
+// the stats clients on a thread of its own, until Stop(), only while an overview page is open.
 #pragma once
 
 #include <atomic>
