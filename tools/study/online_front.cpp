@@ -164,7 +164,7 @@ void OnlineFront::OnOpen(web::ClientId client, web::Role) {
     Send(client, Refused(refused));
     return Close(client, 1008, "refused");
   }
-  if (!running) return Send(client, p.session.PageFrame());
+  if (!running) return SendPhase(p, client);
   // Connecting may take seconds (the graph starting) and more stack than civetweb's workers
   // have: a thread of its own. The page sends nothing but pongs before the graph's hello.
   relays_.fetch_add(1);
@@ -216,7 +216,7 @@ void OnlineFront::Relay(Participant& p, web::ClientId client) {
     here = p.page == client;
     running = p.running;
   }
-  if (here && !running) Send(client, p.session.PageFrame());
+  if (here && !running) SendPhase(p, client);
   else if (here) NextPhase(p, client, "the trial is not reachable: retry");
 }
 
@@ -228,6 +228,20 @@ void OnlineFront::NextPhase(Participant& p, web::ClientId client, const std::str
     p.session.PageClosed(Clock::now());
   }
   Close(client, 1012, reason);
+}
+
+void OnlineFront::SendPhase(Participant& p, web::ClientId client) {
+  const std::string frame = p.session.PageFrame();
+  Send(client, frame);
+  const bool refused = frame.find(R"("op":"refused")") != std::string::npos;
+  if (!refused && frame.find(R"("op":"done")") == std::string::npos) return;
+  {
+    MutexLock lock(mutex_);
+    if (p.page != client) return;
+    p.page = 0;
+    p.session.PageFinished();  // nothing to come back for: not live
+  }
+  Close(client, refused ? 1008 : 1000, refused ? "refused" : "the session is complete");
 }
 
 // A pong to the front's ping: its round trip kept, not relayed.
@@ -280,12 +294,12 @@ void OnlineFront::Answer(Participant& p, web::ClientId client, std::string_view 
   const Json j = Json::parse(text.begin(), text.end(), nullptr, false);
   const std::string op = j.is_object() ? j.value("op", "") : "";
   if (op == "consent" && j.contains("agree") && j["agree"].is_boolean()) {
-    if (p.session.phase() != OnlineSession::Phase::kConsent) return Send(client, p.session.PageFrame());
+    if (p.session.phase() != OnlineSession::Phase::kConsent) return SendPhase(p, client);
     const bool agree = j["agree"].get<bool>();
     if (Status st = p.session.Consent(agree); !st.ok())
       std::cerr << "dyad study serve: " << p.id << ": " << st.ToString() << std::endl;
     std::cout << p.id << (agree ? ": consent given on the consent page" : ": declined on the consent page") << std::endl;
-    return Send(client, p.session.PageFrame());
+    return SendPhase(p, client);
   }
   if (op == "ready" && p.session.phase() == OnlineSession::Phase::kWaiting) return StartTrial(p);
 }

@@ -106,6 +106,9 @@ class OnlineFront final : public web::ClientHandler {
   void Relay(Participant& p, web::ClientId client);
   // Closes p's page `client` with 1012 (it reconnects at once): no longer p's page from now on.
   void NextPhase(Participant& p, web::ClientId client, const std::string& reason);
+  // The page's frame for p's phase (OnlineSession::PageFrame); done or refused, the page is then
+  // closed (1000, 1008: it keeps its view and does not come back) and its session is not live.
+  void SendPhase(Participant& p, web::ClientId client);
   bool Pong(Participant& p, std::string_view text);
   void Pointer(Participant& p, std::string_view text);
   void Answer(Participant& p, web::ClientId client, std::string_view text);

@@ -164,6 +164,12 @@ void OnlineSession::PageClosed(Clock::time_point now) {
   gone_since_ = now;
 }
 
+void OnlineSession::PageFinished() {
+  MutexLock lock(mutex_);
+  page_ = false;
+  gone_since_.reset();
+}
+
 bool OnlineSession::page() const {
   MutexLock lock(mutex_);
   return page_;

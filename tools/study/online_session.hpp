@@ -74,6 +74,8 @@ class OnlineSession {
 
   void PageOpened();
   void PageClosed(Clock::time_point now);
+  // Closed with nothing to come back for (done, refused): not live from now on.
+  void PageFinished();
   bool page() const;
   // How long the page has been gone (zero while it is connected).
   Clock::duration LostFor(Clock::time_point now) const;

@@ -145,6 +145,8 @@ TEST_F(OnlineSessionTest, ThePageIsLostFromWhenItLeftAndTheSessionStaysLiveForRe
   EXPECT_FALSE(s.Live(t0 + 6s, false)) << "reconnect_s (5) after the page left between trials";
   s.PageOpened();
   EXPECT_EQ(s.LostFor(t0 + 10s), OnlineSession::Clock::duration::zero());
+  s.PageFinished();  // done or refused: nothing to come back for
+  EXPECT_FALSE(s.Live(t0 + 10s, false));
 }
 
 }  // namespace

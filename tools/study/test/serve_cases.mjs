@@ -141,10 +141,17 @@ async function openTwiceAndMaxSessions(front) {
   check(!log("P01").length, "the refused study run marked nothing");
   p2.ws.close();
   await sleep(2600);  // P02's session stays live reconnect_s (2 s) after its page left
+  // P02 comes back and declines: told so politely, closed (1008: the page stays), logged; the slot is free at once.
+  const declining = new Page(front, token("P02"));
+  await declining.next("consent");
+  declining.send({ op: "consent", agree: false });
+  check((await declining.next("refused")).message.startsWith("You did not agree"), "declined: a polite end");
+  check(await declining.closed === 1008, "declined: the page is closed (1008)");
+  check(log("P02").some((e) => e.event === "declined"), "declined: logged");
   const p3again = new Page(front, token("P03"));
   await p3again.next("consent");
   p3again.ws.close();
-  console.log("ok: a link open twice is refused (1008); max_sessions refuses a new participant until a session ends");
+  console.log("ok: a link open twice is refused (1008); max_sessions refuses a new participant until a session ends; a declined consent ends politely");
   return first;
 }
 
