@@ -106,7 +106,7 @@ int Serve(const ServeOptions& o) {
   sigaction(SIGINT, &sa, &old_int);
   sigaction(SIGTERM, &sa, &old_term);
   // A trial's graph waits for the page (it comes back at once after the 1012), at most
-  // reconnect_s: the web component's wait does not end on SIGINT, so a stop waits for it too.
+  // reconnect_s: a page not back by then ends the trial anyway.
   OnlineFront front(s, FrontOptions{tools::ThisExecutable(), max_sessions, std::min(15.0, s.online.reconnect_s)});
   OverviewChannel overview(s, &front, max_sessions);
   auto server = web::WebServer::Start(ServerOptions(o, &admission, &front, &overview, max_sessions));
