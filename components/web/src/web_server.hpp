@@ -28,6 +28,12 @@
 /// SSL_get_peer_certificate, which OpenSSL 3 no longer exports (a null call on the first
 /// connection); the server first loads dyad's libdyad_civetweb_ssl.so (civetweb_ssl_shim.c), a
 /// library named "libssl.so" that supplies it, so civetweb finds that one.
+///
+/// Stacks: civetweb's worker threads (pages, handshakes, OnOpen/OnClose) have 100 KB stacks
+/// (Debian's build sets USE_STACK_SIZE 102400), and an OpenSSL 3 SSL_write takes most of that.
+/// Every thread's static TLS comes out of its stack: a program that runs this server must keep
+/// its thread_local data small (a 5 KB std::mt19937 in the dyad command overflowed a page's
+/// SSL_write, web.tls_browser). Deep work belongs on the handler thread or a thread of one's own.
 #pragma once
 
 #include <cstdint>

@@ -5,6 +5,7 @@
 #include <netinet/in.h>
 #include <netinet/tcp.h>
 #include <openssl/evp.h>
+#include <openssl/rand.h>
 #include <openssl/sha.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -42,9 +43,14 @@ std::string AcceptFor(const std::string& key) {
   return Base64(digest, sizeof(digest));
 }
 
+// A frame's masking key, unpredictable as RFC 6455 10.3 asks (OpenSSL's CSPRNG). Not a
+// thread_local engine: a std::mt19937 there is 5 KB of static TLS in every thread of a program
+// that links this (the dyad command), taken from each thread's stack, and civetweb's workers
+// have small stacks: SSL_write on one overflowed it (web.tls_browser crashed in EVP_CipherInit_ex).
 uint32_t RandomWord() {
-  thread_local std::mt19937 random{std::random_device{}()};
-  return static_cast<uint32_t>(random());
+  uint32_t word = 0;
+  if (RAND_bytes(reinterpret_cast<unsigned char*>(&word), sizeof word) != 1) word = static_cast<uint32_t>(std::random_device{}());
+  return word;
 }
 
 // One frame as a client sends it: final, masked (RFC 6455 5.3).
