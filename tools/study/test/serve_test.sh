@@ -3,8 +3,8 @@
 # (serve_cases.mjs), and what it refuses to start with: unknown tokens (404, an address guessing
 # 429), a session the lab holds (and `dyad study run` of a participant online), a link open twice
 # (1008; a silent first page replaced), max_sessions (come back later), a page lost for less and
-# more than reconnect_s mid-trial, and the front restarted by SIGTERM and by SIGKILL mid-trial.
-# Trials of 4 s on a small graph.
+# more than reconnect_s mid-trial, the front restarted by SIGTERM and by SIGKILL mid-trial, and
+# the page over HTTPS and WSS with a certificate. Trials of 4 s on a small graph.
 #   serve_test.sh REPO BUILD_DIR WORK_DIR
 set -euo pipefail
 repo=$1 build=$2 work=$3
@@ -47,6 +47,24 @@ rc=0; "$build/bin/dyad" study serve no_consent.yaml --port 0 > refused.out 2>&1 
 [ $rc = 2 ] && grep -q "no_consent.yaml: online.consent: required to serve a study with consent_required" refused.out ||
   fail "consent required without online.consent: exit $rc: $(cat refused.out)"
 node serve_cases.mjs "$build/bin/dyad" s.yaml serve_test-data
+# With a certificate: HTTPS and WSS only (as off loopback, where it is required).
+openssl req -x509 -newkey rsa:2048 -nodes -keyout key.pem -out cert.pem -days 1 -subj /CN=localhost 2> /dev/null
+cat key.pem cert.pem > web.pem && chmod 600 web.pem
+"$build/bin/dyad" study serve s.yaml --port 0 --port-file tls-port --tls-certificate web.pem > tls.out 2>&1 &
+tls=$!
+wait_port_file tls-port $tls 10 tls.out
+p03=$(sed -n 's/^subject //p' serve_test-data/P03/web-tokens)
+code=$(curl -sk -o /dev/null -w "%{http_code}" "https://127.0.0.1:$(cat tls-port)/subject?token=$p03")
+[ "$code" = 200 ] || { kill $tls; fail "the page over HTTPS: $code: $(cat tls.out)"; }
+op=$(node -e '
+  const WebSocket = require("ws");
+  const ws = new WebSocket(process.argv[1], { rejectUnauthorized: false });
+  ws.on("message", (d) => { console.log(JSON.parse(String(d)).op); process.exit(0); });
+  ws.on("error", (e) => { console.log("error: " + e.message); process.exit(1); });
+  setTimeout(() => { console.log("nothing"); process.exit(1); }, 5000);' "wss://127.0.0.1:$(cat tls-port)/subject/ws?token=$p03") ||
+  { kill $tls; fail "the page's socket over WSS: $op: $(cat tls.out)"; }
+[ "$op" = consent ] || { kill $tls; fail "over WSS P03 got '$op', not the consent page"; }
+kill -TERM $tls; wait $tls || fail "dyad study serve with TLS exited $?: $(cat tls.out)"
 # Killed or stopped, the front leaves no trial's graph behind (each ends by its parent-death signal).
 for _ in $(seq 50); do pgrep -f "$work/serve_test-data" > /dev/null || break; sleep 0.2; done
 if pgrep -fa "$work/serve_test-data"; then fail "a trial's graph outlived dyad study serve"; fi
