@@ -19,10 +19,11 @@ clock: wall
 domain_id: $(test_domain)
 topics:
   web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
+  experiment/notes: {type: Annotation, depth: 8}
 components:
-  web: {type: web, rate_hz: 30, params: {port: 0}, outputs: {pointer: web/pointer}}
+  web: {type: web, rate_hz: 30, params: {port: 0}, outputs: {pointer: web/pointer, notes: experiment/notes}}
   human: {type: web_human, rate_hz: 20, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
-  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input]}}
+  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input, experiment/notes]}}
 YAML
 echo "I agree to take part in this test study." > consent.txt
 cat > s.yaml <<YAML
@@ -47,6 +48,11 @@ rc=0; "$build/bin/dyad" study serve no_consent.yaml --port 0 > refused.out 2>&1 
 [ $rc = 2 ] && grep -q "no_consent.yaml: online.consent: required to serve a study with consent_required" refused.out ||
   fail "consent required without online.consent: exit $rc: $(cat refused.out)"
 node serve_cases.mjs "$build/bin/dyad" s.yaml serve_test-data
+# The page lost for 1 s in P01's trial 1: the graph paused (study serve sets pause_without_subject)
+# and the recording marks both ends.
+"$build/bin/dyad" bag export serve_test-data/P01/01-*.mcap --csv notes > /dev/null
+grep -q "paused: the subject's page is gone" notes/*notes*.csv && grep -q "resumed: the subject's page is back" notes/*notes*.csv ||
+  fail "P01's trial 1 has no pause marks: $(cat notes/*notes*.csv)"
 # With a certificate: HTTPS and WSS only (as off loopback, where it is required).
 openssl req -x509 -newkey rsa:2048 -nodes -keyout key.pem -out cert.pem -days 1 -subj /CN=localhost 2> /dev/null
 cat key.pem cert.pem > web.pem && chmod 600 web.pem
