@@ -111,7 +111,7 @@ async function unknownTokens(front) {
 
 // A participant whose session the lab holds (its session.lock, as `dyad study run` holds it) is asked to come back.
 async function heldByTheLab(front) {
-  const holder = spawn("flock", [`${data}/P04/session.lock`, "sleep", "1.5"]);
+  const holder = spawn("flock", [`${data}/P04/session.lock`, "sleep", "3"]);
   const exited = new Promise((r) => holder.on("exit", r));
   await sleep(300);
   const page = new Page(front, token("P04"));
@@ -140,7 +140,7 @@ async function openTwiceAndMaxSessions(front) {
   check(lab.status === 2 && lab.stderr.includes("holds P01's session"), `study run during the online session: ${lab.status} ${lab.stderr}`);
   check(!log("P01").length, "the refused study run marked nothing");
   p2.ws.close();
-  await sleep(2600);  // P02's session stays live reconnect_s (2 s) after its page left
+  await sleep(3600);  // P02's session stays live reconnect_s (3 s) after its page left
   // P02 comes back and declines: told so politely, closed (1008: the page stays), logged; the slot is free at once.
   const declining = new Page(front, token("P02"));
   await declining.next("consent");
@@ -191,7 +191,7 @@ async function lostAndBack(front, p01) {
   await next.closed;
   (await intoTrial(front, token("P01"))).ws.terminate();
   const lost = await ended("P01", 2);
-  check(lost?.outcome === "incomplete" && lost.incomplete === "the participant's connection was lost for more than 2 s",
+  check(lost?.outcome === "incomplete" && lost.incomplete === "the participant's connection was lost for more than 3 s",
     `lost: ${JSON.stringify(lost)}`);
   const back = new Page(front, token("P01"));
   const again = await back.next("waiting");

@@ -35,7 +35,7 @@ conditions:
   high: {human.engage_timeout_s: 0.4}
 duration: 4
 blind: true
-online: {reconnect_s: 2, max_sessions: 2, consent: consent.txt}
+online: {reconnect_s: 3, max_sessions: 2, consent: consent.txt}
 YAML
 "$build/bin/dyad" study links s.yaml --base-url http://127.0.0.1:8443 > /dev/null
 # Refused before anything listens, naming the flag or key: off loopback without TLS; consent
