@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# `dyad study serve` over TLS (#45 item 1; docs/study.md, "A study online", TLS): the lab's
+# certificate from `dyad security init --web-host 127.0.0.1` on the study's graph, served on
+# 127.0.0.1 with --tls-certificate. Checked:
+#   - one participant in Chromium that trusts the web CA (its NSS database, as a lab's or a
+#     participant's browser once told to) opens its https link, consents, does its two trials
+#     (the page's socket wss:// to the front, the front's relay to each trial's graph plain ws on
+#     loopback) and gets the completion code; both trials complete in its session log;
+#   - Chromium without the web CA is refused the certificate; plain http to the port gets no page.
+#   serve_tls_test.sh REPO BUILD_DIR WORK_DIR
+set -euo pipefail
+repo=$1 build=$2 work=$3
+source "$repo/tests/support/web_test.sh"
+require_browser
+command -v certutil > /dev/null || { echo "SKIP: needs tools/setup.sh (libnss3-tools)"; exit 77; }
+dyad=$build/bin/dyad
+fresh_dir "$work"
+ln -s "$node_modules" node_modules  # serve_tls.mjs imports playwright-core from beside itself
+cp "$repo/tools/study/test/serve_tls.mjs" .
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill "$p" 2> /dev/null || true; done; wait 2> /dev/null || true; }
+trap cleanup EXIT
+
+cat > g.yaml <<YAML
+graph: g
+clock: wall
+domain_id: $(test_domain)
+topics:
+  web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
+components:
+  web: {type: web, rate_hz: 30, params: {port: 0}, outputs: {pointer: web/pointer, notes: experiment/notes}}
+  human: {type: web_human, rate_hz: 20, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
+  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input, experiment/notes]}}
+YAML
+echo "You agree to take part in a test." > consent.txt
+cat > s.yaml <<YAML
+study: tls_test
+graph: g.yaml
+data: sdata
+participants: [P01]
+conditions:
+  low: {human.engage_timeout_s: 0.3}
+  high: {human.engage_timeout_s: 0.4}
+duration: 3
+online: {consent: consent.txt, reconnect_s: 10}
+YAML
+"$dyad" security init keys --graph g.yaml --web-host 127.0.0.1 > init.out
+"$dyad" study links s.yaml --base-url https://127.0.0.1:8443 > links.out
+token=$(sed -n 's|^P01,.*token=||p' sdata/links.csv)
+[ -n "$token" ] || fail "no link: $(cat sdata/links.csv)"
+
+# The participant's browser trusts the web CA: Chromium reads trust from the user's NSS database.
+export HOME=$work/home
+mkdir -p "$HOME/.pki/nssdb"
+certutil -d "sql:$HOME/.pki/nssdb" -N --empty-password
+certutil -d "sql:$HOME/.pki/nssdb" -A -t "C,," -n "dyad web CA" -i keys/web_ca.cert.pem
+"$dyad" study serve s.yaml --port 0 --port-file port --tls-certificate keys/web/tls.pem > serve.out 2> serve.err &
+pid=$!
+pids+=($pid)
+wait_port_file port $pid 10 serve.err
+port=$(cat port)
+grep -q "dyad study serve: tls_test at https://127.0.0.1:$port/subject?token=" serve.out || { cat serve.out; fail "the printed link is not https"; }
+echo "https://127.0.0.1:$port $token" > sessions
+node "$node_dir/sim_participant.mjs" --online --chromium 1 --speed 3 --seconds 40 sessions > clients.out 2> clients.err ||
+  { cat clients.err serve.out serve.err; fail "the Chromium participant over https"; }
+head -1 clients.out | grep -Eq '"acks":[1-9][0-9]*,.*"trials":2,"code":"[^"]' ||
+  { cat clients.out serve.out serve.err; fail "no pointer sample acknowledged, or no completion code after two trials"; }
+ends=$(grep -c '"event":"end".*"outcome":"complete"' sdata/P01/session.log || true)
+[ "$ends" = 2 ] || { cat sdata/P01/session.log; fail "$ends of 2 trials complete"; }
+node serve_tls.mjs "127.0.0.1:$port" "$token" "$work/untrusted_home" || { cat serve.err; fail "serve_tls.mjs"; }
+kill -0 $pid || fail "dyad study serve died: $(cat serve.err)"
+kill -TERM $pid
+wait $pid || fail "dyad study serve exited $?: $(cat serve.err)"
+echo PASS
