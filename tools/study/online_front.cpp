@@ -30,6 +30,12 @@ constexpr const char* kComeBack =
 constexpr const char* kHeldElsewhere =
     "Please come back later: your session is open elsewhere right now (the lab). Your link stays valid.";
 constexpr std::chrono::milliseconds kRelayRetry{200};
+// A trial whose graph failed this many times in a row (a broken graph or machine) is not offered
+// again until `dyad study serve` restarts: the participant is asked to come back later.
+constexpr int kFailuresInARow = 3;
+constexpr const char* kBroken =
+    "Something went wrong on our side, and the study cannot go on right now. Please come back later: your link stays "
+    "valid.";
 
 // A free loopback port (bound to port 0, then closed) for a trial's web component; 0 if none.
 int FreeLoopbackPort() {
@@ -74,6 +80,7 @@ struct OnlineFront::Participant {
   Clock::time_point ping_sent{};
   Clock::time_point heard{};  // the page's last frame (its pongs included)
   double rtt_ms = -1;
+  int failures = 0;  // attempts failed in a row (kFailuresInARow: none more)
   // For the experimenter's overview: the running attempt, the page's engagement, the end.
   int trial = 0, attempt = 0;
   std::string file, ended;
@@ -231,7 +238,12 @@ void OnlineFront::NextPhase(Participant& p, web::ClientId client, const std::str
 }
 
 void OnlineFront::SendPhase(Participant& p, web::ClientId client) {
-  const std::string frame = p.session.PageFrame();
+  bool broken = false;
+  {
+    MutexLock lock(mutex_);
+    broken = p.failures >= kFailuresInARow;
+  }
+  const std::string frame = broken ? Refused(kBroken) : p.session.PageFrame();
   Send(client, frame);
   const bool refused = frame.find(R"("op":"refused")") != std::string::npos;
   if (!refused && frame.find(R"("op":"done")") == std::string::npos) return;
@@ -307,6 +319,10 @@ void OnlineFront::Answer(Participant& p, web::ClientId client, std::string_view 
 void OnlineFront::StartTrial(Participant& p) {
   const std::optional<OnlineSession::Planned> next = p.session.Next();
   if (!next || closing_.load()) return;
+  {
+    MutexLock lock(mutex_);
+    if (p.failures >= kFailuresInARow) return;
+  }
   const std::string token_file = (std::filesystem::path(study_.data) / p.id / (study_.subject_web + "-tokens")).string();
   auto token = ReadSubjectToken(token_file);
   const int port = FreeLoopbackPort();
@@ -361,6 +377,7 @@ void OnlineFront::RunTrial(Participant& p, AttemptRequest r) {
             << (r.attempt > 1 ? ", attempt " + std::to_string(r.attempt) + " (" + r.reason + ")" : "") << " -> "
             << AttemptFile(r.trial, r.attempt) << std::endl;
   auto a = RunAttempt(study_, r);
+  const bool failed = !a.ok() || a->outcome == AttemptOutcome::kFailed;
   std::cout << p.id << ": trial " << r.trial.number << ": "
             << (a.ok() ? std::string(ToString(a->outcome)) + (a->incomplete.empty() ? "" : " (" + a->incomplete + ")") + ", " +
                              std::to_string(static_cast<int>(std::lround(a->seconds))) + " s"
@@ -371,6 +388,11 @@ void OnlineFront::RunTrial(Participant& p, AttemptRequest r) {
   {
     MutexLock lock(mutex_);
     p.running = false;
+    p.failures = failed ? p.failures + 1 : 0;
+    if (p.failures == kFailuresInARow)
+      std::cerr << "dyad study serve: " << p.id << ": trial " << r.trial.number << " failed " << kFailuresInARow
+                << " times in a row (its graph's output is beside the recording): no more attempts for " << p.id
+                << " until dyad study serve restarts" << std::endl;
     std::swap(page, p.page);
     up = std::move(p.upstream);
     if (page != 0) p.session.PageClosed(Clock::now());

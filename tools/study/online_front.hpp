@@ -23,6 +23,10 @@
 //   - A live session holds the participant's SessionLock (a lab `study run` of them is refused,
 //     and a participant the lab holds is refused here); it is released reconnect_s after the
 //     page left between trials.
+//   - A participant whose trial failed 3 times in a row (its graph exited with an error or never
+//     started) is not offered another attempt until the front restarts: their page is told
+//     {"op":"refused","message":"Something went wrong on our side, ..."} (a broken graph or
+//     machine would otherwise fail at every Ready).
 //   - Mid-trial, a page gone more than reconnect_s stops the trial, which ends incomplete: "the
 //     participant's connection was lost for more than N s" (AttemptRequest::incomplete_reason).
 //   - StopSession (the experimenter's overview, overview_channel.hpp): {"event":"session_ended",

@@ -4,7 +4,8 @@
 # 429), a session the lab holds (and `dyad study run` of a participant online), a link open twice
 # (1008; a silent first page replaced), max_sessions (come back later), a page lost for less and
 # more than reconnect_s mid-trial, the front restarted by SIGTERM and by SIGKILL mid-trial, and
-# the page over HTTPS and WSS with a certificate. Trials of 4 s on a small graph.
+# the page over HTTPS and WSS with a certificate, a graph that fails at every trial. Trials of 4 s
+# on a small graph.
 #   serve_test.sh REPO BUILD_DIR WORK_DIR
 set -euo pipefail
 repo=$1 build=$2 work=$3
@@ -71,6 +72,38 @@ op=$(node -e '
   { kill $tls; fail "the page's socket over WSS: $op: $(cat tls.out)"; }
 [ "$op" = consent ] || { kill $tls; fail "over WSS P03 got '$op', not the consent page"; }
 kill -TERM $tls; wait $tls || fail "dyad study serve with TLS exited $?: $(cat tls.out)"
+# A graph that fails at every trial (its data set deleted once the front has started): three
+# failed attempts, then the participant is asked to come back later.
+"$build/bin/dyad" generate dataset --out ds > /dev/null
+sed 's|params: {port: 0}|params: {port: 0, dataset: ds}|' g.yaml > g_broken.yaml
+printf 'study: broken\ngraph: g_broken.yaml\nparticipants: [P01]\nconditions: {low: {human.engage_timeout_s: 0.3}}\nduration: 4\nconsent_required: false\n' > broken.yaml
+"$build/bin/dyad" study links broken.yaml --base-url http://127.0.0.1:8443 > /dev/null
+"$build/bin/dyad" study serve broken.yaml --port 0 --port-file broken-port > broken.out 2>&1 &
+broken=$!
+wait_port_file broken-port $broken 10 broken.out
+rm -r ds
+said=$(node -e '
+  const WebSocket = require("ws");
+  let presses = 0;
+  const open = () => {
+    const ws = new WebSocket(process.argv[1]);
+    ws.on("message", (d) => {
+      const m = JSON.parse(String(d));
+      if (m.op === "ping") ws.send(JSON.stringify({ op: "pong", id: m.id }));
+      if (m.op === "waiting" && m.ready) presses++, ws.send(JSON.stringify({ op: "ready" }));
+      if (m.op === "refused") console.log(presses + " " + m.message), process.exit(0);
+    });
+    ws.on("close", (code) => { if (code !== 1008) setTimeout(open, 100); });
+    ws.on("error", () => {});
+  };
+  open();
+  setTimeout(() => { console.log("no refusal after " + presses + " presses"); process.exit(1); }, 30000);' \
+  "ws://127.0.0.1:$(cat broken-port)/subject/ws?token=$(sed -n 's/^subject //p' broken-data/P01/web-tokens)") ||
+  { kill $broken; fail "a broken graph: $said: $(cat broken.out)"; }
+kill -TERM $broken; wait $broken || true
+[[ "$said" == "3 Something went wrong on our side"* ]] || fail "a broken graph: '$said': $(cat broken.out)"
+[ "$(grep -c '"outcome":"failed"' broken-data/P01/session.log)" = 3 ] || fail "not 3 failed attempts: $(cat broken-data/P01/session.log)"
+grep -q "failed 3 times in a row" broken.out || fail "the front did not say why: $(cat broken.out)"
 # Killed or stopped, the front leaves no trial's graph behind (each ends by its parent-death signal).
 for _ in $(seq 50); do pgrep -f "$work/serve_test-data" > /dev/null || break; sleep 0.2; done
 if pgrep -fa "$work/serve_test-data"; then fail "a trial's graph outlived dyad study serve"; fi
