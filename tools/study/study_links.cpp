@@ -105,6 +105,21 @@ StatusOr<Links> WriteLinks(const Study& s, const std::string& base_url) {
   return out;
 }
 
+std::vector<std::string> LinkOrigins(const Study& s) {
+  std::vector<std::string> origins;
+  std::ifstream in(fs::path(s.data) / "links.csv");
+  std::string line;
+  std::getline(in, line);  // participant,link
+  while (std::getline(in, line)) {
+    const std::string link = line.substr(line.find(',') + 1);
+    const size_t scheme = link.find("://");
+    if (line.find(',') == std::string::npos || scheme == std::string::npos) continue;
+    const std::string origin = link.substr(0, link.find('/', scheme + 3));
+    if (std::find(origins.begin(), origins.end(), origin) == origins.end()) origins.push_back(origin);
+  }
+  return origins;
+}
+
 void AddLinksCommand(CLI::App* study, int& exit_code) {
   struct Options {
     std::string file, base_url;

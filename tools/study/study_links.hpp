@@ -20,6 +20,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "dyad/status.hpp"
 #include "study_file.hpp"
@@ -45,6 +46,9 @@ StatusOr<std::string> ReadRoleToken(const std::string& path, const std::string& 
 
 Status CheckBaseUrl(const std::string& url);
 StatusOr<Links> WriteLinks(const Study& s, const std::string& base_url);
+// The origins (scheme://host[:port]) of the links in DATA/links.csv, each once, in the file's
+// order: where participants open their pages (`dyad study serve` admits them). None without the file.
+std::vector<std::string> LinkOrigins(const Study& s);
 
 // Adds `links` to `dyad study`.
 void AddLinksCommand(CLI::App* study, int& exit_code);

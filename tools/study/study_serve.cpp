@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <ctime>
 #include <fstream>
 #include <iostream>
 #include <thread>
@@ -15,7 +16,9 @@
 #include "overview_channel.hpp"
 #include "pages.hpp"
 #include "run_process.hpp"
+#include "serve_certificate.hpp"
 #include "study_file.hpp"
+#include "study_links.hpp"
 #include "web_server.hpp"
 
 namespace dyad::study {
@@ -39,8 +42,40 @@ std::string WhyNotServed(const Study& s, const ServeOptions& o) {
   return "";
 }
 
-web::WebServer::Options ServerOptions(const ServeOptions& o, FrontAdmission* admission, OnlineFront* front,
-                                      OverviewChannel* overview, int max_sessions) {
+// The host of an origin "scheme://host[:port]" ("[::1]" with its brackets).
+std::string OriginHost(const std::string& origin) {
+  const std::string rest = origin.substr(origin.find("://") + 3);
+  return rest.substr(0, rest[0] == '[' ? rest.find(']') + 1 : rest.find(':'));
+}
+
+// With --tls-certificate: the certificate checked (refused: why, naming the flag), then what to
+// print about it: the names it is for, and a warning for each links' origin (DATA/links.csv) a
+// browser would refuse it at. Not with --origin: then a proxy's own certificate may be the one
+// participants' browsers see.
+StatusOr<std::string> TlsLines(const Study& s, const ServeOptions& o, const std::vector<std::string>& link_origins) {
+  if (o.tls_certificate.empty()) return std::string();
+  auto cert = ReadServeCertificate(o.tls_certificate, std::time(nullptr));
+  if (!cert.ok()) return cert.status();
+  std::string names, lines;
+  for (const std::string& n : cert->names()) names += (names.empty() ? "" : ", ") + n;
+  lines = "TLS: " + o.tls_certificate + ", a certificate for " + names + ", valid until " + cert->not_after() + "\n";
+  const std::string links = s.data + "/links.csv";
+  for (const std::string& origin : o.origins.empty() ? link_origins : std::vector<std::string>{}) {
+    if (origin.rfind("https://", 0) != 0)
+      lines += "warning: " + links + " has links to " + origin +
+               ", plain HTTP, which this TLS port does not answer (dyad study links " + s.file + " --base-url https://...)\n";
+    else if (!cert->Names(OriginHost(origin)))
+      lines += "warning: " + links + " has links to " + origin +
+               ", which the certificate does not name: a browser opening them here refuses it " +
+               "(dyad security init --web-host " + OriginHost(origin) +
+               " issues one; behind a proxy with its own certificate, give --origin)\n";
+  }
+  return lines;
+}
+
+web::WebServer::Options ServerOptions(const ServeOptions& o, const std::vector<std::string>& link_origins,
+                                      FrontAdmission* admission, OnlineFront* front, OverviewChannel* overview,
+                                      int max_sessions) {
   web::WebServer::Options so;
   so.address = o.address;
   so.port = o.port;
@@ -53,7 +88,9 @@ web::WebServer::Options ServerOptions(const ServeOptions& o, FrontAdmission* adm
   so.pages["/overview"] = web::WebServer::Page{"text/html; charset=utf-8", kOverviewHtml, {web::Role::kExperimenter}, ""};
   so.endpoints.push_back(web::WebServer::Endpoint{"/overview/ws", {}, overview, {web::Role::kExperimenter}, /*viewers=*/false});
   so.max_clients = 4 * max_sessions + 16;  // the refused pages are told so over their socket
+  // --origin, and where the links are (DATA/links.csv: a name of this machine, a proxy's)
   so.allowed_origins = o.origins;
+  so.allowed_origins.insert(so.allowed_origins.end(), link_origins.begin(), link_origins.end());
   const std::string scheme = o.tls_certificate.empty() ? "http://" : "https://";
   for (const std::string& host : web::UrlHosts(o.address))
     so.allowed_origins.push_back(scheme + host + (o.port > 0 ? ":" + std::to_string(o.port) : ""));
@@ -88,6 +125,12 @@ int Serve(const ServeOptions& o) {
     std::cerr << "dyad study serve: " << why << "\n";
     return 2;
   }
+  const std::vector<std::string> link_origins = LinkOrigins(s);
+  const auto tls = TlsLines(s, o, link_origins);
+  if (!tls.ok()) {
+    std::cerr << "dyad study serve: " << tls.status().message() << "\n";
+    return 2;
+  }
   const int max_sessions = o.max_sessions > 0 ? o.max_sessions : s.online.max_sessions;
   std::vector<std::string> token_problems;
   FrontAdmission admission(s, &token_problems);
@@ -109,7 +152,7 @@ int Serve(const ServeOptions& o) {
   // reconnect_s: a page not back by then ends the trial anyway.
   OnlineFront front(s, FrontOptions{tools::ThisExecutable(), max_sessions, std::min(15.0, s.online.reconnect_s)});
   OverviewChannel overview(s, &front, max_sessions);
-  auto server = web::WebServer::Start(ServerOptions(o, &admission, &front, &overview, max_sessions));
+  auto server = web::WebServer::Start(ServerOptions(o, link_origins, &admission, &front, &overview, max_sessions));
   if (!server.ok()) {
     std::cerr << "dyad study serve: " << server.status().ToString() << "\n";
     sigaction(SIGINT, &old_int, nullptr);
@@ -121,6 +164,7 @@ int Serve(const ServeOptions& o) {
   overview.Start();
   if (!o.port_file.empty()) std::ofstream(o.port_file) << (*server)->port() << "\n";
   Serving(s, o, (*server)->port(), admission.with_links(), max_sessions, *overview_token);
+  std::cout << *tls << std::flush;
   while (!g_quit.load()) {
     front.Tick(OnlineFront::Clock::now());
     std::this_thread::sleep_for(std::chrono::milliseconds(100));

@@ -11,13 +11,16 @@
 //   - Refused before anything listens (exit 2), each naming the file, key or flag: a study file
 //     with problems; a graph without a subject's page to serve (one `web` component and a
 //     `web_human`, the web component without its own token_file or TLS); consent_required
-//     without online.consent; an address off loopback without --tls-certificate.
+//     without online.consent; an address off loopback without --tls-certificate; a
+//     --tls-certificate that is not a private PEM of a key and its certificate, valid now
+//     (serve_certificate.hpp).
 //   - GET /subject?token=T: the subject's page for a participant's token (front_admission.hpp:
 //     404 for any other, 429 for an address guessing); WebSocket /subject/ws?token=T: the page's
-//     socket (online_front.hpp). Pages from another origin than the front's own URLs (or
-//     --origin) are refused by the web server.
-//   - Prints where it listens and how many participants have links; a line per page refused,
-//     trial started and trial ended.
+//     socket (online_front.hpp). Pages from another origin than the front's own URLs, the links'
+//     (DATA/links.csv, read at start) or --origin are refused by the web server.
+//   - Prints where it listens and how many participants have links; with TLS, the names the
+//     certificate is for and until when, and (without --origin) a warning for links to a host it
+//     does not name or to http://; a line per page refused, trial started and trial ended.
 //   - SIGINT or SIGTERM: every running trial is stopped as `dyad study run` stops it (its
 //     outcome "stopped"; the participant repeats it when they come back), then it exits 0.
 //     Killed (SIGKILL), the trials' graphs end by their parent-death signal; the log keeps a
