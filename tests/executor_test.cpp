@@ -13,6 +13,7 @@
 #include <dyad/msg/types.hpp>
 #include <dyad/on_demand_subscription.hpp>
 
+#include "exec/wall_clock.hpp"
 #include "memory_transport.hpp"
 
 namespace dyad {
@@ -57,6 +58,7 @@ class Probe : public Component {
     spec.Param("code", "invalid");
     spec.Param("fail_step", 2);
     spec.Param("sleep_ms", 0.0);
+    spec.Param("activate_ms", 0.0);  // Activate takes this long (a web component's wait for its page)
     spec.Param("tap", "");  // a topic to subscribe serialized (sleeping sleep_ms per callback)
     // tap on demand: started at step tap_start, stopped at step tap_stop (-1: never)
     spec.Param("tap_start", -1);
@@ -74,6 +76,7 @@ class Probe : public Component {
     code_ = ctx.params().String("code");
     fail_step_ = static_cast<uint64_t>(ctx.params().Int("fail_step"));
     sleep_ = std::chrono::duration<double, std::milli>(ctx.params().Double("sleep_ms"));
+    activate_ = std::chrono::duration<double, std::milli>(ctx.params().Double("activate_ms"));
     in_ = &ctx.input<msg::Counter>("in");
     out_ = &ctx.output<msg::Counter>("out");
     tap_start_ = ctx.params().Int("tap_start");
@@ -96,6 +99,7 @@ class Probe : public Component {
   }
   Status Activate() override {
     g_log->AddLifecycle(name_ + " activate");
+    std::this_thread::sleep_for(activate_);
     return fail_ == "activate" ? Fail(code_, "boom") : Status::OK();
   }
   Status Step(const StepInfo& info) override {
@@ -122,7 +126,7 @@ class Probe : public Component {
  private:
   std::string name_, fail_, code_;
   uint64_t fail_step_ = 0;
-  std::chrono::duration<double, std::milli> sleep_{0};
+  std::chrono::duration<double, std::milli> sleep_{0}, activate_{0};
   Input<msg::Counter>* in_ = nullptr;
   Output<msg::Counter>* out_ = nullptr;
   std::atomic<bool> busy_{false};
@@ -238,6 +242,7 @@ class ExecutorTest : public ::testing::Test {
     o.process = "main";
     o.steps = steps;
     o.duration_s = duration_s;
+    o.session = session_;
     o.transport = [this, spurious](const std::string&, bool) -> StatusOr<std::unique_ptr<Transport>> {
       return std::unique_ptr<Transport>(new testing::MemoryTransport([this](const std::string& e) { log_.Add(e); }, spurious));
     };
@@ -276,6 +281,7 @@ class ExecutorTest : public ::testing::Test {
   Graph graph_;
   ResolvedGraph resolved_;
   std::vector<Executor::Row> rows_;
+  std::function<std::unique_ptr<ProcessSession>()> session_;  // Run()'s (empty: none)
 };
 
 const char* kPair = R"(graph: t
@@ -366,6 +372,46 @@ INSTANTIATE_TEST_SUITE_P(
                      {"a configure", "b configure", "a activate", "b activate", "b deactivate (tapped 0)",
                       "a deactivate (tapped 0)", "b shutdown", "a shutdown", "transport destroyed"}}),
     [](const ::testing::TestParamInfo<PhaseFailure>& i) { return std::string(i.param.name); });
+
+// A session that logs its calls and starts at once, as a graph of one process does (SoloSession).
+class LoggingSession final : public ProcessSession {
+ public:
+  Status Open(Transport*) override { return Status::OK(); }
+  Status AwaitMatched(const std::function<bool()>&) override {
+    g_log->Add("session matched");
+    return Status::OK();
+  }
+  StatusOr<int64_t> AwaitStart(const std::function<bool()>&) override {
+    g_log->Add("session start");
+    start_ns_ = WallNowNs();
+    return start_ns_;
+  }
+  int64_t graph_start_ns() const override { return start_ns_; }
+  void Started() override { g_log->Add("session started"); }
+  Status Heartbeat() override { return Status::OK(); }
+  void Stopping() override {}
+  void Close() override {}
+  bool shared_start() const override { return false; }
+
+ private:
+  int64_t start_ns_ = 0;
+};
+
+// The start is fixed after every Activate (issue #45 item 4): a component that waits there (the
+// web component's wait for the subject's page, here 0.5 s) delays the clock; the first steps are
+// not late by its wait (they were, each a deadline miss: the start came before Activate).
+TEST_F(ExecutorTest, TheSessionsStartIsFixedOnceEveryComponentHasActivated) {
+  session_ = [] { return std::make_unique<LoggingSession>(); };
+  ASSERT_TRUE(Run(Pair("", "activate_ms: 500", "wall"), 3).ok());
+  std::vector<std::string> order;
+  for (const auto& e : log_.events)
+    if (e.starts_with("session") || e.ends_with(" activate") || e == "a step 0") order.push_back(e);
+  EXPECT_EQ(order, (std::vector<std::string>{"session matched", "a activate", "b activate", "session start", "session started",
+                                             "a step 0"}));
+  // Late by the 0.5 s Activate on the old order; a loaded machine stays far below that.
+  EXPECT_LT(Stats("a").jitter_max_s, 0.3);
+  EXPECT_EQ(Stats("a").steps, 3u);
+}
 
 TEST_F(ExecutorTest, TriggeredCycleIsCappedInOneInstant) {
   Status s = Run(R"(graph: t

@@ -87,6 +87,45 @@ TEST(StartBarrier, TwoProcessesOnOneBusStartAtTheSameInstantAndSeeEachOtherRunni
   EXPECT_EQ(mind_hears.running, std::set<std::string>{"lab"});
 }
 
+// The start is agreed once every process has activated (issue #45 item 4): a process whose
+// Activate waits (the web component's wait for the subject's page) holds the common start, which
+// comes after it is ready, not before its wait ended.
+TEST(StartBarrier, AProcessStillActivatingHoldsTheCommonStart) {
+  const Graph g = TwoProcesses("{}", "duo", "{start_timeout_s: 10}");
+  testing::MemoryTransport bus;
+  StartBarrier lab(g, "lab", "h1", 0), mind(g, "mind", "h2", 0);
+  ASSERT_TRUE(lab.Open(&bus).ok());
+  ASSERT_TRUE(mind.Open(&bus).ok());
+  ASSERT_TRUE(lab.WaitMatched(Never).ok());
+  ASSERT_TRUE(mind.WaitMatched(Never).ok());
+  StatusOr<int64_t> lab_start = Status::Internal("not waited");
+  std::thread other([&] { lab_start = lab.Wait(Never); });      // lab has activated
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // mind activates meanwhile
+  const int64_t activated = WallNowNs();
+  const StatusOr<int64_t> mind_start = mind.Wait(Never);
+  other.join();
+  ASSERT_TRUE(lab_start.ok()) << lab_start.status().message();
+  ASSERT_TRUE(mind_start.ok()) << mind_start.status().message();
+  EXPECT_EQ(lab_start.value(), mind_start.value());
+  EXPECT_GE(mind_start.value(), activated + kStartMarginNs);
+}
+
+// A process timing out on one that is still activating says so (not "not seen").
+TEST(StartBarrier, ATimeoutNamesAProcessStillActivating) {
+  const Graph g = TwoProcesses("{}", "duo", "{start_timeout_s: 0.3}");
+  testing::MemoryTransport bus;
+  StartBarrier lab(g, "lab", "h1", 0), mind(g, "mind", "h2", 0);
+  ASSERT_TRUE(lab.Open(&bus).ok());
+  ASSERT_TRUE(mind.Open(&bus).ok());
+  ASSERT_TRUE(mind.WaitMatched(Never).ok());  // then its Activate never ends
+  const StatusOr<int64_t> start = lab.Wait(Never);
+  ASSERT_FALSE(start.ok());
+  const std::string& m = start.status().message();
+  EXPECT_NE(m.find("'mind' (still activating: a component's Activate waits, e.g. the web component's wait_for_subject_s)"),
+            std::string::npos)
+      << m;
+}
+
 TEST(StartBarrier, ARequiredProcessNeverHeardEndsTheWaitNamingIt) {
   const Graph g = TwoProcesses();
   testing::MemoryTransport bus;

@@ -580,24 +580,28 @@ Status Executor::RunWall() {
   return Status::OK();
 }
 
+Status Executor::ActivateAll() {
+  for (auto& inst : instances_) {
+    if (Status s = inst->component->Activate(); !s.ok()) return s.WithContext(inst->name() + ": activate failed");
+    inst->activated = true;
+    inst->active.store(true, std::memory_order_release);
+  }
+  return Status::OK();
+}
+
 Status Executor::Run() {
   Status s = Setup();
-  // Several processes: nobody activates (and may publish) before every endpoint has matched.
-  if (s.ok() && session_) {
-    auto start = session_->AwaitStart([this] { return stopping(); });
+  const auto is_stopping = [this] { return stopping(); };
+  // Several processes: nobody activates (and may publish) before its endpoints have matched.
+  if (s.ok() && session_) s = session_->AwaitMatched(is_stopping);
+  if (s.ok() && !(session_ && stopping())) s = ActivateAll();
+  // The start is fixed once every component is active (with several processes, once every
+  // process is): an Activate that waits (the web component's wait for the subject's page)
+  // delays the clock instead of making every first step late by the wait.
+  if (s.ok() && session_ && !stopping()) {
+    auto start = session_->AwaitStart(is_stopping);
     if (start.ok()) start_wall_ns_ = start.value();
     else s = start.status();
-  }
-  if (s.ok() && !(session_ && start_wall_ns_ == 0)) {
-    for (auto& inst : instances_) {
-      s = inst->component->Activate();
-      if (!s.ok()) {
-        s = s.WithContext(inst->name() + ": activate failed");
-        break;
-      }
-      inst->activated = true;
-      inst->active.store(true, std::memory_order_release);
-    }
   }
   if (s.ok()) {
     Status r = clock_->stepped() ? RunStepped() : RunWall();

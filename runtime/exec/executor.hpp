@@ -25,12 +25,15 @@
 // upstream's Publish()) is measured on its own and subtracted from the enclosing step; a
 // periodic step misses its deadline when its late start plus its own time exceed the period.
 //
-// Several processes (wall clock): the executor is given a ProcessSession (exec/process_session.hpp,
-// made by the hosts layer). After Configure and before Activate (so nothing is published before
-// every endpoint has matched) it awaits the session's common start and starts its periodic
-// components at that instant. With `steps`, a process without the graph's fastest periodic
-// component stops once that many of its periods have passed since the graph's start, plus a
-// second for the last samples to arrive.
+// Wall clock with a ProcessSession (exec/process_session.hpp, made by the hosts layer; every
+// wall-clock `dyad run` has one): after Configure and before Activate it awaits the session's
+// matching (several processes: nothing is published before this process's endpoints have matched
+// their peers); after every Activate it awaits the session's start (one process: now; several:
+// the instant agreed once every process has activated) and starts its periodic components then.
+// So a component that waits in Activate (the web component's wait for the subject's page) delays
+// the clock instead of making the first steps late by its wait (each a deadline miss). With
+// `steps`, a process without the graph's fastest periodic component stops once that many of its
+// periods have passed since the graph's start, plus a second for the last samples to arrive.
 //
 // Serialized subscriptions (Context::SubscribeSerialized, and SubscribeSerializedOnDemand's while
 // started) call back on the delivering thread; each is closed (unread samples delivered first)
@@ -109,6 +112,7 @@ class Executor {
   Status Setup();
   Status CreateTransport();
   Status BindPorts(Instance& inst);
+  Status ActivateAll();  // in graph order; stops at the first failure
   void BuildTopicList();
   const TopicInfo* FindTopic(const std::string& name) const;
   Status StepOnce(Instance& inst, int64_t scheduled_ns, bool periodic);

@@ -6,8 +6,13 @@
 // graph runs without one.
 //
 // Calls, all from the executor's Run() thread except Close():
-//   Open(transport)       after the components' ports exist, before Activate
-//   AwaitStart(stopping)  blocks until the agreed start (wall-clock ns; 0: stopped while waiting)
+//   Open(transport)         after the components' ports exist, before Configure
+//   AwaitMatched(stopping)  after Configure, before Activate: blocks until this process's endpoints
+//                           have matched their peers (so nothing it publishes is lost to them)
+//   AwaitStart(stopping)    after every component's Activate: blocks until the agreed start
+//                           (wall-clock ns; 0: stopped while waiting). The start is fixed only
+//                           now, so that a component that waits in Activate (the web component's
+//                           wait for the subject's page) delays the clock, not its first steps.
 //   Started()             the clocks start: background work begins, "running" is announced
 //   Heartbeat()           once per stats period while running; an error fails the process
 //   Stopping()            the run ends (before any component is deactivated)
@@ -28,6 +33,8 @@ class ProcessSession {
  public:
   virtual ~ProcessSession() = default;
   virtual Status Open(Transport* transport) = 0;
+  // OK also when `stopping()` ended the wait (the executor checks it); an error fails the run.
+  virtual Status AwaitMatched(const std::function<bool()>& /*stopping*/) { return Status::OK(); }
   virtual StatusOr<int64_t> AwaitStart(const std::function<bool()>& stopping) = 0;
   // When the graph started (valid after AwaitStart): the agreed instant, or for a process that
   // joined a running graph (restarted), the others' start, so it ends with them.

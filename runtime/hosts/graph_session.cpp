@@ -32,6 +32,7 @@ class GraphSession final : public ProcessSession {
     if (Status s = barrier_.Open(transport); !s.ok()) return s;
     return clock_sync_.Open(transport);
   }
+  Status AwaitMatched(const std::function<bool()>& stopping) override { return barrier_.WaitMatched(stopping); }
   StatusOr<int64_t> AwaitStart(const std::function<bool()>& stopping) override { return barrier_.Wait(stopping); }
   int64_t graph_start_ns() const override { return barrier_.graph_start_ns(); }
   void Started() override {
@@ -84,6 +85,7 @@ class SoloSession final : public ProcessSession {
   SoloSession(const Graph& graph, const std::string& process, const std::string& host, uint32_t restarts)
       : announcer_(graph, process, host, restarts) {}
   Status Open(Transport* transport) override { return announcer_.Open(transport); }
+  // After every component's Activate: a wait there (for the subject's page) delays the start.
   StatusOr<int64_t> AwaitStart(const std::function<bool()>&) override {
     announcer_.StartAlone(WallNowNs());
     return announcer_.graph_start_ns();

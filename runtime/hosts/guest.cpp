@@ -23,20 +23,20 @@
 namespace dyad {
 namespace {
 
-// The guest's part in the watched graph: nothing to announce; it starts once the endpoints it
-// needs are discovered (or its wait is over).
+// The guest's part in the watched graph: nothing to announce; its components activate once the
+// endpoints it needs are discovered (or its wait is over), and it starts when they are active.
 class GuestSession final : public ProcessSession {
  public:
   GuestSession(const DdsParticipant* participant, const GuestOptions& o) : participant_(participant), o_(o) {}
   Status Open(Transport*) override { return Status::OK(); }
-  StatusOr<int64_t> AwaitStart(const std::function<bool()>& stopping) override {
+  Status AwaitMatched(const std::function<bool()>& stopping) override {
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o_.watch.wait_s);
     std::vector<std::string> missing = Missing();
     while (!missing.empty() && std::chrono::steady_clock::now() < end && !stopping()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
       missing = Missing();
     }
-    if (stopping()) return int64_t{0};
+    if (stopping()) return Status::OK();
     // Then 50 ms for the rest of that burst (another reader, say). A guest that writes waits
     // 0.5 s: its writer matched the graph's readers, but they match it only when its announcement
     // reaches their process (discovery is not symmetric; no Fast DDS call tells a writer).
@@ -47,6 +47,9 @@ class GuestSession final : public ProcessSession {
                    JoinList(missing).c_str());
     else
       std::this_thread::sleep_for(std::chrono::milliseconds(o_.await_readers.empty() ? 50 : 500));
+    return Status::OK();
+  }
+  StatusOr<int64_t> AwaitStart(const std::function<bool()>&) override {
     start_ns_ = WallNowNs();
     return start_ns_;
   }

@@ -85,6 +85,25 @@ std::string StartBarrier::MissingEndpoints(const std::vector<EndpointMatch>& mat
   return out;
 }
 
+Status StartBarrier::WaitMatched(const std::function<bool()>& stopping) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(graph_.network.start_timeout_s);
+  Announce("waiting");
+  for (;;) {
+    if (stopping()) return Status::OK();
+    const std::string missing = MissingEndpoints(transport_->Matches());
+    if (missing.empty()) break;
+    if (std::chrono::steady_clock::now() >= deadline) {
+      char waited[32];
+      std::snprintf(waited, sizeof waited, "%g", graph_.network.start_timeout_s);
+      return Status::FailedPrecondition("process '" + process_ + "' waited " + waited +
+                                        " s (network.start_timeout_s) for its endpoints to match the graph's: " + missing);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  Announce("activating");
+  return Status::OK();
+}
+
 StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
   std::set<std::string> processes;
   for (const auto& c : graph_.components)
@@ -119,7 +138,10 @@ StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
       const int64_t ready = it == heard_.end() ? 0 : it->second.ready_ns();
       if (ready == 0)
         not_heard += std::string(not_heard.empty() ? "" : ", ") + "'" + p + "'" +
-                     (it == heard_.end() ? " (not seen)" : " (seen, its endpoints not all matched)");
+                     (it == heard_.end()                   ? " (not seen)"
+                      : it->second.state() == "activating" ? " (still activating: a component's Activate waits, e.g. the web "
+                                                             "component's wait_for_subject_s)"
+                                                           : " (seen, its endpoints not all matched)");
       last_ready = std::max(last_ready, ready);
     }
     if (ready_ns_ != 0 && not_heard.empty()) {

@@ -3,17 +3,19 @@
 //
 // A process started apart from the others used to run without them: a robot started 3 s before
 // the human ran 30 steps with no input, and those samples were missing from the recording. Now
-// every process of a graph with several processes, its components configured (not yet activated:
-// nothing is published before every endpoint has matched):
+// every process of a graph with several processes, its components configured:
 //   1. waits until each endpoint of its own has matched as many peers as the graph binds to its
 //      topic (a reader: every writer of the topic; a writer: every reader; the runtime's own
-//      dyad/ topics excepted), and then announces its wall-clock `ready_ns` on dyad/processes;
+//      dyad/ topics excepted; WaitMatched: nothing is published before that), activates its
+//      components, and then announces its wall-clock `ready_ns` on dyad/processes;
 //   2. waits until it has heard every process of the graph announce itself ready;
 //   3. starts its clocks at max(ready_ns) + kStartMargin, an instant every process computes
 //      alike from the same announcements (as exact as the hosts' clock sync, docs/distributed.md).
-// Processes with `required: false` are not waited for. A process that hears another already "running" (it was restarted, or started late) joins at
-// once instead. After `network.start_timeout_s` it gives up with a message naming every process
-// not heard from and every endpoint of its own still short of matches.
+// Processes with `required: false` are not waited for. A process that hears another already
+// "running" (it was restarted, or started late) joins at once instead. After
+// `network.start_timeout_s` it gives up with a message naming every process not heard from and
+// every endpoint of its own still short of matches (a process heard "activating" is named so:
+// its Activate takes that long, and the others' timeout must cover it).
 //
 // Announcements (dyad::msg::ProcessState) are RELIABLE and TRANSIENT_LOCAL, so a process that
 // starts last still hears the earlier ones. State changes after the start ("running",
@@ -50,6 +52,14 @@ class StartBarrier {
   // the barrier). Call once, before Wait().
   Status Open(Transport* transport);
 
+  // Before the components' Activate: blocks until each endpoint of this process has matched as
+  // many peers as the graph binds to its topic (OK), `stopping()` becomes true (OK), or the
+  // timeout (FailedPrecondition naming the endpoints short of matches); then announces
+  // "activating" (another process's timeout message says so while this one activates).
+  Status WaitMatched(const std::function<bool()>& stopping);
+
+  // After Activate (ready means activated too: a component may wait there, as the web component
+  // waits for the subject's page, and the common start waits with it).
   // Blocks until the common start instant is known (returned, wall-clock ns; it may already be
   // past), `stopping()` becomes true (returns 0), or the timeout (FailedPrecondition naming what
   // is missing).
