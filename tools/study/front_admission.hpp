@@ -10,8 +10,9 @@
 //   - Any other token (or none): Refusal 404 "not found". Before answering, the token files that
 //     were missing are read again, at most once a second (links made while the front runs).
 //   - An address with more than 10 unknown tokens within a minute (from its first) gets 429
-//     "too many unknown links: wait a minute" for every request, known tokens included, until
-//     that minute is over: guessing costs a minute per 10 guesses.
+//     "too many unknown links: wait a minute" for every further unknown token until that minute
+//     is over: guessing costs a minute per 10 guesses. A known token is never refused (behind a
+//     proxy or NAT every participant shares the guesser's address): only unknown ones count.
 //   - A token file that cannot be used (not a regular 0600 file, no subject line) is said once,
 //     on `problems` at load, and that participant has no link.
 #pragma once
