@@ -1,13 +1,11 @@
 #include "online_front.hpp"
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -18,6 +16,7 @@
 #include "online_session.hpp"
 #include "study_links.hpp"
 #include "ws_client.hpp"
+#include "yaml_file.hpp"
 
 namespace dyad::study {
 namespace {
@@ -37,19 +36,15 @@ constexpr const char* kBroken =
     "Something went wrong on our side, and the study cannot go on right now. Please come back later: your link stays "
     "valid.";
 
-// A free loopback port (bound to port 0, then closed) for a trial's web component; 0 if none.
-int FreeLoopbackPort() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) return 0;
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t n = sizeof a;
-  int port = 0;
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 && ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &n) == 0)
-    port = ntohs(a.sin_port);
-  ::close(fd);
-  return port;
+// The port a trial's graph bound, from the file its web component wrote (port_file): 0 while the
+// file is missing or not yet whole (one line ending in a newline).
+int ReadPortFile(const std::string& file) {
+  std::ifstream in(file);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (text.empty() || text.back() != '\n') return 0;
+  char* end = nullptr;
+  const long port = std::strtol(text.c_str(), &end, 10);
+  return end != text.c_str() && *end == '\n' && port > 0 && port <= 65535 ? static_cast<int>(port) : 0;
 }
 
 std::string Refused(const std::string& message) { return Json{{"op", "refused"}, {"message", message}}.dump(); }
@@ -74,7 +69,8 @@ struct OnlineFront::Participant {
   web::ClientId page = 0;                   // the page connected now (0: none)
   std::shared_ptr<web::WsClient> upstream;  // the relay to the trial's graph, while a trial runs
   bool running = false;
-  int port = 0;
+  int port = 0;           // the running trial's, once read from port_file (0: not yet)
+  std::string port_file;  // where the running trial's graph writes the port it bound
   std::string token, lost_reason;
   int ping_id = 0;
   Clock::time_point ping_sent{};
@@ -181,6 +177,19 @@ void OnlineFront::OnOpen(web::ClientId client, web::Role) {
   }).detach();
 }
 
+int OnlineFront::TrialPort(Participant& p) const {
+  std::string file;
+  {
+    MutexLock lock(mutex_);
+    if (!p.running || p.port > 0) return p.running ? p.port : 0;
+    file = p.port_file;
+  }
+  const int port = ReadPortFile(file);  // outside the lock: a file read
+  MutexLock lock(mutex_);
+  if (port > 0 && p.running && p.port_file == file) p.port = port;
+  return p.running ? p.port : 0;
+}
+
 // Connects the page to the trial's graph (retrying while it starts), or, when the trial has
 // ended meanwhile, tells the page what comes next.
 void OnlineFront::Relay(Participant& p, web::ClientId client) {
@@ -188,18 +197,22 @@ void OnlineFront::Relay(Participant& p, web::ClientId client) {
       Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options_.wait_for_subject_s));
   web::WebServer* server = server_.load();
   while (true) {
-    int port = 0;
     std::string token;
     {
       MutexLock lock(mutex_);
       if (!p.running || p.page != client) break;
-      port = p.port;
       token = p.token;
     }
-    web::WsClient::Callbacks cb;
-    cb.on_text = [server, client](std::string_view text) { server->SendText(client, std::string(text)); };
-    cb.on_close = [this, &p, client] { NextPhase(p, client, "the trial's page closed"); };
-    auto up = web::WsClient::Connect("127.0.0.1", port, "/subject/ws?token=" + token, std::move(cb), std::chrono::seconds(2));
+    // Only the port the graph itself bound and wrote (never one picked for it: another process
+    // could take that first and be sent the participant's token).
+    const int port = TrialPort(p);
+    StatusOr<std::unique_ptr<web::WsClient>> up = Status::NotFound("the trial's graph has not written its port yet");
+    if (port > 0) {
+      web::WsClient::Callbacks cb;
+      cb.on_text = [server, client](std::string_view text) { server->SendText(client, std::string(text)); };
+      cb.on_close = [this, &p, client] { NextPhase(p, client, "the trial's page closed"); };
+      up = web::WsClient::Connect("127.0.0.1", port, "/subject/ws?token=" + token, std::move(cb), std::chrono::seconds(2));
+    }
     if (up.ok()) {
       std::shared_ptr<web::WsClient> relay(std::move(*up));
       MutexLock lock(mutex_);
@@ -325,12 +338,15 @@ void OnlineFront::StartTrial(Participant& p) {
   }
   const std::string token_file = (std::filesystem::path(study_.data) / p.id / (study_.subject_web + "-tokens")).string();
   auto token = ReadSubjectToken(token_file);
-  const int port = FreeLoopbackPort();
-  if (!token.ok() || port == 0) {
+  if (!token.ok()) {
     std::cerr << "dyad study serve: " << p.id << ": trial " << next->trial.number
-              << " cannot start: " << (token.ok() ? "no free loopback port" : token.status().ToString()) << std::endl;
+              << " cannot start: " << token.status().ToString() << std::endl;
     return;
   }
+  // The graph binds a free loopback port itself and writes it into the participant's folder
+  // (0700): the relay and the overview connect only to that port.
+  const std::string port_file =
+      (std::filesystem::path(study_.data) / p.id / (".trial-" + std::to_string(next->trial.number) + ".port")).string();
   AttemptRequest r;
   r.dyad = options_.dyad;
   r.participant = p.id;
@@ -339,10 +355,11 @@ void OnlineFront::StartTrial(Participant& p) {
   r.reason = next->reason;
   r.stop = &p.stop;
   r.own_signals = false;
-  r.subject_port = port;
   r.wait_for_subject_s = options_.wait_for_subject_s;
   r.run_log = std::filesystem::path(AttemptFile(r.trial, r.attempt)).replace_extension(".log").string();
-  r.serve_sets = {study_.subject_web + ".address=127.0.0.1", study_.subject_web + ".pause_without_subject=true"};
+  r.serve_sets = {study_.subject_web + ".address=127.0.0.1", study_.subject_web + ".port=0",
+                  study_.subject_web + ".port_file=" + tools::YamlQuoted(port_file),
+                  study_.subject_web + ".pause_without_subject=true"};
   r.incomplete_reason = [this, &p] {
     MutexLock lock(mutex_);
     return p.lost_reason;
@@ -361,11 +378,14 @@ void OnlineFront::StartTrial(Participant& p) {
     p.engaged.reset();
     p.stop.store(false);
     p.lost_reason.clear();
-    p.port = port;
+    p.port = 0;
+    p.port_file = port_file;
     p.token = *token;
     std::swap(page, p.page);
     p.session.PageClosed(Clock::now());  // it comes back at once, to the trial
   }
+  std::error_code ec;
+  std::filesystem::remove(port_file, ec);  // a stale one (a serve killed mid-trial): never read
   if (page != 0) Close(page, 1012, "the trial starts");
   p.worker = std::thread([this, &p, r] { RunTrial(p, r); });
 }
@@ -396,7 +416,10 @@ void OnlineFront::RunTrial(Participant& p, AttemptRequest r) {
     std::swap(page, p.page);
     up = std::move(p.upstream);
     if (page != 0) p.session.PageClosed(Clock::now());
+    p.port = 0;
   }
+  std::error_code ec;
+  std::filesystem::remove(p.port_file, ec);  // p.port_file changes only in StartTrial, on this thread's join
   if (up) up->Close();
   if (page != 0) Close(page, 1012, "the trial ended");  // the page comes back at once and hears what is next
 }
@@ -477,6 +500,7 @@ std::vector<OnlineFront::SessionView> OnlineFront::Snapshot(Clock::time_point no
   }
   // Between trials the phase and the next trial come from the log: read outside the lock.
   for (SessionView& v : out) {
+    if (!v.file.empty() && v.port == 0) v.port = TrialPort(*participants_.at(v.participant));
     OnlineSession& session = participants_.at(v.participant)->session;
     if (v.file.empty()) {
       static constexpr const char* kNames[] = {"consent", "waiting", "done", "refused"};

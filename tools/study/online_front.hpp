@@ -4,10 +4,12 @@
 // Each participant's page is told, between trials, what OnlineSession says (consent, waiting with
 // a Ready button, done with the completion code, refused); it answers {"op":"consent","agree":b}
 // and {"op":"ready"}. Ready starts the next attempt on a thread of the participant's: RunAttempt
-// as the lab runs it, the graph's subject web component on a free loopback port of its own,
-// waiting for the page (wait_for_subject_s) and paused while it is gone (pause_without_subject).
-// During the trial every text frame of the page is relayed to that web component and back (a
-// WsClient per page connection, connected every 200 ms until the graph listens). At each phase
+// as the lab runs it, the graph's subject web component on a loopback port it picks itself (port
+// 0) and writes into the participant's folder (DATA/P/.trial-N.port, the folder 0700), waiting
+// for the page (wait_for_subject_s) and paused while it is gone (pause_without_subject). During
+// the trial every text frame of the page is relayed to that web component and back (a WsClient
+// per page connection, tried every 200 ms until the graph has written its port and listens):
+// the relay and the overview's stats connect only to the port the graph wrote. At each phase
 // change (a trial starts, a trial ends) the page's socket is closed with 1012: the page
 // reconnects at once, so each phase starts on a fresh socket. Every ping_interval each page gets
 // {"op":"ping","id":n}; its pong is swallowed (not relayed) and gives the round trip.
@@ -107,6 +109,8 @@ class OnlineFront final : public web::ClientHandler {
   // Why `client` may not be p's page now ("" when it is, from now on).
   std::string Take(Participant& p, web::ClientId client, Clock::time_point now) REQUIRES(mutex_);
   int LiveLocked(Clock::time_point now) const REQUIRES(mutex_);
+  // The running trial's port, as its graph wrote it into p's port_file (0: no trial, or not yet).
+  int TrialPort(Participant& p) const;
   void Relay(Participant& p, web::ClientId client);
   // Closes p's page `client` with 1012 (it reconnects at once): no longer p's page from now on.
   void NextPhase(Participant& p, web::ClientId client, const std::string& reason);

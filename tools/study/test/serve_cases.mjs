@@ -90,10 +90,11 @@ async function intoTrial(front, tok) {
   return page;
 }
 
-function status(front, path, localAddress) {
+function statusAt(port, path, localAddress) {
   return new Promise((resolve, reject) =>
-    http.get({ host: "127.0.0.1", port: front.port, path, localAddress }, (res) => { res.resume(); resolve(res.statusCode); }).on("error", reject));
+    http.get({ host: "127.0.0.1", port, path, localAddress }, (res) => { res.resume(); resolve(res.statusCode); }).on("error", reject));
 }
+const status = (front, path, localAddress) => statusAt(front.port, path, localAddress);
 
 async function unknownTokens(front) {
   check(await status(front, `/subject?token=${token("P01")}`) === 200, "a participant's link opens the page");
@@ -174,6 +175,20 @@ async function silentPage(front) {
   console.log("ok: a page silent for 5 s is replaced by a new page of its link");
 }
 
+// The trial's graph picked its own port (web.port=0 on its command line, no port of the front's
+// choosing) and wrote it into the participant's folder; that port is the graph's web component.
+async function trialPort(p, trial) {
+  const file = `${data}/${p}/.trial-${trial}.port`;
+  check(fs.existsSync(file), `no port file ${file}`);
+  const port = Number(fs.readFileSync(file, "utf8"));
+  const runs = fs.readdirSync("/proc").filter((d) => /^\d+$/.test(d)).map((d) => {
+    try { return fs.readFileSync(`/proc/${d}/cmdline`, "utf8").split("\0"); } catch { return []; }
+  }).filter((a) => a[1] === "run" && a.some((x) => x.startsWith(`recorder.file=`) && x.includes(`${data}/${p}/`)));
+  check(runs.length === 1 && runs[0].includes("web.port=0") && runs[0].some((x) => x.startsWith("web.port_file=")),
+    `the trial's graph binds port 0 and writes its port file: ${JSON.stringify(runs)}`);
+  check(await statusAt(port, `/subject?token=${token(p)}`) === 200, `the port file's ${port} is the graph's web component`);
+}
+
 async function lostAndBack(front, p01) {
   p01.send({ op: "consent", agree: true });
   const waiting = await p01.next("waiting");
@@ -181,6 +196,7 @@ async function lostAndBack(front, p01) {
   p01.send({ op: "ready" });
   check(await p01.closed === 1012, "the trial starts: the page's socket closed with 1012");
   let page = await intoTrial(front, token("P01"));
+  await trialPort("P01", 1);
   await page.steer(1000);
   page.ws.terminate();  // the connection lost for 1 s (< reconnect_s): the trial goes on
   await sleep(1000);
@@ -189,6 +205,7 @@ async function lostAndBack(front, p01) {
   check(await page.closed === 1012, "the trial ended: 1012");
   const end = await ended("P01", 1);
   check(end?.outcome === "complete", `back in time: trial 1 complete: ${JSON.stringify(end)}`);
+  check(!fs.existsSync(`${data}/P01/.trial-1.port`), "the trial's port file is removed at its end");
   console.log("ok: a page back within reconnect_s: the trial goes on, complete");
   // Trial 2: the page leaves for good: stopped after reconnect_s, incomplete with the reason.
   const next = new Page(front, token("P01"));
