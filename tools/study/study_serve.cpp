@@ -191,7 +191,10 @@ void AddServeCommand(CLI::App* study, int& exit_code) {
   serve->add_option("study", o->file, "Study file (YAML)")->required()->check(CLI::ExistingFile);
   serve->add_option("--address", o->address, "Listen address (off loopback: with --tls-certificate)");
   serve->add_option("--port", o->port, "Port (0: any free one)")->check(CLI::Range(0, 65535));
-  serve->add_option("--tls-certificate", o->tls_certificate, "PEM file: private key and certificate chain (HTTPS, WSS)")
+  serve
+      ->add_option("--tls-certificate", o->tls_certificate,
+                   "PEM file (0600): private key, then certificate chain (HTTPS, WSS); "
+                   "dyad security init KEYSTORE --graph GRAPH --web-host HOST makes KEYSTORE/web/tls.pem")
       ->check(CLI::ExistingFile);
   serve->add_option("--max-sessions", o->max_sessions, "Live sessions at once (default: the study file's online.max_sessions)")
       ->check(CLI::Range(1, 100000));
