@@ -94,8 +94,6 @@ std::string GraphHash(const std::string& graph, const std::vector<std::string>& 
   return hex;
 }
 
-constexpr std::chrono::seconds kStopGrace{10};  // a graph's time to end after the second stop
-
 std::atomic<int> g_stop_signals{0};  // lock-free: safe in a handler and read by another thread
 static_assert(std::atomic<int>::is_always_lock_free);
 extern "C" void OnStopSignal(int) { g_stop_signals.fetch_add(1); }
@@ -395,6 +393,37 @@ void SetOutcome(const Study& s, const AttemptRequest& r, const tools::ExitStatus
   }
 }
 
+// Runs the attempt's graph to its end. One stop is forwarded as one SIGINT: the graph finishes
+// its recording. A second stop (a graph that hangs while ending) is forwarded too: dyad then
+// exits at once, losing at most its last chunk; a graph still there r.stop_grace (10 s) after
+// it is killed, with its process group. A stop through r.stop comes once (nobody can press again, and
+// a caller without its own signals has no second Ctrl-C to give): the graph still there
+// r.stop_grace after it gets the second stop as if asked.
+tools::ExitStatus RunGraph(const Study& s, const AttemptRequest& r, std::chrono::steady_clock::time_point t0, int* forwarded,
+                           double* first_stop_s, bool* interrupted) {
+  std::optional<StopSignals> signals;
+  if (r.own_signals) signals.emplace();
+  tools::ChildOptions options;
+  options.log = r.run_log;
+  options.own_group = true;
+  tools::ChildProcess graph(AttemptCommand(s, r), options);
+  std::optional<std::chrono::steady_clock::time_point> stop_asked;  // when r.stop was first seen
+  while (true) {
+    if (std::optional<tools::ExitStatus> end = graph.Poll()) return *end;
+    const auto now = std::chrono::steady_clock::now();
+    const int signals_now = r.own_signals ? g_stop_signals.load() : 0;
+    const bool stop = r.stop && r.stop->load();
+    if (stop && !stop_asked) stop_asked = now;
+    const bool overdue = stop_asked && now - *stop_asked >= r.stop_grace;
+    const int wanted = overdue ? 2 : std::min(2, signals_now + (stop ? 1 : 0));
+    *interrupted = *interrupted || signals_now > 0;
+    if (*forwarded == 0 && wanted > 0) *first_stop_s = std::chrono::duration<double>(now - t0).count();
+    for (; *forwarded < wanted; ++*forwarded) graph.Signal(SIGINT);
+    if (*forwarded == 2) return graph.Stop(r.stop_grace, 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 }  // namespace
 
 StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
@@ -422,34 +451,9 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   if (Status st = AppendSessionEvent(s, r.participant, Dump(start)); !st.ok()) return st;
 
   const auto t0 = std::chrono::steady_clock::now();
-  int forwarded = 0;  // SIGINTs sent to the graph
+  int forwarded = 0;        // SIGINTs sent to the graph
   double first_stop_s = 0;  // when the first was sent, from the graph's start
-  tools::ExitStatus exit;   // how the graph ended
-  {
-    std::optional<StopSignals> signals;
-    if (r.own_signals) signals.emplace();
-    tools::ChildOptions options;
-    options.log = r.run_log;
-    options.own_group = true;
-    tools::ChildProcess graph(AttemptCommand(s, r), options);
-    // One stop is forwarded as one SIGINT: the graph finishes its recording. A second stop (a
-    // graph that hangs while ending) is forwarded too: dyad then exits at once, losing at most
-    // its last chunk; a graph still there kStopGrace after it is killed, with its process group.
-    std::optional<tools::ExitStatus> end;
-    while (!(end = graph.Poll())) {
-      const int signals_now = r.own_signals ? g_stop_signals.load() : 0;
-      const int wanted = std::min(2, signals_now + (r.stop && r.stop->load() ? 1 : 0));
-      a.interrupted = a.interrupted || signals_now > 0;
-      if (forwarded == 0 && wanted > 0) first_stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      for (; forwarded < wanted; ++forwarded) graph.Signal(SIGINT);
-      if (forwarded == 2) {
-        end = graph.Stop(kStopGrace, 0);
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    exit = *end;
-  }
+  const tools::ExitStatus exit = RunGraph(s, r, t0, &forwarded, &first_stop_s, &a.interrupted);
   a.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   SetOutcome(s, r, exit, forwarded > 0, first_stop_s, &a);
   Json end = {{"event", "end"},

@@ -33,7 +33,9 @@
 //     trial: the graph gets one SIGINT (it is in a process group of its own, with SIGINT as its
 //     parent-death signal: a runner that dies, even by SIGKILL, stops it too) and finishes its
 //     recording; a second one is forwarded too (dyad then exits at once), and a graph still
-//     there 10 s after it is killed with its process group. Attempt::interrupted says a signal
+//     there 10 s after it is killed with its process group. A stop through AttemptRequest::stop
+//     (set once) becomes the second one by itself after stop_grace (10 s): a graph that hangs
+//     while ending is killed even when nobody can press Ctrl-C again (`dyad study serve`). Attempt::interrupted says a signal
 //     came, so a caller running several trials stops there.
 //   - Recording metadata ("dyad.run" in the MCAP file): study, participant, condition (its label
 //     when the study is blind), trial, attempt, rehearsal (true|false), dyad_version (the
@@ -56,6 +58,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <string>
 #include <vector>
@@ -121,6 +124,9 @@ struct AttemptRequest {
   std::vector<std::string> extra_sets;  // after the condition's (a rehearsal's seed)
   std::string run_log;      // the graph's output; empty: the terminal
   const std::atomic<bool>* stop = nullptr;  // set: stop the trial as SIGINT does (the study page's Stop)
+  // A graph still there this long after `stop` is set gets the second stop (a second SIGINT,
+  // then killed this long after with its group), as a second Ctrl-C would: `stop` is set once.
+  std::chrono::milliseconds stop_grace{10000};
   // The session's subject's link (subject_lobby.hpp): the study's subject_web binds this port
   // (> 0), and its clock waits up to wait_for_subject_s for the page (0: no wait).
   int subject_port = 0;

@@ -354,6 +354,56 @@ TEST_F(StudySession, ACallersIncompleteReasonMakesAStoppedTrialIncomplete) {
   else EXPECT_NE(missing.find("P01 trial 1 "), std::string::npos) << missing;
 }
 
+// A graph that hangs while ending, stopped through AttemptRequest::stop by a caller without its
+// own signals (`dyad study serve`: nobody can press Ctrl-C again): stop_grace after the stop it
+// gets the second SIGINT by itself, and one that ignores that too is killed. The "graph" is a
+// script that counts its SIGINTs and ends on the second (or never).
+TEST_F(StudySession, AGraphHangingAfterTheCallersStopGetsTheSecondStopAndIsKilled) {
+  const Study s = Make("wall", 30);
+  const auto trials = s.TrialsOf("P01");
+  ASSERT_TRUE(MarkConsent(s, "P01", "test").ok());
+  for (const bool ends_on_second : {true, false}) {
+    SCOPED_TRACE(ends_on_second ? "ends on the second SIGINT" : "ignores every SIGINT");
+    const std::string script = (dir_ / "hang.sh").string(), ints = (dir_ / "ints").string(), pid = (dir_ / "pid").string();
+    fs::remove(ints);
+    fs::remove(pid);
+    std::ofstream(script) << "#!/bin/bash\necho $$ > " << pid << "\nn=0\ntrap 'n=$((n+1)); echo int >> " << ints
+                          << (ends_on_second ? "; [ $n -ge 2 ] && exit 130" : "") << "' INT\nwhile true; do sleep 0.05; done\n";
+    fs::permissions(script, fs::perms::owner_all);
+    std::atomic<bool> stop{false};
+    AttemptRequest r;
+    r.dyad = script;
+    r.participant = "P01";
+    r.trial = trials[0];
+    r.attempt = ends_on_second ? 1 : 2;
+    r.reason = ends_on_second ? "" : "the test's second case";
+    r.stop = &stop;
+    r.own_signals = false;
+    r.stop_grace = std::chrono::milliseconds(300);
+    r.run_log = (dir_ / "run.log").string();
+    std::atomic<bool> returned{false};
+    std::thread stopper([&] {
+      for (int i = 0; i < 1000 && !fs::exists(pid); ++i) usleep(10000);
+      usleep(200'000);  // the trap is set
+      stop.store(true);
+      // The old code waited for ever: the script is killed after 20 s, and the test fails.
+      for (int i = 0; i < 2000 && !returned.load(); ++i) usleep(10000);
+      int group = 0;
+      if (!returned.load()) std::ifstream(pid) >> group;
+      if (group > 0) ::kill(-group, SIGKILL);
+    });
+    auto a = RunAttempt(s, r);
+    returned.store(true);
+    stopper.join();
+    ASSERT_TRUE(a.ok()) << a.status().message();
+    std::ifstream in(ints);
+    int n = 0;
+    for (std::string line; std::getline(in, line);) ++n;
+    EXPECT_EQ(n, 2) << "the caller's one stop and the second after stop_grace";
+    EXPECT_EQ(a->ended, ends_on_second ? "exited with code 130" : "killed by signal 9 (Killed)") << a->ended;
+  }
+}
+
 // The experimenter's notes, a participant excluded (and included again) by the researcher, and
 // one who withdraws consent with their data deleted: all in the session log, the analysis leaves
 // them out saying why, and nothing records for a withdrawn participant without a new consent.
