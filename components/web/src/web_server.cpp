@@ -44,14 +44,22 @@ void WriteClose(mg_connection* conn, int code, const std::string& reason) {
   mg_websocket_write(conn, MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE, payload.data(), payload.size());
 }
 
+// Writes a response whole, its head and body in one mg_write. Not mg_printf: it formats into an
+// 8 KB buffer on the stack (civetweb's MG_BUF_LEN), and this runs on a worker whose 100 KB stack
+// an OpenSSL 3 SSL_write nearly fills (web_server.hpp, "Stacks").
+void WriteWhole(mg_connection* conn, std::string head, const std::string& body) {
+  head.append(body);
+  mg_write(conn, head.data(), head.size());
+}
+
 // Writes a whole plain-text HTTP response (mg_send_http_error crashes in libcivetweb 1.15
 // without a document_root) and returns its status.
 int WriteResponse(mg_connection* conn, int status, const char* reason, const std::string& text) {
-  mg_printf(conn,
-            "HTTP/1.1 %d %s\r\nContent-Type: text/plain; charset=utf-8\r\nContent-Length: %zu\r\n"
-            "Cache-Control: no-store\r\nConnection: close\r\n\r\n",
-            status, reason, text.size());
-  mg_write(conn, text.data(), text.size());
+  WriteWhole(conn,
+             "HTTP/1.1 " + std::to_string(status) + " " + reason +
+                 "\r\nContent-Type: text/plain; charset=utf-8\r\nContent-Length: " + std::to_string(text.size()) +
+                 "\r\nCache-Control: no-store\r\nConnection: close\r\n\r\n",
+             text);
   return status;
 }
 
@@ -355,12 +363,11 @@ int WebServer::OnPage(mg_connection* conn, void* page_ptr) {
   const Role role = std::get<Admission>(admission).role;
   if (!page->roles.count(role))
     return WriteResponse(conn, 403, "Forbidden", std::string("The ") + RoleName(role) + "'s token does not open this page.\n");
-  mg_printf(conn,
-            "HTTP/1.1 200 OK\r\nContent-Type: %s\r\nContent-Length: %zu\r\nCache-Control: no-store\r\n"
-            "Referrer-Policy: no-referrer\r\nX-Frame-Options: DENY\r\nX-Content-Type-Options: nosniff\r\n"
-            "Connection: close\r\n\r\n",
-            page->mime.c_str(), page->body.size());
-  mg_write(conn, page->body.data(), page->body.size());
+  WriteWhole(conn,
+             "HTTP/1.1 200 OK\r\nContent-Type: " + page->mime + "\r\nContent-Length: " + std::to_string(page->body.size()) +
+                 "\r\nCache-Control: no-store\r\nReferrer-Policy: no-referrer\r\nX-Frame-Options: DENY\r\n"
+                 "X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+             page->body);
   return 200;
 }
 

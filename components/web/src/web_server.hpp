@@ -33,7 +33,10 @@
 /// (Debian's build sets USE_STACK_SIZE 102400), and an OpenSSL 3 SSL_write takes most of that.
 /// Every thread's static TLS comes out of its stack: a program that runs this server must keep
 /// its thread_local data small (a 5 KB std::mt19937 in the dyad command overflowed a page's
-/// SSL_write, web.tls_browser). Deep work belongs on the handler thread or a thread of one's own.
+/// SSL_write, web.tls_browser; 4.6 KB more crashes civetweb's own WebSocket handshake, whose
+/// mg_printf formats into an 8 KB stack buffer: the `static_tls` test holds each file of the build
+/// to 1 KB). Pages are written without mg_printf for the same reason. Deep work belongs on the
+/// handler thread or a thread of one's own.
 #pragma once
 
 #include <cstdint>
