@@ -85,6 +85,44 @@ std::string StartBarrier::MissingEndpoints(const std::vector<EndpointMatch>& mat
   return out;
 }
 
+std::set<std::string> StartBarrier::AwaitedProcesses() const {
+  std::set<std::string> processes;
+  for (const auto& c : graph_.components)
+    if (Awaited(graph_.ProcessOf(c))) processes.insert(graph_.ProcessOf(c));
+  return processes;
+}
+
+std::string StartBarrier::NotReady(int64_t* last_ready) const {
+  std::string not_heard;
+  for (const auto& p : AwaitedProcesses()) {
+    const auto it = heard_.find(p);
+    if (p == process_) continue;
+    const int64_t ready = it == heard_.end() ? 0 : it->second.ready_ns();
+    if (ready == 0)
+      not_heard += std::string(not_heard.empty() ? "" : ", ") + "'" + p + "'" +
+                   (it == heard_.end()                   ? " (not seen)"
+                    : it->second.state() == "activating" ? " (still activating: a component's Activate waits, e.g. the web "
+                                                           "component's wait_for_subject_s)"
+                                                         : " (seen, its endpoints not all matched)");
+    *last_ready = std::max(*last_ready, ready);
+  }
+  return not_heard;
+}
+
+Status StartBarrier::TimedOut(const std::string& not_heard, const std::string& missing_endpoints) const {
+  std::string what;
+  if (!not_heard.empty()) what = "processes not ready: " + not_heard;
+  if (!missing_endpoints.empty()) what += std::string(what.empty() ? "" : "; ") + "here: " + missing_endpoints;
+  // A process never heard from, in a graph that reaches this machine only: say so, and how to open it.
+  if (const std::string local = LocalScopeNote(graph_.network);
+      !local.empty() && not_heard.find("(not seen)") != std::string::npos)
+    what += "; " + local;
+  char waited[32];
+  std::snprintf(waited, sizeof waited, "%g", graph_.network.start_timeout_s);  // 0.5 s, not "0 s"
+  return Status::FailedPrecondition("process '" + process_ + "' waited " + waited +
+                                    " s (network.start_timeout_s) for the graph to start together: " + what);
+}
+
 Status StartBarrier::WaitMatched(const std::function<bool()>& stopping) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(graph_.network.start_timeout_s);
   Announce("waiting");
@@ -93,10 +131,9 @@ Status StartBarrier::WaitMatched(const std::function<bool()>& stopping) {
     const std::string missing = MissingEndpoints(transport_->Matches());
     if (missing.empty()) break;
     if (std::chrono::steady_clock::now() >= deadline) {
-      char waited[32];
-      std::snprintf(waited, sizeof waited, "%g", graph_.network.start_timeout_s);
-      return Status::FailedPrecondition("process '" + process_ + "' waited " + waited +
-                                        " s (network.start_timeout_s) for its endpoints to match the graph's: " + missing);
+      TakeAnnouncements();
+      int64_t last_ready = 0;
+      return TimedOut(NotReady(&last_ready), missing);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
@@ -105,9 +142,6 @@ Status StartBarrier::WaitMatched(const std::function<bool()>& stopping) {
 }
 
 StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
-  std::set<std::string> processes;
-  for (const auto& c : graph_.components)
-    if (Awaited(graph_.ProcessOf(c))) processes.insert(graph_.ProcessOf(c));
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(graph_.network.start_timeout_s);
   Announce("waiting");
   for (;;) {
@@ -128,38 +162,15 @@ StatusOr<int64_t> StartBarrier::Wait(const std::function<bool()>& stopping) {
       graph_start_ns_ = running_since;
       return start_ns_;
     }
-    std::string not_heard;
     // The start every process computes alike: from the required processes' ready times only (a
     // process that is not required must not move it by being ready last).
     int64_t last_ready = Required(process_) ? ready_ns_ : 0;
-    for (const auto& p : processes) {
-      const auto it = heard_.find(p);
-      if (p == process_) continue;
-      const int64_t ready = it == heard_.end() ? 0 : it->second.ready_ns();
-      if (ready == 0)
-        not_heard += std::string(not_heard.empty() ? "" : ", ") + "'" + p + "'" +
-                     (it == heard_.end()                   ? " (not seen)"
-                      : it->second.state() == "activating" ? " (still activating: a component's Activate waits, e.g. the web "
-                                                             "component's wait_for_subject_s)"
-                                                           : " (seen, its endpoints not all matched)");
-      last_ready = std::max(last_ready, ready);
-    }
+    const std::string not_heard = NotReady(&last_ready);
     if (ready_ns_ != 0 && not_heard.empty()) {
       start_ns_ = graph_start_ns_ = last_ready + kStartMarginNs;
       return start_ns_;
     }
-    if (std::chrono::steady_clock::now() >= deadline) {
-      std::string what;
-      if (!not_heard.empty()) what = "processes not ready: " + not_heard;
-      if (!missing_endpoints.empty()) what += std::string(what.empty() ? "" : "; ") + "here: " + missing_endpoints;
-      // A process never heard from, in a graph that reaches this machine only: say so, and how to open it.
-      if (const std::string local = LocalScopeNote(graph_.network); !local.empty() && not_heard.find("(not seen)") != std::string::npos)
-        what += "; " + local;
-      char waited[32];
-      std::snprintf(waited, sizeof waited, "%g", graph_.network.start_timeout_s);  // 0.5 s, not "0 s"
-      return Status::FailedPrecondition("process '" + process_ + "' waited " + waited +
-                                        " s (network.start_timeout_s) for the graph to start together: " + what);
-    }
+    if (std::chrono::steady_clock::now() >= deadline) return TimedOut(not_heard, missing_endpoints);
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
 }

@@ -95,6 +95,12 @@ class StartBarrier {
   bool Awaited(const std::string& process) const;
   bool Required(const std::string& process) const;  // `required:` of the process (default true)
   std::string MissingEndpoints(const std::vector<EndpointMatch>& matches) const;
+  std::set<std::string> AwaitedProcesses() const;  // this one and every required process
+  // The awaited processes not heard ready ("'mind' (not seen), ..."); raises *last_ready to the
+  // latest ready time heard.
+  std::string NotReady(int64_t* last_ready) const;
+  // The timeout's error: who was not ready, which endpoints of this process lacked matches.
+  Status TimedOut(const std::string& not_heard, const std::string& missing_endpoints) const;
   void TakeAnnouncements();
 
   const Graph& graph_;
