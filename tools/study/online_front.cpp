@@ -29,6 +29,9 @@ constexpr const char* kComeBack =
 constexpr const char* kHeldElsewhere =
     "Please come back later: your session is open elsewhere right now (the lab). Your link stays valid.";
 constexpr std::chrono::milliseconds kRelayRetry{200};
+// A relayed frame the trial's graph cannot take within this (it stopped reading) drops the relay
+// (the page reconnects) rather than holding the server's one handler thread, every page's.
+constexpr std::chrono::milliseconds kRelayWrite{100};
 // A trial whose graph failed this many times in a row (a broken graph or machine) is not offered
 // again until `dyad study serve` restarts: the participant is asked to come back later.
 constexpr int kFailuresInARow = 3;
@@ -77,6 +80,8 @@ struct OnlineFront::Participant {
   Clock::time_point heard{};  // the page's last frame (its pongs included)
   double rtt_ms = -1;
   int failures = 0;  // attempts failed in a row (kFailuresInARow: none more)
+  std::string view;  // the op of the view the page was sent last: "consent", "waiting" (else "")
+  bool answered = false;  // the page answered that view: more answers ignored until the next view
   // For the experimenter's overview: the running attempt, the page's engagement, the end.
   int trial = 0, attempt = 0;
   std::string file, ended;
@@ -134,6 +139,8 @@ std::string OnlineFront::Take(Participant& p, web::ClientId client, Clock::time_
     p.lock.emplace(std::move(*lock));
   }
   p.page = client;
+  p.view.clear();
+  p.answered = false;
   p.heard = now;
   p.session.PageOpened();
   clients_[client] = &p;
@@ -259,7 +266,13 @@ void OnlineFront::SendPhase(Participant& p, web::ClientId client) {
   const std::string frame = broken ? Refused(kBroken) : p.session.PageFrame();
   Send(client, frame);
   const bool refused = frame.find(R"("op":"refused")") != std::string::npos;
-  if (!refused && frame.find(R"("op":"done")") == std::string::npos) return;
+  if (!refused && frame.find(R"("op":"done")") == std::string::npos) {
+    MutexLock lock(mutex_);
+    if (p.page != client) return;
+    p.view = frame.find(R"("op":"consent")") != std::string::npos ? "consent" : "waiting";
+    p.answered = false;  // a new view: the page may answer it once
+    return;
+  }
   {
     MutexLock lock(mutex_);
     if (p.page != client) return;
@@ -307,7 +320,8 @@ Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
   }
   if (up) {
     Pointer(*p, text);
-    if (Status st = up->SendText(text); !st.ok()) NextPhase(*p, client, "the trial's page closed");
+    if (Status st = up->SendText(text, kRelayWrite); !st.ok())
+      NextPhase(*p, client, "the trial's graph does not take the page's frames");
     return Status::OK();
   }
   if (!running) Answer(*p, client, text);
@@ -318,8 +332,15 @@ Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
 void OnlineFront::Answer(Participant& p, web::ClientId client, std::string_view text) {
   const Json j = Json::parse(text.begin(), text.end(), nullptr, false);
   const std::string op = j.is_object() ? j.value("op", "") : "";
+  {
+    // One answer per view, to that view (consent to the consent page, ready to the waiting one):
+    // anything else between trials is ignored, and a flood costs no log reads.
+    MutexLock lock(mutex_);
+    if (p.page != client || p.answered || op.empty() || op != (p.view == "waiting" ? "ready" : p.view)) return;
+    p.answered = true;
+  }
   if (op == "consent" && j.contains("agree") && j["agree"].is_boolean()) {
-    if (p.session.phase() != OnlineSession::Phase::kConsent) return SendPhase(p, client);
+    if (p.session.phase() != OnlineSession::Phase::kConsent) return;  // an old view's answer
     const bool agree = j["agree"].get<bool>();
     if (Status st = p.session.Consent(agree); !st.ok())
       std::cerr << "dyad study serve: " << p.id << ": " << st.ToString() << std::endl;

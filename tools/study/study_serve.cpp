@@ -1,6 +1,7 @@
 #include "study_serve.hpp"
 
 #include <signal.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -26,7 +27,19 @@ extern const char* const kOverviewHtml;  // overview.html, embedded at configure
 namespace {
 
 std::atomic<int> g_quit{0};  // lock-free: set by the handler, read by the loop
-extern "C" void OnServeSignal(int) { g_quit.store(1); }
+static_assert(std::atomic<int>::is_always_lock_free);
+// The first SIGINT or SIGTERM stops the serve: its trials stopped as `dyad study run` stops them,
+// waited for. A second one (a graph that does not end) exits at once, saying so: each trial's
+// graph then gets its parent-death SIGINT, and its attempt stays unended in the log (repeated
+// with that reason when the participant comes back).
+extern "C" void OnServeSignal(int) {
+  if (g_quit.fetch_add(1) == 0) return;
+  static constexpr char kNow[] =
+      "dyad study serve: a second stop: exiting now, without waiting for the trials' graphs (each gets SIGINT as its "
+      "parent ends; their attempts stay unended in the session logs)\n";
+  [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, kNow, sizeof kNow - 1);
+  ::_exit(130);
+}
 
 // Why the study cannot be served ("" when it can): each names its key or flag.
 std::string WhyNotServed(const Study& s, const ServeOptions& o) {
@@ -88,6 +101,7 @@ web::WebServer::Options ServerOptions(const ServeOptions& o, const std::vector<s
   so.pages["/overview"] = web::WebServer::Page{"text/html; charset=utf-8", kOverviewHtml, {web::Role::kExperimenter}, ""};
   so.endpoints.push_back(web::WebServer::Endpoint{"/overview/ws", {}, overview, {web::Role::kExperimenter}, /*viewers=*/false});
   so.max_clients = 4 * max_sessions + 16;  // the refused pages are told so over their socket
+  so.max_frame_bytes = 16 << 10;           // a page's frames are small (pointer samples, answers): 16 KiB, not 1 MiB
   // --origin, and where the links are (DATA/links.csv: a name of this machine, a proxy's)
   so.allowed_origins = o.origins;
   so.allowed_origins.insert(so.allowed_origins.end(), link_origins.begin(), link_origins.end());

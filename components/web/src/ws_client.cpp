@@ -288,9 +288,9 @@ struct WsClient::State {
   }
   // Writes one frame: false if it could not be written whole within kWriteTimeout (after the
   // frame before it, which has as long).
-  bool Write(const std::string& frame) {
+  bool Write(const std::string& frame, std::chrono::milliseconds timeout = kWriteTimeout) {
     std::lock_guard<std::mutex> lock(write_mutex);
-    return SendAll(fd, frame, Clock::now() + kWriteTimeout);
+    return SendAll(fd, frame, Clock::now() + timeout);
   }
   // Whether the reading thread may run a callback now.
   bool Open() {
@@ -399,13 +399,13 @@ StatusOr<std::unique_ptr<WsClient>> WsClient::Connect(const std::string& host, i
   return std::unique_ptr<WsClient>(new WsClient(std::move(state)));
 }
 
-Status WsClient::SendText(std::string_view text) {
+Status WsClient::SendText(std::string_view text, std::chrono::milliseconds timeout) {
   State& s = *state_;
   {
     std::lock_guard<std::mutex> lock(s.mutex);
     if (s.ended || s.closed) return Status::FailedPrecondition(s.where, "the WebSocket is closed");
   }
-  if (s.Write(EncodeFrame(kOpText, text))) return Status::OK();
+  if (s.Write(EncodeFrame(kOpText, text), timeout)) return Status::OK();
   shutdown(s.fd, SHUT_RDWR);  // a frame half written: nothing after it can be read right; the link ends
   return Status::IOError(s.where, "cannot send a frame (the peer does not read, or the link failed)");
 }

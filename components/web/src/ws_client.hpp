@@ -20,7 +20,9 @@
 ///     the client sends 1009/1003 first).
 ///   - SendText: thread-safe (one frame at a time, whole); an error (FailedPrecondition) once
 ///     closed, by either side; IOError when the write fails (the link then ends: on_close).
-///     A write blocks while the peer's receive window is full, at most kWriteTimeout.
+///     A write blocks while the peer's receive window is full, at most `timeout` (kWriteTimeout
+///     by default; a relay on a shared thread gives a short one, and a peer that stops reading
+///     then ends the link rather than holding the thread).
 ///   - Close(): idempotent, from any thread (a callback included). Sends a close frame (1000),
 ///     shuts the socket down, and when called from another thread waits for the reading thread:
 ///     no callback runs after it returns. From a callback of its own
@@ -60,7 +62,7 @@ class WsClient {
   // with '/'.
   static StatusOr<std::unique_ptr<WsClient>> Connect(const std::string& host, int port, const std::string& path_and_query,
                                                      Callbacks callbacks, std::chrono::milliseconds timeout);
-  Status SendText(std::string_view text);
+  Status SendText(std::string_view text, std::chrono::milliseconds timeout = kWriteTimeout);
   void Close();
   ~WsClient();
   WsClient(const WsClient&) = delete;

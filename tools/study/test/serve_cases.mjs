@@ -171,28 +171,39 @@ async function silentPage(front) {
   const fresh = new Page(front, token("P03"));
   await fresh.next("consent");
   check(await silent.closed === 1001, "the silent page is closed (1001)");
-  fresh.ws.close();
-  console.log("ok: a page silent for 5 s is replaced by a new page of its link");
+  // A frame over 16 KiB (a page's are a few hundred bytes) closes the page: 1009.
+  fresh.ws.send(JSON.stringify({ op: "pong", pad: "x".repeat(20000) }));
+  const big = await Promise.race([fresh.closed, sleep(3000).then(() => "still open")]);
+  check(big === 1009, `a 20 KB frame closes the page with 1009: ${big}`);
+  console.log("ok: a page silent for 5 s is replaced by a new page of its link; a 20 KB frame closes a page");
 }
 
 // The trial's graph picked its own port (web.port=0 on its command line, no port of the front's
 // choosing) and wrote it into the participant's folder; that port is the graph's web component.
+// The `dyad run` processes of p's trials: [pid, argv].
+function trialGraphs(p) {
+  return fs.readdirSync("/proc").filter((d) => /^\d+$/.test(d)).map((d) => {
+    try { return [Number(d), fs.readFileSync(`/proc/${d}/cmdline`, "utf8").split("\0")]; } catch { return [0, []]; }
+  }).filter(([, a]) => a[1] === "run" && a.some((x) => x.startsWith(`recorder.file=`) && x.includes(`${data}/${p}/`)));
+}
+
 async function trialPort(p, trial) {
   const file = `${data}/${p}/.trial-${trial}.port`;
   check(fs.existsSync(file), `no port file ${file}`);
   const port = Number(fs.readFileSync(file, "utf8"));
-  const runs = fs.readdirSync("/proc").filter((d) => /^\d+$/.test(d)).map((d) => {
-    try { return fs.readFileSync(`/proc/${d}/cmdline`, "utf8").split("\0"); } catch { return []; }
-  }).filter((a) => a[1] === "run" && a.some((x) => x.startsWith(`recorder.file=`) && x.includes(`${data}/${p}/`)));
+  const runs = trialGraphs(p).map(([, a]) => a);
   check(runs.length === 1 && runs[0].includes("web.port=0") && runs[0].some((x) => x.startsWith("web.port_file=")),
     `the trial's graph binds port 0 and writes its port file: ${JSON.stringify(runs)}`);
   check(await statusAt(port, `/subject?token=${token(p)}`) === 200, `the port file's ${port} is the graph's web component`);
 }
 
 async function lostAndBack(front, p01) {
-  p01.send({ op: "consent", agree: true });
+  for (let i = 0; i < 5; i++) p01.send({ op: "consent", agree: true });  // answered once, the rest ignored
   const waiting = await p01.next("waiting");
   check(waiting.ready?.label === "Start trial 1 of 2", `Ready: ${JSON.stringify(waiting)}`);
+  await sleep(300);
+  check(!p01.frames.some((f) => f.op === "waiting"), `5 consents, 1 view: ${JSON.stringify(p01.frames)}`);
+  check(log("P01").filter((e) => e.event === "consent").length === 1, "5 consents, 1 logged");
   p01.send({ op: "ready" });
   check(await p01.closed === 1012, "the trial starts: the page's socket closed with 1012");
   let page = await intoTrial(front, token("P01"));
@@ -255,6 +266,20 @@ async function restarts(front) {
   await intoTrial(front, token("P04"));
   const third = log("P04").filter((e) => e.event === "start")[2];
   check(third?.attempt === 3 && third.reason === "the server restarted during attempt 2", `attempt 3: ${JSON.stringify(third)}`);
+  // A graph that does not end (stopped here by SIGSTOP): SIGTERM, and the front waits for it; a
+  // second SIGTERM exits at once, saying so; the graph ends by its parent-death SIGINT once it runs.
+  const graphs = trialGraphs("P04");
+  check(graphs.length === 1, `P04's trial graph: ${JSON.stringify(graphs)}`);
+  process.kill(graphs[0][0], "SIGSTOP");
+  front.proc.kill("SIGTERM");
+  for (let t = 0; t < 5000 && !front.out.includes("dyad study serve: stopping"); t += 50) await sleep(50);
+  const waiting = await Promise.race([front.exited, sleep(500).then(() => "waiting")]);
+  check(waiting === "waiting", `the front waits for its trial's graph: ${waiting}`);
+  front.proc.kill("SIGTERM");
+  const second = await Promise.race([front.exited, sleep(3000).then(() => "still there")]);
+  process.kill(graphs[0][0], "SIGCONT");
+  check(second === 130 && front.out.includes("a second stop: exiting now"), `a second SIGTERM: ${second}`);
+  console.log("ok: a second SIGTERM while the front waits for a trial's graph exits at once (130)");
   console.log("ok: restarts (SIGTERM, SIGKILL) keep the log; the unfinished trial is repeated with its reason");
 }
 
@@ -267,7 +292,6 @@ try {
   await silentPage(front);
   await lostAndBack(front, p01);
   await restarts(front);
-  check(await front.stop("SIGINT") === 0, "SIGINT: exit 0");
 } catch (e) {
   console.error(`FAIL: ${e.message}\n--- dyad study serve:\n${front.out}`);
   front.proc?.kill("SIGKILL");
