@@ -9,6 +9,7 @@
 #include <mutex>
 #include <optional>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -221,13 +222,18 @@ void OnlineFront::Relay(Participant& p, web::ClientId client) {
       up = web::WsClient::Connect("127.0.0.1", port, "/subject/ws?token=" + token, std::move(cb), std::chrono::seconds(2));
     }
     if (up.ok()) {
-      std::shared_ptr<web::WsClient> relay(std::move(*up));
-      MutexLock lock(mutex_);
-      if (p.running && p.page == client) {
-        p.upstream = relay;
-        return;
+      std::shared_ptr<web::WsClient> relay(std::move(*up)), old;
+      {
+        MutexLock lock(mutex_);
+        if (p.running && p.page == client) {
+          old = std::exchange(p.upstream, relay);
+          relay.reset();
+        }
       }
-      break;  // the page or the trial left meanwhile (the relay closes as it goes)
+      if (old) old->Close();  // never under mutex_: Close waits for its callbacks, which take it
+      if (!relay) return;
+      relay->Close();
+      break;  // the page or the trial left meanwhile
     }
     // Nothing listens yet (the graph starting), or it is ending: again until the trial ends.
     if (Clock::now() > deadline) {
@@ -248,12 +254,15 @@ void OnlineFront::Relay(Participant& p, web::ClientId client) {
 }
 
 void OnlineFront::NextPhase(Participant& p, web::ClientId client, const std::string& reason) {
+  std::shared_ptr<web::WsClient> up;  // the page's relay goes with it (a stale one would fail the next page's frames)
   {
     MutexLock lock(mutex_);
     if (p.page != client) return;
     p.page = 0;  // before the close: the page's next socket may come before this one's OnClose
     p.session.PageClosed(Clock::now());
+    up = std::move(p.upstream);
   }
+  if (up) up->Close();  // after unlocking (also from the relay's own on_close: allowed there)
   Close(client, 1012, reason);
 }
 
