@@ -356,22 +356,33 @@ void OnlineFront::Answer(Participant& p, web::ClientId client, std::string_view 
     std::cout << p.id << (agree ? ": consent given on the consent page" : ": declined on the consent page") << std::endl;
     return SendPhase(p, client);
   }
-  if (op == "ready" && p.session.phase() == OnlineSession::Phase::kWaiting) return StartTrial(p);
+  if (op != "ready" || p.session.phase() != OnlineSession::Phase::kWaiting) return;
+  if (const std::string why = StartTrial(p); !why.empty()) {  // it cannot start: the page is told, and closed (1008)
+    std::cout << p.id << ": a page refused: " << why << std::endl;
+    Send(client, Refused(why));
+    {
+      MutexLock lock(mutex_);
+      if (p.page != client) return;
+      p.page = 0;
+      p.session.PageFinished();
+    }
+    Close(client, 1008, "refused");
+  }
 }
 
-void OnlineFront::StartTrial(Participant& p) {
+std::string OnlineFront::StartTrial(Participant& p) {
   const std::optional<OnlineSession::Planned> next = p.session.Next();
-  if (!next || closing_.load()) return;
+  if (!next || closing_.load()) return "";
   {
     MutexLock lock(mutex_);
-    if (p.failures >= kFailuresInARow) return;
+    if (p.failures >= kFailuresInARow) return kBroken;
   }
   const std::string token_file = (std::filesystem::path(study_.data) / p.id / (study_.subject_web + "-tokens")).string();
   auto token = ReadSubjectToken(token_file);
   if (!token.ok()) {
     std::cerr << "dyad study serve: " << p.id << ": trial " << next->trial.number
               << " cannot start: " << token.status().ToString() << std::endl;
-    return;
+    return kBroken;  // the page is told, not left with its Ready button pressed
   }
   // The graph binds a free loopback port itself and writes it into the participant's folder
   // (0700): the relay and the overview connect only to that port.
@@ -395,12 +406,12 @@ void OnlineFront::StartTrial(Participant& p) {
     return p.lost_reason;
   };
   std::lock_guard<std::mutex> worker(p.worker_mutex);
-  if (closing_.load()) return;
+  if (closing_.load()) return "";
   if (p.worker.joinable()) p.worker.join();  // the last trial's thread, ended (running is false)
   web::ClientId page = 0;
   {
     MutexLock lock(mutex_);
-    if (p.running || !p.ended.empty()) return;
+    if (p.running || !p.ended.empty()) return "";
     p.running = true;
     p.trial = r.trial.number;
     p.attempt = r.attempt;
@@ -418,6 +429,7 @@ void OnlineFront::StartTrial(Participant& p) {
   std::filesystem::remove(port_file, ec);  // a stale one (a serve killed mid-trial): never read
   if (page != 0) Close(page, 1012, "the trial starts");
   p.worker = std::thread([this, &p, r] { RunTrial(p, r); });
+  return "";
 }
 
 void OnlineFront::RunTrial(Participant& p, AttemptRequest r) {

@@ -120,7 +120,9 @@ class OnlineFront final : public web::ClientHandler {
   bool Pong(Participant& p, std::string_view text);
   void Pointer(Participant& p, std::string_view text);
   void Answer(Participant& p, web::ClientId client, std::string_view text);
-  void StartTrial(Participant& p);
+  // Starts p's next trial; a trial that cannot start (its token file unreadable, its graph failed
+  // kFailuresInARow times) returns what its page is told ("" when started or nothing to say).
+  std::string StartTrial(Participant& p);
   void RunTrial(Participant& p, AttemptRequest r);
   Participant* Of(web::ClientId client);
   void Send(web::ClientId client, std::string text);

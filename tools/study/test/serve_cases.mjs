@@ -175,7 +175,18 @@ async function silentPage(front) {
   fresh.ws.send(JSON.stringify({ op: "pong", pad: "x".repeat(20000) }));
   const big = await Promise.race([fresh.closed, sleep(3000).then(() => "still open")]);
   check(big === 1009, `a 20 KB frame closes the page with 1009: ${big}`);
-  console.log("ok: a page silent for 5 s is replaced by a new page of its link; a 20 KB frame closes a page");
+  // A trial that cannot start (P03's token file no longer private: the graph would not get its
+  // token) tells the page, which is closed (1008), instead of leaving its Ready pressed.
+  const p3 = new Page(front, token("P03"));
+  await p3.next("consent");
+  p3.send({ op: "consent", agree: true });
+  await p3.next("waiting");
+  fs.chmodSync(`${data}/P03/web-tokens`, 0o644);
+  p3.send({ op: "ready" });
+  const cannot = await p3.next("refused", 5000).finally(() => fs.chmodSync(`${data}/P03/web-tokens`, 0o600));
+  check(/Something went wrong on our side/.test(cannot.message) && await p3.closed === 1008, `cannot start: ${cannot.message}`);
+  check(!log("P03").some((e) => e.event === "start"), "nothing started for P03");
+  console.log("ok: a page silent for 5 s is replaced by a new page of its link; a 20 KB frame closes a page; a trial that cannot start tells its page");
 }
 
 // The trial's graph picked its own port (web.port=0 on its command line, no port of the front's

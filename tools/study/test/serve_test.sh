@@ -70,7 +70,7 @@ op=$(node -e '
   ws.on("error", (e) => { console.log("error: " + e.message); process.exit(1); });
   setTimeout(() => { console.log("nothing"); process.exit(1); }, 5000);' "wss://127.0.0.1:$(cat tls-port)/subject/ws?token=$p03") ||
   { kill $tls; fail "the page's socket over WSS: $op: $(cat tls.out)"; }
-[ "$op" = consent ] || { kill $tls; fail "over WSS P03 got '$op', not the consent page"; }
+[ "$op" = waiting ] || { kill $tls; fail "over WSS P03 (consent given in serve_cases.mjs) got '$op', not the waiting page"; }
 kill -TERM $tls; wait $tls || fail "dyad study serve with TLS exited $?: $(cat tls.out)"
 # A graph that fails at every trial (its data set deleted once the front has started): three
 # failed attempts, then the participant is asked to come back later.
