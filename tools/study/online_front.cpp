@@ -131,9 +131,9 @@ int OnlineFront::running() const {
   return n;
 }
 
-std::string OnlineFront::Take(Participant& p, web::ClientId client, Clock::time_point now) {
+std::string OnlineFront::Take(Participant& p, web::ClientId client, Clock::time_point now, bool final) {
   if (p.page != 0) return kOpenTwice;
-  if (!p.session.Live(now, p.running) && LiveLocked(now) >= options_.max_sessions) return kComeBack;
+  if (!final && !p.session.Live(now, p.running) && LiveLocked(now) >= options_.max_sessions) return kComeBack;
   if (!p.lock) {
     auto lock = SessionLock::Acquire(study_, p.id);
     if (!lock.ok()) return kHeldElsewhere;
@@ -165,8 +165,18 @@ void OnlineFront::OnOpen(web::ClientId client, web::Role) {
       silent_relay = std::move(p.upstream);
       p.session.PageClosed(now);
     }
-    refused = Take(p, client, now);
+    refused = Take(p, client, now, false);
     running = p.running;
+  }
+  if (refused == kComeBack) {
+    // Done, declined, withdrawn or ended: the page only hears that and is closed, taking no
+    // session's place (reopening the link to see the code is not "come back later").
+    const OnlineSession::Phase ph = p.session.phase();  // the log, read outside the lock
+    if (ph == OnlineSession::Phase::kDone || ph == OnlineSession::Phase::kRefused) {
+      MutexLock lock(mutex_);
+      refused = Take(p, client, Clock::now(), true);
+      running = p.running;
+    }
   }
   if (silent_relay) silent_relay->Close();
   if (silent != 0) Close(silent, 1001, "replaced by a newer page of this link");
@@ -580,7 +590,10 @@ Status OnlineFront::StopSession(const std::string& participant, const std::strin
     running = p.running;
     if (running && p.lost_reason.empty()) p.lost_reason = "stopped by the experimenter: " + reason;
     if (running) p.stop.store(true);  // its end closes the page, which comes back to hear the session ended
-    else page = p.page;
+    if (!running) {                   // nothing to come back for: the session's place is free at once
+      std::swap(page, p.page);
+      p.session.PageFinished();
+    }
   }
   std::cout << participant << ": the session is ended by the experimenter: " << reason
             << (running ? " (its trial is stopped)" : "") << std::endl;

@@ -22,6 +22,9 @@
 //   - At most max_sessions live sessions (a page connected, a trial running, or the page gone
 //     less than reconnect_s between trials): a participant whose session is not live then gets
 //     {"op":"refused","message":"Please come back later: ..."}, closed with 1008; nothing starts.
+//     A participant done or refused (declined, withdrawn, ended) is not counted: their page is
+//     told that (the completion code, the refusal) and closed; StopSession between trials frees
+//     the session's place at once.
 //   - A live session holds the participant's SessionLock (a lab `study run` of them is refused,
 //     and a participant the lab holds is refused here); it is released reconnect_s after the
 //     page left between trials.
@@ -106,8 +109,9 @@ class OnlineFront final : public web::ClientHandler {
 
  private:
   struct Participant;
-  // Why `client` may not be p's page now ("" when it is, from now on).
-  std::string Take(Participant& p, web::ClientId client, Clock::time_point now) REQUIRES(mutex_);
+  // Why `client` may not be p's page now ("" when it is, from now on). `final`: p's session is
+  // done or refused (its page is only told so): max_sessions does not apply.
+  std::string Take(Participant& p, web::ClientId client, Clock::time_point now, bool final) REQUIRES(mutex_);
   int LiveLocked(Clock::time_point now) const REQUIRES(mutex_);
   // The running trial's port, as its graph wrote it into p's port_file (0: no trial, or not yet).
   int TrialPort(Participant& p) const;

@@ -157,6 +157,10 @@ async function openTwiceAndMaxSessions(front) {
   check(log("P02").some((e) => e.event === "declined"), "declined: logged");
   const p3again = new Page(front, token("P03"));
   await p3again.next("consent");
+  // P01 and P03 live (max_sessions 2): P02, who declined, reopening the link hears that, not "come back later".
+  const reopened = new Page(front, token("P02"));
+  const declined = await reopened.next("refused");
+  check(declined.message.startsWith("You did not agree") && await reopened.closed === 1008, `declined at max_sessions: ${declined.message}`);
   p3again.ws.close();
   console.log("ok: a link open twice is refused (1008); max_sessions refuses a new participant until a session ends; a declined consent ends politely");
   return first;
