@@ -12,6 +12,7 @@
 #include <iostream>
 #include <thread>
 
+#include "dyad/private_file.hpp"
 #include "front_admission.hpp"
 #include "online_front.hpp"
 #include "overview_channel.hpp"
@@ -115,9 +116,18 @@ void Serving(const Study& s, const ServeOptions& o, int port, int with_links, in
   const std::string scheme = o.tls_certificate.empty() ? "http://" : "https://";
   for (const std::string& host : web::UrlHosts(o.address))
     std::cout << "dyad study serve: " << s.name << " at " << scheme << host << ":" << port << "/subject?token=..." << std::endl;
+  // The overview's link holds the experimenter's token: written to a private file, never printed
+  // (the output may go to a journal or a CI log).
+  std::string links;
   for (const std::string& host : web::UrlHosts(o.address))
-    std::cout << "experimenter's overview: " << scheme << host << ":" << port << "/overview?token=" << token
-              << " (the token is kept in " << s.data << "/serve-tokens)" << std::endl;
+    links += scheme + host + ":" + std::to_string(port) + "/overview?token=" + token + "\n";
+  const std::string file = s.data + "/overview-link";
+  if (Status st = WritePrivateFile(file, links, CreateMode::kReplace); st.ok())
+    std::cout << "experimenter's overview: its link is in " << file << " (0600: it holds the token, kept in " << s.data
+              << "/serve-tokens)" << std::endl;
+  else
+    std::cerr << "dyad study serve: the experimenter's overview: " << st.ToString() << " (its link: " << scheme << "HOST:" << port
+              << "/overview?token= and the experimenter token in " << s.data << "/serve-tokens)" << std::endl;
   std::cout << "participants with links: " << with_links << " of " << s.participants.size()
             << (with_links < static_cast<int>(s.participants.size()) ? " (dyad study links " + s.file + " --base-url " + scheme +
                                                                            "HOST:" + std::to_string(port) + " makes the others')"

@@ -58,7 +58,9 @@ serve() {
 }
 serve
 [ "$(stat -c %a sdata/serve-tokens)" = 600 ] || fail "sdata/serve-tokens is $(stat -c %a sdata/serve-tokens), not 600"
-url=$(sed -n "s/^experimenter's overview: \(http[^ ]*\).*/\1/p" serve.out | head -1)
+url=$(head -1 sdata/overview-link)
+[ "$(stat -c %a sdata/overview-link)" = 600 ] || fail "sdata/overview-link is $(stat -c %a sdata/overview-link), not 600"
+! grep -q "${url#*token=}" serve.out serve.err || fail "the overview's token printed: $(cat serve.out)"
 token() { sed -n 's/^subject //p' "sdata/$1/web-tokens"; }
 code=$(curl -s -o /dev/null -w '%{http_code}' "http://127.0.0.1:$port/overview?token=$(token P01)")
 [ "$code" != 200 ] || fail "a participant's token opened the overview"
@@ -99,7 +101,7 @@ rc=0; "$dyad" study serve s.yaml --port "$port" > bad.out 2> bad.err || rc=$?
   { cat bad.out bad.err; fail "a serve-tokens readable by others: exit $rc"; }
 chmod 600 sdata/serve-tokens
 serve
-[ "$(sed -n "s/^experimenter's overview: \(http[^ ]*\).*/\1/p" serve.out | head -1)" = "$url" ] || fail "a new overview token at the restart"
+[ "$(head -1 sdata/overview-link)" = "$url" ] || fail "a new overview token at the restart"
 node "$node_dir/sim_participant.mjs" --online --seconds 10 p02.sessions > p02b.json 2> p02b.err || { cat p02b.err; fail "P02 again"; }
 grep -q '"refused":"The experimenter has ended this session.' p02b.json || { cat p02b.json; fail "P02's session open again after a restart"; }
 # Resumed from the overview's socket: P02's link opens the session again, the stopped trial next.
