@@ -108,7 +108,7 @@ web::WebServer::Options ServerOptions(const ServeOptions& o, const std::vector<s
   so.allowed_origins.insert(so.allowed_origins.end(), link_origins.begin(), link_origins.end());
   const std::string scheme = o.tls_certificate.empty() ? "http://" : "https://";
   for (const std::string& host : web::UrlHosts(o.address))
-    so.allowed_origins.push_back(scheme + host + (o.port > 0 ? ":" + std::to_string(o.port) : ""));
+    so.allowed_origins.push_back(scheme + host + ":" + std::to_string(o.port));  // ":0": the port bound (--port 0)
   return so;
 }
 

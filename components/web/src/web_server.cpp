@@ -459,8 +459,11 @@ WebServer::~WebServer() {
 }
 
 bool WebServer::OriginAllowed(const std::string& origin) const {
-  for (const auto& o : options_.allowed_origins)
+  for (const auto& o : options_.allowed_origins) {
     if (o == "*" || o == origin) return true;
+    // "scheme://host:0" on a server given port 0: that host at the port it bound.
+    if (options_.port == 0 && o.ends_with(":0") && origin == o.substr(0, o.size() - 1) + std::to_string(port_)) return true;
+  }
   if (IsLoopback(options_.address)) {
     for (const char* local : {"http://localhost", "http://127.0.0.1", "https://localhost", "https://127.0.0.1"}) {
       const std::string l(local);

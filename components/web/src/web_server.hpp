@@ -18,7 +18,8 @@
 /// (the participant, say), or refuses with an HTTP status and a plain-text body, which a page
 /// request and a WebSocket handshake both get as their answer.
 /// At most `max_clients` WebSocket clients. A request carrying an Origin header must
-/// name an allowed origin (`allowed_origins`, entries "scheme://host[:port]" or "*"; localhost
+/// name an allowed origin (`allowed_origins`, entries "scheme://host[:port]" or "*"; on a server
+/// given port 0, an entry "scheme://host:0" stands for that host at the port it bound; localhost
 /// origins are always allowed when the server binds a loopback address). Pages are sent with
 /// `Referrer-Policy: no-referrer` (their URL holds the token), `Cache-Control: no-store` and
 /// `X-Frame-Options: DENY` (no page of another site can frame the steering page).

@@ -72,6 +72,21 @@ op=$(node -e '
   { kill $tls; fail "the page's socket over WSS: $op: $(cat tls.out)"; }
 [ "$op" = waiting ] || { kill $tls; fail "over WSS P03 (consent given in serve_cases.mjs) got '$op', not the waiting page"; }
 kill -TERM $tls; wait $tls || fail "dyad study serve with TLS exited $?: $(cat tls.out)"
+# Off loopback on --port 0: a page from the printed address (its origin carries the bound port) is admitted.
+"$build/bin/dyad" study serve s.yaml --address 0.0.0.0 --port 0 --port-file any-port --tls-certificate web.pem > any.out 2>&1 &
+any=$!
+wait_port_file any-port $any 10 any.out
+for _ in $(seq 50); do grep -q "/subject?token=" any.out && break; sleep 0.1; done
+at=$(sed -n 's|^dyad study serve: serve_test at \(https://[^/]*\)/subject.*|\1|p' any.out | head -1)
+op=$(node -e '
+  const WebSocket = require("ws");
+  const ws = new WebSocket(process.argv[1], { rejectUnauthorized: false, origin: process.argv[2] });
+  ws.on("message", (d) => { console.log(JSON.parse(String(d)).op); process.exit(0); });
+  ws.on("error", (e) => { console.log("error: " + e.message); process.exit(1); });
+  setTimeout(() => { console.log("nothing"); process.exit(1); }, 5000);' "wss://127.0.0.1:$(cat any-port)/subject/ws?token=$p03" "$at") ||
+  { kill $any; fail "off loopback on port 0, a page from $at: $op: $(cat any.out)"; }
+kill -TERM $any; wait $any || fail "dyad study serve --address 0.0.0.0 --port 0 exited $?: $(cat any.out)"
+[ "$op" = waiting ] || fail "off loopback on port 0, P03 from $at got '$op'"
 # A graph that fails at every trial (its data set deleted once the front has started): three
 # failed attempts, then the participant is asked to come back later.
 "$build/bin/dyad" generate dataset --out ds > /dev/null
