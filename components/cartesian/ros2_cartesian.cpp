@@ -55,9 +55,9 @@ void Ros2Cartesian::Describe(ComponentSpec& spec) {
   spec.Param("watchdog_s", 0.5).Min(1e-6).Unit("s").Doc("no command this long: zero twist / setpoint held");
   spec.Param("pose_timeout_s", 0.5).Min(1e-6).Unit("s").Doc(
       "no arm pose this long: stopped = true, zero twist / the measured pose re-sent, until poses return; none "
-      "this long after activation: an error (logged, stopped states published)");
+      "this long after the run's start: an error (logged, stopped states published)");
   spec.Param("require_arm", false).Doc(
-      "true: no pose within pose_timeout_s of activation fails the run (false: an error on the log and the state)");
+      "true: no pose within pose_timeout_s of the run's start fails the run (false: an error on the log and the state)");
   spec.Param("pose_frame", "").Doc(
       "header.frame_id of the arm's poses; empty: frame_id. Poses in any other frame are refused (counted, logged once)");
   spec.Param("pose_transform", std::vector<double>{}).Doc(
@@ -136,8 +136,11 @@ Vec3 Ros2Cartesian::PoseTransform::Apply(const Vec3& p) const {
   return t + p + (2 * q[3]) * uv + 2.0 * cross(u, uv);
 }
 
+// The first pose is awaited from the run's first step, not from here: a process activates before
+// the start barrier (every process of the graph, and a subject's page, may still be on their way),
+// which would spend the arm's time to answer on the others'.
 Status Ros2Cartesian::Activate() {
-  activated_ns_ = ctx_->clock().now_ns();
+  activated_ns_ = -1;
   return Status::OK();
 }
 
@@ -198,7 +201,7 @@ Status Ros2Cartesian::Step(const StepInfo& info) {
   const int64_t now = info.now_ns;
   const double dt = last_step_ns_ < 0 ? 0 : (now - last_step_ns_) * 1e-9;
   last_step_ns_ = now;
-  if (activated_ns_ < 0) activated_ns_ = now;  // Activate() not called (unit tests)
+  if (activated_ns_ < 0) activated_ns_ = now;  // the run's first step: the first pose is due pose_timeout_s after it
   TakePoses(now);
   TakeCommand(now);
   const bool stale_pose = last_pose_ns_ < 0 || now - last_pose_ns_ > pose_timeout_ns_;
@@ -237,7 +240,7 @@ Status Ros2Cartesian::WatchArm(int64_t now_ns, bool stale_pose) {
 
 std::string Ros2Cartesian::NoPoseMessage() const {
   return "no pose from the arm on '" + arm_pose_->topic() + "' within pose_timeout_s (" + Seconds(pose_timeout_ns_) +
-         ") of activation" + WhyNoPose();
+         ") of the run's start" + WhyNoPose();
 }
 
 std::string Ros2Cartesian::WhyNoPose() const {

@@ -19,7 +19,7 @@
 /// begins with a fresh pose, and re-sent unchanged after (a sagging or pushed arm does not creep
 /// away; a stale pose never becomes the target); nothing before the first pose. Motion after it
 /// starts from the measured pose, at rest.
-/// A silent arm: no pose within pose_timeout_s of activation is an error (logged once, stopped
+/// A silent arm: no pose within pose_timeout_s of the run's first step is an error (logged once, stopped
 /// states published every step from then on, named again by Deactivate); with require_arm it
 /// fails the run instead. Poses whose header.frame_id is not pose_frame (default: frame_id) are
 /// refused (counted, logged once); pose_frame other than frame_id needs pose_transform (a fixed

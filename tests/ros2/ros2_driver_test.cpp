@@ -179,7 +179,7 @@ TEST_F(Ros2DriverTest, AnArmThatNeverAnswersIsAnErrorAndWithRequireArmFailsTheRu
   ASSERT_TRUE(arm.WaitForOutput("ready", 10)) << arm.err();
   ChildProcess run({DYAD_EXE, "run", Graph("ros2_servo.yaml"), "--duration", "2"}, dir_, "run");
   ASSERT_EQ(run.Wait(30), 0) << run.err();
-  EXPECT_NE(run.err().find("no pose from the arm on 'arm/pose' within pose_timeout_s (0.5 s) of activation"),
+  EXPECT_NE(run.err().find("no pose from the arm on 'arm/pose' within pose_timeout_s (0.5 s) of the run's start"),
             std::string::npos)
       << run.err();
   EXPECT_NE(run.err().find("the arm was never driven"), std::string::npos) << run.err();
@@ -195,7 +195,7 @@ TEST_F(Ros2DriverTest, AnArmThatNeverAnswersIsAnErrorAndWithRequireArmFailsTheRu
                        "driver.params.require_arm=true"},
                       dir_, "strict");
   EXPECT_EQ(strict.Wait(30), 1) << strict.err();
-  EXPECT_NE(strict.err().find("failed: no pose from the arm on 'arm/pose' within pose_timeout_s (0.5 s) of activation"),
+  EXPECT_NE(strict.err().find("failed: no pose from the arm on 'arm/pose' within pose_timeout_s (0.5 s) of the run's start"),
             std::string::npos)
       << strict.err();
   EXPECT_NE(strict.err().find("(require_arm)"), std::string::npos) << strict.err();
