@@ -1,10 +1,25 @@
 #include "front_admission.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+
+#include <algorithm>
 #include <filesystem>
 
 #include "study_links.hpp"
 
 namespace dyad::study {
+
+std::string FrontAdmission::AddressKey(std::string_view address) {
+  in6_addr a{};
+  if (address.find(':') == std::string_view::npos || inet_pton(AF_INET6, std::string(address).c_str(), &a) != 1)
+    return std::string(address);
+  if (IN6_IS_ADDR_V4MAPPED(&a)) return std::string(address.substr(address.rfind(':') + 1));
+  std::fill(a.s6_addr + 8, a.s6_addr + 16, 0);  // one window per /64: a host's rotating addresses are one
+  char text[INET6_ADDRSTRLEN] = {};
+  inet_ntop(AF_INET6, &a, text, sizeof text);
+  return std::string(text) + "/64";
+}
 
 FrontAdmission::FrontAdmission(const Study& s, std::vector<std::string>* problems) : study_(s) {
   MutexLock lock(mutex_);
@@ -47,18 +62,24 @@ std::variant<web::Admission, web::Refusal> FrontAdmission::Admit(std::string_vie
       if (web::TokenMatches(token, known)) who = participant;
   }
   if (!who.empty()) return web::Admission{web::Role::kSubject, who};
-  auto window = by_address_.find(remote_address);
+  // The windows over a minute old go, in one sweep at most once a second (not per request).
+  if (now - last_sweep_ >= std::chrono::seconds(1)) {
+    last_sweep_ = now;
+    std::erase_if(by_address_, [&](const auto& kv) { return now - kv.second.start >= std::chrono::minutes(1); });
+  }
+  const web::Refusal too_many{429, "too many unknown links: wait a minute"};
+  const std::string key = AddressKey(remote_address);
+  auto window = by_address_.find(key);
   if (window != by_address_.end() && now - window->second.start >= std::chrono::minutes(1)) {
     by_address_.erase(window);
     window = by_address_.end();
   }
-  if (window != by_address_.end() && window->second.unknown > kUnknownPerMinute)
-    return web::Refusal{429, "too many unknown links: wait a minute"};
-  if (window == by_address_.end()) window = by_address_.emplace(std::string(remote_address), Window{now, 0}).first;
+  if (window != by_address_.end() && window->second.unknown > kUnknownPerMinute) return too_many;
+  if (window == by_address_.end()) {
+    if (by_address_.size() >= kMaxAddresses) return too_many;  // many addresses guessing: unknown tokens wait
+    window = by_address_.emplace(key, Window{now, 0}).first;
+  }
   ++window->second.unknown;
-  // The old windows go once in a while (an address that never comes back).
-  if (by_address_.size() > 4096)
-    std::erase_if(by_address_, [&](const auto& kv) { return now - kv.second.start >= std::chrono::minutes(1); });
   return web::Refusal{404, "not found"};
 }
 

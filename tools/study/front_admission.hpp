@@ -13,11 +13,15 @@
 //     "too many unknown links: wait a minute" for every further unknown token until that minute
 //     is over: guessing costs a minute per 10 guesses. A known token is never refused (behind a
 //     proxy or NAT every participant shares the guesser's address): only unknown ones count.
+//     IPv6 addresses count by their /64 (one host's many addresses, one window). At most
+//     kMaxAddresses windows are kept (those over a minute old swept at most once a second):
+//     when that many addresses are guessing, an unknown token from a new one gets 429 too.
 //   - A token file that cannot be used (not a regular 0600 file, no subject line) is said once,
 //     on `problems` at load, and that participant has no link.
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <map>
 #include <string>
 #include <string_view>
@@ -35,6 +39,7 @@ class FrontAdmission {
  public:
   using Clock = std::chrono::steady_clock;
   static constexpr int kUnknownPerMinute = 10;
+  static constexpr size_t kMaxAddresses = 4096;
 
   // Reads every participant's token file now; what is wrong with one goes to `problems`.
   FrontAdmission(const Study& s, std::vector<std::string>* problems);
@@ -45,6 +50,9 @@ class FrontAdmission {
   void SetExperimenterToken(std::string token);
   // How many participants have a link (a usable token file).
   int with_links() const;
+  // The rate limit's key of an address: itself; an IPv6 address's /64 ("2001:db8::/64"); an
+  // IPv4-mapped IPv6 address's IPv4 text.
+  static std::string AddressKey(std::string_view address);
 
  private:
   void ReadMissing(std::vector<std::string>* problems) REQUIRES(mutex_);
@@ -59,6 +67,7 @@ class FrontAdmission {
   std::vector<std::string> missing_ GUARDED_BY(mutex_);                         // participants without one
   std::string experimenter_ GUARDED_BY(mutex_);                                 // the overview's token ("": none)
   Clock::time_point last_read_ GUARDED_BY(mutex_);
+  Clock::time_point last_sweep_ GUARDED_BY(mutex_);
   std::map<std::string, Window, std::less<>> by_address_ GUARDED_BY(mutex_);
 };
 
