@@ -53,11 +53,14 @@ void Ros2Cartesian::Describe(ComponentSpec& spec) {
   spec.Param("max_velocity", 0.25).Min(1e-9).Unit("m/s").Doc("speed limit (norm) of the twist or the setpoint");
   spec.Param("max_acceleration", 2.0).Min(1e-9).Unit("m/s^2").Doc("acceleration limit (norm)");
   spec.Param("watchdog_s", 0.5).Min(1e-6).Unit("s").Doc("no command this long: zero twist / setpoint held");
-  spec.Param("pose_timeout_s", 0.5).Min(1e-6).Unit("s").Doc(
-      "no arm pose this long: stopped = true, zero twist / the measured pose re-sent, until poses return; none "
-      "this long after the run's start: an error (logged, stopped states published)");
-  spec.Param("require_arm", false).Doc(
-      "true: no pose within pose_timeout_s of the run's start fails the run (false: an error on the log and the state)");
+  spec.Param("pose_timeout_s", 0.5)
+      .Min(1e-6)
+      .Unit("s")
+      .Doc(
+          "no arm pose this long: stopped = true, zero twist / the measured pose re-sent, until poses return; none "
+          "this long after the run's start: an error (logged, stopped states published)");
+  spec.Param("require_arm", false)
+      .Doc("true: no pose within pose_timeout_s of the run's start fails the run (false: an error on the log and the state)");
   spec.Param("pose_frame", "").Doc(
       "header.frame_id of the arm's poses; empty: frame_id. Poses in any other frame are refused (counted, logged once)");
   spec.Param("pose_transform", std::vector<double>{}).Doc(

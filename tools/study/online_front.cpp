@@ -80,8 +80,8 @@ struct OnlineFront::Participant {
   Clock::time_point ping_sent{};
   Clock::time_point heard{};  // the page's last frame (its pongs included)
   double rtt_ms = -1;
-  int failures = 0;  // attempts failed in a row (kFailuresInARow: none more)
-  std::string view;  // the op of the view the page was sent last: "consent", "waiting" (else "")
+  int failures = 0;       // attempts failed in a row (kFailuresInARow: none more)
+  std::string view;       // the op of the view the page was sent last: "consent", "waiting" (else "")
   bool answered = false;  // the page answered that view: more answers ignored until the next view
   // For the experimenter's overview: the running attempt, the page's engagement, the end.
   int trial = 0, attempt = 0;

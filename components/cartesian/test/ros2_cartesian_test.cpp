@@ -210,7 +210,7 @@ TEST(Ros2CartesianSilentArm, NoFirstPoseIsAnErrorAndAStoppedState) {
 // with require_arm (before: the run failed at its first step, 1.5 s "overdue").
 TEST(Ros2CartesianSilentArm, TheFirstPoseIsDueFromTheRunsStartNotFromActivation) {
   Rig rig({{"mode", std::string("twist")}, {"pose_timeout_s", 0.5}, {"require_arm", true}});
-  ASSERT_TRUE(rig.Configure().ok());  // activated at t = 0
+  ASSERT_TRUE(rig.Configure().ok());    // activated at t = 0
   rig.ctx.clock_.now += 2'000'000'000;  // the start barrier
   for (int k = 0; k < 20; ++k) ASSERT_TRUE(rig.Step(nullptr, nullptr).ok()) << "step " << k;
   const PoseStamped_ at = Pose(0.4, 0, 0.3);

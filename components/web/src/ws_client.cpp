@@ -276,9 +276,9 @@ struct WsClient::State {
   int fd = -1;
   std::string where;  // "ws://host:port/path", for errors (no query: it holds a token)
   Callbacks callbacks;
-  std::mutex write_mutex;        // one frame at a time on the socket (a plain mutex: TSan 14 cannot see timed locks)
-  std::mutex close_mutex;        // held by a Close() from outside the reading thread, for all of it
-  std::mutex mutex;              // guards the three below
+  std::mutex write_mutex;  // one frame at a time on the socket (a plain mutex: TSan 14 cannot see timed locks)
+  std::mutex close_mutex;  // held by a Close() from outside the reading thread, for all of it
+  std::mutex mutex;        // guards the three below
   std::condition_variable done_cv;
   bool closed = false;  // Close() was called: no callback from now on
   bool ended = false;   // the link is over (either side): nothing more is sent
