@@ -9,6 +9,11 @@
 #   wait_port_file FILE PID [SECONDS [LOG]]
 #                          waits until FILE (a port_file) is written, by default 10 s; if not,
 #                          shows LOG (default run.err), stops PID and fails naming FILE
+#   stop_started           kills what the script started into pids (pids+=($!)): `trap stop_started EXIT`
+#   free_port              a loopback TCP port free now (for a server the test places, e.g. HAProxy's)
+#   subject_graph FILE [WEB_PARAMS]
+#                          the smallest graph a subject steers (web on port 0 with WEB_PARAMS,
+#                          web_human, a recorder of human/input and experiment/notes), for studies
 # Sets node_dir (the node scripts and their node_modules) and node_modules.
 web_test_repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 node_dir=$web_test_repo/components/web/test/node
@@ -36,4 +41,25 @@ wait_port_file() {
   [ -f "$log" ] && cat "$log" >&2
   kill "$pid" 2> /dev/null || true
   fail "$file never written (${seconds} s)"
+}
+
+pids=()
+stop_started() { for p in "${pids[@]}"; do kill "$p" 2> /dev/null || true; done; wait 2> /dev/null || true; }
+
+free_port() { python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }
+
+subject_graph() {
+  local web_params=${2:+, $2}
+  cat > "$1" <<YAML
+graph: g
+clock: wall
+domain_id: $(test_domain)
+topics:
+  web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
+  experiment/notes: {type: Annotation, depth: 8}
+components:
+  web: {type: web, rate_hz: 30, params: {port: 0$web_params}, outputs: {pointer: web/pointer, notes: experiment/notes}}
+  human: {type: web_human, rate_hz: 20, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
+  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input, experiment/notes]}}
+YAML
 }

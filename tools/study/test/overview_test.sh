@@ -19,22 +19,10 @@ dyad=$build/bin/dyad
 fresh_dir "$work"
 ln -s "$node_modules" node_modules  # the script imports playwright-core from beside itself
 cp "$(dirname "$0")/overview.mjs" .
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2> /dev/null || true; done; wait 2> /dev/null || true; }
-trap cleanup EXIT
-port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])')
+trap stop_started EXIT
+port=$(free_port)
 
-cat > g.yaml <<YAML
-graph: g
-clock: wall
-domain_id: $(test_domain)
-topics:
-  web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
-components:
-  web: {type: web, rate_hz: 30, params: {port: 0}, outputs: {pointer: web/pointer}}
-  human: {type: web_human, rate_hz: 20, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
-  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input]}}
-YAML
+subject_graph g.yaml
 cat > s.yaml <<YAML
 study: overview_test
 graph: g.yaml

@@ -17,23 +17,10 @@ require_node
 command -v haproxy > /dev/null || { echo "SKIP: needs tools/setup.sh (Debian haproxy)"; exit 77; }
 dyad=$build/bin/dyad
 fresh_dir "$work"
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2> /dev/null || true; done; wait 2> /dev/null || true; }
-trap cleanup EXIT
-free_port() { python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])'; }
+trap stop_started EXIT
 
 "$dyad" generate dataset --out data > /dev/null
-cat > g.yaml <<YAML
-graph: g
-clock: wall
-domain_id: $(test_domain)
-topics:
-  web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
-components:
-  web: {type: web, rate_hz: 30, params: {port: 0, dataset: data}, outputs: {pointer: web/pointer, notes: experiment/notes}}
-  human: {type: web_human, rate_hz: 20, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
-  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input, experiment/notes]}}
-YAML
+subject_graph g.yaml "dataset: data"
 echo "You agree to take part in a test." > consent.txt
 cat > s.yaml <<YAML
 study: haproxy_test

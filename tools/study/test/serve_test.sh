@@ -14,18 +14,7 @@ require_node
 fresh_dir "$work"
 ln -s "$node_modules" node_modules  # the script imports ws from beside itself
 cp "$repo/tools/study/test/serve_cases.mjs" .
-cat > g.yaml <<YAML
-graph: g
-clock: wall
-domain_id: $(test_domain)
-topics:
-  web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
-  experiment/notes: {type: Annotation, depth: 8}
-components:
-  web: {type: web, rate_hz: 30, params: {port: 0}, outputs: {pointer: web/pointer, notes: experiment/notes}}
-  human: {type: web_human, rate_hz: 20, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
-  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input, experiment/notes]}}
-YAML
+subject_graph g.yaml
 echo "I agree to take part in this test study." > consent.txt
 cat > s.yaml <<YAML
 study: serve_test

@@ -24,21 +24,9 @@ dyad=$build/bin/dyad
 fresh_dir "$work"
 ln -s "$node_modules" node_modules  # serve_tls.mjs imports playwright-core from beside itself
 cp "$repo/tools/study/test/serve_tls.mjs" .
-pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2> /dev/null || true; done; wait 2> /dev/null || true; }
-trap cleanup EXIT
+trap stop_started EXIT
 
-cat > g.yaml <<YAML
-graph: g
-clock: wall
-domain_id: $(test_domain)
-topics:
-  web/pointer: {type: HumanInput, reliability: reliable, depth: 8}
-components:
-  web: {type: web, rate_hz: 30, params: {port: 0}, outputs: {pointer: web/pointer, notes: experiment/notes}}
-  human: {type: web_human, rate_hz: 20, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
-  recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input, experiment/notes]}}
-YAML
+subject_graph g.yaml
 echo "You agree to take part in a test." > consent.txt
 cat > s.yaml <<YAML
 study: tls_test
@@ -52,7 +40,7 @@ duration: 3
 online: {consent: consent.txt, reconnect_s: 10}
 YAML
 "$dyad" security init keys --graph g.yaml --web-host 127.0.0.1 --web-host study.test > init.out
-port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])')
+port=$(free_port)
 "$dyad" study links s.yaml --base-url "https://study.test:$port" > links.out
 
 # What the certificate must be, told before anything listens.
