@@ -162,6 +162,7 @@ async function openTwiceAndMaxSessions(front) {
   const declined = await reopened.next("refused");
   check(declined.message.startsWith("You did not agree") && await reopened.closed === 1008, `declined at max_sessions: ${declined.message}`);
   p3again.ws.close();
+  await p3again.closed;  // the front hears the close before P03's next page opens (else: open twice)
   console.log("ok: a link open twice is refused (1008); max_sessions refuses a new participant until a session ends; a declined consent ends politely");
   return first;
 }
@@ -246,6 +247,7 @@ async function lostAndBack(front, p01) {
   const again = await back.next("waiting");
   check(again.ready?.label === "Start trial 2 of 2" && /starts again/.test(again.message), `repeated: ${JSON.stringify(again)}`);
   back.ws.close();
+  await back.closed;
   console.log("ok: a page gone more than reconnect_s: the trial incomplete with its reason, then repeated");
 }
 
