@@ -2,7 +2,6 @@
 // graph): the consent page, the waiting page with its Ready, the next attempt and why it repeats,
 // the completion code made once, a restart that goes on where they were, and the connection's clock.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -11,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "online_session.hpp"
+#include "online_study_fixture.hpp"
 #include "study_session.hpp"
 
 namespace dyad::study {
@@ -20,24 +20,9 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 using namespace std::chrono_literals;
 
-class OnlineSessionTest : public ::testing::Test {
+class OnlineSessionTest : public testing::OnlineStudyTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("dyad_online_" + std::to_string(getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    study_.name = "gain";
-    study_.file = (dir_ / "s.yaml").string();
-    study_.data = (dir_ / "gain-data").string();
-    study_.participants = {"P01", "P02"};
-    study_.conditions = {Condition{"low", "A", {"src.start=1"}, {}}, Condition{"high", "B", {"src.start=3"}, {}}};
-    study_.online.reconnect_s = 5;
-    study_.online.consent_text = "Do you agree?";
-  }
-  void TearDown() override {
-    if (!HasFailure()) fs::remove_all(dir_);
-  }
+  OnlineSessionTest() : OnlineStudyTest("dyad_online_") {}
   Json Frame(OnlineSession& s) { return Json::parse(s.PageFrame()); }
   // A start and, unless `outcome` is empty, an end of trial `trial` attempt `attempt`, as RunAttempt logs them.
   void Logged(int trial, int attempt, const std::string& outcome, const std::string& incomplete = "") {
@@ -53,8 +38,6 @@ class OnlineSessionTest : public ::testing::Test {
     if (!incomplete.empty()) end["incomplete"] = incomplete;
     ASSERT_TRUE(AppendSessionEvent(study_, "P01", end.dump()).ok());
   }
-  fs::path dir_;
-  Study study_;
 };
 
 TEST_F(OnlineSessionTest, ConsentThenEachTrialInOrderThenOneCodeKeptAcrossARestart) {

@@ -4,7 +4,6 @@
 // when others could read it. The browser test (overview_test.sh) covers a stop mid-trial.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -14,6 +13,7 @@
 
 #include "online_front.hpp"
 #include "online_session.hpp"
+#include "online_study_fixture.hpp"
 #include "overview_channel.hpp"
 #include "study_session.hpp"
 
@@ -23,24 +23,12 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-class OverviewTest : public ::testing::Test {
+class OverviewTest : public testing::OnlineStudyTest {
  protected:
+  OverviewTest() : OnlineStudyTest("dyad_overview_") {}
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("dyad_overview_" + std::to_string(getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    study_.name = "gain";
-    study_.file = (dir_ / "s.yaml").string();
-    study_.data = (dir_ / "gain-data").string();
-    study_.participants = {"P01", "P02"};
-    study_.conditions = {Condition{"low", "A", {"src.start=1"}, {}}, Condition{"high", "B", {"src.start=3"}, {}}};
-    study_.online.reconnect_s = 5;
-    study_.online.consent_text = "Do you agree?";
+    OnlineStudyTest::SetUp();
     for (const std::string& p : study_.participants) EXPECT_TRUE(MarkConsent(study_, p, "in the test").ok());
-  }
-  void TearDown() override {
-    if (!HasFailure()) fs::remove_all(dir_);
   }
   Json LastLine(const std::string& p) {
     std::ifstream in(SessionLogPath(study_, p));
@@ -48,8 +36,6 @@ class OverviewTest : public ::testing::Test {
     while (std::getline(in, line)) last = line;
     return Json::parse(last);
   }
-  fs::path dir_;
-  Study study_;
 };
 
 TEST_F(OverviewTest, ASessionStoppedBetweenTrialsIsLoggedShownEndedRefusedUntilResumed) {
