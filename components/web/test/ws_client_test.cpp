@@ -12,6 +12,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <thread>
@@ -118,6 +119,28 @@ struct Inbox {
   }
 };
 
+// An echo server and a client connected to it that has had the server's hello: where most tests
+// start. `tweak`, if given, changes the server's options (EchoOptions) before it starts. Members
+// are destroyed in reverse: the client first, the handler last.
+struct EchoLink {
+  ::testing::AssertionResult Open(const std::function<void(WebServer::Options&)>& tweak = {}) {
+    WebServer::Options o = EchoOptions(&handler);
+    if (tweak) tweak(o);
+    server = StartEcho(&handler, o);
+    if (server == nullptr) return ::testing::AssertionFailure() << "the echo server did not start";
+    auto c = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, inbox.Callbacks(), seconds(5));
+    if (!c.ok()) return ::testing::AssertionFailure() << c.status().ToString();
+    client = std::move(*c);
+    const std::string hello = inbox.Next();
+    if (hello != "hello") return ::testing::AssertionFailure() << "the server's first frame was '" << hello << "'";
+    return ::testing::AssertionSuccess();
+  }
+  EchoHandler handler;
+  std::unique_ptr<WebServer> server;
+  Inbox inbox;
+  std::unique_ptr<WsClient> client;
+};
+
 // A loopback port nothing listens on (bound, then closed).
 int FreePort() {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
@@ -132,21 +155,17 @@ int FreePort() {
 }
 
 TEST(WsClient, SendsAndReceivesTextFrames) {
-  EchoHandler handler;
-  auto server = StartEcho(&handler, EchoOptions(&handler));
-  ASSERT_NE(server, nullptr);
-  Inbox inbox;
-  auto client = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, inbox.Callbacks(), seconds(5));
-  ASSERT_TRUE(client.ok()) << client.status().ToString();
-  EXPECT_EQ(inbox.Next(), "hello");
+  EchoLink link;
+  ASSERT_TRUE(link.Open());
+  auto& [handler, server, inbox, client] = link;
   for (const std::string& text : {std::string("hi"), std::string(200, 'm'), std::string(70000, 'L'), std::string()}) {
-    ASSERT_TRUE((*client)->SendText(text).ok());
+    ASSERT_TRUE(client->SendText(text).ok());
     EXPECT_EQ(inbox.Next(), "echo:" + text) << text.size() << " bytes";
   }
-  (*client)->Close();
+  client->Close();
   EXPECT_TRUE(Eventually([&] { return handler.closes == 1; })) << "the server saw the client leave";
   EXPECT_EQ(inbox.Closes(), 0) << "on_close runs only when the peer ends the link";
-  EXPECT_EQ((*client)->SendText("late").code(), Status::Code::kFailedPrecondition);
+  EXPECT_EQ(client->SendText("late").code(), Status::Code::kFailedPrecondition);
 }
 
 TEST(WsClient, NothingListeningIsNotFoundWithinTheTimeout) {
@@ -196,13 +215,9 @@ TEST(WsClient, ARefusedHandshakeIsAnIOErrorWithTheServersAnswer) {
 
 // The server's Close(): the frames queued before it arrive, then on_close runs, once.
 TEST(WsClient, TheServerClosingRunsOnCloseOnceAfterTheQueuedFrames) {
-  EchoHandler handler;
-  auto server = StartEcho(&handler, EchoOptions(&handler));
-  ASSERT_NE(server, nullptr);
-  Inbox inbox;
-  auto client = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, inbox.Callbacks(), seconds(5));
-  ASSERT_TRUE(client.ok()) << client.status().ToString();
-  ASSERT_EQ(inbox.Next(), "hello");
+  EchoLink link;
+  ASSERT_TRUE(link.Open());
+  auto& [handler, server, inbox, client] = link;
   const ClientId id = handler.Last();
   server->SendText(id, "one");
   server->SendText(id, "two");
@@ -216,8 +231,8 @@ TEST(WsClient, TheServerClosingRunsOnCloseOnceAfterTheQueuedFrames) {
   std::this_thread::sleep_for(milliseconds(100));
   EXPECT_EQ(inbox.Closes(), 1);
   EXPECT_EQ(inbox.Next(seconds(0)), "") << "nothing after the close frame";
-  EXPECT_EQ((*client)->SendText("late").code(), Status::Code::kFailedPrecondition);
-  (*client)->Close();
+  EXPECT_EQ(client->SendText("late").code(), Status::Code::kFailedPrecondition);
+  client->Close();
   EXPECT_EQ(inbox.Closes(), 1);
   EXPECT_TRUE(server->clients().empty());
 }
@@ -245,17 +260,13 @@ TEST(WsClient, AServerThatNeverAnswersTimesOut) {
 
 // The peer's process going away (its sockets closed, no close frame): on_close, once.
 TEST(WsClient, APeerThatGoesAwayRunsOnCloseOnce) {
-  EchoHandler handler;
-  auto server = StartEcho(&handler, EchoOptions(&handler));
-  ASSERT_NE(server, nullptr);
-  Inbox inbox;
-  auto client = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, inbox.Callbacks(), seconds(5));
-  ASSERT_TRUE(client.ok()) << client.status().ToString();
-  ASSERT_EQ(inbox.Next(), "hello");
+  EchoLink link;
+  ASSERT_TRUE(link.Open());
+  auto& [handler, server, inbox, client] = link;
   server.reset();
   ASSERT_TRUE(inbox.WaitClosed());
-  EXPECT_NE((*client)->SendText("anyone?").code(), Status::Code::kOk);
-  (*client)->Close();
+  EXPECT_NE(client->SendText("anyone?").code(), Status::Code::kOk);
+  client->Close();
   EXPECT_EQ(inbox.Closes(), 1);
 }
 
@@ -361,22 +372,17 @@ TEST(WsClient, ACallbackMayCloseOrDestroyItsOwnClient) {
 // Frames at the server's max_frame_bytes pass; one byte more and the server ends the link
 // (1009), which the client hears as on_close. A large frame from the server arrives whole.
 TEST(WsClient, FramesUpToTheServersLimitPassAndLargerOnesEndTheLink) {
-  EchoHandler handler;
-  WebServer::Options o = EchoOptions(&handler);
-  o.max_frame_bytes = 256 << 10;
-  auto server = StartEcho(&handler, o);
-  ASSERT_NE(server, nullptr);
-  Inbox inbox;
-  auto client = WsClient::Connect("127.0.0.1", server->port(), "/ws?token=" + kToken, inbox.Callbacks(), seconds(5));
-  ASSERT_TRUE(client.ok()) << client.status().ToString();
-  ASSERT_EQ(inbox.Next(), "hello");
-  const std::string at_limit(o.max_frame_bytes, 'a');
-  ASSERT_TRUE((*client)->SendText(at_limit).ok());
+  constexpr size_t kLimit = 256 << 10;
+  EchoLink link;
+  ASSERT_TRUE(link.Open([&](WebServer::Options& o) { o.max_frame_bytes = kLimit; }));
+  auto& [handler, server, inbox, client] = link;
+  const std::string at_limit(kLimit, 'a');
+  ASSERT_TRUE(client->SendText(at_limit).ok());
   EXPECT_EQ(inbox.Next(), "echo:" + at_limit);
   const std::string big(3 << 20, 'b');  // server -> client: past the server's own receive limit
   server->SendText(handler.Last(), big);
   EXPECT_EQ(inbox.Next(), big);
-  ASSERT_TRUE((*client)->SendText(at_limit + "!").ok());
+  ASSERT_TRUE(client->SendText(at_limit + "!").ok());
   ASSERT_TRUE(inbox.WaitClosed()) << "the server kept a client whose frame exceeded its limit";
   EXPECT_EQ(handler.texts, 1);
   EXPECT_TRUE(Eventually([&] { return handler.closes == 1; }));
