@@ -14,6 +14,9 @@
 #   subject_graph FILE [WEB_PARAMS]
 #                          the smallest graph a subject steers (web on port 0 with WEB_PARAMS,
 #                          web_human, a recorder of human/input and experiment/notes), for studies
+#   subject_robot          the lines (under components:) of a subject steering a virtual robot:
+#                          human (web_human on web/pointer), mind (intention_hold), mixer, robot
+#                          (virtual_cartesian, robot/state); for the web component's page tests
 # Sets node_dir (the node scripts and their node_modules) and node_modules.
 web_test_repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 node_dir=$web_test_repo/components/web/test/node
@@ -61,5 +64,14 @@ components:
   web: {type: web, rate_hz: 30, params: {port: 0$web_params}, outputs: {pointer: web/pointer, notes: experiment/notes}}
   human: {type: web_human, rate_hz: 20, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
   recorder: {type: recorder, rate_hz: 10, params: {topics: [human/input, experiment/notes]}}
+YAML
+}
+
+subject_robot() {
+  cat <<'YAML'
+  human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
+  mind: {type: intention_hold, rate_hz: 10, outputs: {intention: robot/intention}}
+  mixer: {type: compliance_mixer, trigger: robot, params: {gain: 0.9, max_step: 5}, inputs: {human: human/input, robot: robot/intention}, outputs: {command: robot/command}}
+  robot: {type: virtual_cartesian, trigger: command, inputs: {command: robot/command}, outputs: {state: robot/state}}
 YAML
 }

@@ -22,10 +22,7 @@ topics:
 components:
   web: {type: web, rate_hz: 30, params: {port: 0, port_file: web.port, token: experimenter-token-0001, subject_token: subject-token-000001, viewer_token: viewer-token-0000001, dataset: data},
         inputs: {robot: robot/state}, outputs: {pointer: web/pointer, notes: experiment/notes, self_report: human/self_report}}
-  human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}
-  mind: {type: intention_hold, rate_hz: 10, outputs: {intention: robot/intention}}
-  mixer: {type: compliance_mixer, trigger: robot, params: {gain: 0.9, max_step: 5}, inputs: {human: human/input, robot: robot/intention}, outputs: {command: robot/command}}
-  robot: {type: virtual_cartesian, trigger: command, inputs: {command: robot/command}, outputs: {state: robot/state}}
+$(subject_robot)
   recorder: {type: recorder, rate_hz: 10, params: {file: rec.mcap, topics: [human/input, human/self_report]}}
 YAML
 "$build/bin/dyad" run graph.yaml --duration 40 > run.out 2> run.err &
