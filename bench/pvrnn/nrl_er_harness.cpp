@@ -45,19 +45,12 @@
 #include <vector>
 
 #include "lib/LibNRL.h"
+#include "nrl_harness.hpp"
 
 namespace {
 
-// Read access to NRL's private members without editing NRL: an explicit instantiation may name
-// a private member (C++ [temp.explicit]), and the friend it defines returns the pointer-to-member.
-template <typename Tag, typename Tag::type M>
-struct Expose {
-  friend typename Tag::type Get(Tag) { return M; }
-};
-struct ModelOf {
-  using type = oist::INetwork* oist::LibNRL::*;
-  friend type Get(ModelOf);
-};
+const char kHarness[] = "nrl_er_harness";
+
 struct LayersOf {
   using type = std::vector<oist::ILayer*> oist::NetworkPvrnn::*;
   friend type Get(LayersOf);
@@ -70,7 +63,6 @@ struct AlCopyOf {
   using type = vectorXf1DContainer oist::LayerPvrnn::*;
   friend type Get(AlCopyOf);
 };
-template struct Expose<ModelOf, &oist::LibNRL::model>;
 template struct Expose<LayersOf, &oist::NetworkPvrnn::layers>;
 template struct Expose<AuCopyOf, &oist::LayerPvrnn::e_au_copy>;
 template struct Expose<AlCopyOf, &oist::LayerPvrnn::e_al_copy>;
@@ -84,11 +76,6 @@ struct Options {
   bool closed_loop = false;
   std::vector<float> w;
 };
-
-[[noreturn]] void Fail(const std::string& msg) {
-  std::cerr << "nrl_er_harness: " << msg << "\n";
-  std::exit(2);
-}
 
 double Number(const std::string& opt, const char* text) {
   char* end = nullptr;

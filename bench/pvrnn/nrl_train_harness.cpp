@@ -25,18 +25,12 @@
 #include <vector>
 
 #include "lib/LibNRL.h"
+#include "nrl_harness.hpp"
 
 namespace {
 
-// Read access to NRL's private members without editing NRL (see nrl_er_harness.cpp).
-template <typename Tag, typename Tag::type M>
-struct Expose {
-  friend typename Tag::type Get(Tag) { return M; }
-};
-struct ModelOf {
-  using type = oist::INetwork* oist::LibNRL::*;
-  friend type Get(ModelOf);
-};
+const char kHarness[] = "nrl_train_harness";
+
 struct TargetsOf {
   using type = vectorXf4DContainer oist::LibNRL::*;
   friend type Get(TargetsOf);
@@ -61,18 +55,12 @@ struct ShuffleOf {
   using type = bool oist::LibNRL::*;
   friend type Get(ShuffleOf);
 };
-template struct Expose<ModelOf, &oist::LibNRL::model>;
 template struct Expose<TargetsOf, &oist::LibNRL::YSoftmax>;
 template struct Expose<SeqLenOf, &oist::LibNRL::seqLen>;
 template struct Expose<AlphaOf, &oist::LibNRL::t_alpha>;
 template struct Expose<Beta1Of, &oist::LibNRL::t_beta1>;
 template struct Expose<Beta2Of, &oist::LibNRL::t_beta2>;
 template struct Expose<ShuffleOf, &oist::LibNRL::t_shuffle>;
-
-[[noreturn]] void Fail(const std::string& msg) {
-  std::cerr << "nrl_train_harness: " << msg << "\n";
-  std::exit(2);
-}
 
 }  // namespace
 
