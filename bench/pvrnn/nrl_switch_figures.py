@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
 """Switching figures of an ER trace (nrl_er_harness's CSV), with the classifier of
-components/pvrnn/test/switching_test.cpp: the robot "follows" primitive p when its last 8
-intentions are nearest (sum of squared distances) to 8 consecutive steps of p's data set
-trajectory (any phase, cyclic) among all primitives.
+components/pvrnn/test/switching_test.cpp (switch_classifier.py): the robot "follows" primitive p
+when its last 8 intentions are nearest (sum of squared distances) to 8 consecutive steps of p's
+data set trajectory (any phase, cyclic) among all primitives.
 
     bench/pvrnn/nrl_switch_figures.py TRACE.csv [DATA_DIR] [--pushed 2] [--own 1] [--human 100]
 
 Prints: first step following the pushed primitive, pushed steps of the human's (and bursts),
 own-primitive steps after release. Errors name the file and line, exit 2."""
 import csv, sys
+
+from switch_classifier import classify, load_primitives
 
 def fail(msg):
     print(f"nrl_switch_figures: {msg}", file=sys.stderr)
@@ -28,24 +30,7 @@ def main(argv):
     if not 1 <= len(args) <= 2:
         fail("usage: nrl_switch_figures.py TRACE.csv [DATA_DIR] [--pushed P] [--own P] [--human H]")
     data = args[1] if len(args) > 1 else "/work/shared/data/vcbot/dataset/Macaw"
-    prims = []
-    for p in range(100):
-        path = f"{data}/primitive_{p}_0.csv"
-        try:
-            with open(path) as f:
-                rows = []
-                for n, line in enumerate(f, 1):
-                    if line.strip():
-                        try:
-                            x, y = map(float, line.split(",")[:2])
-                        except ValueError:
-                            fail(f"{path}:{n}: expected x,y")
-                        rows.append((x, y))
-                prims.append(rows)
-        except FileNotFoundError:
-            break
-    if not prims:
-        fail(f"{data}: no primitive_<p>_0.csv")
+    prims = load_primitives(data, fail)
     recent, first, pushed, bursts, own_after, following = [], None, 0, 0, 0, False
     try:
         f = open(args[0])
@@ -58,14 +43,7 @@ def main(argv):
             except (KeyError, ValueError, TypeError):
                 fail(f"{args[0]}:{n}: needs step, intention_x, intention_y")
             recent = (recent + [(x, y)])[-8:]
-            best, cls = float("inf"), -1
-            for p, seq in enumerate(prims):
-                T = len(seq)
-                for ph in range(T):
-                    s = sum((seq[(ph + i) % T][0] - a) ** 2 + (seq[(ph + i) % T][1] - b) ** 2
-                            for i, (a, b) in enumerate(recent))
-                    if s < best:
-                        best, cls = s, p
+            cls = classify(recent, prims)
             if 0 <= t < opts["--human"]:
                 if cls == opts["--pushed"]:
                     first = t if first is None else first

@@ -6,9 +6,9 @@ configs/sweeps/macaw_nrl.yaml: dyad's error regression and NRL's, side by side).
 
 For each run of SWEEP_OUT/sweep.csv with status ok it reads the analysis' timeline.csv and
 events.csv (SWEEP_OUT/runs/<id>/report/) and applies the classifier of
-components/pvrnn/test/switching_test.cpp to the robot's intentions: the robot "follows"
-primitive p when its last 8 intentions are nearest (sum of squared distances) to 8 consecutive
-steps of p's data set trajectory (any phase, cyclic) among all primitives. Event `--event` (the
+components/pvrnn/test/switching_test.cpp (switch_classifier.py) to the robot's intentions: the
+robot "follows" primitive p when its last 8 intentions are nearest (sum of squared distances)
+to 8 consecutive steps of p's data set trajectory (any phase, cyclic) among all primitives. Event `--event` (the
 first: the human pushes the beak from step 100 to 200 in configs/macaw.yaml) gives, per run: the
 first step of the push (0 = its first) at which the robot follows the pushed primitive, the push
 steps on it (of the event's length) and in how many bursts, and the steps on `--own` (the start
@@ -18,6 +18,8 @@ own metrics (all events, the observer's classes), and the deliberator's solve ti
 (timeline's optimisation_s, wall time even under the stepped clock) as median and p99 over every
 step of every run. Prints a Markdown table. Errors name the file and line, exit 2."""
 import csv, os, statistics, sys
+
+from switch_classifier import classify, load_primitives
 
 
 def fail(msg):
@@ -31,43 +33,6 @@ def read_rows(path):
             return list(csv.DictReader(f))
     except OSError as e:
         fail(f"{path}: cannot open ({e.strerror})")
-
-
-def load_primitives(data):
-    prims = []
-    for p in range(100):
-        path = os.path.join(data, f"primitive_{p}_0.csv")
-        if not os.path.exists(path):
-            break
-        rows = []
-        with open(path) as f:
-            for n, line in enumerate(f, 1):
-                if line.strip():
-                    try:
-                        x, y = map(float, line.split(",")[:2])
-                    except ValueError:
-                        fail(f"{path}:{n}: expected x,y")
-                    rows.append((x, y))
-        prims.append(rows)
-    if not prims:
-        fail(f"{data}: no primitive_<p>_0.csv")
-    return prims
-
-
-def classify(recent, prims):
-    best, cls = float("inf"), -1
-    for p, seq in enumerate(prims):
-        T = len(seq)
-        for ph in range(T):
-            s = 0.0
-            for i, (a, b) in enumerate(recent):
-                qx, qy = seq[(ph + i) % T]
-                s += (qx - a) ** 2 + (qy - b) ** 2
-                if s >= best:
-                    break
-            if s < best:
-                best, cls = s, p
-    return cls
 
 
 def run_figures(report, opts, prims):
@@ -137,7 +102,7 @@ def main(argv):
     if len(args) != 1:
         fail("usage: sweep_switch_figures.py SWEEP_OUT [--data DIR] [--event E] [--own P] [--release N]")
     out = args[0]
-    prims = load_primitives(data)
+    prims = load_primitives(data, fail)
     rows = read_rows(os.path.join(out, "sweep.csv"))
     if not rows:
         fail(f"{out}/sweep.csv: no runs")
