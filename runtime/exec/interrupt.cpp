@@ -1,7 +1,12 @@
 #include "dyad/interrupt.hpp"
 
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <sys/signalfd.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstdint>
 #include <cstdio>
 
 namespace dyad {
@@ -11,25 +16,49 @@ InterruptWatcher::InterruptWatcher(std::function<void(int)> on_signal) : on_sign
   sigaddset(&set_, SIGINT);
   sigaddset(&set_, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &set_, &old_);
-  thread_ = std::thread([this] {
-    while (!done_.load(std::memory_order_acquire)) {
-      timespec ts{0, 50'000'000};
-      const int sig = sigtimedwait(&set_, nullptr, &ts);
-      if (sig <= 0) continue;
-      int expected = 0;
-      if (!signal_.compare_exchange_strong(expected, sig)) {
-        std::fprintf(stderr, "dyad: second signal (%s), exiting now\n", SignalName(sig));
-        _exit(ExitCodeForSignal(sig));
-      }
-      if (on_signal_) on_signal_(sig);
-    }
-  });
+  signal_fd_ = signalfd(-1, &set_, SFD_CLOEXEC);
+  wake_fd_ = eventfd(0, EFD_CLOEXEC);
+  thread_ = std::thread([this] { Watch(); });
 }
 
 InterruptWatcher::~InterruptWatcher() {
   done_.store(true, std::memory_order_release);
+  if (wake_fd_ >= 0) {
+    const uint64_t one = 1;
+    [[maybe_unused]] const ssize_t n = write(wake_fd_, &one, sizeof one);
+  }
   thread_.join();
+  if (signal_fd_ >= 0) close(signal_fd_);
+  if (wake_fd_ >= 0) close(wake_fd_);
   pthread_sigmask(SIG_SETMASK, &old_, nullptr);
+}
+
+int InterruptWatcher::NextSignal() {
+  if (signal_fd_ < 0 || wake_fd_ < 0) {
+    // No descriptor to spare (EMFILE): look every 50 ms instead of sleeping until woken.
+    timespec ts{0, 50'000'000};
+    return sigtimedwait(&set_, nullptr, &ts);
+  }
+  pollfd fds[2] = {{signal_fd_, POLLIN, 0}, {wake_fd_, POLLIN, 0}};
+  if (poll(fds, 2, -1) <= 0 || (fds[1].revents & POLLIN)) return 0;  // EINTR, or woken to end
+  signalfd_siginfo info{};
+  if (read(signal_fd_, &info, sizeof info) != static_cast<ssize_t>(sizeof info)) return 0;
+  return static_cast<int>(info.ssi_signo);
+}
+
+// Sleeps until a signal or the destructor: no periodic wake-up (a dyad process is often idle, and
+// a study server runs dozens of them).
+void InterruptWatcher::Watch() {
+  while (!done_.load(std::memory_order_acquire)) {
+    const int sig = NextSignal();
+    if (sig <= 0 || done_.load(std::memory_order_acquire)) continue;
+    int expected = 0;
+    if (!signal_.compare_exchange_strong(expected, sig)) {
+      std::fprintf(stderr, "dyad: second signal (%s), exiting now\n", SignalName(sig));
+      _exit(ExitCodeForSignal(sig));
+    }
+    if (on_signal_) on_signal_(sig);
+  }
 }
 
 const char* SignalName(int signal) {

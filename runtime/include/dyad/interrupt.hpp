@@ -2,8 +2,9 @@
 //
 // An InterruptWatcher blocks SIGINT and SIGTERM in the thread that creates it, so every thread
 // started afterwards (Fast DDS's, components', trainers') inherits the block, and takes them on
-// a thread of its own with sigtimedwait. So a signal never interrupts a system call of a Fast
-// DDS thread, never runs code in a signal handler, and `on_signal` runs on an ordinary thread
+// a thread of its own, asleep on a signalfd until one comes (no periodic wake-up: a study server
+// runs dozens of dyad processes). So a signal never interrupts a system call of a Fast DDS
+// thread, never runs code in a signal handler, and `on_signal` runs on an ordinary thread
 // (it may lock, log, call Executor::RequestStop). A second signal while the first is being
 // handled ends the process at once (exit 128 + signal): Ctrl-C twice always works.
 //
@@ -39,7 +40,11 @@ class InterruptWatcher {
   bool interrupted() const { return signal() != 0; }
 
  private:
+  int NextSignal();  // the next SIGINT/SIGTERM, or 0 (woken to end, or nothing)
+  void Watch();
+
   sigset_t set_, old_;
+  int signal_fd_ = -1, wake_fd_ = -1;  // -1: polling every 50 ms instead
   std::function<void(int)> on_signal_;
   std::atomic<int> signal_{0};
   std::atomic<bool> done_{false};
