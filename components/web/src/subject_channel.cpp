@@ -201,6 +201,7 @@ Status SubjectChannel::OnPointer(ClientId client, const json& j, double handler_
   if (!std::isfinite(px) || !std::isfinite(py)) return Status::InvalidArgument("pointer: x and y must be finite");
   // The page clamps to the workspace; a position outside it is clamped here too.
   const double h = options_.half_width;
+  bool ack = false;
   {
     MutexLock lock(mutex_);
     if (roles_[client] == Role::kViewer) return Status::FailedPrecondition("pointer: a viewer's token may not steer");
@@ -218,9 +219,14 @@ Status SubjectChannel::OnPointer(ClientId client, const json& j, double handler_
         delays_.handler_to_published.push_back(published_ms - handler_ms);
       }
     }
+    if (auto t = j.find("t"); t != j.end() && t->is_number() && (acked_ != client || handler_ms - acked_ms_ >= kAckIntervalMs)) {
+      acked_ = client;
+      acked_ms_ = handler_ms;
+      ack = true;
+    }
   }
-  if (auto t = j.find("t"); t != j.end() && t->is_number())
-    if (WebServer* server = server_.load()) server->SendText(client, json{{"op", "ack"}, {"t", t->get<double>()}}.dump());
+  if (ack)
+    if (WebServer* server = server_.load()) server->SendText(client, json{{"op", "ack"}, {"t", j["t"].get<double>()}}.dump());
   return Status::OK();
 }
 

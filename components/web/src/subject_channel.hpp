@@ -10,8 +10,9 @@
 /// {"op":"role","steering":bool}, {"op":"task","target":k,"message":"..","countdown_s":s,
 /// "practice":bool} (the experimenter's task: sent to every page at each change and to a page
 /// that opens, its countdown as what is left of it then), {"op":"state","x","y"} (newest
-/// only: a slow page never builds a backlog), {"op":"ack","t":ms} after each pointer sample was
-/// published (the page measures the round trip), {"op":"question","segment":i,"of":n,"stroke":
+/// only: a slow page never builds a backlog), {"op":"ack","t":ms} after a pointer sample was
+/// published, at most one per kAckIntervalMs to a page (the page measures the round trip; an ack
+/// per sample, 60 a second, was a third of a participant's frames), {"op":"question","segment":i,"of":n,"stroke":
 /// [[x,y],...],"robot":[[x,y],...]} after the trial (the hold's stroke: the pointer's path while
 /// held, what the person drew; the robot's path meanwhile, maybe empty; segment -1: every
 /// question answered, "thank you"). A pointer
@@ -51,6 +52,9 @@ namespace dyad::web {
 
 class SubjectChannel final : public ClientHandler {
  public:
+  // A page's round trip is sampled as often as the control step: at most one ack per this.
+  static constexpr double kAckIntervalMs = 100;
+
   struct Options {
     std::string engage_key = "Space";  // KeyboardEvent.code; the mouse button always engages
     double half_width = 50;            // the workspace is [-half_width, half_width]^2
@@ -134,6 +138,8 @@ class SubjectChannel final : public ClientHandler {
   ClientId steering_ GUARDED_BY(mutex_) = 0;  // 0: none
   double last_x_ GUARDED_BY(mutex_) = 0;
   double last_y_ GUARDED_BY(mutex_) = 0;
+  ClientId acked_ GUARDED_BY(mutex_) = 0;  // the page acknowledged last, and when (wall ms)
+  double acked_ms_ GUARDED_BY(mutex_) = 0;
   Task task_ GUARDED_BY(mutex_);
   bool trial_over_ GUARDED_BY(mutex_) = false;  // EndSteering came: no more steering
   bool asking_ GUARDED_BY(mutex_) = false;      // AskAfterTrial came: questions_ are asked
