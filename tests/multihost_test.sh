@@ -100,44 +100,25 @@ command -v python3 > /dev/null || skip "no python3"
 [ "${modes[*]}" = net ] || [ -x "$dyad" ] || fail "no dyad at $dyad"
 
 hosts=(lab mind rec)
-declare -A ns addr
+declare -A addr
 addr=([lab]=10.77.0.1 [mind]=10.77.0.2 [rec]=10.77.0.3)
-prefix=dyadmh
-sw=${prefix}_sw_$$
-for h in "${hosts[@]}"; do ns[$h]=${prefix}_${h}_$$; done
-
-# Namespaces of an earlier run of this test that was killed before its trap ran (its pid is gone).
-for old in $(ip netns list | awk '{print $1}' | grep -E "^${prefix}_(sw|lab|mind|rec)_[0-9]+$" || true); do
-  if ! kill -0 "${old##*_}" 2> /dev/null; then
-    ip netns pids "$old" 2> /dev/null | xargs -r kill -KILL 2> /dev/null || true
-    ip netns del "$old" 2> /dev/null || true
-  fi
-done
+source "$repo/tests/support/netns_test.sh"
+netns_names dyadmh
 
 rm -rf "$work"
 mkdir -p "$work"
 work=$(cd "$work" && pwd)
 stamp=$work/.start
 touch "$stamp"
-made=() started=()
 
 # Kills what runs in our namespaces and deletes them. With MULTIHOST_SHARED_SHM=1 also removes
 # the new Fast DDS shared-memory files that no live process maps (a killed participant leaves its
 # segments and locks behind); otherwise each host's own tmpfs went with its last process.
 cleanup() {
-  local code=$? n p f base i
+  local code=$? f base
   set +e
   trap - EXIT INT TERM
-  for p in "${started[@]}"; do kill -KILL "$p" 2> /dev/null; done
-  for i in 1 2 3 4 5 6 7 8 9 10; do
-    p=""
-    for n in "${made[@]}"; do p+=$(ip netns pids "$n" 2> /dev/null); done
-    [ -z "$p" ] && break
-    echo "$p" | xargs -r kill -KILL 2> /dev/null
-    sleep 0.3
-  done
-  for p in "${started[@]}"; do wait "$p" 2> /dev/null; done
-  for n in "${made[@]}"; do ip netns del "$n" 2> /dev/null || echo "multihost: could not delete namespace $n" >&2; done
+  netns_stop multihost
   if [ -f "$stamp" ] && [ "${MULTIHOST_SHARED_SHM:-0}" = 1 ]; then
     local mapped
     mapped=$(cat /proc/[0-9]*/maps 2> /dev/null | grep -o '/dev/shm/[^ ]*' | sort -u)
@@ -156,31 +137,15 @@ trap 'exit 143' TERM
 
 # --- the network: a bridge in $sw, one veth pair per host -----------------------------------------
 # A step that fails here is a limit of this machine (no CAP_NET_ADMIN, no bridge or veth driver):
-# skipped, with the reason.
-setup() { "$@" 2> "$work/netns.err" || skip "cannot set up the network: '$*': $(cat "$work/netns.err")"; }
-setup ip netns add "$sw"
-made+=("$sw")
-setup ip -n "$sw" link set lo up
-setup ip -n "$sw" link add br0 type bridge
-# IGMP snooping off: with no querier on this bridge a group's membership could age out (260 s)
-# and a long run would lose multicast discovery halfway; a plain flooding switch is what we want.
-setup ip -n "$sw" link set br0 type bridge mcast_snooping 0
-setup ip -n "$sw" link set br0 up
-setup ip netns exec "$sw" nft add table ip dyad_multihost_probe  # nf_tables works here
-setup ip netns exec "$sw" nft delete table ip dyad_multihost_probe
-for h in "${hosts[@]}"; do
-  n=${ns[$h]}
-  setup ip netns add "$n"
-  made+=("$n")
-  setup ip -n "$sw" link add "v$h" type veth peer name eth0 netns "$n"
-  setup ip -n "$sw" link set "v$h" master br0 up
-  setup ip -n "$n" link set lo up
-  setup ip -n "$n" addr add "${addr[$h]}/24" dev eth0
-  setup ip -n "$n" link set eth0 up
-  # No default route in the namespace: without this one, a send to a multicast group fails
-  # (ENETUNREACH) unless the socket names its interface.
-  setup ip -n "$n" route add 224.0.0.0/4 dev eth0
-done
+# skipped, with the reason. IGMP snooping off: with no querier on this bridge a group's membership
+# could age out (260 s) and a long run would lose multicast discovery halfway; a plain flooding
+# switch is what we want.
+netns_network mcast_snooping 0
+netns_setup ip netns exec "$sw" nft add table ip dyad_multihost_probe  # nf_tables works here
+netns_setup ip netns exec "$sw" nft delete table ip dyad_multihost_probe
+# No default route in the namespaces: without this one, a send to a multicast group fails
+# (ENETUNREACH) unless the socket names its interface.
+for h in "${hosts[@]}"; do netns_setup ip -n "${ns[$h]}" route add 224.0.0.0/4 dev eth0; done
 echo "multihost: namespaces ${made[*]}: ${addr[lab]} lab, ${addr[mind]} mind, ${addr[rec]} rec on a bridge"
 
 # --- the probe: UDP unicast and multicast between every pair of hosts -----------------------------

@@ -49,58 +49,25 @@ command -v ip > /dev/null && ip netns list > /dev/null 2>&1 || skip "no 'ip netn
 [ -x "$dyad" ] || fail "no dyad at $dyad"
 
 hosts=(lab mind rec guest)
-declare -A ns addr
+declare -A addr
 addr=([lab]=10.78.0.1 [mind]=10.78.0.2 [rec]=10.78.0.3 [guest]=10.78.0.4)
-prefix=dyadsh
-sw=${prefix}_sw_$$
-for h in "${hosts[@]}"; do ns[$h]=${prefix}_${h}_$$; done
-# Namespaces of an earlier run that was killed before its trap ran (its pid is gone).
-for old in $(ip netns list | awk '{print $1}' | grep -E "^${prefix}_(sw|lab|mind|rec|guest)_[0-9]+$" || true); do
-  if ! kill -0 "${old##*_}" 2> /dev/null; then
-    ip netns pids "$old" 2> /dev/null | xargs -r kill -KILL 2> /dev/null || true
-    ip netns del "$old" 2> /dev/null || true
-  fi
-done
+source "$repo/tests/support/netns_test.sh"
+netns_names dyadsh
 rm -rf "$work"
 mkdir -p "$work"
 work=$(cd "$work" && pwd)
-made=() started=()
 cleanup() {
-  local code=$? n p i
+  local code=$?
   set +e
   trap - EXIT INT TERM
-  for p in "${started[@]}"; do kill -KILL "$p" 2> /dev/null; done
-  for i in 1 2 3 4 5 6 7 8 9 10; do
-    p=""
-    for n in "${made[@]}"; do p+=$(ip netns pids "$n" 2> /dev/null); done
-    [ -z "$p" ] && break
-    echo "$p" | xargs -r kill -KILL 2> /dev/null
-    sleep 0.3
-  done
-  for p in "${started[@]}"; do wait "$p" 2> /dev/null; done
-  for n in "${made[@]}"; do ip netns del "$n" 2> /dev/null || echo "secure_hosts: could not delete namespace $n" >&2; done
+  netns_stop secure_hosts
   exit "$code"
 }
 trap cleanup EXIT
 trap 'exit 130' INT
 trap 'exit 143' TERM
 
-setup() { "$@" 2> "$work/netns.err" || skip "cannot set up the network: '$*': $(cat "$work/netns.err")"; }
-setup ip netns add "$sw"
-made+=("$sw")
-setup ip -n "$sw" link set lo up
-setup ip -n "$sw" link add br0 type bridge
-setup ip -n "$sw" link set br0 up
-for h in "${hosts[@]}"; do
-  n=${ns[$h]}
-  setup ip netns add "$n"
-  made+=("$n")
-  setup ip -n "$sw" link add "v$h" type veth peer name eth0 netns "$n"
-  setup ip -n "$sw" link set "v$h" master br0 up
-  setup ip -n "$n" link set lo up
-  setup ip -n "$n" addr add "${addr[$h]}/24" dev eth0
-  setup ip -n "$n" link set eth0 up
-done
+netns_network
 echo "secure_hosts: namespaces ${made[*]}: lab ${addr[lab]}, mind ${addr[mind]}, rec ${addr[rec]}, guest ${addr[guest]}"
 
 # on HOST CMD...: CMD in HOST's namespace with a /dev/shm of its own, as on another machine.
