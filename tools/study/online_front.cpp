@@ -1,5 +1,6 @@
 #include "online_front.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -30,8 +31,11 @@ constexpr const char* kComeBack =
 constexpr const char* kHeldElsewhere =
     "Please come back later: your session is open elsewhere right now (the lab). Your link stays valid.";
 constexpr std::chrono::milliseconds kRelayRetry{200};
+// A page's frames queued for the front's thread beyond this (it is far behind, or the page
+// floods): the page is closed rather than its frames held in memory.
+constexpr size_t kQueuedBytes = 1 << 20;
 // A relayed frame the trial's graph cannot take within this (it stopped reading) drops the relay
-// (the page reconnects) rather than holding the server's one handler thread, every page's.
+// (the page reconnects) rather than holding the front's one thread, every page's.
 constexpr std::chrono::milliseconds kRelayWrite{100};
 // A trial whose graph failed this many times in a row (a broken graph or machine) is not offered
 // again until `dyad study serve` restarts: the participant is asked to come back later.
@@ -95,6 +99,7 @@ OnlineFront::OnlineFront(const Study& s, FrontOptions o) : study_(s), options_(s
     participant->ended = ReadOnlineEvents(SessionLogPath(s, p)).ended;  // ended before a restart: shown, and resumable
     participants_.emplace(p, std::move(participant));
   }
+  events_thread_ = std::thread([this] { Events(); });
 }
 
 OnlineFront::~OnlineFront() { StopAll(); }
@@ -148,11 +153,71 @@ std::string OnlineFront::Take(Participant& p, web::ClientId client, Clock::time_
   return "";
 }
 
+// The ClientHandler calls, on civetweb's workers (OnText on the server's handler thread, while a
+// worker waits): each only queues the event for the front's thread, never waiting for it.
 void OnlineFront::OnOpen(web::ClientId client, web::Role) {
   web::WebServer* server = server_.load();
   const auto it = server ? participants_.find(server->who(client)) : participants_.end();
   if (it == participants_.end()) return Close(client, 1008, "not a participant");
-  Participant& p = *it->second;
+  {
+    MutexLock lock(events_mutex_);
+    if (!events_stopped_) {
+      opening_.insert(client);
+      events_.push_back(Event{Event::Kind::kOpen, client, it->second.get(), {}});
+      events_cv_.notify_one();
+      return;
+    }
+  }
+  Close(client, 1001, "the study's server is stopping");
+}
+
+Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
+  MutexLock lock(events_mutex_);
+  if (events_stopped_) return Status::OK();
+  size_t& queued = queued_bytes_[client];
+  if (queued + text.size() > kQueuedBytes) {
+    queued_bytes_.erase(client);  // the server closes the page: its close comes next
+    return Status::FailedPrecondition("the page sent more than the study's server could take in time");
+  }
+  queued += text.size();
+  events_.push_back(Event{Event::Kind::kText, client, nullptr, std::string(text)});
+  events_cv_.notify_one();
+  return Status::OK();
+}
+
+void OnlineFront::OnClose(web::ClientId client) {
+  MutexLock lock(events_mutex_);
+  queued_bytes_.erase(client);
+  if (events_stopped_ || opening_.erase(client) > 0) return;  // its open never handled: nothing to undo
+  events_.push_back(Event{Event::Kind::kClose, client, nullptr, {}});
+  events_cv_.notify_one();
+}
+
+void OnlineFront::Events() {
+  UniqueLock lock(events_mutex_);
+  while (true) {
+    events_cv_.wait(lock.native(), [this] {
+      events_mutex_.AssertHeld();
+      return events_stopped_ || !events_.empty();
+    });
+    if (events_stopped_) return;
+    Event e = std::move(events_.front());
+    events_.pop_front();
+    bool handle = true;
+    if (e.kind == Event::Kind::kOpen) handle = opening_.erase(e.client) > 0;  // else closed while queued
+    if (const auto queued = queued_bytes_.find(e.client); e.kind == Event::Kind::kText && queued != queued_bytes_.end()) {
+      queued->second -= std::min(queued->second, e.text.size());
+      if (queued->second == 0) queued_bytes_.erase(queued);
+    }
+    lock.Unlock();
+    if (handle && e.kind == Event::Kind::kOpen) Open(*e.participant, e.client);
+    else if (e.kind == Event::Kind::kText) Text(e.client, e.text);
+    else if (e.kind == Event::Kind::kClose) Closed(e.client);
+    lock.Lock();
+  }
+}
+
+void OnlineFront::Open(Participant& p, web::ClientId client) {
   std::string refused;
   bool running = false;
   web::ClientId silent = 0;  // p's page until now, silent too long: a connection dead without a close
@@ -186,8 +251,8 @@ void OnlineFront::OnOpen(web::ClientId client, web::Role) {
     return Close(client, 1008, "refused");
   }
   if (!running) return SendPhase(p, client);
-  // Connecting may take seconds (the graph starting) and more stack than civetweb's workers
-  // have: a thread of its own. The page sends nothing but pongs before the graph's hello.
+  // Connecting may take seconds (the graph starting): a thread of its own, the front's thread
+  // goes on with the other pages. The page sends nothing but pongs before the graph's hello.
   relays_.fetch_add(1);
   std::thread([this, &p, client] {
     Relay(p, client);
@@ -321,19 +386,19 @@ void OnlineFront::Pointer(Participant& p, std::string_view text) {
   p.engaged = j["engaged"].get<bool>();
 }
 
-Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
+void OnlineFront::Text(web::ClientId client, std::string_view text) {
   Participant* p = Of(client);
-  if (p == nullptr) return Status::OK();
+  if (p == nullptr) return;
   {
     MutexLock lock(mutex_);
     if (p->page == client) p->heard = Clock::now();
   }
-  if (Pong(*p, text)) return Status::OK();
+  if (Pong(*p, text)) return;
   std::shared_ptr<web::WsClient> up;
   bool running = false;
   {
     MutexLock lock(mutex_);
-    if (p->page != client) return Status::OK();  // a page being closed
+    if (p->page != client) return;  // a page being closed
     up = p->upstream;
     running = p->running;
   }
@@ -341,10 +406,9 @@ Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
     Pointer(*p, text);
     if (Status st = up->SendText(text, kRelayWrite); !st.ok())
       NextPhase(*p, client, "the trial's graph does not take the page's frames");
-    return Status::OK();
+    return;
   }
   if (!running) Answer(*p, client, text);
-  return Status::OK();
 }
 
 // The page's answers between trials.
@@ -476,7 +540,7 @@ void OnlineFront::RunTrial(Participant& p, AttemptRequest r) {
   if (page != 0) Close(page, 1012, "the trial ended");  // the page comes back at once and hears what is next
 }
 
-void OnlineFront::OnClose(web::ClientId client) {
+void OnlineFront::Closed(web::ClientId client) {
   std::shared_ptr<web::WsClient> up;
   {
     MutexLock lock(mutex_);
@@ -621,6 +685,18 @@ Status OnlineFront::ResumeSession(const std::string& participant) {
 
 void OnlineFront::StopAll() {
   closing_.store(true);
+  std::vector<web::ClientId> unopened;  // pages whose open was still queued: closed, nothing else
+  {
+    MutexLock lock(events_mutex_);
+    events_stopped_ = true;
+    unopened.assign(opening_.begin(), opening_.end());
+    opening_.clear();
+    events_.clear();
+    queued_bytes_.clear();
+  }
+  events_cv_.notify_all();
+  if (events_thread_.joinable() && events_thread_.get_id() != std::this_thread::get_id()) events_thread_.join();
+  for (web::ClientId client : unopened) Close(client, 1001, "the study's server is stopping");
   for (auto& [id, p] : participants_) p->stop.store(true);
   for (auto& [id, p] : participants_) {
     std::lock_guard<std::mutex> worker(p->worker_mutex);

@@ -44,17 +44,28 @@
 //   - StopAll (SIGINT/SIGTERM): no trial starts any more, every running one is stopped as `dyad
 //     study run` stops it, and this returns once they have ended and every relay is closed.
 //
-// Threads: the ClientHandler calls come from the web server (see web_server.hpp); Tick from the
-// server's loop; each trial runs on a thread of its own. Everything shared is under one mutex,
-// never held while a socket is written or a trial runs.
+// Threads: the ClientHandler calls come from the web server (see web_server.hpp): OnOpen and
+// OnClose on civetweb's workers, whose 100 KB stacks an ASan build overflowed reading a session
+// log there. So they and OnText only queue the page's event (a map look-up, no file, no lock
+// file, no send that waits) for the front's own thread (a normal stack), started with the front
+// and stopped by StopAll, which handles every page's events in the order they came: one page's
+// open, then its frames, then its close; a close that comes while its open is still queued ends
+// both unhandled. A page whose frames queue up past 1 MiB (the front's thread far behind) is
+// closed (1008) rather than held in memory. Tick comes from the server's loop; each trial runs on
+// a thread of its own, each relay's connection too. Everything shared is under one mutex, never
+// held while a socket is written or a trial runs.
 #pragma once
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <deque>
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "dyad/thread_annotations.hpp"
@@ -94,6 +105,8 @@ class OnlineFront final : public web::ClientHandler {
   void SetServer(web::WebServer* server) { server_.store(server); }
   // From the server's loop, every 100 ms or so: lost pages, released sessions, pings.
   void Tick(Clock::time_point now);
+  // Also stops the front's thread: the page events still queued are dropped (a page opened is
+  // closed, 1001) and those that come later too.
   void StopAll();
   int running() const;  // trials running now
   int live(Clock::time_point now) const;
@@ -102,6 +115,7 @@ class OnlineFront final : public web::ClientHandler {
   Status StopSession(const std::string& participant, const std::string& reason);
   Status ResumeSession(const std::string& participant);
 
+  // Each only queues the page's event for the front's thread (see Threads above).
   void OnOpen(web::ClientId client, web::Role role) override;
   Status OnText(web::ClientId client, std::string_view text) override;
   Status OnBinary(web::ClientId, std::span<const uint8_t>) override { return Status::OK(); }
@@ -109,6 +123,18 @@ class OnlineFront final : public web::ClientHandler {
 
  private:
   struct Participant;
+  struct Event {
+    enum class Kind { kOpen, kText, kClose } kind;
+    web::ClientId client = 0;
+    Participant* participant = nullptr;  // kOpen: whose link the page opened
+    std::string text;                    // kText
+  };
+  // The front's thread: the queued events, one at a time, until StopAll.
+  void Events();
+  // On the front's thread: a page opened, a frame, a page closed.
+  void Open(Participant& p, web::ClientId client);
+  void Text(web::ClientId client, std::string_view text);
+  void Closed(web::ClientId client);
   // Why `client` may not be p's page now ("" when it is, from now on). `final`: p's session is
   // done or refused (its page is only told so): max_sessions does not apply.
   std::string Take(Participant& p, web::ClientId client, Clock::time_point now, bool final) REQUIRES(mutex_);
@@ -140,6 +166,14 @@ class OnlineFront final : public web::ClientHandler {
   std::map<std::string, std::unique_ptr<Participant>> participants_;  // fixed at construction
   mutable Mutex mutex_;
   std::map<web::ClientId, Participant*> clients_ GUARDED_BY(mutex_);
+  // The page events for the front's thread (never held while one is handled).
+  Mutex events_mutex_;
+  std::condition_variable events_cv_;
+  std::deque<Event> events_ GUARDED_BY(events_mutex_);
+  std::map<web::ClientId, size_t> queued_bytes_ GUARDED_BY(events_mutex_);  // a page's frames queued
+  std::set<web::ClientId> opening_ GUARDED_BY(events_mutex_);  // opens queued (a close meanwhile erases one: neither is handled)
+  bool events_stopped_ GUARDED_BY(events_mutex_) = false;
+  std::thread events_thread_;  // last: started once the rest is made
 };
 
 }  // namespace dyad::study

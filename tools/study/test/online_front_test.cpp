@@ -1,0 +1,175 @@
+// The participants' side of `dyad study serve` (online_front.hpp) on a real web server, without a
+// graph: the ClientHandler calls only queue the page's event (civetweb's 100 KB worker stacks
+// overflowed under ASan when OnOpen read the session log there), and the front's own thread does
+// the work. The session log is made a FIFO that no one writes, so any read of it blocks: the
+// calls must return all the same, and the page hears its phase once the test lets the read end.
+// The scripted pages of serve_test.sh cover the rest (a link open twice, max_sessions, trials).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "online_front.hpp"
+#include "online_study_fixture.hpp"
+#include "study_session.hpp"
+#include "web_server.hpp"
+#include "ws_client.hpp"
+
+namespace dyad::study {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using namespace std::chrono_literals;
+
+// Long enough never to be reached by a call that returns at once; reached only on a failure.
+constexpr auto kGuard = 10s;
+
+// The server's own handler of the pages' endpoint: it only notes who connected, so that the test
+// calls the front's handler itself, on its own thread.
+class Pages final : public web::ClientHandler {
+ public:
+  void OnOpen(web::ClientId client, web::Role) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    opened_.push_back(client);
+    cv_.notify_all();
+  }
+  Status OnText(web::ClientId, std::string_view) override { return Status::OK(); }
+  Status OnBinary(web::ClientId, std::span<const uint8_t>) override { return Status::OK(); }
+  void OnClose(web::ClientId) override {}
+  web::ClientId Opened(size_t n) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait_for(lock, kGuard, [&] { return opened_.size() >= n; });
+    return opened_.size() >= n ? opened_[n - 1] : 0;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::vector<web::ClientId> opened_;
+};
+
+// A participant's page: the frames the front sent it.
+struct Page {
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::vector<Json> frames;
+  std::unique_ptr<web::WsClient> ws;
+  // The op of the frame n (1-based), or "" when none came.
+  std::string Op(size_t n) {
+    std::unique_lock<std::mutex> lock(mutex);
+    cv.wait_for(lock, kGuard, [&] { return frames.size() >= n; });
+    return frames.size() >= n ? frames[n - 1].value("op", "") : "";
+  }
+  size_t count() {
+    std::lock_guard<std::mutex> lock(mutex);
+    return frames.size();
+  }
+};
+
+class OnlineFrontTest : public testing::OnlineStudyTest {
+ protected:
+  OnlineFrontTest() : OnlineStudyTest("dyad_online_front_") {}
+  void SetUp() override {
+    OnlineStudyTest::SetUp();
+    web::WebServer::Options o;
+    o.port = 0;
+    o.admit = [](std::string_view token, std::string_view) -> std::variant<web::Admission, web::Refusal> {
+      return web::Admission{web::Role::kSubject, std::string(token)};
+    };
+    o.endpoints.push_back(web::WebServer::Endpoint{"/subject/ws", {}, &pages_, {web::Role::kSubject}, false});
+    auto server = web::WebServer::Start(o);
+    ASSERT_TRUE(server.ok()) << server.status().ToString();
+    server_ = std::move(*server);
+    log_ = SessionLogPath(study_, "P01");
+    fs::create_directories(fs::path(log_).parent_path());
+    fs::permissions(fs::path(log_).parent_path(), fs::perms::owner_all);
+    fifo_ = (dir_ / "log.fifo").string();
+    ASSERT_EQ(mkfifo(fifo_.c_str(), 0600), 0);
+  }
+  void TearDown() override {
+    server_.reset();
+    OnlineStudyTest::TearDown();
+  }
+  // P01's page connected to the server; its client id.
+  web::ClientId Connect(Page& page) {
+    web::WsClient::Callbacks cb;
+    cb.on_text = [&page](std::string_view text) {
+      std::lock_guard<std::mutex> lock(page.mutex);
+      page.frames.push_back(Json::parse(text));
+      page.cv.notify_all();
+    };
+    auto ws = web::WsClient::Connect("127.0.0.1", server_->port(), "/subject/ws?token=P01", std::move(cb), 2s);
+    EXPECT_TRUE(ws.ok()) << ws.status().ToString();
+    if (ws.ok()) page.ws = std::move(*ws);
+    return pages_.Opened(++connected_);
+  }
+  // P01's session log becomes the FIFO (its text kept aside): reading it blocks.
+  void BlockTheLog() {
+    if (fs::exists(log_)) fs::rename(log_, log_ + ".kept");
+    else std::ofstream(log_ + ".kept").close();
+    fs::create_hard_link(fifo_, log_);
+  }
+  // The log back, and a read blocked on the FIFO let through (it reads the kept text), until
+  // `done` (the front has gone on: the page heard from it).
+  void UnblockTheLog(const std::function<bool()>& done) {
+    std::ifstream in(log_ + ".kept");
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    fs::rename(log_ + ".kept", log_);
+    for (auto until = std::chrono::steady_clock::now() + kGuard; !done() && std::chrono::steady_clock::now() < until;) {
+      if (const int fd = ::open(fifo_.c_str(), O_WRONLY | O_NONBLOCK); fd >= 0) {  // a reader waits on it
+        EXPECT_EQ(::write(fd, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+        ::close(fd);
+      }
+      std::this_thread::sleep_for(10ms);
+    }
+  }
+
+  Pages pages_;
+  std::unique_ptr<web::WebServer> server_;
+  std::string log_, fifo_;
+  size_t connected_ = 0;
+};
+
+TEST_F(OnlineFrontTest, ThePageHandlerOnlyQueuesTheLogIsReadOnTheFrontsOwnThread) {
+  OnlineFront front(study_, FrontOptions{"dyad", 2});
+  front.SetServer(server_.get());
+  Page page;
+  const web::ClientId client = Connect(page);
+  ASSERT_NE(client, 0u);
+
+  BlockTheLog();
+  auto open = std::async(std::launch::async, [&] { front.OnOpen(client, web::Role::kSubject); });
+  const bool open_returned = open.wait_for(kGuard) == std::future_status::ready;
+  EXPECT_TRUE(open_returned) << "OnOpen waited for the session log: it read it on the web server's thread";
+  EXPECT_EQ(page.count(), 0u) << "the page's phase comes from the log, which no one could read yet";
+  UnblockTheLog([&] { return page.count() > 0; });
+  EXPECT_EQ(page.Op(1), "consent") << "the front's thread read the log once it could";
+
+  BlockTheLog();
+  auto text = std::async(std::launch::async, [&] { return front.OnText(client, R"({"op":"consent","agree":true})"); });
+  const bool text_returned = text.wait_for(kGuard) == std::future_status::ready;
+  EXPECT_TRUE(text_returned) << "OnText waited for the session log: it read it on the web server's thread";
+  UnblockTheLog([&] { return page.count() > 1; });
+  EXPECT_TRUE(text.get().ok());
+  EXPECT_EQ(page.Op(2), "waiting") << "the consent marked, the page is offered trial 1";
+  EXPECT_TRUE(ReadSession(study_, "P01").consent);
+  EXPECT_TRUE(open_returned && text_returned);
+  front.OnClose(client);
+  front.StopAll();
+}
+
+}  // namespace
+}  // namespace dyad::study
