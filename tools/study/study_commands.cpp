@@ -195,7 +195,7 @@ ExitCode RunOnPage(const study::Study& s, const RunOptions& o, const study::Sess
   }
   study::PageOptions po = o.page_options;
   po.dyad = tools::ThisExecutable();
-  return static_cast<ExitCode>(study::RunStudyPage(s, o.participant, po));  // a code of the table
+  return study::RunStudyPage(s, o.participant, po);
 }
 
 // The participant's trials in their order, each not yet complete run; a trial that did not

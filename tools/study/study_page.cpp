@@ -286,7 +286,7 @@ Status OpenLobby(const Study& study, const std::string& participant, const PageO
 
 }  // namespace
 
-int RunStudyPage(const Study& study, const std::string& participant, const PageOptions& o) {
+tools::ExitCode RunStudyPage(const Study& study, const std::string& participant, const PageOptions& o) {
   // Before anything can start a trial: a trial's own handlers restore these when it ends.
   struct sigaction sa {}, old_int {}, old_term {};
   sa.sa_handler = OnQuitSignal;
@@ -299,7 +299,7 @@ int RunStudyPage(const Study& study, const std::string& participant, const PageO
     std::cerr << "dyad study run: " << st.ToString() << "\n";
     sigaction(SIGINT, &old_int, nullptr);
     sigaction(SIGTERM, &old_term, nullptr);
-    return 1;
+    return tools::ExitCode::kFailure;
   }
   StudyChannel channel(study, participant, o.dyad, lobby.get());
   web::WebServer::Options so;
@@ -314,7 +314,7 @@ int RunStudyPage(const Study& study, const std::string& participant, const PageO
     std::cerr << "dyad study run: the study page: " << server.status().ToString() << "\n";
     sigaction(SIGINT, &old_int, nullptr);
     sigaction(SIGTERM, &old_term, nullptr);
-    return 1;
+    return tools::ExitCode::kFailure;
   }
   channel.SetServer(server->get());
   if (!o.port_file.empty()) std::ofstream(o.port_file) << (*server)->port() << "\n";
@@ -358,7 +358,7 @@ int RunStudyPage(const Study& study, const std::string& participant, const PageO
   const Session session = ReadSession(study, participant);
   for (const Trial& t : study.TrialsOf(participant)) done = done && session.Complete(t.number);
   std::cout << "study page closed: " << (done ? "every trial complete" : "trials remain") << std::endl;
-  return done ? 0 : 1;  // as the terminal's session: 1 while trials remain
+  return done ? tools::ExitCode::kOk : tools::ExitCode::kFailure;  // as the terminal's session while trials remain
 }
 
 }  // namespace dyad::study

@@ -26,6 +26,7 @@
 
 #include <string>
 
+#include "exit_code.hpp"
 #include "study_file.hpp"
 
 namespace dyad::study {
@@ -40,7 +41,10 @@ struct PageOptions {
   int subject_port = -1;
 };
 
-// Serves the page until SIGINT/SIGTERM between trials; returns the process exit code.
-int RunStudyPage(const Study& study, const std::string& participant, const PageOptions& options);
+// Serves the page until SIGINT/SIGTERM between trials, or until every trial is complete. Returns
+// the command's exit code: kOk once every trial of the participant is complete; kFailure while
+// trials remain (as the terminal's session) or when the page or the subject's page between
+// trials cannot open (said on stderr).
+tools::ExitCode RunStudyPage(const Study& study, const std::string& participant, const PageOptions& options);
 
 }  // namespace dyad::study
