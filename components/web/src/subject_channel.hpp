@@ -2,7 +2,7 @@
 /// the page, robot state to it.
 ///
 /// Page -> server (JSON text): {"op":"pointer","x":..,"y":..,"engaged":bool,"t":ms} on every
-/// pointer or key event and every 50 ms while engaged (a keepalive); {"op":"steer"} to take the
+/// pointer or key event and, while engaged, after 50 ms without one (a keepalive); {"op":"steer"} to take the
 /// steering role; {"op":"self_report","choice":k} the subject's answer to "What were you
 /// drawing?" (k: a primitive's index, -1 "something else"; from the steering page only, a viewer's
 /// is refused), with "segment":i when it answers a question after the trial (below). Server -> page: {"op":"hello",...} (role, steering, workspace, engage key,

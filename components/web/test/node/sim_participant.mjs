@@ -5,7 +5,7 @@
 //   - connects with its token (reconnects a second after a close, as the page does; a 1008 close
 //     is final), sends a pointer sample on each pointer event (a browser's pointermove, about
 //     60 Hz here, at most one per 4 ms as the page), on each press and release, and every 50 ms
-//     while engaged (the page's keepalive), each stamped "t" (the ack's round trip) and "wall"
+//     while engaged and still (the page's keepalive), each stamped "t" (the ack's round trip) and "wall"
 //     (the event's wall-clock time: the server keeps the event -> published delay);
 //   - draws the data set's primitives (an NRL folder: primitive_<id>_<sample>.csv, x,y rows at
 //     100 ms; the experimenter's task target when one is set, else one at random), each as one
@@ -123,7 +123,10 @@ export class SimParticipant {
     const t = setTimeout(() => { this.timers.delete(t); if (!this.stopped) fn(); }, ms / this.speed);
     this.timers.add(t);
   }
-  start() { this.connect(); this.rest(); this.keepalive = setInterval(() => { if (this.down) this.send(true); }, 50); }
+  start() {  // the page's keepalive: while held and the pointer still (no sample for 45 ms)
+    this.connect(); this.rest();
+    this.keepalive = setInterval(() => { if (this.down && performance.now() - this.lastSent >= 45) this.send(true); }, 50);
+  }
   stop() {
     this.stopped = true;
     clearInterval(this.keepalive);
