@@ -695,8 +695,8 @@ void OnlineFront::StopAll() {
     queued_bytes_.clear();
   }
   events_cv_.notify_all();
-  if (events_thread_.joinable() && events_thread_.get_id() != std::this_thread::get_id()) events_thread_.join();
   for (web::ClientId client : unopened) Close(client, 1001, "the study's server is stopping");
+  if (events_thread_.joinable()) events_thread_.join();  // the event it handles now (a page's phase, a trial's start)
   for (auto& [id, p] : participants_) p->stop.store(true);
   for (auto& [id, p] : participants_) {
     std::lock_guard<std::mutex> worker(p->worker_mutex);

@@ -66,6 +66,7 @@ struct Page {
   std::mutex mutex;
   std::condition_variable cv;
   std::vector<Json> frames;
+  bool closed = false;  // by the server
   std::unique_ptr<web::WsClient> ws;
   // The op of the frame n (1-based), or "" when none came.
   std::string Op(size_t n) {
@@ -76,6 +77,11 @@ struct Page {
   size_t count() {
     std::lock_guard<std::mutex> lock(mutex);
     return frames.size();
+  }
+  bool Closed() {
+    std::unique_lock<std::mutex> lock(mutex);
+    cv.wait_for(lock, kGuard, [&] { return closed; });
+    return closed;
   }
 };
 
@@ -103,15 +109,20 @@ class OnlineFrontTest : public testing::OnlineStudyTest {
     server_.reset();
     OnlineStudyTest::TearDown();
   }
-  // P01's page connected to the server; its client id.
-  web::ClientId Connect(Page& page) {
+  // `participant`'s page connected to the server; its client id.
+  web::ClientId Connect(Page& page, const std::string& participant = "P01") {
     web::WsClient::Callbacks cb;
     cb.on_text = [&page](std::string_view text) {
       std::lock_guard<std::mutex> lock(page.mutex);
       page.frames.push_back(Json::parse(text));
       page.cv.notify_all();
     };
-    auto ws = web::WsClient::Connect("127.0.0.1", server_->port(), "/subject/ws?token=P01", std::move(cb), 2s);
+    cb.on_close = [&page] {
+      std::lock_guard<std::mutex> lock(page.mutex);
+      page.closed = true;
+      page.cv.notify_all();
+    };
+    auto ws = web::WsClient::Connect("127.0.0.1", server_->port(), "/subject/ws?token=" + participant, std::move(cb), 2s);
     EXPECT_TRUE(ws.ok()) << ws.status().ToString();
     if (ws.ok()) page.ws = std::move(*ws);
     return pages_.Opened(++connected_);
@@ -122,12 +133,25 @@ class OnlineFrontTest : public testing::OnlineStudyTest {
     else std::ofstream(log_ + ".kept").close();
     fs::create_hard_link(fifo_, log_);
   }
-  // The log back, and a read blocked on the FIFO let through (it reads the kept text), until
-  // `done` (the front has gone on: the page heard from it).
-  void UnblockTheLog(const std::function<bool()>& done) {
+  // Once a reader has opened the FIFO (the front's thread reading the log): a writer's end of
+  // it, held open so that the reader waits for its text (-1: no reader came).
+  int Reader() {
+    for (auto until = std::chrono::steady_clock::now() + kGuard; std::chrono::steady_clock::now() < until;) {
+      if (const int fd = ::open(fifo_.c_str(), O_WRONLY | O_NONBLOCK); fd >= 0) return fd;
+      std::this_thread::sleep_for(10ms);
+    }
+    return -1;
+  }
+  // The log back, and a read blocked on the FIFO let through (it reads the kept text: through
+  // `writer` from Reader(), else each reader that comes), until `done` (the front has gone on).
+  void UnblockTheLog(const std::function<bool()>& done, int writer = -1) {
     std::ifstream in(log_ + ".kept");
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     fs::rename(log_ + ".kept", log_);
+    if (writer >= 0) {
+      EXPECT_EQ(::write(writer, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+      ::close(writer);
+    }
     for (auto until = std::chrono::steady_clock::now() + kGuard; !done() && std::chrono::steady_clock::now() < until;) {
       if (const int fd = ::open(fifo_.c_str(), O_WRONLY | O_NONBLOCK); fd >= 0) {  // a reader waits on it
         EXPECT_EQ(::write(fd, text.data(), text.size()), static_cast<ssize_t>(text.size()));
@@ -169,6 +193,40 @@ TEST_F(OnlineFrontTest, ThePageHandlerOnlyQueuesTheLogIsReadOnTheFrontsOwnThread
   EXPECT_TRUE(open_returned && text_returned);
   front.OnClose(client);
   front.StopAll();
+}
+
+TEST_F(OnlineFrontTest, APageClosedWhileItsOpenIsQueuedTakesNothingAndStopAllClosesAQueuedOne) {
+  OnlineFront front(study_, FrontOptions{"dyad", 2});
+  front.SetServer(server_.get());
+  Page first, gone, last;
+  const web::ClientId p01 = Connect(first), p02 = Connect(gone, "P02");
+  ASSERT_NE(p02, 0u);
+  BlockTheLog();
+  // The front's thread reads P01's log (blocked there) while P02's page opens and closes, then
+  // opens again and the front is stopped: each call returns, none waits for the front's thread.
+  auto calls = std::async(std::launch::async, [&] {
+    front.OnOpen(p01, web::Role::kSubject);
+    front.OnOpen(p02, web::Role::kSubject);
+    front.OnClose(p02);
+  });
+  const bool returned = calls.wait_for(kGuard) == std::future_status::ready;
+  EXPECT_TRUE(returned) << "the page handler waited for the session log";
+  const int writer = Reader();  // the front's thread is in P01's log: P02's next open stays queued
+  EXPECT_GE(writer, 0) << "no one read P01's log";
+  const web::ClientId again = Connect(last, "P02");
+  auto stop = std::async(std::launch::async, [&] {
+    front.OnOpen(again, web::Role::kSubject);
+    front.StopAll();
+  });
+  EXPECT_TRUE(last.Closed()) << "a page whose open was queued at StopAll is closed, at once";
+  UnblockTheLog([&] { return calls.wait_for(0s) == std::future_status::ready && stop.wait_for(0s) == std::future_status::ready; },
+                writer);
+  ASSERT_EQ(stop.wait_for(kGuard), std::future_status::ready) << "StopAll did not return";
+  EXPECT_EQ(first.Op(1), "consent") << "P01's open, handled once the log could be read";
+  EXPECT_EQ(front.live(OnlineFront::Clock::now()), 1) << "P02's page closed before its open was handled: no session";
+  EXPECT_TRUE(SessionLock::Acquire(study_, "P02").ok()) << "P02's session lock was taken for a page already gone";
+  EXPECT_EQ(last.count(), 0u) << "and told nothing: its open was not handled";
+  EXPECT_EQ(gone.count(), 0u);
 }
 
 }  // namespace
