@@ -229,5 +229,25 @@ TEST_F(OnlineFrontTest, APageClosedWhileItsOpenIsQueuedTakesNothingAndStopAllClo
   EXPECT_EQ(gone.count(), 0u);
 }
 
+TEST_F(OnlineFrontTest, StoppingASessionBetweenTrialsFreesItsPlaceAtOnce) {
+  OnlineFront front(study_, FrontOptions{"dyad", 1});  // max_sessions 1
+  front.SetServer(server_.get());
+  Page p01, early, p02;
+  front.OnOpen(Connect(p01), web::Role::kSubject);
+  EXPECT_EQ(p01.Op(1), "consent");
+  front.OnOpen(Connect(early, "P02"), web::Role::kSubject);
+  EXPECT_EQ(early.Op(1), "refused");
+  EXPECT_NE(early.frames.at(0).value("message", "").find("Please come back later"), std::string::npos) << early.frames[0];
+  EXPECT_TRUE(early.Closed());
+
+  ASSERT_TRUE(front.StopSession("P01", "the participant asked to stop").ok());
+  EXPECT_EQ(p01.Op(2), "refused") << "P01's page is told the session has ended";
+  EXPECT_TRUE(p01.Closed());
+  EXPECT_EQ(front.live(OnlineFront::Clock::now()), 0) << "P01's place is free at once, not reconnect_s later";
+  front.OnOpen(Connect(p02, "P02"), web::Role::kSubject);
+  EXPECT_EQ(p02.Op(1), "consent") << "P02 is let in";
+  front.StopAll();
+}
+
 }  // namespace
 }  // namespace dyad::study
