@@ -10,7 +10,9 @@
 #include <ctime>
 #include <fstream>
 #include <iostream>
+#include <string_view>
 #include <thread>
+#include <utility>
 
 #include "dyad/private_file.hpp"
 #include "front_admission.hpp"
@@ -103,12 +105,7 @@ web::WebServer::Options ServerOptions(const ServeOptions& o, const std::vector<s
   so.endpoints.push_back(web::WebServer::Endpoint{"/overview/ws", {}, overview, {web::Role::kExperimenter}, /*viewers=*/false});
   so.max_clients = 4 * max_sessions + 16;  // the refused pages are told so over their socket
   so.max_frame_bytes = 16 << 10;           // a page's frames are small (pointer samples, answers): 16 KiB, not 1 MiB
-  // --origin, and where the links are (DATA/links.csv: a name of this machine, a proxy's)
-  so.allowed_origins = o.origins;
-  so.allowed_origins.insert(so.allowed_origins.end(), link_origins.begin(), link_origins.end());
-  const std::string scheme = o.tls_certificate.empty() ? "http://" : "https://";
-  for (const std::string& host : web::UrlHosts(o.address))
-    so.allowed_origins.push_back(scheme + host + ":" + std::to_string(o.port));  // ":0": the port bound (--port 0)
+  so.allowed_origins = PageOrigins(o, link_origins);
   return so;
 }
 
@@ -136,6 +133,23 @@ void Serving(const Study& s, const ServeOptions& o, int port, int with_links, in
 }
 
 }  // namespace
+
+std::vector<std::string> PageOrigins(const ServeOptions& o, const std::vector<std::string>& link_origins) {
+  // --origin, and where the links are (DATA/links.csv: a name of this machine, a proxy's)
+  std::vector<std::string> origins = o.origins;
+  origins.insert(origins.end(), link_origins.begin(), link_origins.end());
+  const std::string scheme = o.tls_certificate.empty() ? "http://" : "https://";
+  for (const std::string& host : web::UrlHosts(o.address))
+    origins.push_back(scheme + host + ":" + std::to_string(o.port));  // ":0": the port bound (--port 0)
+  static constexpr std::pair<std::string_view, std::string_view> kDefaultPorts[] = {{"https://", ":443"}, {"http://", ":80"}};
+  for (size_t i = 0, n = origins.size(); i < n; ++i) {
+    const std::string origin = origins[i];  // a copy: the vector grows
+    for (const auto& [scheme_of, port] : kDefaultPorts)
+      if (origin.starts_with(scheme_of) && origin.ends_with(port))
+        origins.push_back(origin.substr(0, origin.size() - port.size()));
+  }
+  return origins;
+}
 
 int Serve(const ServeOptions& o) {
   std::vector<Diagnostic> problems;

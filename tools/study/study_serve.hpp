@@ -46,6 +46,11 @@ struct ServeOptions {
 };
 
 int Serve(const ServeOptions& o);
+// The origins the pages are admitted from: --origin, the links' (`link_origins`, from
+// DATA/links.csv) and the front's own URLs (each host of --address at --port; "HOST:0" for port
+// 0, which the web server takes for the port it bound). One at its scheme's default port (https
+// 443, http 80) is admitted with and without it: a browser's Origin leaves that port out.
+std::vector<std::string> PageOrigins(const ServeOptions& o, const std::vector<std::string>& link_origins);
 // Adds `serve` to `dyad study`.
 void AddServeCommand(CLI::App* study, int& exit_code);
 

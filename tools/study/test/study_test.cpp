@@ -31,6 +31,7 @@
 #include "study_analysis.hpp"
 #include "study_commands.hpp"
 #include "study_file.hpp"
+#include "study_serve.hpp"
 #include "study_session.hpp"
 
 namespace dyad::study {
@@ -157,6 +158,28 @@ TEST_F(StudyFile, BadRecorderRehearsalAndSelfReportsAreSaidAtTheirLine) {
     for (const auto& p : problems) all += p.ToString() + "\n";
     EXPECT_NE(all.find(expected), std::string::npos) << "no '" << expected << "' in\n" << all;
   }
+}
+
+// Where dyad study serve admits pages from: a browser leaves the scheme's default port out of its
+// Origin, so an origin at 443 (https) or 80 (http) is admitted in both forms; others as given.
+TEST(ServeOrigins, AnOriginAtItsSchemesDefaultPortIsAdmittedWithoutItToo) {
+  ServeOptions o;
+  o.address = "127.0.0.1";
+  o.port = 443;
+  o.tls_certificate = "web.pem";
+  o.origins = {"https://proxy.example.org:8443", "http://lab.example.org:80"};
+  const std::vector<std::string> got = PageOrigins(o, {"https://study.example.org:443", "https://study.example.org"});
+  const std::set<std::string> origins(got.begin(), got.end());
+  for (const char* expected : {"https://127.0.0.1:443", "https://127.0.0.1", "https://study.example.org",
+                               "https://study.example.org:443", "http://lab.example.org", "https://proxy.example.org:8443"})
+    EXPECT_EQ(origins.count(expected), 1u) << expected;
+  EXPECT_EQ(origins.count("https://proxy.example.org"), 0u) << "8443 is no default port";
+  o.port = 8443;
+  o.tls_certificate.clear();
+  const std::vector<std::string> plain = PageOrigins(o, {});
+  EXPECT_EQ(std::set<std::string>(plain.begin(), plain.end()),
+            (std::set<std::string>{"https://proxy.example.org:8443", "http://lab.example.org:80", "http://lab.example.org",
+                                   "http://127.0.0.1:8443"}));
 }
 
 // The `online:` map of `dyad study serve`: its defaults, its values read, and each bad one at its line.
