@@ -109,16 +109,18 @@ uint64_t DdsReader::DeadlineMisses() const { return listener_->deadline_misses()
 DdsReader::~DdsReader() {
   if (!destroy_) return;
   for (fdds::DataReader* d : graveyard_) destroy_(d);
-  destroy_(retired_);
-  destroy_(reader_);
+  destroy_(retired_.load());
+  destroy_(reader_.load());
 }
 
 // One taker at a time (the port's component, whose steps never overlap; the runtime's own
-// readers under their owner's lock): seen_ needs no lock of its own.
+// readers under their owner's lock): seen_ needs no lock of its own. The entities are loaded
+// without one (see DdsReader): reader_ first, then retired_.
 bool DdsReader::TakeNext(void* sample) {
-  std::shared_lock<EntityLock> lock(entities_);
+  fdds::DataReader* const current = reader_.load(std::memory_order_acquire);
+  fdds::DataReader* const retired = retired_.load(std::memory_order_acquire);
   fdds::SampleInfo& info = *info_;
-  for (fdds::DataReader* r : {retired_, reader_}) {  // the retired one's samples are older
+  for (fdds::DataReader* r : {retired, current}) {  // the retired one's samples are older
     if (r == nullptr) continue;
     while (r->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK)
       if (info.valid_data && FreshSample(seen_, info)) return true;
@@ -127,34 +129,33 @@ bool DdsReader::TakeNext(void* sample) {
 }
 
 uint64_t DdsReader::Unread() const {
-  std::shared_lock<EntityLock> lock(entities_);
-  return reader_->get_unread_count() + (retired_ != nullptr ? retired_->get_unread_count() : 0);
+  fdds::DataReader* const current = reader_.load(std::memory_order_acquire);
+  fdds::DataReader* const retired = retired_.load(std::memory_order_acquire);
+  return current->get_unread_count() + (retired != nullptr && retired != current ? retired->get_unread_count() : 0);
 }
 
 int DdsReader::Matched() const { return listener_->matched(); }
 
+// Under renewal_ throughout (one renewal at a time); make_() waits for the old entity's callbacks
+// in flight (CallbackGate), none of which takes renewal_.
 bool DdsReader::Renew() {
-  {
-    std::shared_lock<EntityLock> lock(entities_);
-    if (retired_ != nullptr) return false;  // one renewal at a time: its retired reader may hold samples
-  }
+  MutexLock lock(renewal_);
+  if (retired_.load(std::memory_order_relaxed) != nullptr) return false;  // its retired reader may hold samples
   fdds::DataReader* fresh = make_();  // counted by the listener from now on
   if (fresh == nullptr) return false;
-  std::unique_lock<EntityLock> lock(entities_);
-  retired_ = reader_;
-  reader_ = fresh;
   retired_at_ = std::chrono::steady_clock::now();
+  retired_.store(reader_.load(std::memory_order_relaxed), std::memory_order_release);
+  reader_.store(fresh, std::memory_order_release);  // after retired_: see DdsReader
   return true;
 }
 
 bool DdsReader::Reap(bool force) {
-  {
-    std::shared_lock<EntityLock> lock(entities_);
-    if (retired_ == nullptr) return true;
-    if (!force && !RetiredDone(retired_, retired_at_)) return false;
-  }
-  std::unique_lock<EntityLock> lock(entities_);
-  graveyard_.push_back(std::exchange(retired_, nullptr));  // deleted with this reader (kRetireS)
+  MutexLock lock(renewal_);
+  fdds::DataReader* const retired = retired_.load(std::memory_order_relaxed);
+  if (retired == nullptr) return true;
+  if (!force && !RetiredDone(retired, retired_at_)) return false;
+  graveyard_.push_back(retired);  // deleted with this reader (kRetireS); a take may still use it
+  retired_.store(nullptr, std::memory_order_release);
   return true;
 }
 
@@ -255,8 +256,9 @@ StatusOr<TypedReader*> DdsParticipant::CreateReader(const std::string& topic, co
     return d;
   };
   r->destroy_ = DeleteReader;
-  r->reader_ = r->make_();
-  if (r->reader_ == nullptr) return Status::Internal("cannot create reader on topic '" + topic + "'" + SecurityHint("subscribe to"));
+  r->reader_.store(r->make_());
+  if (r->reader_.load() == nullptr)
+    return Status::Internal("cannot create reader on topic '" + topic + "'" + SecurityHint("subscribe to"));
   readers_.push_back(std::move(r));
   return readers_.back().get();
 }

@@ -134,9 +134,9 @@ DdsParticipant::~DdsParticipant() {
   // typed readers' listeners detached. Then endpoints, then the participant.
   for (auto& r : serialized_readers_) r->Close();
   for (auto& r : readers_) {
-    std::unique_lock<EntityLock> lock(r->entities_);
+    MutexLock lock(r->renewal_);
     for (fdds::DataReader* d : r->graveyard_) d->set_listener(nullptr);
-    for (fdds::DataReader* d : {r->reader_, r->retired_})
+    for (fdds::DataReader* d : {r->reader_.load(), r->retired_.load()})
       if (d != nullptr) d->set_listener(nullptr);
   }
   serialized_readers_.clear();

@@ -25,6 +25,7 @@
 #include <dyad/graph.hpp>
 #include <dyad/security.hpp>
 #include <dyad/status.hpp>
+#include <dyad/thread_annotations.hpp>
 
 #include "dds/transport.hpp"
 
@@ -56,13 +57,13 @@ class SeenWriters {
   std::vector<std::pair<Guid, int64_t>> seen_;
 };
 
-// The lock of a renewable endpoint's entity pointers (below): shared by every use (a take, a
-// write, a status query), exclusive only to swap them. Like glibc's shared mutex it lets a use
-// through while a swap waits (DdsReader says why that matters); unlike it, a use costs two atomic
-// increments and no call (six uses per bench_pingpong round trip: docs/runtime.md). A swap raises
-// a flag and takes its turn when no use is under way, else lowers it and waits; a use that meets
-// the raised flag waits for that swap alone (a few pointer stores). For std::shared_lock and
-// std::unique_lock.
+// The lock of a renewable writer's entity pointer (DdsWriter below): shared by every use (a
+// write, a status query), exclusive only to swap it, after which the old entity is deleted. Like
+// glibc's shared mutex it lets a use through while a swap waits; unlike it, a use costs two
+// atomic increments and no call (two uses per bench_pingpong round trip: docs/runtime.md). A
+// swap raises a flag and takes its turn when no use is under way, else lowers it and waits; a
+// use that meets the raised flag waits for that swap alone (a few pointer stores). For
+// std::shared_lock and std::unique_lock. (A reader needs none: its retired entities outlive it.)
 class EntityLock {
  public:
   void lock_shared() {
@@ -100,7 +101,8 @@ class EntityLock {
 // `retired_` for kRetireS (until every writer has matched the new one: each side learns the
 // other on its own) and takes from it first, each sample once (SeenWriters); it is not renewed
 // again before Reap() lets the old one go. A writer switches at once.
-// Each endpoint's EntityLock guards its entity pointers against the threads that use them.
+// A writer's EntityLock guards its entity pointer against the threads that use it; a reader's
+// pointers are atomics that every use loads without a lock (DdsReader).
 //
 // A retired entity is not deleted during the run but kept, unused (its callbacks dropped), until
 // the endpoint goes: Fast DDS 2.9 crashes (a best-effort writer's intra-process delivery to a
@@ -125,17 +127,22 @@ class DdsReader final : public TypedReader {
   class Listener;
   DdsReader() = default;
   int Matched() const;
-  bool Renew();
-  bool Reap(bool force);  // true: nothing retired is left
+  bool Renew() EXCLUDES(renewal_);
+  bool Reap(bool force) EXCLUDES(renewal_);  // true: nothing retired is left
   std::string topic_;
-  // Shared by every use of the entities below, exclusive only to swap them (never while calling
-  // Fast DDS: a delivery holds its reader's lock while our on_data steps a component that takes
-  // from this reader; EntityLock lets that shared use through while a swap waits).
-  mutable EntityLock entities_;
-  eprosima::fastdds::dds::DataReader* reader_ = nullptr;   // owned by the participant's subscriber
-  eprosima::fastdds::dds::DataReader* retired_ = nullptr;  // renewed away, still taken from
-  std::chrono::steady_clock::time_point retired_at_;
-  std::vector<eprosima::fastdds::dds::DataReader*> graveyard_;  // retired for good, deleted with this
+  // The entities, loaded by every use (a take, an unread count) without a lock: no entity is
+  // deleted before this reader (a retired one goes to graveyard_), so a use that loaded a pointer
+  // just before a swap still holds a live entity. Renew stores retired_ before reader_ (release)
+  // and a take loads reader_ before retired_ (acquire): a take that sees the new entity sees the
+  // retired one as well and takes from it first (its samples are older). Only Renew and Reap
+  // change them, under renewal_, which no use and no Fast DDS callback takes (a delivery holds
+  // its DDS reader's lock while our on_data steps a component that takes from this reader). A
+  // shared lock around each take cost eight atomic read-modify-writes per bench_pingpong round trip.
+  Mutex renewal_;
+  std::atomic<eprosima::fastdds::dds::DataReader*> reader_{nullptr};   // owned by the participant's subscriber
+  std::atomic<eprosima::fastdds::dds::DataReader*> retired_{nullptr};  // renewed away, still taken from
+  std::chrono::steady_clock::time_point retired_at_ GUARDED_BY(renewal_);
+  std::vector<eprosima::fastdds::dds::DataReader*> graveyard_ GUARDED_BY(renewal_);  // retired for good, deleted with this
   // TakeNext's alone: a reader has one taker at a time (its port's component, whose steps never
   // overlap, or the runtime object that owns it, each under its own lock where several threads
   // take), so they need no lock of their own. info_ is made once, not at every take.
