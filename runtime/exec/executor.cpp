@@ -97,8 +97,8 @@ struct Executor::Instance {
   InputBase* trigger_port = nullptr;                         // the trigger's input (in `inputs`)
   StepStats stats;
   std::atomic<bool> active{false};
-  std::atomic<bool> busy{false};
-  std::atomic<bool> pending{false};
+  // Triggered steps (TriggerStep): deliveries not yet answered by a step; not 0 while one steps.
+  std::atomic<uint64_t> notes{0};
   uint64_t index = 0;
   size_t slot = 0;  // in instances_ (and LiveParams' targets)
   Params params;    // the component's ctx.params(): live ones change at step boundaries
@@ -426,22 +426,23 @@ Status Executor::StepOnce(Instance& inst, int64_t scheduled_steady_ns, bool peri
   return s;
 }
 
+// Each delivery adds a note; the one that finds none steps the component, again as long as notes
+// came during its step, and clears them with a compare-exchange that fails if another came
+// meanwhile. Every change of `notes` is a read-modify-write of that one word, so a delivery and
+// the stepping thread's last look cannot miss each other (two flags, a store of one then a load
+// of the other on each side, can: a store-load reordering, and a delivery's step was lost). Cost:
+// two atomic read-modify-writes for a step, one for a delivery that finds the component busy.
+// All sequentially consistent, as the loads of `active` and stop_ here and the stores in Run(),
+// which then waits for `notes` to be 0: a step either sees the stop or is waited for.
 void Executor::TriggerStep(Instance& inst) {
-  inst.pending.store(true, std::memory_order_release);
+  uint64_t seen = inst.notes.fetch_add(1) + 1;
+  if (seen != 1) return;  // another thread is stepping it and will see this note
   for (;;) {
-    bool expected = false;
-    if (!inst.busy.compare_exchange_strong(expected, true, std::memory_order_acquire)) return;  // the owner steps again
-    while (inst.pending.exchange(false, std::memory_order_acq_rel)) {
-      if (!inst.active.load(std::memory_order_acquire) || stopping()) break;
-      // A notification is not a sample: StepOnce steps only if the trigger brought one.
-      Status s = StepOnce(inst, 0, false);
-      if (!s.ok()) {
-        Fail(s);
-        break;
-      }
+    // A notification is not a sample: StepOnce steps only if the trigger brought one.
+    if (inst.active.load() && !stop_.load()) {
+      if (Status s = StepOnce(inst, 0, false); !s.ok()) Fail(s);  // stops the run: no more steps
     }
-    inst.busy.store(false, std::memory_order_release);
-    if (!inst.pending.load(std::memory_order_acquire) || !inst.active.load(std::memory_order_acquire) || stopping()) return;
+    if (inst.notes.compare_exchange_strong(seen, 0)) return;  // else `seen` holds the notes now
   }
 }
 
@@ -608,13 +609,14 @@ Status Executor::Run() {
     if (!r.ok()) Fail(r);
   }
   if (session_) session_->Stopping();
-  // Stop: no more triggered steps, wait for any in flight, then deactivate in reverse order.
-  stop_.store(true, std::memory_order_release);
+  // Stop: no more triggered steps, wait for any in flight, then deactivate in reverse order
+  // (sequentially consistent: see TriggerStep).
+  stop_.store(true);
   cv_.notify_all();
   for (auto& inst : instances_) {
-    inst->active.store(false, std::memory_order_release);
+    inst->active.store(false);
     if (inst->thread.joinable()) inst->thread.join();
-    while (inst->busy.load(std::memory_order_acquire)) std::this_thread::yield();
+    while (inst->notes.load() != 0) std::this_thread::yield();
   }
   if (live_params_) live_params_->Stop();  // no preparation runs inside a component deactivating
   // The last stats, while every subscriber (a recorder) still listens.
