@@ -30,13 +30,18 @@ class Pong final : public dyad::Component {
     out_ = &ctx.output<dyad::msg::PingPong>("out");
     return dyad::Status::OK();
   }
+  // received() is const and Publish fills the header: the sample is copied once, into an object
+  // kept from step to step (its strings and sequences keep their storage: no allocation).
   dyad::Status Step(const dyad::StepInfo&) override {
-    for (auto s : in_->received())
-      if (auto st = out_->Publish(s); !st.ok()) return st;
+    for (const auto& s : in_->received()) {
+      reply_ = s;
+      if (auto st = out_->Publish(reply_); !st.ok()) return st;
+    }
     return dyad::Status::OK();
   }
 
  private:
+  dyad::msg::PingPong reply_;
   dyad::Input<dyad::msg::PingPong>* in_ = nullptr;
   dyad::Output<dyad::msg::PingPong>* out_ = nullptr;
 };
