@@ -229,6 +229,26 @@ TEST_F(OnlineFrontTest, APageClosedWhileItsOpenIsQueuedTakesNothingAndStopAllClo
   EXPECT_EQ(gone.count(), 0u);
 }
 
+TEST_F(OnlineFrontTest, APageWhoseFramesQueueUpPastOneMiBIsRefusedTheNextOne) {
+  OnlineFront front(study_, FrontOptions{"dyad", 2});
+  front.SetServer(server_.get());
+  Page page;
+  const web::ClientId client = Connect(page);
+  BlockTheLog();
+  auto open = std::async(std::launch::async, [&] { front.OnOpen(client, web::Role::kSubject); });
+  EXPECT_EQ(open.wait_for(kGuard), std::future_status::ready) << "OnOpen waited for the session log";
+  const int writer = Reader();  // the front's thread is held in the log: the frames queue up
+  ASSERT_GE(writer, 0) << "no one read P01's log";
+  const std::string frame(16 << 10, 'x');  // the front's largest frame (16 KiB)
+  for (int i = 0; i < 64; ++i) ASSERT_TRUE(front.OnText(client, frame).ok()) << "frame " << i + 1 << ": 1 MiB may wait";
+  const Status over = front.OnText(client, frame);
+  EXPECT_EQ(over.code(), Status::Code::kFailedPrecondition) << "the server closes the page with this (1008)";
+  EXPECT_NE(over.message().find("more than the study's server could take"), std::string::npos) << over.message();
+  UnblockTheLog([&] { return page.count() > 0; }, writer);
+  EXPECT_EQ(page.Op(1), "consent") << "what was queued before is handled";
+  front.StopAll();
+}
+
 TEST_F(OnlineFrontTest, StoppingASessionBetweenTrialsFreesItsPlaceAtOnce) {
   OnlineFront front(study_, FrontOptions{"dyad", 1});  // max_sessions 1
   front.SetServer(server_.get());
