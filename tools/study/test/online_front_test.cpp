@@ -249,6 +249,71 @@ TEST_F(OnlineFrontTest, APageWhoseFramesQueueUpPastOneMiBIsRefusedTheNextOne) {
   front.StopAll();
 }
 
+// A trial's "graph" that takes its page's relay and then reads nothing (a graph stuck): it binds a
+// loopback port with a small receive buffer, writes it where the front said (web.port_file),
+// answers the relay's WebSocket handshake, leaves a mark beside the port file, and waits for its
+// SIGINT.
+constexpr const char* kStuckGraph = R"(#!/usr/bin/env python3
+import base64, hashlib, os, signal, socket, sys
+signal.signal(signal.SIGINT, lambda *_: os._exit(0))
+port_file = next(a.split("port_file=", 1)[1] for a in sys.argv if ".port_file=" in a).strip(chr(39) + chr(34))  # unquoted
+s = socket.socket()
+s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+s.bind(("127.0.0.1", 0))
+s.listen(1)
+with open(port_file, "w") as f:
+    f.write("%d\n" % s.getsockname()[1])
+c, _ = s.accept()
+request = b""
+while b"\r\n\r\n" not in request:
+    request += c.recv(1)
+key = [l.split(b":", 1)[1].strip() for l in request.split(b"\r\n") if l.lower().startswith(b"sec-websocket-key:")][0]
+accept = base64.b64encode(hashlib.sha1(key + b"258EAFA5-E914-47DA-95CA-C5AB0DC85B11").digest())
+c.sendall(b"HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: " + accept + b"\r\n\r\n")
+open(os.path.join(os.path.dirname(port_file), "relayed"), "w").close()
+while True:
+    signal.pause()
+)";
+
+TEST_F(OnlineFrontTest, AFrameTheTrialsGraphDoesNotTakeDropsThePagesRelayNotTheTrial) {
+  const std::string graph = (dir_ / "stuck_graph.py").string();
+  std::ofstream(graph) << kStuckGraph;
+  fs::permissions(graph, fs::perms::owner_all);
+  study_.subject_web = "web";
+  ASSERT_TRUE(MarkConsent(study_, "P01", "in the test").ok());
+  const std::string tokens = study_.data + "/P01/web-tokens";
+  std::ofstream(tokens) << "subject 0123456789abcdef0123456789abcdef\n";
+  fs::permissions(tokens, fs::perms::owner_read | fs::perms::owner_write);
+  OnlineFront front(study_, FrontOptions{graph, 2, 15});
+  front.SetServer(server_.get());
+  Page waiting, trial;
+  const web::ClientId first = Connect(waiting);
+  front.OnOpen(first, web::Role::kSubject);
+  ASSERT_EQ(waiting.Op(1), "waiting");
+  ASSERT_TRUE(front.OnText(first, R"({"op":"ready"})").ok());
+  EXPECT_TRUE(waiting.Closed()) << "the trial starts: its page is closed (1012) and comes back";
+  const web::ClientId second = Connect(trial);
+  front.OnOpen(second, web::Role::kSubject);
+  const fs::path relayed = fs::path(study_.data) / "P01" / "relayed";
+  for (auto until = std::chrono::steady_clock::now() + kGuard; !fs::exists(relayed) && std::chrono::steady_clock::now() < until;)
+    std::this_thread::sleep_for(10ms);
+  ASSERT_TRUE(fs::exists(relayed)) << "the page was never relayed to the trial's graph";
+  // The page's frames, until the graph's socket is full: a write that waits past 100 ms drops the
+  // relay and closes the page (it reconnects), rather than holding the front's one thread.
+  const std::string frame(16 << 10, 'x');
+  size_t sent = 0;
+  for (int i = 0; i < 4096 && trial.count() == 0; ++i) {
+    if (front.OnText(second, frame).ok()) ++sent;
+    else std::this_thread::sleep_for(1ms);  // 1 MiB waits for the front's thread: it is behind
+    std::lock_guard<std::mutex> lock(trial.mutex);
+    if (trial.closed) break;
+  }
+  EXPECT_TRUE(trial.Closed()) << "the page was not closed after " << sent << " frames of 16 KiB that its graph did not read";
+  EXPECT_EQ(front.running(), 1) << "the trial goes on (the page reconnects to it)";
+  front.StopAll();  // the graph's SIGINT
+  EXPECT_EQ(front.running(), 0);
+}
+
 TEST_F(OnlineFrontTest, StoppingASessionBetweenTrialsFreesItsPlaceAtOnce) {
   OnlineFront front(study_, FrontOptions{"dyad", 1});  // max_sessions 1
   front.SetServer(server_.get());
