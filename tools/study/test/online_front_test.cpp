@@ -3,7 +3,9 @@
 // overflowed under ASan when OnOpen read the session log there), and the front's own thread does
 // the work. The session log is made a FIFO that no one writes, so any read of it blocks: the
 // calls must return all the same, and the page hears its phase once the test lets the read end.
-// The scripted pages of serve_test.sh cover the rest (a link open twice, max_sessions, trials).
+// Also: the queue's 1 MiB per page, the overview's stop freeing a place, and the relay's 100 ms
+// write limit (a python stand-in for the trial's graph that reads nothing). The scripted pages
+// of serve_test.sh cover the rest (a link open twice, max_sessions, trials of a real graph).
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
