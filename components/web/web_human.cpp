@@ -6,8 +6,12 @@ namespace dyad::web {
 
 void WebHuman::Describe(ComponentSpec& spec) {
   spec.Summary("The subject's pointer from the web page, sampled at the experiment's rate, as HumanInput.");
-  spec.Param("engage_timeout_s", 0.3).Min(1e-3).Unit("s").Doc(
-      "an engaged pointer silent for longer counts as released (the page sends a sample at least every 50 ms while engaged)");
+  spec.Param("engage_timeout_s", 0.3)
+      .Min(1e-3)
+      .Unit("s")
+      .Doc(
+          "an engaged pointer silent for longer counts as released (the page sends a sample at least every 50 ms "
+          "while engaged)");
   spec.Input<msg::HumanInput>("pointer").Doc(
       "raw pointer samples from the web component (browser event rate); its pause marker (x = y = NaN): one released sample, "
       "then nothing until the page is back (the mixer holds)");

@@ -2,22 +2,22 @@
 /// the page, robot state to it.
 ///
 /// Page -> server (JSON text): {"op":"pointer","x":..,"y":..,"engaged":bool,"t":ms} on every
-/// pointer or key event and, while engaged, after 50 ms without one (a keepalive); {"op":"steer"} to take the
-/// steering role; {"op":"self_report","choice":k} the subject's answer to "What were you
-/// drawing?" (k: a primitive's index, -1 "something else"; from the steering page only, a viewer's
-/// is refused), with "segment":i when it answers a question after the trial (below). Server -> page: {"op":"hello",...} (role, steering, workspace, engage key,
+/// pointer or key event and, while engaged, after 50 ms without one (a keepalive);
+/// {"op":"steer"} to take the steering role; {"op":"self_report","choice":k} the subject's answer
+/// to "What were you drawing?" (k: a primitive's index, -1 "something else"; from the steering
+/// page only, a viewer's is refused), with "segment":i when it answers a question after the trial
+/// (below). Server -> page: {"op":"hello",...} (role, steering, workspace, engage key,
 /// primitives, whether they are a watermark, whether and after how long a hold to ask),
 /// {"op":"role","steering":bool}, {"op":"task","target":k,"message":"..","countdown_s":s,
 /// "practice":bool} (the experimenter's task: sent to every page at each change and to a page
 /// that opens, its countdown as what is left of it then), {"op":"state","x","y"} (newest
 /// only: a slow page never builds a backlog), {"op":"ack","t":ms} after a pointer sample was
 /// published, at most one per kAckIntervalMs to a page (the page measures the round trip; an ack
-/// per sample, 60 a second, was a third of a participant's frames), {"op":"question","segment":i,"of":n,"stroke":
-/// [[x,y],...],"robot":[[x,y],...]} after the trial (the hold's stroke: the pointer's path while
-/// held, what the person drew; the robot's path meanwhile, maybe empty; segment -1: every
-/// question answered, "thank you"). A pointer
-/// sample may carry "wall" (the event's time, ms since the epoch): the channel then keeps the
-/// event-to-publication delay.
+/// per sample, 60 a second, was a third of a participant's frames), {"op":"question","segment":i,
+/// "of":n,"stroke":[[x,y],...],"robot":[[x,y],...]} after the trial (the hold's stroke: the
+/// pointer's path while held, what the person drew; the robot's path meanwhile, maybe empty;
+/// segment -1: every question answered, "thank you"). A pointer sample may carry "wall" (the
+/// event's time, ms since the epoch): the channel then keeps the event-to-publication delay.
 ///
 /// After the trial (self_reports: after_trial, AskAfterTrial): steering ends for good (the hold
 /// ends at once, every later pointer sample is published released) and the pages are asked about
@@ -29,9 +29,10 @@
 /// Several pages may watch; one steers: the first to connect with the subject's or the
 /// experimenter's token, until it leaves (the oldest such page left then steers, a subject's
 /// before an experimenter's) or another such page asks to steer. A subject's page that connects
-/// while an experimenter's steers takes the steering (the experimenter opened /subject first). A viewer's page only watches: a pointer sample or a steering request from
-/// it closes it. Only the steering page's pointer reaches the graph; when it disconnects, a
-/// disengaged sample is published at once.
+/// while an experimenter's steers takes the steering (the experimenter opened /subject first). A
+/// viewer's page only watches: a pointer sample or a steering request from it closes it. Only the
+/// steering page's pointer reaches the graph; when it disconnects, a disengaged sample is
+/// published at once.
 #pragma once
 
 #include <array>
