@@ -11,9 +11,10 @@
 #include <dyad/security.hpp>
 
 #include "dds/dds_participant.hpp"
-#include "graph/graph_topics.hpp"
 #include "exec/logger.hpp"
+#include "exec/step_clock.hpp"
 #include "exec/wall_clock.hpp"
+#include "graph/graph_topics.hpp"
 #include "graph/run_partition.hpp"
 
 namespace dyad {
@@ -43,7 +44,7 @@ thread_local NestFrame* t_frame __attribute__((tls_model("initial-exec"))) = nul
 
 class NestedTimer {
  public:
-  NestedTimer() : start_(SteadyNs()) {
+  NestedTimer() : start_(StepClockNow()) {
     frame_.parent = t_frame;
     t_frame = &frame_;
   }
@@ -52,11 +53,12 @@ class NestedTimer {
   ~NestedTimer() {
     if (!stopped_) Stop();
   }
-  int64_t start_ns() const { return start_; }
+  // The start, steady and wall time (exec/step_clock.hpp: one reading for both).
+  const ClockReading& start() const { return start_; }
   // Ends the region; returns its own time (its duration minus the regions nested in it).
   int64_t Stop() {
     stopped_ = true;
-    const int64_t total = SteadyNs() - start_;
+    const int64_t total = StepClockNow().steady_ns - start_.steady_ns;
     t_frame = frame_.parent;
     if (frame_.parent != nullptr) frame_.parent->nested_ns += total;
     return total - frame_.nested_ns;
@@ -64,7 +66,7 @@ class NestedTimer {
 
  private:
   NestFrame frame_;
-  int64_t start_;
+  ClockReading start_;
   bool stopped_ = false;
 };
 
@@ -73,9 +75,12 @@ class NestedTimer {
 class Executor::ClockImpl final : public Clock {
  public:
   explicit ClockImpl(bool stepped) : stepped_(stepped) {}
-  int64_t now_ns() const override {
+  // Wall time from the step path's clock (exec/step_clock.hpp: a wall-clock step shows within 1 ms).
+  int64_t now_ns() const override { return At(StepClockNow()); }
+  // The clock's time at `reading` (taken just before): simulated time in a stepped run.
+  int64_t At(const ClockReading& reading) const {
     if (stepped_) return sim_ns_.load(std::memory_order_acquire);
-    return WallNowNs();
+    return reading.wall_ns;
   }
   void Set(int64_t t) { sim_ns_.store(t, std::memory_order_release); }
   bool stepped() const { return stepped_; }
@@ -275,6 +280,9 @@ void Executor::Fail(const Status& status) {
 }
 
 Status Executor::Setup() {
+  // The step clock's origin: its TSC calibration starts here, long before the first step, and
+  // its one file read (the kernel's clocksource) is not on a step thread.
+  (void)detail::StepClockUsesTsc();
   if (Status s = CreateTransport(); !s.ok()) return s;
   for (const auto& rc : resolved_.components) {
     if (graph_.ProcessOf(*rc.config) != options_.process) continue;
@@ -403,8 +411,8 @@ Status Executor::BindPorts(Instance& inst) {
 // first cost a lock of our own and one of Fast DDS's per step: bench_pingpong.)
 Status Executor::StepOnce(Instance& inst, int64_t scheduled_steady_ns, bool periodic) {
   NestedTimer timer;
-  const int64_t t0 = timer.start_ns();
-  const int64_t now = clock_->now_ns();
+  const int64_t t0 = timer.start().steady_ns;
+  const int64_t now = clock_->At(timer.start());
   InputBase* const first = periodic ? nullptr : inst.trigger_port;
   if (first != nullptr && first->Poll(now) == 0) return Status::OK();
   if (live_params_) live_params_->BeforeStep(inst.slot);
