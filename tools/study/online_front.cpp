@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -40,6 +41,23 @@ constexpr std::chrono::milliseconds kRelayWrite{100};
 // A trial whose graph failed this many times in a row (a broken graph or machine) is not offered
 // again until `dyad study serve` restarts: the participant is asked to come back later.
 constexpr int kFailuresInARow = 3;
+
+// One line on stdout for the pointer delays through the front (nothing when none was relayed);
+// empties both.
+void LogPointerDelays(std::vector<double>& to_worker_ms, std::vector<double>& to_relayed_ms) {
+  if (to_worker_ms.empty()) return;
+  auto median_p99 = [](std::vector<double>& ms) {
+    std::sort(ms.begin(), ms.end());
+    char text[64];
+    std::snprintf(text, sizeof text, "median %.2f ms, p99 %.2f ms", ms[ms.size() / 2], ms[ms.size() * 99 / 100]);
+    return std::string(text);
+  };
+  std::cout << "pointer hops through the front: page -> a worker has the frame " << median_p99(to_worker_ms)
+            << "; -> relayed to the trial's graph " << median_p99(to_relayed_ms) << " (" << to_worker_ms.size() << " samples)"
+            << std::endl;
+  to_worker_ms.clear();
+  to_relayed_ms.clear();
+}
 constexpr const char* kBroken =
     "Something went wrong on our side, and the study cannot go on right now. Please come back later: your link stays "
     "valid.";
@@ -70,7 +88,7 @@ struct OnlineFront::Participant {
   const std::string id;
   OnlineSession session;
   std::atomic<bool> stop{false};
-  std::mutex worker_mutex;  // StartTrial (the handler thread) and StopAll (the server's loop)
+  std::mutex worker_mutex;  // StartTrial (the front's thread) and StopAll (the server's loop)
   std::thread worker;       // the running or last trial (under worker_mutex)
   // Under OnlineFront::mutex_:
   std::optional<SessionLock> lock;
@@ -153,8 +171,8 @@ std::string OnlineFront::Take(Participant& p, web::ClientId client, Clock::time_
   return "";
 }
 
-// The ClientHandler calls, on civetweb's workers (OnText on the server's handler thread, while a
-// worker waits): each only queues the event for the front's thread, never waiting for it.
+// The ClientHandler calls, on civetweb's workers (OnText too: study serve's endpoint says its
+// handler only queues): each only queues the event for the front's thread, never waiting for it.
 void OnlineFront::OnOpen(web::ClientId client, web::Role) {
   web::WebServer* server = server_.load();
   const auto it = server ? participants_.find(server->who(client)) : participants_.end();
@@ -180,7 +198,9 @@ Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
     return Status::FailedPrecondition("the page sent more than the study's server could take in time");
   }
   queued += text.size();
-  events_.push_back(Event{Event::Kind::kText, client, nullptr, std::string(text)});
+  const int64_t received_ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  events_.push_back(Event{Event::Kind::kText, client, nullptr, std::string(text), received_ns});
   events_cv_.notify_one();
   return Status::OK();
 }
@@ -211,7 +231,7 @@ void OnlineFront::Events() {
     }
     lock.Unlock();
     if (handle && e.kind == Event::Kind::kOpen) Open(*e.participant, e.client);
-    else if (e.kind == Event::Kind::kText) Text(e.client, e.text);
+    else if (e.kind == Event::Kind::kText) Text(e.client, e.text, e.received_ns);
     else if (e.kind == Event::Kind::kClose) Closed(e.client);
     lock.Lock();
   }
@@ -377,16 +397,28 @@ bool OnlineFront::Pong(Participant& p, std::string_view text) {
   return true;
 }
 
-// A relayed pointer sample: whether the person holds (the overview's "engaged").
-void OnlineFront::Pointer(Participant& p, std::string_view text) {
-  if (text.find("\"pointer\"") == std::string_view::npos) return;
+double OnlineFront::Pointer(Participant& p, std::string_view text) {
+  if (text.find("\"pointer\"") == std::string_view::npos) return -1;
   const Json j = Json::parse(text.begin(), text.end(), nullptr, false);
-  if (!j.is_object() || j.value("op", "") != "pointer" || !j.contains("engaged") || !j["engaged"].is_boolean()) return;
-  MutexLock lock(mutex_);
-  p.engaged = j["engaged"].get<bool>();
+  if (!j.is_object() || j.value("op", "") != "pointer" || !j.contains("engaged") || !j["engaged"].is_boolean()) return -1;
+  {
+    MutexLock lock(mutex_);
+    p.engaged = j["engaged"].get<bool>();
+  }
+  const auto wall = j.find("wall");
+  return wall != j.end() && wall->is_number() ? wall->get<double>() : -1;
 }
 
-void OnlineFront::Text(web::ClientId client, std::string_view text) {
+void OnlineFront::NotePointerDelay(double wall_ms, int64_t received_ns) {
+  if (to_worker_ms_.size() >= 1000000) return;  // a bound on memory (over 4 hours of one page)
+  const double received_ms = static_cast<double>(received_ns) / 1e6;
+  const double relayed_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
+  to_worker_ms_.push_back(received_ms - wall_ms);
+  to_relayed_ms_.push_back(relayed_ms - received_ms);
+}
+
+void OnlineFront::Text(web::ClientId client, std::string_view text, int64_t received_ns) {
   Participant* p = Of(client);
   if (p == nullptr) return;
   {
@@ -403,9 +435,10 @@ void OnlineFront::Text(web::ClientId client, std::string_view text) {
     running = p->running;
   }
   if (up) {
-    Pointer(*p, text);
+    const double wall_ms = Pointer(*p, text);
     if (Status st = up->SendText(text, kRelayWrite); !st.ok())
       NextPhase(*p, client, "the trial's graph does not take the page's frames");
+    else if (wall_ms >= 0) NotePointerDelay(wall_ms, received_ns);
     return;
   }
   if (!running) Answer(*p, client, text);
@@ -697,6 +730,7 @@ void OnlineFront::StopAll() {
   events_cv_.notify_all();
   for (web::ClientId client : unopened) Close(client, 1001, "the study's server is stopping");
   if (events_thread_.joinable()) events_thread_.join();  // the event it handles now (a page's phase, a trial's start)
+  LogPointerDelays(to_worker_ms_, to_relayed_ms_);
   for (auto& [id, p] : participants_) p->stop.store(true);
   for (auto& [id, p] : participants_) {
     std::lock_guard<std::mutex> worker(p->worker_mutex);

@@ -44,16 +44,17 @@
 //   - StopAll (SIGINT/SIGTERM): no trial starts any more, every running one is stopped as `dyad
 //     study run` stops it, and this returns once they have ended and every relay is closed.
 //
-// Threads: the ClientHandler calls come from the web server (see web_server.hpp): OnOpen and
-// OnClose on civetweb's workers, whose 100 KB stacks an ASan build overflowed reading a session
-// log there. So they and OnText only queue the page's event (a map look-up, no file, no lock
-// file, no send that waits) for the front's own thread (a normal stack), started with the front
-// and stopped by StopAll, which handles every page's events in the order they came: one page's
-// open, then its frames, then its close; a close that comes while its open is still queued ends
-// both unhandled. A page whose frames queue up past 1 MiB (the front's thread far behind) is
-// closed (1008) rather than held in memory. Tick comes from the server's loop; each trial runs on
-// a thread of its own, each relay's connection too. Everything shared is under one mutex, never
-// held while a socket is written or a trial runs.
+// Threads: the ClientHandler calls come from the web server (see web_server.hpp): OnOpen, OnClose
+// and (study serve's endpoint says its handler only queues) OnText on civetweb's workers, whose
+// 100 KB stacks an ASan build overflowed reading a session log there. So each only queues the
+// page's event (a map look-up, no file, no lock file, no send that waits) for the front's own
+// thread (a normal stack), started with the front and stopped by StopAll, which handles every
+// page's events in the order they came: one page's open, then its frames, then its close; a
+// close that comes while its open is still queued ends both unhandled. A page whose frames queue
+// up past 1 MiB (the front's thread far behind) is closed (1008) rather than held in memory.
+// Tick comes from the server's loop; each trial runs on a thread of its own, each relay's
+// connection too. Everything shared is under one mutex, never held while a socket is written or
+// a trial runs.
 #pragma once
 
 #include <atomic>
@@ -128,12 +129,13 @@ class OnlineFront final : public web::ClientHandler {
     web::ClientId client = 0;
     Participant* participant = nullptr;  // kOpen: whose link the page opened
     std::string text;                    // kText
+    int64_t received_ns = 0;             // kText: when a worker had it (wall clock, ns since the epoch)
   };
   // The front's thread: the queued events, one at a time, until StopAll.
   void Events();
   // On the front's thread: a page opened, a frame, a page closed.
   void Open(Participant& p, web::ClientId client);
-  void Text(web::ClientId client, std::string_view text);
+  void Text(web::ClientId client, std::string_view text, int64_t received_ns);
   void Closed(web::ClientId client);
   // Why `client` may not be p's page now ("" when it is, from now on). `final`: p's session is
   // done or refused (its page is only told so): max_sessions does not apply.
@@ -148,7 +150,12 @@ class OnlineFront final : public web::ClientHandler {
   // closed (1000, 1008: it keeps its view and does not come back) and its session is not live.
   void SendPhase(Participant& p, web::ClientId client);
   bool Pong(Participant& p, std::string_view text);
-  void Pointer(Participant& p, std::string_view text);
+  // A relayed frame: a pointer sample's "engaged" for the overview; returns its page's stamp
+  // "wall" (ms since the epoch), or a negative number when it has none.
+  double Pointer(Participant& p, std::string_view text);
+  // The pointer delays through the front (page -> a worker has the frame -> relayed), logged on
+  // StopAll (bench/capacity reads them): where the graph's "page -> socket" goes.
+  void NotePointerDelay(double wall_ms, int64_t received_ns);
   void Answer(Participant& p, web::ClientId client, std::string_view text);
   // Starts p's next trial; a trial that cannot start (its token file unreadable, its graph failed
   // kFailuresInARow times) returns what its page is told ("" when started or nothing to say).
@@ -173,6 +180,7 @@ class OnlineFront final : public web::ClientHandler {
   std::map<web::ClientId, size_t> queued_bytes_ GUARDED_BY(events_mutex_);  // a page's frames queued
   std::set<web::ClientId> opening_ GUARDED_BY(events_mutex_);  // opens queued (a close meanwhile erases one: neither is handled)
   bool events_stopped_ GUARDED_BY(events_mutex_) = false;
+  std::vector<double> to_worker_ms_, to_relayed_ms_;  // the front's thread only (read after it ends)
   std::thread events_thread_;  // last: started once the rest is made
 };
 

@@ -100,7 +100,9 @@ web::WebServer::Options ServerOptions(const ServeOptions& o, const std::vector<s
     return admission->Admit(token, remote, FrontAdmission::Clock::now());
   };
   so.pages["/subject"] = web::WebServer::Page{"text/html; charset=utf-8", web::kSubjectHtml, {web::Role::kSubject}, ""};
-  so.endpoints.push_back(web::WebServer::Endpoint{"/subject/ws", {}, front, {web::Role::kSubject}, /*viewers=*/false});
+  web::WebServer::Endpoint pages{"/subject/ws", {}, front, {web::Role::kSubject}, /*viewers=*/false};
+  pages.handler_only_queues = true;  // the front's OnText only queues (online_front.hpp, Threads)
+  so.endpoints.push_back(pages);
   so.pages["/overview"] = web::WebServer::Page{"text/html; charset=utf-8", kOverviewHtml, {web::Role::kExperimenter}, ""};
   so.endpoints.push_back(web::WebServer::Endpoint{"/overview/ws", {}, overview, {web::Role::kExperimenter}, /*viewers=*/false});
   so.max_clients = 4 * max_sessions + 16;  // the refused pages are told so over their socket

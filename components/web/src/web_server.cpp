@@ -206,7 +206,9 @@ bool IsLoopback(const std::string& address) {
 
 // civetweb's worker threads have small stacks (an ASan build overflowed one parsing a small JSON
 // message): client messages are handled on this thread of ours, with a normal stack, one at a
-// time, while the worker waits.
+// time, while the worker waits. Each waiting worker is woken by its own task's end only: with one
+// condition variable for all, every task's end woke every worker waiting (a study server's dozens
+// of pages: a wake-up of each per frame, and the frames' latency grew with their number).
 class WebServer::HandlerThread {
  public:
   HandlerThread() : thread_([this] { Loop(); }) {}
@@ -215,37 +217,42 @@ class WebServer::HandlerThread {
       std::lock_guard<std::mutex> lock(mutex_);
       stop_ = true;
     }
-    cv_.notify_all();
+    work_.notify_one();
     thread_.join();
   }
   // Runs `task` on the handler thread and returns when it is done.
   void Run(const std::function<void()>& task) {
+    Pending pending;
+    pending.task = &task;
     std::unique_lock<std::mutex> lock(mutex_);
-    const uint64_t ticket = ++posted_;
-    tasks_.push_back(&task);
-    cv_.notify_all();
-    cv_.wait(lock, [&] { return done_ >= ticket; });
+    tasks_.push_back(&pending);
+    work_.notify_one();
+    pending.ended.wait(lock, [&] { return pending.done; });
   }
 
  private:
+  struct Pending {
+    const std::function<void()>* task = nullptr;
+    bool done = false;
+    std::condition_variable ended;
+  };
   void Loop() {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
-      cv_.wait(lock, [&] { return stop_ || !tasks_.empty(); });
+      work_.wait(lock, [&] { return stop_ || !tasks_.empty(); });
       if (tasks_.empty()) return;  // stop_ and nothing left
-      const std::function<void()>* task = tasks_.front();
+      Pending* pending = tasks_.front();
       tasks_.pop_front();
       lock.unlock();
-      (*task)();
+      (*pending->task)();
       lock.lock();
-      ++done_;
-      cv_.notify_all();
+      pending->done = true;
+      pending->ended.notify_one();  // under the lock: the waiter cannot leave (and free it) first
     }
   }
   std::mutex mutex_;
-  std::condition_variable cv_;
-  std::deque<const std::function<void()>*> tasks_;
-  uint64_t posted_ = 0, done_ = 0;
+  std::condition_variable work_;
+  std::deque<Pending*> tasks_;
   bool stop_ = false;
   std::thread thread_;
 };
@@ -254,6 +261,7 @@ struct WebServer::EndpointState {
   WebServer* server = nullptr;
   ClientHandler* handler = nullptr;
   bool viewers = true;
+  bool handler_only_queues = false;
   std::set<Role> roles;
   std::vector<const char*> protocol_ptrs;
   mg_websocket_subprotocols protocols{};
@@ -338,6 +346,7 @@ StatusOr<std::unique_ptr<WebServer>> WebServer::Start(const Options& options) {
     st->server = s.get();
     st->handler = e.handler;
     st->viewers = e.viewers;
+    st->handler_only_queues = e.handler_only_queues;
     st->roles = e.roles;
     for (const auto& p : e.subprotocols) st->protocol_ptrs.push_back(p.c_str());
     st->protocols.nb_subprotocols = static_cast<int>(st->protocol_ptrs.size());
@@ -584,15 +593,22 @@ int WebServer::OnData(mg_connection* conn, int bits, char* data, size_t len, voi
     return 0;
   }
   Status s;
-  const int64_t received_ns =
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-  self->handler_thread_->Run([&] {
-    self->message_received_ns_ = received_ns;
+  auto handle = [&] {
     if (opcode == MG_WEBSOCKET_OPCODE_TEXT) s = handler->OnText(id, std::string_view(data, len));
     else if (opcode == MG_WEBSOCKET_OPCODE_BINARY)
       s = handler->OnBinary(id, std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(data), len));
     else s = Status::InvalidArgument("unknown opcode " + std::to_string(opcode));
-  });
+  };
+  if (static_cast<EndpointState*>(endpoint)->handler_only_queues) {
+    handle();
+  } else {
+    const int64_t received_ns =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+    self->handler_thread_->Run([&] {
+      self->message_received_ns_ = received_ns;
+      handle();
+    });
+  }
   if (!s.ok()) {
     WriteClose(conn, kClosePolicy, s.message());
     return 0;

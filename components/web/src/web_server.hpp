@@ -109,10 +109,13 @@ std::vector<std::string> UrlHosts(const std::string& address);
 //   - OnOpen and OnClose run on the civetweb worker thread that serves the client's connection
 //     (for a client still open when the server stops, while ~WebServer waits for it).
 //   - OnText and OnBinary run on the server's one handler thread (a normal stack: civetweb's are
-//     small), one message at a time across all clients, while the client's worker waits.
+//     small), one message at a time across all clients, while the client's worker waits; or,
+//     for an endpoint whose handler only queues (Endpoint::handler_only_queues), on the client's
+//     worker itself, two clients' messages then at the same time.
 // So one client's calls never overlap and come in order (OnOpen, messages, OnClose), and two
-// clients' messages never overlap either; but one client's OnOpen or OnClose may run while
-// another client's OnText or OnBinary does. Producers calling Send* run on their own threads.
+// clients' messages never overlap either (unless the handler only queues); but one client's
+// OnOpen or OnClose may run while another client's OnText or OnBinary does. Producers calling
+// Send* run on their own threads.
 class ClientHandler {
  public:
   virtual ~ClientHandler() = default;
@@ -142,6 +145,12 @@ class WebServer {
     // first) yet get a fair share of the CPU. False: every sample at once, normal scheduling
     // (the subject's page, whose robot state is what the subject steers by).
     bool viewers = true;
+    // The handler's OnText/OnBinary only queue the frame for a thread of its own (a lock, a push,
+    // a notify: a shallow stack): they are then called on civetweb's worker, with no hand-over to
+    // the server's handler thread (a wake-up of that thread and one of the worker per frame; the
+    // study server relays dozens of pages' pointer streams). message_received_ns() is not set for
+    // them. False: on the handler thread (see the Stacks paragraph above).
+    bool handler_only_queues = false;
   };
   struct Options {
     std::string address = "127.0.0.1";

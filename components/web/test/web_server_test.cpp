@@ -15,8 +15,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <mutex>
 #include <thread>
+#include <vector>
+
+#include "ws_client.hpp"
 
 namespace dyad::web {
 namespace {
@@ -436,6 +440,65 @@ TEST(WebServer, AnUnusableCertificateIsAClearError) {
   ASSERT_FALSE(server.ok());
   EXPECT_NE(server.status().message().find(pem), std::string::npos) << server.status().ToString();
   std::filesystem::remove_all(dir);
+}
+
+// Which thread each text frame reached the handler on, per client, in order.
+class ThreadRecordingHandler final : public ClientHandler {
+ public:
+  void OnOpen(ClientId, Role) override {}
+  Status OnText(ClientId client, std::string_view text) override {
+    std::lock_guard<std::mutex> lock(mutex);
+    frames[client].push_back({std::string(text), std::this_thread::get_id()});
+    return Status::OK();
+  }
+  Status OnBinary(ClientId, std::span<const uint8_t>) override { return Status::OK(); }
+  void OnClose(ClientId) override {}
+  size_t count() {
+    std::lock_guard<std::mutex> lock(mutex);
+    size_t n = 0;
+    for (const auto& f : frames) n += f.second.size();
+    return n;
+  }
+  std::mutex mutex;
+  std::map<ClientId, std::vector<std::pair<std::string, std::thread::id>>> frames;
+};
+
+// An endpoint whose handler only queues (the study server's) gets each client's frames on that
+// client's own worker: two clients on two threads, none of them the handler thread, which takes
+// every client's frames of an ordinary endpoint one at a time. Each client's frames in order.
+TEST(WebServer, AHandlerThatOnlyQueuesIsCalledOnEachClientsOwnWorker) {
+  for (const bool only_queues : {false, true}) {
+    SCOPED_TRACE(only_queues ? "handler_only_queues" : "on the handler thread");
+    ThreadRecordingHandler handler;
+    WebServer::Options o;
+    o.port = 0;
+    o.tokens = {{Role::kSubject, kSubject}};
+    o.endpoints = {WebServer::Endpoint{"/ws", {}, &handler, {Role::kSubject}, false, only_queues}};
+    auto server = WebServer::Start(o);
+    ASSERT_TRUE(server.ok()) << server.status().ToString();
+    auto a = WsClient::Connect("127.0.0.1", (*server)->port(), "/ws?token=" + kSubject, {}, std::chrono::seconds(5));
+    auto b = WsClient::Connect("127.0.0.1", (*server)->port(), "/ws?token=" + kSubject, {}, std::chrono::seconds(5));
+    ASSERT_TRUE(a.ok() && b.ok());
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_TRUE((*a)->SendText("a" + std::to_string(i)).ok());
+      ASSERT_TRUE((*b)->SendText("b" + std::to_string(i)).ok());
+    }
+    ASSERT_TRUE(WaitFor([&] { return handler.count() == 6; }, std::chrono::seconds(5)));
+    std::lock_guard<std::mutex> lock(handler.mutex);
+    ASSERT_EQ(handler.frames.size(), 2u);
+    std::vector<std::thread::id> threads;
+    for (const auto& [client, frames] : handler.frames) {
+      const char name = frames[0].first[0];
+      for (size_t i = 0; i < frames.size(); ++i) {
+        EXPECT_EQ(frames[i].first, std::string(1, name) + std::to_string(i));
+        EXPECT_EQ(frames[i].second, frames[0].second) << "one client's frames on one thread";
+        EXPECT_NE(frames[i].second, std::this_thread::get_id());
+      }
+      threads.push_back(frames[0].second);
+    }
+    if (only_queues) EXPECT_NE(threads[0], threads[1]) << "each client's own worker";
+    else EXPECT_EQ(threads[0], threads[1]) << "the one handler thread";
+  }
 }
 
 }  // namespace
