@@ -85,7 +85,8 @@ TEST_P(StepClockTest, AStepOfTheWallClockShowsWithinOneMillisecond) {
         const int64_t steady_before = SteadyNs(), wall_before = SteppedWallNs();
         const ClockReading r = StepClockNow();
         const int64_t wall_after = SteppedWallNs();
-        if (steady_before < stepped_at + kAnchorNs) continue;
+        // 1 ms after the step, as the TSC's measured rate counts it: 1% of margin for its error.
+        if (steady_before < stepped_at + kAnchorNs + kAnchorNs / 100) continue;
         ASSERT_GE(r.wall_ns, wall_before - kToleranceNs)
             << "a step of " << step << " ns not seen after " << steady_before - stepped_at << " ns";
         ASSERT_LE(r.wall_ns, wall_after + kToleranceNs)

@@ -37,8 +37,7 @@ uint64_t ReadTsc() {
 bool TscUsable() {
 #if defined(__x86_64__)
   unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
-  if (__get_cpuid_max(0x80000000, nullptr) < 0x80000007) return false;
-  __get_cpuid(0x80000007, &eax, &ebx, &ecx, &edx);
+  if (__get_cpuid(0x80000007, &eax, &ebx, &ecx, &edx) == 0) return false;  // 0: no such leaf
   if ((edx & (1u << 8)) == 0) return false;
   std::ifstream in("/sys/devices/system/clocksource/clocksource0/current_clocksource");
   std::string source;

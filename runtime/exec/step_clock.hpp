@@ -14,7 +14,8 @@
 //   reading instead of two). NTP slews CLOCK_MONOTONIC and CLOCK_REALTIME alike, so only a step of
 //   the wall clock (settimeofday, an NTP step) changes the difference: it is measured again on a
 //   thread's first reading at least kAnchorNs (1 ms) of steady time after the last measurement.
-//   Bound: a reading reflects every step of the wall clock made at least 1 ms before it.
+//   Bound: a reading reflects every step of the wall clock made at least 1 ms before it (with the
+//   TSC, 1 ms as its measured rate counts it: a few ppm off).
 // - Steady readings never go back on one thread (a new anchor's CLOCK_MONOTONIC may lie a few ns
 //   behind the extrapolation: the rate is an average, and NTP may slew the clock meanwhile; such
 //   a reading repeats the previous one). Between threads they agree to that extrapolation error
