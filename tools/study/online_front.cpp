@@ -1,6 +1,7 @@
 #include "online_front.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -36,11 +37,45 @@ constexpr std::chrono::milliseconds kRelayRetry{200};
 // floods): the page is closed rather than its frames held in memory.
 constexpr size_t kQueuedBytes = 1 << 20;
 // A relayed frame the trial's graph cannot take within this (it stopped reading) drops the relay
-// (the page reconnects) rather than holding the front's one thread, every page's.
+// (the page reconnects) rather than holding the thread that relays it (the page's worker, or the
+// front's one thread, every page's).
 constexpr std::chrono::milliseconds kRelayWrite{100};
 // A trial whose graph failed this many times in a row (a broken graph or machine) is not offered
 // again until `dyad study serve` restarts: the participant is asked to come back later.
 constexpr int kFailuresInARow = 3;
+
+int64_t WallNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+// What the front reads of a relayed pointer sample, without a JSON parser (every frame of every
+// page passes here, on a civetweb worker's small stack): the page's frames are JSON.stringify's,
+// {"op":"pointer","x":..,"y":..,"engaged":true,"wall":..,...}. A frame written otherwise (spaces
+// around the colons of "op") is relayed all the same; the overview then shows no "engaged" for it.
+struct PointerScan {
+  std::optional<bool> engaged;
+  double wall_ms = -1;  // the page's stamp; negative: none
+};
+PointerScan ScanPointer(std::string_view text) {
+  PointerScan scan;
+  if (text.find("\"op\":\"pointer\"") == std::string_view::npos) return scan;
+  auto value_of = [text](std::string_view key) -> std::string_view {
+    size_t at = text.find(key);
+    if (at == std::string_view::npos) return {};
+    at = text.find_first_not_of(" \t", at + key.size());
+    if (at == std::string_view::npos || text[at] != ':') return {};
+    at = text.find_first_not_of(" \t", at + 1);
+    return at == std::string_view::npos ? std::string_view{} : text.substr(at);
+  };
+  const std::string_view engaged = value_of("\"engaged\"");
+  if (engaged.starts_with("true")) scan.engaged = true;
+  else if (engaged.starts_with("false")) scan.engaged = false;
+  const std::string_view wall = value_of("\"wall\"");
+  double ms = 0;
+  if (std::from_chars(wall.data(), wall.data() + wall.size(), ms).ec == std::errc() && std::isfinite(ms) && ms >= 0)
+    scan.wall_ms = ms;
+  return scan;
+}
 
 // One line on stdout for the pointer delays through the front (nothing when none was relayed);
 // empties both.
@@ -190,6 +225,8 @@ void OnlineFront::OnOpen(web::ClientId client, web::Role) {
 }
 
 Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
+  const int64_t received_ns = WallNs();
+  if (RelayAtOnce(client, text, received_ns)) return Status::OK();
   MutexLock lock(events_mutex_);
   if (events_stopped_) return Status::OK();
   size_t& queued = queued_bytes_[client];
@@ -198,8 +235,7 @@ Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
     return Status::FailedPrecondition("the page sent more than the study's server could take in time");
   }
   queued += text.size();
-  const int64_t received_ns =
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  ++in_flight_[client];
   events_.push_back(Event{Event::Kind::kText, client, nullptr, std::string(text), received_ns});
   events_cv_.notify_one();
   return Status::OK();
@@ -234,6 +270,8 @@ void OnlineFront::Events() {
     else if (e.kind == Event::Kind::kText) Text(e.client, e.text, e.received_ns);
     else if (e.kind == Event::Kind::kClose) Closed(e.client);
     lock.Lock();
+    if (const auto f = in_flight_.find(e.client); e.kind == Event::Kind::kText && f != in_flight_.end() && --f->second == 0)
+      in_flight_.erase(f);  // handled: the page's next frame may go at once
   }
 }
 
@@ -398,24 +436,43 @@ bool OnlineFront::Pong(Participant& p, std::string_view text) {
 }
 
 double OnlineFront::Pointer(Participant& p, std::string_view text) {
-  if (text.find("\"pointer\"") == std::string_view::npos) return -1;
-  const Json j = Json::parse(text.begin(), text.end(), nullptr, false);
-  if (!j.is_object() || j.value("op", "") != "pointer" || !j.contains("engaged") || !j["engaged"].is_boolean()) return -1;
-  {
+  const PointerScan scan = ScanPointer(text);
+  if (scan.engaged) {
     MutexLock lock(mutex_);
-    p.engaged = j["engaged"].get<bool>();
+    p.engaged = *scan.engaged;
   }
-  const auto wall = j.find("wall");
-  return wall != j.end() && wall->is_number() ? wall->get<double>() : -1;
+  return scan.wall_ms;
 }
 
 void OnlineFront::NotePointerDelay(double wall_ms, int64_t received_ns) {
-  if (to_worker_ms_.size() >= 1000000) return;  // a bound on memory (over 4 hours of one page)
   const double received_ms = static_cast<double>(received_ns) / 1e6;
-  const double relayed_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
+  const double relayed_ms = static_cast<double>(WallNs()) / 1e6;
+  MutexLock lock(delays_mutex_);
+  if (to_worker_ms_.size() >= 1000000) return;  // a bound on memory (over 4 hours of one page)
   to_worker_ms_.push_back(received_ms - wall_ms);
   to_relayed_ms_.push_back(relayed_ms - received_ms);
+}
+
+bool OnlineFront::RelayAtOnce(web::ClientId client, std::string_view text, int64_t received_ns) {
+  if (text.find("\"pong\"") != std::string_view::npos) return false;  // the front's own round trip, not relayed
+  {
+    MutexLock lock(events_mutex_);
+    if (events_stopped_ || opening_.count(client) > 0 || in_flight_.count(client) > 0) return false;
+  }
+  Participant* p = nullptr;
+  std::shared_ptr<web::WsClient> up;
+  {
+    MutexLock lock(mutex_);
+    const auto it = clients_.find(client);
+    if (it == clients_.end() || it->second->page != client || !it->second->upstream) return false;
+    p = it->second;
+    up = p->upstream;
+    p->heard = Clock::now();
+  }
+  const double wall_ms = Pointer(*p, text);
+  if (!up->SendText(text, kRelayWrite).ok()) return false;  // the front's thread tries it again, and ends the phase
+  if (wall_ms >= 0) NotePointerDelay(wall_ms, received_ns);
+  return true;
 }
 
 void OnlineFront::Text(web::ClientId client, std::string_view text, int64_t received_ns) {
@@ -726,11 +783,15 @@ void OnlineFront::StopAll() {
     opening_.clear();
     events_.clear();
     queued_bytes_.clear();
+    in_flight_.clear();
   }
   events_cv_.notify_all();
   for (web::ClientId client : unopened) Close(client, 1001, "the study's server is stopping");
   if (events_thread_.joinable()) events_thread_.join();  // the event it handles now (a page's phase, a trial's start)
-  LogPointerDelays(to_worker_ms_, to_relayed_ms_);
+  {
+    MutexLock lock(delays_mutex_);
+    LogPointerDelays(to_worker_ms_, to_relayed_ms_);
+  }
   for (auto& [id, p] : participants_) p->stop.store(true);
   for (auto& [id, p] : participants_) {
     std::lock_guard<std::mutex> worker(p->worker_mutex);

@@ -52,6 +52,8 @@
 // page's events in the order they came: one page's open, then its frames, then its close; a
 // close that comes while its open is still queued ends both unhandled. A page whose frames queue
 // up past 1 MiB (the front's thread far behind) is closed (1008) rather than held in memory.
+// Except during a trial: a page's frame is relayed by the worker that read it (RelayAtOnce), unless
+// one of the page's events still waits for the front's thread (then it queues behind them).
 // Tick comes from the server's loop; each trial runs on a thread of its own, each relay's
 // connection too. Everything shared is under one mutex, never held while a socket is written or
 // a trial runs.
@@ -116,7 +118,8 @@ class OnlineFront final : public web::ClientHandler {
   Status StopSession(const std::string& participant, const std::string& reason);
   Status ResumeSession(const std::string& participant);
 
-  // Each only queues the page's event for the front's thread (see Threads above).
+  // Each only queues the page's event for the front's thread (see Threads above); but a frame of a
+  // page whose trial runs, with none of the page's events waiting, is relayed at once (RelayAtOnce).
   void OnOpen(web::ClientId client, web::Role role) override;
   Status OnText(web::ClientId client, std::string_view text) override;
   Status OnBinary(web::ClientId, std::span<const uint8_t>) override { return Status::OK(); }
@@ -153,6 +156,11 @@ class OnlineFront final : public web::ClientHandler {
   // A relayed frame: a pointer sample's "engaged" for the overview; returns its page's stamp
   // "wall" (ms since the epoch), or a negative number when it has none.
   double Pointer(Participant& p, std::string_view text);
+  // On the worker that read the frame: relays it to the page's trial when one runs and none of the
+  // page's events wait for the front's thread (they go first: a page's frames keep their order),
+  // so a page's frames do not queue behind every other page's on one thread. False: the frame is
+  // for the front's thread (a pong, no trial, an earlier event waiting, a write that failed).
+  bool RelayAtOnce(web::ClientId client, std::string_view text, int64_t received_ns);
   // The pointer delays through the front (page -> a worker has the frame -> relayed), logged on
   // StopAll (bench/capacity reads them): where the graph's "page -> socket" goes.
   void NotePointerDelay(double wall_ms, int64_t received_ns);
@@ -180,7 +188,9 @@ class OnlineFront final : public web::ClientHandler {
   std::map<web::ClientId, size_t> queued_bytes_ GUARDED_BY(events_mutex_);  // a page's frames queued
   std::set<web::ClientId> opening_ GUARDED_BY(events_mutex_);  // opens queued (a close meanwhile erases one: neither is handled)
   bool events_stopped_ GUARDED_BY(events_mutex_) = false;
-  std::vector<double> to_worker_ms_, to_relayed_ms_;  // the front's thread only (read after it ends)
+  std::map<web::ClientId, int> in_flight_ GUARDED_BY(events_mutex_);  // a page's frames queued or being handled
+  Mutex delays_mutex_;
+  std::vector<double> to_worker_ms_ GUARDED_BY(delays_mutex_), to_relayed_ms_ GUARDED_BY(delays_mutex_);
   std::thread events_thread_;  // last: started once the rest is made
 };
 

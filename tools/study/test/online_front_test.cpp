@@ -15,6 +15,7 @@
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <future>
 #include <mutex>
 #include <string>
@@ -314,6 +315,121 @@ TEST_F(OnlineFrontTest, AFrameTheTrialsGraphDoesNotTakeDropsThePagesRelayNotTheT
   EXPECT_EQ(front.running(), 1) << "the trial goes on (the page reconnects to it)";
   front.StopAll();  // the graph's SIGINT
   EXPECT_EQ(front.running(), 0);
+}
+
+// A trial's "graph" that takes its page's relay and writes each text frame it reads, one a line,
+// into "relayed" beside its port file.
+constexpr const char* kRecordingGraph = R"(#!/usr/bin/env python3
+import base64, hashlib, os, signal, socket, sys
+signal.signal(signal.SIGINT, lambda *_: os._exit(0))
+port_file = next(a.split("port_file=", 1)[1] for a in sys.argv if ".port_file=" in a).strip(chr(39) + chr(34))
+out = os.path.join(os.path.dirname(port_file), "relayed")
+s = socket.socket()
+s.bind(("127.0.0.1", 0))
+s.listen(1)
+with open(port_file, "w") as f:
+    f.write("%d\n" % s.getsockname()[1])
+c, _ = s.accept()
+request = b""
+while b"\r\n\r\n" not in request:
+    request += c.recv(1)
+key = [l.split(b":", 1)[1].strip() for l in request.split(b"\r\n") if l.lower().startswith(b"sec-websocket-key:")][0]
+accept = base64.b64encode(hashlib.sha1(key + b"258EAFA5-E914-47DA-95CA-C5AB0DC85B11").digest())
+c.sendall(b"HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: " + accept + b"\r\n\r\n")
+def read(n):
+    data = b""
+    while len(data) < n:
+        chunk = c.recv(n - len(data))
+        if not chunk:
+            signal.pause()
+        data += chunk
+    return data
+while True:
+    head = read(2)
+    n = head[1] & 127
+    if n == 126:
+        n = int.from_bytes(read(2), "big")
+    mask = read(4)
+    data = bytes(b ^ mask[i % 4] for i, b in enumerate(read(n)))
+    if head[0] & 15 == 1:
+        with open(out, "a") as f:
+            f.write(data.decode() + "\n")
+)";
+
+// Whether `done` came true within `limit` (looked at every 10 ms).
+bool Within(std::chrono::milliseconds limit, const std::function<bool()>& done) {
+  for (const auto until = std::chrono::steady_clock::now() + limit; !done();) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(10ms);
+  }
+  return true;
+}
+
+// The lines the recording graph has written (none yet: empty).
+std::vector<std::string> Relayed(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// During a trial a page's frames go to its graph from the thread that read them: they do not wait
+// while the front's one thread is held by another page (here P02's session log, which no one
+// writes); and they keep their order: a frame that comes while one of the page's own events waits
+// for the front's thread (a pong) goes after it.
+TEST_F(OnlineFrontTest, ATrialsFramesAreRelayedAtOnceAndInOrderWhileTheFrontsThreadIsHeld) {
+  const std::string graph = (dir_ / "recording_graph.py").string();
+  std::ofstream(graph) << kRecordingGraph;
+  fs::permissions(graph, fs::perms::owner_all);
+  study_.subject_web = "web";
+  ASSERT_TRUE(MarkConsent(study_, "P01", "in the test").ok());
+  const std::string tokens = study_.data + "/P01/web-tokens";
+  std::ofstream(tokens) << "subject 0123456789abcdef0123456789abcdef\n";
+  fs::permissions(tokens, fs::perms::owner_read | fs::perms::owner_write);
+  OnlineFront front(study_, FrontOptions{graph, 2, 15});
+  front.SetServer(server_.get());
+  Page waiting, trial, other;
+  const web::ClientId first = Connect(waiting);
+  front.OnOpen(first, web::Role::kSubject);
+  ASSERT_EQ(waiting.Op(1), "waiting");
+  ASSERT_TRUE(front.OnText(first, R"({"op":"ready"})").ok());
+  ASSERT_TRUE(waiting.Closed()) << "the trial starts: its page is closed (1012) and comes back";
+  const web::ClientId page = Connect(trial);
+  front.OnOpen(page, web::Role::kSubject);
+  const fs::path relayed = fs::path(study_.data) / "P01" / "relayed";
+  const std::string a = R"({"op":"pointer","x":1,"y":2,"engaged":true,"wall":1})";
+  // Sent until the relay is up (the graph starting).
+  ASSERT_TRUE(Within(kGuard, [&] { return front.OnText(page, a).ok() && !Relayed(relayed).empty(); }))
+      << "the page was never relayed to the trial's graph";
+
+  // P02's page opens: the front's thread reads P02's session log, a FIFO no one writes yet.
+  const std::string log02 = SessionLogPath(study_, "P02");
+  fs::create_directories(fs::path(log02).parent_path());
+  fs::create_hard_link(fifo_, log02);
+  front.OnOpen(Connect(other, "P02"), web::Role::kSubject);
+  const int writer = Reader();
+  ASSERT_GE(writer, 0) << "the front's thread did not read P02's log";
+  const size_t before = Relayed(relayed).size();
+  const std::string b = R"({"op":"pointer","x":3,"y":4,"engaged":false,"wall":2})";
+  ASSERT_TRUE(front.OnText(page, b).ok());
+  Within(2s, [&] { return Relayed(relayed).size() > before; });
+  EXPECT_EQ(Relayed(relayed).size(), before + 1) << "a trial's frame waited for the front's thread, held by another page";
+
+  // A pong waits for the front's thread (it is the front's, not relayed); the frame after it too.
+  ASSERT_TRUE(front.OnText(page, R"({"op":"pong","id":1})").ok());
+  const std::string c = R"({"op":"pointer","x":5,"y":6,"engaged":true,"wall":3})";
+  ASSERT_TRUE(front.OnText(page, c).ok());
+  std::this_thread::sleep_for(300ms);
+  EXPECT_EQ(Relayed(relayed).size(), before + 1) << "a frame overtook its page's pong, which waits for the front's thread";
+  fs::remove(log02);
+  std::ofstream(log02).close();
+  ASSERT_EQ(::close(writer), 0);  // P02's read ends (an empty log): the front's thread goes on
+  Within(kGuard, [&] { return Relayed(relayed).size() >= before + 2; });
+  const std::vector<std::string> lines = Relayed(relayed);
+  ASSERT_EQ(lines.size(), before + 2);
+  EXPECT_EQ(lines[before], b);
+  EXPECT_EQ(lines[before + 1], c) << "then the frame behind the pong, relayed by the front's thread";
+  front.StopAll();
 }
 
 TEST_F(OnlineFrontTest, StoppingASessionBetweenTrialsFreesItsPlaceAtOnce) {
