@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 
 namespace dyad {
 
@@ -34,16 +35,35 @@ InterruptWatcher::~InterruptWatcher() {
 }
 
 int InterruptWatcher::NextSignal() {
-  if (signal_fd_ < 0 || wake_fd_ < 0) {
-    // No descriptor to spare (EMFILE): look every 50 ms instead of sleeping until woken.
+  if (looking_ || signal_fd_ < 0 || wake_fd_ < 0) {
+    // No descriptor to spare (EMFILE), or they failed: look every 50 ms instead of sleeping until woken.
     timespec ts{0, 50'000'000};
     return sigtimedwait(&set_, nullptr, &ts);
   }
   pollfd fds[2] = {{signal_fd_, POLLIN, 0}, {wake_fd_, POLLIN, 0}};
-  if (poll(fds, 2, -1) <= 0 || (fds[1].revents & POLLIN)) return 0;  // EINTR, or woken to end
+  const int ready = poll(fds, 2, -1);
+  if (ready < 0) return errno == EINTR ? 0 : LookFromNowOn("poll", errno);
+  if (fds[1].revents & POLLIN) return 0;  // woken to end
+  // A descriptor closed under it (POLLNVAL) or in error: polling again would return at once.
+  const int events = fds[0].revents | fds[1].revents;
+  if ((events & (POLLERR | POLLNVAL)) || !(fds[0].revents & POLLIN))
+    return LookFromNowOn("poll", (events & POLLNVAL) ? EBADF : EIO);
   signalfd_siginfo info{};
-  if (read(signal_fd_, &info, sizeof info) != static_cast<ssize_t>(sizeof info)) return 0;
-  return static_cast<int>(info.ssi_signo);
+  const ssize_t n = read(signal_fd_, &info, sizeof info);
+  if (n == static_cast<ssize_t>(sizeof info)) return static_cast<int>(info.ssi_signo);
+  if (n < 0 && errno == EINTR) return 0;
+  return LookFromNowOn("read", n < 0 ? errno : EIO);
+}
+
+// The signal stays pending when poll or read fails (blocked in every thread, not taken):
+// sigtimedwait takes it.
+int InterruptWatcher::LookFromNowOn(const char* call, int err) {
+  const char* name = strerrorname_np(err);
+  std::fprintf(stderr,
+               "dyad: interrupt watcher: %s on its signalfd failed (%s: %s); looking for signals every 50 ms from now on\n", call,
+               name != nullptr ? name : "errno", std::strerror(err));
+  looking_ = true;
+  return 0;
 }
 
 // Sleeps until a signal or the destructor: no periodic wake-up (a dyad process is often idle, and

@@ -3,7 +3,10 @@
 // An InterruptWatcher blocks SIGINT and SIGTERM in the thread that creates it, so every thread
 // started afterwards (Fast DDS's, components', trainers') inherits the block, and takes them on
 // a thread of its own, asleep on a signalfd until one comes (no periodic wake-up: a study server
-// runs dozens of dyad processes). So a signal never interrupts a system call of a Fast DDS
+// runs dozens of dyad processes). Should poll or read on the signalfd fail (a descriptor closed
+// under it, say), it says so once on stderr, naming the errno, and looks every 50 ms from then on
+// (sigtimedwait, as without descriptors to spare): never a busy loop, and no signal lost (it
+// stays pending until taken). So a signal never interrupts a system call of a Fast DDS
 // thread, never runs code in a signal handler, and `on_signal` runs on an ordinary thread
 // (it may lock, log, call Executor::RequestStop). A second signal while the first is being
 // handled ends the process at once (exit 128 + signal): Ctrl-C twice always works.
@@ -41,10 +44,12 @@ class InterruptWatcher {
 
  private:
   int NextSignal();  // the next SIGINT/SIGTERM, or 0 (woken to end, or nothing)
+  int LookFromNowOn(const char* call, int err);  // says why once, sets looking_; returns 0
   void Watch();
 
   sigset_t set_, old_;
   int signal_fd_ = -1, wake_fd_ = -1;  // -1: polling every 50 ms instead
+  bool looking_ = false;               // they failed: polling every 50 ms (the watcher's thread only)
   std::function<void(int)> on_signal_;
   std::atomic<int> signal_{0};
   std::atomic<bool> done_{false};
