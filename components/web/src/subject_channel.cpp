@@ -109,6 +109,8 @@ double WallNowMs() {
 }
 }  // namespace
 
+double SubjectChannel::WallMs() const { return options_.wall_ms ? options_.wall_ms() : WallNowMs(); }
+
 void SubjectChannel::BroadcastState(double x, double y) {
   WebServer* server = server_.load();
   if (server == nullptr) return;
@@ -178,7 +180,7 @@ void SubjectChannel::OnOpen(ClientId client, Role role) {
 }
 
 Status SubjectChannel::OnText(ClientId client, std::string_view text) {
-  const double handler_ms = WallNowMs();
+  const double handler_ms = WallMs();
   if (!JsonDepthWithin(text)) return Status::InvalidArgument("nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   const json j = json::parse(text.begin(), text.end(), nullptr, false);
   if (j.is_discarded() || !j.is_object()) return Status::InvalidArgument("not a JSON object");
@@ -210,7 +212,7 @@ Status SubjectChannel::OnPointer(ClientId client, const json& j, double handler_
     last_y_ = std::clamp(py, -h, h);
     sink_(last_x_, last_y_, engaged->get<bool>() && !trial_over_);  // after the trial nobody steers
     if (auto wall = j.find("wall"); wall != j.end() && wall->is_number() && delays_.total.size() < 100000) {
-      const double event_ms = wall->get<double>(), published_ms = WallNowMs();
+      const double event_ms = wall->get<double>(), published_ms = WallMs();
       delays_.total.push_back(published_ms - event_ms);
       if (WebServer* server = server_.load(); server != nullptr && server->message_received_ns() > 0) {
         const double received_ms = static_cast<double>(server->message_received_ns()) / 1e6;

@@ -13,7 +13,9 @@
 /// that opens, its countdown as what is left of it then), {"op":"state","x","y"} (newest
 /// only: a slow page never builds a backlog), {"op":"ack","t":ms} after a pointer sample was
 /// published, at most one per kAckIntervalMs to a page (the page measures the round trip; an ack
-/// per sample, 60 a second, was a third of a participant's frames), {"op":"question","segment":i,
+/// per sample, 60 a second, was a third of a participant's frames): a sample is acknowledged when
+/// the page's last ack is kAckIntervalMs old or older, else never (no ack comes later for it, so
+/// the first sample after a pause always has its own), {"op":"question","segment":i,
 /// "of":n,"stroke":[[x,y],...],"robot":[[x,y],...]} after the trial (the hold's stroke: the
 /// pointer's path while held, what the person drew; the robot's path meanwhile, maybe empty;
 /// segment -1: every question answered, "thank you"). A pointer sample may carry "wall" (the
@@ -64,6 +66,9 @@ class SubjectChannel final : public ClientHandler {
     bool watermark = true;          // draw the primitives faintly behind the workspace
     bool ask = false;               // ask "What were you drawing?" after each release
     double ask_after_hold_s = 1.0;  // ... of a hold at least this long (a tap is no event)
+    // The wall clock in ms since the epoch, read as a message is handled: the acks' interval and
+    // the pointer delays. Empty: the system's (a test gives its own).
+    std::function<double()> wall_ms;
   };
   // Publishes one pointer sample on the graph (called on civetweb threads, serialised here).
   using PointerSink = std::function<void(double x, double y, bool engaged)>;
@@ -128,6 +133,7 @@ class SubjectChannel final : public ClientHandler {
   std::string QuestionJson() const REQUIRES(mutex_);
   void EndSteeringLocked() REQUIRES(mutex_);
   void SendToAll(uint32_t channel, const std::string& frame);
+  double WallMs() const;  // options_.wall_ms, or the system's
   const Options options_;
   const PointerSink sink_;
   const ReportSink report_;

@@ -1,10 +1,24 @@
 // SubjectChannel's answers to "What were you drawing?": only the steering page's, only when
-// asked, only a primitive of the data set or -1, and a viewer's refused (it closes the page).
+// asked, only a primitive of the data set or -1, and a viewer's refused (it closes the page);
+// its acks, through a WebServer to a WsClient: at most one per kAckIntervalMs.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <random>
+#include <string>
+#include <string_view>
+#include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "subject_channel.hpp"
+#include "web_server.hpp"
+#include "ws_client.hpp"
 
 namespace dyad::web {
 namespace {
@@ -146,6 +160,91 @@ TEST(SubjectChannel, TheSubjectsPageSteersBeforeTheExperimenters) {
   ASSERT_TRUE(pointer(3).ok());
   ASSERT_TRUE(pointer(1).ok());
   EXPECT_EQ(published.back(), (std::pair<int, bool>{3, true}));
+}
+
+bool Eventually(const std::function<bool()>& done) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+// The "t" of each ack a page received, in order.
+struct Acks {
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::vector<int> t;
+  WsClient::Callbacks Callbacks() {
+    return {[this](std::string_view text) {
+              const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
+              if (!j.is_object() || j.value("op", "") != "ack") return;
+              std::lock_guard<std::mutex> lock(mutex);
+              t.push_back(static_cast<int>(j.at("t").get<double>()));
+              cv.notify_all();
+            },
+            {}};
+  }
+  // Every ack up to the one of sample `last`.
+  std::vector<int> Until(int last) {
+    std::unique_lock<std::mutex> lock(mutex);
+    cv.wait_for(lock, std::chrono::seconds(10), [&] { return !t.empty() && t.back() == last; });
+    return t;
+  }
+};
+
+// The page's pointer at 60 Hz (15-18.5 ms apart, a browser's pointermove) for 1 s, then one
+// sample after a pause, each "t" its index; the channel's clock is the test's, set per sample.
+// Acked: the first sample and each one kAckIntervalMs or more after the last ack (the newest
+// sample's then: an ack at most one frame interval late), about 10 in the second; the sample
+// after the pause at once. Before the throttle every sample was acked (61 here).
+TEST(SubjectChannel, APageGetsAtMostOneAckPer100MsAndTheFirstSampleAfterAPauseHasOne) {
+  std::atomic<double> now_ms{0};
+  std::atomic<int> published{0};
+  SubjectChannel::Options o;
+  o.wall_ms = [&] { return now_ms.load(); };
+  SubjectChannel ch(o, [&](double, double, bool) { ++published; });
+  WebServer::Options so;
+  so.port = 0;
+  so.tokens = {{Role::kSubject, "subject-token-0123456789"}};
+  so.endpoints = {WebServer::Endpoint{"/subject/ws", {}, &ch, {Role::kSubject}, /*viewers=*/false}};
+  auto server = WebServer::Start(so);
+  ASSERT_TRUE(server.ok()) << server.status().ToString();
+  ch.SetServer(server->get());
+  Acks acks;
+  auto page = WsClient::Connect("127.0.0.1", (*server)->port(), "/subject/ws?token=subject-token-0123456789", acks.Callbacks(),
+                                std::chrono::seconds(5));
+  ASSERT_TRUE(page.ok()) << page.status().ToString();
+  ASSERT_TRUE(Eventually([&] { return ch.steered(); }));
+  std::mt19937 rng(45);
+  std::uniform_real_distribution<double> interval(15, 18.5);
+  std::vector<double> at;  // each sample's time, ms
+  for (double t = 1.7e12; at.size() < 61; t += at.size() < 60 ? interval(rng) : 500) {
+    const int i = static_cast<int>(at.size());
+    at.push_back(t);
+    now_ms = t;
+    ASSERT_TRUE((*page)->SendText(R"({"op":"pointer","x":1,"y":2,"engaged":true,"t":)" + std::to_string(i) + "}").ok());
+    ASSERT_TRUE(Eventually([&] { return published == i + 1; })) << "sample " << i << " not published";
+  }
+  ASSERT_GE(at[59] - at[0], 900);
+  std::vector<int> expected;  // the rule: kAckIntervalMs or more since the last ack
+  for (size_t i = 0; i < at.size(); i++)
+    if (expected.empty() || at[i] - at[expected.back()] >= SubjectChannel::kAckIntervalMs)
+      expected.push_back(static_cast<int>(i));
+  const std::vector<int> got = acks.Until(60);
+  EXPECT_EQ(got, expected);
+  ASSERT_FALSE(got.empty());
+  EXPECT_EQ(got.back(), 60) << "the sample after the pause is acked at once";
+  const size_t in_the_second = got.size() - 1;
+  EXPECT_GE(in_the_second, 9u);
+  EXPECT_LE(in_the_second, 11u) << "60 samples in a second, acked every 100 ms";
+  for (size_t k = 1; k < in_the_second; k++) {
+    const double gap = at[got[k]] - at[got[k - 1]];
+    EXPECT_GE(gap, SubjectChannel::kAckIntervalMs) << "acks " << got[k - 1] << " and " << got[k];
+    EXPECT_LE(gap, SubjectChannel::kAckIntervalMs + 18.5) << "acks " << got[k - 1] << " and " << got[k];
+  }
+  (*page)->Close();
 }
 
 }  // namespace
