@@ -123,8 +123,8 @@ export class SimParticipant {
     const t = setTimeout(() => { this.timers.delete(t); if (!this.stopped) fn(); }, ms / this.speed);
     this.timers.add(t);
   }
-  start() {  // the page's keepalive: while held and the pointer still (no sample for 45 ms)
-    this.connect(); this.rest();
+  start() { this.connect(); this.rest(); this.startKeepalive(); }
+  startKeepalive() {  // the page's keepalive: while held and the pointer still (no sample for 45 ms)
     this.keepalive = setInterval(() => { if (this.down && performance.now() - this.lastSent >= 45) this.send(true); }, 50);
   }
   stop() {
