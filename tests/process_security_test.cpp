@@ -119,7 +119,8 @@ TEST_F(SecurityTest, AGuestPublishesWhatTheGraphGrantsItAndNothingElse) {
 // `dyad security export`: each host runs from its own subset (its host identity and its
 // processes' only) and the secured graph delivers across the two; a host that starts with the
 // other host's subset is refused before anything starts, naming the identity it lacks, the host
-// the subset is for and the export that would give it.
+// the subset is for and the export that would give it. Without --host, `dyad run` runs the host
+// its subset was exported for (as the watchers join as it), and says so.
 TEST_F(SecurityTest, EachHostRunsFromItsOwnExportAndNotFromAnothers) {
   auto graph = [&](const std::string& keystore) {
     return "graph: subsets\nclock: wall\ndomain_id: " + std::to_string(domain_) +
@@ -142,11 +143,17 @@ TEST_F(SecurityTest, EachHostRunsFromItsOwnExportAndNotFromAnothers) {
   }
   ASSERT_FALSE(fs::exists(dir_ / "h1_keys" / "identities" / "process.b"));
   const fs::path on_h1 = Write("h1.yaml", graph("h1_keys")), on_h2 = Write("h2.yaml", graph("h2_keys"));
-  Child a(Dyad({"run", on_h1.string(), "--host", "h1", "--steps", "40"}), dir_, "a");
+  // h1 from its subset alone (this machine's name is neither h1 nor h2), h2 named with --host.
+  Child a(Dyad({"run", on_h1.string(), "--steps", "40"}), dir_, "a");
   Child b(Dyad({"run", on_h2.string(), "--host", "h2", "--steps", "40"}), dir_, "b");
   EXPECT_EQ(a.Wait(90), 0) << a.err();
   EXPECT_EQ(b.Wait(90), 0) << b.err();
   EXPECT_GE(ReadSink(dir_ / "sink.txt").size(), 30u) << a.err() << b.err();
+  const std::string said = "dyad run: running as host 'h1', the host keystore " + (dir_ / "h1_keys").string() +
+                           " was exported for (" + (dir_ / "h1_keys" / "subset.yaml").string() + ")\n";
+  EXPECT_NE(a.err().find(said), std::string::npos) << a.err();
+  EXPECT_EQ(a.err().find(said, a.err().find(said) + 1), std::string::npos) << "said once, by the launcher:\n" << a.err();
+  EXPECT_EQ(b.err().find("running as host"), std::string::npos) << "--host given: nothing to say\n" << b.err();
 
   Child wrong(Dyad({"run", on_h2.string(), "--host", "h1", "--steps", "5"}), dir_, "wrong");
   EXPECT_EQ(wrong.Wait(60), 2);

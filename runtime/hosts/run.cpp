@@ -5,20 +5,22 @@
 
 #include <algorithm>
 #include <atomic>
-#include <condition_variable>
-#include <thread>
-#include <cstdlib>
-#include <cstdio>
 #include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <mutex>
 #include <random>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "dyad/catalog.hpp"
 #include "dyad/interrupt.hpp"
+#include "dyad/security.hpp"
 #include "dyad/validate.hpp"
 #include "exec/executor.hpp"
 #include "graph/run_partition.hpp"
@@ -47,8 +49,24 @@ std::set<std::string> ProcessesToCheck(const Graph& g, const RunOptions* run) {
   return here.empty() ? std::set<std::string>{""} : here;  // {""}: none (only the discovery server)
 }
 
+// A keystore subset exported for host H (`dyad security export --host H`) says which host this
+// machine is: without --host, `dyad run` runs H's processes with H's identity, as the watchers
+// join as H; one line says so. The launcher gives --host H to its children. An explicit --host
+// stays what it says (a host the subset does not hold is refused, naming the export that gives
+// it). A guest's subset, a whole keystore, an unreadable subset.yaml (CheckKeystore says why) or
+// the subset of a graph on one machine (host.local: any name gets that identity) change nothing.
+void AdoptSubsetHost(const Graph& g, RunOptions* run, std::ostream& err) {
+  if (run == nullptr || !run->host.empty() || !g.security.enabled()) return;
+  auto subset = ReadKeystoreSubset(g.security.keystore);
+  if (!subset.ok() || subset.value().whole || subset.value().host.empty() || subset.value().host == kLocalHost) return;
+  run->host = subset.value().host;
+  err << "dyad run: running as host '" << run->host << "', the host keystore " << g.security.keystore << " was exported for ("
+      << (std::filesystem::path(g.security.keystore) / kSubsetFile).string() << ")\n";
+}
+
 // Returns false (after printing every problem) when the graph is invalid. `run`: what runs here
-// (see ProcessesToCheck); null: everything is checked (`dyad validate`).
+// (see ProcessesToCheck; its host is taken from a keystore subset when it names none:
+// AdoptSubsetHost); null: everything is checked (`dyad validate`).
 // kBuiltinOnly (validate --no-plugins): a component whose type no built-in plugin has cannot be
 // checked; its "unknown component type" becomes a note, and the rest of the graph is validated.
 void NoteUncheckedComponents(const Graph& g, std::vector<Diagnostic>* diags, std::ostream& err) {
@@ -65,10 +83,11 @@ void NoteUncheckedComponents(const Graph& g, std::vector<Diagnostic>* diags, std
 }
 
 bool LoadAndValidate(const std::string& path, const std::vector<Override>& overrides,
-                     const std::vector<std::string>& plugin_paths, Loaded* l, std::ostream& err,
-                     const RunOptions* run = nullptr, PluginLoading loading = PluginLoading::kAll) {
+                     const std::vector<std::string>& plugin_paths, Loaded* l, std::ostream& err, RunOptions* run = nullptr,
+                     PluginLoading loading = PluginLoading::kAll) {
   std::vector<Diagnostic> diags;
   l->graph = LoadGraph(path, overrides, &diags);
+  if (diags.empty()) AdoptSubsetHost(l->graph, run, err);
   if (loading == PluginLoading::kBuiltinOnly) {
     if (Status s = l->catalog.Load(Catalog::BuiltinPluginDir()); !s.ok()) err << "warning: " << s.message() << "\n";
   } else {
@@ -217,7 +236,8 @@ int ValidateGraphFile(const std::string& path, const std::vector<Override>& over
   return 0;
 }
 
-int RunGraph(const RunOptions& options, std::ostream& out, std::ostream& err) {
+int RunGraph(const RunOptions& given, std::ostream& out, std::ostream& err) {
+  RunOptions options = given;  // its host may come from the keystore (AdoptSubsetHost)
   Loaded l;
   // The launcher (no --process) checks the components of every process it starts before starting
   // any (all of them, unless the graph places processes on hosts); a child checks its own (the

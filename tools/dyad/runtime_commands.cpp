@@ -244,7 +244,9 @@ CLI::App* AddRunCommand(CLI::App& app, std::function<void(const RunOptions&)> on
   r->add_option("graph", run.graph_path, "Graph YAML file")->required();
   r->add_option("--process", run.process, "Run only the components placed in this process");
   r->add_option("--logs", run.logs_dir, "Folder for each process's log (<process>.log); default: the graph's logs:");
-  r->add_option("--host", run.host, "This machine's name in the graph (processes: NAME: {host: ...}); default: its host name");
+  r->add_option("--host", run.host,
+                "This machine's name in the graph (processes: NAME: {host: ...}); default: the host its keystore "
+                "subset was exported for (a secured graph), else its host name");
   r->add_option("--set", sets, kSetHelp);
   r->add_option("--plugins", plugins, "Extra plugin file or folder (repeatable)");
   r->add_option("--duration", run.duration_s, "Stop after this many seconds of wall time")->check(CLI::NonNegativeNumber);

@@ -6,7 +6,8 @@
 //   - runs the components placed in `process` (one DDS participant for them), or
 //   - with no `process` given and components in several processes (or processes placed on
 //     hosts): starts one child `dyad run --process P` per process whose host is this machine
-//     (`host`, else the machine's host name; a graph naming no host runs all here), forwards
+//     (`host`, else the host a keystore subset of a secured graph was exported for, said on
+//     stderr, else the machine's host name; a graph naming no host runs all here), forwards
 //     SIGINT/SIGTERM to them and waits. Children run in their own process group (a terminal's
 //     Ctrl-C reaches them once, through the launcher) and get SIGTERM if the launcher dies. When
 //     one child fails, the others are stopped and the exit code is the failed child's. When the
@@ -46,7 +47,7 @@ struct RunOptions {
   std::string graph_path;
   std::vector<Override> overrides;
   std::string process;             // empty: every process of the graph (see above)
-  std::string host;                // this machine's name in the graph; empty: gethostname()
+  std::string host;                // this machine's name in the graph; empty: a subset's host, else gethostname()
   std::string logs_dir;            // the launcher's per-process logs (default: the graph's `logs:`)
   double duration_s = 0;           // > 0: stop after this much wall time
   uint64_t steps = 0;              // > 0: stop after the fastest periodic component ran this many steps
