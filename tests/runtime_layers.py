@@ -19,7 +19,7 @@ PUBLIC = {
     "thread_annotations.hpp": None,
     "graph.hpp": "graph", "validate.hpp": "graph", "catalog.hpp": "graph", "topic_select.hpp": "graph", "topic_readers.hpp": "graph",
     "diagnostic.hpp": "graph", "strict_yaml.hpp": "graph", "security.hpp": "graph", "ros2_names.hpp": "graph",
-    "wire_names.hpp": "graph",
+    "wire_names.hpp": "graph", "keystore_graph.hpp": "graph",
     "on_demand_subscription.hpp": "graph", "run_stopping.hpp": "graph",
     "decode_sample.hpp": "dds", "encode_sample.hpp": "dds",
     "interrupt.hpp": "exec", "private_file.hpp": "exec",

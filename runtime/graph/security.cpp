@@ -1,5 +1,6 @@
 #include <dyad/security.hpp>
 
+#include <dyad/keystore_graph.hpp>
 #include <dyad/wire_names.hpp>
 
 #include <fnmatch.h>
@@ -220,6 +221,17 @@ std::vector<std::string> CheckKeystore(const Graph& graph, int64_t now_s) {
   if (std::string problem = CheckFile(FileIn(graph.security.keystore, kNamesKeyFile), true); !problem.empty())
     problems.push_back(problem + " (the keystore's names key: make it with `dyad security init " + graph.security.keystore +
                        " --graph " + graph.file + "`)");
+  // One graph per keystore (dyad/keystore_graph.hpp).
+  if (auto owner = ReadKeystoreGraph(graph.security.keystore); !owner.ok()) {
+    problems.push_back(owner.status().message());
+  } else if (owner.value().empty()) {
+    problems.push_back(FileIn(graph.security.keystore, kKeystoreGraphFile) +
+                       ": missing (the graph this keystore is for; one made before dyad recorded it: run `dyad security init " +
+                       graph.security.keystore + " --graph " + graph.file +
+                       "` on the whole keystore, then export again for each machine)");
+  } else if (Status s = CheckKeystoreGraph(graph, graph.security.keystore); !s.ok()) {
+    problems.push_back(s.message());
+  }
   auto subset = ReadKeystoreSubset(graph.security.keystore);
   if (!subset.ok()) {
     problems.push_back(subset.status().message());

@@ -23,6 +23,7 @@
 #include <openssl/x509.h>
 #include <openssl/x509v3.h>
 
+#include <dyad/keystore_graph.hpp>
 #include <dyad/private_file.hpp>
 #include <dyad/security.hpp>
 #include <dyad/wire_names.hpp>
@@ -371,6 +372,18 @@ StatusOr<std::string> NamesKey(const fs::path& dir, std::ostream& out) {
   return ReadNamesKey(path);
 }
 
+// The graph the keystore is for (dyad/keystore_graph.hpp): written once, when the keystore has
+// none (a new one, or one made before dyad recorded it); CheckKeystoreGraph refused another's.
+Status RecordGraph(const Graph& graph, const fs::path& dir, std::ostream& out) {
+  auto owner = ReadKeystoreGraph(dir.string());
+  if (!owner.ok()) return owner.status();
+  if (!owner.value().empty()) return Status::OK();
+  const std::string path = (dir / kKeystoreGraphFile).string();
+  if (Status s = WritePrivateFile(path, graph.name + "\n", CreateMode::kNew); !s.ok()) return s;
+  out << "made     " << path << " (this keystore is graph '" << graph.name << "''s: a keystore serves one graph)\n";
+  return Status::OK();
+}
+
 std::string CommonName(X509* cert) {
   char cn[256] = {0};
   if (cert == nullptr || X509_NAME_get_text_by_NID(X509_get_subject_name(cert), NID_commonName, cn, sizeof cn) < 0) return "";
@@ -406,7 +419,7 @@ Status InitIdentity(const Graph& graph, const std::map<std::string, TopicAccess>
   if (!cert.ok()) return cert.status();
   if ("CN=" + CommonName(cert.value().get()) != subject) {
     out << "renewing " << identity << ": its subject is not this keystore's opaque one (CN=" << CommonName(cert.value().get())
-        << "; a keystore made before names were opaque, a renamed graph or a new names.key)\n";
+        << "; a keystore made before names were opaque, or a new names.key)\n";
     return IssueIdentity(graph, access, options, identity, subject, identity_ca, permissions_ca, out);
   }
   out << "kept     " << identity << ": " << cert_path << "\n";
@@ -422,8 +435,11 @@ Status InitKeystore(const Graph& graph, const std::map<std::string, TopicAccess>
                     std::ostream& out) {
   const fs::path dir(options.dir), identities = dir / "identities";
   const fs::path ca_dir = options.ca_dir.empty() ? dir / "ca" : fs::path(options.ca_dir);
+  // One graph per keystore: another graph's is refused before anything is made or renewed.
+  if (Status s = CheckKeystoreGraph(graph, options.dir); !s.ok()) return s;
   for (const fs::path& d : {dir, identities})
     if (Status s = CreatePrivateDirectories(d.string()); !s.ok()) return s;
+  if (Status s = RecordGraph(graph, dir, out); !s.ok()) return s;
   Authority identity_ca("identity CA", (dir / "identity_ca.cert.pem").string(), (ca_dir / "identity_ca.key.pem").string());
   Authority permissions_ca("permissions CA", (dir / "permissions_ca.cert.pem").string(),
                            (ca_dir / "permissions_ca.key.pem").string());

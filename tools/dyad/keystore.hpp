@@ -24,6 +24,9 @@
 //     `tls_certificate`: a new ECDSA P-256 key and a TLS server certificate for exactly those
 //     hosts (subjectAltName), valid `identity_days`; web/cert.pem is the certificate alone. It is
 //     reissued when the hosts change or with `renew` "web" (or "all").
+//   - One graph per keystore (dyad/keystore_graph.hpp): DIR/graph.name records the graph it is
+//     for (written when missing); an init for another graph is refused before anything is made
+//     or renewed, naming the keystore's graph, its record and the fix (a keystore per graph).
 //   - Folders 0700, files 0600, created O_EXCL | O_NOFOLLOW (dyad/private_file.hpp).
 // Each created or kept file is reported on `out`; errors name the file.
 #pragma once

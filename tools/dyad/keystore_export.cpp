@@ -15,6 +15,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <dyad/keystore_graph.hpp>
 #include <dyad/private_file.hpp>
 #include <dyad/security.hpp>
 #include <dyad/wire_names.hpp>
@@ -40,10 +41,10 @@ StatusOr<std::string> ReadRegular(const std::string& path) {
 }
 
 // The files of the subset, relative to the keystore: the CA certificates, the governance, the
-// names key and each identity's four files.
+// names key, the graph the keystore is for and each identity's four files.
 std::vector<std::string> SubsetFiles(const std::string& keystore, const std::vector<std::string>& identities, bool web) {
-  std::vector<std::string> files = {"identity_ca.cert.pem", "permissions_ca.cert.pem", "governance.xml", "governance.p7s",
-                                    kNamesKeyFile};
+  std::vector<std::string> files = {"identity_ca.cert.pem", "permissions_ca.cert.pem", "governance.xml", "governance.p7s"};
+  files.insert(files.end(), {kNamesKeyFile, kKeystoreGraphFile});
   if (fs::exists(fs::symlink_status(fs::path(keystore) / "web_ca.cert.pem"))) files.push_back("web_ca.cert.pem");
   for (const std::string& id : identities)
     for (const char* f : {"cert.pem", "key.pem", "permissions.xml", "permissions.p7s"})

@@ -9,6 +9,7 @@
 //     failure leaves no OUT. Folders 0700, files 0600 (O_EXCL | O_NOFOLLOW, dyad/private_file.hpp).
 //   - OUT holds the CA certificates (identity_ca.cert.pem, permissions_ca.cert.pem, and
 //     web_ca.cert.pem when there is one), never a CA key; governance.xml and .p7s; names.key;
+//     graph.name (the graph the keystore is for: dyad/keystore_graph.hpp);
 //     identities/<identity>/ for exactly SubsetIdentities (host H: host.H and the processes placed
 //     on H or on no host; guest: guest; both when both are asked); and subset.yaml, which says
 //     whom it is for, the graph file and the keystore it came from (absolute paths: what a refusal

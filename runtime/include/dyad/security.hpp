@@ -18,6 +18,8 @@
 //                                                   issue identities; runs do not (keep them off
 //                                                   the experiment machines)
 //   identities/<identity>/cert.pem, key.pem, permissions.xml, permissions.p7s
+//   graph.name                                      the graph the keystore is for: one graph per
+//                                                   keystore (dyad/keystore_graph.hpp)
 // Identities: "process.<p>" for each process of the graph (its participant is dyad/<graph>/<p>)
 // and "host.<h>" for each host's launcher and watchers ("host.local" when the graph places
 // nothing on hosts), and "guest" when the graph has `security.guests`: the identity of `dyad pub`

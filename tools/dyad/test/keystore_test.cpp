@@ -388,6 +388,64 @@ TEST_F(KeystoreTest, ValidateRefusesAKeystoreThatIsIncompleteLeakyOrExpired) {
   EXPECT_NE(earlier[0].find("not valid yet"), std::string::npos) << earlier[0];
 }
 
+// One graph per keystore (dyad/keystore_graph.hpp): the permissions' partition is dyad/* and the
+// CA admits whatever it issued, so a second graph's identities under the same CA could publish
+// into the first. init records the graph; an init for another graph is refused before anything is
+// issued or renewed (the old init renewed every identity under the other graph's subjects), and
+// validate refuses a graph whose keystore is another's, naming both; a keystore without the
+// record (an older dyad's) is refused by validate and adopted by the next init.
+TEST_F(KeystoreTest, AKeystoreServesOneGraph) {
+  ASSERT_EQ(Init().code, 0);
+  const fs::path record = keys_ / "graph.name";
+  EXPECT_EQ(ReadFile(record), "sec\n");
+  EXPECT_EQ(Mode(record), 0600u);
+  const std::string cert = ReadFile(Identity("process.pub", "cert.pem"));
+  auto renamed = [&](const std::string& extra, const std::string& name) {
+    std::string text = ReadFile(WriteGraph(extra, name));
+    text.replace(text.find("graph: sec"), 10, "graph: other");
+    std::ofstream(dir_ / name) << text;
+    return dir_ / name;
+  };
+  const fs::path other = renamed("", "other.yaml");
+  auto refused = Init({}, other);
+  EXPECT_EQ(refused.code, 1);
+  EXPECT_NE(refused.err.find("dyad security init: keystore " + keys_.string() + " was made for graph 'sec' (" + record.string() +
+                             "), not for graph 'other' (" + other.string() + "): a keystore serves one graph"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_NE(refused.err.find("Make a keystore per graph: `dyad security init NEW_DIR --graph " + other.string() + "`"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_EQ(refused.out, "") << "nothing issued, renewed or signed for 'other'";
+  EXPECT_EQ(ReadFile(Identity("process.pub", "cert.pem")), cert);
+  EXPECT_EQ(ReadFile(record), "sec\n");
+
+  const fs::path mine = WriteGraph("security: {keystore: keys}\n", "secured.yaml");
+  const fs::path theirs = renamed("security: {keystore: keys}\n", "secured_other.yaml");
+  auto validate = [](const fs::path& g) { return dyad::testing::RunCommand(AddRuntimeCommands, {"validate", g.string()}); };
+  auto ok = validate(mine);
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  auto wrong = validate(theirs);
+  EXPECT_EQ(wrong.code, 2);
+  EXPECT_NE(
+      wrong.err.find("secured_other.yaml:5:22: security.keystore: keystore " + keys_.string() + " was made for graph 'sec' (" +
+                     record.string() + "), not for graph 'other' (" + theirs.string() + ")"),
+      std::string::npos)
+      << wrong.err;
+
+  fs::remove(record);  // a keystore made by an older dyad
+  auto unrecorded = validate(mine);
+  EXPECT_EQ(unrecorded.code, 2);
+  EXPECT_NE(unrecorded.err.find(record.string() + ": missing (the graph this keystore is for"), std::string::npos)
+      << unrecorded.err;
+  auto adopted = Init();
+  ASSERT_EQ(adopted.code, 0) << adopted.err;
+  EXPECT_NE(adopted.out.find("made     " + record.string() + " (this keystore is graph 'sec''s"), std::string::npos)
+      << adopted.out;
+  EXPECT_EQ(ReadFile(Identity("process.pub", "cert.pem")), cert);
+  EXPECT_EQ(validate(mine).code, 0);
+}
+
 // `dyad status`, `topics`, `param` and `graph --live` read the runtime's own topics, which only a
 // host's identity may: on a machine that is none of a secured graph's hosts (this one: its name is
 // neither 'lab' nor 'robot') they are refused before joining, saying exactly what to pass (and, in
@@ -450,6 +508,7 @@ std::set<std::string> SubsetBase(const std::vector<std::string>& identities) {
                                "0600 governance.xml",
                                "0600 governance.p7s",
                                "0600 names.key",
+                               "0600 graph.name",
                                "0600 subset.yaml",
                                "0700 identities"};
   for (const std::string& id : identities) {
