@@ -235,8 +235,10 @@ Status OnlineFront::OnText(web::ClientId client, std::string_view text) {
     return Status::FailedPrecondition("the page sent more than the study's server could take in time");
   }
   queued += text.size();
-  ++in_flight_[client];
-  events_.push_back(Event{Event::Kind::kText, client, nullptr, std::string(text), received_ns});
+  // A pong is the front's own (a round trip), never relayed: a page's later frames may overtake it.
+  const bool ordered = text.find("\"pong\"") == std::string_view::npos;
+  if (ordered) ++in_flight_[client];
+  events_.push_back(Event{Event::Kind::kText, client, nullptr, std::string(text), received_ns, ordered});
   events_cv_.notify_one();
   return Status::OK();
 }
@@ -270,7 +272,7 @@ void OnlineFront::Events() {
     else if (e.kind == Event::Kind::kText) Text(e.client, e.text, e.received_ns);
     else if (e.kind == Event::Kind::kClose) Closed(e.client);
     lock.Lock();
-    if (const auto f = in_flight_.find(e.client); e.kind == Event::Kind::kText && f != in_flight_.end() && --f->second == 0)
+    if (const auto f = in_flight_.find(e.client); e.ordered && f != in_flight_.end() && --f->second == 0)
       in_flight_.erase(f);  // handled: the page's next frame may go at once
   }
 }

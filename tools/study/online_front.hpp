@@ -53,7 +53,7 @@
 // close that comes while its open is still queued ends both unhandled. A page whose frames queue
 // up past 1 MiB (the front's thread far behind) is closed (1008) rather than held in memory.
 // Except during a trial: a page's frame is relayed by the worker that read it (RelayAtOnce), unless
-// one of the page's events still waits for the front's thread (then it queues behind them).
+// an earlier frame of the page still waits for the front's thread (then it queues behind it).
 // Tick comes from the server's loop; each trial runs on a thread of its own, each relay's
 // connection too. Everything shared is under one mutex, never held while a socket is written or
 // a trial runs.
@@ -133,6 +133,7 @@ class OnlineFront final : public web::ClientHandler {
     Participant* participant = nullptr;  // kOpen: whose link the page opened
     std::string text;                    // kText
     int64_t received_ns = 0;             // kText: when a worker had it (wall clock, ns since the epoch)
+    bool ordered = false;                // kText: counted in in_flight_ (a pong is not: never relayed)
   };
   // The front's thread: the queued events, one at a time, until StopAll.
   void Events();
@@ -157,7 +158,7 @@ class OnlineFront final : public web::ClientHandler {
   // "wall" (ms since the epoch), or a negative number when it has none.
   double Pointer(Participant& p, std::string_view text);
   // On the worker that read the frame: relays it to the page's trial when one runs and none of the
-  // page's events wait for the front's thread (they go first: a page's frames keep their order),
+  // page's frames wait for the front's thread (they go first: a page's frames keep their order),
   // so a page's frames do not queue behind every other page's on one thread. False: the frame is
   // for the front's thread (a pong, no trial, an earlier event waiting, a write that failed).
   bool RelayAtOnce(web::ClientId client, std::string_view text, int64_t received_ns);
@@ -188,7 +189,8 @@ class OnlineFront final : public web::ClientHandler {
   std::map<web::ClientId, size_t> queued_bytes_ GUARDED_BY(events_mutex_);  // a page's frames queued
   std::set<web::ClientId> opening_ GUARDED_BY(events_mutex_);  // opens queued (a close meanwhile erases one: neither is handled)
   bool events_stopped_ GUARDED_BY(events_mutex_) = false;
-  std::map<web::ClientId, int> in_flight_ GUARDED_BY(events_mutex_);  // a page's frames queued or being handled
+  // A page's frames queued or being handled that a relayed frame must not overtake (not its pongs).
+  std::map<web::ClientId, int> in_flight_ GUARDED_BY(events_mutex_);
   Mutex delays_mutex_;
   std::vector<double> to_worker_ms_ GUARDED_BY(delays_mutex_), to_relayed_ms_ GUARDED_BY(delays_mutex_);
   std::thread events_thread_;  // last: started once the rest is made

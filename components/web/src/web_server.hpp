@@ -145,8 +145,10 @@ class WebServer {
     // first) yet get a fair share of the CPU. False: every sample at once, normal scheduling
     // (the subject's page, whose robot state is what the subject steers by).
     bool viewers = true;
-    // The handler's OnText/OnBinary only queue the frame for a thread of its own (a lock, a push,
-    // a notify: a shallow stack): they are then called on civetweb's worker, with no hand-over to
+    // The handler's OnText/OnBinary only queue the frame for a thread of its own, or do as little
+    // (a shallow stack, bounded in time: a socket write with a short timeout, say; the study
+    // server's front relays a trial's frame within 100 ms): they are then called on civetweb's
+    // worker (that client's only: a slow call delays no other client), with no hand-over to
     // the server's handler thread (a wake-up of that thread and one of the worker per frame; the
     // study server relays dozens of pages' pointer streams). message_received_ns() is not set for
     // them. False: on the handler thread (see the Stacks paragraph above).

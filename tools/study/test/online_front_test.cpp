@@ -317,13 +317,16 @@ TEST_F(OnlineFrontTest, AFrameTheTrialsGraphDoesNotTakeDropsThePagesRelayNotTheT
   EXPECT_EQ(front.running(), 0);
 }
 
-// A trial's "graph" that takes its page's relay and writes each text frame it reads, one a line,
-// into "relayed" beside its port file.
+// A trial's "graph" that waits for a file "go" beside its port file, then takes its page's relay,
+// leaves a mark "connected" there, and writes each text frame it reads, one a line, into
+// "relayed".
 constexpr const char* kRecordingGraph = R"(#!/usr/bin/env python3
-import base64, hashlib, os, signal, socket, sys
+import base64, hashlib, os, signal, socket, sys, time
 signal.signal(signal.SIGINT, lambda *_: os._exit(0))
 port_file = next(a.split("port_file=", 1)[1] for a in sys.argv if ".port_file=" in a).strip(chr(39) + chr(34))
-out = os.path.join(os.path.dirname(port_file), "relayed")
+here = os.path.dirname(port_file)
+while not os.path.exists(os.path.join(here, "go")):
+    time.sleep(0.01)
 s = socket.socket()
 s.bind(("127.0.0.1", 0))
 s.listen(1)
@@ -336,6 +339,7 @@ while b"\r\n\r\n" not in request:
 key = [l.split(b":", 1)[1].strip() for l in request.split(b"\r\n") if l.lower().startswith(b"sec-websocket-key:")][0]
 accept = base64.b64encode(hashlib.sha1(key + b"258EAFA5-E914-47DA-95CA-C5AB0DC85B11").digest())
 c.sendall(b"HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: " + accept + b"\r\n\r\n")
+open(os.path.join(here, "connected"), "w").close()
 def read(n):
     data = b""
     while len(data) < n:
@@ -352,7 +356,7 @@ while True:
     mask = read(4)
     data = bytes(b ^ mask[i % 4] for i, b in enumerate(read(n)))
     if head[0] & 15 == 1:
-        with open(out, "a") as f:
+        with open(os.path.join(here, "relayed"), "a") as f:
             f.write(data.decode() + "\n")
 )";
 
@@ -373,62 +377,69 @@ std::vector<std::string> Relayed(const fs::path& file) {
   return lines;
 }
 
-// During a trial a page's frames go to its graph from the thread that read them: they do not wait
-// while the front's one thread is held by another page (here P02's session log, which no one
-// writes); and they keep their order: a frame that comes while one of the page's own events waits
-// for the front's thread (a pong) goes after it.
+// During a trial a page's frames go to its graph from the thread that read them, and keep their
+// order: a frame that came before the relay was up waits for the front's one thread, and the
+// frames after it wait behind it, even once the relay is up; a pong (the front's own, never
+// relayed) holds nothing back. The front's thread is held meanwhile by another page: P02's
+// session log, a FIFO that no one writes.
 TEST_F(OnlineFrontTest, ATrialsFramesAreRelayedAtOnceAndInOrderWhileTheFrontsThreadIsHeld) {
   const std::string graph = (dir_ / "recording_graph.py").string();
   std::ofstream(graph) << kRecordingGraph;
   fs::permissions(graph, fs::perms::owner_all);
   study_.subject_web = "web";
   ASSERT_TRUE(MarkConsent(study_, "P01", "in the test").ok());
-  const std::string tokens = study_.data + "/P01/web-tokens";
-  std::ofstream(tokens) << "subject 0123456789abcdef0123456789abcdef\n";
-  fs::permissions(tokens, fs::perms::owner_read | fs::perms::owner_write);
+  const fs::path here = fs::path(study_.data) / "P01";
+  std::ofstream(here / "web-tokens") << "subject 0123456789abcdef0123456789abcdef\n";
+  fs::permissions(here / "web-tokens", fs::perms::owner_read | fs::perms::owner_write);
   OnlineFront front(study_, FrontOptions{graph, 2, 15});
   front.SetServer(server_.get());
-  Page waiting, trial, other;
+  Page waiting, trial, other, again;
   const web::ClientId first = Connect(waiting);
   front.OnOpen(first, web::Role::kSubject);
   ASSERT_EQ(waiting.Op(1), "waiting");
   ASSERT_TRUE(front.OnText(first, R"({"op":"ready"})").ok());
   ASSERT_TRUE(waiting.Closed()) << "the trial starts: its page is closed (1012) and comes back";
   const web::ClientId page = Connect(trial);
-  front.OnOpen(page, web::Role::kSubject);
-  const fs::path relayed = fs::path(study_.data) / "P01" / "relayed";
-  const std::string a = R"({"op":"pointer","x":1,"y":2,"engaged":true,"wall":1})";
-  // Sent until the relay is up (the graph starting).
-  ASSERT_TRUE(Within(kGuard, [&] { return front.OnText(page, a).ok() && !Relayed(relayed).empty(); }))
-      << "the page was never relayed to the trial's graph";
+  front.OnOpen(page, web::Role::kSubject);  // the front's thread starts its relay (the graph waits for "go")
 
-  // P02's page opens: the front's thread reads P02's session log, a FIFO no one writes yet.
   const std::string log02 = SessionLogPath(study_, "P02");
   fs::create_directories(fs::path(log02).parent_path());
   fs::create_hard_link(fifo_, log02);
-  front.OnOpen(Connect(other, "P02"), web::Role::kSubject);
-  const int writer = Reader();
+  const web::ClientId p02 = Connect(other, "P02");
+  front.OnOpen(p02, web::Role::kSubject);
+  int writer = Reader();
   ASSERT_GE(writer, 0) << "the front's thread did not read P02's log";
-  const size_t before = Relayed(relayed).size();
-  const std::string b = R"({"op":"pointer","x":3,"y":4,"engaged":false,"wall":2})";
-  ASSERT_TRUE(front.OnText(page, b).ok());
-  Within(2s, [&] { return Relayed(relayed).size() > before; });
-  EXPECT_EQ(Relayed(relayed).size(), before + 1) << "a trial's frame waited for the front's thread, held by another page";
-
-  // A pong waits for the front's thread (it is the front's, not relayed); the frame after it too.
-  ASSERT_TRUE(front.OnText(page, R"({"op":"pong","id":1})").ok());
-  const std::string c = R"({"op":"pointer","x":5,"y":6,"engaged":true,"wall":3})";
-  ASSERT_TRUE(front.OnText(page, c).ok());
+  const std::string f1 = R"({"op":"pointer","x":1,"y":2,"engaged":true,"wall":1})";
+  const std::string f2 = R"({"op":"pointer","x":3,"y":4,"engaged":false,"wall":2})";
+  const std::string f3 = R"({"op":"pointer","x":5,"y":6,"engaged":true,"wall":3})";
+  ASSERT_TRUE(front.OnText(page, f1).ok());  // no relay yet: queued for the front's thread
+  std::ofstream(here / "go").close();
+  ASSERT_TRUE(Within(kGuard, [&] { return fs::exists(here / "connected"); })) << "the relay never reached the graph";
+  std::this_thread::sleep_for(200ms);  // the relay's thread stores its link
+  ASSERT_TRUE(front.OnText(page, f2).ok());
   std::this_thread::sleep_for(300ms);
-  EXPECT_EQ(Relayed(relayed).size(), before + 1) << "a frame overtook its page's pong, which waits for the front's thread";
+  EXPECT_TRUE(Relayed(here / "relayed").empty()) << "a frame overtook its page's earlier one, which waits for the front's thread";
   fs::remove(log02);
   std::ofstream(log02).close();
   ASSERT_EQ(::close(writer), 0);  // P02's read ends (an empty log): the front's thread goes on
-  Within(kGuard, [&] { return Relayed(relayed).size() >= before + 2; });
-  const std::vector<std::string> lines = Relayed(relayed);
-  ASSERT_EQ(lines.size(), before + 2);
-  EXPECT_EQ(lines[before], b);
-  EXPECT_EQ(lines[before + 1], c) << "then the frame behind the pong, relayed by the front's thread";
+  Within(kGuard, [&] { return Relayed(here / "relayed").size() >= 2; });
+  EXPECT_EQ(Relayed(here / "relayed"), (std::vector<std::string>{f1, f2})) << "the front's thread relays both, in order";
+
+  // The front's thread held again (P02's page closed and opened again: its log read again).
+  front.OnClose(p02);
+  fs::remove(log02);
+  fs::create_hard_link(fifo_, log02);
+  front.OnOpen(Connect(again, "P02"), web::Role::kSubject);
+  writer = Reader();
+  ASSERT_GE(writer, 0) << "the front's thread did not read P02's log again";
+  ASSERT_TRUE(front.OnText(page, R"({"op":"pong","id":1})").ok());
+  ASSERT_TRUE(front.OnText(page, f3).ok());
+  Within(2s, [&] { return Relayed(here / "relayed").size() >= 3; });
+  EXPECT_EQ(Relayed(here / "relayed"), (std::vector<std::string>{f1, f2, f3}))
+      << "a trial's frame waited for the front's thread (held by another page; the page's own pong queued)";
+  fs::remove(log02);
+  std::ofstream(log02).close();
+  ::close(writer);
   front.StopAll();
 }
 
