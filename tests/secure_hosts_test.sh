@@ -13,7 +13,8 @@
 #              unsecured tool) hears nothing. About 35 s.
 #   exports    the same as guests, but each machine holds only its export (`dyad security export`:
 #              lab's, rec's and the guest's, each in a folder of its own beside a copy of the
-#              graph, as copied to that machine), never the whole keystore; and from guest,
+#              graph, as copied to that machine), never the whole keystore; lab's launcher is
+#              started without --host (its export says which host it is); and from guest,
 #              `dyad echo --host lab` is refused naming the identity host.lab and the export that
 #              would give it. About 35 s.
 #   starts[:N] secured against open starts under load (issue #43 item 5): N rounds (default 20) of
@@ -116,7 +117,9 @@ run_guests() {
       at[$m]=$out/$m/visit_secured.yaml
     done
   fi
-  on lab "$dyad" run "${at[lab]}" --host lab --duration 25 --quiet > "$out/lab.log" 2>&1 &
+  local lab_host=(--host lab)
+  [ "$mode" = exports ] && lab_host=()  # lab's launcher: its export says which host it is
+  on lab "$dyad" run "${at[lab]}" "${lab_host[@]}" --duration 25 --quiet > "$out/lab.log" 2>&1 &
   lab_pid=$!; started+=($!)
   on rec "$dyad" run "${at[rec]}" --host rec --duration 25 --quiet > "$out/rec.log" 2>&1 &
   rec_pid=$!; started+=($!)
@@ -168,6 +171,8 @@ run_guests() {
        [ "$(ls "$out/rec/keys/identities" | tr "\n" " ")" = "host.rec process.ctl " ] &&
        [ "$(ls "$out/guest/keys/identities" | tr "\n" " ")" = "guest " ] &&
        ! find "$out/lab" "$out/rec" "$out/guest" -name "*.key.pem" | grep -q .'
+    check "lab's launcher, given no --host, ran as host lab from its export and said so" \
+      'grep -q "dyad run: running as host .lab., the host keystore .*/lab/keys was exported for" "$out/lab.log"'
     check "dyad echo --host lab on guest refused (exit 2), naming host.lab and the export that gives it" \
       '[ $refused_host = 2 ] && grep -q "identity .host.lab. is not in keystore .*--host lab OUT" "$out/refused_host.txt"'
   fi
