@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <mutex>
+#include <regex>
 #include <thread>
 
 #include <dyad/decode_sample.hpp>
@@ -59,6 +60,7 @@ class Probe : public Component {
     spec.Param("fail_step", 2);
     spec.Param("sleep_ms", 0.0);
     spec.Param("activate_ms", 0.0);  // Activate takes this long (a web component's wait for its page)
+    spec.Param("deactivate_ms", 0.0);  // Deactivate takes this long (a recorder writing its summary)
     spec.Param("tap", "");  // a topic to subscribe serialized (sleeping sleep_ms per callback)
     // tap on demand: started at step tap_start, stopped at step tap_stop (-1: never)
     spec.Param("tap_start", -1);
@@ -77,6 +79,7 @@ class Probe : public Component {
     fail_step_ = static_cast<uint64_t>(ctx.params().Int("fail_step"));
     sleep_ = std::chrono::duration<double, std::milli>(ctx.params().Double("sleep_ms"));
     activate_ = std::chrono::duration<double, std::milli>(ctx.params().Double("activate_ms"));
+    deactivate_ = std::chrono::duration<double, std::milli>(ctx.params().Double("deactivate_ms"));
     in_ = &ctx.input<msg::Counter>("in");
     out_ = &ctx.output<msg::Counter>("out");
     tap_start_ = ctx.params().Int("tap_start");
@@ -119,6 +122,7 @@ class Probe : public Component {
   }
   Status Deactivate() override {
     g_log->AddLifecycle(name_ + " deactivate (tapped " + std::to_string(tapped_) + ")");
+    std::this_thread::sleep_for(deactivate_);
     return fail_ == "deactivate" ? Fail(code_, "boom") : Status::OK();
   }
   void Shutdown() override { g_log->AddLifecycle(name_ + " shutdown"); }
@@ -126,7 +130,7 @@ class Probe : public Component {
  private:
   std::string name_, fail_, code_;
   uint64_t fail_step_ = 0;
-  std::chrono::duration<double, std::milli> sleep_{0}, activate_{0};
+  std::chrono::duration<double, std::milli> sleep_{0}, activate_{0}, deactivate_{0};
   Input<msg::Counter>* in_ = nullptr;
   Output<msg::Counter>* out_ = nullptr;
   std::atomic<bool> busy_{false};
@@ -243,6 +247,7 @@ class ExecutorTest : public ::testing::Test {
     o.steps = steps;
     o.duration_s = duration_s;
     o.session = session_;
+    o.stop_report_s = stop_report_s_;
     o.transport = [this, spurious](const std::string&, bool) -> StatusOr<std::unique_ptr<Transport>> {
       return std::unique_ptr<Transport>(new testing::MemoryTransport([this](const std::string& e) { log_.Add(e); }, spurious));
     };
@@ -282,6 +287,7 @@ class ExecutorTest : public ::testing::Test {
   ResolvedGraph resolved_;
   std::vector<Executor::Row> rows_;
   std::function<std::unique_ptr<ProcessSession>()> session_;  // Run()'s (empty: none)
+  double stop_report_s_ = 10;                                 // Run()'s Options::stop_report_s
 };
 
 const char* kPair = R"(graph: t
@@ -411,6 +417,21 @@ TEST_F(ExecutorTest, TheSessionsStartIsFixedOnceEveryComponentHasActivated) {
   // Late by the 0.5 s Activate on the old order; a loaded machine stays far below that.
   EXPECT_LT(Stats("a").jitter_max_s, 0.3);
   EXPECT_EQ(Stats("a").steps, 3u);
+}
+
+// A stop that takes long says what it waits for, every stop_report_s (a Deactivate that never
+// returned once left a study's graph running for minutes with nothing said); a quick one nothing.
+TEST_F(ExecutorTest, AStopThatTakesLongSaysWhatItWaitsFor) {
+  stop_report_s_ = 0.1;
+  ::testing::internal::CaptureStderr();
+  ASSERT_TRUE(Run(Pair("deactivate_ms: 350"), 3).ok());
+  const std::string slow = ::testing::internal::GetCapturedStderr();
+  EXPECT_TRUE(std::regex_search(slow, std::regex(R"(still stopping after 0\.[1-3] s: deactivating 'a')"))) << slow;
+  stop_report_s_ = 1;  // a quick stop, even on a loaded machine
+  ::testing::internal::CaptureStderr();
+  ASSERT_TRUE(Run(Pair(), 3).ok());
+  const std::string quick = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(quick.find("still stopping"), std::string::npos) << quick;
 }
 
 TEST_F(ExecutorTest, TriggeredCycleIsCappedInOneInstant) {

@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <set>
+#include <string>
+#include <thread>
 
 #include <dyad/msg/types.hpp>
 #include <dyad/run_stopping.hpp>
@@ -598,6 +602,51 @@ Status Executor::ActivateAll() {
   return Status::OK();
 }
 
+namespace {
+
+// While Run() stops: every `period` that the stop is still under way, one line on stderr saying
+// what it waits for. Seen once in a study under heavy load: a graph recorded its trial and never
+// exited, and nothing said where it stood.
+class StopReporter {
+ public:
+  explicit StopReporter(double period_s)
+      : period_(std::chrono::duration<double>(period_s)), start_(std::chrono::steady_clock::now()), thread_([this] { Loop(); }) {}
+  ~StopReporter() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      done_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+  StopReporter(const StopReporter&) = delete;
+  StopReporter& operator=(const StopReporter&) = delete;
+  void At(std::string what) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    what_ = std::move(what);
+  }
+
+ private:
+  void Loop() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!cv_.wait_for(lock, period_, [this] { return done_; })) {
+      char waited[32];
+      std::snprintf(waited, sizeof waited, "%.1f",
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
+      StderrLogger("dyad").Warn(std::string("still stopping after ") + waited + " s: " + what_);
+    }
+  }
+  const std::chrono::duration<double> period_;
+  const std::chrono::steady_clock::time_point start_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool done_ = false;
+  std::string what_ = "stopping";
+  std::thread thread_;  // last: started once the rest is made
+};
+
+}  // namespace
+
 Status Executor::Run() {
   Status s = Setup();
   const auto is_stopping = [this] { return stopping(); };
@@ -621,23 +670,30 @@ Status Executor::Run() {
   // (sequentially consistent: see TriggerStep).
   stop_.store(true);
   cv_.notify_all();
+  StopReporter reporter(options_.stop_report_s);
   for (auto& inst : instances_) {
     inst->active.store(false);
+    reporter.At("waiting for the step of '" + inst->name() + "' to end");
     if (inst->thread.joinable()) inst->thread.join();
     while (inst->notes.load() != 0) std::this_thread::yield();
   }
+  reporter.At("stopping the live parameters' preparations, publishing the last stats");
   if (live_params_) live_params_->Stop();  // no preparation runs inside a component deactivating
   // The last stats, while every subscriber (a recorder) still listens.
   if (stats_output_) PublishStats();
   for (auto it = instances_.rbegin(); it != instances_.rend(); ++it) {
     Instance& inst = **it;
+    reporter.At("closing the subscriptions of '" + inst.name() + "'");
     for (auto& r : inst.serialized_readers) r->Close();
     if (!inst.activated) continue;
+    reporter.At("deactivating '" + inst.name() + "'");
     Status d = inst.component->Deactivate();
     if (!d.ok() && s.ok()) s = d.WithContext(inst.name() + ": deactivate failed");
   }
-  for (auto it = instances_.rbegin(); it != instances_.rend(); ++it)
+  for (auto it = instances_.rbegin(); it != instances_.rend(); ++it) {
+    reporter.At("shutting down '" + (*it)->name() + "'");
     if ((*it)->configured) (*it)->component->Shutdown();
+  }
   MutexLock lock(mutex_);
   if (!s.ok()) return s;
   return failure_;

@@ -73,6 +73,9 @@ class Executor {
     double duration_s = 0;  // > 0: stop after this long (wall time, or simulated time when stepped)
     uint64_t steps = 0;     // > 0: stop after the fastest periodic component ran this many steps
     double stats_period_s = 1.0;
+    // A stop that takes longer says, this often, what it waits for (a step, a Deactivate that
+    // does not return would otherwise look like a process that ignores its stop).
+    double stop_report_s = 10.0;
     // A guest (dyad/guest.hpp) is none of the graph's processes: no writer on dyad/stats (`dyad
     // status` must not list its components as the graph's), no answers to live parameter requests.
     bool guest = false;
