@@ -400,7 +400,11 @@ void SetOutcome(const Study& s, const AttemptRequest& r, const tools::ExitStatus
 // a caller without its own signals has no second Ctrl-C to give): the graph still there
 // r.stop_grace after it gets the second stop as if asked.
 tools::ExitStatus RunGraph(const Study& s, const AttemptRequest& r, std::chrono::steady_clock::time_point t0, int* forwarded,
-                           double* first_stop_s, bool* interrupted) {
+                           double* first_stop_s, bool* interrupted, bool* overran) {
+  const bool guarded = r.overrun.count() > 0 && s.duration_s > 0 && !r.rehearsal && !AskedAfterTrial(s);
+  const auto overdue_at = t0 + r.overrun +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                              std::chrono::duration<double>(s.duration_s + r.wait_for_subject_s));
   std::optional<StopSignals> signals;
   if (r.own_signals) signals.emplace();
   tools::ChildOptions options;
@@ -412,7 +416,8 @@ tools::ExitStatus RunGraph(const Study& s, const AttemptRequest& r, std::chrono:
     if (std::optional<tools::ExitStatus> end = graph.Poll()) return *end;
     const auto now = std::chrono::steady_clock::now();
     const int signals_now = r.own_signals ? g_stop_signals.load() : 0;
-    const bool stop = r.stop && r.stop->load();
+    if (guarded && !stop_asked && now >= overdue_at) *overran = true;
+    const bool stop = (r.stop && r.stop->load()) || *overran;
     if (stop && !stop_asked) stop_asked = now;
     const bool overdue = stop_asked && now - *stop_asked >= r.stop_grace;
     const int wanted = overdue ? 2 : std::min(2, signals_now + (stop ? 1 : 0));
@@ -453,9 +458,17 @@ StatusOr<Attempt> RunAttempt(const Study& s, const AttemptRequest& r) {
   const auto t0 = std::chrono::steady_clock::now();
   int forwarded = 0;        // SIGINTs sent to the graph
   double first_stop_s = 0;  // when the first was sent, from the graph's start
-  const tools::ExitStatus exit = RunGraph(s, r, t0, &forwarded, &first_stop_s, &a.interrupted);
+  bool overran = false;     // stopped by r.overrun
+  const tools::ExitStatus exit = RunGraph(s, r, t0, &forwarded, &first_stop_s, &a.interrupted, &overran);
   a.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   SetOutcome(s, r, exit, forwarded > 0, first_stop_s, &a);
+  if (overran && a.outcome != AttemptOutcome::kFailed) {
+    char late[64];
+    std::snprintf(late, sizeof late, "%g s after its planned end (%g s)", std::chrono::duration<double>(r.overrun).count(),
+                  s.duration_s + r.wait_for_subject_s);
+    a.outcome = AttemptOutcome::kIncomplete;
+    a.incomplete = std::string("its graph did not end by itself: still running ") + late + ", it was stopped";
+  }
   Json end = {{"event", "end"},
               {"trial", a.trial},
               {"attempt", a.attempt},

@@ -127,6 +127,12 @@ struct AttemptRequest {
   // A graph still there this long after `stop` is set gets the second stop (a second SIGINT,
   // then killed this long after with its group), as a second Ctrl-C would: `stop` is set once.
   std::chrono::milliseconds stop_grace{10000};
+  // A timed trial's graph still running this long after its planned end (the wait for the
+  // subject's page plus the duration) is stopped as if asked (then the second stop and the kill
+  // as above): a graph that hangs while it ends would otherwise hold its participant for ever.
+  // The attempt is then incomplete, saying so. Not for a rehearsal (simulated time) nor a trial
+  // asked about after it (its end waits for the answers). 0: no limit.
+  std::chrono::milliseconds overrun{60000};
   // The session's subject's link (subject_lobby.hpp): the study's subject_web binds this port
   // (> 0), and its clock waits up to wait_for_subject_s for the page (0: no wait).
   int subject_port = 0;

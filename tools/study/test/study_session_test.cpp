@@ -404,6 +404,51 @@ TEST_F(StudySession, AGraphHangingAfterTheCallersStopGetsTheSecondStopAndIsKille
   }
 }
 
+// A timed trial whose graph is still running well past its planned end (a graph that hangs while
+// it ends: seen once at 48 participants on 2 cores) is stopped by the runner, not left holding its
+// participant, and the attempt is incomplete saying why. The "graph" runs on after its duration
+// and ends on its first SIGINT.
+TEST_F(StudySession, AGraphStillRunningPastItsPlannedEndIsStoppedAndTheTrialIncomplete) {
+  const Study s = Make("wall", 1);
+  const auto trials = s.TrialsOf("P01");
+  ASSERT_TRUE(MarkConsent(s, "P01", "test").ok());
+  const std::string script = (dir_ / "overrun.sh").string(), ints = (dir_ / "ints").string(), pid = (dir_ / "pid").string();
+  std::ofstream(script) << "#!/bin/bash\necho $$ > " << pid << "\ntrap 'echo int >> " << ints
+                        << "; exit 130' INT\nwhile true; do sleep 0.05; done\n";
+  fs::permissions(script, fs::perms::owner_all);
+  std::atomic<bool> stop{false};
+  AttemptRequest r;
+  r.dyad = script;
+  r.participant = "P01";
+  r.trial = trials[0];
+  r.stop = &stop;
+  r.own_signals = false;
+  r.overrun = std::chrono::milliseconds(500);
+  r.run_log = (dir_ / "run.log").string();
+  std::atomic<bool> returned{false};
+  std::thread guard([&] {  // the old runner waited for ever: the script is killed after 20 s
+    for (int i = 0; i < 2000 && !returned.load(); ++i) usleep(10000);
+    int group = 0;
+    if (!returned.load()) std::ifstream(pid) >> group;
+    if (group > 0) ::kill(-group, SIGKILL);
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  auto a = RunAttempt(s, r);
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  returned.store(true);
+  guard.join();
+  ASSERT_TRUE(a.ok()) << a.status().message();
+  EXPECT_TRUE(fs::exists(ints)) << "the graph got no SIGINT";
+  EXPECT_GE(took, 1.4) << "stopped before its duration and the overrun had passed";
+  EXPECT_LT(took, 10) << "not stopped by the runner";
+  EXPECT_EQ(a->outcome, AttemptOutcome::kIncomplete);
+  EXPECT_EQ(a->incomplete, "its graph did not end by itself: still running 0.5 s after its planned end (1 s), it was stopped")
+      << a->incomplete;
+  const auto log = LogLines(SessionLogPath(s, "P01"));
+  ASSERT_FALSE(log.empty());
+  EXPECT_EQ(log.back().value("outcome", ""), "incomplete") << log.back().dump();
+}
+
 // The experimenter's notes, a participant excluded (and included again) by the researcher, and
 // one who withdraws consent with their data deleted: all in the session log, the analysis leaves
 // them out saying why, and nothing records for a withdrawn participant without a new consent.
