@@ -164,6 +164,21 @@ class OnlineFrontTest : public testing::OnlineStudyTest {
     }
   }
 
+  // kFakeGraph (below) as the dyad the front starts trials with, written beside the test, and P01
+  // ready for a trial (consented, a subject token); the script's path.
+  std::string UseFakeGraph();
+  // The front's P01 taken to a trial: their page `waiting` opened and Ready, then (closed with
+  // 1012 when the trial starts) their page `trial` opened; its client id (0: it went otherwise).
+  web::ClientId StartTrial(OnlineFront& front, Page& waiting, Page& trial) {
+    const web::ClientId first = Connect(waiting);
+    front.OnOpen(first, web::Role::kSubject);
+    if (waiting.Op(1) != "waiting" || !front.OnText(first, R"({"op":"ready"})").ok()) return 0;
+    if (!waiting.Closed()) return 0;  // the trial starts: its page is closed (1012) and comes back
+    const web::ClientId page = Connect(trial);
+    front.OnOpen(page, web::Role::kSubject);
+    return page;
+  }
+
   Pages pages_;
   std::unique_ptr<web::WebServer> server_;
   std::string log_, fifo_;
@@ -252,82 +267,22 @@ TEST_F(OnlineFrontTest, APageWhoseFramesQueueUpPastOneMiBIsRefusedTheNextOne) {
   front.StopAll();
 }
 
-// A trial's "graph" that takes its page's relay and then reads nothing (a graph stuck): it binds a
-// loopback port with a small receive buffer, writes it where the front said (web.port_file),
-// answers the relay's WebSocket handshake, leaves a mark beside the port file, and waits for its
-// SIGINT.
-constexpr const char* kStuckGraph = R"(#!/usr/bin/env python3
-import base64, hashlib, os, signal, socket, sys
-signal.signal(signal.SIGINT, lambda *_: os._exit(0))
-port_file = next(a.split("port_file=", 1)[1] for a in sys.argv if ".port_file=" in a).strip(chr(39) + chr(34))  # unquoted
-s = socket.socket()
-s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
-s.bind(("127.0.0.1", 0))
-s.listen(1)
-with open(port_file, "w") as f:
-    f.write("%d\n" % s.getsockname()[1])
-c, _ = s.accept()
-request = b""
-while b"\r\n\r\n" not in request:
-    request += c.recv(1)
-key = [l.split(b":", 1)[1].strip() for l in request.split(b"\r\n") if l.lower().startswith(b"sec-websocket-key:")][0]
-accept = base64.b64encode(hashlib.sha1(key + b"258EAFA5-E914-47DA-95CA-C5AB0DC85B11").digest())
-c.sendall(b"HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: " + accept + b"\r\n\r\n")
-open(os.path.join(os.path.dirname(port_file), "relayed"), "w").close()
-while True:
-    signal.pause()
-)";
-
-TEST_F(OnlineFrontTest, AFrameTheTrialsGraphDoesNotTakeDropsThePagesRelayNotTheTrial) {
-  const std::string graph = (dir_ / "stuck_graph.py").string();
-  std::ofstream(graph) << kStuckGraph;
-  fs::permissions(graph, fs::perms::owner_all);
-  study_.subject_web = "web";
-  ASSERT_TRUE(MarkConsent(study_, "P01", "in the test").ok());
-  const std::string tokens = study_.data + "/P01/web-tokens";
-  std::ofstream(tokens) << "subject 0123456789abcdef0123456789abcdef\n";
-  fs::permissions(tokens, fs::perms::owner_read | fs::perms::owner_write);
-  OnlineFront front(study_, FrontOptions{graph, 2, 15});
-  front.SetServer(server_.get());
-  Page waiting, trial;
-  const web::ClientId first = Connect(waiting);
-  front.OnOpen(first, web::Role::kSubject);
-  ASSERT_EQ(waiting.Op(1), "waiting");
-  ASSERT_TRUE(front.OnText(first, R"({"op":"ready"})").ok());
-  EXPECT_TRUE(waiting.Closed()) << "the trial starts: its page is closed (1012) and comes back";
-  const web::ClientId second = Connect(trial);
-  front.OnOpen(second, web::Role::kSubject);
-  const fs::path relayed = fs::path(study_.data) / "P01" / "relayed";
-  for (auto until = std::chrono::steady_clock::now() + kGuard; !fs::exists(relayed) && std::chrono::steady_clock::now() < until;)
-    std::this_thread::sleep_for(10ms);
-  ASSERT_TRUE(fs::exists(relayed)) << "the page was never relayed to the trial's graph";
-  // The page's frames, until the graph's socket is full: a write that waits past 100 ms drops the
-  // relay and closes the page (it reconnects), rather than holding the front's one thread.
-  const std::string frame(16 << 10, 'x');
-  size_t sent = 0;
-  for (int i = 0; i < 4096 && trial.count() == 0; ++i) {
-    if (front.OnText(second, frame).ok()) ++sent;
-    else std::this_thread::sleep_for(1ms);  // 1 MiB waits for the front's thread: it is behind
-    std::lock_guard<std::mutex> lock(trial.mutex);
-    if (trial.closed) break;
-  }
-  EXPECT_TRUE(trial.Closed()) << "the page was not closed after " << sent << " frames of 16 KiB that its graph did not read";
-  EXPECT_EQ(front.running(), 1) << "the trial goes on (the page reconnects to it)";
-  front.StopAll();  // the graph's SIGINT
-  EXPECT_EQ(front.running(), 0);
-}
-
-// A trial's "graph" that waits for a file "go" beside its port file, then takes its page's relay,
-// leaves a mark "connected" there, and writes each text frame it reads, one a line, into
-// "relayed".
-constexpr const char* kRecordingGraph = R"(#!/usr/bin/env python3
+// A trial's "graph" for the front's relay, run in place of dyad with the trial's arguments. It
+// waits for a file "go" beside the port file the front names (web.port_file), binds a loopback
+// port and writes it there, answers the relay's WebSocket handshake and leaves a mark "connected"
+// beside it. Then, with a file "stuck" there, it reads nothing (a graph stuck; its receive buffer
+// small) until its SIGINT; else it writes each text frame it reads, one a line, into "relayed".
+constexpr const char* kFakeGraph = R"(#!/usr/bin/env python3
 import base64, hashlib, os, signal, socket, sys, time
 signal.signal(signal.SIGINT, lambda *_: os._exit(0))
-port_file = next(a.split("port_file=", 1)[1] for a in sys.argv if ".port_file=" in a).strip(chr(39) + chr(34))
+port_file = next(a.split("port_file=", 1)[1] for a in sys.argv if ".port_file=" in a).strip(chr(39) + chr(34))  # unquoted
 here = os.path.dirname(port_file)
 while not os.path.exists(os.path.join(here, "go")):
     time.sleep(0.01)
+stuck = os.path.exists(os.path.join(here, "stuck"))
 s = socket.socket()
+if stuck:
+    s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
 s.bind(("127.0.0.1", 0))
 s.listen(1)
 with open(port_file, "w") as f:
@@ -340,6 +295,8 @@ key = [l.split(b":", 1)[1].strip() for l in request.split(b"\r\n") if l.lower().
 accept = base64.b64encode(hashlib.sha1(key + b"258EAFA5-E914-47DA-95CA-C5AB0DC85B11").digest())
 c.sendall(b"HTTP/1.1 101 Switching Protocols\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Accept: " + accept + b"\r\n\r\n")
 open(os.path.join(here, "connected"), "w").close()
+while stuck:
+    signal.pause()
 def read(n):
     data = b""
     while len(data) < n:
@@ -360,6 +317,18 @@ while True:
             f.write(data.decode() + "\n")
 )";
 
+std::string OnlineFrontTest::UseFakeGraph() {
+  const std::string graph = (dir_ / "fake_graph.py").string();
+  std::ofstream(graph) << kFakeGraph;
+  fs::permissions(graph, fs::perms::owner_all);
+  study_.subject_web = "web";
+  EXPECT_TRUE(MarkConsent(study_, "P01", "in the test").ok());
+  const fs::path tokens = fs::path(study_.data) / "P01" / "web-tokens";
+  std::ofstream(tokens) << "subject 0123456789abcdef0123456789abcdef\n";
+  fs::permissions(tokens, fs::perms::owner_read | fs::perms::owner_write);
+  return graph;
+}
+
 // Whether `done` came true within `limit` (looked at every 10 ms).
 bool Within(std::chrono::milliseconds limit, const std::function<bool()>& done) {
   for (const auto until = std::chrono::steady_clock::now() + limit; !done();) {
@@ -367,6 +336,33 @@ bool Within(std::chrono::milliseconds limit, const std::function<bool()>& done) 
     std::this_thread::sleep_for(10ms);
   }
   return true;
+}
+
+TEST_F(OnlineFrontTest, AFrameTheTrialsGraphDoesNotTakeDropsThePagesRelayNotTheTrial) {
+  OnlineFront front(study_, FrontOptions{UseFakeGraph(), 2, 15});
+  front.SetServer(server_.get());
+  const fs::path here = fs::path(study_.data) / "P01";
+  std::ofstream(here / "stuck").close();
+  std::ofstream(here / "go").close();
+  Page waiting, trial;
+  const web::ClientId second = StartTrial(front, waiting, trial);
+  ASSERT_NE(second, 0u) << "the trial did not start";
+  ASSERT_TRUE(Within(kGuard, [&] { return fs::exists(here / "connected"); }))
+      << "the page was never relayed to the trial's graph";
+  // The page's frames, until the graph's socket is full: a write that waits past 100 ms drops the
+  // relay and closes the page (it reconnects), rather than holding the front's one thread.
+  const std::string frame(16 << 10, 'x');
+  size_t sent = 0;
+  for (int i = 0; i < 4096 && trial.count() == 0; ++i) {
+    if (front.OnText(second, frame).ok()) ++sent;
+    else std::this_thread::sleep_for(1ms);  // 1 MiB waits for the front's thread: it is behind
+    std::lock_guard<std::mutex> lock(trial.mutex);
+    if (trial.closed) break;
+  }
+  EXPECT_TRUE(trial.Closed()) << "the page was not closed after " << sent << " frames of 16 KiB that its graph did not read";
+  EXPECT_EQ(front.running(), 1) << "the trial goes on (the page reconnects to it)";
+  front.StopAll();  // the graph's SIGINT
+  EXPECT_EQ(front.running(), 0);
 }
 
 // The lines the recording graph has written (none yet: empty).
@@ -383,24 +379,12 @@ std::vector<std::string> Relayed(const fs::path& file) {
 // relayed) holds nothing back. The front's thread is held meanwhile by another page: P02's
 // session log, a FIFO that no one writes.
 TEST_F(OnlineFrontTest, ATrialsFramesAreRelayedAtOnceAndInOrderWhileTheFrontsThreadIsHeld) {
-  const std::string graph = (dir_ / "recording_graph.py").string();
-  std::ofstream(graph) << kRecordingGraph;
-  fs::permissions(graph, fs::perms::owner_all);
-  study_.subject_web = "web";
-  ASSERT_TRUE(MarkConsent(study_, "P01", "in the test").ok());
-  const fs::path here = fs::path(study_.data) / "P01";
-  std::ofstream(here / "web-tokens") << "subject 0123456789abcdef0123456789abcdef\n";
-  fs::permissions(here / "web-tokens", fs::perms::owner_read | fs::perms::owner_write);
-  OnlineFront front(study_, FrontOptions{graph, 2, 15});
+  OnlineFront front(study_, FrontOptions{UseFakeGraph(), 2, 15});
   front.SetServer(server_.get());
+  const fs::path here = fs::path(study_.data) / "P01";
   Page waiting, trial, other, again;
-  const web::ClientId first = Connect(waiting);
-  front.OnOpen(first, web::Role::kSubject);
-  ASSERT_EQ(waiting.Op(1), "waiting");
-  ASSERT_TRUE(front.OnText(first, R"({"op":"ready"})").ok());
-  ASSERT_TRUE(waiting.Closed()) << "the trial starts: its page is closed (1012) and comes back";
-  const web::ClientId page = Connect(trial);
-  front.OnOpen(page, web::Role::kSubject);  // the front's thread starts its relay (the graph waits for "go")
+  const web::ClientId page = StartTrial(front, waiting, trial);  // its relay starts (the graph waits for "go")
+  ASSERT_NE(page, 0u) << "the trial did not start";
 
   const std::string log02 = SessionLogPath(study_, "P02");
   fs::create_directories(fs::path(log02).parent_path());

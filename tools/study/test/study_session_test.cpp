@@ -61,6 +61,18 @@ class StudySession : public ::testing::Test {
     if (!HasFailure()) fs::remove_all(dir_);
   }
   // A study of two blind conditions on a counter graph with a recorder, on `clock`.
+  // P01's attempt at `trial` as `dyad study serve` asks for it: `dyad` as the executable, stopped
+  // through `stop` (no signals of its own), the graph's output into run.log.
+  AttemptRequest ServedAttempt(const std::string& dyad, const Trial& trial, const std::atomic<bool>* stop) {
+    AttemptRequest r;
+    r.dyad = dyad;
+    r.participant = "P01";
+    r.trial = trial;
+    r.stop = stop;
+    r.own_signals = false;
+    r.run_log = (dir_ / "run.log").string();
+    return r;
+  }
   Study Make(const std::string& clock, double duration_s) {
     std::ofstream(dir_ / "g.yaml") << "graph: g\nclock: " << clock << "\ncomponents:\n"
                                       "  src: {type: counter_source, rate_hz: 20, outputs: {out: c}}\n"
@@ -321,13 +333,7 @@ TEST_F(StudySession, ACallersIncompleteReasonMakesAStoppedTrialIncomplete) {
   const auto trials = s.TrialsOf("P01");
   ASSERT_TRUE(MarkConsent(s, "P01", "test").ok());
   std::atomic<bool> stop{false};
-  AttemptRequest r;
-  r.dyad = DYAD_EXE;
-  r.participant = "P01";
-  r.trial = trials[0];
-  r.stop = &stop;
-  r.own_signals = false;
-  r.run_log = (dir_ / "run.log").string();
+  AttemptRequest r = ServedAttempt(DYAD_EXE, trials[0], &stop);
   r.incomplete_reason = [] { return std::string("the participant's connection was lost for more than 5 s"); };
   std::thread stopper([&] {
     for (int i = 0; i < 3000 && !fs::exists(trials[0].file); ++i) usleep(10000);
@@ -371,16 +377,10 @@ TEST_F(StudySession, AGraphHangingAfterTheCallersStopGetsTheSecondStopAndIsKille
                           << (ends_on_second ? "; [ $n -ge 2 ] && exit 130" : "") << "' INT\nwhile true; do sleep 0.05; done\n";
     fs::permissions(script, fs::perms::owner_all);
     std::atomic<bool> stop{false};
-    AttemptRequest r;
-    r.dyad = script;
-    r.participant = "P01";
-    r.trial = trials[0];
+    AttemptRequest r = ServedAttempt(script, trials[0], &stop);
     r.attempt = ends_on_second ? 1 : 2;
     r.reason = ends_on_second ? "" : "the test's second case";
-    r.stop = &stop;
-    r.own_signals = false;
     r.stop_grace = std::chrono::milliseconds(300);
-    r.run_log = (dir_ / "run.log").string();
     std::atomic<bool> returned{false};
     std::thread stopper([&] {
       for (int i = 0; i < 1000 && !fs::exists(pid); ++i) usleep(10000);
@@ -417,14 +417,8 @@ TEST_F(StudySession, AGraphStillRunningPastItsPlannedEndIsStoppedAndTheTrialInco
                         << "; exit 130' INT\nwhile true; do sleep 0.05; done\n";
   fs::permissions(script, fs::perms::owner_all);
   std::atomic<bool> stop{false};
-  AttemptRequest r;
-  r.dyad = script;
-  r.participant = "P01";
-  r.trial = trials[0];
-  r.stop = &stop;
-  r.own_signals = false;
+  AttemptRequest r = ServedAttempt(script, trials[0], &stop);
   r.overrun = std::chrono::milliseconds(500);
-  r.run_log = (dir_ / "run.log").string();
   std::atomic<bool> returned{false};
   std::thread guard([&] {  // the old runner waited for ever: the script is killed after 20 s
     for (int i = 0; i < 2000 && !returned.load(); ++i) usleep(10000);
