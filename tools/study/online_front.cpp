@@ -471,9 +471,8 @@ bool OnlineFront::RelayAtOnce(web::ClientId client, std::string_view text, int64
     up = p->upstream;
     p->heard = Clock::now();
   }
-  const double wall_ms = Pointer(*p, text);
   if (!up->SendText(text, kRelayWrite).ok()) return false;  // the front's thread tries it again, and ends the phase
-  if (wall_ms >= 0) NotePointerDelay(wall_ms, received_ns);
+  if (const double wall_ms = Pointer(*p, text); wall_ms >= 0) NotePointerDelay(wall_ms, received_ns);
   return true;
 }
 
@@ -494,10 +493,10 @@ void OnlineFront::Text(web::ClientId client, std::string_view text, int64_t rece
     running = p->running;
   }
   if (up) {
-    const double wall_ms = Pointer(*p, text);
     if (Status st = up->SendText(text, kRelayWrite); !st.ok())
       NextPhase(*p, client, "the trial's graph does not take the page's frames");
-    else if (wall_ms >= 0) NotePointerDelay(wall_ms, received_ns);
+    else if (const double wall_ms = Pointer(*p, text); wall_ms >= 0)  // only what reached the graph
+      NotePointerDelay(wall_ms, received_ns);
     return;
   }
   if (!running) Answer(*p, client, text);
