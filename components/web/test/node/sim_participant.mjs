@@ -14,7 +14,7 @@
 //     1 to 3 s and moves to the next start, released;
 //   - answers "What were you drawing?" (after each hold of at least the page's minimum, and each
 //     question after the trial) with what it drew, 1 to 3 s later, wrong with probability
-//     `report_error`.
+//     `report_error`; after a hold it is asked about, it rests only once it has answered.
 // Without a data set folder it draws generated shapes (a circle, a figure eight, a square), so it
 // works from a clean clone. `speed` > 1 (tests) divides every duration of its behaviour (rests,
 // holds, answers), never the pointer's event rate.
@@ -259,7 +259,9 @@ export class SimParticipant {
       this.stats.holds++;
       if (performance.now() - held >= this.askAfterMs) {  // real time: the page's minimum hold
         this.drawn.push(k);
-        if (this.ask && this.steering) this.later(this.r.uniform(1000, 3000), () => this.answer(k));
+        // A person answers before drawing again: an answer sent during the next hold is not taken
+        // (the page asks about a finished hold), so the rest starts once it is given.
+        if (this.ask && this.steering) return this.later(this.r.uniform(1000, 3000), () => { this.answer(k); this.rest(); });
       }
       this.rest();
     });
