@@ -131,6 +131,7 @@ struct OnlineFront::Participant {
   std::shared_ptr<web::WsClient> upstream;  // the relay to the trial's graph, while a trial runs
   bool running = false;
   int port = 0;           // the running trial's, once read from port_file (0: not yet)
+  int domain = -1;        // the running trial's DDS domain, taken from domains_ (-1: none taken)
   std::string port_file;  // where the running trial's graph writes the port it bound
   std::string token, lost_reason;
   int ping_id = 0;
@@ -146,7 +147,7 @@ struct OnlineFront::Participant {
   std::optional<bool> engaged;
 };
 
-OnlineFront::OnlineFront(const Study& s, FrontOptions o) : study_(s), options_(std::move(o)) {
+OnlineFront::OnlineFront(const Study& s, FrontOptions o) : study_(s), options_(std::move(o)), domains_(options_.domains) {
   for (const std::string& p : s.participants) {
     auto participant = std::make_unique<Participant>(s, p);
     participant->ended = ReadOnlineEvents(SessionLogPath(s, p)).ended;  // ended before a restart: shown, and resumable
@@ -577,6 +578,16 @@ std::string OnlineFront::StartTrial(Participant& p) {
   {
     MutexLock lock(mutex_);
     if (p.running || !p.ended.empty()) return "";
+    if (domains_.range().size() > 0) {
+      const std::optional<int> domain = domains_.Take();
+      if (!domain) {  // more trials than live sessions: a stopped session's graph still ending
+        std::cerr << "dyad study serve: " << p.id << ": trial " << r.trial.number << " cannot start yet: every domain of "
+                  << domains_.range().first << "-" << domains_.range().last << " has a trial's graph running" << std::endl;
+        return kComeBack;
+      }
+      p.domain = *domain;
+      r.serve_sets.push_back("domain_id=" + std::to_string(*domain));
+    }
     p.running = true;
     p.trial = r.trial.number;
     p.attempt = r.attempt;
@@ -615,6 +626,8 @@ void OnlineFront::RunTrial(Participant& p, AttemptRequest r) {
   {
     MutexLock lock(mutex_);
     p.running = false;
+    if (p.domain >= 0) domains_.Give(p.domain);  // its graph has exited
+    p.domain = -1;
     p.failures = failed ? p.failures + 1 : 0;
     if (p.failures == kFailuresInARow)
       std::cerr << "dyad study serve: " << p.id << ": trial " << r.trial.number << " failed " << kFailuresInARow
@@ -698,6 +711,7 @@ std::vector<OnlineFront::SessionView> OnlineFront::Snapshot(Clock::time_point no
         v.attempt = p->attempt;
         v.file = p->file;
         v.port = p->port;
+        v.domain = p->domain;
         v.engaged = p->engaged;
       } else if (p->page == 0) {
         v.phase = "away";

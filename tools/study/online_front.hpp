@@ -74,6 +74,7 @@
 #include "dyad/thread_annotations.hpp"
 #include "study_file.hpp"
 #include "study_session.hpp"
+#include "trial_domains.hpp"
 #include "web_server.hpp"
 
 namespace dyad::study {
@@ -83,6 +84,9 @@ struct FrontOptions {
   int max_sessions = 16;           // >= 1
   double wait_for_subject_s = 15;  // a trial's graph waits this long for the page (it reconnects at once)
   std::chrono::milliseconds ping_interval{2000};
+  // Each running trial's graph on a domain of its own from these (trial_domains.hpp); empty (the
+  // default): every trial on the graph's own domain.
+  DomainRange domains{};
 };
 
 class OnlineFront final : public web::ClientHandler {
@@ -97,6 +101,7 @@ class OnlineFront final : public web::ClientHandler {
     std::string shown;                   // its condition as the experimenter may see it (Study::Shown)
     std::string file;                    // the running attempt's recording ("" between trials)
     int port = 0;                        // the running trial's web component (0: none)
+    int domain = -1;                     // the running trial's DDS domain (-1: none, or the graph's own)
     std::optional<bool> engaged;         // the relayed page's last pointer sample this trial (none yet: nullopt)
     double rtt_ms = -1;                  // the page's last ping round trip (-1: none yet)
     std::string ended;                   // the experimenter's reason, when ended
@@ -167,7 +172,7 @@ class OnlineFront final : public web::ClientHandler {
   void NotePointerDelay(double wall_ms, int64_t received_ns);
   void Answer(Participant& p, web::ClientId client, std::string_view text);
   // Starts p's next trial; a trial that cannot start (its token file unreadable, its graph failed
-  // kFailuresInARow times) returns what its page is told ("" when started or nothing to say).
+  // kFailuresInARow times, no domain free) returns what its page is told ("" when started or nothing to say).
   std::string StartTrial(Participant& p);
   void RunTrial(Participant& p, AttemptRequest r);
   Participant* Of(web::ClientId client);
@@ -182,6 +187,7 @@ class OnlineFront final : public web::ClientHandler {
   std::map<std::string, std::unique_ptr<Participant>> participants_;  // fixed at construction
   mutable Mutex mutex_;
   std::map<web::ClientId, Participant*> clients_ GUARDED_BY(mutex_);
+  TrialDomains domains_ GUARDED_BY(mutex_);  // the running trials' domains
   // The page events for the front's thread (never held while one is handled).
   Mutex events_mutex_;
   std::condition_variable events_cv_;

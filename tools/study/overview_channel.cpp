@@ -175,6 +175,7 @@ std::string OverviewChannel::StateOf(const std::vector<OnlineFront::SessionView>
                         {"attempt", v.attempt},
                         {"shown", v.shown},
                         {"file", v.file},
+                        {"domain", v.domain >= 0 ? Json(v.domain) : Json(nullptr)},  // `dyad echo --domain` reaches its graph
                         {"recording_bytes", v.file.empty() || ec ? Json(nullptr) : Json(bytes)},
                         {"engaged", v.phase == "paused" ? Json(false)
                                     : v.engaged         ? Json(*v.engaged)

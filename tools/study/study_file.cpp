@@ -152,6 +152,7 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
     std::set<std::string> processes;
     bool subject_steers = false;  // a web_human: a person steers from the subject's page
     const Graph graph = LoadGraph(s->graph, {}, &ignored);
+    s->graph_domain = graph.domain_id;
     for (const ComponentConfig& c : graph.components) {
       processes.insert(graph.ProcessOf(c));
       if (c.type == "web") {
@@ -211,12 +212,18 @@ void ReadRehearsal(StrictYaml& y, const YAML::Node& root, const std::string& pat
 // The `online:` map (`dyad study serve`): its keys, each checked at its line; the consent text read.
 void ReadOnline(StrictYaml& y, const YAML::Node& root, const std::string& path, Study* s) {
   const YAML::Node o = root["online"];
-  if (!o || !y.Map(o, "online", {"reconnect_s", "max_sessions", "completion_code", "consent"})) return;
+  if (!o || !y.Map(o, "online", {"reconnect_s", "max_sessions", "domains", "completion_code", "consent"})) return;
   Online& on = s->online;
   if (y.Get(o, "reconnect_s", "online.reconnect_s", &on.reconnect_s, "a number of seconds") && !(on.reconnect_s > 0))
     y.Error(o["reconnect_s"], "online.reconnect_s", "must be > 0 (how long a page gone mid-trial may take to come back)");
   if (y.Get(o, "max_sessions", "online.max_sessions", &on.max_sessions, "an integer") && on.max_sessions < 1)
     y.Error(o["max_sessions"], "online.max_sessions", "must be >= 1");
+  if (std::vector<int> d; y.Get(o, "domains", "online.domains", &d, "[FIRST, LAST]: two DDS domain ids")) {
+    auto range = d.size() == 2 ? ParseDomainRange(std::to_string(d[0]) + "-" + std::to_string(d[1]))
+                               : StatusOr<DomainRange>(Status::InvalidArgument("want [FIRST, LAST]"));
+    if (range.ok()) on.domains = *range;
+    else y.Error(o["domains"], "online.domains", "must be [FIRST, LAST], two DDS domain ids in 0..232, FIRST <= LAST");
+  }
   static const std::regex code("[A-Za-z0-9_-]{1,64}");
   if (y.Get(o, "completion_code", "online.completion_code", &on.completion_code, "a code") &&
       !std::regex_match(on.completion_code, code)) {

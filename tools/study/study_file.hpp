@@ -20,6 +20,9 @@
 //   online:                              # `dyad study serve` (docs/study.md, "A study online")
 //     reconnect_s: 60                    # a page gone mid-trial may come back this long (default 60, > 0)
 //     max_sessions: 16                   # live sessions at once (default 16, >= 1; --max-sessions overrides)
+//     domains: [40, 55]                  # each running trial's graph on a DDS domain of its own from these
+//                                        # (default: the graph's domain_id and the max_sessions - 1 after it;
+//                                        # --domains overrides; trial_domains.hpp)
 //     completion_code: C1A2B3            # one code for everyone (letters, digits, _ -; default: one each)
 //     consent: consent.txt               # the consent page's text, relative to this file (required
 //                                        # to serve a study with consent_required)
@@ -39,6 +42,7 @@
 //     to the conditions in an order drawn from the study's name (the same every time).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -46,6 +50,7 @@
 #include "dyad/diagnostic.hpp"
 #include "self_reports.hpp"
 #include "study_task.hpp"
+#include "trial_domains.hpp"
 
 namespace dyad::study {
 
@@ -66,6 +71,7 @@ struct Trial {
 struct Online {
   double reconnect_s = 60;      // > 0
   int max_sessions = 16;        // >= 1
+  std::optional<DomainRange> domains;  // the trials' domains (none given: from the graph's domain_id)
   std::string completion_code;  // empty: a random code per participant (OnlineSession makes it)
   std::string consent;          // the consent text's file, absolute; empty: none given
   std::string consent_text;     // its text (read by LoadStudy: not empty)
@@ -73,6 +79,7 @@ struct Online {
 
 struct Study {
   std::string name, file, graph, data;  // graph and data absolute
+  int graph_domain = 0;                 // the graph's domain_id
   std::vector<std::string> participants;
   std::vector<Condition> conditions;
   int trials = 1;

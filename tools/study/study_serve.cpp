@@ -111,7 +111,8 @@ web::WebServer::Options ServerOptions(const ServeOptions& o, const std::vector<s
   return so;
 }
 
-void Serving(const Study& s, const ServeOptions& o, int port, int with_links, int max_sessions, const std::string& token) {
+void Serving(const Study& s, const ServeOptions& o, int port, int with_links, int max_sessions, const DomainRange& domains,
+             const std::string& token) {
   const std::string scheme = o.tls_certificate.empty() ? "http://" : "https://";
   for (const std::string& host : web::UrlHosts(o.address))
     std::cout << "dyad study serve: " << s.name << " at " << scheme << host << ":" << port << "/subject?token=..." << std::endl;
@@ -131,7 +132,8 @@ void Serving(const Study& s, const ServeOptions& o, int port, int with_links, in
             << (with_links < static_cast<int>(s.participants.size()) ? " (dyad study links " + s.file + " --base-url " + scheme +
                                                                            "HOST:" + std::to_string(port) + " makes the others')"
                                                                      : std::string())
-            << "; max_sessions " << max_sessions << ", reconnect_s " << s.online.reconnect_s << std::endl;
+            << "; max_sessions " << max_sessions << ", reconnect_s " << s.online.reconnect_s << "; trials on DDS domains "
+            << domains.first << "-" << domains.last << " (one each)" << std::endl;
 }
 
 }  // namespace
@@ -172,6 +174,24 @@ int Serve(const ServeOptions& o) {
     return 2;
   }
   const int max_sessions = o.max_sessions > 0 ? o.max_sessions : s.online.max_sessions;
+  // Each running trial on a DDS domain of its own (trial_domains.hpp): --domains, online.domains,
+  // else from the graph's domain_id on.
+  std::optional<DomainRange> given = s.online.domains;
+  std::string given_by = s.file + ": online.domains";
+  if (!o.domains.empty()) {
+    const auto parsed = ParseDomainRange(o.domains);
+    if (!parsed.ok()) {
+      std::cerr << "dyad study serve: --domains " << parsed.status().message() << "\n";
+      return 2;
+    }
+    given = *parsed;
+    given_by = "--domains";
+  }
+  const auto domains = TrialDomainRange(given, given_by, s.graph_domain, max_sessions);
+  if (!domains.ok()) {
+    std::cerr << "dyad study serve: " << domains.status().message() << "\n";
+    return 2;
+  }
   std::vector<std::string> token_problems;
   FrontAdmission admission(s, &token_problems);
   for (const std::string& p : token_problems) std::cerr << "dyad study serve: " << p << " (that participant has no link)\n";
@@ -190,7 +210,8 @@ int Serve(const ServeOptions& o) {
   sigaction(SIGTERM, &sa, &old_term);
   // A trial's graph waits for the page (it comes back at once after the 1012), at most
   // reconnect_s: a page not back by then ends the trial anyway.
-  OnlineFront front(s, FrontOptions{tools::ThisExecutable(), max_sessions, std::min(15.0, s.online.reconnect_s)});
+  OnlineFront front(s, FrontOptions{tools::ThisExecutable(), max_sessions, std::min(15.0, s.online.reconnect_s),
+                                    std::chrono::milliseconds(2000), *domains});
   OverviewChannel overview(s, &front, max_sessions);
   auto server = web::WebServer::Start(ServerOptions(o, link_origins, &admission, &front, &overview, max_sessions));
   if (!server.ok()) {
@@ -203,7 +224,7 @@ int Serve(const ServeOptions& o) {
   overview.SetServer(server->get());
   overview.Start();
   if (!o.port_file.empty()) std::ofstream(o.port_file) << (*server)->port() << "\n";
-  Serving(s, o, (*server)->port(), admission.with_links(), max_sessions, *overview_token);
+  Serving(s, o, (*server)->port(), admission.with_links(), max_sessions, *domains, *overview_token);
   std::cout << *tls << std::flush;
   while (!g_quit.load()) {
     front.Tick(OnlineFront::Clock::now());
@@ -238,6 +259,9 @@ void AddServeCommand(CLI::App* study, int& exit_code) {
       ->check(CLI::ExistingFile);
   serve->add_option("--max-sessions", o->max_sessions, "Live sessions at once (default: the study file's online.max_sessions)")
       ->check(CLI::Range(1, 100000));
+  serve->add_option("--domains", o->domains,
+                    "FIRST-LAST: the DDS domains of the trials running at once, one each (default: the study file's "
+                    "online.domains, else the graph's domain_id and the max_sessions - 1 after it)");
   serve->add_option("--port-file", o->port_file, "Write the bound port here");
   serve->add_option("--origin", o->origins, "Another origin participants' pages come from (scheme://host[:port], repeatable)");
   serve->add_option("--plugins", o->plugins, "Extra plugin file or folder (repeatable)");

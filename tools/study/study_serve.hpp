@@ -42,6 +42,7 @@ struct ServeOptions {
   int port = 8443;  // 0: any free one
   std::string tls_certificate, port_file;
   int max_sessions = 0;  // 0: the study file's online.max_sessions
+  std::string domains;   // "FIRST-LAST" (--domains); empty: the study file's online.domains, else the graph's on
   std::vector<std::string> origins, plugins;
 };
 

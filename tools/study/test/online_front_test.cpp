@@ -164,9 +164,9 @@ class OnlineFrontTest : public testing::OnlineStudyTest {
     }
   }
 
-  // kFakeGraph (below) as the dyad the front starts trials with, written beside the test, and P01
-  // ready for a trial (consented, a subject token); the script's path.
-  std::string UseFakeGraph();
+  // kFakeGraph (below) as the dyad the front starts trials with, written beside the test, and
+  // `participant` ready for a trial (consented, a subject token); the script's path.
+  std::string UseFakeGraph(const std::string& participant = "P01");
   // The front's P01 taken to a trial: their page `waiting` opened and Ready, then (closed with
   // 1012 when the trial starts) their page `trial` opened; its client id (0: it went otherwise).
   web::ClientId StartTrial(OnlineFront& front, Page& waiting, Page& trial) {
@@ -267,16 +267,18 @@ TEST_F(OnlineFrontTest, APageWhoseFramesQueueUpPastOneMiBIsRefusedTheNextOne) {
   front.StopAll();
 }
 
-// A trial's "graph" for the front's relay, run in place of dyad with the trial's arguments. It
-// waits for a file "go" beside the port file the front names (web.port_file), binds a loopback
-// port and writes it there, answers the relay's WebSocket handshake and leaves a mark "connected"
-// beside it. Then, with a file "stuck" there, it reads nothing (a graph stuck; its receive buffer
-// small) until its SIGINT; else it writes each text frame it reads, one a line, into "relayed".
+// A trial's "graph" for the front's relay, run in place of dyad with the trial's arguments (which
+// it writes into a file "args" beside the port file, one a line). It waits for a file "go" beside the port file the front names
+// (web.port_file), binds a loopback port and writes it there, answers the relay's WebSocket handshake and leaves a mark
+// "connected" beside it. Then, with a file "stuck" there, it reads nothing (a graph stuck; its receive buffer small) until its
+// SIGINT; else it writes each text frame it reads, one a line, into "relayed".
 constexpr const char* kFakeGraph = R"(#!/usr/bin/env python3
 import base64, hashlib, os, signal, socket, sys, time
 signal.signal(signal.SIGINT, lambda *_: os._exit(0))
 port_file = next(a.split("port_file=", 1)[1] for a in sys.argv if ".port_file=" in a).strip(chr(39) + chr(34))  # unquoted
 here = os.path.dirname(port_file)
+with open(os.path.join(here, "args"), "w") as f:
+    f.write("\n".join(sys.argv[1:]) + "\n")
 while not os.path.exists(os.path.join(here, "go")):
     time.sleep(0.01)
 stuck = os.path.exists(os.path.join(here, "stuck"))
@@ -317,13 +319,13 @@ while True:
             f.write(data.decode() + "\n")
 )";
 
-std::string OnlineFrontTest::UseFakeGraph() {
+std::string OnlineFrontTest::UseFakeGraph(const std::string& participant) {
   const std::string graph = (dir_ / "fake_graph.py").string();
   std::ofstream(graph) << kFakeGraph;
   fs::permissions(graph, fs::perms::owner_all);
   study_.subject_web = "web";
-  EXPECT_TRUE(MarkConsent(study_, "P01", "in the test").ok());
-  const fs::path tokens = fs::path(study_.data) / "P01" / "web-tokens";
+  EXPECT_TRUE(MarkConsent(study_, participant, "in the test").ok());
+  const fs::path tokens = fs::path(study_.data) / participant / "web-tokens";
   std::ofstream(tokens) << "subject 0123456789abcdef0123456789abcdef\n";
   fs::permissions(tokens, fs::perms::owner_read | fs::perms::owner_write);
   return graph;
@@ -444,6 +446,48 @@ TEST_F(OnlineFrontTest, StoppingASessionBetweenTrialsFreesItsPlaceAtOnce) {
   EXPECT_EQ(front.live(OnlineFront::Clock::now()), 0) << "P01's place is free at once, not reconnect_s later";
   front.OnOpen(Connect(p02, "P02"), web::Role::kSubject);
   EXPECT_EQ(p02.Op(1), "consent") << "P02 is let in";
+  front.StopAll();
+}
+
+// Each running trial's graph is started on a domain of its own (FrontOptions::domains), given back
+// once its graph has exited; with none free a trial does not start and its page hears "come back
+// later". One domain for two sessions here, so P02's trial waits for P01's.
+TEST_F(OnlineFrontTest, EachRunningTrialGetsADomainOfItsOwnGivenBackWhenItsGraphExits) {
+  FrontOptions o{UseFakeGraph(), 2, 15};
+  UseFakeGraph("P02");
+  o.domains = DomainRange{40, 40};
+  OnlineFront front(study_, o);
+  front.SetServer(server_.get());
+  const fs::path p01 = fs::path(study_.data) / "P01", p02 = fs::path(study_.data) / "P02";
+  Page waiting, trial, refused, waiting2;
+  ASSERT_NE(StartTrial(front, waiting, trial), 0u) << "P01's trial did not start";
+  ASSERT_TRUE(Within(kGuard, [&] { return Relayed(p01 / "args").size() > 2; })) << "P01's graph never started";
+  const std::vector<std::string> args = Relayed(p01 / "args");
+  EXPECT_EQ(std::count(args.begin(), args.end(), "domain_id=40"), 1) << "P01's graph is not on domain 40";
+  const auto views = front.Snapshot(OnlineFront::Clock::now());
+  ASSERT_EQ(views.size(), 1u);
+  EXPECT_EQ(views[0].domain, 40) << "the overview shows the trial's domain";
+
+  // P02's Ready while P01's graph runs on the only domain: refused for now, nothing started.
+  const web::ClientId second = Connect(refused, "P02");
+  front.OnOpen(second, web::Role::kSubject);
+  ASSERT_EQ(refused.Op(1), "waiting");
+  ASSERT_TRUE(front.OnText(second, R"({"op":"ready"})").ok());
+  ASSERT_TRUE(Within(kGuard, [&] { return refused.count() > 1; })) << "P02's Ready was not answered";
+  EXPECT_EQ(refused.Op(2), "refused");
+  EXPECT_NE(refused.frames.at(1).value("message", "").find("Please come back later"), std::string::npos) << refused.frames[1];
+  EXPECT_FALSE(fs::exists(p02 / "args")) << "a graph started without a domain of its own";
+
+  // P01's trial stopped: its graph exits, the domain is free, and P02's trial starts on it.
+  ASSERT_TRUE(front.StopSession("P01", "in the test").ok());
+  ASSERT_TRUE(Within(kGuard, [&] { return front.running() == 0; })) << "P01's graph did not end";
+  const web::ClientId third = Connect(waiting2, "P02");
+  front.OnOpen(third, web::Role::kSubject);
+  ASSERT_EQ(waiting2.Op(1), "waiting");
+  ASSERT_TRUE(front.OnText(third, R"({"op":"ready"})").ok());
+  ASSERT_TRUE(Within(kGuard, [&] { return Relayed(p02 / "args").size() > 2; })) << "P02's graph never started";
+  const std::vector<std::string> args2 = Relayed(p02 / "args");
+  EXPECT_EQ(std::count(args2.begin(), args2.end(), "domain_id=40"), 1) << "the domain P01's trial gave back";
   front.StopAll();
 }
 

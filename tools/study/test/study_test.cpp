@@ -193,12 +193,17 @@ TEST_F(StudyFile, OnlineKeysAreReadAndEachBadOneIsSaidAtItsLine) {
   EXPECT_EQ(defaults.online.completion_code, "");
   EXPECT_EQ(defaults.online.consent, "");
   std::ofstream(dir_ / "consent.txt") << "I agree to take part.\n";
-  const Study s = LoadStudy(
-      Write(head + "online:\n  reconnect_s: 5\n  max_sessions: 3\n  completion_code: C0DE-42\n  consent: consent.txt\n"), {},
-      &problems);
+  const Study s =
+      LoadStudy(Write(head + "online:\n  reconnect_s: 5\n  max_sessions: 3\n  domains: [40, 42]\n  completion_code: C0DE-42\n"
+                             "  consent: consent.txt\n"),
+                {}, &problems);
   ASSERT_TRUE(problems.empty()) << problems.front().ToString();
   EXPECT_EQ(s.online.reconnect_s, 5);
   EXPECT_EQ(s.online.max_sessions, 3);
+  ASSERT_TRUE(s.online.domains.has_value());
+  EXPECT_EQ(s.online.domains->first, 40);
+  EXPECT_EQ(s.online.domains->last, 42);
+  EXPECT_FALSE(defaults.online.domains.has_value()) << "none given: from the graph's domain_id";
   EXPECT_EQ(s.online.completion_code, "C0DE-42");
   EXPECT_EQ(s.online.consent, (dir_ / "consent.txt").string());
   EXPECT_EQ(s.online.consent_text, "I agree to take part.\n");
@@ -207,6 +212,11 @@ TEST_F(StudyFile, OnlineKeysAreReadAndEachBadOneIsSaidAtItsLine) {
            {"online:\n  reconnect_s: 0\n", "s.yaml:7:16: online.reconnect_s: must be > 0"},
            {"online:\n  reconnect_s: soon\n", "s.yaml:7:16: online.reconnect_s: must be a number of seconds, got 'soon'"},
            {"online:\n  max_sessions: 0\n", "s.yaml:7:17: online.max_sessions: must be >= 1"},
+           {"online:\n  domains: [40]\n", "s.yaml:7:12: online.domains: must be [FIRST, LAST], two DDS domain ids in 0..232"},
+           {"online:\n  domains: [42, 40]\n", "s.yaml:7:12: online.domains: must be [FIRST, LAST]"},
+           {"online:\n  domains: [230, 233]\n", "s.yaml:7:12: online.domains: must be [FIRST, LAST]"},
+           {"online:\n  domains: [-1, 3]\n", "s.yaml:7:12: online.domains: must be [FIRST, LAST]"},
+           {"online:\n  domains: 40-42\n", "s.yaml:7:12: online.domains: must be [FIRST, LAST]: two DDS domain ids"},
            {"online:\n  completion_code: a b\n", "s.yaml:7:20: online.completion_code: a code is 1-64 letters, digits"},
            {"online:\n  consent: missing.txt\n", "s.yaml:7:12: online.consent: cannot read " + (dir_ / "missing.txt").string()},
            {"online:\n  consent: empty.txt\n", "s.yaml:7:12: online.consent: " + (dir_ / "empty.txt").string() + " is empty"},
