@@ -31,8 +31,8 @@
 # whole machine's busy share over the window (other users' load shows there).
 #
 # CAPACITY_FRONT=serve: the N participants are the N participants of one study generated per
-# level (BUILD_DIR's copy of configs/interactive.yaml, as above, on one DDS domain: its graph; one
-# condition; one trial each, the window plus the arrivals' allowance long; consent required, its
+# level (BUILD_DIR's copy of configs/interactive.yaml, as above; each running trial on a DDS domain
+# of its own, from the graph's on, as study serve gives them; one condition; one trial each, the window plus the arrivals' allowance long; consent required, its
 # text; `dyad study links` for their tokens), served by ONE `dyad study serve` on loopback (port
 # 0, --port-file, --max-sessions N): each participant's trial is a `dyad run` child of the front
 # (its own process group, its log beside its recording: DATA/P001/01-capacity.log) and their page
@@ -132,7 +132,7 @@ fi
 drawn=${CAPACITY_DATASET:-$here/../shared/data/vcbot/dataset/Macaw}
 [ -d "$drawn" ] || drawn=$dataset
 
-base=$(( 100 + $$ % 60 ))  # domains base+1 .. base+N (<= 232)
+base=$(( 1 + $$ % 60 ))  # domains base .. base+N (<= 232: N <= 171)
 
 start_session() {  # start_session DIR I
   local d=$1 i=$2
@@ -181,7 +181,7 @@ direct_level() {
 }
 
 # serve_study DIR N: the level's study in DIR: its graph (configs/interactive.yaml with the bench's
-# models, one DDS domain), the consent text, N participants P001.., one condition, one trial of
+# models; its domain_id the first of the trials'), the consent text, N participants P001.., one condition, one trial of
 # $duration s each; their links (tokens) by `dyad study links`.
 serve_study() {
   local d=$1 n=$2 list="" i

@@ -35,15 +35,19 @@ online: {consent: consent.txt, reconnect_s: 10}
 YAML
 hp=$(free_port) pa=$(free_port) pb=$(free_port)
 "$dyad" study links s.yaml --base-url "http://127.0.0.1:$hp" > links.out
-serve() {  # serve NAME PORT: an instance, its output appended to NAME.out
-  "$dyad" study serve s.yaml --port "$2" --origin "http://127.0.0.1:$hp" >> "$1.out" 2>> "$1.err" &
+serve() {  # serve NAME PORT DOMAINS: an instance, its output appended to NAME.out
+  "$dyad" study serve s.yaml --port "$2" --domains "$3" --origin "http://127.0.0.1:$hp" >> "$1.out" 2>> "$1.err" &
   pids+=($!)
   eval "pid_$1=$!"
   for _ in $(seq 100); do grep -q "dyad study serve: haproxy_test at" "$1.out" 2> /dev/null && return 0; sleep 0.1; done
   cat "$1.err"; fail "instance $1 never listened"
 }
-serve a "$pa"
-serve b "$pb"
+# Two instances on one machine: their trials on disjoint domains (docs/study.md).
+d=$(test_domain) da="$d-$((d + 15))" db="$((d + 16))-$((d + 31))"
+serve a "$pa" "$da"
+serve b "$pb" "$db"
+grep -q "trials on DDS domains $da (one each)" a.out && grep -q "trials on DDS domains $db (one each)" b.out ||
+  { cat a.out b.out; fail "the instances do not say their trials' domains"; }
 # Sticky by token: a participant's first request picks an instance (round robin), the table keeps
 # it there; one whose instance is down is sent to the other (redispatch) and kept there.
 cat > haproxy.cfg <<CFG
@@ -91,7 +95,7 @@ wait "$pid_b" || fail "instance b's SIGTERM exit: $?"
 # reconnect every second, are sent to A, which takes their sessions on from the shared log.
 sleep 3
 echo "--- restarted" >> b.out
-serve b "$pb"
+serve b "$pb" "$db"
 wait $client || { cat clients.err; fail "the simulated participants"; }
 grep -c '"code":"' clients.json | grep -qx 4 || { cat clients.json a.out b.out; fail "not every participant got a completion code"; }
 
