@@ -580,7 +580,7 @@ std::string OnlineFront::StartTrial(Participant& p) {
     if (p.running || !p.ended.empty()) return "";
     if (domains_.range().size() > 0) {
       const std::optional<int> domain = domains_.Take();
-      if (!domain) {  // more trials than live sessions: a stopped session's graph still ending
+      if (!domain) {  // a guard: a running trial keeps its session live, and serve gives max_sessions domains
         std::cerr << "dyad study serve: " << p.id << ": trial " << r.trial.number << " cannot start yet: every domain of "
                   << domains_.range().first << "-" << domains_.range().last << " has a trial's graph running" << std::endl;
         return kComeBack;

@@ -25,6 +25,8 @@
 //     A participant done or refused (declined, withdrawn, ended) is not counted: their page is
 //     told that (the completion code, the refusal) and closed; StopSession between trials frees
 //     the session's place at once.
+//   - A running trial's graph is on a DDS domain no other running trial has
+//     (FrontOptions::domains, trial_domains.hpp), given back when its `dyad run` has exited.
 //   - A live session holds the participant's SessionLock (a lab `study run` of them is refused,
 //     and a participant the lab holds is refused here); it is released reconnect_s after the
 //     page left between trials.

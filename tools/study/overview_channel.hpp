@@ -10,13 +10,14 @@
 //
 // WebSocket `/overview/ws?token=E` (the experimenter's role only), JSON text both ways:
 //   server -> page: {"op":"state","study","blind","participants":n,"max_sessions","reconnect_s",
-//     "sessions":[{"participant","phase","gone_s","trial","of","attempt","shown","file",
+//     "sessions":[{"participant","phase","gone_s","trial","of","attempt","shown","file","domain",
 //     "recording_bytes","engaged","rtt_ms","step_p99_ms","step_component","misses","ended"}]}
 //     once a second and after each request: every live session and each one ended (OnlineFront::
 //     Snapshot; phase: consent, waiting, trial, paused (a trial whose page is gone: gone_s),
 //     away (between trials, gone_s), done, refused, ended (ended: the experimenter's reason));
 //     trial of `of`: the running trial, else the next one; shown: its condition as the
-//     experimenter may see it (the label when the study is blind); recording_bytes: the running
+//     experimenter may see it (the label when the study is blind); domain: the running trial's DDS
+//     domain (null: none, or every trial on the graph's own); recording_bytes: the running
 //     attempt's file now; engaged: the relayed page's last pointer sample (false while the page
 //     is gone); rtt_ms: the page's ping round trip; step_p99_ms and misses: the running trial's
 //     graph's own stats (the largest step p99 of its components, which one, and their deadline

@@ -1,5 +1,6 @@
 #include "trial_domains.hpp"
 
+#include <algorithm>
 #include <charconv>
 
 namespace dyad::study {
@@ -31,9 +32,10 @@ StatusOr<DomainRange> TrialDomainRange(const std::optional<DomainRange>& given, 
   if (given) {
     if (given->size() < max_sessions)
       return Status::InvalidArgument(given_by + " " + std::to_string(given->first) + "-" + std::to_string(given->last) +
-                                     " holds " + std::to_string(given->size()) + " domains for max_sessions " +
-                                     std::to_string(max_sessions) +
-                                     " (each live session's trial runs on a domain of its own): widen it or lower max_sessions");
+                                     " holds " + std::to_string(given->size()) + (given->size() == 1 ? " domain" : " domains") +
+                                     " for max_sessions " + std::to_string(max_sessions) +
+                                     " (each live session's trial runs on a domain of its own): widen it, or lower max_sessions "
+                                     "(--max-sessions, online.max_sessions)");
     return *given;
   }
   const DomainRange range{graph_domain, graph_domain + max_sessions - 1};
@@ -41,22 +43,25 @@ StatusOr<DomainRange> TrialDomainRange(const std::optional<DomainRange>& given, 
     return Status::InvalidArgument(std::string("max_sessions ") + std::to_string(max_sessions) + " trials need domains " +
                                    std::to_string(range.first) + "-" + std::to_string(range.last) +
                                    " from the graph's domain_id on (each runs on a domain of its own; DDS has 0..232): "
-                                   "set online.domains (or --domains) to a range within 0..232, or lower max_sessions");
+                                   "set online.domains (or --domains) to a range within 0..232, or lower max_sessions "
+                                   "(--max-sessions, online.max_sessions)");
   return range;
 }
 
+TrialDomains::TrialDomains(DomainRange range) : range_(range) {
+  for (int d = range.first; d <= range.last; ++d) free_.push_back(d);
+}
+
 std::optional<int> TrialDomains::Take() {
-  for (size_t i = 0; i < used_.size(); ++i)
-    if (!used_[i]) {
-      used_[i] = true;
-      return range_.first + static_cast<int>(i);
-    }
-  return std::nullopt;
+  if (free_.empty()) return std::nullopt;
+  const int d = free_.front();
+  free_.pop_front();
+  return d;
 }
 
 void TrialDomains::Give(int domain) {
-  const int i = domain - range_.first;
-  if (i >= 0 && i < static_cast<int>(used_.size())) used_[static_cast<size_t>(i)] = false;
+  if (domain < range_.first || domain > range_.last || std::find(free_.begin(), free_.end(), domain) != free_.end()) return;
+  free_.push_back(domain);
 }
 
 }  // namespace dyad::study

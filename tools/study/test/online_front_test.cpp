@@ -268,7 +268,8 @@ TEST_F(OnlineFrontTest, APageWhoseFramesQueueUpPastOneMiBIsRefusedTheNextOne) {
 }
 
 // A trial's "graph" for the front's relay, run in place of dyad with the trial's arguments (which
-// it writes into a file "args" beside the port file, one a line). It waits for a file "go" beside the port file the front names
+// it writes into a file "args" beside the port file, one a line). It exits (0) on a file "end"
+// there, or waits for a file "go" beside the port file the front names
 // (web.port_file), binds a loopback port and writes it there, answers the relay's WebSocket handshake and leaves a mark
 // "connected" beside it. Then, with a file "stuck" there, it reads nothing (a graph stuck; its receive buffer small) until its
 // SIGINT; else it writes each text frame it reads, one a line, into "relayed".
@@ -280,6 +281,8 @@ here = os.path.dirname(port_file)
 with open(os.path.join(here, "args"), "w") as f:
     f.write("\n".join(sys.argv[1:]) + "\n")
 while not os.path.exists(os.path.join(here, "go")):
+    if os.path.exists(os.path.join(here, "end")):
+        sys.exit(0)
     time.sleep(0.01)
 stuck = os.path.exists(os.path.join(here, "stuck"))
 s = socket.socket()
@@ -450,44 +453,47 @@ TEST_F(OnlineFrontTest, StoppingASessionBetweenTrialsFreesItsPlaceAtOnce) {
 }
 
 // Each running trial's graph is started on a domain of its own (FrontOptions::domains), given back
-// once its graph has exited; with none free a trial does not start and its page hears "come back
-// later". One domain for two sessions here, so P02's trial waits for P01's.
+// once its graph has exited and taken again last: with two domains, P01's first trial runs on 40,
+// its next on 41 (40, given back just now, waits its turn), and P02's then on 40 again.
 TEST_F(OnlineFrontTest, EachRunningTrialGetsADomainOfItsOwnGivenBackWhenItsGraphExits) {
   FrontOptions o{UseFakeGraph(), 2, 15};
   UseFakeGraph("P02");
-  o.domains = DomainRange{40, 40};
+  o.domains = DomainRange{40, 41};
   OnlineFront front(study_, o);
   front.SetServer(server_.get());
   const fs::path p01 = fs::path(study_.data) / "P01", p02 = fs::path(study_.data) / "P02";
-  Page waiting, trial, refused, waiting2;
-  ASSERT_NE(StartTrial(front, waiting, trial), 0u) << "P01's trial did not start";
-  ASSERT_TRUE(Within(kGuard, [&] { return Relayed(p01 / "args").size() > 2; })) << "P01's graph never started";
-  const std::vector<std::string> args = Relayed(p01 / "args");
-  EXPECT_EQ(std::count(args.begin(), args.end(), "domain_id=40"), 1) << "P01's graph is not on domain 40";
+  // The domain_id the graph started for `here` was given ("" if none started within kGuard).
+  const auto domain_of = [](const fs::path& here) -> std::string {
+    Within(kGuard, [&] { return Relayed(here / "args").size() > 2; });
+    for (const std::string& a : Relayed(here / "args"))
+      if (a.rfind("domain_id=", 0) == 0) return a.substr(10);
+    return "";
+  };
+  // Ends the graph running for `here` (it exits on "end") and waits until the front saw it end.
+  const auto end = [&front](const fs::path& here) {
+    std::ofstream(here / "end").close();
+    const bool ended = Within(kGuard, [&] { return front.running() == 0; });
+    fs::remove(here / "end");
+    fs::remove(here / "args");
+    return ended;
+  };
+  Page waiting, trial, waiting_again, trial_again, other;
+  ASSERT_NE(StartTrial(front, waiting, trial), 0u) << "P01's first trial did not start";
+  EXPECT_EQ(domain_of(p01), "40");
   const auto views = front.Snapshot(OnlineFront::Clock::now());
   ASSERT_EQ(views.size(), 1u);
   EXPECT_EQ(views[0].domain, 40) << "the overview shows the trial's domain";
+  ASSERT_TRUE(end(p01)) << "P01's graph did not end";
 
-  // P02's Ready while P01's graph runs on the only domain: refused for now, nothing started.
-  const web::ClientId second = Connect(refused, "P02");
-  front.OnOpen(second, web::Role::kSubject);
-  ASSERT_EQ(refused.Op(1), "waiting");
-  ASSERT_TRUE(front.OnText(second, R"({"op":"ready"})").ok());
-  ASSERT_TRUE(Within(kGuard, [&] { return refused.count() > 1; })) << "P02's Ready was not answered";
-  EXPECT_EQ(refused.Op(2), "refused");
-  EXPECT_NE(refused.frames.at(1).value("message", "").find("Please come back later"), std::string::npos) << refused.frames[1];
-  EXPECT_FALSE(fs::exists(p02 / "args")) << "a graph started without a domain of its own";
+  ASSERT_NE(StartTrial(front, waiting_again, trial_again), 0u) << "P01's next trial did not start";
+  EXPECT_EQ(domain_of(p01), "41") << "40, given back just now, is taken after 41";
+  ASSERT_TRUE(end(p01)) << "P01's graph did not end";
 
-  // P01's trial stopped: its graph exits, the domain is free, and P02's trial starts on it.
-  ASSERT_TRUE(front.StopSession("P01", "in the test").ok());
-  ASSERT_TRUE(Within(kGuard, [&] { return front.running() == 0; })) << "P01's graph did not end";
-  const web::ClientId third = Connect(waiting2, "P02");
-  front.OnOpen(third, web::Role::kSubject);
-  ASSERT_EQ(waiting2.Op(1), "waiting");
-  ASSERT_TRUE(front.OnText(third, R"({"op":"ready"})").ok());
-  ASSERT_TRUE(Within(kGuard, [&] { return Relayed(p02 / "args").size() > 2; })) << "P02's graph never started";
-  const std::vector<std::string> args2 = Relayed(p02 / "args");
-  EXPECT_EQ(std::count(args2.begin(), args2.end(), "domain_id=40"), 1) << "the domain P01's trial gave back";
+  const web::ClientId page = Connect(other, "P02");
+  front.OnOpen(page, web::Role::kSubject);
+  ASSERT_EQ(other.Op(1), "waiting");
+  ASSERT_TRUE(front.OnText(page, R"({"op":"ready"})").ok());
+  EXPECT_EQ(domain_of(p02), "40") << "a domain given back is taken again";
   front.StopAll();
 }
 

@@ -35,7 +35,7 @@ rc=0; "$build/bin/dyad" study serve s.yaml --address 0.0.0.0 --port 0 > refused.
   fail "off loopback without TLS: exit $rc: $(cat refused.out)"
 # Fewer trial domains than live sessions (each running trial has one of its own), or not a range.
 rc=0; "$build/bin/dyad" study serve s.yaml --port 0 --domains 40-40 > refused.out 2>&1 || rc=$?
-[ $rc = 2 ] && grep -q -- "--domains 40-40 holds 1 domains for max_sessions 2" refused.out ||
+[ $rc = 2 ] && grep -q -- "--domains 40-40 holds 1 domain for max_sessions 2" refused.out ||
   fail "one domain for two sessions: exit $rc: $(cat refused.out)"
 rc=0; "$build/bin/dyad" study serve s.yaml --port 0 --domains 40 > refused.out 2>&1 || rc=$?
 [ $rc = 2 ] && grep -q -- "--domains '40': want FIRST-LAST" refused.out || fail "--domains 40: exit $rc: $(cat refused.out)"

@@ -39,16 +39,21 @@ TEST(TrialDomains, TheRangeHoldsOneDomainPerLiveSessionAndItsErrorSaysWhatToChan
   ASSERT_FALSE(small.ok());
   EXPECT_EQ(small.status().message(),
             "s.yaml: online.domains 40-49 holds 10 domains for max_sessions 16 (each live session's trial runs on a domain of "
-            "its own): widen it or lower max_sessions");
+            "its own): widen it, or lower max_sessions (--max-sessions, online.max_sessions)");
 }
 
-TEST(TrialDomains, EachTakeIsTheLowestFreeUntilNoneIsLeft) {
+// In order at first, then the domain given back longest ago: one given back just now (its graph's
+// launcher gone, a process of it perhaps still ending) is the last to be taken again.
+TEST(TrialDomains, EachTakeIsTheDomainFreeLongestUntilNoneIsLeft) {
   TrialDomains pool(DomainRange{40, 42});
   EXPECT_EQ(pool.Take(), 40);
   EXPECT_EQ(pool.Take(), 41);
-  EXPECT_EQ(pool.Take(), 42);
+  pool.Give(40);
+  EXPECT_EQ(pool.Take(), 42) << "42 was free longer than 40, given back just now";
+  EXPECT_EQ(pool.Take(), 40);
   EXPECT_EQ(pool.Take(), std::nullopt) << "three domains, three trials";
   pool.Give(41);
+  pool.Give(41);  // free already: nothing changes
   pool.Give(99);  // not of the range: nothing changes
   EXPECT_EQ(pool.Take(), 41) << "a domain given back is taken again";
   EXPECT_EQ(pool.Take(), std::nullopt);
