@@ -136,6 +136,15 @@ void Serving(const Study& s, const ServeOptions& o, int port, int with_links, in
             << domains.first << "-" << domains.last << " (one each)" << std::endl;
 }
 
+// Each running trial on a DDS domain of its own (trial_domains.hpp): --domains, online.domains,
+// else from the graph's domain_id on.
+StatusOr<DomainRange> ServeDomains(const Study& s, const ServeOptions& o, int max_sessions) {
+  if (o.domains.empty()) return TrialDomainRange(s.online.domains, s.file + ": online.domains", s.graph_domain, max_sessions);
+  const auto given = ParseDomainRange(o.domains);
+  if (!given.ok()) return Status::InvalidArgument("--domains " + std::string(given.status().message()));
+  return TrialDomainRange(*given, "--domains", s.graph_domain, max_sessions);
+}
+
 }  // namespace
 
 std::vector<std::string> PageOrigins(const ServeOptions& o, const std::vector<std::string>& link_origins) {
@@ -174,20 +183,7 @@ int Serve(const ServeOptions& o) {
     return 2;
   }
   const int max_sessions = o.max_sessions > 0 ? o.max_sessions : s.online.max_sessions;
-  // Each running trial on a DDS domain of its own (trial_domains.hpp): --domains, online.domains,
-  // else from the graph's domain_id on.
-  std::optional<DomainRange> given = s.online.domains;
-  std::string given_by = s.file + ": online.domains";
-  if (!o.domains.empty()) {
-    const auto parsed = ParseDomainRange(o.domains);
-    if (!parsed.ok()) {
-      std::cerr << "dyad study serve: --domains " << parsed.status().message() << "\n";
-      return 2;
-    }
-    given = *parsed;
-    given_by = "--domains";
-  }
-  const auto domains = TrialDomainRange(given, given_by, s.graph_domain, max_sessions);
+  const auto domains = ServeDomains(s, o, max_sessions);
   if (!domains.ok()) {
     std::cerr << "dyad study serve: " << domains.status().message() << "\n";
     return 2;
