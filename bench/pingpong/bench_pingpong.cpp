@@ -4,6 +4,7 @@
 //
 //   build/bin/bench_pingpong [--rounds N] [--repeats R] [--payload BYTES]
 //                            [--processes [--pong-prefix "ip netns exec NS"]] [--security] [--only bare|dyad]
+//                            [--evict KIB]
 //
 // --only runs one contender (no ratio), for a profile of its path alone; e.g. instructions per
 // round trip under callgrind, which a loaded machine does not disturb (docs/runtime.md,
@@ -16,6 +17,11 @@
 // `security:` keystore (`dyad security init`: authentication, access control, everything
 // encrypted; docs/security.md), and the ratio secured/dyad. Use it with --processes: inside one
 // process samples never reach the wire, so there is nothing to encrypt.
+//
+// --evict KIB writes a buffer of KIB KiB before each round trip, outside the timed part, on both
+// sides: each round trip then starts with the core's caches (L1, L2) and first-level TLBs cold,
+// as after the thread was preempted or the vCPU descheduled, which is what the slow round trips
+// of a plain run are (docs/runtime.md); 4096 measures that path alone.
 //
 // --processes puts pong in a second OS process (bare: this binary with --bare-pong; dyad: a
 // `dyad run --process pong` child of a two-process graph), started with the words of
@@ -73,7 +79,7 @@ int64_t SteadyNs() {
 class BarePingPong {
  public:
   enum class Role { kBoth, kPing, kPong };
-  BarePingPong(int domain, size_t payload, Role role = Role::kBoth) : role_(role) {
+  BarePingPong(int domain, size_t payload, Role role = Role::kBoth, size_t evict_kb = 0) : junk_(evict_kb * 1024), role_(role) {
     auto* f = fdds::DomainParticipantFactory::get_instance();
     // The transports dyad's participants use (runtime/dds/network_qos.cpp, the default network
     // section): shared memory first, then UDPv4, declared explicitly.
@@ -136,6 +142,7 @@ class BarePingPong {
     fdds::SampleInfo info;
     while (static_cast<int>(rtt_.size()) < rounds) {
       pending_.store(false);
+      for (size_t i = 0; i < junk_.size(); i += 64) junk_[i] = static_cast<char>(junk_[i] + 1);
       sample_.id(sample_.id() + 1);
       sample_.t0_ns(SteadyNs());
       ping_writer_->write(&sample_);
@@ -179,6 +186,7 @@ class BarePingPong {
     }
     if (done_) cv_.notify_one();
     if (!again) return;
+    for (size_t i = 0; i < junk_.size(); i += 64) junk_[i] = static_cast<char>(junk_[i] + 1);
     sample_.id(sample_.id() + 1);
     sample_.t0_ns(SteadyNs());
     lock.unlock();
@@ -214,6 +222,7 @@ class BarePingPong {
   PingListener ping_listener_;
   dyad::msg::PingPong sample_, reply_;
   std::vector<int64_t> rtt_;
+  std::vector<char> junk_;  // --evict
   std::atomic<bool> pending_{false};
   std::mutex mutex_;
   std::condition_variable cv_;
@@ -244,20 +253,19 @@ void Stop(pid_t pid) {
 }
 
 // `secured`: with the keystore DIR/keys, made on first use.
-std::vector<int64_t> RunDyad(int domain, int rounds, size_t payload, const std::string& dir, bool processes,
+std::vector<int64_t> RunDyad(int domain, int rounds, size_t payload, size_t evict_kb, const std::string& dir, bool processes,
                              const std::vector<std::string>& pong_prefix, bool secured = false) {
   const std::string graph = dir + (secured ? "/pingpong_secured.yaml" : "/pingpong.yaml");
   const std::string out = dir + "/rtt.txt";
-  std::ofstream(graph) << "graph: pingpong\nclock: wall\ndomain_id: " << domain
-                       << (secured ? "\nsecurity: {keystore: keys}" : "")
+  std::ofstream(graph) << "graph: pingpong\nclock: wall\ndomain_id: " << domain << (secured ? "\nsecurity: {keystore: keys}" : "")
                        << (processes ? "\nprocesses: {ping: {}, pong: {}}" : "")
                        << "\ncomponents:\n"
                           "  pong: {type: bench_pong, trigger: in, inputs: {in: ping}, outputs: {out: pong}"
                        << (processes ? ", process: pong" : "")
                        << "}\n"
                           "  ping: {type: bench_ping, trigger: back, params: {rounds: "
-                       << rounds << ", payload: " << payload << ", file: " << out << "}, inputs: {back: pong}, outputs: {out: ping}"
-                       << (processes ? ", process: ping" : "")
+                       << rounds << ", payload: " << payload << ", evict_kb: " << evict_kb << ", file: " << out
+                       << "}, inputs: {back: pong}, outputs: {out: ping}" << (processes ? ", process: ping" : "")
                        << "}\n"
                           "topics:\n  ping: {reliability: reliable, depth: 1}\n  pong: {reliability: reliable, depth: 1}\n";
   if (secured && !std::filesystem::exists(dir + "/keys")) {
@@ -296,6 +304,15 @@ double Percentile(std::vector<int64_t> v, double q) {
   return static_cast<double>(v[std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size())))]) * 1e-3;
 }
 
+// Percent of the round trips that took more than twice the median: the slow mode (docs/runtime.md,
+// "why p99 lags the median"). Above 1 % it holds the p99.
+double SlowPercent(const std::vector<int64_t>& v) {
+  if (v.empty()) return 0;
+  const double limit = 2e3 * Percentile(v, 0.5);
+  const auto slow = std::count_if(v.begin(), v.end(), [&](int64_t x) { return static_cast<double>(x) > limit; });
+  return 100.0 * static_cast<double>(slow) / static_cast<double>(v.size());
+}
+
 double Mean(const std::vector<int64_t>& v) {
   double sum = 0;
   for (int64_t x : v) sum += static_cast<double>(x);
@@ -326,7 +343,7 @@ std::vector<std::string> Words(const std::string& text) {
 
 int main(int argc, char** argv) {
   int rounds = 20000, repeats = 5;
-  size_t payload = 0;
+  size_t payload = 0, evict_kb = 0;
   bool processes = false, security = false;
   std::string only;  // "bare" or "dyad": that contender alone
   std::vector<std::string> pong_prefix;
@@ -339,6 +356,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--rounds")) rounds = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--repeats")) repeats = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--payload")) payload = static_cast<size_t>(std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--evict")) evict_kb = static_cast<size_t>(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--pong-prefix")) pong_prefix = Words(argv[++i]);
     else if (!std::strcmp(argv[i], "--only")) only = argv[++i];
   }
@@ -356,7 +374,7 @@ int main(int argc, char** argv) {
     const std::string self = std::filesystem::read_symlink("/proc/self/exe");
     bare_pong = Spawn(pong_prefix, {self, "--bare-pong", std::to_string(domain), std::to_string(payload)});
   }
-  BarePingPong bare(domain, payload, processes ? BarePingPong::Role::kPing : BarePingPong::Role::kBoth);
+  BarePingPong bare(domain, payload, processes ? BarePingPong::Role::kPing : BarePingPong::Role::kBoth, evict_kb);
   if (processes && !bare.WaitForPong(30)) {
     std::cerr << "bench_pingpong: the bare pong process did not match within 30 s\n";
     Stop(bare_pong);
@@ -369,10 +387,10 @@ int main(int argc, char** argv) {
       bare_all.insert(bare_all.end(), b.begin() + b.size() / 10, b.end());
     }
     if (!run_dyad) continue;
-    auto d = RunDyad(domain + 1, rounds, payload, dir, processes, pong_prefix);
+    auto d = RunDyad(domain + 1, rounds, payload, evict_kb, dir, processes, pong_prefix);
     dyad_all.insert(dyad_all.end(), d.begin() + d.size() / 10, d.end());
     if (security) {
-      auto sec = RunDyad(domain + 1, rounds, payload, dir, processes, pong_prefix, true);
+      auto sec = RunDyad(domain + 1, rounds, payload, evict_kb, dir, processes, pong_prefix, true);
       secured_all.insert(secured_all.end(), sec.begin() + sec.size() / 10, sec.end());
     }
   }
@@ -380,14 +398,19 @@ int main(int argc, char** argv) {
   std::filesystem::remove_all(dir);
   const double bm = Percentile(bare_all, 0.5), bp = Percentile(bare_all, 0.99);
   const double dm = Percentile(dyad_all, 0.5), dp = Percentile(dyad_all, 0.99);
-  std::printf("round trip, %s, RELIABLE KEEP_LAST 1, PingPong with %zu-byte payload, %d x %d rounds (first 10%% of each dropped)\n",
-              processes ? (pong_prefix.empty() ? "two processes" : "two processes, pong behind the prefix") : "one process",
-              payload, repeats, rounds);
+  std::printf(
+      "round trip, %s, RELIABLE KEEP_LAST 1, PingPong with %zu-byte payload, %d x %d rounds (first 10%% of each dropped)%s\n",
+      processes ? (pong_prefix.empty() ? "two processes" : "two processes, pong behind the prefix") : "one process", payload,
+      repeats, rounds, evict_kb > 0 ? (", " + std::to_string(evict_kb) + " KiB written before each").c_str() : "");
   const double ba = Mean(bare_all), da = Mean(dyad_all);
   std::printf("%-22s %12s %12s %12s\n", "", "median_us", "p99_us", "mean_us");
   if (run_bare) std::printf("%-22s %12.2f %12.2f %12.2f\n", "bare Fast DDS", bm, bp, ba);
   if (run_dyad) std::printf("%-22s %12.2f %12.2f %12.2f\n", "dyad components", dm, dp, da);
   if (run_bare && run_dyad) std::printf("%-22s %12.3f %12.3f %12.3f\n", "ratio dyad/bare", dm / bm, dp / bp, da / ba);
+  std::printf("slow round trips (over twice the median):");
+  if (run_bare) std::printf(" bare %.2f %%", SlowPercent(bare_all));
+  if (run_dyad) std::printf("%s dyad %.2f %%", run_bare ? "," : "", SlowPercent(dyad_all));
+  std::printf("\n");
   if (security) {
     const double sm = Percentile(secured_all, 0.5), sp = Percentile(secured_all, 0.99), sa = Mean(secured_all);
     std::printf("%-22s %12.2f %12.2f %12.2f\n", "dyad with security", sm, sp, sa);

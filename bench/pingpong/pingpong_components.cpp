@@ -5,6 +5,8 @@
 // @component ping   inputs: back (PingPong) outputs: out (PingPong)   trigger: back
 //   Sends a sample on Activate and the next one as soon as the previous came back; records each
 //   round trip (steady clock) and ends the run after `rounds`, writing them to `file` (ns, one per line).
+//   With `evict_kb`, it writes a buffer that large before each round trip (untimed), so that the
+//   round trip starts with caches and TLB cold, as after a preemption.
 #include <chrono>
 #include <cstdio>
 #include <vector>
@@ -53,6 +55,7 @@ class Ping final : public dyad::Component {
     spec.Param("rounds", int64_t{10000}).Min(1).Doc("round trips to measure");
     spec.Param("payload", int64_t{0}).Min(0).Doc("payload bytes per sample");
     spec.Param("file", "").Path().Doc("where to write the round-trip times (ns), one per line");
+    spec.Param("evict_kb", int64_t{0}).Min(0).Doc("KiB of memory written before each round trip (cold caches)");
     spec.Input<dyad::msg::PingPong>("back");
     spec.Output<dyad::msg::PingPong>("out");
   }
@@ -61,6 +64,7 @@ class Ping final : public dyad::Component {
     rounds_ = ctx.params().Int("rounds");
     file_ = ctx.params().String("file");
     sample_.payload().resize(static_cast<size_t>(ctx.params().Int("payload")));
+    junk_.resize(static_cast<size_t>(ctx.params().Int("evict_kb")) * 1024);
     back_ = &ctx.input<dyad::msg::PingPong>("back");
     out_ = &ctx.output<dyad::msg::PingPong>("out");
     rtt_.reserve(static_cast<size_t>(rounds_));
@@ -90,6 +94,7 @@ class Ping final : public dyad::Component {
 
  private:
   dyad::Status Send() {
+    for (size_t i = 0; i < junk_.size(); i += 64) junk_[i] = static_cast<char>(junk_[i] + 1);
     sample_.id(sample_.id() + 1);
     sample_.t0_ns(SteadyNs());
     return out_->Publish(sample_);
@@ -99,6 +104,7 @@ class Ping final : public dyad::Component {
   std::string file_;
   dyad::msg::PingPong sample_;
   std::vector<int64_t> rtt_;
+  std::vector<char> junk_;  // evict_kb
   dyad::Input<dyad::msg::PingPong>* back_ = nullptr;
   dyad::Output<dyad::msg::PingPong>* out_ = nullptr;
 };
