@@ -145,6 +145,17 @@ StatusOr<DomainRange> ServeDomains(const Study& s, const ServeOptions& o, int ma
   return TrialDomainRange(*given, "--domains", s.graph_domain, max_sessions);
 }
 
+// A condition's own domain_id would be replaced by the trial's (the front's --set comes last):
+// said once at start, not left to be found in the recordings.
+void WarnConditionDomains(const Study& s, const DomainRange& domains) {
+  for (const Condition& c : s.conditions)
+    for (const std::string& set : c.sets)
+      if (set.starts_with("domain_id="))
+        std::cerr << "dyad study serve: " << s.file << ": condition '" << c.name << "' sets " << set
+                  << ", which serve replaces: each running trial has a DDS domain of its own, from " << domains.first << "-"
+                  << domains.last << "\n";
+}
+
 }  // namespace
 
 std::vector<std::string> PageOrigins(const ServeOptions& o, const std::vector<std::string>& link_origins) {
@@ -188,6 +199,7 @@ int Serve(const ServeOptions& o) {
     std::cerr << "dyad study serve: " << domains.status().message() << "\n";
     return 2;
   }
+  WarnConditionDomains(s, *domains);
   std::vector<std::string> token_problems;
   FrontAdmission admission(s, &token_problems);
   for (const std::string& p : token_problems) std::cerr << "dyad study serve: " << p << " (that participant has no link)\n";

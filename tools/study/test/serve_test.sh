@@ -43,6 +43,14 @@ sed 's/, consent: consent.txt//' s.yaml > no_consent.yaml
 rc=0; "$build/bin/dyad" study serve no_consent.yaml --port 0 > refused.out 2>&1 || rc=$?
 [ $rc = 2 ] && grep -q "no_consent.yaml: online.consent: required to serve a study with consent_required" refused.out ||
   fail "consent required without online.consent: exit $rc: $(cat refused.out)"
+# A condition's own domain_id is replaced by each running trial's: said at start.
+sed -e 's/^study: serve_test/study: serve_dom/' -e 's/high: {human.engage_timeout_s: 0.4}/high: {human.engage_timeout_s: 0.4, domain_id: 7}/' s.yaml > dom.yaml
+"$build/bin/dyad" study serve dom.yaml --port 0 --port-file dom-port > dom.out 2>&1 &
+dom=$!
+wait_port_file dom-port $dom 10 dom.out
+kill -TERM $dom; wait $dom || fail "dyad study serve dom.yaml exited $?: $(cat dom.out)"
+grep -q "dom.yaml: condition 'high' sets domain_id=7, which serve replaces: each running trial has a DDS domain of its own, from" dom.out ||
+  fail "a condition's domain_id replaced without a word: $(cat dom.out)"
 node serve_cases.mjs "$build/bin/dyad" s.yaml serve_test-data
 # The page lost for 1 s in P01's trial 1: the graph paused (study serve sets pause_without_subject)
 # and the recording marks both ends.
