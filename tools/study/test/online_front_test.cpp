@@ -26,6 +26,7 @@
 
 #include "online_front.hpp"
 #include "online_study_fixture.hpp"
+#include "overview_channel.hpp"
 #include "study_session.hpp"
 #include "web_server.hpp"
 #include "ws_client.hpp"
@@ -483,7 +484,11 @@ TEST_F(OnlineFrontTest, EachRunningTrialGetsADomainOfItsOwnGivenBackWhenItsGraph
   const auto views = front.Snapshot(OnlineFront::Clock::now());
   ASSERT_EQ(views.size(), 1u);
   EXPECT_EQ(views[0].domain, 40) << "the overview shows the trial's domain";
+  OverviewChannel overview(study_, &front, 2);
+  const auto state_now = [&overview] { return nlohmann::json::parse(overview.State(OnlineFront::Clock::now())); };
+  EXPECT_EQ(state_now()["sessions"][0]["domain"], 40) << "the overview's state gives it (for dyad echo --domain)";
   ASSERT_TRUE(end(p01)) << "P01's graph did not end";
+  EXPECT_TRUE(state_now()["sessions"][0]["domain"].is_null()) << "no trial running, no domain: " << state_now().dump();
 
   ASSERT_NE(StartTrial(front, waiting_again, trial_again), 0u) << "P01's next trial did not start";
   EXPECT_EQ(domain_of(p01), "41") << "40, given back just now, is taken after 41";
