@@ -216,14 +216,25 @@ void ReadOnline(StrictYaml& y, const YAML::Node& root, const std::string& path, 
   Online& on = s->online;
   if (y.Get(o, "reconnect_s", "online.reconnect_s", &on.reconnect_s, "a number of seconds") && !(on.reconnect_s > 0))
     y.Error(o["reconnect_s"], "online.reconnect_s", "must be > 0 (how long a page gone mid-trial may take to come back)");
-  if (y.Get(o, "max_sessions", "online.max_sessions", &on.max_sessions, "an integer") && on.max_sessions < 1)
+  bool sessions_ok = true, domains_ok = true;
+  if (y.Get(o, "max_sessions", "online.max_sessions", &on.max_sessions, "an integer") && on.max_sessions < 1) {
     y.Error(o["max_sessions"], "online.max_sessions", "must be >= 1");
+    sessions_ok = false;
+  }
   if (std::vector<int> d; y.Get(o, "domains", "online.domains", &d, "[FIRST, LAST]: two DDS domain ids")) {
     auto range = d.size() == 2 ? ParseDomainRange(std::to_string(d[0]) + "-" + std::to_string(d[1]))
                                : StatusOr<DomainRange>(Status::InvalidArgument("want [FIRST, LAST]"));
     if (range.ok()) on.domains = *range;
     else y.Error(o["domains"], "online.domains", "must be [FIRST, LAST], two DDS domain ids in 0..232, FIRST <= LAST");
+    domains_ok = range.ok();
   }
+  // Room for max_sessions trials, each on a domain of its own: said here, at the key that limits
+  // it, not first when `study serve` starts (which checks again with its --max-sessions and --domains).
+  if (sessions_ok && domains_ok)
+    if (const auto room = TrialDomainRange(on.domains, "online.domains", s->graph_domain, on.max_sessions); !room.ok()) {
+      const char* key = on.domains ? "domains" : "max_sessions";
+      y.Error(o[key] ? o[key] : o, std::string("online.") + key, std::string(room.status().message()));
+    }
   static const std::regex code("[A-Za-z0-9_-]{1,64}");
   if (y.Get(o, "completion_code", "online.completion_code", &on.completion_code, "a code") &&
       !std::regex_match(on.completion_code, code)) {

@@ -32,7 +32,9 @@
 //     types, a participant ID that is not pseudonymous or is used twice, also in another case
 //     (AB12, ab12: one folder on a case-insensitive file system; naming the first), no
 //     conditions, a condition that overrides nothing, an override the graph refuses (checked as
-//     `dyad validate --set` would, at the line of that value, and each condition as a whole).
+//     `dyad validate --set` would, at the line of that value, and each condition as a whole), an
+//     `online:` map whose trials' domains (online.domains, else from the graph's domain_id on)
+//     cannot hold online.max_sessions (at the key that limits it).
 //   - The rehearsal graph, with its overrides, is checked against every condition like the
 //     study's graph (a condition must mean the same keys in both); a condition already refused
 //     above is not checked again (each problem is said once).
