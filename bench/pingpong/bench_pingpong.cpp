@@ -27,8 +27,12 @@
 // `dyad run --process pong` child of a two-process graph), started with the words of
 // --pong-prefix in front: run the whole benchmark in one network namespace with the pong side in
 // another (bench/pingpong/bench_netns.sh) and the round trip crosses a veth pair.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
@@ -39,9 +43,6 @@
 #include <iostream>
 #include <sstream>
 #include <string>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <mutex>
 #include <thread>
@@ -308,7 +309,7 @@ double Percentile(std::vector<int64_t> v, double q) {
 // "why p99 lags the median"). Above 1 % it holds the p99.
 double SlowPercent(const std::vector<int64_t>& v) {
   if (v.empty()) return 0;
-  const double limit = 2e3 * Percentile(v, 0.5);
+  const double limit = 2 * 1e3 * Percentile(v, 0.5);  // Percentile is in us, v in ns
   const auto slow = std::count_if(v.begin(), v.end(), [&](int64_t x) { return static_cast<double>(x) > limit; });
   return 100.0 * static_cast<double>(slow) / static_cast<double>(v.size());
 }
@@ -339,6 +340,19 @@ std::vector<std::string> Words(const std::string& text) {
   return out;
 }
 
+// A whole number in [lo, hi] given to `flag`, else a message and exit 2 (atoi took "-1" for a
+// size and "x" for 0: --evict -1 asked for 2^64 KiB).
+size_t Count(const char* flag, const char* text, long long lo, long long hi) {
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(text, &end, 10);
+  if (errno != 0 || end == text || *end != '\0' || v < lo || v > hi) {
+    std::cerr << "bench_pingpong: " << flag << " '" << text << "': want a whole number in " << lo << ".." << hi << "\n";
+    std::exit(2);
+  }
+  return static_cast<size_t>(v);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -353,10 +367,10 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--security")) security = true;
     else if (!std::strcmp(argv[i], "--bare-pong") && i + 2 < argc) return BarePongMain(std::atoi(argv[i + 1]), static_cast<size_t>(std::atoi(argv[i + 2])));
     else if (!has_value) break;
-    else if (!std::strcmp(argv[i], "--rounds")) rounds = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--repeats")) repeats = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--payload")) payload = static_cast<size_t>(std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--evict")) evict_kb = static_cast<size_t>(std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--rounds")) rounds = static_cast<int>(Count(argv[i], argv[i + 1], 10, 100'000'000)), ++i;
+    else if (!std::strcmp(argv[i], "--repeats")) repeats = static_cast<int>(Count(argv[i], argv[i + 1], 1, 10'000)), ++i;
+    else if (!std::strcmp(argv[i], "--payload")) payload = Count(argv[i], argv[i + 1], 0, 64 << 20), ++i;
+    else if (!std::strcmp(argv[i], "--evict")) evict_kb = Count(argv[i], argv[i + 1], 0, 1 << 20), ++i;
     else if (!std::strcmp(argv[i], "--pong-prefix")) pong_prefix = Words(argv[++i]);
     else if (!std::strcmp(argv[i], "--only")) only = argv[++i];
   }
