@@ -366,13 +366,19 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--processes")) processes = true;
     else if (!std::strcmp(argv[i], "--security")) security = true;
     else if (!std::strcmp(argv[i], "--bare-pong") && i + 2 < argc) return BarePongMain(std::atoi(argv[i + 1]), static_cast<size_t>(std::atoi(argv[i + 2])));
-    else if (!has_value) break;
-    else if (!std::strcmp(argv[i], "--rounds")) rounds = static_cast<int>(Count(argv[i], argv[i + 1], 10, 100'000'000)), ++i;
+    else if (!has_value) {
+      std::cerr << "bench_pingpong: " << argv[i] << ": unknown, or wants a value (see the top of bench_pingpong.cpp)\n";
+      return 2;
+    } else if (!std::strcmp(argv[i], "--rounds")) rounds = static_cast<int>(Count(argv[i], argv[i + 1], 10, 100'000'000)), ++i;
     else if (!std::strcmp(argv[i], "--repeats")) repeats = static_cast<int>(Count(argv[i], argv[i + 1], 1, 10'000)), ++i;
     else if (!std::strcmp(argv[i], "--payload")) payload = Count(argv[i], argv[i + 1], 0, 64 << 20), ++i;
     else if (!std::strcmp(argv[i], "--evict")) evict_kb = Count(argv[i], argv[i + 1], 0, 1 << 20), ++i;
     else if (!std::strcmp(argv[i], "--pong-prefix")) pong_prefix = Words(argv[++i]);
     else if (!std::strcmp(argv[i], "--only")) only = argv[++i];
+    else {
+      std::cerr << "bench_pingpong: " << argv[i] << ": unknown option (see the top of bench_pingpong.cpp)\n";
+      return 2;
+    }
   }
   if (!only.empty() && only != "bare" && only != "dyad") {
     std::cerr << "bench_pingpong: --only " << only << ": expected bare or dyad\n";
