@@ -3,7 +3,8 @@
 // back from their opaque names on the wire: dyad/wire_names.hpp), and the problems that
 // stop data where it should flow, reported through Options::on_problem: a remote endpoint on one
 // of our topics with another type (same IDL name, other hash: a layout change, which Fast DDS
-// would match silently or never match and say nothing), an incompatible QoS; and, through
+// would match silently or never match and say nothing), an incompatible QoS (one of this run's
+// partition: Fast DDS reports another run's too, dds/qos_match.hpp); and, through
 // Options::on_foreign_writer, once per writer, a writer of one of our topics in another run's
 // partition. Fast DDS calls these on its threads; the listener's mutex_ guards what it keeps, and
 // it takes the participant's mutex_ (never while holding its own) to read the topic maps.
@@ -34,16 +35,6 @@ std::string GuidPrefixString(const rtps::GuidPrefix_t& p) {
   std::ostringstream os;
   os << p;
   return os.str();
-}
-
-std::string QosPolicyName(fdds::QosPolicyId_t id) {
-  switch (id) {
-    case fdds::RELIABILITY_QOS_POLICY_ID: return "reliability";
-    case fdds::DURABILITY_QOS_POLICY_ID: return "durability";
-    case fdds::DEADLINE_QOS_POLICY_ID: return "deadline";
-    case fdds::HISTORY_QOS_POLICY_ID: return "history";
-    default: return "policy " + std::to_string(static_cast<int>(id));
-  }
 }
 
 // DDS partition matching (DDS 1.4, 2.2.3.13): two endpoints share a partition when a name of
@@ -100,7 +91,7 @@ void DdsParticipant::DiscoveryListener::on_publisher_discovery(fdds::DomainParti
   const bool gone = info.status == rtps::WriterDiscoveryInfo::REMOVED_WRITER;
   const std::string dds_topic = info.info.topicName().to_string();
   const bool same_partition = SharesPartition(dds_topic, info.info.m_qos.m_partition.names());
-  Track(true, gone, dds_topic, info.info.typeName().to_string(), info.info.guid(), same_partition);
+  Track(true, gone, dds_topic, info.info.typeName().to_string(), info.info.guid(), same_partition, TermsOf(info.info.m_qos));
   if (info.status != rtps::WriterDiscoveryInfo::DISCOVERED_WRITER) return;
   if (!same_partition) {
     Foreign(dds_topic, info.info.m_qos.m_partition.names(), info.info.guid());
@@ -114,7 +105,7 @@ void DdsParticipant::DiscoveryListener::on_subscriber_discovery(fdds::DomainPart
   const bool gone = info.status == rtps::ReaderDiscoveryInfo::REMOVED_READER;
   const std::string dds_topic = info.info.topicName().to_string();
   const bool same_partition = SharesPartition(dds_topic, info.info.m_qos.m_partition.names());
-  Track(false, gone, dds_topic, info.info.typeName().to_string(), info.info.guid(), same_partition);
+  Track(false, gone, dds_topic, info.info.typeName().to_string(), info.info.guid(), same_partition, TermsOf(info.info.m_qos));
   if (info.status != rtps::ReaderDiscoveryInfo::DISCOVERED_READER) return;
   if (!same_partition) return;
   Check("reader", dds_topic, info.info.typeName().to_string(), GuidPrefixString(info.info.guid().guidPrefix));
@@ -152,18 +143,55 @@ void DdsParticipant::DiscoveryListener::CheckDiscovered(const std::string& dds_t
   for (const auto& e : known) Check(e.writer ? "writer" : "reader", dds_topic, e.type, e.participant);
 }
 
+// Fast DDS checks QoS before partitions (dds/qos_match.hpp), so these fire for another run's
+// endpoints too, without saying whose: the remote endpoints of the topic are checked here, and
+// only one of this run's partition is reported (once per remote endpoint, whichever of ours
+// it fails).
 void DdsParticipant::DiscoveryListener::on_requested_incompatible_qos(fdds::DataReader* reader,
                                                                       const fdds::RequestedIncompatibleQosStatus& status) {
-  if (on_problem_)
-    on_problem_("topic " + TopicText(reader->get_topicdescription()->get_name()) + ": a writer offers an incompatible " +
-                QosPolicyName(status.last_policy_id) + " QoS; no data will flow to this reader");
+  Incompatible(false, reader->get_topicdescription()->get_name(), TermsOf(reader->get_qos()), status.last_policy_id);
 }
 
 void DdsParticipant::DiscoveryListener::on_offered_incompatible_qos(fdds::DataWriter* writer,
                                                                     const fdds::OfferedIncompatibleQosStatus& status) {
-  if (on_problem_)
-    on_problem_("topic " + TopicText(writer->get_topic()->get_name()) + ": a reader requests an incompatible " +
-                QosPolicyName(status.last_policy_id) + " QoS; this writer's data will not reach it");
+  Incompatible(true, writer->get_topic()->get_name(), TermsOf(writer->get_qos()), status.last_policy_id);
+}
+
+void DdsParticipant::DiscoveryListener::Incompatible(bool local_writer, const std::string& dds_topic, const MatchTerms& local,
+                                                     fdds::QosPolicyId_t policy) {
+  if (!on_problem_) return;
+  std::string type;  // ours: Fast DDS checks the type first, so one of another type is not it
+  {
+    std::lock_guard<std::mutex> lock(owner_->mutex_);
+    auto it = owner_->topic_types_.find(owner_->TopicOfDds(dds_topic));
+    if (it != owner_->topic_types_.end()) type = it->second;
+  }
+  std::vector<std::pair<std::string, std::string>> remotes;  // (name, policies) of this run's, newly found
+  bool known = false;  // an incompatible remote endpoint found: ours already said, or another run's
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& [guid, e] : endpoints_) {
+      auto t = terms_.find(guid);
+      if (e.writer == local_writer || e.topic != dds_topic || t == terms_.end() || (!type.empty() && e.type != type)) continue;
+      const auto bad = local_writer ? IncompatiblePolicies(local, t->second) : IncompatiblePolicies(t->second, local);
+      if (bad.empty()) continue;
+      known = true;
+      if (!e.same_partition || !qos_reported_.insert(guid).second) continue;
+      std::string names;
+      for (auto id : bad) names += (names.empty() ? "" : " and ") + QosPolicyName(id);
+      remotes.emplace_back(RemoteName(e.participant), names);
+    }
+  }
+  const std::string topic = "topic " + TopicText(dds_topic) + ": ";
+  const std::string effect =
+      local_writer ? "; nothing written here will reach it" : "; none of its samples will be delivered here";
+  for (const auto& [name, names] : remotes)
+    on_problem_(topic + (local_writer ? "a reader of " : "a writer of ") + name + (local_writer ? " requests" : " offers") +
+                " an incompatible " + names + " QoS" + effect);
+  // None of the remote endpoints known: one of this participant's own, or a term not modelled.
+  if (remotes.empty() && !known)
+    on_problem_(topic + (local_writer ? "a reader requests" : "a writer offers") + " an incompatible " + QosPolicyName(policy) +
+                " QoS" + effect);
 }
 
 // "'arm/pose'", or "'arm/pose' (ROS 2 topic /arm/pose)" for one of our ROS 2 topics.
@@ -241,15 +269,19 @@ void DdsParticipant::DiscoveryListener::Foreign(const std::string& dds_topic, co
 }
 
 void DdsParticipant::DiscoveryListener::Track(bool writer, bool gone, const std::string& topic, const std::string& type,
-                                              const rtps::GUID_t& guid, bool same_partition) {
+                                              const rtps::GUID_t& guid, bool same_partition, const MatchTerms& terms) {
   std::ostringstream os;
   os << guid;
+  const std::string key = os.str();
   std::lock_guard<std::mutex> lock(mutex_);
   if (gone) {
-    endpoints_.erase(os.str());
+    endpoints_.erase(key);
+    terms_.erase(key);
+    qos_reported_.erase(key);
     return;
   }
-  endpoints_[os.str()] = DiscoveredEndpoint{writer, topic, type, GuidPrefixString(guid.guidPrefix), os.str(), same_partition};
+  endpoints_[key] = DiscoveredEndpoint{writer, topic, type, GuidPrefixString(guid.guidPrefix), key, same_partition};
+  terms_[key] = terms;
 }
 
 std::vector<DiscoveredEndpoint> DdsParticipant::Discovered() const { return listener_->Snapshot(); }

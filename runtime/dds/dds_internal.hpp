@@ -12,7 +12,7 @@
 //   dds_serialized.cpp   serialized endpoints (DdsSerializedReader/Writer: CDR bytes in and out,
 //                        on-demand subscriptions) and DecodeSample
 //   dds_discovery.cpp    DiscoveryListener: endpoints discovered, type mismatch, incompatible QoS
-//                        and foreign-writer reports
+//                        (whose: qos_match.hpp) and foreign-writer reports
 //   dds_ros2.cpp         ROS 2 topics' endpoints: DDS topic "rt/...", their own publisher and
 //                        subscriber in the default partition, and the graph's name back
 //   security_qos.cpp     DDS Security's participant properties, and what a refused endpoint's
@@ -38,6 +38,7 @@
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
 #include "dds/dds_participant.hpp"
+#include "dds/qos_match.hpp"
 
 namespace fdds = eprosima::fastdds::dds;
 namespace rtps = eprosima::fastrtps::rtps;
@@ -70,7 +71,8 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
   void Check(const char* kind, const std::string& dds_topic, const std::string& type, const std::string& prefix);
   void Foreign(const std::string& dds_topic, const std::vector<std::string>& partitions, const rtps::GUID_t& guid);
   void Track(bool writer, bool gone, const std::string& topic, const std::string& type, const rtps::GUID_t& guid,
-             bool same_partition);
+             bool same_partition, const MatchTerms& terms);
+  void Incompatible(bool local_writer, const std::string& dds_topic, const MatchTerms& local, fdds::QosPolicyId_t policy);
 
   DdsParticipant* owner_;
   ProblemHandler on_problem_, on_foreign_;
@@ -79,6 +81,8 @@ class DdsParticipant::DiscoveryListener final : public fdds::DomainParticipantLi
   std::map<std::string, std::string> names_;             // guid prefix -> name (read back), of peers present
   std::string names_key_;                                // "" without security
   std::map<std::string, DiscoveredEndpoint> endpoints_;  // by guid; participant holds the prefix
+  std::map<std::string, MatchTerms> terms_;              // endpoints_' QoS terms, by guid
+  std::set<std::string> qos_reported_;                   // guids of endpoints said incompatible
 };
 
 // Data callbacks of a renewed reader: only its current DDS entity's go through. Fast DDS holds an
