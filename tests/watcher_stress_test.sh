@@ -16,7 +16,8 @@ work=$2
 timing=0
 [ "${3:-}" = --timing ] && timing=1
 rm -rf "$work"; mkdir -p "$work"; cd "$work"
-domain=$(( 1 + $$ % 200 ))
+source "$(dirname "$0")/support/dds_domain.sh"
+claim_test_domains 1 domain
 cat > graph.yaml <<YAML
 graph: watched
 clock: wall

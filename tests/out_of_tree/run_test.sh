@@ -14,7 +14,8 @@ cmake -S "$here/plugin" -B "$work/plugin-build" -DCMAKE_PREFIX_PATH="$work/prefi
 cmake --build "$work/plugin-build" -j2 > "$work/build.log"
 plugin="$work/plugin-build/doubler.so"
 test -f "$plugin"
-domain=$(( 1 + $$ % 200 ))
+source "$here/../support/dds_domain.sh"
+claim_test_domains 1 domain
 cat > "$work/graph.yaml" <<YAML
 graph: oot
 clock: stepped

@@ -10,7 +10,8 @@ work=$3
 rm -rf "$work"
 mkdir -p "$work"
 cd "$work"
-domain=$(( 1 + $$ % 200 ))  # apart from concurrent tests' participants
+source "$(dirname "$0")/../support/dds_domain.sh"
+claim_test_domains 1 domain  # apart from concurrent tests' participants
 
 pids=()
 trap 'for p in "${pids[@]}"; do kill "$p" 2> /dev/null || true; done' EXIT

@@ -10,7 +10,8 @@ work=$2
 rm -rf "$work"
 mkdir -p "$work"
 cd "$work"
-domain=$(( 1 + $$ % 200 ))  # apart from concurrent tests' participants
+source "$(dirname "$0")/../support/dds_domain.sh"
+claim_test_domains 1 domain  # apart from concurrent tests' participants
 types=13                    # the types dyad_ros2_wire_peer carries (see wire_peer.c)
 
 "$peer" listen --count $types --timeout-s 8 --domain $domain > listen.out 2> listen.err &

@@ -5,7 +5,8 @@
 #   require_browser        the same, and Debian's chromium
 #   fail MESSAGE...        "FAIL: MESSAGE" on stderr, exit 1
 #   fresh_dir DIR          DIR emptied (made) and entered
-#   test_domain            a DDS domain id from this shell's pid (tests running at once differ)
+#   test_domain            this test's DDS domain id, held while it runs (dds_domain.sh: tests
+#                          running at once never share one)
 #   wait_port_file FILE PID [SECONDS [LOG]]
 #                          waits until FILE (a port_file) is written, by default 10 s; if not,
 #                          shows LOG (default run.err), stops PID and fails naming FILE
@@ -36,7 +37,9 @@ require_browser() {
 
 fresh_dir() { rm -rf "$1"; mkdir -p "$1"; cd "$1"; }
 
-test_domain() { echo $(( 1 + $$ % 200 )); }
+source "$web_test_repo/tests/support/dds_domain.sh"
+claim_test_domains 1 web_test_domain
+test_domain() { echo "$web_test_domain"; }
 
 wait_port_file() {
   local file=$1 pid=$2 seconds=${3:-10} log=${4:-run.err}

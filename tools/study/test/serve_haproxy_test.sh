@@ -43,7 +43,8 @@ serve() {  # serve NAME PORT DOMAINS: an instance, its output appended to NAME.o
   cat "$1.err"; fail "instance $1 never listened"
 }
 # Two instances on one machine: their trials on disjoint domains (docs/study.md).
-d=$(test_domain) da="$d-$((d + 15))" db="$((d + 16))-$((d + 31))"
+claim_test_domains 32 d
+da="$d-$((d + 15))" db="$((d + 16))-$((d + 31))"
 serve a "$pa" "$da"
 serve b "$pb" "$db"
 grep -q "trials on DDS domains $da (one each)" a.out && grep -q "trials on DDS domains $db (one each)" b.out ||

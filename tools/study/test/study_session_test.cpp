@@ -23,6 +23,7 @@
 
 #include "dyad/mcap/reader.hpp"
 #include "dyad/testing/child_process.hpp"
+#include "dyad/testing/dds_domain.hpp"
 #include "study_analysis.hpp"
 #include "study_file.hpp"
 #include "study_session.hpp"
@@ -179,7 +180,9 @@ TEST_F(StudySession, AfterTheTrialTheSubjectsPageEndsTheRun) {
   const std::string web = "  web: {type: web, rate_hz: 20, params: {port: 0, dataset: " + (dir_ / "data").string() +
                           "}, outputs: {pointer: web/pointer, notes: experiment/notes, self_report: human/self_report}}\n";
   auto write_graph = [&](const std::string& webs) {
-    std::ofstream(dir_ / "w.yaml") << "graph: w\nclock: wall\ndomain_id: " << 1 + getpid() % 200 << "\ncomponents:\n" << webs
+    std::ofstream(dir_ / "w.yaml") << "graph: w\nclock: wall\ndomain_id: " << dyad::testing::DomainForThisProcess()
+                                   << "\ncomponents:\n"
+                                   << webs
                                    << "  src: {type: counter_source, rate_hz: 20, outputs: {out: c}}\n"
                                       "  sink: {type: counter_sink, rate_hz: 20, inputs: {in: c}}\n"
                                       "  recorder: {type: recorder, rate_hz: 1}\n";
@@ -234,10 +237,12 @@ TEST_F(StudySession, AfterTheTrialTheSubjectsPageEndsTheRun) {
 // nobody opens. Each trial's run ends well and its recording is whole, but the session log says
 // "incomplete" with the reason, and the analysis keeps both trials marked, out of the summary.
 TEST_F(StudySession, TrialsWithoutASubjectsPageAreIncompleteInTheLogAndTheAnalysis) {
-  std::ofstream(dir_ / "w.yaml") << "graph: w\nclock: wall\ndomain_id: " << 1 + getpid() % 200 << "\ncomponents:\n"
-                                    "  web: {type: web, rate_hz: 20, params: {port: 0}, outputs: {pointer: web/pointer, notes: experiment/notes}}\n"
-                                    "  human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}\n"
-                                    "  recorder: {type: recorder, rate_hz: 1}\n";
+  std::ofstream(dir_ / "w.yaml")
+      << "graph: w\nclock: wall\ndomain_id: " << dyad::testing::DomainForThisProcess()
+      << "\ncomponents:\n"
+         "  web: {type: web, rate_hz: 20, params: {port: 0}, outputs: {pointer: web/pointer, notes: experiment/notes}}\n"
+         "  human: {type: web_human, rate_hz: 10, inputs: {pointer: web/pointer}, outputs: {input: human/input}}\n"
+         "  recorder: {type: recorder, rate_hz: 1}\n";
   std::ofstream(dir_ / "s.yaml") << "study: gain\ngraph: w.yaml\nparticipants: [P01]\n"
                                     "conditions:\n  low: {human.engage_timeout_s: 0.3}\n  high: {human.engage_timeout_s: 0.4}\nduration: 2\n";
   std::vector<Diagnostic> problems;
