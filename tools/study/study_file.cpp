@@ -231,7 +231,7 @@ void ReadOnline(StrictYaml& y, const YAML::Node& root, const std::string& path, 
   // Room for max_sessions trials, each on a domain of its own: said here, at the key that limits
   // it, not first when `study serve` starts (which checks again with its --max-sessions and --domains).
   if (sessions_ok && domains_ok)
-    if (const auto room = TrialDomainRange(on.domains, "online.domains", s->graph_domain, on.max_sessions); !room.ok()) {
+    if (const auto room = TrialDomainRange(on.domains, "", s->graph_domain, on.max_sessions); !room.ok()) {
       const char* key = on.domains ? "domains" : "max_sessions";
       y.Error(o[key] ? o[key] : o, std::string("online.") + key, std::string(room.status().message()));
     }

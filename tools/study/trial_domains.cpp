@@ -31,9 +31,10 @@ StatusOr<DomainRange> TrialDomainRange(const std::optional<DomainRange>& given, 
                                        int max_sessions) {
   if (given) {
     if (given->size() < max_sessions)
-      return Status::InvalidArgument(given_by + " " + std::to_string(given->first) + "-" + std::to_string(given->last) +
-                                     " holds " + std::to_string(given->size()) + (given->size() == 1 ? " domain" : " domains") +
-                                     " for max_sessions " + std::to_string(max_sessions) +
+      return Status::InvalidArgument((given_by.empty() ? "" : given_by + " ") + std::to_string(given->first) + "-" +
+                                     std::to_string(given->last) + " holds " + std::to_string(given->size()) +
+                                     (given->size() == 1 ? " domain" : " domains") + " for max_sessions " +
+                                     std::to_string(max_sessions) +
                                      " (each live session's trial runs on a domain of its own): widen it, or lower max_sessions "
                                      "(--max-sessions, online.max_sessions)");
     return *given;

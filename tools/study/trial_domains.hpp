@@ -35,7 +35,8 @@ struct DomainRange {
 StatusOr<DomainRange> ParseDomainRange(std::string_view text);
 
 // The range for `max_sessions` trials at once: `given` (said to come from `given_by`, e.g.
-// "--domains" or "online.domains"), else from `graph_domain` on. Its error names what to change.
+// "--domains" or "s.yaml: online.domains"; "" where the caller's error names it already), else
+// from `graph_domain` on. Its error names what to change.
 StatusOr<DomainRange> TrialDomainRange(const std::optional<DomainRange>& given, const std::string& given_by, int graph_domain,
                                        int max_sessions);
 

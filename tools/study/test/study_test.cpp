@@ -219,7 +219,7 @@ TEST_F(StudyFile, OnlineKeysAreReadAndEachBadOneIsSaidAtItsLine) {
            {"online:\n  domains: 40-42\n", "s.yaml:7:12: online.domains: must be [FIRST, LAST]: two DDS domain ids"},
            // fewer domains than live sessions, given or from the graph's domain_id on (past 232)
            {"online:\n  max_sessions: 3\n  domains: [40, 41]\n",
-            "s.yaml:8:12: online.domains: online.domains 40-41 holds 2 domains for max_sessions 3"},
+            "s.yaml:8:12: online.domains: 40-41 holds 2 domains for max_sessions 3"},
            {"online:\n  max_sessions: 234\n", "s.yaml:7:17: online.max_sessions: max_sessions 234 trials need domains 0-233"},
            {"online:\n  completion_code: a b\n", "s.yaml:7:20: online.completion_code: a code is 1-64 letters, digits"},
            {"online:\n  consent: missing.txt\n", "s.yaml:7:12: online.consent: cannot read " + (dir_ / "missing.txt").string()},
