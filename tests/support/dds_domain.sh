@@ -30,5 +30,6 @@ claim_test_domains() {
     fi
     for _fd in "${_held[@]}"; do exec {_fd}>&-; done
   done
-  printf -v "$_var" '%s' $((1 + _start))  # every one held (over 200 tests at once): shared
+  echo "dyad test: no $_n free DDS domain(s) in 1..200 ($_dir): sharing $((1 + _start))" >&2
+  printf -v "$_var" '%s' $((1 + _start))
 }

@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,7 @@ inline int ClaimDomains(int n) {
     if (static_cast<int>(held.size()) == n) return first;  // the descriptors stay open: held
     for (int fd : held) close(fd);
   }
+  std::fprintf(stderr, "dyad test: no %d free DDS domain(s) in 1..200 (%s): sharing %d\n", n, dir.c_str(), 1 + start);
   return 1 + start;
 }
 
